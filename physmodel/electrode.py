@@ -1,0 +1,54 @@
+"""Distributed electrode resistance: the transmission-line sub-model (seed 002 §2.2.2, Fig. 3).
+
+Each slice dz between the electrodes is the polymer branch (impedance 2/θ per length, θ from
+:mod:`physmodel.transport`) in series with the through-thickness resistance r2 of each electrode
+(2 r2 per length), all in parallel with the leakage Rp.  The slice admittance per unit length is
+A(s)/2 with
+
+    A(s) = θ / (1 + r2 θ) + 2/Rp          (seed 002 eq. 11 with r2 = r2'/W, Rp = Rp'/W)
+
+and the electrodes carry r1 per unit length each, so the line has propagation constant
+sqrt(B), B = r1 A.  With x = L sqrt(B):
+
+    terminal impedance  Z = 2 sqrt(B) / (A tanh(sqrt(B) L)) = 2 x coth x / (A L)     (eq. 10)
+    bending kernel      X(x) = (x tanh x + sech x − 1)/x²                           (eq. 14)
+
+X is also the sensing collection kernel: ∫0^L (L−z) cosh(x(L−z)/L)/cosh x dz = L² X(x).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .numerics import line_kernels, principal_sqrt
+
+
+def slice_admittance(theta, r2, Rp):
+    """``(A, frac)``: A(s) = θ/(1 + r2 θ) + 2/Rp [S/m] and frac = 1/(1 + r2 θ) [-].
+
+    ``frac`` is the part of a slice's voltage that reaches the polymer.  ``Rp = inf`` means no
+    leakage; ``r2 = 0`` is an ideal through-thickness contact.
+    """
+    frac = r2 * theta
+    frac += 1.0
+    np.reciprocal(frac, out=frac)
+    A = theta * frac
+    A += 2.0 / Rp
+    return A, frac
+
+
+def line_argument(A, r1, L):
+    """x = L sqrt(r1 A) [-] (principal branch, Re x ≥ 0)."""
+    return principal_sqrt(A * (r1 * L * L))
+
+
+def line_terms(A, r1, L):
+    """``(x, X(x), x coth x)`` for the electrode line."""
+    x = line_argument(A, r1, L)
+    X, xcoth = line_kernels(x)
+    return x, X, xcoth
+
+
+def terminal_impedance(A, L, xcoth):
+    """Z = 2 x coth x / (A L) [Ω] (seed 002 eq. 10)."""
+    return 2.0 * xcoth / (A * L)

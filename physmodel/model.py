@@ -1,0 +1,184 @@
+"""Shared machinery of the physical models: chunked vectorised evaluation and result records.
+
+A model kernel maps a dict of broadcastable parameter arrays (one value per evaluation point)
+and the Laplace variable ``s`` to a dict of complex arrays.  :func:`evaluate_grid` lays the
+points of (parameter sets × temperatures × s) out flat and evaluates them in chunks, so that
+temporaries stay bounded (about 40 complex arrays of ``chunk_size``) whatever the grid size;
+the output may be a preallocated array (e.g. a ``numpy.memmap``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Iterable, Mapping, Sequence
+
+import numpy as np
+
+from .errors import IPMCError
+from .params import STATE_FIELDS, IPMCParameters, State, as_parameter_list, state_at
+
+#: Default number of points per chunk (keeps temporaries in L2/L3 cache).
+DEFAULT_CHUNK = 8192
+
+Kernel = Callable[[Mapping[str, np.ndarray], np.ndarray, Sequence[str]], dict]
+
+
+def check_frequencies(frequency_hz) -> np.ndarray:
+    """Validate a 1-D array of strictly positive, finite frequencies [Hz]."""
+    f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
+    if f.ndim != 1:
+        raise IPMCError(f"frequency_hz must be 1-D, got shape {f.shape}")
+    if f.size == 0:
+        raise IPMCError("frequency_hz is empty; expected at least one frequency [Hz]")
+    bad = ~np.isfinite(f) | (f <= 0)
+    if np.any(bad):
+        raise IPMCError(
+            f"frequencies must be finite and > 0 Hz (use dc_gain() for 0 Hz); got {f[bad][:5].tolist()}"
+        )
+    return f
+
+
+def check_s(s) -> np.ndarray:
+    s = np.atleast_1d(np.asarray(s, dtype=complex))
+    if s.ndim != 1:
+        raise IPMCError(f"s must be 1-D, got shape {s.shape}")
+    if not np.all(np.isfinite(s)):
+        raise IPMCError(f"s must be finite, got {s[~np.isfinite(s)][:5].tolist()}")
+    if np.any(s == 0):
+        raise IPMCError("s = 0 is a singular point of the impedance; use dc_gain() for DC values")
+    return s
+
+
+def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Sequence[str],
+                  chunk_size: int = DEFAULT_CHUNK, out: Mapping[str, np.ndarray] | None = None,
+                  progress: Callable[[int], None] | None = None) -> dict[str, np.ndarray]:
+    """Evaluate ``kernel`` on every (set, temperature, s) point; returns arrays (n_sets, n_T, n_s)."""
+    if chunk_size < 1:
+        raise IPMCError(f"chunk_size must be >= 1, got {chunk_size}")
+    n_sets, n_T = state.T.shape[:2]
+    n_s = s.size
+    n_rows = n_sets * n_T
+    total = n_rows * n_s
+    flat_state = {k: np.ascontiguousarray(getattr(state, k).reshape(n_rows)) for k in STATE_FIELDS}
+    results: dict[str, np.ndarray] = {}
+    for q in quantities:
+        if out is not None and q in out:
+            arr = out[q]
+            if arr.shape != (n_sets, n_T, n_s) or arr.dtype != np.complex128:
+                raise IPMCError(f"out[{q!r}] must be complex128 with shape {(n_sets, n_T, n_s)}, "
+                                f"got {arr.dtype} {arr.shape}")
+            results[q] = arr
+        else:
+            results[q] = np.empty((n_sets, n_T, n_s), dtype=complex)
+    rows_out = {q: results[q].reshape(n_rows, n_s) for q in quantities}
+    if n_s >= chunk_size:
+        # long rows: scalar parameters, chunks along s
+        for r in range(n_rows):
+            params = {k: v[r] for k, v in flat_state.items()}
+            for start in range(0, n_s, chunk_size):
+                stop = min(start + chunk_size, n_s)
+                vals = kernel(params, s[start:stop], quantities)
+                for q in quantities:
+                    rows_out[q][r, start:stop] = vals[q]
+                if progress:
+                    progress(stop - start)
+        return results
+    # short rows: blocks of whole rows, parameters broadcast as columns
+    rows_per_block = max(1, chunk_size // n_s)
+    for r0 in range(0, n_rows, rows_per_block):
+        r1 = min(r0 + rows_per_block, n_rows)
+        params = {k: v[r0:r1, None] for k, v in flat_state.items()}
+        vals = kernel(params, s[None, :], quantities)
+        for q in quantities:
+            rows_out[q][r0:r1] = vals[q]
+        if progress:
+            progress((r1 - r0) * n_s)
+    return results
+
+
+@dataclass(frozen=True)
+class FrequencyResponse:
+    """Complex frequency responses on a grid (parameter sets × temperatures × frequencies).
+
+    Attributes
+    ----------
+    frequency_hz : (n_f,) ndarray          frequencies [Hz]
+    temperature_c : (n_T,) ndarray         temperatures [°C]
+    parameter_sets : tuple of str          names of the parameter sets (first axis)
+    values : dict[str, ndarray]            complex arrays (n_sets, n_T, n_f), SI units in ``units``
+    units : dict[str, str]                 unit of each quantity (output/input)
+    descriptions : dict[str, str]          what each quantity is
+    """
+
+    frequency_hz: np.ndarray
+    temperature_c: np.ndarray
+    parameter_sets: tuple
+    values: dict
+    units: dict
+    descriptions: dict = field(default_factory=dict)
+
+    @property
+    def omega(self) -> np.ndarray:
+        """Angular frequencies [rad/s]."""
+        return 2 * np.pi * self.frequency_hz
+
+    def __getitem__(self, quantity: str) -> np.ndarray:
+        try:
+            return self.values[quantity]
+        except KeyError:
+            raise KeyError(f"no quantity {quantity!r}; available: {sorted(self.values)}") from None
+
+    def magnitude_db(self, quantity: str, scale: float = 1.0) -> np.ndarray:
+        """20 log10(|value|·scale) [dB]; ``scale`` converts units (1e3 for m→mm)."""
+        return 20 * np.log10(np.abs(self[quantity]) * scale)
+
+    def phase_deg(self, quantity: str) -> np.ndarray:
+        """Phase unwrapped along frequency [deg]."""
+        return np.degrees(np.unwrap(np.angle(self[quantity]), axis=-1))
+
+
+class PhysicsModel:
+    """Base class: a parameter set (or batch) evaluated through a kernel."""
+
+    quantities: tuple = ()
+    units: dict = {}
+    descriptions: dict = {}
+
+    def __init__(self, params: IPMCParameters | Sequence[IPMCParameters], chunk_size: int = DEFAULT_CHUNK):
+        self.params = as_parameter_list(params)
+        if int(chunk_size) < 1:
+            raise IPMCError(f"chunk_size must be >= 1, got {chunk_size}")
+        self.chunk_size = int(chunk_size)
+
+    # subclasses provide _kernel(params, s, quantities) -> dict
+    def _kernel(self, p, s, quantities):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _check_quantities(self, quantities: Iterable[str]) -> tuple:
+        qs = tuple(quantities)
+        bad = [q for q in qs if q not in self.quantities]
+        if bad or not qs:
+            raise IPMCError(f"unknown quantity {bad or qs}; {type(self).__name__} provides {self.quantities}")
+        return qs
+
+    def state(self, temperature_c) -> State:
+        return state_at(self.params, temperature_c)
+
+    def evaluate(self, s, temperature_c, quantities=None, out=None, progress=None) -> dict:
+        """Quantities at complex Laplace points ``s`` [1/s]; arrays (n_sets, n_T, n_s)."""
+        qs = self._check_quantities(quantities or self.quantities)
+        s = check_s(s)
+        return evaluate_grid(self.state(temperature_c), s, self._kernel, qs, self.chunk_size, out, progress)
+
+    def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
+                           progress=None) -> FrequencyResponse:
+        """Frequency responses at ``frequency_hz`` [Hz] and ``temperature_c`` [°C]."""
+        qs = self._check_quantities(quantities or self.quantities)
+        f = check_frequencies(frequency_hz)
+        T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
+        vals = evaluate_grid(self.state(T), 2j * np.pi * f, self._kernel, qs, self.chunk_size, out, progress)
+        return FrequencyResponse(
+            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
+            values=vals, units={q: self.units[q] for q in qs},
+            descriptions={q: self.descriptions[q] for q in qs},
+        )

@@ -1,0 +1,113 @@
+"""Named parameter sets, each with its source.  Look them up with :func:`get_parameter_set`.
+
+seed002_table2 / seed002_table3
+    Seed 002 (Frequency response of IPMC actuators), Tables 1-3: L = 15 mm, W = 4 mm,
+    thickness 0.25 mm, T = 300 K, E = 154 MPa, ωn = 75.4 rad/s, ξ = 0.18, Rp' = 0.37 Ω·m²,
+    d, C⁻, α0, κe, r2', r1' initial (Table 2) and fitted (Table 3).
+
+    Two unit conventions had to be pinned down:
+
+    * Seed 002 writes the mode as ωn/(s² + 2ξωn s + ωn²) (eq. 15), whose DC gain is 1/ωn [s].
+      Its fitted α0 (a pure gain knob, §4) therefore absorbed a factor 1/ωn.  We use the
+      unit-DC-gain mode ωn²/(…) and store ``alpha0 = α0_printed / ωn`` [J/C], which reproduces the
+      seed's DC gain exactly: M(0) = 5.7 mm/V for Table 3 (a few mm/V, as measured IPMC strips
+      of this size give), instead of 430 mm/V if −155 were read as J/C with a unit-gain mode.
+    * r1' is printed as "Ω·m" in Table 2 and "Ω" in Table 3; eq. (11) needs r1'/W in Ω/m, so r1'
+      is a sheet resistance [Ω] and r2', Rp' are per-width quantities [Ω·m²].
+    The density is chosen so that the Euler-Bernoulli first mode is 75.4 rad/s at 154 MPa
+    (it includes the added mass of the water the strip was tested in).
+    No sensing coupling is printed; ``a0`` is the development value of ``dev``.
+
+dev
+    A development set with values often quoted for Chen-Tan-type models (physics.md §8; not
+    verifiable here, for development only): C⁻ = 1091 mol/m³, κe = 1.3e-6 F/m, α0 = −0.13 J/C,
+    d = 4e-11 m²/s, E = 300 MPa, with a 20 mm × 5 mm × 0.2 mm strip in water.
+
+seed000_sensor_dev, seed001_actuator_dev
+    The geometries printed by seed 000 (Nafion-117 sensor, 18 mm × 6.5 mm × 210 µm) and seed 001
+    (actuator, 45 mm free length × 11 mm × 0.3 mm) with development material values, to be
+    replaced by calibrated sets.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from .errors import ParameterError
+from .params import IPMCParameters, density_for_mode
+from .temperature import TemperatureLaws
+
+_SEED002_SOURCE = "seed 002 (Frequency response of IPMC actuators), Tables 1-3"
+_OMEGA_N_002 = 75.4
+_E_002 = 154e6
+
+
+def _seed002(table: int) -> IPMCParameters:
+    L, W, h = 15e-3, 4e-3, 0.125e-3
+    if table == 2:
+        vals = dict(d=3.48e-11, C_minus=1068.0, alpha0=-40.0, kappa_e=5.07e-7, r2_specific=9.99e-6, r1_sheet=64.0)
+    else:
+        vals = dict(d=3.07e-11, C_minus=941.94, alpha0=-155.0, kappa_e=4.47e-7, r2_specific=8.81e-6, r1_sheet=56.44)
+    vals["alpha0"] = vals["alpha0"] / _OMEGA_N_002  # seed's mode has ωn, not ωn², in its numerator
+    return IPMCParameters(
+        L=L, W=W, h=h, E=_E_002, rho=density_for_mode(_OMEGA_N_002, _E_002, L, h), xi=0.18,
+        Rp_specific=0.37, a0=_DEV_A0, T_ref=300.0, laws=TemperatureLaws(),
+        name=f"seed002_table{table}",
+        source=f"{_SEED002_SOURCE}; Table {table}{' (initial)' if table == 2 else ' (fitted)'}; "
+               "alpha0 = printed/omega_n (see module doc)",
+        **vals,
+    )
+
+
+#: Development sensing coupling [C/J]; gives ~10 µA/mm at 50 Hz for the seed 000 sample.
+_DEV_A0 = 0.3
+
+
+def _water_density(W: float, h: float, rho_polymer: float = 2000.0, rho_fluid: float = 1000.0) -> float:
+    """Polymer density plus the inviscid added mass of a thin plate in water, π ρ_f W²/4 per length."""
+    import math
+
+    return rho_polymer + rho_fluid * math.pi * W**2 / 4.0 / (2.0 * h * W)
+
+
+def _dev(name: str, L: float, W: float, h: float, source: str) -> IPMCParameters:
+    return IPMCParameters(
+        L=L, W=W, h=h, d=4e-11, C_minus=1091.0, kappa_e=1.3e-6, alpha0=-0.13, a0=_DEV_A0,
+        r1_sheet=10.0, r2_specific=1e-5, Rp_specific=0.5, E=300e6, rho=_water_density(W, h), xi=0.1,
+        T_ref=296.15, laws=TemperatureLaws(), name=name, source=source,
+    )
+
+
+_REGISTRY: dict[str, Callable[[], IPMCParameters]] = {
+    "seed002_table2": lambda: _seed002(2),
+    "seed002_table3": lambda: _seed002(3),
+    "dev": lambda: _dev("dev", 20e-3, 5e-3, 0.1e-3,
+                        "development values quoted for Chen-Tan-type models (physics.md §8), not verifiable"),
+    "seed000_sensor_dev": lambda: _dev("seed000_sensor_dev", 18e-3, 6.5e-3, 105e-6,
+                                       "seed 000 sensor geometry (Nafion-117, 18 x 6.5 mm, 210 um) with development material values"),
+    "seed001_actuator_dev": lambda: _dev("seed001_actuator_dev", 45e-3, 11e-3, 150e-6,
+                                         "seed 001 actuator geometry (45 x 11 mm, 0.3 mm) with development material values"),
+}
+
+
+def available_parameter_sets() -> list[str]:
+    """Names accepted by :func:`get_parameter_set`."""
+    return sorted(_REGISTRY)
+
+
+def get_parameter_set(name: str, **overrides: Any) -> IPMCParameters:
+    """The named parameter set, with any field overridden (``omega_n=`` adjusts ``rho``).
+
+    >>> p = get_parameter_set("seed002_table3", W=2e-3)
+    """
+    if name not in _REGISTRY:
+        raise ParameterError(f"unknown parameter set {name!r}; available: {available_parameter_sets()}")
+    p = _REGISTRY[name]()
+    return p.replace(**overrides) if overrides else p
+
+
+def register_parameter_set(name: str, factory: Callable[[], IPMCParameters], *, overwrite: bool = False) -> None:
+    """Register a parameter set (e.g. a calibrated one) under ``name``."""
+    if name in _REGISTRY and not overwrite:
+        raise ParameterError(f"parameter set {name!r} exists; pass overwrite=True to replace it")
+    _REGISTRY[name] = factory

@@ -1,0 +1,256 @@
+"""Parameter records for IPMC strips: frozen, typed, SI, with their source.
+
+:class:`IPMCParameters` holds the reference values of one strip at ``T_ref`` together with the
+:class:`~physmodel.temperature.TemperatureLaws` that move them with temperature.  Per-width
+electrode quantities (``r1_sheet``, ``r2_specific``, ``Rp_specific``) are stored so that changing
+the width ``W`` keeps the physics width-independent, as seed 002 observes of eq. (13):
+
+    r1 = r1_sheet / W      [Ω/m]   electrode resistance along the length (each electrode)
+    r2 = r2_specific / W   [Ω·m]   through-thickness resistance of one electrode, per slice
+    Rp = Rp_specific / W   [Ω·m]   polymer leakage through the full thickness, per slice
+
+Named sets live in :mod:`physmodel.parameter_sets`; variants come from :meth:`IPMCParameters.replace`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields, replace
+from typing import Any, Sequence
+
+import numpy as np
+
+from .errors import ParameterError
+from .temperature import FARADAY, LAW_PARAMETERS, R_GAS, TemperatureLaws, celsius_to_kelvin
+
+#: (β1 L)² for the first clamped-free bending mode (β1 L = 1.8751...).
+BETA1L_SQ = 1.8751040687119611**2
+
+
+def _meta(unit: str, doc: str, group: str, *, positive=True, allow_inf=False, allow_zero=False):
+    return {"unit": unit, "doc": doc, "group": group, "positive": positive,
+            "allow_inf": allow_inf, "allow_zero": allow_zero}
+
+
+@dataclass(frozen=True)
+class IPMCParameters:
+    """Physical parameters of one IPMC strip at the reference temperature ``T_ref``.
+
+    All values SI.  See ``fields(IPMCParameters)[i].metadata`` for unit, group and meaning.
+    """
+
+    # geometry
+    L: float = field(metadata=_meta("m", "free length", "geometry"))
+    W: float = field(metadata=_meta("m", "width", "geometry"))
+    h: float = field(metadata=_meta("m", "half-thickness of the polymer (thickness 2h)", "geometry"))
+    # material (transport)
+    d: float = field(metadata=_meta("m^2/s", "effective cation diffusivity", "material"))
+    C_minus: float = field(metadata=_meta("mol/m^3", "fixed anion concentration C-", "material"))
+    kappa_e: float = field(metadata=_meta("F/m", "effective dielectric permittivity", "material"))
+    # coupling
+    alpha0: float = field(metadata=_meta("J/C", "actuation coupling: stress = alpha0 * charge density", "material", positive=False))
+    a0: float = field(metadata=_meta("C/J", "sensing coupling: boundary charge density = a0 * stress", "material", positive=False))
+    # electrodes
+    r1_sheet: float = field(metadata=_meta("Ohm", "electrode sheet resistance along the length (r1' of seed 002; r1 = r1'/W)", "electrode", allow_zero=True))
+    r2_specific: float = field(metadata=_meta("Ohm m^2", "through-thickness electrode resistance times width (r2' of seed 002; r2 = r2'/W)", "electrode", allow_zero=True))
+    Rp_specific: float = field(metadata=_meta("Ohm m^2", "polymer leakage resistance times width (Rp' of seed 002; inf = no leakage)", "electrode", allow_inf=True))
+    # mechanics
+    E: float = field(metadata=_meta("Pa", "Young's modulus of the composite beam", "mechanics"))
+    rho: float = field(metadata=_meta("kg/m^3", "effective density setting the first mode (includes any added mass)", "mechanics"))
+    xi: float = field(metadata=_meta("-", "damping ratio of the first bending mode", "mechanics"))
+    # bookkeeping
+    T_ref: float = field(default=300.0, metadata=_meta("K", "reference temperature of the values above", "state"))
+    laws: TemperatureLaws = field(default_factory=TemperatureLaws, metadata={"unit": "", "doc": "temperature laws", "group": "state"})
+    name: str = field(default="custom", metadata={"unit": "", "doc": "name", "group": "source"})
+    source: str = field(default="user", metadata={"unit": "", "doc": "where the values come from", "group": "source"})
+
+    def __post_init__(self):
+        for f in fields(self):
+            if f.name in ("laws", "name", "source"):
+                continue
+            v = getattr(self, f.name)
+            m = f.metadata
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+                raise ParameterError(f"{f.name} must be a real number [{m['unit']}], got {v!r}")
+            v = float(v)
+            object.__setattr__(self, f.name, v)
+            if math.isnan(v):
+                raise ParameterError(f"{f.name} is NaN; expected a number [{m['unit']}]")
+            if math.isinf(v) and not m["allow_inf"]:
+                raise ParameterError(f"{f.name}={v!r} [{m['unit']}] must be finite")
+            if m["positive"]:
+                if v < 0 or (v == 0 and not m["allow_zero"]):
+                    need = ">= 0" if m["allow_zero"] else "> 0"
+                    raise ParameterError(f"{f.name}={v!r} [{m['unit']}] ({m['doc']}) must be {need}")
+        if not isinstance(self.laws, TemperatureLaws):
+            raise ParameterError(f"laws must be a TemperatureLaws record, got {type(self.laws).__name__}")
+
+    # ------------------------------------------------------------------ derived quantities
+    @property
+    def second_moment(self) -> float:
+        """I = (2/3) W h³ [m⁴]."""
+        return 2.0 / 3.0 * self.W * self.h**3
+
+    @property
+    def omega_n(self) -> float:
+        """First clamped-free bending mode at ``T_ref`` [rad/s] (Euler-Bernoulli)."""
+        return first_mode_omega(self.E, self.rho, self.L, self.h)
+
+    @property
+    def K(self) -> float:
+        """K = F² d C⁻ / (κe R T_ref) [1/s]."""
+        return FARADAY**2 * self.d * self.C_minus / (self.kappa_e * R_GAS * self.T_ref)
+
+    @property
+    def gamma0(self) -> float:
+        """γ0 = h sqrt(K/d), the low-frequency value of γ(s) [-]."""
+        return self.h * math.sqrt(self.K / self.d)
+
+    def replace(self, **changes: Any) -> "IPMCParameters":
+        """A copy with fields replaced.  ``omega_n=`` sets the first mode by adjusting ``rho``."""
+        changes = dict(changes)
+        wn = changes.pop("omega_n", None)
+        names = {f.name for f in fields(self)}
+        unknown = set(changes) - names
+        if unknown:
+            raise ParameterError(f"unknown parameter(s) {sorted(unknown)}; expected names from {sorted(names)}")
+        out = replace(self, **changes)
+        if wn is not None:
+            out = replace(out, rho=density_for_mode(wn, out.E, out.L, out.h))
+        return out
+
+    def to_dict(self) -> dict:
+        d = {f.name: getattr(self, f.name) for f in fields(self) if f.name != "laws"}
+        d["laws"] = self.laws.to_dict()
+        return d
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "IPMCParameters":
+        data = dict(data)
+        laws = data.pop("laws", None)
+        if laws is not None and not isinstance(laws, TemperatureLaws):
+            laws = TemperatureLaws.from_dict(laws)
+        names = {f.name for f in fields(cls)}
+        unknown = set(data) - names
+        if unknown:
+            raise ParameterError(f"unknown parameter(s) {sorted(unknown)} in parameter record")
+        if laws is not None:
+            data["laws"] = laws
+        return cls(**{k: (float(v) if k not in ("name", "source") and v is not None else v) for k, v in data.items()})
+
+    @staticmethod
+    def units() -> dict[str, str]:
+        return {f.name: f.metadata["unit"] for f in fields(IPMCParameters)}
+
+
+def first_mode_omega(E, rho, L, h):
+    """ω1 = (β1L)²/L² sqrt(E I / (ρ A)) with I/A = h²/3 [rad/s]."""
+    return BETA1L_SQ / L**2 * np.sqrt(E * h**2 / (3.0 * rho))
+
+
+def density_for_mode(omega_n, E, L, h):
+    """Effective density [kg/m³] that puts the first mode at ``omega_n`` [rad/s]."""
+    if not (np.isfinite(omega_n) and omega_n > 0):
+        raise ParameterError(f"omega_n={omega_n!r} rad/s must be a positive finite number")
+    return E * h**2 / 3.0 * (BETA1L_SQ / (L**2 * omega_n)) ** 2
+
+
+# ---------------------------------------------------------------------- state at temperature
+#: Names of the arrays in a :class:`State`.
+STATE_FIELDS = ("L", "W", "h", "d", "C_minus", "kappa_e", "alpha0", "a0", "r1", "r2", "Rp",
+                "E", "rho", "xi", "T", "K", "omega_n")
+
+
+@dataclass(frozen=True)
+class State:
+    """Parameter values at given temperatures, as broadcastable arrays of shape (n_sets, n_T, 1).
+
+    Electrode values here are per slice: ``r1`` [Ω/m], ``r2`` [Ω·m], ``Rp`` [Ω·m] (may be inf).
+    """
+
+    L: np.ndarray
+    W: np.ndarray
+    h: np.ndarray
+    d: np.ndarray
+    C_minus: np.ndarray
+    kappa_e: np.ndarray
+    alpha0: np.ndarray
+    a0: np.ndarray
+    r1: np.ndarray
+    r2: np.ndarray
+    Rp: np.ndarray
+    E: np.ndarray
+    rho: np.ndarray
+    xi: np.ndarray
+    T: np.ndarray
+    K: np.ndarray
+    omega_n: np.ndarray
+
+    @property
+    def gamma0(self):
+        return self.h * np.sqrt(self.K / self.d)
+
+    @property
+    def second_moment(self):
+        return 2.0 / 3.0 * self.W * self.h**3
+
+    def take(self, i_set: int, i_T: int) -> "State":
+        """The state of one parameter set at one temperature (arrays of shape (1, 1, 1))."""
+        return State(**{k: getattr(self, k)[i_set:i_set + 1, i_T:i_T + 1] for k in STATE_FIELDS})
+
+
+def as_parameter_list(params) -> list[IPMCParameters]:
+    if isinstance(params, IPMCParameters):
+        return [params]
+    out = list(params)
+    if not out:
+        raise ParameterError("an empty batch of parameter sets was given; expected at least one IPMCParameters")
+    for p in out:
+        if not isinstance(p, IPMCParameters):
+            raise ParameterError(f"expected IPMCParameters in the batch, got {type(p).__name__}")
+    return out
+
+
+def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -> State:
+    """Evaluate the temperature laws of one parameter set or a batch at ``temperature_c`` [°C].
+
+    Returns a :class:`State` whose arrays have shape (n_sets, n_T, 1).
+    """
+    plist = as_parameter_list(params)
+    T = np.atleast_1d(celsius_to_kelvin(temperature_c)).astype(float)
+    if T.ndim != 1:
+        raise ParameterError(f"temperature_c must be a scalar or 1-D array, got shape {T.shape}")
+    cols: dict[str, list[np.ndarray]] = {k: [] for k in STATE_FIELDS}
+    for p in plist:
+        fac = p.laws.factors(T, p.T_ref)
+        vals = {}
+        for name in ("L", "W", "alpha0", "a0", "rho", "xi"):
+            vals[name] = np.full_like(T, getattr(p, name))
+        for name in LAW_PARAMETERS:
+            vals[name] = getattr(p, name) * fac[name]
+        vals["T"] = T.copy()
+        vals["r1"] = vals.pop("r1_sheet") / p.W
+        vals["r2"] = vals.pop("r2_specific") / p.W
+        vals["Rp"] = vals.pop("Rp_specific") / p.W
+        vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * T)
+        vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
+        for k in STATE_FIELDS:
+            cols[k].append(vals[k])
+    return State(**{k: np.stack(v)[:, :, None] for k, v in cols.items()})
+
+
+def describe(p: IPMCParameters) -> str:
+    """A human-readable table of a parameter set with units."""
+    lines = [f"{p.name}  ({p.source})"]
+    for f in fields(p):
+        if f.name in ("laws", "name", "source"):
+            continue
+        lines.append(f"  {f.name:12s} = {getattr(p, f.name):<12.6g} [{f.metadata['unit']}]  {f.metadata['doc']}")
+    lines.append(f"  omega_n      = {p.omega_n:<12.6g} [rad/s]  first bending mode at T_ref")
+    lines.append(f"  K            = {p.K:<12.6g} [1/s]")
+    lines.append(f"  gamma0       = {p.gamma0:<12.6g} [-]")
+    return "\n".join(lines)
+
+
+__all__ = ["IPMCParameters", "State", "state_at", "first_mode_omega", "density_for_mode", "describe",
+           "as_parameter_list", "asdict"]
