@@ -136,7 +136,7 @@ class IPMCParameters:
             raise ParameterError(f"unknown parameter(s) {sorted(unknown)} in parameter record")
         if laws is not None:
             data["laws"] = laws
-        return cls(**{k: (float(v) if k not in ("name", "source") and v is not None else v) for k, v in data.items()})
+        return cls(**{k: (float(v) if k not in ("name", "source", "laws") else v) for k, v in data.items()})
 
     @staticmethod
     def units() -> dict[str, str]:

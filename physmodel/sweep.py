@@ -468,7 +468,7 @@ def read_csv(path) -> FrequencySweep:
     T, f = cols["temperature_c"], cols["frequency_hz"]
     for k in range(len(rows)):
         if f[k] <= 0:
-            raise DataFormatError(f"{path}:{line_no[k]}: frequency_hz = {f[k]!r} must be > 0")
+            raise DataFormatError(f"{path}:{line_no[k]}: frequency_hz = {float(f[k])!r} must be > 0")
         if "magnitude_std_db" in cols and (cols["magnitude_std_db"][k] < 0 or cols["phase_std_deg"][k] < 0):
             raise DataFormatError(f"{path}:{line_no[k]}: standard deviations must be >= 0")
     seen_T: set[float] = set()

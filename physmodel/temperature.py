@@ -51,7 +51,7 @@ def celsius_to_kelvin(t_c):
 class _Law:
     """Common part: validity range in °C (inclusive)."""
 
-    valid_c: tuple[float, float] = (0.0, 100.0)
+    valid_c: tuple[float, float] = field(default=(0.0, 100.0), kw_only=True)
 
     def check(self, T_K, name: str = "") -> None:
         lo, hi = self.valid_c
@@ -71,7 +71,7 @@ class _Law:
 class Constant(_Law):
     """The parameter does not depend on temperature."""
 
-    valid_c: tuple[float, float] = (-273.15, 1e6)
+    valid_c: tuple[float, float] = field(default=(-273.15, 1e6), kw_only=True)
 
     def factor(self, T_K, T_ref_K, **_):
         return np.ones_like(np.asarray(T_K, dtype=float))
