@@ -49,18 +49,27 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M")) -> dict:
         if "I" in quantities:
             out["I"] = 1.0 / Z
     need_g = "G" in quantities or "M" in quantities
-    G = beam.first_mode(s, p["omega_n"], p["xi"]) if need_g else None
+    wn = p["omega_n"]
+    if need_g:
+        # G = ωn²/(s² + 2ξωn s + ωn²); keep the denominator, fold ωn² into the gain below
+        gden = s + 2.0 * p["xi"] * wn
+        gden *= s
+        gden += wn * wn
     if "G" in quantities:
-        out["G"] = G
+        out["G"] = (wn * wn) / gden
     if "H" in quantities or "M" in quantities:
-        H = transport.moment_coupling(W, p["kappa_e"], p["alpha0"], K, c)
+        # H = −L² Φ X frac/(E I), with Φ = α0 W κe K (γ − tanh γ)/(sγ + K tanh γ)
+        # (transport.moment_coupling); constants folded into one scalar multiplication.
+        gain = -(L * L) / (p["E"] * beam.second_moment(W, h)) * (p["alpha0"] * W * p["kappa_e"] * K)
+        H = c.gmt / c.den
         H *= X
         H *= frac
-        H *= -(L * L) / (p["E"] * beam.second_moment(W, h))
         if "H" in quantities:
-            out["H"] = H
+            out["H"] = H * gain
         if "M" in quantities:
-            out["M"] = H * G if "H" in quantities else np.multiply(H, G, out=H)
+            H /= gden
+            H *= gain * wn * wn
+            out["M"] = H
     return out
 
 

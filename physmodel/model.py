@@ -18,7 +18,7 @@ from .errors import IPMCError
 from .params import STATE_FIELDS, IPMCParameters, State, as_parameter_list, state_at
 
 #: Default number of points per chunk (keeps temporaries in L2/L3 cache).
-DEFAULT_CHUNK = 8192
+DEFAULT_CHUNK = 16384
 
 Kernel = Callable[[Mapping[str, np.ndarray], np.ndarray, Sequence[str]], dict]
 

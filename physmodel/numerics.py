@@ -57,14 +57,17 @@ def _em1(z):
 TANH_IS_ONE_ABOVE = 20.0
 
 
-def tanh_and_gmt(g):
+def tanh_and_gmt(g, min_real=None):
     """``tanh γ`` and ``γ − tanh γ`` for complex γ with Re γ ≥ 0, without overflow or cancellation.
 
     Returns ``(tanh_g, g_minus_tanh_g)``.  Where Re γ > 20 (every physical case: γ ~ 1e3-1e4)
     tanh γ is exactly 1.0 in double precision and no transcendental is evaluated; when that holds
-    everywhere ``tanh_g`` is returned as the scalar 1.0.
+    everywhere ``tanh_g`` is returned as the scalar 1.0.  ``min_real``: a known lower bound of
+    Re γ (skips the scan).
     """
     g = np.asarray(g, dtype=complex)
+    if min_real is not None and min_real > TANH_IS_ONE_ABOVE:
+        return 1.0, g - 1.0
     near = g.real <= TANH_IS_ONE_ABOVE
     if not np.any(near):
         return 1.0, g - 1.0
@@ -97,13 +100,20 @@ def line_kernels(x, want_xcoth: bool = True):
     * ``xcoth = x coth x`` → 1 for x → 0 (terminal impedance factor); None if not wanted.
 
     With e = e^{-x}, em1 = e − 1: x tanh x + sech x − 1 = −em1 (x (2 + em1) + em1)/(1 + e²),
-    which has no cancellation beyond a factor 2, so the series is needed only for |x| < 1e-4.
+    which has no cancellation beyond a factor 2, so the series is needed only for |x| < 1e-4;
+    expm1 replaces exp − 1 for |x| < 0.1.
     """
     x = np.asarray(x, dtype=complex)
-    small = np.abs(x) < X_SERIES_BELOW
-    any_small = bool(np.any(small))
-    xs = np.where(small, 1.0, x) if any_small else x
-    em1 = _em1(xs)
+    ax = np.abs(x)
+    if ax.size and ax.min() >= EXP_FAST_ABOVE:
+        em1 = np.exp(-x)
+        em1 -= 1.0
+        small = None
+        xs = x
+    else:
+        small = ax < X_SERIES_BELOW
+        xs = np.where(small, 1.0, x)
+        em1 = _em1(xs)
     two_p = em1 + 2.0
     one_p_e2 = two_p * em1          # e² + 1 = (em1 + 1)² + 1 = em1 (em1 + 2) + 2
     one_p_e2 += 2.0
@@ -120,7 +130,7 @@ def line_kernels(x, want_xcoth: bool = True):
         two_p *= em1
         xcoth /= two_p
         np.negative(xcoth, out=xcoth)
-    if any_small:
+    if small is not None and np.any(small):
         x2 = x[small] ** 2
         X[small] = _poly_x2(_X_COEF, x2)
         if want_xcoth:

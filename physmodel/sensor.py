@@ -31,7 +31,7 @@ import numpy as np
 
 from . import electrode, transport
 from .errors import IPMCError
-from .model import PhysicsModel
+from .model import DEFAULT_CHUNK, PhysicsModel
 from .numerics import line_kernels
 
 KERNELS = ("boundary_charge", "reciprocal")
@@ -78,7 +78,7 @@ class SensorModel(PhysicsModel):
     units = UNITS
     descriptions = DESCRIPTIONS
 
-    def __init__(self, params, kernel: str = "boundary_charge", chunk_size: int = 8192):
+    def __init__(self, params, kernel: str = "boundary_charge", chunk_size: int = DEFAULT_CHUNK):
         super().__init__(params, chunk_size)
         if kernel not in KERNELS:
             raise IPMCError(f"unknown sensing kernel {kernel!r}; expected one of {KERNELS}")

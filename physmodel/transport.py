@@ -38,11 +38,32 @@ class ChargeTerms(NamedTuple):
     den: np.ndarray    # s γ + K tanh γ   [1/s]
 
 
+def _gamma_on_axis(w, K, c):
+    """γ = sqrt(c (K + jω)) for real ω and K > 0 with real arithmetic only (K + jω is in the
+    right half-plane, so Re γ = sqrt(c (|K + jω| + K)/2) and Im γ = c ω/(2 Re γ), no cancellation)."""
+    re = np.hypot(K, w)
+    re += K
+    re *= 0.5 * c
+    np.sqrt(re, out=re)
+    im = w * c
+    im /= 2.0 * re
+    g = np.empty(np.broadcast(re, im).shape, dtype=complex)
+    g.real = re
+    g.imag = im
+    return g
+
+
 def charge_terms(s, h, d, K) -> ChargeTerms:
     """The shared terms ``u, γ, sγ, tanh γ, γ − tanh γ, sγ + K tanh γ`` at points ``s``."""
+    s = np.asarray(s)
     u = s + K
-    g = principal_sqrt(u * (h * h / d))
-    t, gmt = tanh_and_gmt(g)
+    c = h * h / d
+    if np.iscomplexobj(s) and not np.any(s.real):
+        g = _gamma_on_axis(s.imag, K, c)        # frequency responses: s = jω
+        t, gmt = tanh_and_gmt(g, min_real=np.min(np.sqrt(c * K)))   # Re γ ≥ γ0 on the axis
+    else:
+        g = principal_sqrt(u * c)
+        t, gmt = tanh_and_gmt(g)
     sg = s * g
     den = sg + K * t
     return ChargeTerms(u, g, sg, t, gmt, den)
