@@ -13,6 +13,11 @@ sqrt(B), B = r1 A.  With x = L sqrt(B):
     terminal impedance  Z = 2 sqrt(B) / (A tanh(sqrt(B) L)) = 2 x coth x / (A L)     (eq. 10)
     bending kernel      X(x) = (x tanh x + sech x − 1)/x²                           (eq. 14)
 
+Topology: this is the circuit of seed 002 eq. (11) (Chen & Tan 2008): the leakage Rp spans the
+whole slice, in parallel with (polymer + r2 of each electrode).  physics.md §3 sketches an
+alternative re-derivation with r2 in series with (polymer ‖ Rp); the two agree when r2 = 0 or
+Rp = inf.  We follow the printed model; the other topology is a discrepancy candidate.
+
 X is also the sensing collection kernel: ∫0^L (L−z) cosh(x(L−z)/L)/cosh x dz = L² X(x).
 """
 
