@@ -35,12 +35,8 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M")) -> dict:
     """All actuator quantities at points ``s`` for parameter values ``p`` (see :class:`State`)."""
     K = p["K"]
     W, h, L = p["W"], p["h"], p["L"]
-    c = transport.charge_terms(s, h, p["d"], K)
-    theta = transport.polymer_admittance(W, h, p["kappa_e"], c)
-    A, frac = electrode.slice_admittance(theta, p["r2"], p["Rp"])
-    x = electrode.line_argument(A, p["r1"], L)
     want_z = "Z" in quantities or "I" in quantities
-    X, xcoth = line_kernels(x, want_xcoth=want_z)
+    c, frac, A, X, xcoth = electrode.strip_terms(p, s, want_xcoth=want_z)
     out = {}
     if want_z:
         Z = electrode.terminal_impedance(A, L, xcoth)

@@ -23,8 +23,11 @@ X is also the sensing collection kernel: ∫0^L (L−z) cosh(x(L−z)/L)/cosh x 
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
+from . import transport
 from .numerics import line_kernels, principal_sqrt
 
 
@@ -47,11 +50,24 @@ def line_argument(A, r1, L):
     return principal_sqrt(A * (r1 * L * L))
 
 
-def line_terms(A, r1, L):
-    """``(x, X(x), x coth x)`` for the electrode line."""
-    x = line_argument(A, r1, L)
-    X, xcoth = line_kernels(x)
-    return x, X, xcoth
+class StripTerms(NamedTuple):
+    """Everything the actuator and sensor share at points s: charge terms, slice and line."""
+
+    c: "transport.ChargeTerms"
+    frac: np.ndarray       # 1/(1 + r2 θ)
+    A: np.ndarray          # slice admittance term [S/m]
+    X: np.ndarray          # bending / collection kernel X(x)
+    xcoth: np.ndarray      # x coth x (None unless asked for)
+
+
+def strip_terms(p, s, want_xcoth: bool) -> StripTerms:
+    """Charge dynamics → polymer admittance → slice → electrode line, for parameter values ``p``
+    (a mapping like :class:`~physmodel.params.State`) at Laplace points ``s``."""
+    c = transport.charge_terms(s, p["h"], p["d"], p["K"])
+    theta = transport.polymer_admittance(p["W"], p["h"], p["kappa_e"], c)
+    A, frac = slice_admittance(theta, p["r2"], p["Rp"])
+    X, xcoth = line_kernels(line_argument(A, p["r1"], p["L"]), want_xcoth=want_xcoth)
+    return StripTerms(c, frac, A, X, xcoth)
 
 
 def terminal_impedance(A, L, xcoth):

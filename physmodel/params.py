@@ -15,7 +15,7 @@ Named sets live in :mod:`physmodel.parameter_sets`; variants come from :meth:`IP
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -253,4 +253,4 @@ def describe(p: IPMCParameters) -> str:
 
 
 __all__ = ["IPMCParameters", "State", "state_at", "first_mode_omega", "density_for_mode", "describe",
-           "as_parameter_list", "asdict"]
+           "as_parameter_list"]

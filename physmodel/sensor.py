@@ -32,7 +32,6 @@ import numpy as np
 from . import electrode, transport
 from .errors import IPMCError
 from .model import DEFAULT_CHUNK, PhysicsModel
-from .numerics import line_kernels
 
 KERNELS = ("boundary_charge", "reciprocal")
 UNITS = {"S": "A/m", "Z": "Ohm"}
@@ -45,11 +44,7 @@ DESCRIPTIONS = {
 def sensor_kernel(p, s, quantities=("S",), kernel: str = "boundary_charge") -> dict:
     K = p["K"]
     W, h, L = p["W"], p["h"], p["L"]
-    c = transport.charge_terms(s, h, p["d"], K)
-    theta = transport.polymer_admittance(W, h, p["kappa_e"], c)
-    A, frac = electrode.slice_admittance(theta, p["r2"], p["Rp"])
-    x = electrode.line_argument(A, p["r1"], L)
-    X, xcoth = line_kernels(x, want_xcoth="Z" in quantities)
+    c, frac, A, X, xcoth = electrode.strip_terms(p, s, want_xcoth="Z" in quantities)
     out = {}
     if "S" in quantities:
         if kernel == "boundary_charge":
