@@ -1,0 +1,318 @@
+"""Exact first-order-hold (FOH) discretisation of the split inverse and the filter engine.
+
+Signal model
+------------
+The sampled signal ``u[k] = u(k dt)`` is taken to be the piecewise-linear interpolant of its
+samples, with ``u[k] = 0`` outside the record (so the record is joined to zero by one-sample
+ramps at both ends).  For a stable continuous block ``x' = M x + B u, y = C x`` driven by such
+a signal the state at the sample instants obeys exactly
+
+    x[k] = Phi x[k-1] + alpha u[k] + beta u[k-1],
+    Phi   = exp(M dt),
+    alpha = int_0^dt exp(M tau) (1 - tau/dt) d tau  B,
+    beta  = int_0^dt exp(M tau) tau/dt d tau  B,
+
+(computed together from one matrix exponential of an (n+2)x(n+2) matrix).  Written with the
+shifted state ``xi = x - alpha u`` it is the ordinary discrete system
+``(Phi, Phi alpha + beta, C, C alpha)``, run with ``scipy.signal.lfilter``.  The causal stable
+part runs this forward; the anticausal part ``x_u(t) = int_t^inf exp(-A_u (t'-t)) B_u u(t') dt'``
+is the same recursion with ``M = -A_u`` run over the time-reversed samples — piecewise-linear
+interpolation commutes with time reversal, so both parts are exact for the same continuous
+signal.  The only discretisation error is therefore the interpolation error of the input,
+``|u - u_interp| <= dt**2/8 max|u''|``, which reaches the output through the strictly proper
+parts only (feedthrough and polynomial terms are applied at the samples):
+
+    |error| <= (||h_s||_1 + ||h_u||_1) * dt**2/8 * max|u''|
+
+(for a sinusoid of angular frequency w that is a relative error of about (w dt)**2/12 on
+the strictly proper parts).
+
+Finite preview
+--------------
+Truncating eq. (6) of seed paper 000 to ``[t, t + N dt]`` gives exactly
+
+    x_bar[k] = x[k] - Phi**N x[k+N]
+
+so the truncated anticausal output is ``C_r x[k] - (C_r Phi**N) x[k+N]``: two passes of the
+same reversed recursion with output rows ``C_r`` and ``C_r Phi**N``, the second advanced by N
+samples.  ``x[j] = 0`` for ``j >= len(u)`` (the signal is zero beyond the record).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.signal as sig
+
+from .split import InverseSplit
+
+__all__ = ["foh_matrices", "FOHFilter", "Plan", "central_difference_kernel"]
+
+
+def foh_matrices(M: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return ``(Phi, alpha, beta)`` of the exact FOH recursion ``x[k] = Phi x[k-1] + alpha u[k] + beta u[k-1]``.
+
+    Parameters
+    ----------
+    M : (n, n) ndarray
+        Continuous state matrix [1/s].
+    B : (n,) ndarray
+        Input vector.
+    dt : float
+        Sampling interval [s].
+    """
+    n = M.shape[0]
+    big = np.zeros((n + 2, n + 2))
+    big[:n, :n] = M * dt
+    big[:n, n] = B * dt
+    big[n, n + 1] = 1.0
+    E = sla.expm(big)
+    Phi = E[:n, :n]
+    J0 = E[:n, n]          # int_0^dt exp(M tau) d tau B
+    alpha = E[:n, n + 1]   # int_0^dt exp(M tau) (1 - tau/dt) d tau B
+    beta = J0 - alpha      # int_0^dt exp(M tau) tau/dt d tau B
+    return Phi, alpha, beta
+
+
+@dataclass
+class FOHFilter:
+    """Scalar output ``y[k] = C x[k] + D_extra u[k]`` of the FOH recursion, as a linear filter.
+
+    The discrete system is ``(Phi, Phi alpha + beta, C, C alpha + D_extra)``.  Two
+    realizations are built and checked against the exact state-space frequency response on
+    a logarithmic grid of the unit circle (down to 1e-7 of the Nyquist frequency):
+
+    * a transfer-function pair run with ``scipy.signal.lfilter`` (fastest), used when its
+      largest relative deviation is below ``1e-10``;
+    * otherwise second-order sections run with ``scipy.signal.sosfilt``: poles are the
+      eigenvalues of ``Phi``, zeros the finite generalised eigenvalues of the Rosenbrock
+      pencil.  A single high-order polynomial loses accuracy when the poles cluster near
+      z = 1 (``|lambda| dt`` small): at 500 kHz sampling the 35 degC sensor inverse lost
+      three orders of magnitude that way.
+    """
+
+    Phi: np.ndarray
+    alpha: np.ndarray
+    beta: np.ndarray
+    C: np.ndarray
+    D: float
+    b: np.ndarray | None
+    a: np.ndarray | None
+    sos: np.ndarray | None
+
+    @classmethod
+    def build(cls, Phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, C: np.ndarray,
+              D_extra: float = 0.0) -> "FOHFilter":
+        n = Phi.shape[0]
+        Bd = Phi @ alpha + beta
+        Dd = float(C @ alpha) + float(D_extra)
+        theta = np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0]))
+        zs = np.exp(1j * theta)
+        eye = np.eye(n)
+        exact = np.array([C @ np.linalg.solve(z * eye - Phi, Bd) + Dd for z in zs])
+        ref = np.maximum(np.abs(exact), 1e-300)
+        bb, aa = sig.ss2tf(Phi, Bd.reshape(n, 1), C.reshape(1, n), np.array([[Dd]]))
+        b = np.atleast_1d(np.asarray(bb, float)[0])
+        a = np.asarray(aa, float)
+        zinv = 1.0 / zs
+        tf_val = np.polyval(b[::-1], zinv) / np.polyval(a[::-1], zinv)
+        # relative to the largest response: deviations far below it do not matter
+        scale = float(np.max(np.abs(exact)))
+        if np.all(np.abs(tf_val - exact) <= 1e-10 * np.maximum(ref, 1e-3 * scale)):
+            return cls(Phi=Phi, alpha=alpha, beta=beta, C=C, D=Dd, b=b, a=a, sos=None)
+        sos = _sos(Phi, Bd, C, Dd, zs, exact)
+        return cls(Phi=Phi, alpha=alpha, beta=beta, C=C, D=Dd, b=None, a=None, sos=sos)
+
+    @property
+    def order(self) -> int:
+        return int(self.Phi.shape[0])
+
+    @property
+    def kind(self) -> str:
+        """``"ba"`` (lfilter) or ``"sos"`` (sosfilt)."""
+        return "ba" if self.sos is None else "sos"
+
+    def zi0(self) -> np.ndarray:
+        if self.sos is None:
+            return np.zeros(max(self.a.size, self.b.size) - 1)
+        return np.zeros((self.sos.shape[0], 2))
+
+    def run(self, x: np.ndarray, zi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.sos is None:
+            return sig.lfilter(self.b, self.a, x, zi=zi)
+        return sig.sosfilt(self.sos, x, zi=zi)
+
+    def run_rows(self, X: np.ndarray) -> np.ndarray:
+        """Filter every row of ``X`` from zero initial state."""
+        if self.sos is None:
+            return sig.lfilter(self.b, self.a, X, axis=1)
+        return sig.sosfilt(self.sos, X, axis=1)
+
+
+def _sos(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray,
+         exact: np.ndarray) -> np.ndarray:
+    n = Phi.shape[0]
+    poles = np.linalg.eigvals(Phi)
+    pencil_a = np.block([[Phi, Bd.reshape(n, 1)], [C.reshape(1, n), np.array([[Dd]])]])
+    pencil_b = np.zeros((n + 1, n + 1))
+    pencil_b[:n, :n] = np.eye(n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        zz = sla.eigvals(pencil_a, pencil_b)
+    zeros = zz[np.isfinite(zz) & (np.abs(zz) < 1e8)]
+    zeros = _conjugate_clean(zeros)
+    poles = _conjugate_clean(poles)
+    prod = np.array([np.prod(z - zeros) / np.prod(z - poles) for z in zs])
+    i = int(np.argmax(np.abs(prod)))
+    k = float(np.real(exact[i] / prod[i]))
+    if k == 0.0:
+        return np.array([[0.0, 0.0, 0.0, 1.0, 0.0, 0.0]])
+    return np.ascontiguousarray(sig.zpk2sos(zeros, poles, k))
+
+
+def _conjugate_clean(r: np.ndarray) -> np.ndarray:
+    """Make nearly-real roots exactly real so that zpk2sos pairs conjugates cleanly."""
+    r = np.asarray(r, complex).copy()
+    small = np.abs(r.imag) <= 1e-12 * np.maximum(1.0, np.abs(r))
+    r[small] = r[small].real
+    return r
+
+
+def central_difference_kernel(coeffs: np.ndarray, dt: float) -> tuple[np.ndarray, int]:
+    """Correlation kernel applying ``sum_k coeffs[k-1] d^k/dt^k`` with O(dt**2) central differences.
+
+    The k-th derivative uses the minimal symmetric stencil of half-width ``ceil(k/2)``
+    (3 points for k = 1, 2; 5 points for k = 3, 4; ...), whose truncation error is
+    ``O(dt**2 max|u^(k+2)|)``.
+
+    Returns
+    -------
+    kernel : ndarray, length 2h+1
+        ``out[k] = sum_j kernel[j] u[k - h + j]``.
+    h : int
+        Half-width (number of future samples needed).
+    """
+    r = coeffs.size
+    if r == 0:
+        return np.zeros(1), 0
+    h = (r + 1) // 2
+    kernel = np.zeros(2 * h + 1)
+    for k in range(1, r + 1):
+        c = coeffs[k - 1]
+        if c == 0:
+            continue
+        hk = (k + 1) // 2
+        offs = np.arange(-hk, hk + 1, dtype=float)
+        # solve sum_j w_j offs_j^q / q! = delta_{qk}, q = 0..2hk
+        V = np.vander(offs, 2 * hk + 1, increasing=True).T
+        rhs = np.zeros(2 * hk + 1)
+        rhs[k] = float(np.prod(np.arange(1, k + 1)))
+        w = np.linalg.solve(V, rhs)
+        kernel[h - hk:h + hk + 1] += c * w / dt**k
+    return kernel, h
+
+
+class Plan:
+    """Discretised inverse for one sampling interval and one preview.
+
+    Parameters
+    ----------
+    split : InverseSplit
+    dt : float
+        Sampling interval [s].
+    n_preview : int or None
+        Preview in samples; ``None`` for infinite preview.
+    """
+
+    def __init__(self, split: InverseSplit, dt: float, n_preview: int | None):
+        self.split = split
+        self.dt = float(dt)
+        self.n_preview = n_preview
+        self.D = float(split.feedthrough)
+        self.kernel, self.h = central_difference_kernel(split.derivative_coefficients, self.dt)
+        self.stable: FOHFilter | None = None
+        if split.n_stable:
+            Phi, al, be = foh_matrices(split.A_s, split.B_s, self.dt)
+            # the feedthrough D is exact at the samples: fold it into the stable filter
+            self.stable = FOHFilter.build(Phi, al, be, split.C_s, D_extra=self.D)
+        self.anti: FOHFilter | None = None
+        self.anti_tail: FOHFilter | None = None
+        self.anti_phi = np.zeros((0, 0))
+        self.anti_alpha = self.anti_beta = self.anti_C = np.zeros(0)
+        if split.n_unstable and (n_preview is None or n_preview > 0):
+            Phi, al, be = foh_matrices(-split.A_u, split.B_u, self.dt)
+            Cr = -split.C_u
+            self.anti_phi, self.anti_alpha, self.anti_beta, self.anti_C = Phi, al, be, Cr
+            self.anti = FOHFilter.build(Phi, al, be, Cr)
+            if n_preview is not None:
+                C2 = Cr @ np.linalg.matrix_power(Phi, n_preview)
+                if np.any(C2 != 0):
+                    self.anti_tail = FOHFilter.build(Phi, al, be, C2)
+
+    # -- chunked passes -------------------------------------------------------------------
+    def forward(self, src: Any, n: int, chunk: int, sink: Any, check: bool = True) -> None:
+        """Causal pass: call ``sink(c0, c1, causal_part, u_chunk)`` chunk by chunk.
+
+        ``check`` verifies that every chunk is finite (skip it when the caller already did).
+        """
+        zi = self.stable.zi0() if self.stable is not None else None
+        h = self.h
+        for c0 in range(0, n, chunk):
+            c1 = min(n, c0 + chunk)
+            x = _read(src, c0, c1, check)
+            if zi is not None:
+                y, zi = self.stable.run(x, zi)   # includes D * x
+            else:
+                y = self.D * x
+            if h:
+                lo, hi = max(0, c0 - h), min(n, c1 + h)
+                ext = np.zeros(c1 - c0 + 2 * h)
+                ext[lo - (c0 - h):hi - (c0 - h)] = _read(src, lo, hi, False)
+                y += np.correlate(ext, self.kernel, mode="valid")
+            sink(c0, c1, y, x)
+
+    def backward(self, src: Any, n: int, chunk: int, sink: Any) -> None:
+        """Anticausal pass: call ``sink(c0, c1, anticausal_part, u_chunk)`` from the end backwards.
+
+        Does nothing (never calls ``sink``) when there is no anticausal part.
+        """
+        if self.anti is None:
+            return
+        N = self.n_preview
+        zi1 = self.anti.zi0()
+        tail_f = self.anti_tail
+        zi2 = tail_f.zi0() if tail_f is not None else None
+        tail = np.zeros(N) if (tail_f is not None and N) else None  # o2 at [c1, c1+N)
+        for c1 in range(n, 0, -chunk):
+            c0 = max(0, c1 - chunk)
+            L = c1 - c0
+            x = _read(src, c0, c1, False)
+            xr = x[::-1]
+            o1r, zi1 = self.anti.run(xr, zi1)
+            yu = o1r[::-1]
+            if tail_f is not None:
+                # yu[k] -= o2[k + N]; o2 of this chunk is o2r reversed, later ones are in `tail`
+                o2r, zi2 = tail_f.run(xr, zi2)
+                o2 = o2r[::-1]
+                if N < L:
+                    yu[:L - N] -= o2[N:]
+                    yu[L - N:] -= tail
+                    tail = o2[:N].copy()
+                else:
+                    yu -= tail[N - L:]
+                    tail = np.concatenate((o2, tail[:N - L]))
+            sink(c0, c1, yu, x)
+
+
+def _read(src: Any, c0: int, c1: int, check: bool) -> np.ndarray:
+    x = np.asarray(src[c0:c1], dtype=float)
+    if check and not np.all(np.isfinite(x)):
+        from ._errors import NonFiniteSignalError
+
+        bad = int(np.flatnonzero(~np.isfinite(x))[0]) + c0
+        raise NonFiniteSignalError(
+            f"the signal must be finite; sample {bad} is {x[bad - c0]!r} (NaN/inf are not "
+            "allowed: fill or interpolate gaps before inverting)")
+    return x

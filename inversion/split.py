@@ -1,0 +1,488 @@
+"""Split the inverse of a SISO model into causal-stable and anticausal-stable parts.
+
+For a proper model ``G(s) = num(s)/den(s)`` the inverse ``H = 1/G = den/num`` is written as
+
+    H(s) = sum_{k=1}^{r} c_k s^k  +  D  +  H_s(s)  +  H_u(s)
+
+where ``r = deg den - deg num`` is the relative degree of ``G`` (the polynomial part is
+present only when ``G`` is strictly proper), ``D`` is the direct feedthrough, ``H_s`` is
+strictly proper with every pole in the open left half-plane (the minimum-phase zeros of
+``G``) and ``H_u`` is strictly proper with every pole in the open right half-plane (the
+non-minimum-phase zeros of ``G``).  ``H_s`` is run forward in time, ``H_u`` backward in time
+(Devasia, Chen & Paden 1996; seed paper 000, Sec. IV-A).
+
+Numerics
+--------
+The partial-fraction split is not done with residues (ill-conditioned for close or repeated
+zeros).  Instead:
+
+1. frequency scaling ``s = w0*sigma`` with ``w0`` the geometric mean of the zero magnitudes,
+   so that polynomial coefficients such as ``4.5e10`` become O(1);
+2. polynomial division ``den/num`` (``numpy.polydiv``) for ``D`` and the polynomial part;
+3. a controllable-canonical realization of the strictly proper remainder, balanced with
+   ``scipy.linalg.matrix_balance``;
+4. a real Schur form ordered with ``sort='lhp'`` (``scipy.linalg.schur``) followed by the
+   Sylvester equation ``T11 X - X T22 = -T12`` (``scipy.linalg.solve_sylvester``) that
+   block-diagonalises the Schur form into the stable and the anti-stable blocks.
+
+Improper inverses (strictly proper ``G``) are handled according to ``improper``:
+
+``"error"`` (default)
+    raise :class:`~inversion.ImproperInverseError`;
+``"filter"``
+    invert ``G`` augmented with ``r`` real poles at ``-filter_bandwidth`` [rad/s]:
+    ``H_f(s) = H(s) * (w_f/(s + w_f))**r``, which is biproper.  The result is the inverse
+    followed by an r-th order low-pass of bandwidth ``w_f``, i.e. ``G H_f = (w_f/(s+w_f))**r``
+    (magnitude error about ``r (w/w_f)**2/2`` and phase lag about ``r w/w_f`` at frequency
+    ``w``);
+``"differentiate"``
+    keep the polynomial part ``sum c_k s^k``; it is applied to the sampled signal with
+    second-order-accurate central finite differences (see :mod:`inversion.batch`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+
+from ._errors import ImproperInverseError, InversionError, NonHyperbolicModelError
+
+__all__ = ["InverseSplit", "split_inverse", "model_coefficients", "IMPROPER_MODES"]
+
+IMPROPER_MODES = ("error", "filter", "differentiate")
+
+#: A zero ``z`` counts as lying on the imaginary axis when ``|Re z| <= _AXIS_RTOL * max(|z|, w0)``.
+_AXIS_RTOL = 1e-9
+#: Largest acceptable norm of the Sylvester coupling ``X`` (in scaled units) before the
+#: stable/anti-stable separation is declared numerically meaningless.
+_MAX_SYLVESTER_NORM = 1e8
+
+
+def _strip(c: np.ndarray) -> np.ndarray:
+    nz = np.flatnonzero(c)
+    if nz.size == 0:
+        return c[:0]
+    return c[nz[0]:]
+
+
+def model_coefficients(model: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(num, den)`` (descending powers of s, leading zeros stripped) of a SISO model.
+
+    Parameters
+    ----------
+    model : control.TransferFunction, control.StateSpace, or (num, den)
+        Continuous-time SISO model ``G(s)``.  A pair of coefficient sequences is read as
+        descending powers of ``s`` [s in rad/s].
+
+    Raises
+    ------
+    InversionError
+        for MIMO, discrete-time, improper (``deg num > deg den``), zero or non-finite models.
+    """
+    num: Any
+    den: Any
+    if isinstance(model, tuple | list) and len(model) == 2:
+        num, den = model
+    else:
+        try:
+            import control  # local: keep import cost out of the module import
+        except ImportError:  # pragma: no cover - control is a hard dependency
+            control = None
+        if control is not None and isinstance(model, control.StateSpace):
+            if model.ninputs != 1 or model.noutputs != 1:
+                raise InversionError(
+                    f"model must be SISO; got a state-space model with {model.ninputs} inputs "
+                    f"and {model.noutputs} outputs")
+            if not model.isctime():
+                raise InversionError(
+                    f"model must be continuous-time; got sampling time dt={model.dt}")
+            model = control.ss2tf(model)
+        if hasattr(model, "num") and hasattr(model, "den"):
+            if getattr(model, "ninputs", 1) != 1 or getattr(model, "noutputs", 1) != 1:
+                raise InversionError(
+                    f"model must be SISO; got {model.ninputs} inputs and {model.noutputs} outputs")
+            dt = getattr(model, "dt", 0)
+            if dt not in (0, None):
+                raise InversionError(
+                    f"model must be continuous-time (dt=0); got sampling time dt={dt}")
+            num, den = model.num, model.den
+            # python-control stores num[0][0]
+            while isinstance(num, list | tuple) and len(num) == 1 and not np.isscalar(num[0]):
+                num = num[0]
+            while isinstance(den, list | tuple) and len(den) == 1 and not np.isscalar(den[0]):
+                den = den[0]
+        elif hasattr(model, "at"):
+            raise InversionError(
+                "model looks like a temperature-scheduled surrogate (it has .at(T)); pass "
+                "model.at(temperature_c) or use inversion.invert_scheduled(model.at, ...)")
+        else:
+            raise InversionError(
+                f"cannot read a transfer function from a {type(model).__name__}; expected a "
+                "control.TransferFunction, control.StateSpace or a (num, den) pair")
+    try:
+        num_a = np.atleast_1d(np.asarray(num, dtype=float)).ravel()
+        den_a = np.atleast_1d(np.asarray(den, dtype=float)).ravel()
+    except (TypeError, ValueError) as exc:
+        raise InversionError(f"model coefficients must be real numbers: {exc}") from exc
+    if not (np.all(np.isfinite(num_a)) and np.all(np.isfinite(den_a))):
+        raise InversionError(
+            f"model coefficients must be finite; got num={num_a.tolist()}, den={den_a.tolist()}")
+    num_a, den_a = _strip(num_a), _strip(den_a)
+    if num_a.size == 0:
+        raise InversionError("model numerator is identically zero; G = 0 has no inverse")
+    if den_a.size == 0:
+        raise InversionError("model denominator is identically zero")
+    if num_a.size > den_a.size:
+        raise InversionError(
+            f"model must be proper (deg num <= deg den); got deg num = {num_a.size - 1} > "
+            f"deg den = {den_a.size - 1}")
+    return num_a, den_a
+
+
+@dataclass(frozen=True, eq=False)
+class InverseSplit:
+    """The inverse ``H = 1/G`` of a model split into polynomial, stable and anti-stable parts.
+
+    ``H(s) = sum_k derivative_coefficients[k-1] s^k + feedthrough
+    + C_s (sI - A_s)^{-1} B_s + C_u (sI - A_u)^{-1} B_u``.
+
+    Attributes
+    ----------
+    num, den : ndarray
+        Coefficients of the model ``G`` that was inverted (descending powers of s), after
+        the ``"filter"`` augmentation if it was used.
+    zeros : ndarray
+        Zeros of ``num`` = poles of ``H`` [rad/s].
+    relative_degree : int
+        ``deg den - deg num`` of the model *as given* (before filter augmentation).
+    improper : str
+        How an improper inverse was handled (``"error"``, ``"filter"``, ``"differentiate"``).
+    filter_bandwidth : float or None
+        Bandwidth of the added low-pass poles [rad/s] (``"filter"`` mode).
+    feedthrough : float
+        ``D = lim_{s->inf} (H(s) - polynomial part)``.
+    derivative_coefficients : ndarray
+        ``c_1 .. c_r`` multiplying ``s^1 .. s^r`` (empty unless ``"differentiate"``).
+    A_s, B_s, C_s : ndarray
+        Realization of the stable part: shapes (n_s, n_s), (n_s,), (n_s,) [A in 1/s].
+    A_u, B_u, C_u : ndarray
+        Realization of the anti-stable part: shapes (n_u, n_u), (n_u,), (n_u,).
+    r0 : float
+        Real part of the least unstable pole of ``H_u`` (the non-minimum-phase zero of ``G``
+        closest to the imaginary axis) [1/s]; ``inf`` for a minimum-phase model.
+    auto_preview_s : float
+        Zou–Devasia preview rule ``T_p* = 4/r0`` [s]; 0 for a minimum-phase model.
+    frequency_scale : float
+        ``w0`` used to scale s during the computation [rad/s].
+    """
+
+    num: np.ndarray
+    den: np.ndarray
+    zeros: np.ndarray
+    relative_degree: int
+    improper: str
+    filter_bandwidth: float | None
+    feedthrough: float
+    derivative_coefficients: np.ndarray
+    A_s: np.ndarray
+    B_s: np.ndarray
+    C_s: np.ndarray
+    A_u: np.ndarray
+    B_u: np.ndarray
+    C_u: np.ndarray
+    r0: float
+    auto_preview_s: float
+    frequency_scale: float = field(default=1.0)
+
+    @property
+    def n_stable(self) -> int:
+        """Order of the stable (causal) part."""
+        return int(self.A_s.shape[0])
+
+    @property
+    def n_unstable(self) -> int:
+        """Order of the anti-stable (anticausal) part."""
+        return int(self.A_u.shape[0])
+
+    @property
+    def is_minimum_phase(self) -> bool:
+        """True when the inverse has no anticausal part."""
+        return self.n_unstable == 0
+
+    @property
+    def unstable_poles(self) -> np.ndarray:
+        """Poles of ``H_u`` (right half-plane zeros of G) [rad/s]."""
+        return np.linalg.eigvals(self.A_u) if self.n_unstable else np.zeros(0, complex)
+
+    @property
+    def stable_poles(self) -> np.ndarray:
+        """Poles of ``H_s`` (left half-plane zeros of G) [rad/s]."""
+        return np.linalg.eigvals(self.A_s) if self.n_stable else np.zeros(0, complex)
+
+    def frequency_response(self, omega: Any, part: str = "total") -> np.ndarray:
+        """Evaluate the inverse (or one of its parts) at ``s = j*omega``.
+
+        Parameters
+        ----------
+        omega : array_like
+            Angular frequencies [rad/s].
+        part : {"total", "stable", "unstable", "polynomial"}
+            ``"stable"`` includes neither the feedthrough nor the polynomial part;
+            ``"polynomial"`` is ``D + sum c_k s^k``.
+
+        Returns
+        -------
+        ndarray of complex
+            ``H(j omega)`` in output units per input unit.
+        """
+        w = np.atleast_1d(np.asarray(omega, dtype=float))
+        s = 1j * w
+
+        def block(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> np.ndarray:
+            n = A.shape[0]
+            if n == 0:
+                return np.zeros_like(s)
+            eye = np.eye(n)
+            out = np.empty(s.shape, complex)
+            for i, si in enumerate(s):
+                out[i] = C @ np.linalg.solve(si * eye - A, B)
+            return out
+
+        poly = np.full(s.shape, self.feedthrough, dtype=complex)
+        for k, c in enumerate(self.derivative_coefficients, start=1):
+            poly = poly + c * s**k
+        if part == "polynomial":
+            return poly
+        hs = block(self.A_s, self.B_s, self.C_s)
+        if part == "stable":
+            return hs
+        hu = block(self.A_u, self.B_u, self.C_u)
+        if part == "unstable":
+            return hu
+        if part != "total":
+            raise InversionError(
+                f"part must be 'total', 'stable', 'unstable' or 'polynomial'; got {part!r}")
+        return poly + hs + hu
+
+    def stable_tf(self) -> Any:
+        """``H_s`` as a ``control.TransferFunction`` (None if empty)."""
+        return _to_tf(self.A_s, self.B_s, self.C_s)
+
+    def unstable_tf(self) -> Any:
+        """``H_u`` as a ``control.TransferFunction`` (None if empty)."""
+        return _to_tf(self.A_u, self.B_u, self.C_u)
+
+    def l1_norms(self) -> tuple[float, float]:
+        """L1 norms of the impulse responses of ``H_s`` and ``H_u`` (integral of |h|).
+
+        Used for the discretisation error estimate: a bounded input perturbation ``e``
+        changes each part's output by at most ``||h||_1 * max|e|``.
+        """
+        return _l1_norm(self.A_s, self.B_s, self.C_s), _l1_norm(-self.A_u, self.B_u, self.C_u)
+
+
+def _to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
+    if A.shape[0] == 0:
+        return None
+    import control
+    import scipy.signal as sig
+
+    b, a = sig.ss2tf(A, B.reshape(-1, 1), C.reshape(1, -1), np.zeros((1, 1)))
+    return control.tf(np.atleast_1d(b[0]), a)
+
+
+def _l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
+    """``int_0^inf |C exp(M t) B| dt`` for a stable ``M`` (trapezoid on a fine grid)."""
+    n = M.shape[0]
+    if n == 0:
+        return 0.0
+    lam = np.linalg.eigvals(M)
+    slow = float(np.min(-lam.real))
+    fast = float(np.max(np.abs(lam)))
+    horizon = 40.0 / slow  # exp(-40) ~ 4e-18 of the slowest mode (times polynomial growth)
+    step = min(0.02 / fast, horizon / 2000.0)
+    n_steps = int(min(max(np.ceil(horizon / step), 2000), 400_000))
+    step = horizon / n_steps
+    Phi = sla.expm(M * step)
+    # propagate x(t) = exp(M t) B on the grid in blocks of powers (vectorised doubling)
+    xs = np.empty((n_steps + 1, n))
+    xs[0] = B
+    filled = 1
+    P = Phi
+    while filled < n_steps + 1:
+        m = min(filled, n_steps + 1 - filled)
+        xs[filled:filled + m] = xs[:m] @ P.T
+        filled += m
+        P = P @ P
+    h = np.abs(xs @ C)
+    return float(step * (h.sum() - 0.5 * (h[0] + h[-1])))
+
+
+def _scale_poly(c: np.ndarray, w0: float) -> np.ndarray:
+    """Coefficients of p(w0*sigma) given those of p(s) (descending powers)."""
+    deg = c.size - 1
+    return c * w0 ** np.arange(deg, -1, -1, dtype=float)
+
+
+def split_inverse(model: Any, *, improper: str = "error",
+                  filter_bandwidth: float | None = None) -> InverseSplit:
+    """Split ``1/G`` into polynomial + feedthrough + stable + anti-stable parts.
+
+    Parameters
+    ----------
+    model : control.TransferFunction, control.StateSpace, or (num, den)
+        Proper continuous-time SISO model ``G(s)`` (s in rad/s).
+    improper : {"error", "filter", "differentiate"}
+        Handling of a strictly proper ``G`` (improper inverse); see the module docstring.
+    filter_bandwidth : float, optional
+        Bandwidth of the low-pass poles for ``improper="filter"`` [rad/s].
+
+    Returns
+    -------
+    InverseSplit
+
+    Raises
+    ------
+    NonHyperbolicModelError
+        if ``G`` has a zero on the imaginary axis (|Re z| <= 1e-9 max(|z|, w0)).
+    ImproperInverseError
+        if ``G`` is strictly proper and ``improper="error"``.
+    InversionError
+        for invalid models or options.
+    """
+    if improper not in IMPROPER_MODES:
+        raise InversionError(
+            f"improper must be one of {IMPROPER_MODES}; got {improper!r}")
+    num, den = model_coefficients(model)
+    rel_deg = den.size - num.size
+    wf: float | None = None
+    if improper == "filter":
+        if filter_bandwidth is None or not (np.isfinite(filter_bandwidth) and filter_bandwidth > 0):
+            raise InversionError(
+                "improper='filter' needs filter_bandwidth, a positive finite bandwidth in "
+                f"rad/s; got {filter_bandwidth!r}")
+        wf = float(filter_bandwidth)
+        if rel_deg > 0:
+            # G_f = G * ((s + wf)/wf)^r  (so that H_f = H * (wf/(s+wf))^r)
+            lp = np.poly(np.full(rel_deg, -wf)) / wf**rel_deg
+            num = np.polymul(num, lp)
+    elif filter_bandwidth is not None:
+        raise InversionError(
+            f"filter_bandwidth={filter_bandwidth!r} is only used with improper='filter'; got "
+            f"improper={improper!r}")
+    r_eff = den.size - num.size
+    if r_eff > 0 and improper == "error":
+        raise ImproperInverseError(
+            f"the model is strictly proper (relative degree {r_eff}), so its inverse is "
+            "improper (it contains s^k terms); choose improper='filter' with "
+            "filter_bandwidth=<rad/s> to low-pass the inverse, or improper='differentiate' "
+            "to apply the s^k terms as central finite differences")
+
+    m = num.size - 1  # number of zeros of G = order of the dynamic part of H
+    zeros = np.roots(num) if m > 0 else np.zeros(0, complex)
+    nonzero = np.abs(zeros)[np.abs(zeros) > 0]
+    w0 = float(np.exp(np.mean(np.log(nonzero)))) if nonzero.size else 1.0
+    if not np.isfinite(w0) or w0 <= 0:  # pragma: no cover - defensive
+        w0 = 1.0
+    for z in zeros:
+        if abs(z.real) <= _AXIS_RTOL * max(abs(z), w0):
+            raise NonHyperbolicModelError(
+                f"the model has a zero at s = {complex(z):.6g} on the imaginary axis "
+                f"(|Re| = {abs(z.real):.3g} rad/s <= {_AXIS_RTOL:g} * max(|z|, {w0:.3g})); "
+                "the inverse would have a pole there and has no bounded stable realization. "
+                "Stable inversion needs a hyperbolic model (no zeros with Re s = 0): remove or "
+                "shift that zero (e.g. a zero at s = 0 of a high-pass sensor)")
+
+    num_sc = _scale_poly(num, w0)
+    den_sc = _scale_poly(den, w0)
+    lead = num_sc[0]
+    num_sc = num_sc / lead
+    den_sc = den_sc / lead
+    q, rem = np.polydiv(den_sc, num_sc)
+    q = np.atleast_1d(q)
+    # q: descending powers sigma^r_eff .. sigma^0
+    feedthrough = float(q[-1])
+    deriv = np.zeros(max(r_eff, 0))
+    for k in range(1, r_eff + 1):
+        deriv[k - 1] = q[-1 - k] / w0**k
+
+    empty2, empty1 = np.zeros((0, 0)), np.zeros(0)
+    if m == 0:
+        return InverseSplit(num=num, den=den, zeros=zeros, relative_degree=rel_deg,
+                            improper=improper, filter_bandwidth=wf, feedthrough=feedthrough,
+                            derivative_coefficients=deriv, A_s=empty2, B_s=empty1, C_s=empty1,
+                            A_u=empty2, B_u=empty1, C_u=empty1, r0=math.inf,
+                            auto_preview_s=0.0, frequency_scale=w0)
+
+    rem = np.atleast_1d(rem)
+    rem_full = np.zeros(m)
+    rem_full[m - rem.size:] = rem[-m:] if rem.size > m else rem
+    # controllable canonical form of rem(sigma)/num(sigma), num monic of degree m
+    A = np.zeros((m, m))
+    A[0, :] = -num_sc[1:]
+    if m > 1:
+        A[1:, :-1] = np.eye(m - 1)
+    B = np.zeros(m)
+    B[0] = 1.0
+    C = rem_full.copy()
+    Ab, (sca, _) = sla.matrix_balance(A, permute=False, separate=True)
+    B = B / sca
+    C = C * sca
+    T, Z, sdim = sla.schur(Ab, output="real", sort="lhp")
+    n_lhp = int(np.sum(zeros.real < 0))
+    if sdim != n_lhp:  # pragma: no cover - only for pathological near-axis cases
+        raise NonHyperbolicModelError(
+            f"cannot separate stable and unstable zeros reliably: the Schur form has {sdim} "
+            f"left half-plane eigenvalues but the zeros {zeros} have {n_lhp}")
+    k = sdim
+    T11, T12, T22 = T[:k, :k], T[:k, k:], T[k:, k:]
+    if 0 < k < m:
+        X = sla.solve_sylvester(T11, -T22, -T12)
+        xn = float(np.linalg.norm(X))
+        if not np.isfinite(xn) or xn > _MAX_SYLVESTER_NORM:
+            raise NonHyperbolicModelError(
+                f"the stable and unstable zeros {zeros} are too close to separate the "
+                f"inverse numerically (Sylvester coupling norm {xn:.3g} > "
+                f"{_MAX_SYLVESTER_NORM:g})")
+    else:
+        X = np.zeros((k, m - k))
+    W = np.eye(m)
+    W[:k, k:] = X
+    Winv = np.eye(m)
+    Winv[:k, k:] = -X
+    V = Z @ W
+    Bt = Winv @ (Z.T @ B)
+    Ct = C @ V
+    A_s = w0 * T11
+    B_s = w0 * Bt[:k]
+    C_s = Ct[:k].copy()
+    A_u = w0 * T22
+    B_u = w0 * Bt[k:]
+    C_u = Ct[k:].copy()
+    # equalise |B| and |C| per part (cosmetic, improves the conditioning of ss2tf later)
+    A_s, B_s, C_s = _equalise(A_s, B_s, C_s)
+    A_u, B_u, C_u = _equalise(A_u, B_u, C_u)
+    if A_u.shape[0]:
+        r0 = float(np.min(np.linalg.eigvals(A_u).real))
+        auto = 4.0 / r0
+    else:
+        r0, auto = math.inf, 0.0
+    return InverseSplit(num=num, den=den, zeros=zeros, relative_degree=rel_deg,
+                        improper=improper, filter_bandwidth=wf, feedthrough=feedthrough,
+                        derivative_coefficients=deriv, A_s=A_s, B_s=B_s, C_s=C_s,
+                        A_u=A_u, B_u=B_u, C_u=C_u, r0=r0, auto_preview_s=auto,
+                        frequency_scale=w0)
+
+
+def _equalise(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, ...]:
+    if A.shape[0] == 0:
+        return A, B, C
+    nb, nc = float(np.linalg.norm(B)), float(np.linalg.norm(C))
+    if nb > 0 and nc > 0:
+        f = math.sqrt(nc / nb)
+        return A, B * f, C / f
+    return A, B, C
