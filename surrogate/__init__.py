@@ -1,0 +1,66 @@
+"""Low-order, temperature-scheduled rational surrogates of IPMC frequency responses.
+
+Fits are solved with CasADi/IPOPT in scaled variables (s̃ = s/ω_ref, response/g_ref,
+τ = (T − T_c)/T_s); frequencies are in Hz at the edges and the fitted transfer functions
+use s in rad/s, like the seed papers' models.
+
+Public API
+----------
+Data
+    FrequencyData(frequency_hz, temperature_c, response, magnitude_std_db=None,
+                  phase_std_deg=None, ...)        validated tidy data, ``fingerprint()``
+    from_sweep(sweep) -> FrequencyData         duck-typed physmodel FrequencySweep adapter
+Fitters (estimator style: settings in the constructor, ``fit`` returns a FitResult and sets
+``model_``, ``result_``, ``history_``)
+    RationalFit(n_zeros, n_poles, stable=True, weighting='auto', init='auto', ...)
+        .fit(frequency_hz, temperature_c, response, magnitude_std_db=None, phase_std_deg=None)
+    ScheduledFit(form='zpk'|'coefficients'|'sections', n_zeros, n_poles, degree,
+                 method='joint'|'two-stage', per_temperature='nlp'|'levy', ...)
+        .fit(frequency_hz, temperature_c, response, magnitude_std_db=None, phase_std_deg=None)
+    fit_sweep(sweep, n_zeros, n_poles, degree=2, form='zpk', **settings) -> FitResult
+    levy(omega_scaled, response_scaled, n_zeros, n_poles)   Levy / Octave-invfreqs baseline
+Results and models
+    FitResult        converged, status, params, stderr, ci95_low/high, per_temperature,
+                     stability, history, two_stage, per_temperature_models, summary()
+    RationalModel    frequency_response(frequency_hz, temperature_c), at(T) -> control.TransferFunction,
+                     coefficients(T), poles(T), zeros(T), stability_check(), parameter_table(),
+                     confidence_intervals(), to_json(path)
+    load(path) -> RationalModel                versioned JSON (schema ``ipmc.surrogate.rational_model``)
+    Structure, Scaling, StabilityCheck, TemperatureError
+Order selection
+    order_selection(frequency_hz, temperature_c, response, orders, ...) -> OrderSelectionReport
+Metrics
+    relative_rms_error, fit_percent (100·(1 − NRMSE)), log_rms_error
+Errors
+    ConvergenceError (raised when IPOPT does not converge; ``.result`` holds the flagged result)
+Command line
+    surrogate.cli.add_parser(subparsers), surrogate.cli.run(args) -> exit code (0/2/3)
+"""
+
+from ._data import FrequencyData, from_sweep
+from ._fit import FitResult, TemperatureError
+from ._init import levy
+from ._nlp import ConvergenceError
+from ._structure import Structure
+from .metrics import fit_percent, log_rms_error, relative_rms_error
+from .models import RationalModel, Scaling, StabilityCheck, load
+from .rational import RationalFit
+from .scheduled import ScheduledFit
+from .selection import OrderRow, OrderSelectionReport, order_selection
+
+__all__ = [
+    "FrequencyData", "from_sweep", "RationalFit", "ScheduledFit", "fit_sweep", "levy",
+    "FitResult", "TemperatureError", "RationalModel", "Scaling", "StabilityCheck", "Structure",
+    "load", "order_selection", "OrderRow", "OrderSelectionReport", "relative_rms_error",
+    "fit_percent", "log_rms_error", "ConvergenceError",
+]
+
+
+def fit_sweep(sweep, n_zeros: int, n_poles: int, degree: int = 2, form: str = "zpk", **settings):
+    """Fit a physmodel ``FrequencySweep`` (duck-typed): one temperature → ``RationalFit``,
+    several → ``ScheduledFit``.  ``settings`` go to the fitter's constructor."""
+    data = from_sweep(sweep)
+    if data.temperatures().size <= 1:
+        settings.pop("method", None)
+        return RationalFit(n_zeros, n_poles, **settings).fit_data(data)
+    return ScheduledFit(form, n_zeros, n_poles, degree, **settings).fit_data(data)

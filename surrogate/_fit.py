@@ -1,0 +1,252 @@
+"""Shared pieces of the fitters: scaling, weighting, order checks, results."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._data import FrequencyData
+from ._nlp import ConvergenceError, Problem, SolveOutcome, Solver, covariance
+from ._structure import Structure
+from .metrics import fit_percent, relative_rms_error
+from .models import RationalModel, Scaling, StabilityCheck
+
+WEIGHTINGS = ("auto", "uncertainty", "log", "relative")
+
+
+def as_data(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg) -> FrequencyData:
+    if isinstance(frequency_hz, FrequencyData):
+        return frequency_hz
+    return FrequencyData(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg)
+
+
+def check_weighting(weighting: str) -> str:
+    if weighting not in WEIGHTINGS:
+        raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {weighting!r}")
+    return weighting
+
+
+def check_positive_int(name, v, minimum=1):
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {v!r}")
+    return int(v)
+
+
+def check_positive_float(name, v, allow_none=True):
+    if v is None and allow_none:
+        return None
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a positive number, got {v!r}") from None
+    if not np.isfinite(f) or f <= 0:
+        raise ValueError(f"{name} must be a positive finite number, got {v!r}")
+    return f
+
+
+def resolve_weighting(weighting: str, data: FrequencyData):
+    """(residual kind, 1/σ_a, 1/σ_b, resolved name)."""
+    if weighting == "auto":
+        weighting = "uncertainty" if data.has_uncertainty else "log"
+    ones = np.ones(data.n)
+    if weighting == "uncertainty":
+        sa, sb = data.log_std()
+        return "log", 1.0 / sa, 1.0 / sb, weighting
+    if weighting == "log":
+        return "log", ones, ones, weighting
+    return "relative", ones, ones, weighting
+
+
+def make_scaling(data: FrequencyData, omega_ref=None, gain_ref=None, t_center=None, t_scale=None) -> Scaling:
+    w = data.omega
+    if omega_ref is None:
+        omega_ref = float(np.sqrt(w.min() * w.max()))
+    if gain_ref is None:
+        gain_ref = float(np.exp(np.mean(np.log(np.abs(data.response)))))
+    temps = data.temperatures()
+    if t_center is None:
+        t_center = float(0.5 * (temps.min() + temps.max())) if temps.size else 0.0
+    if t_scale is None:
+        t_scale = float(0.5 * (temps.max() - temps.min())) if temps.size > 1 else 1.0
+    return Scaling(float(omega_ref), float(gain_ref), float(t_center), float(t_scale))
+
+
+def make_problem(structure: Structure, data: FrequencyData, scaling: Scaling, weighting: str):
+    kind, ia, ib, name = resolve_weighting(weighting, data)
+    w = data.omega / scaling.omega_ref_rad_s
+    if data.temperature_c is None or structure.degree == 0:
+        tau = np.zeros(data.n)
+    else:
+        tau = (data.temperature_c - scaling.temperature_center_c) / scaling.temperature_scale_c
+    return Problem(structure, w, tau, data.response / scaling.gain_ref, kind, ia, ib), name
+
+
+def check_order_per_temperature(structure: Structure, data: FrequencyData):
+    """Each temperature must carry at least as many real equations as a per-T fit has unknowns."""
+    n_unknown = structure.n_zeros + 1 + structure.n_poles
+    groups = [(None, data.n)] if data.temperature_c is None else [
+        (t, int(np.sum(data.temperature_c == t))) for t in data.temperatures()]
+    for t, count in groups:
+        if 2 * count < n_unknown:
+            where = "" if t is None else f" at temperature_c={t:g}"
+            raise ValueError(
+                f"order too high for the number of points: n_zeros={structure.n_zeros}, "
+                f"n_poles={structure.n_poles} has {n_unknown} real unknowns but{where} there are "
+                f"only {count} frequency lines ({2 * count} real equations); "
+                f"need at least {int(np.ceil(n_unknown / 2))} lines"
+            )
+
+
+@dataclass(frozen=True)
+class TemperatureError:
+    """Fit quality at one temperature.
+
+    relative_rms_error : sqrt(mean |H_m − H_d|²/|H_d|²). [-]
+    fit_percent : 100·(1 − NRMSE). [%]
+    """
+
+    temperature_c: float | None
+    n_lines: int
+    relative_rms_error: float
+    fit_percent: float
+
+
+def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolate=False):
+    out = []
+    temps = [None] if data.temperature_c is None else list(data.temperatures())
+    for t in temps:
+        d = data if t is None else data.at_temperature(t)
+        tt = d.temperature_c if model.is_scheduled else None
+        h = model.frequency_response(d.frequency_hz, tt, extrapolate=extrapolate)
+        try:
+            fp = fit_percent(h, d.response)
+        except ValueError:  # a single line per temperature: NRMSE undefined
+            fp = float("nan")
+        out.append(TemperatureError(None if t is None else float(t), d.n,
+                                    relative_rms_error(h, d.response), fp))
+    return out
+
+
+@dataclass
+class FitResult:
+    """What a fit returns.  Every array is in the model's parameter layout.
+
+    converged : IPOPT reported success (``status`` holds its return status).
+    cost : ½·mean of squared weighted residuals at the solution. [-]
+    weighted_rms : sqrt(2·cost), RMS weighted residual (≈1 for a correct model and
+        correct uncertainties with weighting 'uncertainty'). [-]
+    stderr, ci95_low, ci95_high : from the Gauss–Newton covariance at the optimum
+        (None when not available, e.g. for the two-stage baseline).
+    at_bounds : parameters that ended on a bound (their intervals are unreliable).
+    stability : independent pole check (dense temperature grid for scheduled models).
+    history : one dict per solver run (stage, start, status, iterations, cost, time_s,
+        objective trace).
+    """
+
+    model: RationalModel
+    converged: bool
+    status: str
+    iterations: int
+    cost: float
+    weighted_rms: float
+    weighting: str
+    method: str
+    param_names: list
+    params: np.ndarray
+    stderr: np.ndarray | None
+    ci95_low: np.ndarray | None
+    ci95_high: np.ndarray | None
+    covariance_rank_deficient: bool
+    at_bounds: list
+    per_temperature: list
+    stability: StabilityCheck
+    time_s: float
+    data_fingerprint: str
+    history: list = field(default_factory=list)
+    two_stage: RationalModel | None = None
+    per_temperature_models: dict | None = None
+
+    def summary(self) -> str:
+        st = self.model.structure
+        lines = [
+            f"{self.method} fit, form={st.form}, zeros={st.n_zeros}, poles={st.n_poles}, "
+            f"degree={st.degree}: {'converged' if self.converged else 'NOT CONVERGED'} "
+            f"({self.status}, {self.iterations} iterations, {self.time_s:.3f} s)",
+            f"weighting={self.weighting}, weighted RMS residual={self.weighted_rms:.4g}",
+            f"stability: {'stable' if self.stability.stable else 'UNSTABLE'} "
+            f"(max pole real part {self.stability.max_pole_real_part_rad_s:.4g} rad/s over "
+            f"{self.stability.n_temperatures} temperature(s))",
+        ]
+        for e in self.per_temperature:
+            t = "" if e.temperature_c is None else f"T={e.temperature_c:g} °C: "
+            lines.append(f"  {t}relative RMS error {e.relative_rms_error:.4g}, fit {e.fit_percent:.2f} %")
+        return "\n".join(lines)
+
+
+def history_entry(stage: str, start: str, out: SolveOutcome) -> dict:
+    return {"stage": stage, "start": start, "status": out.status, "converged": out.converged,
+            "iterations": out.iterations, "cost": out.cost, "time_s": out.time_s,
+            "objective_trace": out.objective_trace}
+
+
+def best_outcome(outcomes, prefer: str | None = None, rel_tol: float = 0.02):
+    """Lowest-cost converged outcome, else the lowest-cost one (flagged).
+
+    If ``prefer`` names a converged start whose cost is within ``rel_tol`` of the best, it
+    wins (continuation across temperatures keeps section identities that way)."""
+    ok = [o for o in outcomes if o[1].converged]
+    pool = ok or outcomes
+    best = min(pool, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)
+    for o in ok:
+        if o[0] == prefer and o[1].cost <= best[1].cost * (1 + rel_tol) + 1e-300:
+            return o
+    return best
+
+
+def finish(structure, problem: Problem, solver: Solver | None, outcome: SolveOutcome, scaling: Scaling,
+           data: FrequencyData, *, weighting_name: str, method: str, settings: dict,
+           scale_covariance: bool, history: list, time_s: float, temperature_range,
+           compute_covariance: bool = True, two_stage=None, per_temperature_models=None,
+           raise_on_failure: bool = True, stability_grid: int = 501) -> FitResult:
+    theta = outcome.theta
+    r = problem.residual(theta)
+    cov, rank_def = None, False
+    at_bounds = []
+    if compute_covariance and solver is not None:
+        cov, rank_def = covariance(solver.jacobian(problem, theta), r, scale_covariance)
+        lo, hi = structure.bounds(float(problem.w.min()), float(problem.w.max()))
+        names = structure.param_names()
+        at_bounds = [names[i] for i in np.flatnonzero((theta <= lo + 1e-6) | (theta >= hi - 1e-6))]
+    info = {
+        "method": method,
+        "settings": settings,
+        "weighting": weighting_name,
+        "converged": outcome.converged,
+        "status": outcome.status,
+        "cost": outcome.cost if np.isfinite(outcome.cost) else None,
+        "data_fingerprint": data.fingerprint(),
+        "n_lines": data.n,
+        "temperatures_c": data.temperatures().tolist(),
+    }
+    model = RationalModel(structure, theta, scaling, temperature_range, cov, data.labels(), info)
+    stability = model.stability_check(stability_grid)
+    errs = per_temperature_errors(model, data)
+    ci = model.confidence_intervals()
+    res = FitResult(
+        model=model, converged=outcome.converged, status=outcome.status,
+        iterations=outcome.iterations, cost=outcome.cost,
+        weighted_rms=float(np.sqrt(np.mean(r ** 2))), weighting=weighting_name, method=method,
+        param_names=structure.param_names(), params=theta.copy(), stderr=model.stderr,
+        ci95_low=None if ci is None else ci[0], ci95_high=None if ci is None else ci[1],
+        covariance_rank_deficient=rank_def, at_bounds=at_bounds, per_temperature=errs,
+        stability=stability, time_s=time_s, data_fingerprint=info["data_fingerprint"],
+        history=history, two_stage=two_stage, per_temperature_models=per_temperature_models,
+    )
+    if not outcome.converged and raise_on_failure:
+        raise ConvergenceError(
+            f"{method} fit did not converge: IPOPT status {outcome.status!r} after "
+            f"{outcome.iterations} iterations (raise_on_failure=False returns the flagged result)",
+            res,
+        )
+    return res

@@ -1,0 +1,242 @@
+"""CasADi/IPOPT problem builder: weighted residuals, solver with captured status, Jacobian.
+
+Residuals compare the model with the data through the ratio R = H_model/H_data:
+
+* ``log``:      (ln|R|, arg R), optionally divided by the per-line standard deviations of
+                ln|H| [Np] and arg H [rad] (weighting ``uncertainty``); arg R is the
+                principal value, so no phase unwrapping of the data is needed;
+* ``relative``: (Re R − 1, Im R), i.e. (H_model − H_data)/H_data.
+
+The objective is ½·mean(r²); the Jacobian of r at the optimum gives the Gauss–Newton
+covariance used for confidence intervals.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._structure import CasadiBackend, NumpyBackend, Structure, evaluate, hurwitz_matrix
+
+__all__ = ["ConvergenceError", "Problem", "Solver", "SolveOutcome", "get_solver"]
+
+_OK_STATUSES = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+
+
+class ConvergenceError(RuntimeError):
+    """A fit did not converge; ``.result`` holds the flagged result."""
+
+    def __init__(self, message: str, result=None):
+        super().__init__(message)
+        self.result = result
+
+
+def residual(structure: Structure, theta, w, tau, hr, hi, ia, ib, kind: str, be=NumpyBackend):
+    """Weighted residual vector (length 2N) in the backend's type."""
+    nr, ni, dr, di = evaluate(structure, theta, w, tau, be)
+    pr = dr * hr - di * hi
+    pi = dr * hi + di * hr
+    qr = nr * pr + ni * pi
+    qi = ni * pr - nr * pi
+    if kind == "log":
+        r1 = 0.5 * (be.log(nr * nr + ni * ni) - be.log(pr * pr + pi * pi))
+        r2 = be.atan2(qi, qr)
+    else:
+        p2 = pr * pr + pi * pi
+        r1 = qr / p2 - 1.0
+        r2 = qi / p2
+    if be is NumpyBackend:
+        return np.concatenate([r1 * ia, r2 * ib])
+    import casadi as ca
+
+    return ca.vertcat(r1 * ia, r2 * ib)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Everything numeric a fit needs, already scaled.
+
+    ``w`` = ω/ω_ref, ``tau`` scaled temperature, ``h`` = H/g_ref, ``inv_sig_*`` per-line
+    residual weights.
+    """
+
+    structure: Structure
+    w: np.ndarray
+    tau: np.ndarray
+    h: np.ndarray
+    kind: str  # "log" | "relative"
+    inv_sig_a: np.ndarray
+    inv_sig_b: np.ndarray
+
+    @property
+    def n_points(self) -> int:
+        return self.w.shape[0]
+
+    @property
+    def n_residuals(self) -> int:
+        return 2 * self.n_points
+
+    def data_vector(self) -> np.ndarray:
+        return np.concatenate([self.w, self.tau, self.h.real, self.h.imag,
+                               self.inv_sig_a, self.inv_sig_b])
+
+    def residual(self, theta) -> np.ndarray:
+        return residual(self.structure, np.asarray(theta, float), self.w, self.tau, self.h.real,
+                        self.h.imag, self.inv_sig_a, self.inv_sig_b, self.kind)
+
+    def cost(self, theta) -> float:
+        """½·mean(r²); +inf where the model cannot be evaluated."""
+        with np.errstate(all="ignore"):
+            r = self.residual(theta)
+        if not np.all(np.isfinite(r)):
+            return np.inf
+        return 0.5 * float(r @ r) / r.shape[0]
+
+
+@dataclass
+class SolveOutcome:
+    theta: np.ndarray
+    cost: float
+    status: str
+    converged: bool
+    iterations: int
+    time_s: float
+    objective_trace: list = field(default_factory=list)
+
+
+_CACHE: dict = {}
+_CACHE_MAX = 64
+
+
+class Solver:
+    """IPOPT on ½·mean(r(θ; data)²) with the data as NLP parameters.
+
+    One compiled solver serves every problem with the same structure, number of lines and
+    residual kind (e.g. all temperatures of a two-stage fit); use :func:`get_solver`.
+
+    ``grid_taus`` (scheduled models): the log pole-section slots are kept inside
+    ``Structure.slot_bounds`` at these scaled temperatures (linear constraints), and for the
+    ``coefficients`` form with ``hurwitz=True`` the Liénard–Chipart conditions (all
+    denominator coefficients > 0 and Hurwitz minors Δ_{n-1}, Δ_{n-3}, … > 0) are imposed there.
+    """
+
+    def __init__(self, structure: Structure, n_points: int, kind: str, *, max_iter: int = 300,
+                 tol: float = 1e-10, grid_taus=None, hurwitz: bool = False,
+                 hurwitz_margin: float = 1e-4):
+        import casadi as ca
+
+        st = self.structure = structure
+        be = CasadiBackend()
+        x = ca.SX.sym("x", st.n_params)
+        p = ca.SX.sym("p", 6 * n_points)
+        parts = [p[i * n_points:(i + 1) * n_points] for i in range(6)]
+        r = residual(st, x, *parts, kind, be)
+        f = 0.5 * ca.sumsqr(r) / (2 * n_points)
+        g, self._g_kinds = [], []
+        taus = np.asarray([] if grid_taus is None else grid_taus, float)
+        if taus.size and st.degree > 0:
+            nc = st.n_coef
+            for s_name in [s for s in st.slots if s.startswith("log_")]:
+                j = st.slots.index(s_name) * nc
+                for tau in taus:
+                    g.append(ca.dot(x[j:j + nc], ca.DM(tau ** np.arange(nc))))
+                    self._g_kinds.append(s_name)
+        if hurwitz and taus.size:
+            if st.form != "coefficients":
+                raise ValueError("Hurwitz constraints apply to the 'coefficients' form only")
+            h = self._hurwitz_constraints(st, x, taus)
+            g += h
+            self._g_kinds += ["hurwitz"] * len(h)
+        self.hurwitz_margin = hurwitz_margin
+        nlp = {"x": x, "p": p, "f": f, "g": ca.vertcat(*g) if g else ca.SX(0, 1)}
+        opts = {
+            "print_time": False,
+            "error_on_fail": False,
+            "ipopt.print_level": 0,
+            "ipopt.sb": "yes",
+            "ipopt.max_iter": int(max_iter),
+            "ipopt.tol": float(tol),
+            "ipopt.constr_viol_tol": 1e-9,
+        }
+        self._solver = ca.nlpsol("surrogate_fit", "ipopt", nlp, opts)
+        self._jac = ca.Function("residual_jacobian", [x, p], [ca.jacobian(r, x)])
+
+    @staticmethod
+    def _hurwitz_constraints(st: Structure, x, taus):
+        import casadi as ca
+
+        n, nc = st.n_poles, st.n_coef
+        g = []
+        for tau in taus:
+            tp = ca.DM(tau ** np.arange(nc))
+            a = []
+            for j in range(n):
+                k = st.slots.index(f"a{j}")
+                a.append(ca.dot(x[k * nc:(k + 1) * nc], tp))
+            g += a  # Liénard–Chipart: all coefficients positive …
+            hm = hurwitz_matrix([1.0] + a[::-1])
+            for order in range(n - 1, 1, -2):  # … and Δ_{n-1}, Δ_{n-3}, … positive
+                sub = ca.SX(order, order)
+                for i in range(order):
+                    for j in range(order):
+                        sub[i, j] = hm[i][j]
+                g.append(ca.det(sub))
+        return g
+
+    def solve(self, problem: Problem, theta0) -> SolveOutcome:
+        st = self.structure
+        w_min, w_max = float(problem.w.min()), float(problem.w.max())
+        lbx, ubx = st.bounds(w_min, w_max)
+        theta0 = np.clip(np.asarray(theta0, float), lbx + 1e-9, ubx - 1e-9)
+        args = {"x0": theta0, "lbx": lbx, "ubx": ubx, "p": problem.data_vector()}
+        if self._g_kinds:
+            sb = st.slot_bounds(w_min, w_max)
+            lbg = [sb[k][0] if k in sb else self.hurwitz_margin for k in self._g_kinds]
+            ubg = [sb[k][1] if k in sb else np.inf for k in self._g_kinds]
+            args["lbg"], args["ubg"] = lbg, ubg
+        t0 = time.perf_counter()
+        sol = self._solver(**args)
+        elapsed = time.perf_counter() - t0
+        stats = self._solver.stats()
+        theta = np.asarray(sol["x"], float).ravel()
+        status = str(stats.get("return_status", "unknown"))
+        cost = float(sol["f"])
+        ok = status in _OK_STATUSES and np.isfinite(cost) and np.all(np.isfinite(theta))
+        trace = [float(v) for v in stats.get("iterations", {}).get("obj", [])]
+        return SolveOutcome(theta, cost, status, bool(ok), int(stats.get("iter_count", -1)),
+                            elapsed, trace)
+
+    def jacobian(self, problem: Problem, theta) -> np.ndarray:
+        return np.asarray(self._jac(np.asarray(theta, float), problem.data_vector()), float)
+
+
+def get_solver(structure: Structure, n_points: int, kind: str, *, max_iter: int, tol: float,
+               grid_taus=None, hurwitz: bool = False) -> Solver:
+    """Cached :class:`Solver` (building one costs far more than solving a small fit)."""
+    taus = None if grid_taus is None else tuple(np.round(np.asarray(grid_taus, float), 12))
+    key = (structure, int(n_points), kind, int(max_iter), float(tol), taus, bool(hurwitz))
+    solver = _CACHE.get(key)
+    if solver is None:
+        if len(_CACHE) >= _CACHE_MAX:
+            _CACHE.pop(next(iter(_CACHE)))
+        solver = Solver(structure, n_points, kind, max_iter=max_iter, tol=tol,
+                        grid_taus=taus, hurwitz=hurwitz)
+        _CACHE[key] = solver
+    return solver
+
+
+def covariance(jac: np.ndarray, resid: np.ndarray, scale: bool):
+    """Gauss–Newton covariance (JᵀJ)⁻¹·s², s² = reduced χ² when ``scale`` (else 1).
+
+    Returns ``(cov, rank_deficient)``; a rank-deficient Jacobian gives the pseudo-inverse.
+    """
+    n_res, n_par = jac.shape
+    u, s, vt = np.linalg.svd(jac, full_matrices=False)
+    keep = s > s[0] * 1e-12 if s.size else s.astype(bool)
+    inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 0.0)
+    cov = (vt.T * inv_s2) @ vt
+    dof = n_res - n_par
+    s2 = float(resid @ resid) / dof if (scale and dof > 0) else 1.0
+    return cov * s2, bool(not keep.all())

@@ -1,0 +1,498 @@
+"""Model structures: the parametrisations shared by the fitters and the fitted models.
+
+A model is H(s, T) = g_ref · N(s̃, τ) / D(s̃, τ) with s̃ = s/ω_ref (ω_ref in rad/s) and
+τ = (T − T_center)/T_scale.  Every *slot* below is a polynomial of degree ``degree`` in τ
+(degree 0: temperature-independent), and the parameter vector is the slots' polynomial
+coefficients, ascending in τ, slot after slot.
+
+Forms
+-----
+``coefficients`` (paper (i), seed 000)
+    N = Σ b_i s̃^i and D = s̃^n + Σ a_j s̃^j (monic); slots b0..bm, a0..a(n-1).  Stability is
+    not structural: when the unconstrained joint optimum is unstable somewhere, the scheduled
+    fitter re-solves with Hurwitz (Liénard–Chipart) constraints on a temperature grid, and
+    every model is re-checked afterwards on a dense grid.
+``sections`` (per-temperature fits)
+    N as above; D = Π_k (s̃² + a1_k s̃ + a0_k) · (s̃ + c) with a1 = exp(log_a1), a0 = exp(log_a0),
+    c = exp(log_c).  Positive section coefficients ⇔ Hurwitz for degree ≤ 2, so every pole
+    is stable for every parameter value; a section holds a complex pair (a1² < 4a0) or two
+    real poles (a1² ≥ 4a0) and moves continuously between the two.
+``zpk`` (paper (ii), seed 001)
+    N = k · Π_k (s̃² + c1_k s̃ + c0_k) · (s̃ + e) with free c1, c0, e (non-minimum phase allowed)
+    and D as in ``sections``.  Gain, zero sections and log pole-section coefficients are
+    polynomials in T, so a zero or pole pair may turn from complex to real and back at some
+    temperature (the discriminant changes sign) without any change of parametrisation, and
+    the poles are stable at *every* temperature, not only on a grid.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import polynomial as P
+
+FORMS = ("coefficients", "sections", "zpk")
+_LOG_BOUND = 30.0  # |log a| ≤ 30 keeps scaled section coefficients within e^±30
+
+
+@dataclass(frozen=True)
+class Structure:
+    """Which parametrisation, which orders, which polynomial degree in temperature."""
+
+    form: str
+    n_zeros: int
+    n_poles: int
+    degree: int = 0
+
+    def __post_init__(self):
+        if self.form not in FORMS:
+            raise ValueError(f"form must be one of {FORMS}, got {self.form!r}")
+        for name in ("n_zeros", "n_poles", "degree"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+                raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+            object.__setattr__(self, name, int(v))
+        if self.n_poles < 1:
+            raise ValueError(f"n_poles must be >= 1, got {self.n_poles}")
+        if self.n_zeros > self.n_poles:
+            raise ValueError(
+                f"n_zeros={self.n_zeros} > n_poles={self.n_poles}: only proper models are supported"
+            )
+
+    # ------------------------------------------------------------ layout
+    @property
+    def pole_slots(self) -> list[str]:
+        s = []
+        for k in range(self.n_poles // 2):
+            s += [f"log_a1_{k}", f"log_a0_{k}"]
+        if self.n_poles % 2:
+            s.append("log_c")
+        return s
+
+    @property
+    def slots(self) -> list[str]:
+        m, n = self.n_zeros, self.n_poles
+        num = [f"b{i}" for i in range(m + 1)]
+        if self.form == "coefficients":
+            return num + [f"a{j}" for j in range(n)]
+        if self.form == "sections":
+            return num + self.pole_slots
+        zs = ["k"]
+        for k in range(m // 2):
+            zs += [f"zc1_{k}", f"zc0_{k}"]
+        if m % 2:
+            zs.append("ze")
+        return zs + self.pole_slots
+
+    @property
+    def n_coef(self) -> int:
+        return self.degree + 1
+
+    @property
+    def n_params(self) -> int:
+        return len(self.slots) * self.n_coef
+
+    def param_names(self) -> list[str]:
+        if self.degree == 0:
+            return list(self.slots)
+        return [f"{s}:t{q}" for s in self.slots for q in range(self.n_coef)]
+
+    def log_mask(self) -> np.ndarray:
+        """True for parameters of log-parametrised (positive) slots."""
+        return np.repeat([s.startswith("log_") for s in self.slots], self.n_coef)
+
+    def slot_bounds(self, w_min: float = None, w_max: float = None, window: float = 1e3) -> dict:
+        """Bounds on the values of the log-slots (pole-section coefficients).
+
+        With the scaled band [w_min, w_max], poles are kept within [w_min/window,
+        w_max·window] in magnitude and section damping above 1e-4: poles far outside the
+        data band are not identifiable and would only drift towards 0 or ∞.
+        """
+        out = {}
+        if w_min is None:
+            for s in self.pole_slots:
+                out[s] = (-_LOG_BOUND, _LOG_BOUND)
+            return out
+        lo_p, hi_p = np.log(w_min / window), np.log(w_max * window)
+        for s in self.pole_slots:
+            if s.startswith("log_a0"):
+                out[s] = (2 * lo_p, 2 * hi_p)
+            elif s.startswith("log_a1"):
+                out[s] = (lo_p + np.log(2e-4), np.log(2.0) + hi_p)
+            else:
+                out[s] = (lo_p, hi_p)
+        return out
+
+    def bounds(self, w_min: float = None, w_max: float = None) -> tuple[np.ndarray, np.ndarray]:
+        """Parameter bounds: degree 0 applies ``slot_bounds`` directly; otherwise only a
+        generous box (the scheduled fitter imposes ``slot_bounds`` on a temperature grid)."""
+        lo = np.full(self.n_params, -np.inf)
+        hi = np.full(self.n_params, np.inf)
+        sb = self.slot_bounds(w_min, w_max) if self.degree == 0 else self.slot_bounds()
+        for j, s in enumerate(self.slots):
+            if s in sb:
+                lo[j * self.n_coef:(j + 1) * self.n_coef] = sb[s][0] if self.degree == 0 else -_LOG_BOUND
+                hi[j * self.n_coef:(j + 1) * self.n_coef] = sb[s][1] if self.degree == 0 else _LOG_BOUND
+        return lo, hi
+
+    def with_degree(self, degree: int) -> "Structure":
+        return Structure(self.form, self.n_zeros, self.n_poles, degree)
+
+    def with_form(self, form: str) -> "Structure":
+        return Structure(form, self.n_zeros, self.n_poles, self.degree)
+
+    def to_dict(self) -> dict:
+        return {"form": self.form, "n_zeros": self.n_zeros, "n_poles": self.n_poles,
+                "degree": self.degree}
+
+    # ----------------------------------------------------- slot matrices
+    def slot_matrix(self, theta) -> np.ndarray:
+        """Parameters as an array (n_slots, degree+1) (numpy only)."""
+        return np.asarray(theta, float).reshape(len(self.slots), self.n_coef)
+
+
+# ----------------------------------------------------------------- backends
+class NumpyBackend:
+    exp = staticmethod(np.exp)
+    log = staticmethod(np.log)
+    atan2 = staticmethod(np.arctan2)
+
+    @staticmethod
+    def ones_like(x):
+        return np.ones_like(x)
+
+    @staticmethod
+    def zeros_like(x):
+        return np.zeros_like(x)
+
+
+class CasadiBackend:
+    def __init__(self):
+        import casadi as ca
+
+        self.exp = ca.exp
+        self.log = ca.log
+        self.atan2 = ca.atan2
+
+    @staticmethod
+    def ones_like(x):
+        return 0 * x + 1
+
+    @staticmethod
+    def zeros_like(x):
+        return 0 * x
+
+
+def _cmul(ar, ai, br, bi):
+    return ar * br - ai * bi, ar * bi + ai * br
+
+
+def evaluate(structure: Structure, theta, w, tau, be=NumpyBackend):
+    """Real and imaginary parts of N(jw̃) and D(jw̃) at points (w̃, τ).
+
+    ``w`` (= ω/ω_ref) and ``tau`` are vectors of the backend's type (numpy arrays, or
+    CasADi columns, possibly symbolic); ``theta`` a numpy vector or a CasADi symbol.
+    Returns ``(Nr, Ni, Dr, Di)``.
+    """
+    nc = structure.n_coef
+    slots = structure.slots
+    ones = be.ones_like(w)
+    tpow = [ones]
+    for _ in range(1, nc):
+        tpow.append(tpow[-1] * tau)
+
+    def slot(name):
+        j = slots.index(name) * nc
+        v = theta[j] * ones
+        for q in range(1, nc):
+            v = v + theta[j + q] * tpow[q]
+        return v
+
+    m, n = structure.n_zeros, structure.n_poles
+    w2 = w * w
+
+    def linear_poly(prefix, count, monic_degree=None):
+        re, im = be.zeros_like(w), be.zeros_like(w)
+        wp = ones
+        for i in range(max(count, (monic_degree or 0) + 1)):
+            if i < count:
+                v = wp * slot(f"{prefix}{i}")
+            elif i == monic_degree:
+                v = wp
+            else:
+                v = None
+            if v is not None:
+                r = i % 4
+                if r == 0:
+                    re = re + v
+                elif r == 1:
+                    im = im + v
+                elif r == 2:
+                    re = re - v
+                else:
+                    im = im - v
+            wp = wp * w
+        return re, im
+
+    def sections(prefix1, prefix0, count, single, log):
+        re, im = ones, be.zeros_like(w)
+        f = be.exp if log else (lambda x: x)
+        for k in range(count):
+            c1, c0 = f(slot(f"{prefix1}_{k}")), f(slot(f"{prefix0}_{k}"))
+            re, im = _cmul(re, im, c0 - w2, c1 * w)
+        if single is not None:
+            re, im = _cmul(re, im, f(slot(single)), w)
+        return re, im
+
+    if structure.form == "zpk":
+        zr, zi = sections("zc1", "zc0", m // 2, "ze" if m % 2 else None, log=False)
+        k = slot("k")
+        nr, ni = k * zr, k * zi
+    else:
+        nr, ni = linear_poly("b", m + 1)
+    if structure.form == "coefficients":
+        dr, di = linear_poly("a", n, monic_degree=n)
+    else:
+        dr, di = sections("log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, log=True)
+    return nr, ni, dr, di
+
+
+def response(structure: Structure, theta, w, tau) -> np.ndarray:
+    """Complex N/D at scaled frequencies w̃ and scaled temperatures τ (numpy)."""
+    w = np.asarray(w, float)
+    tau = np.broadcast_to(np.asarray(tau, float), w.shape)
+    nr, ni, dr, di = evaluate(structure, np.asarray(theta, float), w, tau)
+    return (nr + 1j * ni) / (dr + 1j * di)
+
+
+# ------------------------------------------------------- polynomials at τ
+def slot_values(structure: Structure, theta, tau: float) -> dict:
+    mat = structure.slot_matrix(theta)
+    tp = float(tau) ** np.arange(structure.n_coef)
+    return dict(zip(structure.slots, mat @ tp))
+
+
+def _section_polys(vals, p1, p0, count, single, log):
+    f = np.exp if log else (lambda x: x)
+    out = []
+    for k in range(count):
+        out.append(np.array([f(vals[f"{p0}_{k}"]), f(vals[f"{p1}_{k}"]), 1.0]))
+    if single is not None:
+        out.append(np.array([f(vals[single]), 1.0]))
+    return out
+
+
+def polynomials(structure: Structure, theta, tau: float = 0.0):
+    """Numerator and monic denominator coefficients in s̃, ascending powers, at τ."""
+    v = slot_values(structure, theta, tau)
+    m, n = structure.n_zeros, structure.n_poles
+    if structure.form == "zpk":
+        num = np.array([v["k"]])
+        for sec in _section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False):
+            num = P.polymul(num, sec)
+    else:
+        num = np.array([v[f"b{i}"] for i in range(m + 1)])
+    if structure.form == "coefficients":
+        den = np.append([v[f"a{j}"] for j in range(n)], 1.0)
+    else:
+        den = np.array([1.0])
+        for sec in _section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True):
+            den = P.polymul(den, sec)
+    return np.asarray(num, float), np.asarray(den, float)
+
+
+def _factor_roots(poly_asc) -> np.ndarray:
+    if len(poly_asc) == 3:
+        c0, c1 = poly_asc[0], poly_asc[1]
+        disc = np.sqrt(complex(c1 * c1 - 4 * c0))
+        return np.array([(-c1 + disc) / 2, (-c1 - disc) / 2])
+    return np.array([-poly_asc[0] + 0j])
+
+
+def roots(structure: Structure, theta, tau: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(zeros, poles) in s̃ at τ; sections are solved in closed form."""
+    v = slot_values(structure, theta, tau)
+    m, n = structure.n_zeros, structure.n_poles
+    num, den = polynomials(structure, theta, tau)
+    if structure.form == "zpk":
+        secs = _section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
+        zeros = np.concatenate([_factor_roots(s) for s in secs]) if secs else np.array([], complex)
+    else:
+        zeros = np.roots(num[::-1]) if np.any(num) else np.array([], complex)
+    if structure.form == "coefficients":
+        poles = np.roots(den[::-1])
+    else:
+        secs = _section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True)
+        poles = np.concatenate([_factor_roots(s) for s in secs])
+    return zeros.astype(complex), poles.astype(complex)
+
+
+# --------------------------------------------------- grouping roots into factors
+def _is_real(r, tol=1e-9):
+    return abs(r.imag) <= tol * max(1.0, abs(r))
+
+
+def _pairings(reals, n_pairs, single):
+    """All ways to split the real roots into n_pairs pairs (+ one single if requested)."""
+    idx = list(range(len(reals)))
+    singles = idx if single else [None]
+    for s in singles:
+        rest = [i for i in idx if i != s]
+
+        def matchings(items):
+            if not items:
+                yield []
+                return
+            a = items[0]
+            for j in range(1, len(items)):
+                b = items[j]
+                for tail in matchings(items[1:j] + items[j + 1:]):
+                    yield [(a, b)] + tail
+
+        for mt in matchings(rest):
+            yield mt, s
+
+
+def group_roots(rts, reference=None):
+    """Group the roots of a real polynomial into quadratic factors and (odd degree) one linear.
+
+    Complex roots stay with their conjugates; real roots are paired.  Without ``reference``
+    the pairing is canonical (adjacent sorted reals, factors by increasing |root|); with a
+    reference grouping of the same size (e.g. from a neighbouring temperature) the pairing
+    and order closest to it are chosen, so section identities are tracked continuously.
+    Returns ``(quads, single)``: list of 2-root arrays and a 1-root array or None.
+    """
+    rts = np.asarray(rts, complex)
+    n = len(rts)
+    real = [r.real for r in rts if _is_real(r)]
+    upper = [r for r in rts if not _is_real(r) and r.imag > 0]
+    lower = [r for r in rts if not _is_real(r) and r.imag < 0]
+    if len(upper) != len(lower):  # numerically broken conjugate symmetry: treat as reals
+        real = sorted(r.real for r in rts)
+        upper = []
+    cquads = [np.array([u, np.conj(u)]) for u in upper]
+    n_real_pairs = n // 2 - len(cquads)
+    real = sorted(real)
+    if reference is None:
+        single = None
+        rr = list(real)
+        if n % 2:
+            # the real root farthest from the rest is the linear factor
+            single = np.array([complex(rr.pop(int(np.argmax(np.abs(rr)))))])
+        rq = [np.array([complex(rr[2 * i]), complex(rr[2 * i + 1])]) for i in range(n_real_pairs)]
+        quads = sorted(cquads + rq, key=lambda q: abs(q[0] * q[1]))
+        return quads, single
+    ref_quads, ref_single = reference
+
+    def dist(a, b):
+        a, b = np.asarray(a), np.asarray(b)
+        scale = 1.0 + np.abs(b)
+        if len(a) == 1:
+            return float(abs(a[0] - b[0]) / scale[0])
+        d1 = abs(a[0] - b[0]) / scale[0] + abs(a[1] - b[1]) / scale[1]
+        d2 = abs(a[1] - b[0]) / scale[0] + abs(a[0] - b[1]) / scale[1]
+        return float(min(d1, d2))
+
+    best = None
+    for mt, s in _pairings(real, n_real_pairs, n % 2 == 1):
+        quads = cquads + [np.array([complex(real[a]), complex(real[b])]) for a, b in mt]
+        single = None if s is None else np.array([complex(real[s])])
+        base = 0.0 if single is None else dist(single, ref_single)
+        for perm in itertools.permutations(range(len(quads))):
+            cost = base + sum(dist(quads[p], ref_quads[i]) for i, p in enumerate(perm))
+            if best is None or cost < best[0]:
+                best = (cost, [quads[p] for p in perm], single)
+    return best[1], best[2]
+
+
+def quad_coefficients(q) -> tuple[float, float]:
+    """(c1, c0) of (s − r1)(s − r2) = s² + c1 s + c0."""
+    return float(-(q[0] + q[1]).real), float((q[0] * q[1]).real)
+
+
+def stabilise_roots(rts, floor: float = 1e-3) -> np.ndarray:
+    """Reflect right-half-plane roots into the left half plane, keep a small damping floor."""
+    rts = np.asarray(rts, complex).copy()
+    re = -np.abs(rts.real)
+    re = np.minimum(re, -floor * np.maximum(np.abs(rts), floor))
+    return re + 1j * rts.imag
+
+
+def pole_slots_from_groups(quads, single) -> list[float]:
+    """Log-section parameters for stable pole groups."""
+    out = []
+    for q in quads:
+        c1, c0 = quad_coefficients(q)
+        out += [np.log(c1), np.log(c0)]
+    if single is not None:
+        out.append(np.log(-single[0].real))
+    return out
+
+
+def zero_slots_from_groups(gain, quads, single) -> list[float]:
+    out = [gain]
+    for q in quads:
+        out += list(quad_coefficients(q))
+    if single is not None:
+        out.append(-single[0].real)
+    return out
+
+
+def groups_from_theta(structure: Structure, theta, which: str):
+    """Root groups of a degree-0 sections/zpk parameter vector, in slot order."""
+    v = slot_values(structure, theta, 0.0)
+    if which == "poles":
+        n = structure.n_poles
+        secs = _section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True)
+        odd = n % 2 == 1
+    else:
+        m = structure.n_zeros
+        secs = _section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
+        odd = m % 2 == 1
+    rts = [_factor_roots(s) for s in secs]
+    if odd:
+        return rts[:-1], rts[-1]
+    return rts, None
+
+
+def convert(structure: Structure, theta, form: str, reference_theta=None) -> np.ndarray:
+    """Convert a degree-0 parameter vector to another form (same orders).
+
+    ``coefficients`` targets are exact; ``sections``/``zpk`` targets need stable poles
+    (unstable ones are reflected).  ``reference_theta`` (in the target form) picks the
+    root pairing closest to it, for tracking sections across temperatures.
+    """
+    if structure.degree != 0:
+        raise ValueError("convert works on degree-0 parameter vectors")
+    target = structure.with_form(form)
+    num, den = polynomials(structure, theta)
+    m = structure.n_zeros
+    if form == "coefficients":
+        return np.concatenate([num, den[:-1]])
+    zeros, poles = roots(structure, theta)
+    ref_p = ref_z = None
+    if reference_theta is not None:
+        ref_p = groups_from_theta(target, reference_theta, "poles")
+        if form == "zpk":
+            ref_z = groups_from_theta(target, reference_theta, "zeros")
+    pq, ps = group_roots(stabilise_roots(poles), ref_p)
+    pole_part = pole_slots_from_groups(pq, ps)
+    if form == "sections":
+        return np.concatenate([num, pole_part])
+    gain = float(num[m]) if len(num) > m else 0.0
+    zq, zs = group_roots(zeros, ref_z) if m else ([], None)
+    return np.concatenate([zero_slots_from_groups(gain, zq, zs), pole_part])
+
+
+def hurwitz_matrix(coeffs_desc):
+    """Hurwitz matrix of a polynomial given by coefficients in descending powers.
+
+    Works for numbers and CasADi symbols (returns a nested list)."""
+    n = len(coeffs_desc) - 1
+
+    def c(k):
+        return coeffs_desc[k] if 0 <= k <= n else 0
+
+    return [[c(2 * j - i + 1) for j in range(n)] for i in range(n)]

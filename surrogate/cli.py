@@ -1,0 +1,173 @@
+"""``ipmc fit``: fit a (temperature-scheduled) rational model to a measured/simulated CSV.
+
+The CSV is the physmodel sweep format: header lines starting with ``#`` (``# input:
+tip_displacement [mm]``, ``# output: current [uA]``, other ``# key: value`` lines kept as
+metadata), then a header row and columns ``temperature_c,frequency_hz,magnitude_db,
+phase_deg`` with optional ``magnitude_std_db,phase_std_deg``.
+
+Outputs (written atomically into ``--out``): ``model.json``, ``report.md``, one Bode overlay
+per temperature (``bode_<T>C.png``) and, for scheduled fits, ``poles_zeros_vs_temperature.png``.
+
+Exit codes: 0 ok, 2 bad input, 3 the fit did not converge.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ._data import FrequencyData
+from ._fit import WEIGHTINGS
+from ._io import atomic_write_text
+from ._nlp import ConvergenceError
+
+__all__ = ["add_parser", "run", "read_csv", "main"]
+
+EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED = 0, 2, 3
+
+
+def read_csv(path) -> FrequencyData:
+    """Read a sweep file (.csv, .npz or .mat in the physmodel format) into ``FrequencyData``.
+
+    Parsing and validation are physmodel's (:func:`physmodel.sweep.read_sweep`): a malformed file
+    raises ``DataFormatError`` (a ``ValueError``) naming the line and the problem.
+    """
+    from physmodel.sweep import read_sweep
+
+    from ._data import from_sweep
+
+    return from_sweep(read_sweep(path))
+
+
+def add_parser(subparsers):
+    """Add the ``fit`` subcommand to an argparse subparsers object."""
+    p = subparsers.add_parser(
+        "fit", help="fit a temperature-scheduled rational transfer function to a sweep CSV",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("csv", help="sweep CSV (physmodel format)")
+    p.add_argument("--zeros", type=int, default=3, help="number of zeros (default 3)")
+    p.add_argument("--poles", type=int, default=3, help="number of poles (default 3)")
+    p.add_argument("--degree", type=int, default=2, help="polynomial degree in T (default 2)")
+    p.add_argument("--form", choices=("coefficients", "zpk", "sections"), default="zpk",
+                   help="schedule form (default zpk)")
+    p.add_argument("--method", choices=("joint", "two-stage"), default="joint")
+    p.add_argument("--weighting", choices=WEIGHTINGS, default="auto")
+    p.add_argument("--exclude", type=float, nargs="*", default=[], metavar="T",
+                   help="temperatures [°C] held out of the fit and reported as validation")
+    p.add_argument("--max-iter", type=int, default=500)
+    p.add_argument("--out", default="fit-out", help="output directory (default fit-out)")
+    p.set_defaults(func=run)
+    return p
+
+
+def _fmt(v, spec=".4g"):
+    return "n/a" if v is None else format(v, spec)
+
+
+def _report(args, data, fit_data, res, held_out, figures) -> str:
+    m = res.model
+    st = m.structure
+    lines = [
+        f"# Surrogate fit: {data.output_name} / {data.input_name}",
+        "",
+        f"- data: `{args.csv}` ({data.n} lines, fingerprint `{data.fingerprint()}`)",
+        f"- model: form `{st.form}`, {st.n_zeros} zeros, {st.n_poles} poles, degree {st.degree} in T, "
+        f"method `{res.method}`, weighting `{res.weighting}`",
+        f"- status: {'converged' if res.converged else 'NOT CONVERGED'} (`{res.status}`, "
+        f"{res.iterations} IPOPT iterations, {res.time_s:.2f} s)",
+        f"- weighted RMS residual: {res.weighted_rms:.4g}",
+        f"- stability: {'stable' if res.stability.stable else 'UNSTABLE'} on {res.stability.n_temperatures} "
+        f"temperatures (max pole real part {res.stability.max_pole_real_part_rad_s:.4g} rad/s)",
+        f"- units: response in {data.output_unit or '?'}/{data.input_unit or '?'}, s in rad/s",
+        "",
+        "## Error per temperature",
+        "",
+        "| T [°C] | role | lines | relative RMS error | fit % |",
+        "|---:|:---|---:|---:|---:|",
+    ]
+    for e in res.per_temperature:
+        lines.append(f"| {_fmt(e.temperature_c, 'g')} | fit | {e.n_lines} | {e.relative_rms_error:.4f} | {e.fit_percent:.2f} |")
+    lo, hi = m.temperature_range_c or (None, None)
+    for e in held_out:
+        role = "held out" if lo is None or lo <= e.temperature_c <= hi else "held out, extrapolated"
+        lines.append(f"| {_fmt(e.temperature_c, 'g')} | {role} | {e.n_lines} | {e.relative_rms_error:.4f} | {e.fit_percent:.2f} |")
+    lines += ["", "## Parameters (scaled; see model.json for the scales)", "",
+              "| name | value | std. error | 95 % CI |", "|:---|---:|---:|:---|"]
+    for row in m.parameter_table():
+        ci = f"[{row['ci95_low']:.4g}, {row['ci95_high']:.4g}]" if "ci95_low" in row else "n/a"
+        lines.append(f"| {row['name']} | {row['value']:.6g} | {_fmt(row.get('stderr'))} | {ci} |")
+    if res.at_bounds:
+        lines += ["", f"Parameters on a bound (intervals unreliable): {', '.join(res.at_bounds)}"]
+    lines += ["", "## Figures", ""] + [f"![{p}]({p})" for p in figures]
+    return "\n".join(lines) + "\n"
+
+
+def run(args) -> int:
+    """Execute ``fit``; returns the exit code (0 ok, 2 bad input, 3 not converged)."""
+    from .metrics import fit_percent, relative_rms_error
+    from ._fit import TemperatureError
+    from .plots import save_bode, save_poles_zeros_vs_temperature
+    from .rational import RationalFit
+    from .scheduled import ScheduledFit
+
+    try:
+        data = read_csv(args.csv)
+        temps = data.temperatures()
+        excl = np.array(sorted(set(args.exclude)), float)
+        for t in excl:
+            if not np.any(np.isclose(temps, t)):
+                raise ValueError(f"--exclude {t:g}: no data at that temperature (have {temps.tolist()})")
+        keep = ~np.any(np.isclose(data.temperature_c[:, None], excl[None, :]), axis=1) if excl.size else np.ones(data.n, bool)
+        fit_data = data.select(keep)
+        fit_temps = fit_data.temperatures()
+        if fit_temps.size == 1:
+            fitter = RationalFit(args.zeros, args.poles, weighting=args.weighting, max_iter=args.max_iter)
+        else:
+            fitter = ScheduledFit(args.form, args.zeros, args.poles, args.degree, method=args.method,
+                                  weighting=args.weighting, max_iter=args.max_iter)
+        res = fitter.fit_data(fit_data)
+    except ConvergenceError as exc:
+        print(f"ipmc fit: {exc}", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
+    except (ValueError, OSError) as exc:
+        print(f"ipmc fit: bad input: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    model = res.model
+    held = []
+    for t in excl:
+        d = data.at_temperature(t)
+        h = model.frequency_response(d.frequency_hz, t if model.is_scheduled else None, extrapolate=True)
+        held.append(TemperatureError(float(t), d.n, relative_rms_error(h, d.response), fit_percent(h, d.response)))
+    figures = []
+    for t in temps:
+        name = f"bode_{t:g}C.png"
+        extrap = model.is_scheduled and not (fit_temps.min() <= t <= fit_temps.max())
+        if extrap:
+            continue
+        save_bode(model, data, t, out / name, title=f"T = {t:g} °C" + (" (held out)" if t in excl else ""))
+        figures.append(name)
+    if model.is_scheduled:
+        save_poles_zeros_vs_temperature(model, out / "poles_zeros_vs_temperature.png",
+                                        res.per_temperature_models)
+        figures.append("poles_zeros_vs_temperature.png")
+    model.to_json(out / "model.json")
+    atomic_write_text(out / "report.md", _report(args, data, fit_data, res, held, figures))
+    print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")
+    return EXIT_OK
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="ipmc")
+    sub = parser.add_subparsers(dest="command", required=True)
+    add_parser(sub)
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,292 @@
+"""Fitted models: one class for a single-temperature and a temperature-scheduled rational model.
+
+``RationalModel`` shares the interface of the physics models: ``frequency_response(frequency_hz,
+temperature_c)`` and ``at(temperature_c)`` → ``control.TransferFunction`` with s in rad/s.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from . import _structure as S
+from ._io import atomic_write_text
+
+__all__ = ["Scaling", "StabilityCheck", "RationalModel", "load", "SCHEMA", "SCHEMA_VERSION"]
+
+SCHEMA = "ipmc.surrogate.rational_model"
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Scaling:
+    """Scales that make the fit variables O(1).
+
+    omega_ref_rad_s : s̃ = s/omega_ref_rad_s. [rad/s]
+    gain_ref : response scale. [output_unit/input_unit]
+    temperature_center_c, temperature_scale_c : τ = (T − center)/scale. [°C]
+    """
+
+    omega_ref_rad_s: float
+    gain_ref: float
+    temperature_center_c: float = 0.0
+    temperature_scale_c: float = 1.0
+
+    def __post_init__(self):
+        for name, v in asdict(self).items():
+            if not math.isfinite(v):
+                raise ValueError(f"{name} must be finite, got {v!r}")
+        if self.omega_ref_rad_s <= 0 or self.gain_ref <= 0 or self.temperature_scale_c <= 0:
+            raise ValueError(f"omega_ref_rad_s, gain_ref and temperature_scale_c must be > 0: {self}")
+
+
+@dataclass(frozen=True)
+class StabilityCheck:
+    """Independent check of the poles on a dense temperature grid.
+
+    max_pole_real_part_rad_s : largest real part of any pole over the grid. [rad/s]
+    worst_temperature_c : where it occurs. [°C]
+    """
+
+    stable: bool
+    max_pole_real_part_rad_s: float
+    worst_temperature_c: float | None
+    n_temperatures: int
+
+
+class RationalModel:
+    """A (possibly temperature-scheduled) rational transfer function H(s, T).
+
+    Parameters
+    ----------
+    structure : Structure
+        Form, orders and polynomial degree in temperature (0: one temperature).
+    params : array
+        Parameter vector in the structure's layout (see ``param_names``).
+    scaling : Scaling
+        Frequency, gain and temperature scales.
+    temperature_range_c : (float, float) or None
+        Validity range; evaluating outside it raises unless ``extrapolate=True``. [°C]
+    covariance : array (p, p) or None
+        Parameter covariance from the fit.
+    labels : dict
+        ``input_name``, ``input_unit``, ``output_name``, ``output_unit``.
+    info : dict
+        Fit settings, status and data fingerprint, saved with the model.
+    """
+
+    def __init__(self, structure: S.Structure, params, scaling: Scaling,
+                 temperature_range_c=None, covariance=None, labels=None, info=None):
+        self.structure = structure
+        p = np.array(params, dtype=float).ravel()
+        if p.shape[0] != structure.n_params:
+            raise ValueError(
+                f"params has {p.shape[0]} entries, structure {structure} needs {structure.n_params}"
+            )
+        if not np.all(np.isfinite(p)):
+            raise ValueError("params contain non-finite values")
+        p.setflags(write=False)
+        self._params = p
+        self.scaling = scaling
+        if temperature_range_c is not None:
+            lo, hi = (float(v) for v in temperature_range_c)
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+                raise ValueError(f"bad temperature_range_c {temperature_range_c!r}")
+            temperature_range_c = (lo, hi)
+        elif structure.degree > 0:
+            raise ValueError("a scheduled model (degree > 0) needs temperature_range_c")
+        self.temperature_range_c = temperature_range_c
+        if covariance is not None:
+            covariance = np.array(covariance, float)
+            if covariance.shape != (p.shape[0], p.shape[0]):
+                raise ValueError(f"covariance must be {p.shape[0]}x{p.shape[0]}")
+            covariance.setflags(write=False)
+        self.covariance = covariance
+        self.labels = dict(labels or {})
+        self.info = dict(info or {})
+
+    # ------------------------------------------------------------ parameters
+    @property
+    def params(self) -> np.ndarray:
+        return self._params
+
+    @property
+    def param_names(self) -> list[str]:
+        return self.structure.param_names()
+
+    @property
+    def is_scheduled(self) -> bool:
+        return self.structure.degree > 0
+
+    @property
+    def stderr(self) -> np.ndarray | None:
+        if self.covariance is None:
+            return None
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    def confidence_intervals(self, level: float = 0.95):
+        """Normal-approximation intervals ``(low, high)`` for ``params``, or None."""
+        if not 0 < level < 1:
+            raise ValueError(f"level must be in (0, 1), got {level!r}")
+        if self.covariance is None:
+            return None
+        from statistics import NormalDist
+
+        z = NormalDist().inv_cdf(0.5 + level / 2)
+        se = self.stderr
+        return self._params - z * se, self._params + z * se
+
+    def parameter_table(self) -> list[dict]:
+        ci = self.confidence_intervals()
+        rows = []
+        for i, name in enumerate(self.param_names):
+            row = {"name": name, "value": float(self._params[i])}
+            if ci is not None:
+                row.update(stderr=float(self.stderr[i]), ci95_low=float(ci[0][i]),
+                           ci95_high=float(ci[1][i]))
+            rows.append(row)
+        return rows
+
+    # ------------------------------------------------------------ temperature
+    def _tau(self, temperature_c, shape=(), extrapolate=False) -> np.ndarray:
+        sc = self.scaling
+        if temperature_c is None:
+            if self.is_scheduled:
+                raise ValueError("temperature_c is required for a temperature-scheduled model")
+            return np.zeros(shape)
+        t = np.asarray(temperature_c, float)
+        if not np.all(np.isfinite(t)):
+            raise ValueError(f"temperature_c must be finite, got {temperature_c!r}")
+        t = np.broadcast_to(t, shape) if shape != () else t
+        if self.temperature_range_c is not None and not extrapolate:
+            lo, hi = self.temperature_range_c
+            tol = 1e-9 * max(1.0, abs(lo), abs(hi))
+            bad = (t < lo - tol) | (t > hi + tol)
+            if np.any(bad):
+                v = float(np.asarray(t)[bad].ravel()[0]) if np.ndim(t) else float(t)
+                raise ValueError(
+                    f"temperature_c={v!r} is outside the model's validity range "
+                    f"[{lo}, {hi}] °C (pass extrapolate=True to evaluate anyway)"
+                )
+        if not self.is_scheduled:
+            return np.zeros(np.shape(t))
+        return (t - sc.temperature_center_c) / sc.temperature_scale_c
+
+    # ------------------------------------------------------------ evaluation
+    def frequency_response(self, frequency_hz, temperature_c=None, *, extrapolate=False):
+        """Complex response at ``frequency_hz`` [Hz] and ``temperature_c`` [°C] (broadcast)."""
+        f = np.asarray(frequency_hz, float)
+        if not np.all(np.isfinite(f)):
+            raise ValueError("frequency_hz must be finite")
+        shape = np.broadcast_shapes(f.shape, np.shape(temperature_c)) if temperature_c is not None else f.shape
+        tau = self._tau(temperature_c, shape, extrapolate)
+        w = np.broadcast_to(2 * np.pi * f / self.scaling.omega_ref_rad_s, shape).ravel()
+        tau = np.broadcast_to(tau, shape).ravel()
+        h = S.response(self.structure, self._params, w, tau)
+        return (self.scaling.gain_ref * h).reshape(shape)
+
+    def _scalar_tau(self, temperature_c, extrapolate):
+        if temperature_c is not None and np.ndim(temperature_c) != 0:
+            raise ValueError("temperature_c must be a scalar here")
+        return float(self._tau(temperature_c, (), extrapolate))
+
+    def coefficients(self, temperature_c=None, *, extrapolate=False):
+        """(num, den) in descending powers of s [rad/s], den monic."""
+        tau = self._scalar_tau(temperature_c, extrapolate)
+        num, den = S.polynomials(self.structure, self._params, tau)
+        n = self.structure.n_poles
+        wr, g = self.scaling.omega_ref_rad_s, self.scaling.gain_ref
+        num_s = np.array([g * c * wr ** (n - i) for i, c in enumerate(num)])
+        den_s = np.array([c * wr ** (n - j) for j, c in enumerate(den)])
+        return num_s[::-1], den_s[::-1]
+
+    def at(self, temperature_c=None, *, extrapolate=False):
+        """python-control ``TransferFunction`` (s in rad/s) at ``temperature_c`` [°C]."""
+        import control
+
+        num, den = self.coefficients(temperature_c, extrapolate=extrapolate)
+        return control.tf(num, den)
+
+    def zeros(self, temperature_c=None, *, extrapolate=False) -> np.ndarray:
+        """Zeros at ``temperature_c`` [rad/s]."""
+        tau = self._scalar_tau(temperature_c, extrapolate)
+        return self.scaling.omega_ref_rad_s * S.roots(self.structure, self._params, tau)[0]
+
+    def poles(self, temperature_c=None, *, extrapolate=False) -> np.ndarray:
+        """Poles at ``temperature_c`` [rad/s]."""
+        tau = self._scalar_tau(temperature_c, extrapolate)
+        return self.scaling.omega_ref_rad_s * S.roots(self.structure, self._params, tau)[1]
+
+    def stability_check(self, n_temperatures: int = 501) -> StabilityCheck:
+        """Largest pole real part over a dense grid of the validity range."""
+        if self.is_scheduled:
+            lo, hi = self.temperature_range_c
+            grid = np.linspace(lo, hi, int(n_temperatures))
+        else:
+            grid = [None]
+        worst, worst_t = -np.inf, None
+        for t in grid:
+            re = float(np.max(self.poles(t).real))
+            if re > worst:
+                worst, worst_t = re, t
+        return StabilityCheck(bool(worst < 0), worst, None if worst_t is None else float(worst_t),
+                              len(grid))
+
+    # ------------------------------------------------------------ persistence
+    def to_dict(self) -> dict:
+        def clean(x):
+            return None if x is None else np.asarray(x, float).tolist()
+
+        return {
+            "schema": SCHEMA,
+            "schema_version": SCHEMA_VERSION,
+            "structure": self.structure.to_dict(),
+            "scaling": asdict(self.scaling),
+            "temperature_range_c": None if self.temperature_range_c is None else list(self.temperature_range_c),
+            "params": {"names": self.param_names, "values": clean(self._params),
+                       "covariance": clean(self.covariance)},
+            "labels": self.labels,
+            "info": self.info,
+            "conventions": {"s": "rad/s", "frequency_edges": "Hz", "temperature": "degC",
+                            "model": "H = gain_ref*N(s/omega_ref, tau)/D(s/omega_ref, tau), "
+                                     "tau = (T - temperature_center_c)/temperature_scale_c"},
+        }
+
+    def to_json(self, path) -> None:
+        """Write the model as versioned JSON (atomically)."""
+        atomic_write_text(path, json.dumps(self.to_dict(), indent=2, allow_nan=False))
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "RationalModel":
+        if not isinstance(d, dict) or d.get("schema") != SCHEMA:
+            raise ValueError(f"not a {SCHEMA} document (schema={d.get('schema') if isinstance(d, dict) else None!r})")
+        if d.get("schema_version") != SCHEMA_VERSION:
+            raise ValueError(
+                f"unsupported schema_version {d.get('schema_version')!r}; this code reads {SCHEMA_VERSION}"
+            )
+        st = S.Structure(**d["structure"])
+        names = d["params"]["names"]
+        if names != st.param_names():
+            raise ValueError("parameter names in the file do not match its structure")
+        return cls(st, d["params"]["values"], Scaling(**d["scaling"]),
+                   d.get("temperature_range_c"), d["params"].get("covariance"),
+                   d.get("labels"), d.get("info"))
+
+    def __repr__(self):
+        st = self.structure
+        rng = "" if self.temperature_range_c is None else f", T in {list(self.temperature_range_c)} °C"
+        return (f"RationalModel(form={st.form!r}, n_zeros={st.n_zeros}, n_poles={st.n_poles}, "
+                f"degree={st.degree}{rng})")
+
+
+def load(path) -> RationalModel:
+    """Read a model written by ``RationalModel.to_json``."""
+    with open(path, encoding="utf-8") as fh:
+        try:
+            d = json.load(fh)
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"{path}: not valid JSON ({exc})") from None
+    return RationalModel.from_dict(d)

@@ -1,0 +1,248 @@
+"""Temperature-scheduled fits: the papers' two-stage method and the joint CasADi fit.
+
+Two-stage (seed 000, seed 001): fit each temperature, then fit each coefficient / gain,
+zero and pole entry with a polynomial in T.  Joint: one NLP over all temperatures whose
+unknowns are the polynomial coefficients themselves, started from the two-stage answer.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from . import _fit as F
+from ._data import FrequencyData
+from ._init import levy
+from ._nlp import SolveOutcome, get_solver
+from ._structure import Structure, convert
+from .models import RationalModel, Scaling
+from .rational import RationalFit
+
+__all__ = ["ScheduledFit"]
+
+_FORMS = ("coefficients", "zpk", "sections")
+_METHODS = ("joint", "two-stage")
+
+
+class ScheduledFit:
+    """Fit H(s, T) whose parameters are polynomials of degree ``degree`` in temperature.
+
+    Parameters
+    ----------
+    form : {'coefficients', 'zpk', 'sections'}
+        'coefficients': every numerator and monic-denominator coefficient is a polynomial
+        in T (seed 000); if the unconstrained joint optimum has an unstable pole anywhere on
+        a dense temperature grid, the fit is repeated with Liénard–Chipart constraints on
+        ``stability_grid`` temperatures (``enforce_stability``), and re-checked on the dense
+        grid (``result.stability``).  'zpk': gain, zero sections (s̃² + c1 s̃ + c0) and log pole-section
+        coefficients are polynomials in T (seed 001's gain/zeros/poles, in a form that
+        survives real↔complex transitions); stable at every temperature by construction.
+        'sections': free numerator coefficients with the 'zpk' denominator.
+    n_zeros, n_poles : int
+        Orders (``n_zeros <= n_poles``).
+    degree : int
+        Polynomial degree in temperature (the papers: 3 for seed 000, 2 for seed 001).
+    method : {'joint', 'two-stage'}
+        'two-stage' returns the papers' baseline; 'joint' refines it with one NLP over all
+        temperatures (the result also carries the two-stage model).
+    weighting, max_iter, tol, raise_on_failure, scale_covariance
+        As in ``RationalFit``.
+    per_temperature : {'nlp', 'levy'}
+        First stage of the two-stage method: our stable IPOPT fit at each temperature
+        ('nlp', default) or Levy's linear least squares ('levy', the papers' ``invfreqs``;
+        unstable Levy poles are reflected when converting to the 'zpk' form).
+    enforce_stability : bool
+        Only for form='coefficients' (the other forms are stable by construction).
+    stability_grid : int
+        Number of temperatures on which the constraints are imposed.
+    omega_ref_rad_s, gain_ref, temperature_center_c, temperature_scale_c : float, optional
+        Scales (defaults from the data: geometric means; mid-range and half-range). [rad/s],
+        [output/input], [°C], [°C]
+
+    Attributes (after ``fit``)
+    --------------------------
+    model_, result_, history_, two_stage_model_, per_temperature_models_
+    """
+
+    def __init__(self, form: str = "zpk", n_zeros: int = 3, n_poles: int = 3, degree: int = 2, *,
+                 method: str = "joint", weighting: str = "auto", enforce_stability: bool = True,
+                 stability_grid: int = 41, max_iter: int = 500, tol: float = 1e-10,
+                 omega_ref_rad_s: float | None = None, gain_ref: float | None = None,
+                 temperature_center_c: float | None = None, temperature_scale_c: float | None = None,
+                 per_temperature: str = "nlp", raise_on_failure: bool = True,
+                 scale_covariance: bool = True):
+        if form not in _FORMS:
+            raise ValueError(f"form must be one of {_FORMS}, got {form!r}")
+        if method not in _METHODS:
+            raise ValueError(f"method must be one of {_METHODS}, got {method!r}")
+        self.structure = Structure(form, n_zeros, n_poles, degree)
+        self.form, self.method = form, method
+        self.n_zeros, self.n_poles, self.degree = n_zeros, n_poles, self.structure.degree
+        self.weighting = F.check_weighting(weighting)
+        self.enforce_stability = bool(enforce_stability)
+        self.stability_grid = F.check_positive_int("stability_grid", stability_grid, 2)
+        self.max_iter = F.check_positive_int("max_iter", max_iter)
+        self.tol = F.check_positive_float("tol", tol, allow_none=False)
+        self.omega_ref_rad_s = F.check_positive_float("omega_ref_rad_s", omega_ref_rad_s)
+        self.gain_ref = F.check_positive_float("gain_ref", gain_ref)
+        if temperature_center_c is not None and not np.isfinite(temperature_center_c):
+            raise ValueError(f"temperature_center_c must be finite, got {temperature_center_c!r}")
+        self.temperature_center_c = temperature_center_c
+        self.temperature_scale_c = F.check_positive_float("temperature_scale_c", temperature_scale_c)
+        if per_temperature not in ("nlp", "levy"):
+            raise ValueError(f"per_temperature must be 'nlp' or 'levy', got {per_temperature!r}")
+        self.per_temperature = per_temperature
+        self.raise_on_failure = bool(raise_on_failure)
+        self.scale_covariance = bool(scale_covariance)
+
+    def settings(self) -> dict:
+        return {"estimator": "ScheduledFit", "form": self.form, "n_zeros": self.n_zeros,
+                "n_poles": self.n_poles, "degree": self.degree, "method": self.method,
+                "weighting": self.weighting, "enforce_stability": self.enforce_stability,
+                "stability_grid": self.stability_grid, "max_iter": self.max_iter, "tol": self.tol,
+                "omega_ref_rad_s": self.omega_ref_rad_s, "gain_ref": self.gain_ref,
+                "temperature_center_c": self.temperature_center_c,
+                "temperature_scale_c": self.temperature_scale_c,
+                "per_temperature": self.per_temperature,
+                "scale_covariance": self.scale_covariance}
+
+    def fit(self, frequency_hz, temperature_c, response, magnitude_std_db=None, phase_std_deg=None):
+        """Fit tidy data (one line per frequency and temperature).
+
+        Units: ``frequency_hz`` [Hz], ``temperature_c`` [°C] (N,), ``response`` complex
+        [output/input], ``magnitude_std_db`` [dB], ``phase_std_deg`` [deg].
+        Returns a ``FitResult``; also sets ``model_``, ``result_``, ``history_``,
+        ``two_stage_model_`` and ``per_temperature_models_``.
+        """
+        data = F.as_data(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg)
+        return self.fit_data(data)
+
+    # ------------------------------------------------------------------ stages
+    def _per_temperature(self, data: FrequencyData, scaling, history):
+        """Per-temperature fits in ascending T.
+
+        'nlp': stable IPOPT fits, each warm-started from its neighbour (kept unless a fresh
+        start is >2 % better, so sections are tracked continuously).  'levy': Levy's linear
+        least squares (Octave ``invfreqs`` without iterations), the papers' first stage.
+        Returns {T: (structure, params, converged)}.
+        """
+        out = {}
+        if self.per_temperature == "levy":
+            st0 = Structure("coefficients", self.n_zeros, self.n_poles, 0)
+            for t in data.temperatures():
+                d = data.at_temperature(t)
+                num, den = levy(d.omega / scaling.omega_ref_rad_s, d.response / scaling.gain_ref,
+                                self.n_zeros, self.n_poles)
+                theta = np.concatenate([num, den[:-1]])
+                ok = bool(np.all(np.isfinite(theta)))
+                history.append({"stage": f"per-T {t:g} °C", "start": "levy", "status": "linear least squares",
+                                "converged": ok, "iterations": 0, "cost": float("nan"), "time_s": 0.0,
+                                "objective_trace": []})
+                out[float(t)] = (st0, theta, ok)
+            return out
+        fitter = RationalFit(self.n_zeros, self.n_poles, stable=True, weighting=self.weighting,
+                             max_iter=self.max_iter, tol=self.tol,
+                             omega_ref_rad_s=scaling.omega_ref_rad_s, gain_ref=scaling.gain_ref,
+                             raise_on_failure=False, scale_covariance=self.scale_covariance)
+        prev = None
+        for t in data.temperatures():
+            res = fitter.fit_data(data.at_temperature(t), theta0=prev, stage=f"per-T {t:g} °C")
+            history.extend(res.history)
+            out[float(t)] = (res.model.structure, res.params, res.converged)
+            prev = res.params
+        return out
+
+    def _two_stage_params(self, per_t: dict, scaling) -> np.ndarray:
+        """Polynomial least squares in τ of each slot of the per-temperature fits."""
+        st = self.structure
+        temps = np.array(sorted(per_t))
+        tau = (temps - scaling.temperature_center_c) / scaling.temperature_scale_c
+        rows, ref = [], None
+        for t in temps:
+            st0, theta, _ = per_t[t]
+            row = theta if st0.form == st.form else convert(st0, theta, st.form, reference_theta=ref)
+            rows.append(row)
+            ref = row
+        y = np.array(rows)  # (n_T, n_slots)
+        coef = np.polynomial.polynomial.polyfit(tau, y, st.degree)  # (degree+1, n_slots)
+        return np.asarray(coef, float).T.ravel()
+
+    def fit_data(self, data: FrequencyData):
+        t_start = time.perf_counter()
+        st = self.structure
+        if data.temperature_c is None:
+            raise ValueError("ScheduledFit needs temperature_c for every line")
+        temps = data.temperatures()
+        if temps.size < st.degree + 1 or temps.size < 2:
+            raise ValueError(
+                f"degree={st.degree} needs at least {max(st.degree + 1, 2)} distinct temperatures, "
+                f"got {temps.size}: {temps.tolist()}"
+            )
+        F.check_order_per_temperature(st, data)
+        scaling = F.make_scaling(data, self.omega_ref_rad_s, self.gain_ref,
+                                 self.temperature_center_c, self.temperature_scale_c)
+        t_range = (float(temps.min()), float(temps.max()))
+        history = []
+        per_t = self._per_temperature(data, scaling, history)
+        per_t_models = {t: RationalModel(s0, th, Scaling(scaling.omega_ref_rad_s, scaling.gain_ref, t, 1.0),
+                                         (t, t), labels=data.labels())
+                        for t, (s0, th, _) in per_t.items()}
+        theta2 = self._two_stage_params(per_t, scaling)
+        problem, wname = F.make_problem(st, data, scaling, self.weighting)
+        settings = self.settings()
+        ok2 = all(c for _, _, c in per_t.values())
+        two_out = SolveOutcome(theta2, problem.cost(theta2),
+                               "two-stage" if ok2 else "two-stage: a per-temperature fit did not converge",
+                               ok2, 0, 0.0)
+        two_res = F.finish(st, problem, None, two_out, scaling, data, weighting_name=wname,
+                           method="two-stage", settings={**settings, "method": "two-stage"},
+                           scale_covariance=self.scale_covariance, history=list(history),
+                           time_s=time.perf_counter() - t_start, temperature_range=t_range,
+                           compute_covariance=False, per_temperature_models=per_t_models,
+                           raise_on_failure=self.raise_on_failure and self.method == "two-stage")
+        if self.method == "two-stage":
+            res = two_res
+        else:
+            lo = (t_range[0] - scaling.temperature_center_c) / scaling.temperature_scale_c
+            hi = (t_range[1] - scaling.temperature_center_c) / scaling.temperature_scale_c
+            taus = np.linspace(lo, hi, self.stability_grid)
+            hurwitz = st.form == "coefficients" and self.enforce_stability
+            solver = get_solver(st, problem.n_points, problem.kind, max_iter=self.max_iter,
+                                tol=self.tol, grid_taus=taus)
+            mid = min(per_t, key=lambda t: abs(t - scaling.temperature_center_c))
+            st0, th0 = per_t[mid][:2]
+            const = np.zeros((len(st.slots), st.n_coef))
+            const[:, 0] = th0 if st0.form == st.form else convert(st0, th0, st.form)
+            starts = [("two-stage", theta2), ("constant", const.ravel())]
+
+            def stable(theta):
+                m = RationalModel(st, theta, scaling, t_range)
+                return m.stability_check(4 * self.stability_grid).stable
+
+            outcomes = []
+            for name, th in starts:
+                out = solver.solve(problem, th)
+                history.append(F.history_entry("joint", name, out))
+                if out.converged and hurwitz and not stable(out.theta):
+                    # the coefficients form is not stable by construction: impose the
+                    # Liénard–Chipart conditions on the grid, from the two-stage start
+                    h_solver = get_solver(st, problem.n_points, problem.kind, max_iter=self.max_iter,
+                                          tol=self.tol, grid_taus=taus, hurwitz=True)
+                    out = h_solver.solve(problem, th if stable(th) else out.theta)
+                    history.append(F.history_entry("joint (Hurwitz constraints)", name, out))
+                    solver = h_solver
+                outcomes.append((name, out))
+                if out.converged:
+                    break
+            _, best = F.best_outcome(outcomes)
+            res = F.finish(st, problem, solver, best, scaling, data, weighting_name=wname,
+                           method="joint", settings=settings,
+                           scale_covariance=self.scale_covariance, history=history,
+                           time_s=time.perf_counter() - t_start, temperature_range=t_range,
+                           two_stage=two_res.model, per_temperature_models=per_t_models,
+                           raise_on_failure=self.raise_on_failure)
+        self.model_, self.result_, self.history_ = res.model, res, res.history
+        self.two_stage_model_ = two_res.model
+        self.per_temperature_models_ = per_t_models
+        return res

@@ -1,0 +1,134 @@
+"""Scheduled fits: synthetic recovery within confidence intervals, stability, baselines."""
+
+import numpy as np
+import pytest
+from surrogate_fixtures import FIT_TEMPS, TRUE_SCALING, TRUE_THETA, noisy_sweep
+
+from surrogate import ConvergenceError, RationalModel, ScheduledFit, Structure, relative_rms_error
+
+SCALES = dict(omega_ref_rad_s=TRUE_SCALING.omega_ref_rad_s, gain_ref=TRUE_SCALING.gain_ref,
+              temperature_center_c=TRUE_SCALING.temperature_center_c,
+              temperature_scale_c=TRUE_SCALING.temperature_scale_c)
+
+
+@pytest.fixture(scope="module")
+def joint_zpk(synthetic_sweep):
+    f, t, h, sm, sp = synthetic_sweep
+    return ScheduledFit("zpk", 2, 3, 2, **SCALES).fit(f, t, h, sm, sp)
+
+
+def test_true_model_has_a_real_to_complex_zero_transition(true_model):
+    z_cold, z_hot = true_model.zeros(19.0), true_model.zeros(55.0)
+    assert np.all(np.abs(z_cold.imag) < 1e-12) and np.all(np.abs(z_hot.imag) > 1.0)
+    assert np.all(z_cold.real > 0) and np.all(z_hot.real > 0)  # non-minimum phase throughout
+
+
+def test_synthetic_scheduled_recovery_within_confidence_intervals(joint_zpk):
+    res = joint_zpk
+    assert res.converged and res.method == "joint"
+    assert np.all(res.ci95_low < res.ci95_high)
+    z = (res.params - TRUE_THETA) / res.stderr
+    # every coefficient within 3.5 standard errors …
+    assert np.max(np.abs(z)) < 3.5, z
+    # … and the intervals are honest, neither inflated nor too narrow
+    assert 0.5 < np.sqrt(np.mean(z ** 2)) < 1.6, z
+    inside = (TRUE_THETA >= res.ci95_low) & (TRUE_THETA <= res.ci95_high)
+    assert inside.mean() >= 0.8
+    # correct uncertainties: weighted residual RMS close to 1
+    assert 0.85 < res.weighted_rms < 1.15
+
+
+def test_joint_fit_reproduces_the_response_at_unseen_temperatures(joint_zpk, true_model):
+    f = np.geomspace(0.1, 30, 50)
+    for t in (22.0, 35.0, 46.0):
+        err = relative_rms_error(joint_zpk.model.frequency_response(f, t), true_model.frequency_response(f, t))
+        assert err < 0.01, (t, err)
+
+
+def test_zpk_schedule_is_stable_on_a_dense_grid(joint_zpk):
+    st = joint_zpk.model.stability_check(2001)
+    assert st.stable and st.n_temperatures == 2001
+    grid = np.linspace(19.0, 55.0, 301)
+    assert max(np.max(joint_zpk.model.poles(t).real) for t in grid) < 0
+
+
+def test_two_stage_baseline_is_returned_and_available(joint_zpk, synthetic_sweep):
+    assert isinstance(joint_zpk.two_stage, RationalModel)
+    assert sorted(joint_zpk.per_temperature_models) == FIT_TEMPS
+    f, t, h, sm, sp = synthetic_sweep
+    two = ScheduledFit("zpk", 2, 3, 2, method="two-stage", **SCALES).fit(f, t, h, sm, sp)
+    assert two.method == "two-stage" and two.stderr is None
+    np.testing.assert_allclose(two.params, joint_zpk.two_stage.params, rtol=1e-6, atol=1e-9)
+    # the joint fit minimises the same objective the two-stage result is scored on
+    assert joint_zpk.cost <= two.cost + 1e-12
+
+
+def test_coefficients_form_is_stable_on_dense_grid_and_matches_truth(synthetic_sweep, true_model):
+    f, t, h, sm, sp = synthetic_sweep
+    res = ScheduledFit("coefficients", 2, 3, 3).fit(f, t, h, sm, sp)
+    assert res.converged
+    grid = np.linspace(19.0, 55.0, 1001)
+    worst = max(np.max(np.roots(res.model.coefficients(T)[1]).real) for T in grid)
+    assert worst < 0 and res.stability.stable
+    fq = np.geomspace(0.1, 30, 50)
+    err = relative_rms_error(res.model.frequency_response(fq, 40.0), true_model.frequency_response(fq, 40.0))
+    assert err < 0.01
+
+
+def test_levy_two_stage_is_the_papers_baseline(synthetic_sweep):
+    f, t, h, sm, sp = synthetic_sweep
+    res = ScheduledFit("coefficients", 2, 3, 2, per_temperature="levy").fit(f, t, h, sm, sp)
+    assert all(e["start"] == "levy" for e in res.history if e["stage"].startswith("per-T"))
+    assert res.converged and res.cost <= ScheduledFit(
+        "coefficients", 2, 3, 2, per_temperature="levy", method="two-stage").fit(f, t, h, sm, sp).cost
+
+
+def test_joint_non_convergence_is_reported(synthetic_sweep):
+    f, t, h, sm, sp = synthetic_sweep
+    fit = ScheduledFit("zpk", 2, 3, 2, max_iter=1)
+    with pytest.raises(ConvergenceError) as info:
+        fit.fit(f, t, h, sm, sp)
+    assert not info.value.result.converged
+    assert "Maximum_Iterations_Exceeded" in str(info.value)
+    res = ScheduledFit("zpk", 2, 3, 2, max_iter=1, raise_on_failure=False).fit(f, t, h, sm, sp)
+    assert not res.converged and res.status == "Maximum_Iterations_Exceeded"
+    assert "NOT CONVERGED" in res.summary()
+
+
+def test_scheduled_fit_rejects_too_few_temperatures(synthetic_sweep):
+    f, t, h, sm, sp = synthetic_sweep
+    keep = np.isin(t, [19.0, 25.0])
+    with pytest.raises(ValueError, match="degree=2 needs at least 3 distinct temperatures"):
+        ScheduledFit("zpk", 2, 3, 2).fit(f[keep], t[keep], h[keep])
+
+
+def test_structure_conversion_preserves_the_response():
+    rng = np.random.default_rng(0)
+    from surrogate._structure import convert, response
+
+    w = np.geomspace(0.05, 20, 30)
+    for _ in range(20):
+        st = Structure("sections", 3, 4, 0)
+        theta = np.concatenate([rng.normal(size=4), rng.normal(scale=0.5, size=4)])
+        ref = response(st, theta, w, 0.0)
+        for form in ("coefficients", "zpk"):
+            th2 = convert(st, theta, form)
+            np.testing.assert_allclose(response(st.with_form(form), th2, w, 0.0), ref, rtol=1e-8)
+
+
+def test_hurwitz_constraints_keep_the_coefficients_form_stable():
+    # truth: a resonance whose damping coefficient a1(τ) = 0.1 − 0.2τ turns negative above mid-range
+    st = Structure("coefficients", 0, 2, 1)
+    theta = np.array([[1.0, 0.0], [1.0, 0.0], [0.1, -0.2]]).ravel()  # b0, a0, a1
+    truth = RationalModel(st, theta, TRUE_SCALING, (19.0, 55.0))
+    assert not truth.stability_check().stable
+    temps = [19.0, 28.0, 37.0, 46.0, 55.0]
+    f, t, h, sm, sp = noisy_sweep(truth, temps, np.geomspace(0.5, 10, 30), mag_db=0.01, ph_deg=0.06)
+    free = ScheduledFit("coefficients", 0, 2, 1, enforce_stability=False, **SCALES).fit(f, t, h, sm, sp)
+    np.testing.assert_allclose(free.params, theta, atol=5e-3)
+    assert not free.stability.stable
+    held = ScheduledFit("coefficients", 0, 2, 1, enforce_stability=True, **SCALES).fit(f, t, h, sm, sp)
+    assert any(e["stage"] == "joint (Hurwitz constraints)" for e in held.history)
+    assert held.stability.stable and held.converged
+    grid = np.linspace(19.0, 55.0, 1001)
+    assert max(np.max(np.roots(held.model.coefficients(T)[1]).real) for T in grid) < 0
