@@ -196,7 +196,7 @@ def cmd_simulate(args) -> int:
 
         traces(ts, args.plot, title=f"{args.experiment}, {model.params[0].name}, {args.temperature:g} °C")
     if not args.quiet:
-        print(f"wrote {out} ({ts.t.size} samples; {ts.metadata.get('realization', '')})")
+        print(f"wrote {out} ({ts.t.size} samples; {ts.metadata.get('realization', 'free response of the first mode')})")
     return EXIT_OK
 
 
