@@ -201,6 +201,12 @@ def _signal(u: Any) -> np.ndarray:
         raise InversionError(f"the signal must be 1-D; got shape {ua.shape}")
     if ua.size < 2:
         raise InversionError(f"the signal must have at least 2 samples; got {ua.size}")
+    # a finite sum proves every sample finite (NaN/inf propagate) without an n-sized mask;
+    # only a non-finite sum (a bad sample, or overflow) needs the element-wise check
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = float(np.add.reduce(ua))
+    if math.isfinite(total):
+        return ua
     finite = np.isfinite(ua)
     if not finite.all():
         i = int(np.flatnonzero(~finite)[0])
@@ -281,33 +287,42 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     if not (isinstance(chunk_size, int | np.integer) and chunk_size > 0):
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
     n = ua.size
+    chunk = int(chunk_size)
     parts: dict[str, Any] = {}
-    if chunk_size >= n:
-        # single chunk: keep the filter outputs themselves, no copies
+    if chunk >= n:
+        # single chunk: keep the filter output itself, no copy
         def put_s(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
             parts["s"] = y
-
-        def put_u(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            parts["u"] = y
     else:
         parts["s"] = np.empty(n)
-        parts["u"] = np.empty(n)
 
         def put_s(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
             parts["s"][c0:c1] = y
 
-        def put_u(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            parts["u"][c0:c1] = y
-
-    plan.forward(ua, n, int(chunk_size), put_s, check=False)
+    plan.forward(ua, n, chunk, put_s, check=False)
+    stable = parts["s"]
     if plan.anti is None:
-        stable = parts["s"]
         unstable = np.zeros(n)
         output = stable.copy()
-    else:
-        plan.backward(ua, n, int(chunk_size), put_u)
-        stable, unstable = parts["s"], parts["u"]
+    elif chunk >= n and plan.fused is None:
+        # one whole-record backward pass: keep its output itself
+        def put_u(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+            parts["u"] = y
+
+        plan.backward(ua, n, chunk, put_u)
+        unstable = parts["u"]
         output = stable + unstable
+    else:
+        # block by block (chunked, or the fused finite-preview pass): write both results
+        # while the block is in cache
+        unstable = np.empty(n)
+        output = np.empty(n)
+
+        def put_u(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+            unstable[c0:c1] = y
+            np.add(stable[c0:c1], y, out=output[c0:c1])
+
+        plan.backward(ua, n, chunk, put_u)
     return InversionResult(
         input=ua, output=output, stable_part=stable, unstable_part=unstable,
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,

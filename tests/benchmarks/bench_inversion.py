@@ -11,7 +11,11 @@ Prints
      wall time, peak Python heap (tracemalloc) and peak RSS;
   4. the seed-000 preview figures (20 Hz, 35 degC): error with T_p*, 0.5 T_p*, infinite;
   5. free vibration after release: pre-actuation error before the release instant;
-  6. drifting bath: scheduled vs fixed-temperature inverse.
+  6. drifting bath: scheduled vs fixed-temperature inverse;
+  7. seed 001 tracking at 45 degC on the physics plant (physmodel, seed001_actuator_dev):
+     scheme 1 (3/3 fit at 19 degC) vs scheme 2 (scheduled 3/3 fit at 45 degC), error bounds
+     for the paper's three references, preview and model-order sensitivity
+     (see tests/inversion/test_inversion_seed001.py).
 Not collected by pytest (the file name does not start with ``test_``).
 """
 
@@ -225,14 +229,121 @@ def figures_drift() -> None:
               f"fixed 35 degC {e35:.3g} mm ({e35 / es:.0f}x); grid {s.grid_c.size} nodes")
 
 
+def figures_seed001() -> None:
+    print("\n7. seed 001 tracking at 45 degC: physics plant (physmodel seed001_actuator_dev, default "
+          "temperature laws),\n   surrogates fitted to noise-free sweeps (30 lines 0.1-9 Hz, the paper's "
+          "10 temperatures; scheduled fit on 8, 35/45 held out)")
+    import physmodel
+    import surrogate
+    from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+    from physmodel.timesim import model_realization, simulate
+
+    plant = physmodel.ActuatorModel(physmodel.get_parameter_set("seed001_actuator_dev"))
+    temps = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
+    f_hz = np.logspace(np.log10(0.1), np.log10(9.0), 30)
+    P = lambda f, T: complex(plant.frequency_response([f], [T])["M"][0, 0, 0]) * 1e3   # mm/V
+    ev = lambda G, f: complex(G(2j * np.pi * f))
+    print("   plant 19 -> 45 degC: " + ", ".join(
+        f"{f:g} Hz |P45/P19| = {abs(P(f, 45.0) / P(f, 19.0)):.3f}, |P45/P19 - 1| = "
+        f"{abs(P(f, 45.0) / P(f, 19.0) - 1):.3f}" for f in (0.5, 2.0)))
+    dt, rec = 1e-3, 12.0
+    t = np.arange(0.0, rec + dt / 2, dt)
+    win = (t >= rec / 3) & (t <= rec - 0.5)
+    real = model_realization(plant, 45.0, 1 / dt, t[-1])
+    refs = {"0.5 Hz": 0.65 * np.sin(np.pi * t), "2 Hz": 0.65 * np.sin(4 * np.pi * t),
+            "two-tone": 0.325 * (np.sin(np.pi * t) + np.sin(4 * np.pi * t))}
+
+    def schemes(sw, nz, npo, form="zpk"):
+        T, F, H = sw.temperature_c, sw.frequency_hz, sw.response
+        ms, ps = sw.magnitude_std_db, sw.phase_std_deg
+        sel = lambda k: (F[k], T[k], H[k]) + (() if ms is None else (ms[k], ps[k]))
+        t0 = time.perf_counter()
+        r1 = surrogate.RationalFit(nz, npo).fit(*sel(T == 19.0))
+        r2 = surrogate.ScheduledFit(form=form, n_zeros=nz, n_poles=npo, degree=2).fit(
+            *sel(~np.isin(T, [35.0, 45.0])))
+        return r1, r2, time.perf_counter() - t0
+
+    def bounds(G1, G2, preview="inf"):
+        out = {}
+        for name, d in refs.items():
+            for key, G in (("s1", G1), ("s2", G2)):
+                v = invert(G, t, d, preview=preview).output
+                y = simulate(plant, 45.0, t, v, realization=real).output * 1e3
+                out[name, key] = float(np.max(np.abs(y - d)[win]))
+        return out
+
+    sw = synthesize_sweep(plant, "M", f_hz, temps)
+    r1, r2, el = schemes(sw, 3, 3)
+    G1, G2 = r1.model.at(19.0), r2.model.at(45.0)
+    print(f"   3/3 fits ({el:.1f} s): scheme 1 converged={r1.converged}, scheme 2 (zpk, degree 2) "
+          f"converged={r2.converged}")
+    for key, G in (("scheme 1 (19 degC fit)", G1), ("scheme 2 (scheduled, 45 degC)", G2)):
+        sp = split_inverse(G)
+        fit_err = max(abs(ev(G, f) / P(f, 45.0) - 1) for f in f_hz)
+        print(f"   {key:29s} zeros {np.array2string(np.sort_complex(G.zeros()), precision=1)}, "
+              f"r0 = {sp.r0:.1f} 1/s, T_p* = {sp.auto_preview_s:.3f} s, max |G/P45 - 1| = {fit_err:.3f}")
+    b = bounds(G1, G2)
+    print(f"   tracking error bound over [{rec / 3:g}, {rec - 0.5:g}] s of a {rec:g} s record, "
+          "preview inf (mm, amplitude 0.65):")
+    for name in refs:
+        e1, e2 = b[name, "s1"], b[name, "s2"]
+        pred = ""
+        if name != "two-tone":
+            f = 0.5 if name == "0.5 Hz" else 2.0
+            pred = (f"   steady-state prediction A|P/G - 1|: {0.65 * abs(P(f, 45.0) / ev(G1, f) - 1):.4f} / "
+                    f"{0.65 * abs(P(f, 45.0) / ev(G2, f) - 1):.4f}")
+        claim = "no worse" if name == "0.5 Hz" else "< 0.5"
+        ok = (e2 <= 1.1 * e1) if name == "0.5 Hz" else (e2 < 0.5 * e1)
+        print(f"     {name:9s} scheme 1 {e1:.4f}  scheme 2 {e2:.4f}  ratio {e2 / e1:5.2f} "
+              f"(claim {claim}: {'reproduced' if ok else 'NOT reproduced'}){pred}")
+    sp2 = split_inverse(G2)
+    d2 = refs["2 Hz"]
+    v_inf = invert(sp2, t, d2, preview="inf").output
+    row = []
+    for mult in (4, 6, 8, 10):
+        v = invert(sp2, t, d2, preview=mult / sp2.r0).output
+        y = simulate(plant, 45.0, t, v, realization=real).output * 1e3
+        row.append(f"{mult}/r0: |v - v_inf| {np.max(np.abs(v - v_inf)[win]):.4f} V, "
+                   f"error {np.max(np.abs(y - d2)[win]):.4f} mm")
+    print(f"   preview sensitivity, scheme 2, 2 Hz (max |v| = {np.max(np.abs(v_inf)):.2f} V, "
+          f"inf-preview error {b['2 Hz', 's2']:.4f} mm):\n     " + "\n     ".join(row))
+    print("   robustness (ratios scheme 2 / scheme 1 at 0.5 Hz, 2 Hz, two-tone):")
+    variants = [("coefficients form 3/3", sw, 3, 3, "coefficients")]
+    for seed in (1, 2):
+        variants.append((f"0.1 dB/1 deg noise, seed {seed}, 3/3",
+                         synthesize_sweep(plant, "M", f_hz, temps, MagnitudePhaseNoise(0.1, 1.0), seed=seed),
+                         3, 3, "zpk"))
+    variants += [("noise-free 4/4", sw, 4, 4, "zpk"), ("noise-free 2/2", sw, 2, 2, "zpk")]
+    for label, s_, nz, npo, form in variants:
+        try:
+            a1, a2, el = schemes(s_, nz, npo, form)
+        except Exception as exc:   # a fitter that does not converge raises
+            print(f"     {label:34s} fit failed: {type(exc).__name__}: {exc}")
+            continue
+        bb = bounds(a1.model.at(19.0), a2.model.at(45.0))
+        print(f"     {label:34s} " + ", ".join(
+            f"{n} {bb[n, 's1']:.4f}/{bb[n, 's2']:.4f} ({bb[n, 's2'] / bb[n, 's1']:.2f})" for n in refs)
+            + f"  [fit {el:.1f} s]")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes (and a 1-hour record)")
     ap.add_argument("--skip-10h", action="store_true", help="skip the long-record test")
+    ap.add_argument("--skip-seed001", action="store_true",
+                    help="skip the seed 001 tracking figures (physmodel + surrogate fits, ~10 s)")
+    ap.add_argument("--only", choices=["batch", "seed001"],
+                    help="run only the batch-throughput section or only the seed 001 figures")
     args = ap.parse_args()
     n = 1 << (20 if args.quick else 22)
     print(f"python {sys.version.split()[0]}, numpy {np.__version__}, scipy {__import__('scipy').__version__}, "
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
+    if args.only == "batch":
+        bench_batch(n, 3 if args.quick else 7)
+        return
+    if args.only == "seed001":
+        figures_seed001()
+        return
     bench_batch(n, 3 if args.quick else 7)
     bench_streaming(1 << (17 if args.quick else 19))
     if not args.skip_10h:
@@ -240,6 +351,8 @@ def main() -> None:
     figures_seed000()
     figures_free_vibration()
     figures_drift()
+    if not args.skip_seed001:
+        figures_seed001()
 
 
 if __name__ == "__main__":
