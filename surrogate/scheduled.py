@@ -2,7 +2,8 @@
 
 Two-stage (seed 000, seed 001): fit each temperature, then fit each coefficient / gain,
 zero and pole entry with a polynomial in T.  Joint: one NLP over all temperatures whose
-unknowns are the polynomial coefficients themselves, started from the two-stage answer.
+unknowns are the polynomial coefficients themselves, started from the two-stage answer and
+from a constant schedule (the lower converged cost wins).
 """
 
 from __future__ import annotations
@@ -233,8 +234,9 @@ class ScheduledFit:
                     history.append(F.history_entry("joint (Hurwitz constraints)", name, out))
                     solver = h_solver
                 outcomes.append((name, out))
-                if out.converged:
-                    break
+                # no early exit: a converged two-stage start can still be a poor local minimum
+                # (physmodel sensor sweeps, zpk 2/2: cost 112 vs 0.49 from the constant start),
+                # so every start is solved and the lowest converged cost wins
             _, best = F.best_outcome(outcomes)
             res = F.finish(st, problem, solver, best, scaling, data, weighting_name=wname,
                            method="joint", settings=settings,

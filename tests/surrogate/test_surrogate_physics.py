@@ -1,0 +1,101 @@
+"""Surrogate fits on real physmodel sweeps (Chen–Tan, infinite-dimensional: no exact answer).
+
+Seed 001's protocol on its strip geometry (``seed001_actuator_dev``): 30 log-spaced lines on
+0.1–9 Hz at the ten bath temperatures, 35 and 45 °C held out, noise 0.2 dB / 1°.  On this
+physics the response needs a fourth-order model (benchmark section 4), and per-temperature zpk
+entries of a 4/4 fit do not interpolate (the papers' two-stage method fails), while the joint
+scheduled fit predicts the held-out temperatures close to the noise-free response.
+
+Known limit (benchmark, robustness table): the zpk 4/4 joint fit converges for 9 of the noise
+seeds 1–10 on this protocol; for seed 7 both automatic starts (two-stage and constant) end in a
+poor basin and the result is flagged ``converged=False`` (it converges from a good start).  This
+test uses seed 2, for which it converges, and raises ``ConvergenceError`` if that ever changes.
+"""
+
+import numpy as np
+import pytest
+
+import physmodel
+from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from surrogate import ScheduledFit, from_sweep, order_selection, relative_rms_error
+
+TEMPS = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
+HELD_OUT = [35.0, 45.0]
+F_HZ = np.geomspace(0.1, 9.0, 30)
+
+
+def _model():
+    return physmodel.ActuatorModel(physmodel.get_parameter_set("seed001_actuator_dev"))
+
+
+@pytest.fixture(scope="module")
+def sweeps():
+    noisy = synthesize_sweep(_model(), "M", F_HZ, TEMPS, MagnitudePhaseNoise(0.2, 1.0), seed=2)
+    exact = synthesize_sweep(_model(), "M", F_HZ, TEMPS, None)
+    return from_sweep(noisy), exact
+
+
+@pytest.fixture(scope="module")
+def joint(sweeps):
+    data, _ = sweeps
+    fit = data.select(~np.isin(data.temperature_c, HELD_OUT))
+    return ScheduledFit("zpk", 4, 4, 2).fit_data(fit)
+
+
+def test_from_sweep_carries_units_and_uncertainty(sweeps):
+    data, exact = sweeps
+    assert (data.input_unit, data.output_unit) == ("V", "mm")
+    assert data.has_uncertainty and np.allclose(data.magnitude_std_db, 0.2) and np.allclose(data.phase_std_deg, 1.0)
+    assert np.array_equal(data.frequency_hz, exact.frequency_hz)
+    assert np.array_equal(data.temperature_c, exact.temperature_c)
+
+
+def test_joint_fit_predicts_held_out_temperatures(sweeps, joint):
+    data, exact = sweeps
+    fit = data.select(~np.isin(data.temperature_c, HELD_OUT))
+    papers = ScheduledFit("zpk", 4, 4, 2, method="two-stage", per_temperature="levy",
+                          raise_on_failure=False).fit_data(fit)
+    assert joint.converged
+    for temp in HELD_OUT:
+        k = data.temperature_c == temp
+        truth = exact.response[k]
+        e_joint = relative_rms_error(joint.model.frequency_response(data.frequency_hz[k], temp), truth)
+        e_papers = relative_rms_error(papers.model.frequency_response(data.frequency_hz[k], temp), truth)
+        assert e_joint < 0.02                      # noise floor of one line is ~0.029
+        assert e_joint <= 0.5 * e_papers           # issue goal, against the papers' two-stage method
+
+
+def test_joint_fit_is_stable_on_a_dense_temperature_grid(joint):
+    check = joint.model.stability_check(501)
+    assert check.stable and check.max_pole_real_part_rad_s < -0.1
+    for temp in np.linspace(19.0, 55.0, 37):
+        assert np.all(joint.model.poles(temp).real < 0)
+
+
+def test_order_selection_on_physics_second_order_is_clearly_worse(sweeps):
+    data, _ = sweeps
+    sub = data.select(np.isin(data.temperature_c, [19.0, 55.0]))
+    rep = order_selection(sub.frequency_hz, sub.temperature_c, sub.response, [(2, 2), (3, 3), (4, 4)],
+                          sub.magnitude_std_db, sub.phase_std_deg)
+    e2, e3, e4 = (rep.row(k, k).worst_relative_rms_error for k in (2, 3, 4))
+    assert all(all(r.stable) for r in rep.rows)
+    assert e2 > 3 * e3 and e3 > e4            # the error falls with order up to 4/4
+    assert e4 < 0.05                          # 4/4 reaches the noise floor (≈ 0.029)
+
+
+def test_joint_fit_keeps_the_best_start_on_the_sensor_sweep():
+    """Seed 000's sensor protocol (10–100 Hz, 35/45 °C held out), zpk 2/2 cubic: the joint NLP
+    from the two-stage start converges to a poor local minimum (cost ≈ 112, 35 °C error ≈ 3900);
+    the constant start reaches cost ≈ 0.49.  The fit must keep the better one."""
+    temps = [23.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 60.0, 65.0]
+    sensor = physmodel.SensorModel(physmodel.get_parameter_set("seed000_sensor_dev"))
+    f_hz = np.geomspace(10.0, 100.0, 60)
+    data = from_sweep(synthesize_sweep(sensor, "S", f_hz, temps, MagnitudePhaseNoise(0.2, 1.0), seed=2))
+    exact = synthesize_sweep(sensor, "S", f_hz, temps, None)
+    res = ScheduledFit("zpk", 2, 2, 3).fit_data(data.select(~np.isin(data.temperature_c, HELD_OUT)))
+    joint_costs = [e["cost"] for e in res.history if e["stage"].startswith("joint") and e["converged"]]
+    assert res.cost == pytest.approx(min(joint_costs)) and res.cost < 1.0
+    assert max(e.relative_rms_error for e in res.per_temperature) < 0.05
+    for temp in HELD_OUT:
+        k = data.temperature_c == temp
+        assert relative_rms_error(res.model.frequency_response(f_hz, temp), exact.response[k]) < 0.02
