@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import beam, electrode, transport
+from . import beam, electrode
 from .model import PhysicsModel
 from .numerics import line_kernels, principal_sqrt, tanh_and_gmt
 

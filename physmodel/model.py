@@ -58,7 +58,6 @@ def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Seque
     n_sets, n_T = state.T.shape[:2]
     n_s = s.size
     n_rows = n_sets * n_T
-    total = n_rows * n_s
     flat_state = {k: np.ascontiguousarray(getattr(state, k).reshape(n_rows)) for k in STATE_FIELDS}
     results: dict[str, np.ndarray] = {}
     for q in quantities:

@@ -138,6 +138,23 @@ def line_kernels(x, want_xcoth: bool = True):
     return X, xcoth
 
 
+def weighted_complex_lstsq(M, rhs, row_weight):
+    """Real least-squares solution of the complex system ``M x ≈ rhs`` (x real), rows weighted.
+
+    Real and imaginary parts are stacked, columns scaled to unit norm for conditioning, solved
+    with ``numpy.linalg.lstsq`` and unscaled.  Shared by vector fitting (timesim) and the Levy /
+    Sanathanan-Koerner initialisers (surrogate).
+    """
+    Mw = M * row_weight[:, None]
+    rw = rhs * row_weight
+    Mr = np.vstack([Mw.real, Mw.imag])
+    rr = np.concatenate([rw.real, rw.imag])
+    scale = np.linalg.norm(Mr, axis=0)
+    scale[scale == 0] = 1.0
+    x, *_ = np.linalg.lstsq(Mr / scale, rr, rcond=None)
+    return x / scale
+
+
 def principal_sqrt(z):
     """Principal complex square root (Re ≥ 0), the branch the closed forms assume."""
     return np.sqrt(np.asarray(z, dtype=complex))

@@ -28,6 +28,7 @@ import numpy as np
 from scipy import signal
 
 from .errors import IPMCError
+from .numerics import weighted_complex_lstsq
 from .sweep import atomic_write
 
 
@@ -80,17 +81,6 @@ def _pairs(eigs):
     return np.array(sorted(out, key=abs))
 
 
-def _solve_ls(M, rhs, weight):
-    Mw = M * weight[:, None]
-    rw = rhs * weight
-    Mr = np.vstack([Mw.real, Mw.imag])
-    rr = np.concatenate([rw.real, rw.imag])
-    scale = np.linalg.norm(Mr, axis=0)
-    scale[scale == 0] = 1.0
-    x, *_ = np.linalg.lstsq(Mr / scale, rr, rcond=None)
-    return x / scale
-
-
 def vector_fit(s, H, n_poles: int, weight=None, iterations: int = 15, direct: bool = True):
     """Fit H(s) ≈ Σ r_m/(s − a_m) + d with stable poles.  Returns (poles, residues, d).
 
@@ -114,13 +104,13 @@ def vector_fit(s, H, n_poles: int, weight=None, iterations: int = 15, direct: bo
         if direct:
             cols.append(np.ones((s.size, 1)))
         cols.append(-H[:, None] * Phi)
-        x = _solve_ls(np.hstack(cols), H, weight)
+        x = weighted_complex_lstsq(np.hstack(cols), H, weight)
         ct = x[-Phi.shape[1]:]
         A, b, c = _block_state(poles, ct)
         poles = _pairs(np.linalg.eigvals(A - np.outer(b, c)))
     Phi = _basis(s, poles)
     M = np.hstack([Phi, np.ones((s.size, 1))]) if direct else Phi
-    x = _solve_ls(M, H, weight)
+    x = weighted_complex_lstsq(M, H, weight)
     res = []
     i = 0
     for a in poles:

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from physmodel.numerics import weighted_complex_lstsq
+
 from ._structure import (
     Structure,
     group_roots,
@@ -19,14 +21,7 @@ __all__ = ["levy", "numerator_ls", "initial_candidates"]
 
 
 def _solve_weighted(a: np.ndarray, rhs: np.ndarray, row_weight: np.ndarray) -> np.ndarray:
-    a = a * row_weight[:, None]
-    rhs = rhs * row_weight
-    a_ri = np.vstack([a.real, a.imag])
-    rhs_ri = np.concatenate([rhs.real, rhs.imag])
-    col = np.linalg.norm(a_ri, axis=0)
-    col[col == 0] = 1.0
-    sol, *_ = np.linalg.lstsq(a_ri / col, rhs_ri, rcond=None)
-    return sol / col
+    return weighted_complex_lstsq(a, rhs, np.asarray(row_weight, dtype=float))
 
 
 def levy(w, h, n_zeros: int, n_poles: int, row_weight=None):

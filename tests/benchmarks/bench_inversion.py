@@ -82,7 +82,7 @@ def bench_batch(n: int, reps: int) -> None:
 
 
 def bench_streaming(n: int) -> None:
-    print(f"\n2. streaming cost per sample (35 degC model, dt = 1 ms, preview auto = 0.113 s)")
+    print("\n2. streaming cost per sample (35 degC model, dt = 1 ms, preview auto = 0.113 s)")
     dt = 1e-3
     u = np.sin(2 * np.pi * 20 * dt * np.arange(n))
     for chunk in (1, 16, 256, 4096):

@@ -10,7 +10,7 @@ import pytest
 from physmodel import ActuatorModel, SensorModel, TransimpedanceChain, get_parameter_set, state_at
 from physmodel.errors import IPMCError
 from physmodel.params import STATE_FIELDS
-from physmodel.timesim import (Realization, free_release, model_realization, released_tip_displacement, simulate,
+from physmodel.timesim import (Realization, free_release, released_tip_displacement, simulate,
                                sine, step)
 
 from mpmath_reference import transfer_mp
