@@ -28,7 +28,8 @@ Units: SI inside (rad/s, K, m, V, A); Hz and °C at the edges, as the argument n
 
 from .errors import DataFormatError, IPMCError, ParameterError, TemperatureRangeError
 from .params import IPMCParameters, describe, state_at
-from .parameter_sets import available_parameter_sets, get_parameter_set, register_parameter_set
+from .parameter_sets import (available_parameter_sets, get_parameter_set, load_parameter_set,
+                             register_parameter_set, save_parameter_set)
 from .temperature import (ISOTHERMAL, Arrhenius, Constant, IonicResistance, Linear, LogLinear,
                           TemperatureLaws, WaterPermittivity)
 from .model import FrequencyResponse
@@ -37,7 +38,7 @@ from .sensor import SensorModel, TransimpedanceChain
 
 __all__ = [
     "IPMCParameters", "describe", "state_at", "available_parameter_sets", "get_parameter_set",
-    "register_parameter_set", "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear",
+    "register_parameter_set", "load_parameter_set", "save_parameter_set", "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear",
     "LogLinear", "WaterPermittivity", "ISOTHERMAL", "FrequencyResponse", "ActuatorModel", "SensorModel",
     "TransimpedanceChain", "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
 ]

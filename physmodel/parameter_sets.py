@@ -31,12 +31,17 @@ seed000_sensor_dev, seed001_actuator_dev
 
 from __future__ import annotations
 
+import json
+import os
+from pathlib import Path
 from typing import Any, Callable
 
 from .errors import ParameterError
 from .params import IPMCParameters, density_for_mode
 from .temperature import TemperatureLaws
 
+_FORMAT = "ipmc-parameter-set"
+_VERSION = 1
 _SEED002_SOURCE = "seed 002 (Frequency response of IPMC actuators), Tables 1-3"
 _OMEGA_N_002 = 75.4
 _E_002 = 154e6
@@ -95,15 +100,67 @@ def available_parameter_sets() -> list[str]:
     return sorted(_REGISTRY)
 
 
-def get_parameter_set(name: str, **overrides: Any) -> IPMCParameters:
+def get_parameter_set(name: str | os.PathLike, **overrides: Any) -> IPMCParameters:
     """The named parameter set, with any field overridden (``omega_n=`` adjusts ``rho``).
+
+    ``name`` may also be the path of a JSON parameter file (what ``ipmc calibrate`` writes, or
+    :func:`save_parameter_set`): any string ending in ``.json``, or an existing path.
 
     >>> p = get_parameter_set("seed002_table3", W=2e-3)
     """
-    if name not in _REGISTRY:
-        raise ParameterError(f"unknown parameter set {name!r}; available: {available_parameter_sets()}")
-    p = _REGISTRY[name]()
+    text = os.fspath(name)
+    if text in _REGISTRY:
+        p = _REGISTRY[text]()
+    elif text.lower().endswith(".json") or Path(text).is_file():
+        p = load_parameter_set(text)
+    else:
+        raise ParameterError(f"unknown parameter set {text!r}; expected one of {available_parameter_sets()} "
+                             "or the path of a JSON parameter file")
     return p.replace(**overrides) if overrides else p
+
+
+def save_parameter_set(params: IPMCParameters, path: str | os.PathLike) -> Path:
+    """Write ``params`` as a versioned JSON parameter file (atomically) and return its path."""
+    from .sweep import atomic_write
+
+    path = Path(path)
+    payload = {"format": _FORMAT, "version": _VERSION, "parameters": _finite_json(params.to_dict())}
+    text = json.dumps(payload, indent=2, allow_nan=False)
+    atomic_write(path, lambda fh: fh.write(text + "\n"))
+    return path
+
+
+def load_parameter_set(path: str | os.PathLike) -> IPMCParameters:
+    """Read a JSON parameter file written by :func:`save_parameter_set` (or a bare parameter record)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"parameter file {str(path)!r} does not exist")
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from exc
+    if isinstance(data, dict) and "parameters" in data:
+        if data.get("format") != _FORMAT:
+            raise ParameterError(f"parameter file {str(path)!r} has format {data.get('format')!r}, "
+                                 f"expected {_FORMAT!r}")
+        if int(data.get("version", 0)) > _VERSION:
+            raise ParameterError(f"parameter file {str(path)!r} has version {data.get('version')}, "
+                                 f"this library reads up to {_VERSION}")
+        data = data["parameters"]
+    if not isinstance(data, dict):
+        raise ParameterError(f"parameter file {str(path)!r} holds {type(data).__name__}, expected an object")
+    return IPMCParameters.from_dict(data)
+
+
+def _finite_json(obj):
+    """Infinite values (Rp' = inf, validity ranges) as the strings "inf"/"-inf", which float() reads back."""
+    if isinstance(obj, dict):
+        return {k: _finite_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite_json(v) for v in obj]
+    if isinstance(obj, float) and obj in (float("inf"), float("-inf")):
+        return "inf" if obj > 0 else "-inf"
+    return obj
 
 
 def register_parameter_set(name: str, factory: Callable[[], IPMCParameters], *, overwrite: bool = False) -> None:

@@ -22,7 +22,8 @@ import numpy as np
 EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED = 0, 2, 3, 130
 
 #: Optional subcommand providers: modules exposing add_parser(subparsers) and run(args) -> int.
-PLUGINS = ("surrogate.cli", "inversion.cli")
+PLUGINS = ("surrogate.cli", "inversion.cli", "physmodel.calibration_cli", "physmodel.discrepancy_cli",
+           "scenarios.validate")
 
 
 class CLIError(Exception):

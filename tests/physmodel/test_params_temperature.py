@@ -117,3 +117,29 @@ def test_batch_state_shapes():
     st = state_at(sets, [10.0, 20.0, 30.0])
     assert st.K.shape == (2, 3, 1)
     assert WaterPermittivity().factor(273.15 + 50, 273.15 + 25) == pytest.approx(69.91 / 78.30, rel=2e-3)
+
+
+@pytest.mark.parametrize("name", ["dev", "seed002_table3", "seed001_actuator_dev"])
+def test_parameter_file_round_trip_and_lookup_by_path(tmp_path, name):
+    from physmodel import get_parameter_set, load_parameter_set, save_parameter_set
+
+    p = get_parameter_set(name).replace(Rp_specific=float("inf"))
+    path = save_parameter_set(p, tmp_path / "set.json")
+    assert load_parameter_set(path) == p
+    assert get_parameter_set(str(path), W=2e-3) == p.replace(W=2e-3)
+    assert "Infinity" not in path.read_text()  # strict JSON
+
+
+def test_parameter_file_errors_name_the_file(tmp_path):
+    from physmodel import ParameterError, get_parameter_set
+
+    with pytest.raises(ParameterError, match="does not exist"):
+        get_parameter_set(str(tmp_path / "missing.json"))
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(ParameterError, match="not valid JSON"):
+        get_parameter_set(str(bad))
+    other = tmp_path / "other.json"
+    other.write_text('{"format": "something-else", "parameters": {}}')
+    with pytest.raises(ParameterError, match="format"):
+        get_parameter_set(str(other))
