@@ -20,6 +20,9 @@ Sweeps and data files (physmodel.sweep)
     read_csv / write_csv, read_npz / write_npz, read_mat / write_mat
 Time-domain virtual experiments (physmodel.timesim)
     realize, simulate, sine, step, free_release, TimeSeries
+Calibration (physmodel.calibration)
+    calibrate, fit_parameters, FreeParameter, CalibrationResult — weighted multi-start least squares
+    with confidence intervals, correlations and an identifiability report; ``ipmc calibrate``
 Errors (physmodel.errors)
     IPMCError, ParameterError, TemperatureRangeError, DataFormatError
 
@@ -35,10 +38,11 @@ from .temperature import (ISOTHERMAL, Arrhenius, Constant, IonicResistance, Line
 from .model import FrequencyResponse
 from .actuator import ActuatorModel
 from .sensor import SensorModel, TransimpedanceChain
+from .calibration import CalibrationResult, FreeParameter, calibrate, fit_parameters
 
 __all__ = [
     "IPMCParameters", "describe", "state_at", "available_parameter_sets", "get_parameter_set",
     "register_parameter_set", "load_parameter_set", "save_parameter_set", "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear",
     "LogLinear", "WaterPermittivity", "ISOTHERMAL", "FrequencyResponse", "ActuatorModel", "SensorModel",
-    "TransimpedanceChain", "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
+    "TransimpedanceChain", "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult", "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
 ]

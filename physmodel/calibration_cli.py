@@ -1,0 +1,247 @@
+"""``ipmc calibrate`` — calibrate physical parameters to a measured sweep (CSV/NPZ/MAT).
+
+    ipmc calibrate SWEEP_FILE --set NAME_OR_JSON --kind actuator|sensor [--quantity M]
+                   --free d --free "kappa_e:1e-7:1e-5" --free laws.d.activation_energy ...
+                   [--starts N] [--seed S] --out FOLDER [--name NAME] [--quiet]
+
+``--free`` (repeatable): ``NAME`` (default bounds, see physmodel.calibration.default_free_parameter),
+``NAME:LOWER:UPPER``, ``NAME:LOWER:UPPER:log|linear`` or ``NAME:LOWER:UPPER:SCALE:INITIAL``, in SI
+units; NAME is an IPMCParameters field, ``omega_n`` or ``laws.<quantity>.<attribute>``.
+
+Writes into FOLDER: ``parameters.json`` (a parameter set: ``get_parameter_set("FOLDER/parameters.json")``
+loads it; calibration metadata inside), ``calibration.json`` (estimates, 95 % intervals, correlation,
+identifiability, starts), ``report.md`` and ``bode.png`` (data/model overlay and standardised residuals).
+Exit codes: 0 converged, 2 bad input, 3 the fit did not converge, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ParameterError
+
+EXIT_OK, EXIT_FAILED = 0, 3
+
+
+def parse_free(spec: str, base):
+    """A ``--free`` specification → FreeParameter (bare names get default bounds)."""
+    from .calibration import FreeParameter, base_value, check_parameter_name, default_free_parameter
+
+    parts = [p.strip() for p in spec.split(":")]
+    name = parts[0]
+    if not name:
+        raise ParameterError(f"--free {spec!r}: missing parameter name")
+    check_parameter_name(base, name)
+    if len(parts) == 1:
+        return default_free_parameter(base, name)
+    if len(parts) not in (3, 4, 5):
+        raise ParameterError(f"--free {spec!r}: expected NAME, NAME:LOWER:UPPER, NAME:LOWER:UPPER:SCALE "
+                             "or NAME:LOWER:UPPER:SCALE:INITIAL")
+    try:
+        lo, hi = float(parts[1]), float(parts[2])
+        initial = float(parts[4]) if len(parts) == 5 else None
+    except ValueError:
+        raise ParameterError(f"--free {spec!r}: bounds and initial value must be numbers (SI units)") from None
+    scale = (parts[3] or None) if len(parts) >= 4 else None
+    if initial is None:
+        v = base_value(base, name)
+        initial = v if lo <= v <= hi else None
+    return FreeParameter(name, lo, hi, scale, initial)
+
+
+def add_parser(subparsers):
+    """Add the ``calibrate`` subcommand."""
+    p = subparsers.add_parser(
+        "calibrate", help="calibrate physical parameters to a measured sweep (estimates, intervals, identifiability)",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("sweep", metavar="SWEEP_FILE", help="frequency sweep (.csv, .npz or .mat; physmodel format)")
+    p.add_argument("--set", required=True, dest="base_set",
+                   help="base parameter set: a name (see 'ipmc sets') or a JSON parameter file")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="override a base parameter in SI units before fitting (repeatable)")
+    p.add_argument("--kind", choices=("actuator", "sensor"), default="actuator", help="model kind (default actuator)")
+    p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
+    p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), default="boundary_charge",
+                   help="sensing kernel (sensor only)")
+    p.add_argument("--free", action="append", required=True, metavar="SPEC",
+                   help="a parameter to fit: NAME[:LOWER:UPPER[:log|linear[:INITIAL]]] (repeatable)")
+    p.add_argument("--starts", type=int, default=4, help="number of starts (base value + seeded Latin hypercube; default 4)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the extra starts (default 0)")
+    p.add_argument("--max-nfev", type=int, help="residual evaluations allowed per start (default: scipy's)")
+    p.add_argument("--no-hold", action="store_true",
+                   help="report undetermined parameters but do not hold them at their base value")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--name", help="name of the calibrated parameter set (default <base>_calibrated)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    p.set_defaults(func=run)
+    return p
+
+
+def _overrides(items) -> dict:
+    out = {}
+    for item in items or []:
+        if "=" not in item:
+            raise ParameterError(f"--param expects NAME=VALUE (SI units), got {item!r}")
+        k, v = item.split("=", 1)
+        try:
+            out[k.strip()] = float(v)
+        except ValueError:
+            raise ParameterError(f"--param {k}: {v!r} is not a number") from None
+    return out
+
+
+def run(args) -> int:
+    """Execute ``ipmc calibrate``; returns 0, or 3 when the fit did not converge (bad input raises)."""
+    from . import get_parameter_set
+    from .calibration import calibrate, model_sweep
+    from .sweep import read_sweep
+
+    if args.starts < 1:
+        raise ParameterError(f"--starts must be >= 1, got {args.starts}")
+    data = read_sweep(args.sweep)
+    over = _overrides(args.param)
+    base = get_parameter_set(args.base_set, **over)
+    free = [parse_free(s, base) for s in args.free]
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--out {out} exists and is not a folder")
+    bar = None
+    if not args.quiet:
+        from tqdm import tqdm
+
+        bar = tqdm(total=args.starts, desc="calibrate (starts)", unit="start", file=sys.stderr)
+    try:
+        res = calibrate(data, base, free, kind=args.kind, quantity=args.quantity, kernel=args.kernel,
+                        starts=args.starts, seed=args.seed, max_nfev=args.max_nfev,
+                        hold_undetermined=not args.no_hold, name=args.name,
+                        progress=bar.update if bar is not None else None)
+    finally:
+        if bar is not None:
+            bar.close()
+    res.metadata["sweep_file"] = str(args.sweep)
+    out.mkdir(parents=True, exist_ok=True)
+    from .sweep import atomic_write
+
+    res.save(out / "parameters.json")
+    record = res.to_dict()
+    record["sweep_file"] = str(args.sweep)
+    record["base_set"] = str(args.base_set)
+    text = json.dumps(record, indent=2, allow_nan=False)
+    atomic_write(out / "calibration.json", lambda fh: fh.write(text + "\n"))
+    model = model_sweep(res, data)
+    write_figure(data, model, res, out / "bode.png")
+    report = render_report(res, data, args)
+    atomic_write(out / "report.md", lambda fh: fh.write(report))
+    if not args.quiet:
+        print(res.summary())
+        print(f"wrote {out}/parameters.json, calibration.json, report.md, bode.png")
+    if not res.converged:
+        print(f"ipmc calibrate: the fit did not converge: {res.message}", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def write_figure(data, model, res, path) -> Path:
+    """Bode overlay (data markers, model lines) and standardised residuals, one colour per temperature."""
+    from scenarios.plots import _plt, _save
+
+    from .calibration import residuals
+
+    plt = _plt()
+    fig, axes = plt.subplots(2, 2, sharex=True, figsize=(11, 6.5))
+    (ax_m, ax_rm), (ax_p, ax_rp) = axes
+    r = residuals(model.response, data)
+    n = data.frequency_hz.size
+    temps = data.temperatures()
+    cmap = plt.get_cmap("viridis")
+    mag_d, ph_d, mag_m, ph_m = data.magnitude_db, data.phase_deg, model.magnitude_db, model.phase_deg
+    for t in temps:
+        m = data.temperature_c == t
+        c = cmap(0.0 if temps.size == 1 else 0.85 * (t - temps.min()) / (temps.max() - temps.min()))
+        f = data.frequency_hz[m]
+        ax_m.semilogx(f, mag_d[m], "o", ms=3, color=c, label=f"data {t:g} °C")
+        ax_m.semilogx(f, mag_m[m], "-", color=c)
+        # plot the model phase on the data's branch (same unwrap offset at the first line)
+        off = 360.0 * np.round((ph_d[m][0] - ph_m[m][0]) / 360.0)
+        ax_p.semilogx(f, ph_d[m], "o", ms=3, color=c)
+        ax_p.semilogx(f, ph_m[m] + off, "-", color=c)
+        ax_rm.semilogx(f, r[:n][m], ".-", ms=3, lw=0.6, color=c)
+        ax_rp.semilogx(f, r[n:][m], ".-", ms=3, lw=0.6, color=c)
+    for ax in (ax_rm, ax_rp):
+        ax.axhspan(-2, 2, color="0.92", zorder=0)
+        ax.axhline(0, color="k", lw=0.6)
+    ax_m.set_ylabel(f"magnitude [dB {data.output_unit}/{data.input_unit}]")
+    ax_p.set_ylabel("phase [deg]")
+    ax_rm.set_ylabel("log-magnitude residual / σ")
+    ax_rp.set_ylabel("phase residual / σ")
+    for ax in (ax_p, ax_rp):
+        ax.set_xlabel("frequency [Hz]")
+    for ax in axes.ravel():
+        ax.grid(True, which="both", alpha=0.3)
+    ax_m.legend(fontsize=7, ncol=2)
+    ax_m.set_title("data (markers) and calibrated model (lines)")
+    ax_rm.set_title(f"standardised residuals (band ±2); cost {res.cost:.4g}, expected {res.expected_cost:.4g}")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def _g(v) -> str:
+    return "–" if v is None or not np.isfinite(v) else f"{v:.5g}"
+
+
+def render_report(res, data, args) -> str:
+    """The Markdown report of a calibration."""
+    lines = [
+        f"# Calibration of `{res.parameters.name}`",
+        "",
+        f"- data: `{args.sweep}` — {res.n_lines} lines, temperatures {', '.join(f'{t:g}' for t in res.temperatures_c)} °C, "
+        f"band {res.band_hz[0]:.4g}–{res.band_hz[1]:.4g} Hz, {data.output_name} [{data.output_unit}] per "
+        f"{data.input_name} [{data.input_unit}]",
+        f"- model: {res.metadata.get('kind')} quantity {res.metadata.get('quantity')}, base set `{args.base_set}`",
+        f"- status: {'converged' if res.converged else '**NOT CONVERGED**'} — {res.message}",
+        f"- weighted cost {res.cost:.5g}; expected for a correct model {res.expected_cost:.5g} ± {res.cost_std:.3g}",
+        "- noise: " + ("**estimated** from the residuals (the sweep has no per-line standard deviations); "
+                        f"intervals scaled by {res.noise_scale:.3g}" if res.noise_estimated
+                        else "per-line standard deviations from the sweep"),
+        f"- effort: {len(res.starts)} start(s), {res.n_evaluations} model evaluations in {res.n_model_calls} "
+        f"batched calls, {res.elapsed_s:.2f} s",
+        "",
+        "## Estimates (95 % intervals)",
+        "",
+        "| parameter | value | std. error | 95 % interval | bounds | scale | status |",
+        "|:---|---:|---:|:---|:---|:---|:---|",
+    ]
+    for n, fp in zip(res.names, res.free):
+        st = res.identifiability[n]
+        status = "determined" if n not in res.held else f"**undetermined** (held at base): {st.reason}"
+        ci = "–" if n in res.held else f"[{_g(res.ci_lower[n])}, {_g(res.ci_upper[n])}]"
+        lines.append(f"| `{n}` | {_g(res.values[n])} | {_g(res.stderr[n])} | {ci} | "
+                     f"[{fp.lower:.4g}, {fp.upper:.4g}] | {fp.scale} | {status} |")
+    det = res.determined
+    if len(det) > 1:
+        idx = [res.names.index(n) for n in det]
+        lines += ["", "## Correlation of the determined parameters", "",
+                  "| | " + " | ".join(f"`{n}`" for n in det) + " |",
+                  "|:---|" + "---:|" * len(det)]
+        for i, n in zip(idx, det):
+            lines.append(f"| `{n}` | " + " | ".join(f"{res.correlation[i, j]:.3f}" for j in idx) + " |")
+    lines += ["", "## Identifiability", ""]
+    for n in res.names:
+        st = res.identifiability[n]
+        peak = ("" if st.sensitivity_peak_hz is None or st.identifiable
+                else f" (sensitivity peak {st.sensitivity_peak_hz:.4g} Hz)")
+        lines.append(f"- `{n}`: {'identifiable' if st.identifiable else 'NOT identifiable'} — {st.reason}{peak}")
+    lines += ["", "## Starts", "", "| start | initial | final | cost | evaluations | status |",
+              "|---:|:---|:---|---:|---:|:---|"]
+    for s in res.starts:
+        ini = ", ".join(f"{k}={v:.4g}" for k, v in s.initial.items())
+        fin = ", ".join(f"{k}={v:.4g}" for k, v in s.final.items())
+        lines.append(f"| {s.index} | {ini} | {fin} | {s.cost:.5g} | {s.nfev} | {s.message} |")
+    lines += ["", "## Figure", "", "![Bode overlay and residuals](bode.png)", "",
+              "Load the calibrated set with `physmodel.get_parameter_set(\"<folder>/parameters.json\")`.", ""]
+    return "\n".join(lines)
