@@ -36,8 +36,19 @@ DEFAULT_CHUNK = 1 << 20
 UNIFORM_RTOL = 1e-6
 
 
+class SampledRecord:
+    """Mixin for result records sampled at ``dt`` from ``t0`` (or at explicit ``time_stamps``)."""
+
+    @cached_property
+    def t(self) -> np.ndarray:
+        """Sample times [s]."""
+        if self.time_stamps is not None:
+            return self.time_stamps
+        return self.t0 + self.dt * np.arange(self.input.size)
+
+
 @dataclass(frozen=True, eq=False)
-class InversionResult:
+class InversionResult(SampledRecord):
     """Result of :func:`invert`.
 
     Attributes
@@ -80,12 +91,6 @@ class InversionResult:
     t0: float = 0.0
     time_stamps: np.ndarray | None = None
 
-    @cached_property
-    def t(self) -> np.ndarray:
-        """Sample times [s]."""
-        if self.time_stamps is not None:
-            return self.time_stamps
-        return self.t0 + self.dt * np.arange(self.input.size)
 
     @cached_property
     def discretisation_error_estimate(self) -> float:

@@ -30,14 +30,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Any, Callable
 
 import numpy as np
 
 from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .batch import DEFAULT_CHUNK, _signal, resolve_preview, sampling_interval
+from .batch import DEFAULT_CHUNK, SampledRecord, _signal, resolve_preview, sampling_interval
 from .split import InverseSplit, split_inverse
 from .streaming import StreamingInverter
 
@@ -114,7 +113,7 @@ def _auto(splits: list[InverseSplit]) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class ScheduledInversionResult:
+class ScheduledInversionResult(SampledRecord):
     """Result of :func:`invert_scheduled`.
 
     Attributes
@@ -153,12 +152,6 @@ class ScheduledInversionResult:
     t0: float = 0.0
     time_stamps: np.ndarray | None = None
 
-    @cached_property
-    def t(self) -> np.ndarray:
-        """Sample times [s]."""
-        if self.time_stamps is not None:
-            return self.time_stamps
-        return self.t0 + self.dt * np.arange(self.input.size)
 
 
 def _run_scheduled(splits: list[InverseSplit], grid: np.ndarray, dt: float, n_prev: int | None,

@@ -37,7 +37,7 @@ import os
 import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -559,18 +559,19 @@ def read_mat(path) -> FrequencySweep:
     return sw
 
 
+def by_extension(path, handlers: Mapping[str, Callable], what: str) -> Callable:
+    """The handler for ``path``'s file extension, or a DataFormatError listing the accepted ones."""
+    ext = Path(path).suffix.lower()
+    if ext not in handlers:
+        raise DataFormatError(f"{path}: unknown {what} file type {ext!r}; expected {', '.join(handlers)}")
+    return handlers[ext]
+
+
 def read_sweep(path) -> FrequencySweep:
     """Read a sweep by file extension (.csv, .npz, .mat)."""
-    ext = Path(path).suffix.lower()
-    readers = {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}
-    if ext not in readers:
-        raise DataFormatError(f"{path}: unknown sweep file type {ext!r}; expected .csv, .npz or .mat")
-    return readers[ext](path)
+    return by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "sweep")(path)
 
 
 def write_sweep(sw: FrequencySweep, path) -> Path:
-    ext = Path(path).suffix.lower()
-    writers = {".csv": write_csv, ".npz": write_npz, ".mat": write_mat}
-    if ext not in writers:
-        raise DataFormatError(f"{path}: unknown sweep file type {ext!r}; expected .csv, .npz or .mat")
-    return writers[ext](sw, path)
+    """Write a sweep by file extension (.csv, .npz, .mat), atomically."""
+    return by_extension(path, {".csv": write_csv, ".npz": write_npz, ".mat": write_mat}, "sweep")(sw, path)

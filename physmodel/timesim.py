@@ -29,7 +29,7 @@ from scipy import signal
 
 from .errors import IPMCError
 from .numerics import weighted_complex_lstsq
-from .sweep import atomic_write
+from .sweep import atomic_write, by_extension
 
 
 class RealizationError(IPMCError):
@@ -333,12 +333,7 @@ class TimeSeries:
         return atomic_write(path, write, "wb")
 
     def save(self, path) -> Path:
-        ext = Path(path).suffix.lower()
-        if ext == ".csv":
-            return self.to_csv(path)
-        if ext == ".npz":
-            return self.to_npz(path)
-        raise IPMCError(f"{path}: unknown time-series file type {ext!r}; expected .csv or .npz")
+        return by_extension(path, {".csv": self.to_csv, ".npz": self.to_npz}, "time-series")(path)
 
 
 def model_realization(model, temperature_c: float, fs: float, duration: float, output: str = "auto",
