@@ -4,6 +4,8 @@
     ipmc sweep ...                  synthetic frequency sweep → CSV/NPZ/MAT (+ Bode plot)
     ipmc simulate ...               time-domain virtual experiment → CSV/NPZ (+ plot)
     ipmc demo                       the flagship chain on embedded defaults → a report folder
+    ipmc run SCENARIO.toml          a scenario file (scenarios/*.toml) → data, figures, report.md
+    ipmc study STUDY.toml           Monte Carlo / grid parameter study (local processes or Dask)
     ipmc fit / ipmc invert ...      surrogate fitting and stable inversion (when installed)
 
 Exit codes: 0 success, 2 bad input (the message names it), 3 a check or a fit failed,
@@ -22,8 +24,8 @@ import numpy as np
 EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED = 0, 2, 3, 130
 
 #: Optional subcommand providers: modules exposing add_parser(subparsers) and run(args) -> int.
-PLUGINS = ("surrogate.cli", "inversion.cli", "physmodel.calibration_cli", "physmodel.discrepancy_cli",
-           "scenarios.validate")
+PLUGINS = ("scenarios.runner", "scenarios.study", "surrogate.cli", "inversion.cli", "physmodel.calibration_cli",
+           "physmodel.discrepancy_cli", "scenarios.validate")
 
 
 class CLIError(Exception):
@@ -249,11 +251,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", help="also write a plot of the traces (PNG)")
     p.set_defaults(func=cmd_simulate)
 
-    p = sub.add_parser("demo", help="run the flagship scenario on embedded defaults and write its report",
-                       description="Physics sweeps at several temperatures, the reduced-model check, a virtual "
-                                   "step and sensor release, written to a report folder with plots.")
+    p = sub.add_parser("demo", help="run the flagship chain (physics → scheduled surrogate → inversion → checks)",
+                       description="The flagship chain on embedded defaults (scenarios/demo.toml): physics sweeps of "
+                                   "the seed 001 actuator at eight temperatures, a joint temperature-scheduled "
+                                   "surrogate fitted without the held-out 35/45 °C, the held-out check, stable-"
+                                   "inversion feedforward at 45 °C applied to the physics plant, and validation "
+                                   "checks; writes data, surrogate.json, PNG figures and report.md (last).  "
+                                   "Exit 3 when a check fails.")
     p.add_argument("--out", default="ipmc-demo", help="report folder (default ./ipmc-demo)")
-    p.add_argument("--quiet", action="store_true")
+    p.add_argument("--quick", action="store_true", help="shorter time records (what the test suite runs)")
+    p.add_argument("--update-figures", action="store_true",
+                   help="also refresh the README figures in scenarios/figures/ (developers)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=_run_demo)
 
     for name in PLUGINS:
@@ -276,7 +285,8 @@ _PLUGIN_COMMANDS: dict = {}
 def _run_demo(args) -> int:
     from .demo import run_demo
 
-    return run_demo(Path(args.out), quiet=args.quiet)
+    return run_demo(Path(args.out), quiet=args.quiet, quick=args.quick,
+                    update_figures=args.update_figures).exit_code
 
 
 def main(argv=None) -> int:

@@ -21,9 +21,10 @@ def _save(fig, path) -> Path:
     from physmodel.sweep import atomic_write
 
     path = Path(path)
-    out = atomic_write(path, lambda fh: fig.savefig(fh, format=path.suffix.lstrip(".") or "png", dpi=120), "wb")
-    _plt().close(fig)
-    return out
+    try:
+        return atomic_write(path, lambda fh: fig.savefig(fh, format=path.suffix.lstrip(".") or "png", dpi=120), "wb")
+    finally:
+        _plt().close(fig)
 
 
 def bode(sweeps, path, title: str = "", labels=None, styles=None) -> Path:
@@ -96,5 +97,52 @@ def curves(x, ys: dict, path, xlabel: str, ylabel: str, title: str = "", logx: b
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(title)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def pole_zero_locus(model, temperatures_c, path, title: str = "") -> Path:
+    """Poles (x) and zeros (o) of a scheduled surrogate across temperature, coloured by °C [rad/s]."""
+    plt = _plt()
+    temps = np.asarray(temperatures_c, float)
+    fig, ax = plt.subplots(figsize=(7, 5))
+    cmap = plt.get_cmap("coolwarm")
+    norm = plt.Normalize(temps.min(), temps.max() if temps.max() > temps.min() else temps.min() + 1)
+    for t in temps:
+        z, p = model.zeros(t, extrapolate=True), model.poles(t, extrapolate=True)
+        c = [cmap(norm(t))]
+        ax.scatter(z.real, z.imag, marker="o", facecolors="none", edgecolors=c, s=18)
+        ax.scatter(p.real, p.imag, marker="x", c=c, s=18)
+    ax.axvline(0, color="k", lw=0.6)
+    ax.set_xscale("symlog", linthresh=1.0)
+    ax.set_xlabel("real part [rad/s] (symlog)")
+    ax.set_ylabel("imaginary part [rad/s]")
+    ax.grid(True, alpha=0.3)
+    sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
+    fig.colorbar(sm, ax=ax, label="temperature [°C]")
+    ax.set_title(title or "poles (x) and zeros (o) vs temperature")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def tracking(t, reference, achieved, path, title: str = "", unit: str = "mm",
+             labels=("reference", "achieved"), window=None) -> Path:
+    """Reference and achieved signals (top) and their error (bottom); ``window`` shades the
+    interval over which the error bound is taken."""
+    plt = _plt()
+    fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(7, 5))
+    a1.plot(t, reference, lw=1.0, label=labels[0])
+    a1.plot(t, achieved, lw=0.8, ls="--", label=labels[1])
+    a1.set_ylabel(f"[{unit}]")
+    a1.legend(fontsize=8)
+    a2.plot(t, np.asarray(achieved) - np.asarray(reference), lw=0.8, color="C3")
+    a2.set_ylabel(f"error [{unit}]")
+    a2.set_xlabel("time [s]")
+    if window is not None:
+        for a in (a1, a2):
+            a.axvspan(*window, color="0.9", zorder=0)
+    for a in (a1, a2):
+        a.grid(True, alpha=0.3)
+    a1.set_title(title)
     fig.tight_layout()
     return _save(fig, path)
