@@ -23,6 +23,10 @@ Time-domain virtual experiments (physmodel.timesim)
 Calibration (physmodel.calibration)
     calibrate, fit_parameters, FreeParameter, CalibrationResult — weighted multi-start least squares
     with confidence intervals, correlations and an identifiability report; ``ipmc calibrate``
+Discrepancy workflow (physmodel.effects, physmodel.discrepancy)
+    EffectModel, LIBRARY — named candidate effects (electrode/contact resistance, leakage, second mode,
+    fluid mass, temperature laws, water uptake, amplifier, delay, CPE, ...) composable with any model;
+    diagnose, Diagnosis — locate, name, add and refit; ``ipmc diagnose``
 Errors (physmodel.errors)
     IPMCError, ParameterError, TemperatureRangeError, DataFormatError
 
@@ -39,10 +43,12 @@ from .model import FrequencyResponse
 from .actuator import ActuatorModel
 from .sensor import SensorModel, TransimpedanceChain
 from .calibration import CalibrationResult, FreeParameter, calibrate, fit_parameters
+from .effects import LIBRARY, EffectModel
+from .discrepancy import Diagnosis, diagnose
 
 __all__ = [
     "IPMCParameters", "describe", "state_at", "available_parameter_sets", "get_parameter_set",
     "register_parameter_set", "load_parameter_set", "save_parameter_set", "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear",
     "LogLinear", "WaterPermittivity", "ISOTHERMAL", "FrequencyResponse", "ActuatorModel", "SensorModel",
-    "TransimpedanceChain", "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult", "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
+    "TransimpedanceChain", "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult", "EffectModel", "LIBRARY", "diagnose", "Diagnosis", "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
 ]

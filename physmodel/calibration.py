@@ -127,7 +127,8 @@ class FreeParameter:
     def from_z(self, z):
         z = np.asarray(z, dtype=float)
         if self.scale == "log":
-            return self.sign * 10.0 ** z
+            # clipped so that the interval of an undetermined parameter (huge se(z)) stays finite
+            return self.sign * 10.0 ** np.clip(z, -300.0, 300.0)
         return self.lower + z * (self.upper - self.lower)
 
     @property
@@ -160,7 +161,9 @@ def noise_std(data: FrequencySweep) -> tuple[np.ndarray, np.ndarray, bool]:
     return s_ln, s_ph, False
 
 
-def _standardised(model_response, data: FrequencySweep, s_ln, s_ph) -> np.ndarray:
+def standardised_residuals(model_response, data: FrequencySweep, s_ln, s_ph) -> np.ndarray:
+    """:func:`residuals` with given per-line σ_ln [Np] and σ_φ [rad] (see :func:`noise_std`);
+    an error, never NaN, where the model response is zero or not finite."""
     G = np.asarray(model_response, dtype=complex)
     n = data.response.size
     if G.shape[-1] != n:
@@ -180,7 +183,7 @@ def residuals(model_response: np.ndarray, data: FrequencySweep) -> np.ndarray:
     Without per-line standard deviations the fallback σ = :data:`FALLBACK_RELATIVE_STD` is used.
     """
     s_ln, s_ph, _ = noise_std(data)
-    return _standardised(model_response, data, s_ln, s_ph)
+    return standardised_residuals(model_response, data, s_ln, s_ph)
 
 
 def weighted_cost(model_response, data: FrequencySweep) -> float:
@@ -404,7 +407,7 @@ def _solve(free, fixed: dict, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_ste
         if key not in cache:
             cache.clear()
             G = many([values_of(z)])[0]
-            cache[key] = _standardised(G, data, s_ln, s_ph)
+            cache[key] = standardised_residuals(G, data, s_ln, s_ph)
         return cache[key]
 
     def jac(z):
@@ -416,7 +419,7 @@ def _solve(free, fixed: dict, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_ste
             zz[i] += steps[i]
             pts.append(values_of(zz))
         G = many(pts)
-        R = _standardised(G, data, s_ln, s_ph)
+        R = standardised_residuals(G, data, s_ln, s_ph)
         return ((R - f0[None, :]) / steps[:, None]).T
 
     z0 = np.clip(np.asarray(z0, dtype=float), lo, hi)
@@ -659,7 +662,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
         for k2 in active:
             C[k, k2] = corr[i, pos[k2]]
     if not active:
-        cost = float(0.5 * np.sum(_standardised(many([dict(fixed, **values)])[0], data, s_ln, s_ph) ** 2))
+        cost = float(0.5 * np.sum(standardised_residuals(many([dict(fixed, **values)])[0], data, s_ln, s_ph) ** 2))
     else:
         cost = fit.cost
     expected = n_lines - n_act / 2.0

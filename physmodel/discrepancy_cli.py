@@ -1,0 +1,216 @@
+"""``ipmc diagnose``: find, name and add the missing physical effect (physmodel.discrepancy).
+
+    ipmc diagnose EXPERIMENT.toml [--out FOLDER] [--seed N] [--quiet]
+    ipmc diagnose --data sweep.csv --kind actuator --set seed002_table3 \\
+                  --free alpha0 --free d --free xi --free omega_n --out diagnosis
+
+EXPERIMENT.toml (paths relative to the TOML file; SI units for parameters)::
+
+    data = "sweep.csv"                 # .csv / .npz / .mat in the physmodel sweep format
+    kind = "actuator"                  # or "sensor"
+    quantity = "M"                     # optional (actuator M/H/Z/I, sensor S/Z)
+    set = "seed002_table3"             # named set or parameter JSON file
+    free = ["alpha0", "d", "xi", "omega_n", "kappa_e:1e-7:1e-5"]   # NAME[:LOWER:UPPER[:SCALE[:INITIAL]]]
+    candidates = ["time_delay", "amplifier_bandwidth"]             # optional (default: all that apply)
+    alpha = 0.05
+    seed = 0
+    out = "diagnosis"
+    [geometry]                         # optional overrides [m]
+    L = 15e-3
+    W = 2e-3
+    [baseline_effects.time_delay]      # effects already in the model (values SI; {} = fitted)
+    delay = 1e-3
+
+Writes report.json (verdict none / named / ambiguous / unexplained, the named effect with its fitted
+value and interval, every candidate's statistics, localisation tables, gap before/after, confusable
+pairs, null calibration), summary.md, bode_before.png and bode_after.png.
+
+Exit codes: 0 for any verdict, 2 bad input, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .errors import IPMCError, ParameterError
+
+EXIT_OK = 0
+_GEOMETRY = ("L", "W", "h")
+
+
+def add_parser(subparsers):
+    """Add the ``diagnose`` subcommand."""
+    p = subparsers.add_parser(
+        "diagnose", help="locate a model/data discrepancy, name the missing effect, refit, show the gap shrink",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("experiment", nargs="?", help="experiment description (TOML); flags override its entries")
+    p.add_argument("--data", help="sweep file (.csv/.npz/.mat)")
+    p.add_argument("--kind", choices=("actuator", "sensor"), help="model kind (default actuator)")
+    p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
+    p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), help="sensing kernel")
+    p.add_argument("--set", dest="base_set", help="starting parameter set: a name or a JSON file")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="override a base parameter (SI), e.g. W=2e-3 (repeatable)")
+    p.add_argument("--free", action="append", metavar="SPEC",
+                   help="free parameter NAME[:LOWER:UPPER[:SCALE[:INITIAL]]] (repeatable; default alpha0)")
+    p.add_argument("--baseline-effect", action="append", metavar="NAME[:P=V,...]",
+                   help="effect already in the model; without values its parameters are fitted (repeatable)")
+    p.add_argument("--candidates", help="comma-separated library effects to test (default: all that apply)")
+    p.add_argument("--alpha", type=float, help="family-wise false-positive rate (default 0.05)")
+    p.add_argument("--null-draws", type=int, help="linearised null Monte Carlo draws (default 4000)")
+    p.add_argument("--null-refits", type=int, help="full-refit bootstrap draws under the null (default 4)")
+    p.add_argument("--seed", type=int, help="seed of the null Monte Carlo (default 0)")
+    p.add_argument("--out", help="report folder (default diagnosis)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    p.set_defaults(func=run)
+    return p
+
+
+def _load_toml(path: Path) -> dict:
+    import tomllib
+
+    if not path.is_file():
+        raise IPMCError(f"experiment file {str(path)!r} does not exist")
+    try:
+        spec = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
+    known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
+             "geometry", "parameters", "baseline_effects", "null_draws", "null_refits"}
+    unknown = set(spec) - known
+    if unknown:
+        raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
+    for key in ("data", "set"):
+        if key in spec and isinstance(spec[key], str):
+            cand = path.parent / spec[key]
+            if key == "data" or cand.suffix.lower() == ".json":
+                spec[key] = str(cand) if not Path(spec[key]).is_absolute() else spec[key]
+    return spec
+
+
+def _parse_effect(item: str) -> tuple[str, dict]:
+    name, _, rest = item.partition(":")
+    vals = {}
+    for kv in filter(None, (s.strip() for s in rest.split(","))):
+        if "=" not in kv:
+            raise IPMCError(f"--baseline-effect {item!r}: expected NAME or NAME:PARAM=VALUE,...")
+        k, v = kv.split("=", 1)
+        try:
+            vals[k.strip()] = float(v)
+        except ValueError:
+            raise IPMCError(f"--baseline-effect {item!r}: {v!r} is not a number") from None
+    return name.strip(), vals
+
+
+def _free(spec: str, base, effects: dict):
+    from .calibration import FreeParameter
+    from .calibration_cli import parse_free
+    from .effects import get_effect
+
+    name = spec.split(":")[0].strip()
+    if "." in name and not name.startswith("laws."):
+        e, p = name.split(".", 1)
+        if e not in effects:
+            raise ParameterError(f"--free {spec!r}: effect {e!r} is not a baseline effect ({sorted(effects)})")
+        par = get_effect(e).parameter(p)
+        parts = spec.split(":")
+        lo, hi = (float(parts[1]), float(parts[2])) if len(parts) >= 3 else (par.lower, par.upper)
+        return FreeParameter(name, lo, hi, "linear", min(max(effects[e][p], lo), hi))
+    return parse_free(spec, base)
+
+
+def build(args):
+    """Resolve TOML + flags into ``(data, base, kwargs for diagnose, out folder, spec)``."""
+    from . import get_parameter_set
+    from .effects import normalize_effects
+    from .sweep import read_sweep
+
+    spec = _load_toml(Path(args.experiment)) if args.experiment else {}
+    pick = lambda flag, key, default=None: flag if flag is not None else spec.get(key, default)  # noqa: E731
+    data_path = pick(args.data, "data")
+    if not data_path:
+        raise IPMCError("no data: give --data FILE or 'data = ...' in the experiment file")
+    set_name = pick(args.base_set, "set")
+    if not set_name:
+        raise IPMCError("no starting parameter set: give --set NAME_OR_JSON or 'set = ...'")
+    over = {}
+    for sect in ("geometry", "parameters"):
+        sec = spec.get(sect, {})
+        if not isinstance(sec, dict):
+            raise IPMCError(f"[{sect}] must be a table of NAME = VALUE (SI)")
+        if sect == "geometry" and set(sec) - set(_GEOMETRY):
+            raise IPMCError(f"[geometry] accepts {_GEOMETRY} [m]; got {sorted(sec)}")
+        over.update({k: float(v) for k, v in sec.items()})
+    for item in args.param or []:
+        if "=" not in item:
+            raise IPMCError(f"--param expects NAME=VALUE (SI units), got {item!r}")
+        k, v = item.split("=", 1)
+        try:
+            over[k.strip()] = float(v)
+        except ValueError:
+            raise IPMCError(f"--param {k}: {v!r} is not a number") from None
+    base = get_parameter_set(set_name, **over)
+    data = read_sweep(data_path)
+    effects_spec = dict(spec.get("baseline_effects", {}))
+    for item in args.baseline_effect or []:
+        n, v = _parse_effect(item)
+        effects_spec[n] = v
+    fitted_effects = [n for n, v in effects_spec.items() if not v]
+    effects = normalize_effects(effects_spec)
+    free_specs = list(args.free) if args.free else list(spec.get("free", ["alpha0"]))
+    free = [_free(s, base, effects) for s in free_specs]
+    names = {f.name for f in free}
+    from .effects import get_effect
+
+    for n in fitted_effects:
+        for p in get_effect(n).parameters:
+            if f"{n}.{p.name}" not in names:
+                free.append(_free(f"{n}.{p.name}", base, effects))
+    cands = pick(args.candidates, "candidates")
+    if isinstance(cands, str):
+        cands = [c.strip() for c in cands.split(",") if c.strip()]
+    kw = dict(kind=pick(args.kind, "kind", "actuator"), quantity=pick(args.quantity, "quantity"),
+              free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
+              null_draws=int(pick(args.null_draws, "null_draws", 4000)),
+              null_refits=int(pick(args.null_refits, "null_refits", 4)), seed=int(pick(args.seed, "seed", 0)),
+              kernel=pick(args.kernel, "kernel", "boundary_charge"))
+    if kw["kind"] not in ("actuator", "sensor"):
+        raise IPMCError(f"kind = {kw['kind']!r}; expected 'actuator' or 'sensor'")
+    return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
+
+
+def run(args) -> int:
+    """Execute ``ipmc diagnose``: 0 for any verdict; bad input raises IPMCError (exit 2)."""
+    from .discrepancy import diagnose, gap_shrink
+
+    data, base, kw, out = build(args)
+    bar = None
+    if not args.quiet:
+        from tqdm import tqdm
+
+        bar = tqdm(total=5, desc="diagnose", unit="stage", file=sys.stderr)
+
+    def progress(msg):
+        if bar is not None:
+            bar.set_postfix_str(msg[:60])
+            bar.update(1)
+
+    try:
+        d = diagnose(data, base, progress=progress, **kw)
+    finally:
+        if bar is not None:
+            bar.close()
+    d.write_report(out)
+    if not args.quiet:
+        print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
+        print(d.message)
+        print(f"weighted cost {d.gap_before['cost']:.4g} -> {d.gap_after['cost']:.4g} "
+              f"(expected {d.gap_after['expected_cost']:.4g}); gap shrink {gap_shrink(d):.3g}x; "
+              f"{d.elapsed_s:.1f} s")
+        print(f"report: {out}/report.json, summary.md, bode_before.png, bode_after.png")
+    return EXIT_OK
+
+
+__all__ = ["add_parser", "run", "build"]

@@ -1,0 +1,170 @@
+"""The discrepancy workflow on blind synthetic cases (known truth hidden under sealed seeds), its null
+calibration (the χ̄² boundary mixture of discrepancy.md §3), the report and the CLI."""
+
+import argparse
+import json
+
+import numpy as np
+import pytest
+
+from physmodel import IPMCError, ParameterError, get_parameter_set
+from physmodel.discrepancy import VERDICTS, _constrained_lr, diagnose, gap_shrink
+from physmodel.effects import OUT_OF_LIBRARY, EffectModel
+from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+
+P = get_parameter_set("seed002_table3")
+F = np.logspace(-1, 1.7, 30)
+T = [20.0, 40.0, 60.0]
+FREE = ("alpha0", "d", "xi", "omega_n")
+#: The generator's sealed entropy: sizes, noise and noise seeds come from here, never from diagnose.
+SEALED = 0x5EA1ED
+
+
+def _hidden(case: int, effects_fn):
+    rng = np.random.default_rng(np.random.SeedSequence(SEALED, spawn_key=(case,)))
+    noise = MagnitudePhaseNoise(float(rng.uniform(0.15, 0.3)), float(rng.uniform(0.8, 1.5)))
+    effects = effects_fn(rng)
+    data = synthesize_sweep(EffectModel(P, "actuator", effects), "M", F, T, noise,
+                            seed=int(rng.integers(2**31)))
+    data = type(data)(**{**data.__dict__, "metadata": {}})       # the workflow never sees the label
+    return data, effects
+
+
+@pytest.fixture(scope="module")
+def blind():
+    cases = {
+        "none": lambda r: {},
+        "time_delay": lambda r: {"time_delay": {"delay": r.uniform(1.5e-3, 4e-3)}},
+        "constant_phase_element": lambda r: {"constant_phase_element": {"beta": r.uniform(0.85, 0.92)}},
+        "fixture_resonance": lambda r: {"fixture_resonance": {"frequency_hz": r.uniform(1.0, 20.0),
+                                                              "depth": r.uniform(0.5, 0.8), "damping": 0.05}},
+        "two": lambda r: {"time_delay": {"delay": r.uniform(1.5e-3, 3e-3)},
+                          "constant_phase_element": {"beta": r.uniform(0.85, 0.9)}},
+    }
+    out = {}
+    for i, (label, fn) in enumerate(cases.items()):
+        data, _ = _hidden(i, fn)
+        out[label] = diagnose(data, P, kind="actuator", free=FREE, seed=0)
+    return out
+
+
+def _named_ok(d, truth):
+    if d.verdict == "named":
+        return d.named == [truth]
+    if d.verdict == "ambiguous":       # allowed only between pairs the report declares confusable
+        declared = {frozenset((a, b)) for a, b, _ in d.confusable}
+        return truth in d.named and all(frozenset((truth, o)) in declared for o in d.named if o != truth)
+    return False
+
+
+def test_null_data_give_no_discrepancy(blind):
+    d = blind["none"]
+    assert d.verdict == "none" and d.named == [] and d.final is None
+    assert max(c.lr for c in d.candidates.values()) <= d.threshold
+
+
+@pytest.mark.parametrize("truth", ["time_delay", "constant_phase_element"])
+def test_hidden_library_effect_is_named_and_the_gap_shrinks(blind, truth):
+    d = blind[truth]
+    assert _named_ok(d, truth), (d.verdict, d.named, d.message)
+    assert gap_shrink(d) >= 5.0
+    assert d.gap_after["cost"] < d.gap_before["cost"] / 5
+    ne = d.named_effect()[truth]
+    for v in ne.values():
+        assert v["ci95"][0] <= v["value"] <= v["ci95"][1]
+
+
+def test_out_of_library_effect_ends_unexplained(blind):
+    d = blind["fixture_resonance"]
+    assert "fixture_resonance" in OUT_OF_LIBRARY
+    assert d.verdict == "unexplained", d.message
+    assert d.named == []
+    assert any(r["flagged"] for r in d.localisation_before)
+
+
+def test_two_hidden_effects_are_named_greedily(blind):
+    d = blind["two"]
+    assert d.verdict == "named", d.message
+    assert sorted(d.named) == ["constant_phase_element", "time_delay"]
+
+
+def test_report_folder(blind, tmp_path):
+    d = blind["time_delay"]
+    d.write_report(tmp_path / "rep")
+    rep = json.loads((tmp_path / "rep" / "report.json").read_text())
+    assert rep["verdict"] in VERDICTS and rep["named_effect"]
+    assert set(rep["candidates"]) >= {"time_delay", "amplifier_bandwidth", "constant_phase_element"}
+    for key in ("lr", "aic", "bic", "significant", "values", "ci95_lower"):
+        assert key in rep["candidates"]["time_delay"]
+    assert rep["gap_before"]["cost"] > rep["gap_after"]["cost"]
+    assert len(rep["gap_after"]["rms_db"]) == len(T) and rep["localisation_before"]
+    assert {"a": "amplifier_bandwidth", "b": "time_delay"} in [{k: p[k] for k in ("a", "b")} for p in rep["confusable_pairs"]]
+    assert all(p["what_separates"] for p in rep["confusable_pairs"])
+    assert "NAMED" in (tmp_path / "rep" / "summary.md").read_text()
+    for png in ("bode_before.png", "bode_after.png"):
+        assert (tmp_path / "rep" / png).read_bytes()[:4] == b"\x89PNG"
+    assert not list((tmp_path / "rep").glob("*.tmp*"))
+
+
+def test_sensor_amplifier_pole_is_named():
+    ps = get_parameter_set("seed000_sensor_dev")
+    rng = np.random.default_rng(np.random.SeedSequence(SEALED, spawn_key=(99,)))
+    tau = rng.uniform(1e-3, 2e-3)
+    data = synthesize_sweep(EffectModel(ps, "sensor", {"amplifier_bandwidth": {"time_constant": tau}}), "S",
+                            np.logspace(1, 2, 20), [25, 45, 65], MagnitudePhaseNoise(0.2, 1.0), seed=int(rng.integers(2**31)))
+    d = diagnose(data, ps, kind="sensor", free=("a0", "d"), seed=1, null_refits=2)
+    assert _named_ok(d, "amplifier_bandwidth"), d.message
+    fitted = d.final.values["amplifier_bandwidth.time_constant"]
+    assert d.final.ci_lower["amplifier_bandwidth.time_constant"] <= tau <= d.final.ci_upper["amplifier_bandwidth.time_constant"] \
+        or abs(fitted / tau - 1) < 0.05
+
+
+def test_linearised_null_gives_the_chi_bar_squared_boundary_mixture():
+    # one parameter with its "off" value at a bound: LR ~ ½χ²0 + ½χ²1, 95 % point 2.71 (discrepancy.md §3);
+    # two-sided: χ²1, 3.84.
+    rng = np.random.default_rng(3)
+    S = rng.standard_normal((40, 1))
+    E = rng.standard_normal((40, 40000))
+    assert np.quantile(_constrained_lr(S, np.array([True]), E), 0.95) == pytest.approx(2.706, abs=0.12)
+    assert np.quantile(_constrained_lr(S, np.array([False]), E), 0.95) == pytest.approx(3.841, abs=0.15)
+    assert np.mean(_constrained_lr(S, np.array([True]), E) == 0) == pytest.approx(0.5, abs=0.01)
+    # two one-sided parameters, orthogonal: ¼χ²0 + ½χ²1 + ¼χ²2, 95 % point 4.23
+    S2 = np.linalg.qr(rng.standard_normal((40, 2)))[0]
+    assert np.quantile(_constrained_lr(S2, np.array([True, True]), E), 0.95) == pytest.approx(4.231, abs=0.15)
+
+
+def test_bad_input_is_named():
+    data = synthesize_sweep(EffectModel(P, "actuator"), "M", F[:10], [25.0], MagnitudePhaseNoise(0.1, 1.0), seed=1)
+    with pytest.raises(IPMCError, match="alpha"):
+        diagnose(data, P, alpha=0.7)
+    with pytest.raises(ParameterError, match="unknown candidate"):
+        diagnose(data, P, candidates=["fixture_resonance"])
+    with pytest.raises(ParameterError, match="does not apply"):
+        diagnose(data, P, candidates=["coupling_compliance"])
+    with pytest.raises(IPMCError, match="null_draws"):
+        diagnose(data, P, null_draws=10)
+
+
+def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
+    from physmodel import discrepancy_cli
+
+    data, _ = _hidden(7, lambda r: {"amplifier_bandwidth": {"time_constant": 2e-3}})
+    data.to_csv(tmp_path / "sweep.csv")
+    (tmp_path / "exp.toml").write_text(
+        'data = "sweep.csv"\nkind = "actuator"\nset = "seed002_table3"\nfree = ["alpha0", "d", "xi", "omega_n"]\n'
+        'candidates = ["time_delay", "amplifier_bandwidth", "electrode_resistance"]\nnull_refits = 1\n'
+        f'out = "{tmp_path / "out"}"\n[geometry]\nW = 2e-3\n')
+    parser = argparse.ArgumentParser()
+    sub = parser.add_subparsers()
+    discrepancy_cli.add_parser(sub)
+    args = parser.parse_args(["diagnose", str(tmp_path / "exp.toml"), "--quiet"])
+    assert args.func(args) == 0
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert rep["verdict"] in ("named", "ambiguous") and "amplifier_bandwidth" in rep["named"]
+    bad = parser.parse_args(["diagnose", "--data", str(tmp_path / "missing.csv"), "--set", "seed002_table3", "--quiet"])
+    with pytest.raises(IPMCError):
+        bad.func(bad)
+    (tmp_path / "bad.toml").write_text('data = "sweep.csv"\nset = "seed002_table3"\nbogus = 1\n')
+    bad = parser.parse_args(["diagnose", str(tmp_path / "bad.toml"), "--quiet"])
+    with pytest.raises(IPMCError, match="bogus"):
+        bad.func(bad)

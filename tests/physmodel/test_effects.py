@@ -1,0 +1,225 @@
+"""The effects library: each effect's "off" value is the base model exactly, each has its documented
+physical signature (checked against an independent oracle: an equivalent base-model parameter set,
+a closed form, an Euler-Bernoulli root, a constant-phase limit), and effects compose."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from physmodel import ActuatorModel, IPMCError, ParameterError, SensorModel, get_parameter_set
+from physmodel.effects import (CPE_REFERENCE_HZ, LIBRARY, OUT_OF_LIBRARY, SECOND_MODE_RATIO, EffectModel,
+                               candidates_for, get_effect)
+from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.temperature import Arrhenius, LogLinear
+
+F = np.logspace(-2, 3, 60)
+T = [10.0, 26.85, 60.0]
+P = get_parameter_set("seed002_table3")
+PS = get_parameter_set("seed000_sensor_dev")
+
+
+def act(effects, params=P, q=("M", "Z", "I", "H")):
+    return EffectModel(params, "actuator", effects).frequency_response(F, T, quantities=q)
+
+
+def sen(effects, params=PS, q=("S", "Z")):
+    return EffectModel(params, "sensor", effects).frequency_response(F, T, quantities=q)
+
+
+def test_library_has_at_least_ten_documented_candidates():
+    assert len(LIBRARY) >= 10
+    assert not set(OUT_OF_LIBRARY) & set(LIBRARY)
+    for e in LIBRARY.values():
+        assert e.description and e.reference and e.parameters and e.level in ("parameter", "response", "kernel")
+        for p in e.parameters:
+            assert p.lower <= p.off <= p.upper and p.typical != p.off
+    for kind, q in (("actuator", "M"), ("sensor", "S"), ("actuator", "Z")):
+        assert not set(candidates_for(kind, q)) & set(OUT_OF_LIBRARY)
+
+
+@pytest.mark.parametrize("name", sorted(LIBRARY) + sorted(OUT_OF_LIBRARY))
+def test_off_value_reproduces_base_exactly(name):
+    e = get_effect(name)
+    if "actuator" in e.kinds:
+        base = ActuatorModel(P).frequency_response(F, T, quantities=("M", "Z", "I", "H"))
+        got = act({name: e.off})
+        for q in ("M", "Z", "I", "H"):
+            assert np.array_equal(got[q], base[q]), q
+    if "sensor" in e.kinds:
+        base = SensorModel(PS).frequency_response(F, T, quantities=("S", "Z"))
+        got = sen({name: e.off})
+        for q in ("S", "Z"):
+            assert np.array_equal(got[q], base[q]), q
+
+
+def test_every_effect_changes_what_it_claims():
+    for name, e in {**LIBRARY, **OUT_OF_LIBRARY}.items():
+        for kind, fn, q in (("actuator", act, "M"), ("sensor", sen, "S")):
+            if kind in e.kinds and q in e.quantities:
+                on, off = fn({name: e.typical})[q], fn({})[q]
+                assert np.max(np.abs(np.log(on / off))) > 1e-3, (name, kind)
+
+
+def test_time_delay_is_phase_only_minus_omega_tau():
+    tau = 2.5e-3
+    r = act({"time_delay": {"delay": tau}})["M"] / act({})["M"]
+    np.testing.assert_allclose(np.abs(r), 1.0, atol=1e-13)
+    np.testing.assert_allclose(np.angle(r * np.exp(2j * np.pi * F * tau)), 0.0, atol=1e-12)
+
+
+def test_amplifier_pole_is_first_order_low_pass():
+    ta = 1e-3
+    r = sen({"amplifier_bandwidth": {"time_constant": ta}})["S"] / sen({})["S"]
+    np.testing.assert_allclose(r, np.broadcast_to(1 / (1 + 2j * np.pi * F * ta), r.shape), rtol=1e-13)
+
+
+@pytest.mark.parametrize("name,param,field,combine", [
+    ("electrode_resistance", "r1_sheet", "r1_sheet", lambda b, v: b + v),
+    ("contact_resistance", "r2_specific", "r2_specific", lambda b, v: b + v),
+    ("leakage", "conductance", "Rp_specific", lambda b, v: 1.0 / (1.0 / b + v)),
+])
+def test_electrode_effects_equal_the_base_model_with_changed_parameters(name, param, field, combine):
+    v = get_effect(name).typical[param]
+    t_ref = [P.T_ref - 273.15]        # leakage is added temperature-independently: compare at T_ref
+    oracle = ActuatorModel(P.replace(**{field: combine(getattr(P, field), v)})).frequency_response(F, t_ref)
+    got = EffectModel(P, "actuator", {name: {param: v}}).frequency_response(F, t_ref)
+    for q in ("M", "Z"):
+        np.testing.assert_allclose(got[q], oracle[q], rtol=1e-12)
+
+
+def test_contact_resistance_lowers_the_gain_seed002():
+    lo = act({"contact_resistance": {"r2_specific": 1e-5}})["M"]
+    hi = act({"contact_resistance": {"r2_specific": 1e-4}})["M"]
+    assert np.all(np.abs(hi) < np.abs(lo)) and np.all(np.abs(lo) < np.abs(act({})["M"]))
+
+
+def test_series_resistance_is_a_voltage_divider():
+    Rs = 50.0
+    got, base = act({"series_resistance": {"resistance": Rs}}), act({})
+    np.testing.assert_allclose(got["Z"], base["Z"] + Rs, rtol=1e-13)
+    np.testing.assert_allclose(got["I"], 1 / (base["Z"] + Rs), rtol=1e-13)
+    np.testing.assert_allclose(got["M"], base["M"] * got["I"] * base["Z"], rtol=1e-12)
+    assert np.all(np.abs(got["M"]) < np.abs(base["M"]))      # Re Z > 0: a passive divider
+
+
+def test_temperature_effects_equal_modified_laws_and_vanish_at_T_ref():
+    c, dEa = -0.01, 12e3
+    got = act({"modulus_temperature": {"slope": c}, "diffusivity_temperature": {"activation_energy": dEa}})
+    laws = P.laws.with_(E=LogLinear(slope=P.laws.E.slope + c),
+                        d=Arrhenius(activation_energy=P.laws.d.activation_energy + dEa))
+    oracle = ActuatorModel(P.replace(laws=laws)).frequency_response(F, T)
+    for q in ("M", "Z"):
+        np.testing.assert_allclose(got[q], oracle[q], rtol=1e-12)
+    t_ref = [P.T_ref - 273.15]
+    for name, e in LIBRARY.items():
+        if e.needs_temperatures:
+            m = EffectModel(P, "actuator", {name: e.typical}).frequency_response(F, t_ref)["M"]
+            np.testing.assert_allclose(m, ActuatorModel(P).frequency_response(F, t_ref)["M"], rtol=1e-13)
+
+
+def test_water_uptake_equals_swollen_strip_at_one_temperature():
+    u, t = 0.004, 60.0
+    sw = 1 + u * (t + 273.15 - P.T_ref)
+    oracle = ActuatorModel(P.replace(h=P.h * sw, C_minus=P.C_minus / sw)).frequency_response(F, [t])["M"]
+    got = EffectModel(P, "actuator", {"water_uptake": {"swelling": u}}).frequency_response(F, [t])["M"]
+    np.testing.assert_allclose(got, oracle, rtol=1e-12)
+
+
+def test_added_fluid_mass_lowers_the_resonance_by_sqrt_one_plus_mu():
+    mu, zf = 0.5, 0.05
+    oracle = ActuatorModel(P.replace(rho=P.rho * (1 + mu), xi=(P.xi + zf) / math.sqrt(1 + mu))).frequency_response(F, T)
+    got = act({"added_fluid_mass": {"mass_ratio": mu, "damping_ratio": zf}})
+    np.testing.assert_allclose(got["M"], oracle["M"], rtol=1e-12)
+    st0 = ActuatorModel(P).state(T)
+    st1 = EffectModel(P, "actuator", {"added_fluid_mass": {"mass_ratio": mu}}).state(T)
+    np.testing.assert_allclose(st1.omega_n, st0.omega_n / math.sqrt(1 + mu), rtol=1e-13)
+
+
+def test_second_mode_ratio_is_the_euler_bernoulli_root_and_dc_gain_is_kept():
+    b = [brentq(lambda x: 1 + math.cos(x) * math.cosh(x), a, a + 1.5) for a in (1.0, 4.0)]
+    assert SECOND_MODE_RATIO == pytest.approx((b[1] / b[0]) ** 2, rel=1e-12)
+    p = P.replace(xi=0.02)
+    f = np.concatenate([[1e-4], np.linspace(30, 150, 600)])
+    m = EffectModel(p, "actuator", {"second_mode": {"participation": 0.3}}).frequency_response(f, [26.85])
+    base = ActuatorModel(p).frequency_response(f, [26.85])
+    assert abs(m["M"][0, 0, 0] / base["M"][0, 0, 0] - 1) < 1e-6
+    r = np.abs(m["M"][0, 0, 1:] / base["M"][0, 0, 1:])
+    f2 = SECOND_MODE_RATIO * p.omega_n / (2 * np.pi)
+    assert abs(f[1:][np.argmax(r)] - f2) < 0.03 * f2       # the added resonance sits at the second mode
+
+
+def test_constant_phase_element_gives_a_constant_phase_double_layer():
+    beta = 0.8
+    p = P.replace(r1_sheet=0.0, r2_specific=0.0, Rp_specific=float("inf"))
+    f = np.array([1e-5, 1e-4])
+    z = EffectModel(p, "actuator", {"constant_phase_element": {"beta": beta}}).frequency_response(f, [26.85], quantities=("Z",))["Z"][0, 0]
+    z0 = ActuatorModel(p).frequency_response(f, [26.85], quantities=("Z",))["Z"][0, 0]
+    # low frequency: a constant-phase double layer, phase −β·90° (the capacitive model gives −90°)
+    np.testing.assert_allclose(np.degrees(np.angle(z)), -90 * beta, atol=0.05)
+    np.testing.assert_allclose(np.degrees(np.angle(z0)), -90, atol=0.05)
+    # and |Z| falls as ω^-β: 20β dB per decade
+    assert 20 * np.log10(abs(z[0] / z[1])) == pytest.approx(20 * beta, abs=0.02)
+
+
+def test_constant_phase_element_is_the_transport_at_s_hat_with_the_mode_at_s():
+    beta, f = 0.9, np.array([0.3, 3.0, 30.0])
+    s = 2j * np.pi * f
+    wc = 2 * np.pi * CPE_REFERENCE_HZ
+    s_hat = wc * np.abs(s / wc) ** beta * np.exp(1j * beta * np.pi / 2)    # polar form of ω_c (s/ω_c)^β
+    got = EffectModel(P, "actuator", {"constant_phase_element": {"beta": beta}}).frequency_response(f, [26.85])
+    at_hat = ActuatorModel(P).evaluate(s_hat, [26.85], quantities=("Z", "H"))
+    G = ActuatorModel(P).frequency_response(f, [26.85], quantities=("G",))["G"]
+    np.testing.assert_allclose(got["Z"], at_hat["Z"], rtol=1e-12)
+    np.testing.assert_allclose(got["M"], at_hat["H"] * G, rtol=1e-12)
+
+
+def test_coupling_compliance_divides_the_sensor_gain_quasi_statically():
+    eps = 0.3
+    f = np.array([1e-6])
+    r = (EffectModel(PS, "sensor", {"coupling_compliance": {"compliance_ratio": eps}}).frequency_response(f, [25])["S"]
+         / SensorModel(PS).frequency_response(f, [25])["S"])
+    assert r[0, 0, 0] == pytest.approx(1 / (1 + eps), rel=1e-8)
+
+
+def test_composition_commutes_and_multiplies():
+    a = {"time_delay": {"delay": 1e-3}, "amplifier_bandwidth": {"time_constant": 2e-3},
+         "second_mode": {"participation": 0.2}, "series_resistance": {"resistance": 30.0},
+         "electrode_resistance": {"r1_sheet": 100.0}, "modulus_temperature": {"slope": -0.005}}
+    b = dict(reversed(list(a.items())))
+    for q in ("M", "Z", "I"):
+        np.testing.assert_allclose(act(a)[q], act(b)[q], rtol=1e-13)
+    c = {k: v for k, v in a.items() if k not in ("electrode_resistance", "modulus_temperature")}
+    prod = act({})["M"]
+    for k, v in c.items():
+        prod = prod * (act({k: v})["M"] / act({})["M"])
+    np.testing.assert_allclose(act(c)["M"], prod, rtol=1e-9)   # response-level effects compose as products
+
+
+def test_simulates_sweeps_and_predicts_them():
+    m = EffectModel(PS, "sensor", {"time_delay": {"delay": 1e-3}})
+    sw = synthesize_sweep(m, "S", [10, 20, 50], [25, 45])
+    assert sw.output_unit == "uA" and sw.metadata["model"].startswith("EffectSensorModel")
+    pred = m.predictor(sw)
+    np.testing.assert_allclose(pred({}), sw.response, rtol=1e-13)
+    vals = [{"time_delay.delay": 2e-3}, {"a0": 0.5, "time_delay.delay": 1e-3}, {}]
+    many = pred.many(vals)
+    for k, v in enumerate(vals):
+        np.testing.assert_allclose(many[k], pred(v), rtol=1e-13)
+    noisy = synthesize_sweep(EffectModel(P, "actuator", {"leakage": {"conductance": 10.0}}), "M", [1, 2], [25],
+                             MagnitudePhaseNoise(0.1, 1.0), seed=1)
+    assert noisy.magnitude_std_db is not None
+
+
+def test_bad_input_is_named():
+    with pytest.raises(ParameterError, match="unknown effect"):
+        EffectModel(P, "actuator", {"warp_drive": {}})
+    with pytest.raises(ParameterError, match="time_delay.delay"):
+        EffectModel(P, "actuator", {"time_delay": {"delay": -1.0}})
+    with pytest.raises(ParameterError, match="no parameter"):
+        EffectModel(P, "actuator", {"time_delay": {"tau": 1e-3}})
+    with pytest.raises(IPMCError, match="does not apply"):
+        EffectModel(P, "actuator", {"coupling_compliance": {"compliance_ratio": 0.1}})
+    with pytest.raises(IPMCError, match="kind"):
+        EffectModel(P, "beam", {})
