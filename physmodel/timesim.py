@@ -347,7 +347,7 @@ def model_realization(model, temperature_c: float, fs: float, duration: float, o
     if output == "auto":
         output = "displacement" if is_act else "current"
     f_lo = min(1e-3, 0.01 / duration)
-    f_hi = 20.0 * fs
+    f_hi = min(20.0 * fs, max(5.0 * fs, 1e5))   # beyond 100 kHz, 5 fs suffices for FOH input spectra
     if is_act and output == "displacement":
         q, deriv, dc = "M", False, float(model.dc_gain([temperature_c])["M0"][set_index, 0])
     elif output == "current":
