@@ -7,16 +7,23 @@ use s in rad/s, like the seed papers' models.
 Public API
 ----------
 Data
+    Every fitter takes a ``physmodel.sweep.FrequencySweep`` directly (``fit(sweep)`` or
+    ``fit_data(sweep)``), or arrays.
     FrequencyData(frequency_hz, temperature_c, response, magnitude_std_db=None,
-                  phase_std_deg=None, ...)        validated tidy data, ``fingerprint()``
-    from_sweep(sweep) -> FrequencyData         duck-typed physmodel FrequencySweep adapter
+                  phase_std_deg=None, ...)        for data a sweep does not cover (no
+                                               temperature, free unit labels); validated by
+                                               FrequencySweep's own checks; ``fingerprint()``
+    from_sweep(sweep) -> FrequencyData         FrequencySweep (or look-alike) → FrequencyData
 Fitters (estimator style: settings in the constructor, ``fit`` returns a FitResult and sets
 ``model_``, ``result_``, ``history_``)
     RationalFit(n_zeros, n_poles, stable=True, weighting='auto', init='auto', ...)
-        .fit(frequency_hz, temperature_c, response, magnitude_std_db=None, phase_std_deg=None)
+        .fit(frequency_hz | sweep, temperature_c=None, response=None, magnitude_std_db=None,
+             phase_std_deg=None)
     ScheduledFit(form='zpk'|'coefficients'|'sections', n_zeros, n_poles, degree,
-                 method='joint'|'two-stage', per_temperature='nlp'|'levy', ...)
-        .fit(frequency_hz, temperature_c, response, magnitude_std_db=None, phase_std_deg=None)
+                 method='joint'|'two-stage', per_temperature='nlp'|'levy',
+                 stability_margin=1e-3, ...)
+        .fit(frequency_hz | sweep, temperature_c=None, response=None, magnitude_std_db=None,
+             phase_std_deg=None)
     fit_sweep(sweep, n_zeros, n_poles, degree=2, form='zpk', **settings) -> FitResult
     levy(omega_scaled, response_scaled, n_zeros, n_poles)   Levy / Octave-invfreqs baseline
 Results and models
@@ -57,7 +64,7 @@ __all__ = [
 
 
 def fit_sweep(sweep, n_zeros: int, n_poles: int, degree: int = 2, form: str = "zpk", **settings):
-    """Fit a physmodel ``FrequencySweep`` (duck-typed): one temperature → ``RationalFit``,
+    """Fit a physmodel ``FrequencySweep``: one temperature → ``RationalFit``,
     several → ``ScheduledFit``.  ``settings`` go to the fitter's constructor."""
     data = from_sweep(sweep)
     if data.temperatures().size <= 1:

@@ -1,4 +1,12 @@
-"""Frequency-response data: validation, weighting, fingerprint, duck-typed sweep adapter.
+"""Frequency-response data for the fitters: a thin layer over ``physmodel.sweep.FrequencySweep``.
+
+The fitters accept a :class:`physmodel.sweep.FrequencySweep` directly.  :class:`FrequencyData`
+exists for what a sweep does not cover: data without a temperature (a single unspecified one),
+free-form unit labels, and the per-line log-domain standard deviations used by the weighting.
+Its validation *is* the sweep's (lengths, finiteness, f > 0, H ≠ 0, strictly increasing
+frequencies per temperature, both-or-neither standard deviations): ``__post_init__`` builds a
+``FrequencySweep`` and keeps its arrays; the only check added here is that standard deviations
+are > 0 (they become weights 1/σ).
 
 Hz and °C at the edges; the fitters convert to ω = 2πf [rad/s] inside.
 """
@@ -10,27 +18,28 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["FrequencyData", "from_sweep"]
+from physmodel.errors import IPMCError
+from physmodel.sweep import FrequencySweep
+
+__all__ = ["FrequencyData", "from_sweep", "to_data"]
 
 _LN10_OVER_20 = np.log(10.0) / 20.0
+_SWEEP_ATTRS = ("frequency_hz", "temperature_c", "response")
 
 
-def _as_1d_float(name: str, values, n: int | None = None) -> np.ndarray:
+def _temperature_column(temperature_c, n: int) -> np.ndarray | None:
+    """``None`` → ``None``; scalar → broadcast to ``n`` lines; array → float array. [°C]"""
+    if temperature_c is None:
+        return None
     try:
-        arr = np.asarray(values, dtype=float)
+        t = np.asarray(temperature_c, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be an array of real numbers ({exc})") from None
-    if arr.ndim != 1:
-        raise ValueError(f"{name} must be one-dimensional, got shape {arr.shape}")
-    if n is not None and arr.shape[0] != n:
-        raise ValueError(
-            f"{name} has length {arr.shape[0]} but frequency_hz has length {n}"
-        )
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(f"{name} contains a non-finite value ({float(arr[i])!r}) at index {i}")
-    return arr
+        raise IPMCError(f"temperature_c must be an array of real numbers or a scalar ({exc})") from None
+    if t.ndim == 0:
+        return np.full(n, float(t))
+    if t.shape != (n,):
+        raise IPMCError(f"temperature_c has shape {t.shape} but frequency_hz has {n} lines")
+    return t
 
 
 @dataclass(frozen=True)
@@ -40,18 +49,18 @@ class FrequencyData:
     Parameters
     ----------
     frequency_hz : array, shape (N,)
-        Excitation frequencies, strictly positive. [Hz]
+        Excitation frequencies, > 0 and strictly increasing within each temperature. [Hz]
     temperature_c : array, shape (N,), float or None
         Temperature of each line; a scalar is broadcast; ``None`` means a single
         unspecified temperature. [°C]
     response : complex array, shape (N,)
         Complex frequency response, nonzero. [output_unit/input_unit]
-    magnitude_std_db : array, shape (N,), optional
-        Standard deviation of the measured magnitude of each line. [dB]
-    phase_std_deg : array, shape (N,), optional
-        Standard deviation of the measured phase of each line. [deg]
+    magnitude_std_db, phase_std_deg : array, shape (N,), optional (both or neither)
+        Standard deviation of the measured magnitude [dB] and phase [deg] of each line, > 0.
     input_name, input_unit, output_name, output_unit : str
-        Labels carried into saved models and reports.
+        Labels carried into saved models and reports (free-form).
+    metadata : dict
+        Provenance.
     """
 
     frequency_hz: np.ndarray
@@ -66,59 +75,24 @@ class FrequencyData:
     metadata: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        f = _as_1d_float("frequency_hz", self.frequency_hz)
-        n = f.shape[0]
-        if n == 0:
-            raise ValueError("frequency_hz is empty: at least one frequency line is needed")
-        if (f <= 0).any():
-            i = int(np.argmax(f <= 0))
-            raise ValueError(f"frequency_hz must be > 0, got {float(f[i])!r} at index {i}")
-        try:
-            h = np.asarray(self.response, dtype=complex)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"response must be an array of complex numbers ({exc})") from None
-        if h.ndim != 1:
-            raise ValueError(f"response must be one-dimensional, got shape {h.shape}")
-        if h.shape[0] != n:
-            raise ValueError(
-                f"response has length {h.shape[0]} but frequency_hz has length {n}"
-            )
-        bad = ~np.isfinite(h)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise ValueError(
-                f"response contains a non-finite value ({complex(h[i])!r}) at index {i} "
-                f"(frequency_hz={float(f[i])!r})"
-            )
-        if (h == 0).any():
-            i = int(np.argmax(h == 0))
-            raise ValueError(
-                f"response is exactly zero at index {i} (frequency_hz={float(f[i])!r}); "
-                "log-magnitude and relative weighting need a nonzero response"
-            )
-        t = self.temperature_c
-        if t is not None:
-            t = _as_1d_float("temperature_c", [t] * n if np.ndim(t) == 0 else t, n)
-        stds = {}
+        n = int(np.size(self.frequency_hz))
+        t = _temperature_column(self.temperature_c, n)
+        # the sweep's checks, once; a missing temperature is one (arbitrary) temperature
+        sweep = FrequencySweep(np.zeros(n) if t is None else t, self.frequency_hz, self.response,
+                               self.magnitude_std_db, self.phase_std_deg)
         for name in ("magnitude_std_db", "phase_std_deg"):
-            v = getattr(self, name)
+            v = getattr(sweep, name)
+            if v is not None and np.any(v <= 0):
+                i = int(np.argmax(v <= 0))
+                raise IPMCError(f"{name} must be > 0 (it becomes a weight 1/σ), got {float(v[i])!r} at index {i}")
+        values = {"frequency_hz": sweep.frequency_hz, "response": sweep.response,
+                  "temperature_c": None if t is None else sweep.temperature_c,
+                  "magnitude_std_db": sweep.magnitude_std_db, "phase_std_deg": sweep.phase_std_deg}
+        for name, v in values.items():
             if v is not None:
-                v = _as_1d_float(name, v, n)
-                if (v <= 0).any():
-                    i = int(np.argmax(v <= 0))
-                    raise ValueError(f"{name} must be > 0, got {float(v[i])!r} at index {i}")
-            stds[name] = v
-        f.setflags(write=False)
-        h.setflags(write=False)
-        object.__setattr__(self, "frequency_hz", f)
-        object.__setattr__(self, "response", h)
-        object.__setattr__(self, "temperature_c", t)
-        for name, v in stds.items():
-            if v is not None:
+                v = v.copy()
                 v.setflags(write=False)
             object.__setattr__(self, name, v)
-        if t is not None:
-            t.setflags(write=False)
 
     # ------------------------------------------------------------------ views
     @property
@@ -132,7 +106,7 @@ class FrequencyData:
 
     @property
     def has_uncertainty(self) -> bool:
-        return self.magnitude_std_db is not None and self.phase_std_deg is not None
+        return self.magnitude_std_db is not None
 
     def temperatures(self) -> np.ndarray:
         """Sorted unique temperatures (empty if none were given). [°C]"""
@@ -144,7 +118,7 @@ class FrequencyData:
         """Subset of the lines selected by a boolean mask or index array."""
         idx = np.arange(self.n)[mask]
         if idx.size == 0:
-            raise ValueError("selection is empty")
+            raise IPMCError("selection is empty")
 
         def take(a):
             return None if a is None else a[idx]
@@ -157,18 +131,20 @@ class FrequencyData:
         )
 
     def at_temperature(self, temperature_c: float) -> "FrequencyData":
+        """The lines at one temperature (within 1e-9 °C)."""
         if self.temperature_c is None:
-            raise ValueError("these data carry no temperature")
+            raise IPMCError("these data carry no temperature")
         mask = np.isclose(self.temperature_c, temperature_c, rtol=0, atol=1e-9)
         if not mask.any():
-            raise ValueError(
+            raise IPMCError(
                 f"no data at temperature_c={temperature_c!r}; available: "
                 f"{self.temperatures().tolist()}"
             )
         return self.select(mask)
 
     def fingerprint(self) -> str:
-        """SHA-256 of the numerical content (float64, little-endian), as ``sha256:<hex>``."""
+        """SHA-256 of the numerical content including the standard deviations (float64,
+        little-endian; a missing column hashes as ``none``), as ``sha256:<hex>``."""
         hsh = hashlib.sha256()
         parts = [
             ("f", self.frequency_hz),
@@ -189,7 +165,7 @@ class FrequencyData:
     def log_std(self) -> tuple[np.ndarray, np.ndarray]:
         """Standard deviations of ln|H| [Np] and arg H [rad] per line."""
         if not self.has_uncertainty:
-            raise ValueError(
+            raise IPMCError(
                 "weighting='uncertainty' needs both magnitude_std_db and phase_std_deg"
             )
         return self.magnitude_std_db * _LN10_OVER_20, np.deg2rad(self.phase_std_deg)
@@ -202,15 +178,13 @@ class FrequencyData:
 
 
 def from_sweep(sweep) -> FrequencyData:
-    """Adapter for a ``physmodel.sweep.FrequencySweep`` (duck-typed, no import).
-
-    Uses only the attributes ``temperature_c``, ``frequency_hz``, ``response``,
-    ``magnitude_std_db``, ``phase_std_deg``, ``input_name``, ``input_unit``,
-    ``output_name``, ``output_unit`` and ``metadata``.
-    """
-    missing = [a for a in ("frequency_hz", "temperature_c", "response") if not hasattr(sweep, a)]
+    """``FrequencyData`` of a ``physmodel.sweep.FrequencySweep`` (or any object with its
+    attributes ``frequency_hz``, ``temperature_c``, ``response`` and, optionally,
+    ``magnitude_std_db``, ``phase_std_deg``, ``input_name``, ``input_unit``, ``output_name``,
+    ``output_unit``, ``metadata``)."""
+    missing = [a for a in _SWEEP_ATTRS if not hasattr(sweep, a)]
     if missing:
-        raise ValueError(f"sweep object lacks attribute(s) {missing}")
+        raise IPMCError(f"sweep object lacks attribute(s) {missing}; expected a physmodel FrequencySweep")
     return FrequencyData(
         frequency_hz=sweep.frequency_hz,
         temperature_c=sweep.temperature_c,
@@ -223,3 +197,13 @@ def from_sweep(sweep) -> FrequencyData:
         output_unit=str(getattr(sweep, "output_unit", "")),
         metadata=dict(getattr(sweep, "metadata", {}) or {}),
     )
+
+
+def to_data(data) -> FrequencyData:
+    """What every fitter's ``fit_data`` accepts: a ``FrequencyData`` (returned as is) or a
+    ``FrequencySweep`` / sweep-like object (converted by :func:`from_sweep`)."""
+    if isinstance(data, FrequencyData):
+        return data
+    if isinstance(data, FrequencySweep) or all(hasattr(data, a) for a in _SWEEP_ATTRS):
+        return from_sweep(data)
+    raise IPMCError(f"expected FrequencyData or a physmodel FrequencySweep, got {type(data).__name__}")

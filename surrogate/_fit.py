@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._data import FrequencyData
+from ._data import FrequencyData, to_data
 from ._nlp import ConvergenceError, Problem, SolveOutcome, Solver, covariance
 from ._structure import Structure
 from .metrics import fit_percent, relative_rms_error
@@ -16,8 +16,10 @@ WEIGHTINGS = ("auto", "uncertainty", "log", "relative")
 
 
 def as_data(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg) -> FrequencyData:
-    if isinstance(frequency_hz, FrequencyData):
-        return frequency_hz
+    """Arrays → ``FrequencyData``; a ``FrequencyData`` or ``FrequencySweep`` passed as the first
+    argument (the others ``None``) is taken as the data."""
+    if temperature_c is None and response is None:
+        return to_data(frequency_hz)
     return FrequencyData(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg)
 
 
@@ -191,17 +193,44 @@ def history_entry(stage: str, start: str, out: SolveOutcome) -> dict:
 
 
 def best_outcome(outcomes, prefer: str | None = None, rel_tol: float = 0.02):
-    """Lowest-cost converged outcome, else the lowest-cost one (flagged).
+    """Lowest-cost converged outcome, unless an unconverged one is more than ``rel_tol``
+    cheaper (then that one, flagged: a converged poor local minimum is not reported as the
+    answer); with no converged outcome, the lowest-cost one (flagged).
 
     If ``prefer`` names a converged start whose cost is within ``rel_tol`` of the best, it
     wins (continuation across temperatures keeps section identities that way)."""
+    def cost(o):
+        return o[1].cost if np.isfinite(o[1].cost) else np.inf
+
     ok = [o for o in outcomes if o[1].converged]
-    pool = ok or outcomes
-    best = min(pool, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)
+    lowest = min(outcomes, key=cost)
+    if not ok:
+        return lowest
+    best = min(ok, key=cost)
+    if cost(lowest) < cost(best) * (1 - rel_tol):
+        return lowest
     for o in ok:
         if o[0] == prefer and o[1].cost <= best[1].cost * (1 + rel_tol) + 1e-300:
             return o
     return best
+
+
+#: iteration budget (× max_iter) of the one resumed solve, see :func:`resume_slowest`
+RESUME_FACTOR = 6
+
+
+def resume_slowest(outcomes: list, solve_long, history: list, stage: str) -> None:
+    """If the lowest-cost outcome ran out of iterations, resume it once from where it stopped
+    with ``solve_long(theta)`` (a solver with ``RESUME_FACTOR × max_iter`` iterations) and
+    append the new outcome.  Slow is not failed: poles and zeros far outside the data band
+    are weakly determined and IPOPT can need over a thousand iterations to settle them; a
+    fresh solve restarts the barrier, so only one long resume is tried."""
+    name, low = min(outcomes, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)
+    if low.converged or low.status != "Maximum_Iterations_Exceeded":
+        return
+    out = solve_long(low.theta)
+    history.append(history_entry(f"{stage} (resumed, {RESUME_FACTOR}× max_iter)", name, out))
+    outcomes.append((name, out))
 
 
 def finish(structure, problem: Problem, solver: Solver | None, outcome: SolveOutcome, scaling: Scaling,

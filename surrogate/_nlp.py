@@ -116,15 +116,18 @@ class Solver:
     One compiled solver serves every problem with the same structure, number of lines and
     residual kind (e.g. all temperatures of a two-stage fit); use :func:`get_solver`.
 
-    ``grid_taus`` (scheduled models): the log pole-section slots are kept inside
-    ``Structure.slot_bounds`` at these scaled temperatures (linear constraints), and for the
+    ``grid_taus`` (scheduled models): the log pole-section slots (and the 'zpk' zero-section
+    slots) are kept inside ``Structure.slot_bounds`` at these scaled temperatures (linear
+    constraints), and for the
     ``coefficients`` form with ``hurwitz=True`` the Liénard–Chipart conditions (all
-    denominator coefficients > 0 and Hurwitz minors Δ_{n-1}, Δ_{n-3}, … > 0) are imposed there.
+    denominator coefficients > 0 and Hurwitz minors Δ_{n-1}, Δ_{n-3}, … > 0) are imposed there
+    on the shifted denominator D(s̃ − ``pole_margin``), i.e. every pole has Re s̃ < −pole_margin
+    at the grid temperatures (a margin, so that poles cannot cross the axis between them).
     """
 
     def __init__(self, structure: Structure, n_points: int, kind: str, *, max_iter: int = 300,
                  tol: float = 1e-10, grid_taus=None, hurwitz: bool = False,
-                 hurwitz_margin: float = 1e-4):
+                 hurwitz_margin: float = 1e-4, pole_margin: float = 0.0):
         import casadi as ca
 
         st = self.structure = structure
@@ -138,7 +141,7 @@ class Solver:
         taus = np.asarray([] if grid_taus is None else grid_taus, float)
         if taus.size and st.degree > 0:
             nc = st.n_coef
-            for s_name in [s for s in st.slots if s.startswith("log_")]:
+            for s_name in [s for s in st.slots if s.startswith("log_")] + st.zero_slots:
                 j = st.slots.index(s_name) * nc
                 for tau in taus:
                     g.append(ca.dot(x[j:j + nc], ca.DM(tau ** np.arange(nc))))
@@ -146,7 +149,7 @@ class Solver:
         if hurwitz and taus.size:
             if st.form != "coefficients":
                 raise ValueError("Hurwitz constraints apply to the 'coefficients' form only")
-            h = self._hurwitz_constraints(st, x, taus)
+            h = self._hurwitz_constraints(st, x, taus, pole_margin)
             g += h
             self._g_kinds += ["hurwitz"] * len(h)
         self.hurwitz_margin = hurwitz_margin
@@ -164,10 +167,14 @@ class Solver:
         self._jac = ca.Function("residual_jacobian", [x, p], [ca.jacobian(r, x)])
 
     @staticmethod
-    def _hurwitz_constraints(st: Structure, x, taus):
+    def _hurwitz_constraints(st: Structure, x, taus, shift: float = 0.0):
         import casadi as ca
+        from math import comb
 
         n, nc = st.n_poles, st.n_coef
+        # Taylor shift D(s) → D(s − shift): q_i = Σ_{k≥i} a_k C(k, i) (−shift)^(k−i), a_n = 1
+        tmat = np.array([[comb(k, i) * (-shift) ** (k - i) if k >= i else 0.0 for k in range(n + 1)]
+                         for i in range(n)])
         g = []
         for tau in taus:
             tp = ca.DM(tau ** np.arange(nc))
@@ -175,6 +182,9 @@ class Solver:
             for j in range(n):
                 k = st.slots.index(f"a{j}")
                 a.append(ca.dot(x[k * nc:(k + 1) * nc], tp))
+            a_all = a + [1.0]
+            a = [sum(float(tmat[i, k]) * a_all[k] for k in range(n + 1) if tmat[i, k] != 0.0)
+                 for i in range(n)]
             g += a  # Liénard–Chipart: all coefficients positive …
             hm = hurwitz_matrix([1.0] + a[::-1])
             for order in range(n - 1, 1, -2):  # … and Δ_{n-1}, Δ_{n-3}, … positive
@@ -213,16 +223,17 @@ class Solver:
 
 
 def get_solver(structure: Structure, n_points: int, kind: str, *, max_iter: int, tol: float,
-               grid_taus=None, hurwitz: bool = False) -> Solver:
+               grid_taus=None, hurwitz: bool = False, pole_margin: float = 0.0) -> Solver:
     """Cached :class:`Solver` (building one costs far more than solving a small fit)."""
     taus = None if grid_taus is None else tuple(np.round(np.asarray(grid_taus, float), 12))
-    key = (structure, int(n_points), kind, int(max_iter), float(tol), taus, bool(hurwitz))
+    key = (structure, int(n_points), kind, int(max_iter), float(tol), taus, bool(hurwitz),
+           float(pole_margin))
     solver = _CACHE.get(key)
     if solver is None:
         if len(_CACHE) >= _CACHE_MAX:
             _CACHE.pop(next(iter(_CACHE)))
         solver = Solver(structure, n_points, kind, max_iter=max_iter, tol=tol,
-                        grid_taus=taus, hurwitz=hurwitz)
+                        grid_taus=taus, hurwitz=hurwitz, pole_margin=pole_margin)
         _CACHE[key] = solver
     return solver
 

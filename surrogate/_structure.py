@@ -103,12 +103,24 @@ class Structure:
         """True for parameters of log-parametrised (positive) slots."""
         return np.repeat([s.startswith("log_") for s in self.slots], self.n_coef)
 
+    @property
+    def zero_slots(self) -> list[str]:
+        """The 'zpk' zero-section slots (empty for the other forms)."""
+        if self.form != "zpk":
+            return []
+        return [s for s in self.slots if s.startswith(("zc1_", "zc0_")) or s == "ze"]
+
     def slot_bounds(self, w_min: float = None, w_max: float = None, window: float = 1e3) -> dict:
-        """Bounds on the values of the log-slots (pole-section coefficients).
+        """Bounds on the values of the log-slots (pole-section coefficients) and, with a band,
+        of the 'zpk' zero-section slots.
 
         With the scaled band [w_min, w_max], poles are kept within [w_min/window,
-        w_max·window] in magnitude and section damping above 1e-4: poles far outside the
-        data band are not identifiable and would only drift towards 0 or ∞.
+        w_max·window] in magnitude and section damping above 1e-4, and zero sections
+        (s̃² + c1 s̃ + c0), (s̃ + e) within |c0| ≤ Z², |c1| ≤ 2Z, |e| ≤ Z, Z = w_max·window
+        (zeros within about 2Z): poles and zeros far outside the data band are not
+        identifiable and would only drift towards 0 or ∞ (a monic zero section cannot reach
+        a zero at infinity, so without a bound the gain and the section drift together and
+        IPOPT runs out of iterations).
         """
         out = {}
         if w_min is None:
@@ -123,11 +135,16 @@ class Structure:
                 out[s] = (lo_p + np.log(2e-4), np.log(2.0) + hi_p)
             else:
                 out[s] = (lo_p, hi_p)
+        z = w_max * window
+        for s in self.zero_slots:
+            lim = z * z if s.startswith("zc0") else (2 * z if s.startswith("zc1") else z)
+            out[s] = (-lim, lim)
         return out
 
     def bounds(self, w_min: float = None, w_max: float = None) -> tuple[np.ndarray, np.ndarray]:
         """Parameter bounds: degree 0 applies ``slot_bounds`` directly; otherwise only a
-        generous box (the scheduled fitter imposes ``slot_bounds`` on a temperature grid)."""
+        generous box on the log slots (the scheduled fitter imposes ``slot_bounds`` on a
+        temperature grid)."""
         lo = np.full(self.n_params, -np.inf)
         hi = np.full(self.n_params, np.inf)
         sb = self.slot_bounds(w_min, w_max) if self.degree == 0 else self.slot_bounds()

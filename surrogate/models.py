@@ -188,6 +188,27 @@ class RationalModel:
         h = S.response(self.structure, self._params, w, tau)
         return (self.scaling.gain_ref * h).reshape(shape)
 
+    def response_std(self, frequency_hz, temperature_c=None, *, extrapolate=False) -> np.ndarray:
+        """Standard deviation of the complex response implied by the parameter covariance
+        (delta method: sqrt(J Σ Jᴴ), J = ∂H/∂θ by central differences), same shape as
+        ``frequency_response``. [output/input]  For a fit with weighting 'uncertainty' this is
+        the noise-induced error of the model itself, e.g. at a held-out temperature."""
+        if self.covariance is None:
+            raise ValueError("this model carries no parameter covariance (e.g. a two-stage model)")
+        h0 = self.frequency_response(frequency_hz, temperature_c, extrapolate=extrapolate)
+        jac = np.empty(h0.shape + (self._params.size,), complex)
+        for i in range(self._params.size):
+            step = 1e-6 * max(1.0, abs(self._params[i]))
+            hs = []
+            for sign in (1.0, -1.0):
+                th = self._params.copy()
+                th[i] += sign * step
+                m = RationalModel(self.structure, th, self.scaling, self.temperature_range_c)
+                hs.append(m.frequency_response(frequency_hz, temperature_c, extrapolate=extrapolate))
+            jac[..., i] = (hs[0] - hs[1]) / (2 * step)
+        var = np.einsum("...i,ij,...j->...", jac, self.covariance, jac.conj()).real
+        return np.sqrt(np.clip(var, 0.0, None))
+
     def _scalar_tau(self, temperature_c, extrapolate):
         if temperature_c is not None and np.ndim(temperature_c) != 0:
             raise ValueError("temperature_c must be a scalar here")
@@ -220,19 +241,31 @@ class RationalModel:
         tau = self._scalar_tau(temperature_c, extrapolate)
         return self.scaling.omega_ref_rad_s * S.roots(self.structure, self._params, tau)[1]
 
+    def max_pole_real_part(self, temperature_c=None, *, extrapolate=False) -> np.ndarray:
+        """Largest pole real part at each temperature [rad/s] (shape of ``temperature_c``);
+        eigenvalues of the stacked companion matrices, one batched call."""
+        t = None if temperature_c is None else np.asarray(temperature_c, float)
+        shape = () if t is None else t.shape
+        taus = np.atleast_1d(self._tau(t, shape, extrapolate)).ravel()
+        den = np.array([S.polynomials(self.structure, self._params, tau)[1] for tau in taus])
+        n = den.shape[1] - 1
+        comp = np.zeros((taus.size, n, n))
+        comp[:, 0, :] = -den[:, -2::-1] / den[:, -1:]
+        comp[:, np.arange(1, n), np.arange(n - 1)] = 1.0
+        re = np.linalg.eigvals(comp).real.max(axis=1) * self.scaling.omega_ref_rad_s
+        return re.reshape(shape)
+
     def stability_check(self, n_temperatures: int = 501) -> StabilityCheck:
         """Largest pole real part over a dense grid of the validity range."""
         if self.is_scheduled:
             lo, hi = self.temperature_range_c
             grid = np.linspace(lo, hi, int(n_temperatures))
+            re = self.max_pole_real_part(grid)
         else:
-            grid = [None]
-        worst, worst_t = -np.inf, None
-        for t in grid:
-            re = float(np.max(self.poles(t).real))
-            if re > worst:
-                worst, worst_t = re, t
-        return StabilityCheck(bool(worst < 0), worst, None if worst_t is None else float(worst_t),
+            grid, re = [None], np.atleast_1d(self.max_pole_real_part())
+        i = int(np.argmax(re))
+        worst = float(re[i])
+        return StabilityCheck(bool(worst < 0), worst, None if grid[i] is None else float(grid[i]),
                               len(grid))
 
     # ------------------------------------------------------------ persistence

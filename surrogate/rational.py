@@ -7,7 +7,7 @@ import time
 import numpy as np
 
 from . import _fit as F
-from ._data import FrequencyData
+from ._data import FrequencyData, to_data
 from ._init import initial_candidates
 from ._nlp import get_solver
 from ._structure import Structure
@@ -80,8 +80,10 @@ class RationalFit:
                 "omega_ref_rad_s": self.omega_ref_rad_s, "gain_ref": self.gain_ref,
                 "scale_covariance": self.scale_covariance}
 
-    def fit(self, frequency_hz, temperature_c, response, magnitude_std_db=None, phase_std_deg=None):
-        """Fit one temperature's data (``temperature_c`` scalar, constant array or None).
+    def fit(self, frequency_hz, temperature_c=None, response=None, magnitude_std_db=None,
+            phase_std_deg=None):
+        """Fit one temperature's data (``temperature_c`` scalar, constant array or None), or a
+        ``FrequencySweep`` / ``FrequencyData`` passed alone.
 
         Units: ``frequency_hz`` [Hz], ``temperature_c`` [°C], ``response`` complex
         [output/input], ``magnitude_std_db`` [dB], ``phase_std_deg`` [deg].
@@ -91,12 +93,13 @@ class RationalFit:
         return self.fit_data(data)
 
     def fit_data(self, data: FrequencyData, theta0=None, *, stage: str = "per-temperature"):
-        """Fit a ``FrequencyData``.
+        """Fit a ``FrequencyData`` or a ``physmodel.sweep.FrequencySweep``.
 
         ``theta0`` (same layout, e.g. a neighbouring temperature's solution) is an extra
         start that is kept unless another start is more than 2 % better.
         """
         t_start = time.perf_counter()
+        data = to_data(data)
         temps = data.temperatures()
         if temps.size > 1:
             raise ValueError(
@@ -128,6 +131,12 @@ class RationalFit:
             out = solver.solve(problem, th)
             history.append(F.history_entry(stage, name, out))
             outcomes.append((name, out))
+
+        def solve_long(theta):
+            return get_solver(st, problem.n_points, problem.kind, tol=self.tol,
+                              max_iter=F.RESUME_FACTOR * self.max_iter).solve(problem, theta)
+
+        F.resume_slowest(outcomes, solve_long, history, stage)
         _, best = F.best_outcome(outcomes, prefer="warm")
         temp_range = None if not temps.size else (float(temps[0]), float(temps[0]))
         res = F.finish(st, problem, solver, best, scaling, data, weighting_name=wname,

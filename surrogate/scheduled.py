@@ -3,7 +3,8 @@
 Two-stage (seed 000, seed 001): fit each temperature, then fit each coefficient / gain,
 zero and pole entry with a polynomial in T.  Joint: one NLP over all temperatures whose
 unknowns are the polynomial coefficients themselves, started from the two-stage answer and
-from a constant schedule (the lower converged cost wins).
+from a constant schedule (the lower converged cost wins, unless an unconverged solve is
+cheaper: then that one is returned, flagged).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import time
 import numpy as np
 
 from . import _fit as F
-from ._data import FrequencyData
+from ._data import FrequencyData, to_data
 from ._init import levy
 from ._nlp import SolveOutcome, get_solver
 from ._structure import Structure, convert
@@ -24,6 +25,8 @@ __all__ = ["ScheduledFit"]
 
 _FORMS = ("coefficients", "zpk", "sections")
 _METHODS = ("joint", "two-stage")
+_DENSE_CHECK = 501   # temperatures of the final stability check (FitResult.stability)
+_MAX_REFINE = 4      # rounds of adding unstable temperatures to the Hurwitz constraint grid
 
 
 class ScheduledFit:
@@ -56,7 +59,11 @@ class ScheduledFit:
     enforce_stability : bool
         Only for form='coefficients' (the other forms are stable by construction).
     stability_grid : int
-        Number of temperatures on which the constraints are imposed.
+        Number of temperatures on which the constraints are imposed at first; temperatures
+        where the 501-point check still finds an unstable pole are added (up to 4 rounds).
+    stability_margin : float
+        Form 'coefficients' with constraints: every pole has Re s < −stability_margin·ω_ref
+        at the constrained temperatures (so none crosses the axis between them). [-]
     omega_ref_rad_s, gain_ref, temperature_center_c, temperature_scale_c : float, optional
         Scales (defaults from the data: geometric means; mid-range and half-range). [rad/s],
         [output/input], [°C], [°C]
@@ -68,7 +75,7 @@ class ScheduledFit:
 
     def __init__(self, form: str = "zpk", n_zeros: int = 3, n_poles: int = 3, degree: int = 2, *,
                  method: str = "joint", weighting: str = "auto", enforce_stability: bool = True,
-                 stability_grid: int = 41, max_iter: int = 500, tol: float = 1e-10,
+                 stability_grid: int = 41, stability_margin: float = 1e-3, max_iter: int = 500, tol: float = 1e-10,
                  omega_ref_rad_s: float | None = None, gain_ref: float | None = None,
                  temperature_center_c: float | None = None, temperature_scale_c: float | None = None,
                  per_temperature: str = "nlp", raise_on_failure: bool = True,
@@ -83,6 +90,8 @@ class ScheduledFit:
         self.weighting = F.check_weighting(weighting)
         self.enforce_stability = bool(enforce_stability)
         self.stability_grid = F.check_positive_int("stability_grid", stability_grid, 2)
+        self.stability_margin = F.check_positive_float("stability_margin", stability_margin,
+                                                       allow_none=False)
         self.max_iter = F.check_positive_int("max_iter", max_iter)
         self.tol = F.check_positive_float("tol", tol, allow_none=False)
         self.omega_ref_rad_s = F.check_positive_float("omega_ref_rad_s", omega_ref_rad_s)
@@ -101,15 +110,18 @@ class ScheduledFit:
         return {"estimator": "ScheduledFit", "form": self.form, "n_zeros": self.n_zeros,
                 "n_poles": self.n_poles, "degree": self.degree, "method": self.method,
                 "weighting": self.weighting, "enforce_stability": self.enforce_stability,
-                "stability_grid": self.stability_grid, "max_iter": self.max_iter, "tol": self.tol,
+                "stability_grid": self.stability_grid,
+                "stability_margin": self.stability_margin, "max_iter": self.max_iter, "tol": self.tol,
                 "omega_ref_rad_s": self.omega_ref_rad_s, "gain_ref": self.gain_ref,
                 "temperature_center_c": self.temperature_center_c,
                 "temperature_scale_c": self.temperature_scale_c,
                 "per_temperature": self.per_temperature,
                 "scale_covariance": self.scale_covariance}
 
-    def fit(self, frequency_hz, temperature_c, response, magnitude_std_db=None, phase_std_deg=None):
-        """Fit tidy data (one line per frequency and temperature).
+    def fit(self, frequency_hz, temperature_c=None, response=None, magnitude_std_db=None,
+            phase_std_deg=None):
+        """Fit tidy data (one line per frequency and temperature), or a ``FrequencySweep`` /
+        ``FrequencyData`` passed alone.
 
         Units: ``frequency_hz`` [Hz], ``temperature_c`` [°C] (N,), ``response`` complex
         [output/input], ``magnitude_std_db`` [dB], ``phase_std_deg`` [deg].
@@ -169,8 +181,66 @@ class ScheduledFit:
         coef = np.polynomial.polynomial.polyfit(tau, y, st.degree)  # (degree+1, n_slots)
         return np.asarray(coef, float).T.ravel()
 
+    def _joint(self, problem, scaling, t_range, per_t, theta2, history):
+        """One NLP over all temperatures from two starts (two-stage answer; constant schedule
+        of the mid-range per-T fit).  Returns ``(solver, outcome)``.
+
+        * form 'coefficients': a converged solve with a pole at or right of the axis anywhere
+          on the 501-point grid is re-solved with Liénard–Chipart constraints (margin
+          ``stability_margin``) on ``stability_grid`` temperatures, refined where the dense
+          check still fails;
+        * every start is solved (a converged two-stage start can be a poor local minimum:
+          sensor zpk 2/2, cost 112 vs 0.49), and the lowest converged cost wins;
+        * if the lowest cost belongs to a solve that ran out of iterations (slow, not failed:
+          far-out zeros are weakly determined), it is resumed once with
+          ``RESUME_FACTOR × max_iter`` iterations (``_fit.resume_slowest``); if it still
+          does not converge, the result is that solve, flagged (``_fit.best_outcome``).
+        """
+        st = self.structure
+        c, sc = scaling.temperature_center_c, scaling.temperature_scale_c
+        taus = np.linspace((t_range[0] - c) / sc, (t_range[1] - c) / sc, self.stability_grid)
+        dense_t = np.linspace(t_range[0], t_range[1], _DENSE_CHECK)
+        hurwitz = st.form == "coefficients" and self.enforce_stability
+
+        def solver_for(grid, constrained, budget=1):
+            return get_solver(st, problem.n_points, problem.kind, max_iter=budget * self.max_iter,
+                              tol=self.tol, grid_taus=grid, hurwitz=constrained,
+                              pole_margin=self.stability_margin if constrained else 0.0)
+
+        def unstable(theta):
+            return RationalModel(st, theta, scaling, t_range).max_pole_real_part(dense_t) >= 0
+
+        mid = min(per_t, key=lambda t: abs(t - c))
+        st0, th0 = per_t[mid][:2]
+        const = np.zeros((len(st.slots), st.n_coef))
+        const[:, 0] = th0 if st0.form == st.form else convert(st0, th0, st.form)
+        outcomes, setups = [], {}
+        for name, th in (("two-stage", theta2), ("constant", const.ravel())):
+            grid, constrained = taus, False
+            out = solver_for(grid, False).solve(problem, th)
+            history.append(F.history_entry("joint", name, out))
+            if out.converged and hurwitz and unstable(out.theta).any():
+                constrained, th = True, (th if not unstable(th).any() else out.theta)
+                for _ in range(_MAX_REFINE + 1):
+                    out = solver_for(grid, True).solve(problem, th)
+                    history.append(F.history_entry(
+                        f"joint (Hurwitz constraints at {grid.size} temperatures)", name, out))
+                    bad = unstable(out.theta)
+                    if not out.converged or not bad.any():
+                        break
+                    grid, th = np.union1d(grid, (dense_t[bad] - c) / sc), out.theta
+            outcomes.append((name, out))
+            setups[name] = (grid, constrained)
+        low = min(outcomes, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)[0]
+        F.resume_slowest(outcomes, lambda th: solver_for(*setups[low], F.RESUME_FACTOR).solve(problem, th),
+                         history, "joint")
+        name, best = F.best_outcome(outcomes)
+        return solver_for(*setups[name]), best
+
     def fit_data(self, data: FrequencyData):
+        """Fit a ``FrequencyData`` or a ``physmodel.sweep.FrequencySweep``."""
         t_start = time.perf_counter()
+        data = to_data(data)
         st = self.structure
         if data.temperature_c is None:
             raise ValueError("ScheduledFit needs temperature_c for every line")
@@ -205,39 +275,7 @@ class ScheduledFit:
         if self.method == "two-stage":
             res = two_res
         else:
-            lo = (t_range[0] - scaling.temperature_center_c) / scaling.temperature_scale_c
-            hi = (t_range[1] - scaling.temperature_center_c) / scaling.temperature_scale_c
-            taus = np.linspace(lo, hi, self.stability_grid)
-            hurwitz = st.form == "coefficients" and self.enforce_stability
-            solver = get_solver(st, problem.n_points, problem.kind, max_iter=self.max_iter,
-                                tol=self.tol, grid_taus=taus)
-            mid = min(per_t, key=lambda t: abs(t - scaling.temperature_center_c))
-            st0, th0 = per_t[mid][:2]
-            const = np.zeros((len(st.slots), st.n_coef))
-            const[:, 0] = th0 if st0.form == st.form else convert(st0, th0, st.form)
-            starts = [("two-stage", theta2), ("constant", const.ravel())]
-
-            def stable(theta):
-                m = RationalModel(st, theta, scaling, t_range)
-                return m.stability_check(4 * self.stability_grid).stable
-
-            outcomes = []
-            for name, th in starts:
-                out = solver.solve(problem, th)
-                history.append(F.history_entry("joint", name, out))
-                if out.converged and hurwitz and not stable(out.theta):
-                    # the coefficients form is not stable by construction: impose the
-                    # Liénard–Chipart conditions on the grid, from the two-stage start
-                    h_solver = get_solver(st, problem.n_points, problem.kind, max_iter=self.max_iter,
-                                          tol=self.tol, grid_taus=taus, hurwitz=True)
-                    out = h_solver.solve(problem, th if stable(th) else out.theta)
-                    history.append(F.history_entry("joint (Hurwitz constraints)", name, out))
-                    solver = h_solver
-                outcomes.append((name, out))
-                # no early exit: a converged two-stage start can still be a poor local minimum
-                # (physmodel sensor sweeps, zpk 2/2: cost 112 vs 0.49 from the constant start),
-                # so every start is solved and the lowest converged cost wins
-            _, best = F.best_outcome(outcomes)
+            solver, best = self._joint(problem, scaling, t_range, per_t, theta2, history)
             res = F.finish(st, problem, solver, best, scaling, data, weighting_name=wname,
                            method="joint", settings=settings,
                            scale_covariance=self.scale_covariance, history=history,

@@ -73,16 +73,17 @@ class OrderSelectionReport:
         return "\n".join(lines)
 
 
-def order_selection(frequency_hz, temperature_c, response, orders, magnitude_std_db=None,
-                    phase_std_deg=None, *, weighting: str = "auto", stable: bool = True,
+def order_selection(frequency_hz, temperature_c=None, response=None, orders=None,
+                    magnitude_std_db=None, phase_std_deg=None, *, weighting: str = "auto", stable: bool = True,
                     max_iter: int = 300) -> OrderSelectionReport:
     """Fit every (n_zeros, n_poles) in ``orders`` at every temperature and tabulate the errors.
 
-    Units as in ``RationalFit.fit``.  Fits that do not converge are kept and flagged in the
-    ``converged`` column (never dropped silently).
+    Units as in ``RationalFit.fit``; a ``FrequencySweep`` / ``FrequencyData`` may be passed as
+    the first argument instead of the arrays (``orders`` then by keyword).  Fits that do not
+    converge are kept and flagged in the ``converged`` column (never dropped silently).
     """
     data = F.as_data(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg)
-    orders = [tuple(int(v) for v in o) for o in orders]
+    orders = [tuple(int(v) for v in o) for o in (orders or [])]
     if not orders:
         raise ValueError("orders is empty")
     temps = [None] if data.temperature_c is None else list(data.temperatures())

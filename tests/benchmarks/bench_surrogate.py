@@ -9,15 +9,22 @@ through ``surrogate.from_sweep``; the noise-free truth is the same call with ``n
 
 Samples (``SAMPLES``):
   * seed-002 sample  — ``ActuatorModel(get_parameter_set("seed002_table3"))``, quantity "M" [mm/V]
-  * seed-001 geometry — ``ActuatorModel(get_parameter_set("seed001_actuator_dev"))`` (seed 001's
-    45 x 11 x 0.3 mm strip with development material values), quantity "M" [mm/V]
-  * seed-001 geometry, r1' = 2 Ω — the same with ``r1_sheet=2.0`` (a labelled sensitivity case:
-    lower electrode resistance, where a 3/3 model comes close to the noise floor)
-  * seed-000 sensor  — ``SensorModel(get_parameter_set("seed000_sensor_dev"))``, quantity "S" [µA/mm]
+  * seed-001 actuator — ``ActuatorModel(get_parameter_set("seed001_actuator"))`` (seed 001's
+    45 x 11 x 0.3 mm strip, E and the C⁻ temperature law calibrated to the printed 19-vs-55 °C
+    trend), quantity "M" [mm/V]
+  * seed-001 actuator, r1' = 2 Ω — the same with ``r1_sheet=2.0`` (a labelled sensitivity case:
+    lower electrode resistance)
+  * seed-000 sensor  — ``SensorModel(get_parameter_set("seed000_sensor"))`` (calibrated to seed
+    000's printed 35 °C model; temperature laws chosen for the published trend directions),
+    quantity "S" [µA/mm]
 
 Prints:
   1. held-out error at 35 and 45 °C (excluded from the fit): joint scheduled fit vs the
-     two-stage method (papers' Levy/invfreqs first stage, and our stable-NLP first stage);
+     two-stage method (papers' Levy/invfreqs first stage, and our stable-NLP first stage), with
+     the floors that decide whether the goal "joint ≤ ½ two-stage" is reachable at all: the
+     order-limited floor (best fit of that order to the noise-free response at the held-out
+     temperature) and the joint model's own noise-induced error (delta method); then the
+     joint fit's convergence over ten noise seeds;
   2. per-temperature fit error and pole stability vs scipy AAA, scikit-rf VectorFitting and a
      Levy linear least-squares fit, at equal order, with times;
   3. fit times: joint fit (10 temperatures x 60 frequencies, order 4/4, cubic schedules) vs the
@@ -54,27 +61,27 @@ ORDER_NOISE = MagnitudePhaseNoise(0.3, 2.0)    # order-selection protocol (as be
 # name -> (model class, parameter set, overrides, quantity)
 SAMPLES = {
     "seed-002 sample": ("actuator", "seed002_table3", {}, "M"),
-    "seed-001 geometry": ("actuator", "seed001_actuator_dev", {}, "M"),
-    "seed-001 geometry, r1'=2 Ω": ("actuator", "seed001_actuator_dev", {"r1_sheet": 2.0}, "M"),
-    "seed-000 sensor": ("sensor", "seed000_sensor_dev", {}, "S"),
+    "seed-001 actuator": ("actuator", "seed001_actuator", {}, "M"),
+    "seed-001 actuator, r1'=2 Ω": ("actuator", "seed001_actuator", {"r1_sheet": 2.0}, "M"),
+    "seed-000 sensor": ("sensor", "seed000_sensor", {}, "S"),
 }
 TEMPS = {"seed-000 sensor": SEED000_TEMPS}
 
 
-def physics_model(sample: str):
+def physics_model(sample: str, extra=None):
     kind, name, overrides, _ = SAMPLES[sample]
-    params = physmodel.get_parameter_set(name, **overrides)
+    params = physmodel.get_parameter_set(name, **{**overrides, **(extra or {})})
     return physmodel.ActuatorModel(params) if kind == "actuator" else physmodel.SensorModel(params)
 
 
-def generate_sweep(sample: str, temperatures_c, frequency_hz, seed: int, noise=NOISE):
+def generate_sweep(sample: str, temperatures_c, frequency_hz, seed: int, noise=NOISE, overrides=None):
     """THE data source of this benchmark.
 
     Returns ``(data, truth)``: ``data = surrogate.from_sweep(synthesize_sweep(..., noise, seed))``
     (a ``FrequencyData`` carrying the noise's per-line std) and the noise-free response on the
     same lines (``synthesize_sweep(..., noise=None)``).
     """
-    model = physics_model(sample)
+    model = physics_model(sample, overrides)
     q = SAMPLES[sample][3]
     sweep = synthesize_sweep(model, q, frequency_hz, temperatures_c, noise, seed=seed)
     exact = synthesize_sweep(model, q, frequency_hz, temperatures_c, None)
@@ -91,10 +98,10 @@ def _noise_floor(noise) -> float:
 # --------------------------------------------------------------------------- 1. held-out
 HELD_OUT_CASES = [  # sample, band [Hz], lines, form, zeros, poles, degree, note
     ("seed-002 sample", (0.1, 20.0), 60, "coefficients", 4, 4, 3, ""),
-    ("seed-001 geometry", (0.1, 9.0), 30, "zpk", 3, 3, 2, "seed 001's model"),
-    ("seed-001 geometry", (0.1, 9.0), 30, "zpk", 4, 4, 2, "order the physics needs"),
-    ("seed-001 geometry", (0.1, 9.0), 30, "coefficients", 4, 4, 2, ""),
-    ("seed-001 geometry, r1'=2 Ω", (0.1, 9.0), 30, "zpk", 3, 3, 2, "seed 001's model"),
+    ("seed-001 actuator", (0.1, 9.0), 30, "zpk", 3, 3, 2, "seed 001's model"),
+    ("seed-001 actuator", (0.1, 9.0), 30, "zpk", 4, 4, 2, "order the physics needs"),
+    ("seed-001 actuator", (0.1, 9.0), 30, "coefficients", 4, 4, 2, ""),
+    ("seed-001 actuator, r1'=2 Ω", (0.1, 9.0), 30, "zpk", 3, 3, 2, "seed 001's model"),
     ("seed-000 sensor", (10.0, 100.0), 60, "coefficients", 4, 4, 3, "seed 000's model"),
     ("seed-000 sensor", (10.0, 100.0), 60, "coefficients", 2, 2, 3, "lowest order at the noise floor"),
     ("seed-000 sensor", (10.0, 100.0), 60, "zpk", 2, 2, 3, "lowest order at the noise floor"),
@@ -110,6 +117,25 @@ def _held_out_errors(model, data, truth):
     return out
 
 
+def _floors(data, truth, m, n):
+    """Reference errors at each held-out temperature (against the noise-free response):
+
+    * ``order``: best stable m/n fit to the *noise-free* response at that temperature — no
+      model of this order can do better there, whatever it is fitted to (order-limited floor);
+    * ``own``: m/n fit to that temperature's own *noisy* data — what measuring the held-out
+      temperature would have given (noise-limited reference).
+    """
+    out = {}
+    for temp in HELD_OUT:
+        k = data.temperature_c == temp
+        f = data.frequency_hz[k]
+        exact = RationalFit(m, n, raise_on_failure=False).fit(f, temp, truth[k])
+        own = RationalFit(m, n, raise_on_failure=False).fit_data(data.at_temperature(temp))
+        out[temp] = (relative_rms_error(exact.model.frequency_response(f), truth[k]),
+                     relative_rms_error(own.model.frequency_response(f), truth[k]))
+    return out
+
+
 def held_out_section(quick: bool):
     print("\n## 1. Held-out temperatures (35 and 45 °C excluded from the fit)\n")
     print(f"Actuators: fit on {[t for t in SEED001_TEMPS if t not in HELD_OUT]} °C (seed 001); "
@@ -119,17 +145,27 @@ def held_out_section(quick: bool):
     print("Errors are relative RMS errors against the noise-free physics response at the held-out temperature, "
           "mean over the noise seeds (worst seed in brackets). Ratios: of the means, and of the medians. "
           "'joint ok' = joint fits that converged AND whose poles are stable on a 501-point T grid "
-          "(largest pole real part over grid and seeds in brackets, rad/s).\n")
+          "(largest pole real part over grid and seeds in brackets, rad/s). "
+          "Floors (means over seeds): 'order' = best fit of this order to the noise-free response AT the held-out "
+          "temperature (no model of this order does better there); 'own data' = fit of this order to the "
+          "held-out temperature's own noisy data; 'joint σ' = RMS relative standard deviation of the joint "
+          "model's response at the held-out temperature from its own parameter covariance (delta method, "
+          "RationalModel.response_std): the noise-induced error the joint fit is expected to have. "
+          "Verdict: 'met'; 'order-limited' when the order floor exceeds half the papers' two-stage error "
+          "(unreachable at this order); 'noise-limited' when the joint fit's own expected noise error σ "
+          "exceeds half the papers' error (reaching the goal would take beating the model's noise floor); "
+          "'joint / own data' < 1 means the joint model predicts the unmeasured temperature better than a fit "
+          "to that temperature's own measurement.\n")
     seeds = [1, 2] if quick else [1, 2, 3, 4, 5]
     print("| data | band [Hz] × lines | form | order | degree | T [°C] | joint | two-stage (Levy = papers') | "
-          "two-stage (our NLP) | joint / papers' (mean; median) | joint / NLP two-stage (mean; median) | "
-          "joint ok | joint time [s] |")
-    print("|:--|:--|:--|:--|--:|--:|--:|--:|--:|--:|--:|:--:|--:|")
+          "two-stage (our NLP) | floor: order | floor: own data | joint σ (delta) | joint / papers' (mean; median) | "
+          "joint / NLP two-stage (mean; median) | verdict | joint ok | joint time [s] |")
+    print("|:--|:--|:--|:--|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|:--|:--:|--:|")
     summary = []
     for sample, band, nf, form, m, n, deg, note in HELD_OUT_CASES:
         f1 = np.geomspace(band[0], band[1], nf)
         temps = TEMPS.get(sample, SEED001_TEMPS)
-        acc = {k: {t: [] for t in HELD_OUT} for k in ("joint", "levy", "nlp")}
+        acc = {k: {t: [] for t in HELD_OUT} for k in ("joint", "levy", "nlp", "order", "own", "sigma")}
         n_ok, max_re, times = 0, -np.inf, []
         for seed in seeds:
             data, truth = generate_sweep(sample, temps, f1, seed)
@@ -145,6 +181,12 @@ def held_out_section(quick: bool):
             for key, model in (("joint", res.model), ("levy", res_levy.model), ("nlp", res.two_stage)):
                 for temp, e in _held_out_errors(model, data, truth).items():
                     acc[key][temp].append(e[0])
+            for temp, (e_order, e_own) in _floors(data, truth, m, n).items():
+                acc["order"][temp].append(e_order)
+                acc["own"][temp].append(e_own)
+                k = data.temperature_c == temp
+                rel_std = res.model.response_std(data.frequency_hz[k], temp) / np.abs(truth[k])
+                acc["sigma"][temp].append(float(np.sqrt(np.mean(rel_std ** 2))))
         label = sample + (f" ({note})" if note else "")
         for temp in HELD_OUT:
             mean = {k: float(np.mean(acc[k][temp])) for k in acc}
@@ -152,11 +194,20 @@ def held_out_section(quick: bool):
             worst = {k: float(np.max(acc[k][temp])) for k in acc}
             r_levy, r_nlp = mean["joint"] / mean["levy"], mean["joint"] / mean["nlp"]
             q_levy, q_nlp = med["joint"] / med["levy"], med["joint"] / med["nlp"]
-            summary.append((label, form, m, temp, r_levy, r_nlp, q_levy))
+            if r_levy <= 0.5:
+                verdict = "met"
+            elif mean["order"] > 0.5 * mean["levy"]:
+                verdict = f"order-limited (floor / papers' = {mean['order'] / mean['levy']:.2f})"
+            elif mean["sigma"] > 0.5 * mean["levy"]:
+                verdict = f"noise-limited (joint σ / papers' = {mean['sigma'] / mean['levy']:.2f})"
+            else:
+                verdict = "NOT met"
+            verdict += f"; joint / own data = {mean['joint'] / mean['own']:.2f}"
+            summary.append((label, form, m, temp, r_levy, r_nlp, q_levy, verdict))
             cells = " | ".join(f"{mean[k]:.4g} ({worst[k]:.3g})" for k in ("joint", "levy", "nlp"))
             print(f"| {label} | {band[0]:g}–{band[1]:g} × {nf} | {form} | {m}/{n} | {deg} | {temp:g} | {cells} | "
-                  f"{r_levy:.3g}; {q_levy:.3g} | {r_nlp:.3g}; {q_nlp:.3g} | "
-                  f"{n_ok}/{len(seeds)} ({max_re:.3g}) | {np.mean(times):.1f} |")
+                  f"{mean['order']:.4g} | {mean['own']:.4g} | {mean['sigma']:.4g} | {r_levy:.3g}; {q_levy:.3g} | {r_nlp:.3g}; {q_nlp:.3g} | "
+                  f"{verdict} | {n_ok}/{len(seeds)} ({max_re:.3g}) | {np.mean(times):.1f} |")
     n_ok = sum(r[4] <= 0.5 for r in summary)
     n_ok2 = sum(r[5] <= 0.5 for r in summary)
     n_okm = sum(r[6] <= 0.5 for r in summary)
@@ -164,20 +215,21 @@ def held_out_section(quick: bool):
           f"(ratio of means; {n_okm}/{len(summary)} by medians); against our NLP two-stage: met in "
           f"{n_ok2}/{len(summary)} rows.")
     print("Rows where it is not met (ratio of means): " + ("; ".join(
-        f"{lab} {form} {m}/{m} at {t:g} °C (×{r:.2f})" for lab, form, m, t, r, *_ in summary if r > 0.5) or "none"))
+        f"{lab} {form} {m}/{m} at {t:g} °C (×{r:.2f}, {v})" for lab, form, m, t, r, _, _, v in summary if r > 0.5)
+        or "none"))
     robustness(quick)
 
 
 def robustness(quick: bool):
     """How often the joint fit converges, over more noise draws (the cheap seed-001 cases)."""
     seeds = range(1, 5) if quick else range(1, 11)
-    print(f"\nJoint-fit convergence over noise seeds {seeds.start}–{seeds.stop - 1} (seed-001 geometry, "
+    print(f"\nJoint-fit convergence over noise seeds {seeds.start}–{seeds.stop - 1} (seed-001 actuator, "
           "35/45 °C held out); held-out error vs truth at 35 °C, median and worst over the seeds:\n")
     print("| data | form | order | degree | converged | median err 35 °C | worst err 35 °C | seeds not converged |")
     print("|:--|:--|:--|--:|--:|--:|--:|:--|")
     f1 = np.geomspace(0.1, 9.0, 30)
-    for sample, form, m, deg in (("seed-001 geometry", "zpk", 3, 2), ("seed-001 geometry", "zpk", 4, 2),
-                                 ("seed-001 geometry", "coefficients", 4, 2)):
+    for sample, form, m, deg in (("seed-001 actuator", "zpk", 3, 2), ("seed-001 actuator", "zpk", 4, 2),
+                                 ("seed-001 actuator", "coefficients", 4, 2)):
         errs, bad = [], []
         for seed in seeds:
             data, truth = generate_sweep(sample, SEED001_TEMPS, f1, seed)
@@ -228,7 +280,7 @@ def _levy(w, h, m, n):
     return g * np.polyval(num[::-1], jw) / np.polyval(den[::-1], jw), wr * np.roots(den[::-1])
 
 
-PER_T_CASES = [("seed-002 sample", (0.1, 20.0), 60), ("seed-001 geometry", (0.1, 9.0), 60),
+PER_T_CASES = [("seed-002 sample", (0.1, 20.0), 60), ("seed-001 actuator", (0.1, 9.0), 60),
                ("seed-000 sensor", (10.0, 100.0), 60)]
 
 
@@ -345,20 +397,25 @@ def order_section(quick: bool):
     # ---- seed 001
     print("### Seed 001 protocol: 30 log-spaced lines on 0.1–9 Hz, 19 and 55 °C\n")
     f001 = np.geomspace(0.1, 9, 30)
-    for sample in ("seed-001 geometry", "seed-001 geometry, r1'=2 Ω"):
+    for sample in ("seed-001 actuator", "seed-001 actuator, r1'=2 Ω"):
         print(f"{sample}:\n")
-        rep, rep0 = _orders(sample, [19.0, 55.0], f001, [(2, 2), (3, 3), (4, 4), (5, 5)], seed=31)
+        rep, rep0 = _orders(sample, [19.0, 55.0], f001, [(2, 2), (2, 3), (3, 3), (4, 4), (5, 5)], seed=31)
         e = {k: rep.row(k, k).worst_relative_rms_error for k in (2, 3, 4)}
         b = {k: rep0.row(k, k).worst_relative_rms_error for k in (2, 3, 4)}
+        e23 = rep.row(2, 3).worst_relative_rms_error
         c1 = e[2] > 3 * e[3]
         c2 = e[4] > 0.8 * e[3]
+        c2b = e23 >= 0.95 * e[3]
         print(f"\n- 2nd order clearly worse than 3rd: error ×{e[2] / e[3]:.1f} → {_verdict(c1)}")
         print(f"- 4th adds little over 3rd: error 4th/3rd = {e[4] / e[3]:.2f} (noise-free bias "
-              f"{b[3]:.4f} → {b[4]:.4f}) → {_verdict(c2)}\n")
-        claims += [(f"001: 2nd order clearly worse ({sample})", c1), (f"001: 4th adds little over 3rd ({sample})", c2)]
+              f"{b[3]:.4f} → {b[4]:.4f}) → {_verdict(c2)}")
+        print(f"- strictly proper 3rd order (2 zeros / 3 poles) fits no better than the proper 3/3: "
+              f"error 2/3 ÷ 3/3 = {e23 / e[3]:.2f} → {_verdict(c2b)}\n")
+        claims += [(f"001: 2nd order clearly worse ({sample})", c1), (f"001: 4th adds little over 3rd ({sample})", c2),
+                   (f"001: strictly proper 3rd no better than proper ({sample})", c2b)]
 
     # zeros / poles of per-temperature fits at all ten temperatures (seed 001's observations)
-    data, truth = generate_sweep("seed-001 geometry", SEED001_TEMPS, f001, seed=32, noise=ORDER_NOISE)
+    data, truth = generate_sweep("seed-001 actuator", SEED001_TEMPS, f001, seed=32, noise=ORDER_NOISE)
     rhp_pair, big_pole = [], []
     for temp in SEED001_TEMPS:
         d = data.at_temperature(temp)
@@ -368,7 +425,7 @@ def order_section(quick: bool):
         big_pole.append(float(np.max(np.abs(p)) / (2 * np.pi * 9.0)))
     c3 = all(rhp_pair)
     c4 = sum(r > 10 for r in big_pole) >= len(big_pole) / 2
-    print("Seed-001 geometry, all ten temperatures (noisy protocol):")
+    print("Seed-001 actuator, all ten temperatures (noisy protocol):")
     print(f"- 3/3 fit has a complex pair of right-half-plane zeros at every temperature: "
           f"{sum(rhp_pair)}/{len(rhp_pair)} temperatures → {_verdict(c3)}")
     print(f"- 4/4 fit 'often shows one very large negative pole' (|p| > 10 × band edge): "
@@ -376,7 +433,7 @@ def order_section(quick: bool):
           f"{min(big_pole):.1f} to {max(big_pole):.1f}) → {_verdict(c4)}")
     # response shape: resonance shift and the 19 vs 55 °C magnitude difference (noise-free, dense)
     fd = np.geomspace(0.1, 9, 400)
-    sw = synthesize_sweep(physics_model("seed-001 geometry"), "M", fd, [19.0, 55.0], None)
+    sw = synthesize_sweep(physics_model("seed-001 actuator"), "M", fd, [19.0, 55.0], None)
     _, _, H = sw.grid()
     fpk = fd[np.argmax(np.abs(H), axis=1)]
     diff = 20 * np.log10(np.abs(H[0]) / np.abs(H[1]))   # > 0: 19 °C larger
@@ -394,15 +451,26 @@ def order_section(quick: bool):
                ("001: resonance shifts lower with T", c5), ("001: ~7 dB drop near 3 Hz from 19 to 55 °C", c6)]
 
     # ---- seed 002
-    print("### Seed 002 protocol: seed-002 sample, 60 log-spaced lines on 0.1–100 Hz, 300 K\n")
-    rep, rep0 = _orders("seed-002 sample", [26.85], np.geomspace(0.1, 100, 60), [(1, 4), (2, 5)], seed=41)
-    f14, f25 = rep.row(1, 4).min_fit_percent, rep.row(2, 5).min_fit_percent
-    g14, g25 = rep0.row(1, 4).min_fit_percent, rep0.row(2, 5).min_fit_percent
-    c7 = f25 >= 92.5
-    c8 = f14 < f25 - 2
-    print(f"\n- 5 poles / 2 zeros fit ≥ 92.5 %: {f25:.2f} % (noise-free {g25:.2f} %) → {_verdict(c7)}")
-    print(f"- 4 poles / 1 zero fits the resonance but misses the response: {f14:.2f} % vs {f25:.2f} % "
-          f"(noise-free {g14:.2f} % vs {g25:.2f} %) → {_verdict(c8)}\n")
+    print("### Seed 002 protocol: seed-002 sample (Table 3), 60 log-spaced lines on 0.1–100 Hz, 300 K, "
+          "the four printed widths\n")
+    c7 = c8 = True
+    for k, width_mm in enumerate((4.0, 2.0, 1.0, 0.5)):
+        data, truth = generate_sweep("seed-002 sample", [26.85], np.geomspace(0.1, 100, 60), seed=41,
+                                     noise=ORDER_NOISE, overrides={"W": width_mm * 1e-3})
+        rep = order_selection(data, orders=[(1, 4), (2, 5)])
+        rep0 = order_selection(data.frequency_hz, data.temperature_c, truth, orders=[(1, 4), (2, 5)])
+        if k == 0:
+            print(rep.to_markdown() + "\n")
+        f14, f25 = rep.row(1, 4).min_fit_percent, rep.row(2, 5).min_fit_percent
+        g14, g25 = rep0.row(1, 4).min_fit_percent, rep0.row(2, 5).min_fit_percent
+        c7 &= f25 >= 92.5
+        c8 &= f14 < f25 - 2
+        print(f"- W = {width_mm:g} mm: fit 4p/1z {f14:.2f} %, 5p/2z {f25:.2f} % (noise-free {g14:.2f} % / {g25:.2f} %)")
+    print(f"\n- 5 poles / 2 zeros fit ≥ 92.5 % at every width → {_verdict(c7)} (the noisy fit % is set by the "
+          f"protocol noise: the noise-free 5p/2z fit is ≈ 100 %)")
+    print(f"- 4 poles / 1 zero fits the resonance but misses the response (fit % more than 2 points below "
+          f"5p/2z) → {_verdict(c8)}: the physics itself is fitted by 4p/1z nearly as well as by 5p/2z; the "
+          f"paper's misfit is of measured data, not of this model\n")
     claims += [("002: 5p/2z fit ≥ 92.5 %", c7), ("002: 4p/1z clearly worse than 5p/2z", c8)]
 
     # ---- seed 000

@@ -4,6 +4,8 @@ import numpy as np
 import pytest
 from surrogate_standin import physics_sweep
 
+from physmodel.errors import IPMCError
+from physmodel.sweep import FrequencySweep
 from surrogate import ConvergenceError, FrequencyData, RationalFit, from_sweep
 
 F = np.geomspace(1.0, 100.0, 12)
@@ -12,23 +14,36 @@ H = 1.0 / (1 + 1j * F / 10.0)
 
 @pytest.mark.parametrize(
     "kwargs, message",
-    [
-        (dict(frequency_hz=np.append(F[:-1], np.nan)), r"frequency_hz contains a non-finite value \(nan\) at index 11"),
-        (dict(response=np.append(H[:-1], np.nan)), r"response contains a non-finite value .* at index 11"),
-        (dict(response=H[:-1]), r"response has length 11 but frequency_hz has length 12"),
-        (dict(temperature_c=np.full(11, 25.0)), r"temperature_c has length 11 but frequency_hz has length 12"),
-        (dict(frequency_hz=-F), r"frequency_hz must be > 0, got -1.0 at index 0"),
-        (dict(magnitude_std_db=np.zeros(12), phase_std_deg=np.ones(12)), r"magnitude_std_db must be > 0"),
-        (dict(phase_std_deg=np.full(12, np.inf), magnitude_std_db=np.ones(12)), r"phase_std_deg contains a non-finite"),
-        (dict(response=np.where(np.arange(12) == 3, 0, H)), r"response is exactly zero at index 3"),
+    [   # FrequencyData is validated by physmodel.sweep.FrequencySweep's checks (one code path)
+        (dict(frequency_hz=np.append(F[:-1], np.nan)), r"frequency_hz contains NaN or inf at rows \[11\]"),
+        (dict(response=np.append(H[:-1], np.nan)), r"response contains NaN or inf at rows \[11\]"),
+        (dict(response=H[:-1]), r"one value per line; got 12, 12, 11"),
+        (dict(temperature_c=np.full(11, 25.0)), r"temperature_c has shape \(11,\) but frequency_hz has 12 lines"),
+        (dict(frequency_hz=-F), r"frequencies must be > 0 Hz; got \[-1.0"),
+        (dict(frequency_hz=F[::-1]), r"frequencies at 25 °C must strictly increase"),
+        (dict(magnitude_std_db=np.zeros(12), phase_std_deg=np.ones(12)),
+         r"magnitude_std_db must be > 0 \(it becomes a weight 1/σ\), got 0.0 at index 0"),
+        (dict(phase_std_deg=np.full(12, np.inf), magnitude_std_db=np.ones(12)), r"phase_std_deg must be finite"),
+        (dict(magnitude_std_db=np.ones(12)), r"give both magnitude_std_db and phase_std_deg, or neither"),
+        (dict(response=np.where(np.arange(12) == 3, 0, H)), r"response is exactly 0 at rows \[3\]"),
         (dict(temperature_c="warm"), r"temperature_c must be an array of real numbers"),
     ],
 )
 def test_bad_data_is_named(kwargs, message):
     args = dict(frequency_hz=F, temperature_c=25.0, response=H)
     args.update(kwargs)
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(IPMCError, match=message):
         FrequencyData(**args)
+
+
+def test_fitters_take_a_frequency_sweep_directly():
+    sweep = FrequencySweep(np.full(12, 30.0), F, H, input_unit="V", output_unit="mm")
+    res = RationalFit(0, 1).fit(sweep)
+    np.testing.assert_allclose(res.model.poles(), [-2 * np.pi * 10.0], rtol=1e-6)
+    assert res.model.labels["output_unit"] == "mm"
+    assert RationalFit(0, 1).fit_data(sweep).data_fingerprint == res.data_fingerprint
+    with pytest.raises(IPMCError, match="expected FrequencyData or a physmodel FrequencySweep, got str"):
+        RationalFit(0, 1).fit("sweep.csv")
 
 
 def test_order_too_high_for_the_number_of_points():
@@ -47,7 +62,7 @@ def test_bad_settings_are_named():
 
 def test_uncertainty_weighting_needs_both_standard_deviations():
     with pytest.raises(ValueError, match="needs both magnitude_std_db and phase_std_deg"):
-        RationalFit(0, 1, weighting="uncertainty").fit(F, 25.0, H, magnitude_std_db=np.ones(12))
+        RationalFit(0, 1, weighting="uncertainty").fit(F, 25.0, H)
 
 
 def test_rational_fit_rejects_several_temperatures():
