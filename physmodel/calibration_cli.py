@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._cli import parse_assignments
 from .errors import ParameterError
 
 EXIT_OK, EXIT_FAILED = 0, 3
@@ -82,19 +83,6 @@ def add_parser(subparsers):
     return p
 
 
-def _overrides(items) -> dict:
-    out = {}
-    for item in items or []:
-        if "=" not in item:
-            raise ParameterError(f"--param expects NAME=VALUE (SI units), got {item!r}")
-        k, v = item.split("=", 1)
-        try:
-            out[k.strip()] = float(v)
-        except ValueError:
-            raise ParameterError(f"--param {k}: {v!r} is not a number") from None
-    return out
-
-
 def run(args) -> int:
     """Execute ``ipmc calibrate``; returns 0, or 3 when the fit did not converge (bad input raises)."""
     from . import get_parameter_set
@@ -104,7 +92,7 @@ def run(args) -> int:
     if args.starts < 1:
         raise ParameterError(f"--starts must be >= 1, got {args.starts}")
     data = read_sweep(args.sweep)
-    over = _overrides(args.param)
+    over = parse_assignments(args.param)
     base = get_parameter_set(args.base_set, **over)
     free = [parse_free(s, base) for s in args.free]
     out = Path(args.out)

@@ -34,6 +34,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from ._cli import parse_assignments
 from .errors import IPMCError, ParameterError
 
 EXIT_OK = 0
@@ -143,14 +144,7 @@ def build(args):
         if sect == "geometry" and set(sec) - set(_GEOMETRY):
             raise IPMCError(f"[geometry] accepts {_GEOMETRY} [m]; got {sorted(sec)}")
         over.update({k: float(v) for k, v in sec.items()})
-    for item in args.param or []:
-        if "=" not in item:
-            raise IPMCError(f"--param expects NAME=VALUE (SI units), got {item!r}")
-        k, v = item.split("=", 1)
-        try:
-            over[k.strip()] = float(v)
-        except ValueError:
-            raise IPMCError(f"--param {k}: {v!r} is not a number") from None
+    over.update(parse_assignments(args.param))
     base = get_parameter_set(set_name, **over)
     data = read_sweep(data_path)
     effects_spec = dict(spec.get("baseline_effects", {}))

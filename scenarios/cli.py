@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from physmodel._cli import parse_assignments
+
 EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED = 0, 2, 3, 130
 
 #: Optional subcommand providers: modules exposing add_parser(subparsers) and run(args) -> int.
@@ -45,19 +47,6 @@ def _floats(text: str, what: str) -> list[float]:
     return vals
 
 
-def _param_overrides(items) -> dict:
-    out = {}
-    for item in items or []:
-        if "=" not in item:
-            raise CLIError(f"--param expects NAME=VALUE (SI units), got {item!r}")
-        k, v = item.split("=", 1)
-        try:
-            out[k.strip()] = float(v)
-        except ValueError:
-            raise CLIError(f"--param {k}: {v!r} is not a number") from None
-    return out
-
-
 def _load_params(args):
     from physmodel import get_parameter_set
     from physmodel.params import IPMCParameters
@@ -69,9 +58,9 @@ def _load_params(args):
         if not path.exists():
             raise CLIError(f"--params-json {path}: no such file")
         p = IPMCParameters.from_dict(json.loads(path.read_text()))
-        over = _param_overrides(args.param)
+        over = parse_assignments(args.param)
         return p.replace(**over) if over else p
-    return get_parameter_set(args.set, **_param_overrides(args.param))
+    return get_parameter_set(args.set, **parse_assignments(args.param))
 
 
 def _model(args, params):
