@@ -105,6 +105,16 @@ class InversionResult(SampledRecord):
         return _disc_estimate(self.split, self.input, self.preview_samples)
 
 
+def time_base(t: Any, u: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """``(time stamps or None, dt)`` for a scalar sampling interval or an array of times matching ``u``."""
+    if np.ndim(t) == 0:
+        return None, sampling_interval(t)
+    ta = np.asarray(t, dtype=float)
+    if ta.shape != u.shape:
+        raise InversionError(f"t and u must have the same length; got {ta.shape} and {u.shape}")
+    return ta, sampling_interval(ta)
+
+
 def sampling_interval(t: Any) -> float:
     """Return the sampling interval of uniformly spaced time stamps ``t`` [s].
 
@@ -276,15 +286,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     """
     split = _as_split(model, improper, filter_bandwidth)
     ua = _signal(u)
-    ta: np.ndarray | None = None
-    if np.ndim(t) == 0:
-        dt = sampling_interval(t)
-    else:
-        ta = np.asarray(t, dtype=float)
-        if ta.shape != ua.shape:
-            raise InversionError(
-                f"t and u must have the same length; got {ta.shape} and {ua.shape}")
-        dt = sampling_interval(ta)
+    ta, dt = time_base(t, ua)
     n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
     plan = Plan(split, dt, n_prev)
     if chunk_size is None:

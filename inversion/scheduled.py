@@ -36,7 +36,7 @@ import numpy as np
 
 from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .batch import DEFAULT_CHUNK, SampledRecord, _signal, resolve_preview, sampling_interval
+from .batch import DEFAULT_CHUNK, SampledRecord, _signal, resolve_preview, sampling_interval, time_base
 from .split import InverseSplit, split_inverse
 from .streaming import StreamingInverter
 
@@ -210,14 +210,7 @@ def invert_scheduled(model_at: Callable[[float], Any], t: Any, u: Any, temperatu
     ua = _signal(u)
     n = ua.size
     Ta = _check_temperature(temperature, n)
-    ta: np.ndarray | None = None
-    if np.ndim(t) == 0:
-        dt = sampling_interval(t)
-    else:
-        ta = np.asarray(t, dtype=float)
-        if ta.shape != ua.shape:
-            raise InversionError(f"t and u must have the same length; got {ta.shape} and {ua.shape}")
-        dt = sampling_interval(ta)
+    ta, dt = time_base(t, ua)
     g = _grid(grid, Ta, grid_step)
     splits = _splits(model_at, g, improper, filter_bandwidth)
     n_prev, prev_s = resolve_preview(preview, _auto(splits), dt, n)

@@ -766,10 +766,39 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
     return FreeParameter(name, lo, hi, "log", v)
 
 
-_KIND_OF_QUANTITY = {("actuator", "M"): ("voltage", "length"), ("actuator", "H"): ("voltage", "length"),
-                     ("actuator", "G"): ("dimensionless", "dimensionless"),
-                     ("actuator", "Z"): ("current", "voltage"), ("actuator", "I"): ("voltage", "current"),
-                     ("sensor", "S"): ("length", "current"), ("sensor", "Z"): ("current", "voltage")}
+@dataclass(frozen=True)
+class SweepLayout:
+    """How a model response maps onto the rows of a sweep: evaluate at ``temperatures_c`` ×
+    ``frequencies_hz`` (unique, sorted), take ``[..., t_index, f_index]`` and multiply by ``factor``
+    (SI response → the sweep's display units)."""
+
+    quantity: str
+    factor: float
+    frequencies_hz: np.ndarray
+    f_index: np.ndarray
+    temperatures_c: np.ndarray
+    t_index: np.ndarray
+
+
+def sweep_layout(data: FrequencySweep, kind: str, quantity: str | None = None) -> SweepLayout:
+    """Check that ``data`` can hold the ``kind`` model's ``quantity`` (default M / S) and lay it out."""
+    if kind not in ("actuator", "sensor"):
+        raise IPMCError(f"kind={kind!r}; expected 'actuator' or 'sensor'")
+    q = quantity or ("M" if kind == "actuator" else "S")
+    if (kind, q) not in QUANTITY_UNITS:
+        raise IPMCError(f"{kind} quantity {q!r} cannot be compared with data; expected one of "
+                        f"{[k[1] for k in QUANTITY_UNITS if k[0] == kind]}")
+    _, unit_in, _, unit_out = QUANTITY_UNITS[(kind, q)]
+    want_in, want_out = UNITS[unit_in][0], UNITS[unit_out][0]
+    got_in, got_out = UNITS[data.input_unit][0], UNITS[data.output_unit][0]
+    if (got_in, got_out) != (want_in, want_out):
+        raise DataFormatError(f"the sweep is {data.output_name} [{data.output_unit}] per {data.input_name} "
+                              f"[{data.input_unit}] ({got_out}/{got_in}); {kind} quantity {q} needs "
+                              f"{want_out}/{want_in} (see physmodel.sweep.QUANTITY_UNITS {QUANTITY_UNITS[(kind, q)]})")
+    factor = unit_scale(data.input_unit) / unit_scale(data.output_unit)   # SI response -> sweep units
+    fu, inv_f = np.unique(data.frequency_hz, return_inverse=True)
+    Tu, inv_T = np.unique(data.temperature_c, return_inverse=True)
+    return SweepLayout(q, factor, fu, inv_f, Tu, inv_T)
 
 
 def merge_sweeps(data: FrequencySweep | Sequence[FrequencySweep]) -> FrequencySweep:
@@ -805,21 +834,9 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
     from .actuator import ActuatorModel
     from .sensor import SensorModel
 
-    if kind not in ("actuator", "sensor"):
-        raise IPMCError(f"kind={kind!r}; expected 'actuator' or 'sensor'")
-    q = quantity or ("M" if kind == "actuator" else "S")
-    if (kind, q) not in _KIND_OF_QUANTITY:
-        raise IPMCError(f"{kind} quantity {q!r} cannot be calibrated; expected one of "
-                        f"{[k[1] for k in _KIND_OF_QUANTITY if k[0] == kind]}")
-    want_in, want_out = _KIND_OF_QUANTITY[(kind, q)]
-    got_in, got_out = UNITS[data.input_unit][0], UNITS[data.output_unit][0]
-    if (got_in, got_out) != (want_in, want_out):
-        raise DataFormatError(f"the sweep is {data.output_name} [{data.output_unit}] per {data.input_name} "
-                              f"[{data.input_unit}] ({got_out}/{got_in}); {kind} quantity {q} needs "
-                              f"{want_out}/{want_in} (see physmodel.sweep.QUANTITY_UNITS {QUANTITY_UNITS.get((kind, q))})")
-    factor = unit_scale(data.input_unit) / unit_scale(data.output_unit)   # SI response -> sweep units
-    fu, inv_f = np.unique(data.frequency_hz, return_inverse=True)
-    Tu, inv_T = np.unique(data.temperature_c, return_inverse=True)
+    lay = sweep_layout(data, kind, quantity)
+    q, factor, fu, inv_f, Tu, inv_T = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,
+                                       lay.temperatures_c, lay.t_index)
 
     def model_of(values_list):
         plist = [apply_values(base, v) for v in values_list]

@@ -93,16 +93,8 @@ def _load_toml(path: Path) -> dict:
 
 def _parse_effect(item: str) -> tuple[str, dict]:
     name, _, rest = item.partition(":")
-    vals = {}
-    for kv in filter(None, (s.strip() for s in rest.split(","))):
-        if "=" not in kv:
-            raise IPMCError(f"--baseline-effect {item!r}: expected NAME or NAME:PARAM=VALUE,...")
-        k, v = kv.split("=", 1)
-        try:
-            vals[k.strip()] = float(v)
-        except ValueError:
-            raise IPMCError(f"--baseline-effect {item!r}: {v!r} is not a number") from None
-    return name.strip(), vals
+    items = [s.strip() for s in rest.split(",") if s.strip()]
+    return name.strip(), parse_assignments(items, option=f"--baseline-effect {item!r}:")
 
 
 def _free(spec: str, base, effects: dict):

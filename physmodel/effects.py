@@ -491,22 +491,11 @@ class _EffectMixin:
         is the batched form (n_sets, N) for ``fit_parameters(predict_many=...)``; it uses the first
         parameter set of this model as the base.
         """
-        from .sweep import QUANTITY_UNITS, unit_scale
+        from .calibration import sweep_layout
 
-        q = quantity or DEFAULT_QUANTITY[self.kind]
-        if (self.kind, q) not in QUANTITY_UNITS:
-            raise IPMCError(f"{self.kind} quantity {q!r} cannot be predicted; expected one of "
-                            f"{[k[1] for k in QUANTITY_UNITS if k[0] == self.kind]}")
-        in_unit, out_unit = data.input_unit, data.output_unit
-        _, si_in, _, si_out = QUANTITY_UNITS[(self.kind, q)]
-        from .sweep import UNITS
-
-        if UNITS[in_unit][0] != UNITS[si_in][0] or UNITS[out_unit][0] != UNITS[si_out][0]:
-            raise IPMCError(f"data are {data.output_name} [{out_unit}] per {data.input_name} [{in_unit}]; "
-                            f"a {self.kind} {q} response is {UNITS[si_out][0]} per {UNITS[si_in][0]}")
-        scale = unit_scale(in_unit) / unit_scale(out_unit)
-        temps, ti = np.unique(data.temperature_c, return_inverse=True)
-        freqs, fi = np.unique(data.frequency_hz, return_inverse=True)
+        lay = sweep_layout(data, self.kind, quantity or DEFAULT_QUANTITY[self.kind])
+        q, scale, freqs, fi, temps, ti = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,
+                                          lay.temperatures_c, lay.t_index)
 
         def predict(values: Mapping[str, float]) -> np.ndarray:
             m = self.with_values(values) if values else self

@@ -247,16 +247,20 @@ def parse_scenario(raw: dict, where: str = "<scenario>", *, quick: bool = False)
     return Scenario(data["scenario"]["name"], where, data, quick)
 
 
-def load_scenario(path, *, quick: bool = False) -> Scenario:
-    """Read and validate a scenario TOML file; ``quick`` merges its ``[quick]`` table."""
+def read_toml(path, what: str, error: type[Exception]) -> dict:
+    """The parsed TOML file at ``path``, or ``error`` naming the file (missing or not valid TOML)."""
     path = Path(path)
     if not path.is_file():
-        raise ScenarioError(f"scenario file {str(path)!r} does not exist")
+        raise error(f"{what} file {str(path)!r} does not exist")
     try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
-    return parse_scenario(raw, str(path), quick=quick)
+        raise error(f"{path}: not valid TOML: {exc}") from None
+
+
+def load_scenario(path, *, quick: bool = False) -> Scenario:
+    """Read and validate a scenario TOML file; ``quick`` merges its ``[quick]`` table."""
+    return parse_scenario(read_toml(path, "scenario", ScenarioError), str(path), quick=quick)
 
 
 def bundled_scenarios() -> list[Path]:

@@ -40,15 +40,15 @@ import json
 import os
 import sys
 import time
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from physmodel.errors import IPMCError
+from physmodel.sweep import by_extension
 
-from .spec import ScenarioError
+from .spec import ScenarioError, read_toml
 
 _STUDY_KEYS = {"name", "kind", "set", "quantity", "kernel", "method", "samples", "seed", "temperatures_c",
                "frequencies_hz", "fmin_hz", "fmax_hz", "points", "chunk_size", "noise", "parameters"}
@@ -157,14 +157,8 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
 
 
 def load_study(path) -> dict:
-    path = Path(path)
-    if not path.is_file():
-        raise StudyError(f"study file {str(path)!r} does not exist")
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{path}: not valid TOML: {exc}") from None
-    return parse_study(raw, str(path))
+    """Read and validate a study TOML file."""
+    return parse_study(read_toml(path, "study", StudyError), str(path))
 
 
 # ---------------------------------------------------------------------------- evaluation
@@ -274,12 +268,7 @@ class StudyTable:
         return atomic_write(path, write, "wb")
 
     def save(self, path) -> Path:
-        ext = Path(path).suffix.lower()
-        if ext == ".csv":
-            return self.to_csv(path)
-        if ext == ".npz":
-            return self.to_npz(path)
-        raise StudyError(f"{path}: a study table is written as .csv or .npz, not {ext!r}")
+        return by_extension(path, {".csv": self.to_csv, ".npz": self.to_npz}, "study table")(path)
 
 
 def _chunks(spec) -> list[list[int]]:
