@@ -18,12 +18,12 @@ Reduced models
 Sweeps and data files (physmodel.sweep)
     FrequencySweep, synthesize_sweep, MagnitudePhaseNoise, ComplexGaussianNoise,
     read_csv / write_csv, read_npz / write_npz, read_mat / write_mat
-Time-domain virtual experiments (physmodel.timesim)
+Time-domain virtual experiments (physmodel.data.timesim)
     realize, simulate, sine, step, free_release, TimeSeries
-Calibration (physmodel.calibration)
+Calibration (physmodel.estimation.calibration)
     calibrate, fit_parameters, FreeParameter, CalibrationResult — weighted multi-start least squares
     with confidence intervals, correlations and an identifiability report; ``ipmc calibrate``
-Discrepancy workflow (physmodel.effects, physmodel.discrepancy)
+Discrepancy workflow (physmodel.effects, physmodel.estimation.discrepancy)
     EffectModel, LIBRARY — named candidate effects (electrode/contact resistance, leakage, second mode,
     fluid mass, temperature laws, water uptake, amplifier, delay, CPE, ...) composable with any model;
     diagnose, Diagnosis — locate, name, add and refit; ``ipmc diagnose``
@@ -35,16 +35,17 @@ Units: SI inside (rad/s, K, m, V, A); Hz and °C at the edges, as the argument n
 
 from .errors import DataFormatError, IPMCError, ParameterError, TemperatureRangeError
 from .params import IPMCParameters, describe, state_at
-from .parameter_sets import (available_parameter_sets, get_parameter_set, load_parameter_set,
-                             register_parameter_set, save_parameter_set)
+from .parameter_sets import available_parameter_sets, get_parameter_set, load_parameter_set, register_parameter_set, save_parameter_set
 from .temperature import (ISOTHERMAL, Arrhenius, Constant, IonicResistance, Linear, LogLinear,
                           TemperatureLaws, WaterPermittivity)
 from .model import FrequencyResponse
 from .actuator import ActuatorModel
 from .sensor import SensorModel, TransimpedanceChain
-from .calibration import CalibrationResult, FreeParameter, calibrate, fit_parameters
+from .estimation.records import CalibrationResult, FreeParameter
+from .estimation.calibration import calibrate
+from .estimation.lsq import fit_parameters
 from .effects import LIBRARY, EffectModel
-from .discrepancy import Diagnosis, diagnose
+from .estimation.discrepancy import Diagnosis, diagnose
 
 __all__ = [
     "IPMCParameters", "describe", "state_at", "available_parameter_sets", "get_parameter_set",

@@ -4,7 +4,7 @@
                    --free d --free "kappa_e:1e-7:1e-5" --free laws.d.activation_energy ...
                    [--starts N] [--seed S] --out FOLDER [--name NAME] [--quiet]
 
-``--free`` (repeatable): ``NAME`` (default bounds, see physmodel.calibration.default_free_parameter),
+``--free`` (repeatable): ``NAME`` (default bounds, see physmodel.estimation.calibration.default_free_parameter),
 ``NAME:LOWER:UPPER``, ``NAME:LOWER:UPPER:log|linear`` or ``NAME:LOWER:UPPER:SCALE:INITIAL``, in SI
 units; NAME is an IPMCParameters field, ``omega_n`` or ``laws.<quantity>.<attribute>``.
 
@@ -31,7 +31,9 @@ EXIT_OK, EXIT_FAILED = 0, 3
 
 def parse_free(spec: str, base):
     """A ``--free`` specification → FreeParameter (bare names get default bounds)."""
-    from .calibration import FreeParameter, base_value, check_parameter_name, default_free_parameter
+    from .estimation.records import FreeParameter
+    from .parameter_paths import base_value, check_parameter_name
+    from .estimation.calibration import default_free_parameter
 
     parts = [p.strip() for p in spec.split(":")]
     name = parts[0]
@@ -86,8 +88,8 @@ def add_parser(subparsers):
 def run(args) -> int:
     """Execute ``ipmc calibrate``; returns 0, or 3 when the fit did not converge (bad input raises)."""
     from . import get_parameter_set
-    from .calibration import calibrate, model_sweep
-    from .sweep import read_sweep
+    from .estimation.calibration import calibrate, model_sweep
+    from .data.files import read_sweep
 
     if args.starts < 1:
         raise ParameterError(f"--starts must be >= 1, got {args.starts}")
@@ -113,7 +115,7 @@ def run(args) -> int:
             bar.close()
     res.metadata["sweep_file"] = str(args.sweep)
     out.mkdir(parents=True, exist_ok=True)
-    from .sweep import atomic_write
+    from .data.files import atomic_write
 
     res.save(out / "parameters.json")
     record = res.to_dict()
@@ -138,7 +140,7 @@ def write_figure(data, model, res, path) -> Path:
     """Bode overlay (data markers, model lines) and standardised residuals, one colour per temperature."""
     from scenarios.plots import _plt, _save
 
-    from .calibration import residuals
+    from .estimation.residuals import residuals
 
     plt = _plt()
     fig, axes = plt.subplots(2, 2, sharex=True, figsize=(11, 6.5))

@@ -1,4 +1,4 @@
-"""``ipmc diagnose``: find, name and add the missing physical effect (physmodel.discrepancy).
+"""``ipmc diagnose``: find, name and add the missing physical effect (physmodel.estimation.discrepancy).
 
     ipmc diagnose EXPERIMENT.toml [--out FOLDER] [--seed N] [--quiet]
     ipmc diagnose --data sweep.csv --kind actuator --set seed002_table3 \\
@@ -98,7 +98,7 @@ def _parse_effect(item: str) -> tuple[str, dict]:
 
 
 def _free(spec: str, base, effects: dict):
-    from .calibration import FreeParameter
+    from .estimation.records import FreeParameter
     from .calibration_cli import parse_free
     from .effects import get_effect
 
@@ -118,7 +118,7 @@ def build(args):
     """Resolve TOML + flags into ``(data, base, kwargs for diagnose, out folder, spec)``."""
     from . import get_parameter_set
     from .effects import normalize_effects
-    from .sweep import read_sweep
+    from .data.files import read_sweep
 
     spec = _load_toml(Path(args.experiment)) if args.experiment else {}
     pick = lambda flag, key, default=None: flag if flag is not None else spec.get(key, default)  # noqa: E731
@@ -169,7 +169,7 @@ def build(args):
 
 def run(args) -> int:
     """Execute ``ipmc diagnose``: 0 for any verdict; bad input raises IPMCError (exit 2)."""
-    from .discrepancy import diagnose, gap_shrink
+    from .estimation.discrepancy import diagnose, gap_shrink
 
     data, base, kw, out = build(args)
     bar = None

@@ -109,7 +109,7 @@ def cmd_sets(args) -> int:
         if args.json:
             import json
 
-            from physmodel.sweep import atomic_write
+            from physmodel.data.files import atomic_write
 
             atomic_write(args.json, lambda fh: fh.write(json.dumps(get_parameter_set(args.name).to_dict(), indent=2, default=str)))
         return EXIT_OK
@@ -120,7 +120,8 @@ def cmd_sets(args) -> int:
 
 # ------------------------------------------------------------------------ sweep
 def cmd_sweep(args) -> int:
-    from physmodel.sweep import ComplexGaussianNoise, MagnitudePhaseNoise, synthesize_sweep, write_sweep
+    from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise, synthesize_sweep
+    from physmodel.data.files import write_sweep
 
     temps = _floats(args.temperatures, "--temperatures")
     if not (0 < args.fmin < args.fmax):
@@ -157,7 +158,7 @@ def cmd_sweep(args) -> int:
 # ------------------------------------------------------------------------ simulate
 def cmd_simulate(args) -> int:
     from physmodel import TransimpedanceChain
-    from physmodel.timesim import free_release, sine, step
+    from physmodel.data.timesim import free_release, sine, step
 
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".npz"):

@@ -29,7 +29,7 @@ def run_demo(out: Path, quiet: bool = False, quick: bool = False, update_figures
     if update_figures:
         figs = Path(__file__).with_name("figures")
         for src, dst in README_FIGURES.items():
-            from physmodel.sweep import atomic_write
+            from physmodel.data.files import atomic_write
 
             data = (res.out / src).read_bytes()
             atomic_write(figs / dst, lambda fh: fh.write(data), "wb")

@@ -18,7 +18,7 @@ def _plt():
 
 
 def _save(fig, path) -> Path:
-    from physmodel.sweep import atomic_write
+    from physmodel.data.files import atomic_write
 
     path = Path(path)
     try:
@@ -28,12 +28,12 @@ def _save(fig, path) -> Path:
 
 
 def bode(sweeps, path, title: str = "", labels=None, styles=None) -> Path:
-    """Bode plot of one or more :class:`~physmodel.sweep.FrequencySweep` (one line per temperature).
+    """Bode plot of one or more :class:`~physmodel.data.sweep.FrequencySweep` (one line per temperature).
 
     ``sweeps``: a sweep or a list of sweeps drawn with the given ``styles`` (e.g. data as markers,
     model as lines).
     """
-    from physmodel.sweep import FrequencySweep
+    from physmodel.data.sweep import FrequencySweep
 
     plt = _plt()
     if isinstance(sweeps, FrequencySweep):
@@ -68,7 +68,7 @@ def bode(sweeps, path, title: str = "", labels=None, styles=None) -> Path:
 
 
 def traces(ts, path, title: str = "", output_scale: float = 1.0, output_label: str | None = None) -> Path:
-    """Input and output of a :class:`~physmodel.timesim.TimeSeries`."""
+    """Input and output of a :class:`~physmodel.data.timesim.TimeSeries`."""
     plt = _plt()
     fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(7, 5))
     a1.plot(ts.t, ts.input, lw=0.8)

@@ -124,7 +124,7 @@ def _quantity(ctx) -> str:
 
 
 def _noise(ctx):
-    from physmodel.sweep import ComplexGaussianNoise, MagnitudePhaseNoise
+    from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise
 
     n = ctx.spec.section("noise")
     kind = n.get("kind", "none")
@@ -149,7 +149,7 @@ def _resonance_hz(f, h) -> float:
 
 
 def step_sweep(ctx: _Ctx):
-    from physmodel.sweep import synthesize_sweep
+    from physmodel.data.sweep import synthesize_sweep
 
     from . import plots
 
@@ -248,7 +248,7 @@ def step_surrogate(ctx: _Ctx):
 
 def _plant_response(ctx: _Ctx, f_hz: float, T: float) -> complex:
     """The physics response at one line in the sweep's display units (mm/V or uA/mm)."""
-    from physmodel.sweep import synthesize_sweep
+    from physmodel.data.sweep import synthesize_sweep
 
     return complex(synthesize_sweep(ctx.model, _quantity(ctx), [f_hz], [T]).response[0])
 
@@ -265,7 +265,7 @@ def _stimulus(exp: dict, t: np.ndarray, lead: float = 0.0, ramp: float = 0.0) ->
 
 def step_inversion(ctx: _Ctx):
     from inversion import decode_sensor, feedforward
-    from physmodel.timesim import free_release, simulate, time_grid
+    from physmodel.data.timesim import free_release, simulate, time_grid
 
     from . import plots
 
@@ -411,11 +411,11 @@ def step_blackbox(ctx: _Ctx):
 
 def step_discrepancy(ctx: _Ctx):
     try:
-        from physmodel.discrepancy import diagnose
+        from physmodel.estimation.discrepancy import diagnose
         from physmodel.effects import EffectModel
     except ModuleNotFoundError as exc:
         raise ScenarioError(f"{ctx.spec.path}: [discrepancy] needs {exc.name}, which is not installed") from None
-    from physmodel.sweep import synthesize_sweep
+    from physmodel.data.sweep import synthesize_sweep
 
     cfg = ctx.spec.section("discrepancy")
     kind, q = ctx.spec.section("model")["kind"], _quantity(ctx)
@@ -442,7 +442,7 @@ def step_discrepancy(ctx: _Ctx):
     hidden = sorted(effects)
     ctx.metric("discrepancy.hidden_effect_named", all(h in named for h in hidden))
     ctx.metric("discrepancy.n_named", len(named))
-    from physmodel.discrepancy import gap_shrink
+    from physmodel.estimation.discrepancy import gap_shrink
 
     ctx.metric("discrepancy.gap_shrink", gap_shrink(diag))
     fitted = diag.named_effect() or {}
@@ -462,8 +462,9 @@ def step_discrepancy(ctx: _Ctx):
 
 
 def step_fixtures(ctx: _Ctx):
-    from physmodel.sweep import read_sweep, synthesize_sweep, write_sweep
-    from physmodel.timesim import step
+    from physmodel.data.files import read_sweep, write_sweep
+    from physmodel.data.sweep import synthesize_sweep
+    from physmodel.data.timesim import step
 
     cfg = ctx.spec.section("fixtures")
     formats = cfg.get("formats", ["csv", "npz", "mat"])
@@ -501,7 +502,7 @@ def step_fixtures(ctx: _Ctx):
     ctx.metric("fixtures.roundtrip_max_rel_error", worst)
     ctx.metric("fixtures.reproducible", make(0).fingerprint() == manifest[0]["fingerprint"])
     ctx.metric("fixtures.distinct", len({m["fingerprint"] for m in manifest}) == n if noise else 1.0)
-    from physmodel.sweep import atomic_write
+    from physmodel.data.files import atomic_write
 
     ctx.file(atomic_write(ctx.out / "fixtures" / "manifest.json",
                           lambda fh: fh.write(json.dumps({"scenario": ctx.spec.name, "files": manifest}, indent=2))))
@@ -544,7 +545,7 @@ def evaluate_checks(spec: Scenario, metrics: dict) -> list[CheckResult]:
 
 def run_scenario(spec: Scenario, out, *, quiet: bool = False) -> RunResult:
     """Run every step of ``spec`` into folder ``out`` and write its report (last)."""
-    from physmodel.sweep import atomic_write
+    from physmodel.data.files import atomic_write
 
     t0 = time.perf_counter()
     out = Path(out)

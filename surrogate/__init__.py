@@ -7,7 +7,7 @@ use s in rad/s, like the seed papers' models.
 Public API
 ----------
 Data
-    Every fitter takes a ``physmodel.sweep.FrequencySweep`` directly (``fit(sweep)`` or
+    Every fitter takes a ``physmodel.data.sweep.FrequencySweep`` directly (``fit(sweep)`` or
     ``fit_data(sweep)``), or arrays.
     FrequencyData(frequency_hz, temperature_c, response, magnitude_std_db=None,
                   phase_std_deg=None, ...)        for data a sweep does not cover (no

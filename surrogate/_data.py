@@ -1,6 +1,6 @@
-"""Frequency-response data for the fitters: a thin layer over ``physmodel.sweep.FrequencySweep``.
+"""Frequency-response data for the fitters: a thin layer over ``physmodel.data.sweep.FrequencySweep``.
 
-The fitters accept a :class:`physmodel.sweep.FrequencySweep` directly.  :class:`FrequencyData`
+The fitters accept a :class:`physmodel.data.sweep.FrequencySweep` directly.  :class:`FrequencyData`
 exists for what a sweep does not cover: data without a temperature (a single unspecified one),
 free-form unit labels, and the per-line log-domain standard deviations used by the weighting.
 Its validation *is* the sweep's (lengths, finiteness, f > 0, H ≠ 0, strictly increasing
@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from physmodel.errors import IPMCError
-from physmodel.sweep import FrequencySweep
+from physmodel.data.sweep import FrequencySweep
 
 __all__ = ["FrequencyData", "from_sweep", "to_data"]
 
@@ -178,7 +178,7 @@ class FrequencyData:
 
 
 def from_sweep(sweep) -> FrequencyData:
-    """``FrequencyData`` of a ``physmodel.sweep.FrequencySweep`` (or any object with its
+    """``FrequencyData`` of a ``physmodel.data.sweep.FrequencySweep`` (or any object with its
     attributes ``frequency_hz``, ``temperature_c``, ``response`` and, optionally,
     ``magnitude_std_db``, ``phase_std_deg``, ``input_name``, ``input_unit``, ``output_name``,
     ``output_unit``, ``metadata``)."""

@@ -32,10 +32,10 @@ EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED = 0, 2, 3
 def read_csv(path) -> FrequencyData:
     """Read a sweep file (.csv, .npz or .mat in the physmodel format) into ``FrequencyData``.
 
-    Parsing and validation are physmodel's (:func:`physmodel.sweep.read_sweep`): a malformed file
+    Parsing and validation are physmodel's (:func:`physmodel.data.sweep.read_sweep`): a malformed file
     raises ``DataFormatError`` (a ``ValueError``) naming the line and the problem.
     """
-    from physmodel.sweep import read_sweep
+    from physmodel.data.files import read_sweep
 
     from ._data import from_sweep
 

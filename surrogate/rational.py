@@ -93,7 +93,7 @@ class RationalFit:
         return self.fit_data(data)
 
     def fit_data(self, data: FrequencyData, theta0=None, *, stage: str = "per-temperature"):
-        """Fit a ``FrequencyData`` or a ``physmodel.sweep.FrequencySweep``.
+        """Fit a ``FrequencyData`` or a ``physmodel.data.sweep.FrequencySweep``.
 
         ``theta0`` (same layout, e.g. a neighbouring temperature's solution) is an extra
         start that is kept unless another start is more than 2 % better.

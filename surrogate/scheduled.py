@@ -238,7 +238,7 @@ class ScheduledFit:
         return solver_for(*setups[name]), best
 
     def fit_data(self, data: FrequencyData):
-        """Fit a ``FrequencyData`` or a ``physmodel.sweep.FrequencySweep``."""
+        """Fit a ``FrequencyData`` or a ``physmodel.data.sweep.FrequencySweep``."""
         t_start = time.perf_counter()
         data = to_data(data)
         st = self.structure

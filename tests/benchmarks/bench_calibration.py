@@ -25,8 +25,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from physmodel import ActuatorModel, get_parameter_set  # noqa: E402
-from physmodel.calibration import calibrate  # noqa: E402
-from physmodel.sweep import ComplexGaussianNoise, MagnitudePhaseNoise, synthesize_sweep  # noqa: E402
+from physmodel.estimation.calibration import calibrate  # noqa: E402
+from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise
+from physmodel.data.sweep import synthesize_sweep  # noqa: E402
 from physmodel.temperature import Arrhenius, LogLinear  # noqa: E402
 
 FREE = ["d", "kappa_e", "alpha0", "E", "xi", "r1_sheet", "laws.d.activation_energy", "laws.E.slope"]

@@ -5,7 +5,7 @@
 
 A generator hides one library effect (random size), none, one out-of-library effect (a fixture
 resonance) or two library effects, with noise at three levels, under sealed seeds derived from
-SEALED that :func:`physmodel.discrepancy.diagnose` never sees (it gets its own seed = case number).
+SEALED that :func:`physmodel.estimation.discrepancy.diagnose` never sees (it gets its own seed = case number).
 Data: seed 002 Table 3 actuator, 30 log-spaced lines 0.1-50 Hz at 20, 40, 60 °C; the user frees
 alpha0, d, xi, omega_n.  An effect is *detectable* when the baseline fitted to the noiseless data
 leaves 2·cost ≥ 25 (noncentrality, in units of the data's own noise).
@@ -31,10 +31,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from physmodel import get_parameter_set  # noqa: E402
-from physmodel.calibration import fit_parameters  # noqa: E402
-from physmodel.discrepancy import _free_list, diagnose, gap_shrink  # noqa: E402
-from physmodel.effects import LIBRARY, EffectModel, candidates_for  # noqa: E402
-from physmodel.sweep import FrequencySweep, MagnitudePhaseNoise, synthesize_sweep  # noqa: E402
+from physmodel.estimation.lsq import fit_parameters  # noqa: E402
+from physmodel.estimation.discrepancy import _free_list, diagnose, gap_shrink  # noqa: E402
+from physmodel.effects.library import LIBRARY, EffectModel, candidates_for  # noqa: E402
+from physmodel.data.sweep import FrequencySweep, MagnitudePhaseNoise
+from physmodel.data.sweep import synthesize_sweep  # noqa: E402
 
 SEALED = 0xB11D_2026
 ALPHA = 0.05

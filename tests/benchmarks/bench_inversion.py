@@ -235,8 +235,8 @@ def figures_seed001() -> None:
           "10 temperatures; scheduled fit on 8, 35/45 held out)")
     import physmodel
     import surrogate
-    from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
-    from physmodel.timesim import model_realization, simulate
+    from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
+    from physmodel.data.timesim import model_realization, simulate
 
     plant = physmodel.ActuatorModel(physmodel.get_parameter_set("seed001_actuator_dev"))
     temps = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]

@@ -4,7 +4,7 @@
 
 Data: every sweep is a ``physmodel`` Chen–Tan sweep (infinite-dimensional, so there is no exact
 low-order answer), synthesised by :func:`generate_sweep` with
-``physmodel.sweep.synthesize_sweep`` and seeded ``MagnitudePhaseNoise``, and handed to the fitters
+``physmodel.data.sweep.synthesize_sweep`` and seeded ``MagnitudePhaseNoise``, and handed to the fitters
 through ``surrogate.from_sweep``; the noise-free truth is the same call with ``noise=None``.
 
 Samples (``SAMPLES``):
@@ -42,7 +42,7 @@ import warnings
 import numpy as np
 
 import physmodel
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 from surrogate import (
     RationalFit,
     ScheduledFit,

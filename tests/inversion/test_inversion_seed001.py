@@ -14,7 +14,7 @@ Virtual experiment (the oracle is independent of the package under test):
 * plant: physmodel's Chen-Tan actuator with the calibrated seed 001 set (``seed001_actuator``:
   its E and C- law are solved from the printed trend, 19 degC about 7 dB above 55 degC near
   3 Hz); its time response comes from
-  ``physmodel.timesim.simulate`` (vector-fitted realisation of the exact transfer function
+  ``physmodel.data.timesim.simulate`` (vector-fitted realisation of the exact transfer function
   to 1e-4, exact FOH simulation);
 * surrogates: the paper's data set synthesised from the same physics (30 log-spaced lines,
   0.1-9 Hz, the paper's ten temperatures, noise-free, mm/V), fitted with
@@ -52,8 +52,8 @@ import scipy.signal as ss
 import physmodel
 import surrogate
 from inversion import feedforward, split_inverse
-from physmodel.sweep import synthesize_sweep
-from physmodel.timesim import model_realization, simulate
+from physmodel.data.sweep import synthesize_sweep
+from physmodel.data.timesim import model_realization, simulate
 
 TEMPS_C = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
 HELD_OUT_C = (35.0, 45.0)

@@ -17,10 +17,13 @@ import numpy as np
 import pytest
 
 from physmodel import ActuatorModel, SensorModel, get_parameter_set
-from physmodel.calibration import (FALLBACK_RELATIVE_STD, FreeParameter, apply_values, calibrate,
-                                   default_free_parameter, fit_parameters, residuals, weighted_cost)
+from physmodel.estimation.residuals import FALLBACK_RELATIVE_STD, residuals, weighted_cost
+from physmodel.estimation.records import FreeParameter
+from physmodel.parameter_paths import apply_values
+from physmodel.estimation.calibration import calibrate, default_free_parameter
+from physmodel.estimation.lsq import fit_parameters
 from physmodel.errors import DataFormatError, IPMCError, ParameterError
-from physmodel.sweep import ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.sweep import ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, synthesize_sweep
 from physmodel.temperature import Arrhenius, LogLinear
 
 

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from physmodel import ActuatorModel, SensorModel, get_parameter_set
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep, write_sweep
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.files import write_sweep
 from scenarios.cli import main
 
 TRUTH = dict(d=4.0e-11, kappa_e=3.8e-7)

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from physmodel import IPMCError, ParameterError, get_parameter_set
-from physmodel.discrepancy import VERDICTS, _constrained_lr, diagnose, gap_shrink
-from physmodel.effects import OUT_OF_LIBRARY, EffectModel
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.estimation.discrepancy import VERDICTS, _constrained_lr, diagnose, gap_shrink
+from physmodel.effects.library import OUT_OF_LIBRARY, EffectModel
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 
 P = get_parameter_set("seed002_table3")
 F = np.logspace(-1, 1.7, 30)

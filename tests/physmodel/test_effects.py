@@ -9,9 +9,8 @@ import pytest
 from scipy.optimize import brentq
 
 from physmodel import ActuatorModel, IPMCError, ParameterError, SensorModel, get_parameter_set
-from physmodel.effects import (CPE_REFERENCE_HZ, LIBRARY, OUT_OF_LIBRARY, SECOND_MODE_RATIO, EffectModel,
-                               candidates_for, get_effect)
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.effects.library import CPE_REFERENCE_HZ, LIBRARY, OUT_OF_LIBRARY, SECOND_MODE_RATIO, EffectModel, candidates_for, get_effect
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 from physmodel.temperature import Arrhenius, LogLinear
 
 F = np.logspace(-2, 3, 60)

@@ -3,7 +3,7 @@
 Oracles: the printed 35 °C sensor model (evaluated here with python-control from
 shared/data/published.toml, independently of the package's copy of the numbers), the printed
 seed 001 trend (7 dB at about 3 Hz, resonance moving down), the Euler-Bernoulli scaling of the first
-mode with the modulus law, and re-running the derivation (scenarios/seed_calibration.py) to
+mode with the modulus law, and re-running the derivation (physmodel/parameter_sets/derivation.py) to
 check that the stored numbers are what it produces.
 """
 
@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 
 from physmodel import ActuatorModel, SensorModel, get_parameter_set, load_parameter_set, save_parameter_set
-from physmodel.parameter_sets import SEED000_SENSOR_CAL, SEED001_ACTUATOR_CAL
+from physmodel.parameter_sets.seed000 import SEED000_SENSOR_CAL
+from physmodel.parameter_sets.seed001 import SEED001_ACTUATOR_CAL
 from physmodel.temperature import TemperatureLaws
-from scenarios import seed_calibration as sc
+from physmodel.parameter_sets import derivation as sc
 from scenarios.validate import DEFAULT_PUBLISHED
 
 

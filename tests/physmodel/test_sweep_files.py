@@ -7,8 +7,8 @@ import pytest
 
 from physmodel import ActuatorModel, SensorModel, get_parameter_set
 from physmodel.errors import DataFormatError, IPMCError
-from physmodel.sweep import (ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, read_csv, read_sweep,
-                             synthesize_sweep, write_sweep)
+from physmodel.data.sweep import ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.files import read_csv, read_sweep, write_sweep
 
 F = np.logspace(-1, 2, 30)
 T = [20.0, 40.0, 60.0]

@@ -10,8 +10,7 @@ import pytest
 from physmodel import ActuatorModel, SensorModel, TransimpedanceChain, get_parameter_set, state_at
 from physmodel.errors import IPMCError
 from physmodel.params import STATE_FIELDS
-from physmodel.timesim import (Realization, free_release, released_tip_displacement, simulate,
-                               sine, step)
+from physmodel.data.timesim import Realization, free_release, released_tip_displacement, simulate, sine, step
 
 from mpmath_reference import transfer_mp
 

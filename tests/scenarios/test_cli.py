@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physmodel.sweep import read_csv
+from physmodel.data.files import read_csv
 from scenarios.cli import main
 
 
@@ -23,7 +23,7 @@ def test_sweep_writes_csv_and_plot(tmp_path, capsys):
 
 
 def test_sensor_sweep_mat(tmp_path):
-    from physmodel.sweep import read_mat
+    from physmodel.data.files import read_mat
 
     out = tmp_path / "s.mat"
     assert main(["sweep", "--kind", "sensor", "--set", "seed000_sensor_dev", "--points", "5", "--out", str(out), "--quiet"]) == 0

@@ -8,7 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from physmodel.sweep import read_csv, read_sweep, synthesize_sweep
+from physmodel.data.files import read_csv, read_sweep
+from physmodel.data.sweep import synthesize_sweep
 from scenarios.runner import run_scenario
 from scenarios.spec import bundled_scenarios, load_scenario
 
@@ -45,7 +46,7 @@ def _path(name):
 def test_scenario_quick_mode_passes_and_is_complete(path, quick_run):
     spec = load_scenario(path, quick=True)
     if spec.has("discrepancy"):
-        pytest.importorskip("physmodel.discrepancy", reason="the discrepancy scenario needs physmodel.discrepancy")
+        pytest.importorskip("physmodel.estimation.discrepancy", reason="the discrepancy scenario needs physmodel.estimation.discrepancy")
     res = quick_run(path.stem)
     failed = [(c.name, c.value, c.bound_text()) for c in res.checks if not c.passed]
     assert not failed, failed
@@ -101,7 +102,7 @@ def test_demo_tracking_error_matches_the_steady_state_oracle(quick_run):
 
 def test_fixture_files_regenerate_from_their_seeds(quick_run):
     import physmodel
-    from physmodel.sweep import MagnitudePhaseNoise
+    from physmodel.data.sweep import MagnitudePhaseNoise
 
     out = quick_run("fixture_batch").out / "fixtures"
     spec = load_scenario(_path("fixture_batch"), quick=True)

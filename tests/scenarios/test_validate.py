@@ -54,7 +54,7 @@ def test_statuses_and_reasons(report):
 
 def test_35c_misfit_in_table_matches_the_calibration_module(report):
     from physmodel import get_parameter_set
-    from scenarios.seed_calibration import sensor_misfit_35c
+    from physmodel.parameter_sets.derivation import sensor_misfit_35c
 
     m = sensor_misfit_35c(get_parameter_set("seed000_sensor"))
     by = {r.claim_id: r for r in report.rows}

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import physmodel
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 from surrogate import RationalFit, fit_percent, order_selection
 
 NOISE = MagnitudePhaseNoise(0.3, 2.0)

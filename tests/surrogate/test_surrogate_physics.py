@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import physmodel
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 from surrogate import ScheduledFit, from_sweep, order_selection, relative_rms_error
 
 TEMPS = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]

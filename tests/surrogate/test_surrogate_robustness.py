@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import physmodel
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 from surrogate import RationalFit, RationalModel, Scaling, ScheduledFit, Structure, relative_rms_error
 from surrogate._fit import best_outcome
 from surrogate._nlp import SolveOutcome

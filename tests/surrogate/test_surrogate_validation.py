@@ -5,7 +5,7 @@ import pytest
 from surrogate_standin import physics_sweep
 
 from physmodel.errors import IPMCError
-from physmodel.sweep import FrequencySweep
+from physmodel.data.sweep import FrequencySweep
 from surrogate import ConvergenceError, FrequencyData, RationalFit, from_sweep
 
 F = np.geomspace(1.0, 100.0, 12)
@@ -14,7 +14,7 @@ H = 1.0 / (1 + 1j * F / 10.0)
 
 @pytest.mark.parametrize(
     "kwargs, message",
-    [   # FrequencyData is validated by physmodel.sweep.FrequencySweep's checks (one code path)
+    [   # FrequencyData is validated by physmodel.data.sweep.FrequencySweep's checks (one code path)
         (dict(frequency_hz=np.append(F[:-1], np.nan)), r"frequency_hz contains NaN or inf at rows \[11\]"),
         (dict(response=np.append(H[:-1], np.nan)), r"response contains NaN or inf at rows \[11\]"),
         (dict(response=H[:-1]), r"one value per line; got 12, 12, 11"),
@@ -94,7 +94,7 @@ def test_rational_non_convergence_raises_or_is_flagged():
 
 
 def test_from_sweep_uses_only_the_documented_attributes():
-    class Sweep:  # duck-typed stand-in for physmodel.sweep.FrequencySweep
+    class Sweep:  # duck-typed stand-in for physmodel.data.sweep.FrequencySweep
         __slots__ = ("temperature_c", "frequency_hz", "response", "magnitude_std_db", "phase_std_deg",
                      "input_name", "input_unit", "output_name", "output_unit", "metadata")
 

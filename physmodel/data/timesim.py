@@ -27,9 +27,9 @@ from typing import Callable
 import numpy as np
 from scipy import signal
 
-from .errors import IPMCError
-from .numerics import weighted_complex_lstsq
-from .sweep import atomic_write, by_extension
+from ..errors import IPMCError
+from ..numerics import weighted_complex_lstsq
+from .files import atomic_write, by_extension
 
 
 class RealizationError(IPMCError):
@@ -341,7 +341,7 @@ def model_realization(model, temperature_c: float, fs: float, duration: float, o
     """Realise the model's main transfer function at one temperature for a simulation at ``fs`` [Hz]
     lasting ``duration`` [s].  ``output``: actuator "displacement" (M) or "current" (1/Z);
     sensor "current" (S)."""
-    from .actuator import ActuatorModel
+    from ..actuator import ActuatorModel
 
     is_act = isinstance(model, ActuatorModel)
     if output == "auto":
@@ -373,7 +373,7 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
     (output becomes volts).  Noise: white Gaussian of the given RMS added to the recorded output
     and input (the laser/voltage measurement), seeded.
     """
-    from .actuator import ActuatorModel
+    from ..actuator import ActuatorModel
 
     t = np.asarray(t, dtype=float)
     dt = check_uniform_time(t)
@@ -463,7 +463,7 @@ def free_release(model, temperature_c: float, w0: float, t_release: float, durat
     steady state of the held tip.  Actuator: the electrodes are shorted (V = 0) and the output is
     the displacement itself.
     """
-    from .actuator import ActuatorModel
+    from ..actuator import ActuatorModel
 
     st = model.state([temperature_c])
     wn = float(st.omega_n[set_index, 0, 0])

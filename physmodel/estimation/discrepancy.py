@@ -3,7 +3,7 @@
 :func:`diagnose` (discrepancy.md) takes frequency-response data, a base parameter set and the
 user's free parameters, and:
 
-1. calibrates the baseline model (:func:`physmodel.calibration.fit_parameters`, the project's one
+1. calibrates the baseline model (:func:`physmodel.estimation.calibration.fit_parameters`, the project's one
    calibration engine) and tabulates where the standardised residuals exceed their band
    (frequency band × temperature × magnitude/phase, and the trend with temperature);
 2. refits the full model with each candidate effect of :data:`physmodel.effects.LIBRARY` switched
@@ -31,7 +31,7 @@ user's free parameters, and:
    pair, closes).  The gap test compares 2·cost with the (1 − α/5) quantile of its null
    distribution from the same Monte Carlo (stricter than α: a false "unexplained" costs a name).
 
-Residuals are those of :func:`physmodel.calibration.residuals`: ln-magnitude/σ_ln and wrapped
+Residuals are those of :func:`physmodel.estimation.calibration.residuals`: ln-magnitude/σ_ln and wrapped
 phase/σ_φ per line.  Data without per-line standard deviations use the calibration module's
 fallback (1 % per line); the report says so, and absolute gap tests are then relative to that.
 """
@@ -49,13 +49,16 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from .calibration import (CalibrationResult, FreeParameter, base_value, default_free_parameter,
-                          fit_parameters, noise_std, standardised_residuals)
-from .effects import (DEFAULT_QUANTITY, LIBRARY, EffectModel, candidates_for, get_effect,
-                      normalize_effects)
-from .errors import IPMCError, ParameterError
-from .params import IPMCParameters
-from .sweep import FrequencySweep, atomic_write
+from ..data.files import atomic_write
+from ..data.sweep import FrequencySweep
+from ..effects import DEFAULT_QUANTITY, LIBRARY, EffectModel, candidates_for, get_effect, normalize_effects
+from ..errors import IPMCError, ParameterError
+from ..params import IPMCParameters
+from ..parameter_paths import base_value
+from .calibration import default_free_parameter
+from .lsq import fit_parameters
+from .records import CalibrationResult, FreeParameter
+from .residuals import noise_std, standardised_residuals
 
 VERDICTS = ("none", "named", "ambiguous", "unexplained")
 #: Candidates whose signatures have a canonical correlation at least this high are confusable.

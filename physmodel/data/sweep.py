@@ -29,42 +29,19 @@ Rows are grouped by temperature; inside a group frequencies strictly increase.  
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import json
-import math
-import os
-import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from typing import Sequence
 
 import numpy as np
 
-from .errors import DataFormatError, IPMCError
+from ..errors import DataFormatError, IPMCError
+from .units import QUANTITY_UNITS, UNITS, unit_scale
 
 FORMAT_VERSION = 1
 REQUIRED_COLUMNS = ("temperature_c", "frequency_hz", "magnitude_db", "phase_deg")
 OPTIONAL_COLUMNS = ("magnitude_std_db", "phase_std_deg")
-
-#: Units the files may use, as multiples of the SI unit of their kind.
-UNITS: dict[str, tuple[str, float]] = {
-    "V": ("voltage", 1.0), "mV": ("voltage", 1e-3), "uV": ("voltage", 1e-6), "µV": ("voltage", 1e-6),
-    "m": ("length", 1.0), "mm": ("length", 1e-3), "um": ("length", 1e-6), "µm": ("length", 1e-6),
-    "A": ("current", 1.0), "mA": ("current", 1e-3), "uA": ("current", 1e-6), "µA": ("current", 1e-6),
-    "nA": ("current", 1e-9),
-    "Ohm": ("impedance", 1.0), "ohm": ("impedance", 1.0), "Ω": ("impedance", 1.0), "kOhm": ("impedance", 1e3),
-    "N": ("force", 1.0), "mN": ("force", 1e-3),
-    "1": ("dimensionless", 1.0),
-}
-
-
-def unit_scale(unit: str) -> float:
-    """Size of ``unit`` in SI (``'mm'`` → 1e-3)."""
-    if unit not in UNITS:
-        raise DataFormatError(f"unknown unit {unit!r}; expected one of {sorted(UNITS)}")
-    return UNITS[unit][1]
-
 
 # ----------------------------------------------------------------------------------- noise
 @dataclass(frozen=True)
@@ -266,28 +243,22 @@ class FrequencySweep:
 
     # -------------------------------------------------------------- files
     def to_csv(self, path) -> Path:
+        from .files import write_csv
+
         return write_csv(self, path)
 
     def to_npz(self, path) -> Path:
+        from .files import write_npz
+
         return write_npz(self, path)
 
     def to_mat(self, path) -> Path:
+        from .files import write_mat
+
         return write_mat(self, path)
 
 
 # ----------------------------------------------------------------------------------- synthesis
-#: Display units per physical quantity of the models: (input name, unit, output name, unit, SI scale).
-QUANTITY_UNITS = {
-    ("actuator", "M"): ("voltage", "V", "tip_displacement", "mm"),
-    ("actuator", "H"): ("voltage", "V", "tip_displacement", "mm"),
-    ("actuator", "G"): ("quasi_static_displacement", "1", "tip_displacement", "1"),
-    ("actuator", "Z"): ("current", "A", "voltage", "V"),
-    ("actuator", "I"): ("voltage", "V", "current", "A"),
-    ("sensor", "S"): ("tip_displacement", "mm", "current", "uA"),
-    ("sensor", "Z"): ("current", "A", "voltage", "V"),
-}
-
-
 def synthesize_sweep(model, quantity: str, frequency_hz, temperature_c, noise=None, seed: int | None = None,
                      set_index: int = 0, progress=None) -> FrequencySweep:
     """A synthetic sweep of ``model`` (ActuatorModel / SensorModel) with seeded noise.
@@ -296,7 +267,7 @@ def synthesize_sweep(model, quantity: str, frequency_hz, temperature_c, noise=No
     The sweep carries the noise's per-line standard deviations.  Units: mm/V for actuation,
     µA/mm for sensing, Ω for impedance.
     """
-    from .actuator import ActuatorModel
+    from ..actuator import ActuatorModel
 
     kind = "actuator" if isinstance(model, ActuatorModel) else "sensor"
     key = (kind, quantity)
@@ -329,249 +300,62 @@ def synthesize_sweep(model, quantity: str, frequency_hz, temperature_c, noise=No
     return FrequencySweep(T, f, H, mstd, pstd, in_name, in_unit, out_name, out_unit, meta)
 
 
-# ----------------------------------------------------------------------------------- I/O helpers
-def atomic_write(path, write_fn, mode: str = "w") -> Path:
-    """Write via a temporary file in the same folder, then rename: never a half-written file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=".part", dir=path.parent)
-    try:
-        with os.fdopen(fd, mode, **({"newline": "", "encoding": "utf-8"} if "b" not in mode else {})) as fh:
-            write_fn(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-    return path
+# ----------------------------------------------------------------------------------- layout
+@dataclass(frozen=True)
+class SweepLayout:
+    """How a model response maps onto the rows of a sweep: evaluate at ``temperatures_c`` ×
+    ``frequencies_hz`` (unique, sorted), take ``[..., t_index, f_index]`` and multiply by ``factor``
+    (SI response → the sweep's display units)."""
+
+    quantity: str
+    factor: float
+    frequencies_hz: np.ndarray
+    f_index: np.ndarray
+    temperatures_c: np.ndarray
+    t_index: np.ndarray
 
 
-def _columns(sw: FrequencySweep) -> dict[str, np.ndarray]:
-    cols = {
-        "temperature_c": sw.temperature_c,
-        "frequency_hz": sw.frequency_hz,
-        "magnitude_db": sw.magnitude_db,
-        "phase_deg": sw.phase_deg,
-    }
-    if sw.magnitude_std_db is not None:
-        cols["magnitude_std_db"] = sw.magnitude_std_db
-        cols["phase_std_deg"] = sw.phase_std_deg
-    return cols
+def sweep_layout(data: FrequencySweep, kind: str, quantity: str | None = None) -> SweepLayout:
+    """Check that ``data`` can hold the ``kind`` model's ``quantity`` (default M / S) and lay it out."""
+    if kind not in ("actuator", "sensor"):
+        raise IPMCError(f"kind={kind!r}; expected 'actuator' or 'sensor'")
+    q = quantity or ("M" if kind == "actuator" else "S")
+    if (kind, q) not in QUANTITY_UNITS:
+        raise IPMCError(f"{kind} quantity {q!r} cannot be compared with data; expected one of "
+                        f"{[k[1] for k in QUANTITY_UNITS if k[0] == kind]}")
+    _, unit_in, _, unit_out = QUANTITY_UNITS[(kind, q)]
+    want_in, want_out = UNITS[unit_in][0], UNITS[unit_out][0]
+    got_in, got_out = UNITS[data.input_unit][0], UNITS[data.output_unit][0]
+    if (got_in, got_out) != (want_in, want_out):
+        raise DataFormatError(f"the sweep is {data.output_name} [{data.output_unit}] per {data.input_name} "
+                              f"[{data.input_unit}] ({got_out}/{got_in}); {kind} quantity {q} needs "
+                              f"{want_out}/{want_in} (see physmodel.sweep.QUANTITY_UNITS {QUANTITY_UNITS[(kind, q)]})")
+    factor = unit_scale(data.input_unit) / unit_scale(data.output_unit)   # SI response -> sweep units
+    fu, inv_f = np.unique(data.frequency_hz, return_inverse=True)
+    Tu, inv_T = np.unique(data.temperature_c, return_inverse=True)
+    return SweepLayout(q, factor, fu, inv_f, Tu, inv_T)
 
 
-def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], where: str) -> FrequencySweep:
-    def unit_of(key):
-        if key not in header:
-            raise DataFormatError(f"{where}: missing header line '# {key}: <name> [<unit>]'")
-        text = header[key].strip()
-        if not (text.endswith("]") and "[" in text):
-            raise DataFormatError(f"{where}: header '{key}: {text}' must look like 'name [unit]'")
-        name, unit = text[:-1].split("[", 1)
-        unit = unit.strip()
-        if unit not in UNITS:
-            raise DataFormatError(f"{where}: unknown {key} unit {unit!r}; expected one of {sorted(UNITS)}")
-        return name.strip(), unit
-
-    in_name, in_unit = unit_of("input")
-    out_name, out_unit = unit_of("output")
-    H = 10 ** (cols["magnitude_db"] / 20) * np.exp(1j * np.radians(cols["phase_deg"]))
-    meta = {k: v for k, v in header.items() if k not in ("input", "output", "ipmc-sweep")}
-    has_std = "magnitude_std_db" in cols
-    return FrequencySweep(cols["temperature_c"], cols["frequency_hz"], H,
-                          cols["magnitude_std_db"] if has_std else None,
-                          cols["phase_std_deg"] if has_std else None,
-                          in_name, in_unit, out_name, out_unit, meta)
-
-
-def _header_lines(sw: FrequencySweep) -> list[str]:
-    lines = [f"ipmc-sweep {FORMAT_VERSION}", f"input: {sw.input_name} [{sw.input_unit}]",
-             f"output: {sw.output_name} [{sw.output_unit}]"]
-    for k, v in sw.metadata.items():
-        v = str(v).replace("\n", " ")
-        lines.append(f"{k}: {v}")
-    return lines
-
-
-# ----------------------------------------------------------------------------------- CSV
-def write_csv(sw: FrequencySweep, path) -> Path:
-    """Write the tidy CSV (see module doc), atomically."""
-    cols = _columns(sw)
-
-    def write(fh):
-        for line in _header_lines(sw):
-            fh.write(f"# {line}\n")
-        w = csv.writer(fh, lineterminator="\n")
-        w.writerow(list(cols))
-        for row in zip(*cols.values()):
-            w.writerow([repr(float(v)) for v in row])
-
-    return atomic_write(path, write)
-
-
-def read_csv(path) -> FrequencySweep:
-    """Read the tidy CSV; a malformed file raises :class:`DataFormatError` naming the line."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    header: dict[str, str] = {}
-    lines = text.splitlines()
-    i = 0
-    while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
-        body = lines[i].lstrip("#").strip()
-        if body.startswith("ipmc-sweep"):
-            header["ipmc-sweep"] = body.split(None, 1)[1] if len(body.split()) > 1 else ""
-        elif ":" in body:
-            k, v = body.split(":", 1)
-            header[k.strip()] = v.strip()
-        i += 1
-    if i >= len(lines):
-        raise DataFormatError(f"{path}: no column header line after the '#' header")
-    colnames = [c.strip() for c in lines[i].split(",")]
-    missing = [c for c in REQUIRED_COLUMNS if c not in colnames]
-    if missing:
-        raise DataFormatError(f"{path}:{i + 1}: missing column(s) {missing}; found {colnames}")
-    unknown = [c for c in colnames if c not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS]
-    if unknown:
-        raise DataFormatError(f"{path}:{i + 1}: unknown column(s) {unknown}; expected {list(REQUIRED_COLUMNS + OPTIONAL_COLUMNS)}")
-    has_std = [c in colnames for c in OPTIONAL_COLUMNS]
-    if any(has_std) and not all(has_std):
-        raise DataFormatError(f"{path}:{i + 1}: give both {OPTIONAL_COLUMNS} or neither")
-    rows = []
-    line_no = []
-    for j in range(i + 1, len(lines)):
-        raw = lines[j]
-        if not raw.strip() or raw.lstrip().startswith("#"):
-            continue
-        parts = [p.strip() for p in raw.split(",")]
-        if len(parts) != len(colnames):
-            raise DataFormatError(f"{path}:{j + 1}: expected {len(colnames)} values, got {len(parts)}")
-        vals = []
-        for name, p in zip(colnames, parts):
-            try:
-                v = float(p)
-            except ValueError:
-                raise DataFormatError(f"{path}:{j + 1}: {name} = {p!r} is not a number") from None
-            if not math.isfinite(v):
-                raise DataFormatError(f"{path}:{j + 1}: {name} is {p!r}; expected a finite number")
-            vals.append(v)
-        rows.append(vals)
-        line_no.append(j + 1)
-    if not rows:
-        raise DataFormatError(f"{path}: no data rows")
-    arr = np.array(rows)
-    cols = {name: arr[:, k] for k, name in enumerate(colnames)}
-    T, f = cols["temperature_c"], cols["frequency_hz"]
-    for k in range(len(rows)):
-        if f[k] <= 0:
-            raise DataFormatError(f"{path}:{line_no[k]}: frequency_hz = {float(f[k])!r} must be > 0")
-        if "magnitude_std_db" in cols and (cols["magnitude_std_db"][k] < 0 or cols["phase_std_deg"][k] < 0):
-            raise DataFormatError(f"{path}:{line_no[k]}: standard deviations must be >= 0")
-    seen_T: set[float] = set()
-    for k in range(len(rows)):
-        if k > 0 and T[k] == T[k - 1]:
-            if f[k] == f[k - 1]:
-                raise DataFormatError(f"{path}:{line_no[k]}: duplicate frequency {f[k]:g} Hz at {T[k]:g} °C")
-            if f[k] < f[k - 1]:
-                raise DataFormatError(f"{path}:{line_no[k]}: frequencies at {T[k]:g} °C are not sorted "
-                                      f"({f[k]:g} Hz after {f[k - 1]:g} Hz)")
-        else:
-            if T[k] in seen_T:
-                raise DataFormatError(f"{path}:{line_no[k]}: rows at {T[k]:g} °C are not contiguous")
-            seen_T.add(T[k])
-    try:
-        return _from_columns(cols, header, str(path))
-    except DataFormatError:
-        raise
-    except IPMCError as exc:
-        raise DataFormatError(f"{path}: {exc}") from None
-
-
-# ----------------------------------------------------------------------------------- NPZ / MAT
-def write_npz(sw: FrequencySweep, path) -> Path:
-    cols = _columns(sw)
-    header = json.dumps({"format": "ipmc-sweep", "version": FORMAT_VERSION,
-                         "input": f"{sw.input_name} [{sw.input_unit}]",
-                         "output": f"{sw.output_name} [{sw.output_unit}]", "metadata": sw.metadata})
-
-    def write(fh):
-        np.savez(fh, header=np.array(header), response_real=sw.response.real, response_imag=sw.response.imag, **cols)
-
-    return atomic_write(path, write, "wb")
-
-
-def read_npz(path) -> FrequencySweep:
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    if "header" not in data:
-        raise DataFormatError(f"{path}: not an ipmc-sweep NPZ (no 'header')")
-    hdr = json.loads(str(data["header"]))
-    missing = [c for c in REQUIRED_COLUMNS if c not in data]
-    if missing:
-        raise DataFormatError(f"{path}: missing array(s) {missing}")
-    cols = {k: np.asarray(data[k], dtype=float) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
-    header = {"input": hdr["input"], "output": hdr["output"], **{k: str(v) for k, v in hdr.get("metadata", {}).items()}}
-    sw = _from_columns(cols, header, str(path))
-    if "response_real" in data:   # exact complex values, not rounded through dB/deg
-        sw = replace(sw, response=data["response_real"] + 1j * data["response_imag"])
-    return sw
-
-
-def write_mat(sw: FrequencySweep, path) -> Path:
-    """MATLAB .mat (v5) with one column vector per field, the complex response and header strings."""
-    from scipy.io import savemat
-
-    cols = {k: v.reshape(-1, 1) for k, v in _columns(sw).items()}
-    cols["response"] = sw.response.reshape(-1, 1)
-    cols["input"] = f"{sw.input_name} [{sw.input_unit}]"
-    cols["output"] = f"{sw.output_name} [{sw.output_unit}]"
-    cols["format"] = f"ipmc-sweep {FORMAT_VERSION}"
-    cols["metadata_json"] = json.dumps(sw.metadata)
-
-    def write(fh):
-        savemat(fh, cols, do_compression=True)
-
-    return atomic_write(path, write, "wb")
-
-
-def read_mat(path) -> FrequencySweep:
-    from scipy.io import loadmat
-
-    try:
-        data = loadmat(path)
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    missing = [c for c in REQUIRED_COLUMNS if c not in data]
-    if missing:
-        raise DataFormatError(f"{path}: missing variable(s) {missing}")
-    cols = {k: np.asarray(data[k], dtype=float).reshape(-1) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
-    meta = json.loads(str(data["metadata_json"][0])) if "metadata_json" in data else {}
-    header = {"input": str(data["input"][0]), "output": str(data["output"][0]), **{k: str(v) for k, v in meta.items()}}
-    sw = _from_columns(cols, header, str(path))
-    if "response" in data:
-        sw = replace(sw, response=np.asarray(data["response"], dtype=complex).reshape(-1))
-    return sw
-
-
-def by_extension(path, handlers: Mapping[str, Callable], what: str) -> Callable:
-    """The handler for ``path``'s file extension, or a DataFormatError listing the accepted ones."""
-    ext = Path(path).suffix.lower()
-    if ext not in handlers:
-        raise DataFormatError(f"{path}: unknown {what} file type {ext!r}; expected {', '.join(handlers)}")
-    return handlers[ext]
-
-
-def read_sweep(path) -> FrequencySweep:
-    """Read a sweep by file extension (.csv, .npz, .mat)."""
-    return by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "sweep")(path)
-
-
-def write_sweep(sw: FrequencySweep, path) -> Path:
-    """Write a sweep by file extension (.csv, .npz, .mat), atomically."""
-    return by_extension(path, {".csv": write_csv, ".npz": write_npz, ".mat": write_mat}, "sweep")(sw, path)
+def merge_sweeps(data: FrequencySweep | Sequence[FrequencySweep]) -> FrequencySweep:
+    """One sweep from several (distinct temperatures), in the units of the first."""
+    if isinstance(data, FrequencySweep):
+        return data
+    sweeps = list(data)
+    if not sweeps or not all(isinstance(s, FrequencySweep) for s in sweeps):
+        raise IPMCError("data must be a FrequencySweep or a non-empty sequence of them")
+    first = sweeps[0]
+    conv = [s.in_units(first.input_unit, first.output_unit) for s in sweeps]
+    seen: set = set()
+    for s in conv:
+        common = seen & set(s.temperatures().tolist())
+        if common:
+            raise IPMCError(f"several sweeps hold lines at {sorted(common)} °C; merge them into one sweep first")
+        seen |= set(s.temperatures().tolist())
+    std = all(s.magnitude_std_db is not None for s in conv)
+    if not std and any(s.magnitude_std_db is not None for s in conv):
+        raise IPMCError("some sweeps carry per-line standard deviations and others do not; give all or none")
+    cat = lambda k: np.concatenate([getattr(s, k) for s in conv])  # noqa: E731
+    return FrequencySweep(cat("temperature_c"), cat("frequency_hz"), cat("response"),
+                          cat("magnitude_std_db") if std else None, cat("phase_std_deg") if std else None,
+                          first.input_name, first.input_unit, first.output_name, first.output_unit,
+                          dict(first.metadata))

@@ -24,7 +24,7 @@ Mechanics are unchanged, so ``Z, H, I, S`` are the base quantities evaluated at 
 ``M = H(ŝ) G(s)``.  β = 1 is off; ω_c = 2π·:data:`CPE_REFERENCE_HZ` is where |ŝ| = |s|.
 
 :class:`EffectModel` composes any set of effects with a base parameter set; it is an
-``ActuatorModel`` / ``SensorModel`` (so :func:`physmodel.sweep.synthesize_sweep` simulates data
+``ActuatorModel`` / ``SensorModel`` (so :func:`physmodel.data.sweep.synthesize_sweep` simulates data
 with any effect switched on) and gives the ``predict(values)`` closure used by the calibration
 engine (:meth:`EffectModel.predictor`).  Effect parameters are addressed as ``"effect.param"``.
 Out-of-library effects for blind tests live in :data:`OUT_OF_LIBRARY` and are never candidates.
@@ -38,12 +38,12 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from .actuator import ActuatorModel
-from .errors import IPMCError, ParameterError
-from .model import DEFAULT_CHUNK, FrequencyResponse, check_frequencies, evaluate_grid
-from .params import STATE_FIELDS, IPMCParameters, State, first_mode_omega
-from .sensor import SensorModel
-from .temperature import FARADAY, R_GAS
+from ..actuator import ActuatorModel
+from ..errors import IPMCError, ParameterError
+from ..model import DEFAULT_CHUNK, FrequencyResponse, check_frequencies, evaluate_grid
+from ..params import STATE_FIELDS, IPMCParameters, State, first_mode_omega
+from ..sensor import SensorModel
+from ..temperature import FARADAY, R_GAS
 
 #: Frequency [Hz] at which |ŝ| = |s| for the constant-phase element (ŝ = ω_c (s/ω_c)^β).
 CPE_REFERENCE_HZ = 10.0
@@ -372,7 +372,7 @@ def split_values(values: Mapping[str, float]) -> tuple[dict, dict]:
     """Split ``{"alpha0": .., "time_delay.delay": ..}`` into base-parameter and effect dicts.
 
     Base names are IPMCParameters fields, ``omega_n`` or ``laws.<quantity>.<attribute>``
-    (see :func:`physmodel.calibration.apply_values`)."""
+    (see :func:`physmodel.estimation.calibration.apply_values`)."""
     base, eff = {}, {}
     for k, v in values.items():
         if "." in k and not k.startswith("laws."):
@@ -387,7 +387,7 @@ def split_values(values: Mapping[str, float]) -> tuple[dict, dict]:
 def _apply(p: IPMCParameters, base_vals: Mapping[str, float]) -> IPMCParameters:
     if not base_vals:
         return p
-    from .calibration import apply_values
+    from ..parameter_paths import apply_values
 
     return apply_values(p, base_vals)
 
@@ -491,7 +491,7 @@ class _EffectMixin:
         is the batched form (n_sets, N) for ``fit_parameters(predict_many=...)``; it uses the first
         parameter set of this model as the base.
         """
-        from .calibration import sweep_layout
+        from ..data.sweep import sweep_layout
 
         lay = sweep_layout(data, self.kind, quantity or DEFAULT_QUANTITY[self.kind])
         q, scale, freqs, fi, temps, ti = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,

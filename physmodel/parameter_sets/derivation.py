@@ -1,6 +1,6 @@
 """Reproducible derivation of the calibrated seed sets ``seed000_sensor`` and ``seed001_actuator``.
 
-Run ``python3 -m scenarios.seed_calibration`` (a few seconds) to re-derive the numbers stored in
+Run ``python3 -m physmodel.parameter_sets.derivation`` (a few seconds) to re-derive the numbers stored in
 :mod:`physmodel.parameter_sets`; nothing here runs at import.  The trend metrics below are also
 what :mod:`scenarios.validate` and the tests use to check the stored sets against the seeds.
 
@@ -8,7 +8,7 @@ Seed 000 sensor (18 × 6.5 × 0.21 mm Nafion-117)
     *Data.*  The only printed response is the 35 °C fourth-order model (Sec. IV-A); it is treated
     as measured data over the paper's band, 10–100 Hz (:func:`printed_sensor_sweep`), with a per-line
     uncertainty of 0.5 dB / 5° (the coefficients are printed to 2–3 significant figures).
-    *Fit.*  :func:`physmodel.calibration.calibrate` (kind "sensor", kernel "boundary_charge") frees the
+    *Fit.*  :func:`physmodel.estimation.calibration.calibrate` (kind "sensor", kernel "boundary_charge") frees the
     sensing coupling a0 (printed nowhere), the diffusivity d, the permittivity κe and the electrode
     resistances r1', r2' (:data:`SENSOR_FREE`), with ``T_ref`` = 35 °C so the temperature laws do not
     enter.  a0 is negative: the printed phase at 10 Hz (−58°) is within 90° of the physics phase for
@@ -40,14 +40,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physmodel import ActuatorModel, SensorModel, get_parameter_set
-from physmodel.errors import IPMCError
-from physmodel.sweep import FrequencySweep
-from physmodel.temperature import LogLinear
+from ..actuator import ActuatorModel
+from ..data.sweep import FrequencySweep
+from ..errors import IPMCError
+from ..sensor import SensorModel
+from ..temperature import LogLinear
+from . import get_parameter_set
+from .published import seed000_printed_model_35c
 
 #: Seed 000, Sec. IV-A: the printed 35 °C model, tip displacement [mm] → current [µA], s in rad/s.
-#: (The same numbers as inversion.examples.SEED000_NUM_35C / _DEN_35C; imported from there.)
-from inversion.examples import SEED000_DEN_35C, SEED000_NUM_35C
+SEED000_NUM_35C, SEED000_DEN_35C, _ = seed000_printed_model_35c()
 
 SENSOR_BAND_HZ = (10.0, 100.0)
 SENSOR_T_CAL_C = 35.0
@@ -91,7 +93,8 @@ def sensor_base():
 
 def calibrate_seed000_sensor(*, starts: int = 4, seed: int = 0, progress=None):
     """Calibrate the sensor physics to the printed 35 °C model (10–100 Hz); a CalibrationResult."""
-    from physmodel.calibration import FreeParameter, calibrate
+    from ..estimation.calibration import calibrate
+    from ..estimation.lsq import FreeParameter
 
     base = sensor_base()
     # start at the development values, a0 with the sign the phase calls for (module doc)

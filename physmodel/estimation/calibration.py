@@ -1,0 +1,141 @@
+"""Calibration of an IPMC physics model's parameters (fields, ``omega_n``, temperature-law
+parameters) to measured sweeps: the physics binding of the least-squares engine in
+:mod:`physmodel.estimation.lsq` (weighted, multi-start, with intervals and identifiability).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..data.sweep import FrequencySweep, merge_sweeps, sweep_layout
+from ..errors import IPMCError, ParameterError
+from ..params import IPMCParameters
+from ..parameter_paths import apply_values, base_value, check_parameter_name
+from .lsq import CalibrationResult, FreeParameter, SensitivityProbe, fit_parameters
+
+def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
+    """Default bounds for a bare name (initial = base value):
+
+    * positive fields and ``omega_n``: [base/10, 10·base], log (``xi`` capped at 2; ``omega_n`` ×/÷ 3);
+    * signed couplings ``alpha0``/``a0``: the same decade either side, log of the magnitude, sign kept;
+    * ``laws.*.activation_energy``: [0, 60] kJ/mol, linear; ``laws.*.slope``: [−0.05, 0.05] /K, linear;
+      ``laws.*.alpha``: [−5e-3, 5e-3] /K, linear.
+    A zero or infinite base value (e.g. ``Rp_specific = inf``) needs explicit bounds.
+    """
+    v = base_value(base, name)
+    if name.startswith("laws."):
+        attr = name.split(".")[2]
+        defaults = {"activation_energy": (0.0, 60e3), "slope": (-0.05, 0.05), "alpha": (-5e-3, 5e-3)}
+        if attr not in defaults:
+            raise ParameterError(f"no default bounds for {name!r}; give them as FreeParameter(name, lower, upper)")
+        lo, hi = defaults[attr]
+        return FreeParameter(name, lo, hi, "linear", min(max(v, lo), hi))
+    if not math.isfinite(v) or v == 0:
+        raise ParameterError(f"{name} = {v!r} in the base set: no default bounds; give them explicitly "
+                             f"(e.g. '{name}:LOWER:UPPER')")
+    span = 3.0 if name == "omega_n" else 10.0
+    lo, hi = sorted((v / span, v * span))
+    if name == "xi":
+        hi = min(hi, 2.0)
+        lo = min(lo, hi / 10)
+    return FreeParameter(name, lo, hi, "log", v)
+
+
+def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "actuator",
+                      quantity: str | None = None, kernel: str = "boundary_charge"):
+    """``predict_many(list of values) -> (n_sets, N)`` in the sweep's units, plus a wide-band
+    :class:`SensitivityProbe` at the median data temperature.  One model call per batch
+    (sets × temperatures × union of frequencies)."""
+    from ..actuator import ActuatorModel
+    from ..sensor import SensorModel
+
+    lay = sweep_layout(data, kind, quantity)
+    q, factor, fu, inv_f, Tu, inv_T = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,
+                                       lay.temperatures_c, lay.t_index)
+
+    def model_of(values_list):
+        plist = [apply_values(base, v) for v in values_list]
+        return ActuatorModel(plist) if kind == "actuator" else SensorModel(plist, kernel=kernel)
+
+    def predict_many(values_list):
+        R = model_of(values_list).frequency_response(fu, Tu, quantities=(q,))[q]
+        return R[:, inv_T, inv_f] * factor
+
+    t_probe = float(Tu[np.argmin(np.abs(Tu - np.median(data.temperature_c)))])
+    f_probe = np.logspace(math.log10(fu[0]) - 3, math.log10(fu[-1]) + 3, 121)
+
+    def probe_many(values_list):
+        return model_of(values_list).frequency_response(f_probe, [t_probe], quantities=(q,))[q][:, 0, :] * factor
+
+    return predict_many, SensitivityProbe(f_probe, probe_many), q
+
+
+def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParameters,
+              free: Sequence[FreeParameter | str], *, kind: str = "actuator", quantity: str | None = None,
+              starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
+              identify: bool = True, hold_undetermined: bool = True, name: str | None = None,
+              progress: Callable[[int], None] | None = None, **kwargs) -> CalibrationResult:
+    """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
+
+    ``free``: :class:`FreeParameter` records or bare names (default bounds: see
+    :func:`default_free_parameter`); names are IPMCParameters fields, ``"omega_n"`` or
+    ``"laws.<quantity>.<attribute>"`` (temperature-law parameters, fitted jointly across
+    temperatures).  Start 0 is the base value (or ``initial``); ``starts − 1`` more are seeded
+    Latin-hypercube points.  ``kind``/``quantity``: ``"actuator"`` (``"M"`` tip displacement per
+    volt by default, also ``H``, ``Z``, ``I``) or ``"sensor"`` (``"S"``, ``"Z"``); the data's units must
+    be of the matching kinds (mm/V, µA/mm, Ω, ...).  Returns a :class:`CalibrationResult` whose
+    ``parameters`` is ``base`` with the determined values (held ones at their base value), named
+    ``name`` (default ``"<base.name>_calibrated"``).
+    """
+    if not isinstance(base, IPMCParameters):
+        raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
+    data = merge_sweeps(data)
+    fps = []
+    for item in free:
+        if isinstance(item, str):
+            fps.append(default_free_parameter(base, item))
+        elif isinstance(item, FreeParameter):
+            check_parameter_name(base, item.name)
+            if item.initial is None:
+                v = base_value(base, item.name)
+                if not item.lower <= v <= item.upper:
+                    raise ParameterError(f"free parameter {item.name}: the base value {v!r} lies outside the "
+                                         f"bounds [{item.lower!r}, {item.upper!r}]; give an initial value")
+                item = item.with_initial(v)
+            fps.append(item)
+        else:
+            raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
+    predict_many, probe, q = physics_predictor(data, base, kind, quantity, kernel)
+    res = fit_parameters(data, None, fps, starts=starts, seed=seed, predict_many=predict_many,
+                         max_nfev=max_nfev, identify=identify, hold_undetermined=hold_undetermined,
+                         probe=probe, progress=progress, **kwargs)
+    label = name or f"{base.name}_calibrated"
+    src = (f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
+           f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"
+           + (f"; undetermined (held at base): {', '.join(res.held)}" if res.held else "")
+           + f"; base: {base.name}")
+    res.parameters = replace(apply_values(base, res.values), name=label, source=src)
+    res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
+                         "data_fingerprint": data.fingerprint(), "seed": seed})
+    return res
+
+
+def model_sweep(result: CalibrationResult, data: FrequencySweep, kind: str | None = None,
+                quantity: str | None = None, kernel: str | None = None) -> FrequencySweep:
+    """The calibrated model's response on the data's lines, as a sweep (for overlays)."""
+    if result.parameters is None:
+        raise IPMCError("the result has no physical parameter set (use calibrate(), not fit_parameters())")
+    kind = kind or result.metadata.get("kind", "actuator")
+    predict_many, _, _ = physics_predictor(data, result.parameters, kind,
+                                           quantity or result.metadata.get("quantity"),
+                                           kernel or result.metadata.get("kernel", "boundary_charge"))
+    G = predict_many([{}])[0]
+    return replace(data, response=G, magnitude_std_db=None, phase_std_deg=None,
+                   metadata={"source": "calibrated model", "parameter_set": result.parameters.name})
+
+
+__all__ = ["default_free_parameter", "physics_predictor", "calibrate", "model_sweep"]

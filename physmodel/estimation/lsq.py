@@ -1,0 +1,404 @@
+"""Calibration of physical parameters to measured frequency responses, with honest uncertainty.
+
+A subset of physical parameters (:class:`FreeParameter`: bounds, log or linear scale) is fitted to
+one or many :class:`~physmodel.data.sweep.FrequencySweep` by weighted nonlinear least squares
+(``scipy.optimize.least_squares``, trust-region reflective, in a scaled space), multi-start, and
+returned as a :class:`CalibrationResult` with 95 % confidence intervals, the correlation matrix
+and an identifiability report.
+
+Residuals (discrepancy.md §1)
+    For each line the relative error ln(G_data/G_model) is split into log-magnitude and phase:
+    ``r = [ln|G_d/G_m| / σ_ln, wrap(∠G_d − ∠G_m) / σ_φ]`` with σ_ln = magnitude_std_db·ln10/20 and
+    σ_φ = phase_std_deg·π/180 from the sweep.  The cost ½Σr² of a correct model averages
+    F − nθ/2 (F lines, nθ fitted parameters) with spread ≈ sqrt(F − nθ/2).
+
+    Fallback when the sweep carries no per-line standard deviations: every line gets
+    σ_ln = σ_φ = :data:`FALLBACK_RELATIVE_STD` (1 % relative error), the result says
+    ``noise_estimated=True``, and the covariance is rescaled by the residual variance
+    2·cost/(2F − nθ) (the usual estimated-σ² least-squares covariance).
+
+Scaled space
+    A ``"log"`` parameter is fitted as z = log10(|x|) (both bounds of one sign; its sign is kept),
+    a ``"linear"`` one as z = (x − lower)/(upper − lower).  Jacobians are forward finite
+    differences in z, evaluated in ONE batched model call (all perturbed parameter sets at once).
+    Confidence intervals are z ± 1.96·se(z) mapped back: asymmetric in physical units for log
+    parameters.  ``n_evaluations`` counts full-data model evaluations (one per parameter set
+    predicted, also inside batched calls); ``n_model_calls`` counts the batched calls.
+
+Identifiability (see :func:`fit_parameters`)
+    From the SVD of the weighted, scaled Jacobian at the optimum a parameter is *undetermined* if
+    its 95 % interval spans more than :data:`MAX_CI_DECADES` decade (log) or more than its bounds
+    (linear) — this includes near-null directions of the Jacobian, where se(z) is huge — or if it
+    is pinned at a bound.  The reason names where its sensitivity peaks (from an optional
+    :class:`SensitivityProbe` over a wide band) relative to the measured band, or the parameter it
+    is confounded with.  Undetermined parameters are held at their start value (the base value in
+    :func:`calibrate`) and the others refitted; they are reported without an interval.
+
+Temperature-law parameters are named ``"laws.<quantity>.<attribute>"``, e.g.
+``"laws.d.activation_energy"`` [J/mol] or ``"laws.E.slope"`` [1/K] (see :mod:`physmodel.temperature`);
+``"omega_n"`` [rad/s] sets the first bending mode through the density.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..data.sweep import FrequencySweep
+from ..errors import IPMCError, ParameterError
+from .records import (CalibrationResult, FreeParameter, Identifiability, SensitivityProbe, StartRecord,
+                      Values)
+from .residuals import noise_std, standardised_residuals
+
+#: Two-sided 95 % normal quantile.
+Z95 = 1.959963984540054
+#: A log parameter whose 95 % interval spans more decades than this is reported as undetermined.
+MAX_CI_DECADES = 1.0
+#: A parameter closer than this fraction of its scaled range to a bound is "pinned at the bound".
+BOUND_TOL = 1e-3
+#: Forward finite-difference step in the scaled space.
+FD_STEP = 1e-6
+
+
+
+# =============================================================================== the engine
+class _Counter:
+    def __init__(self):
+        self.evaluations = 0
+        self.calls = 0
+
+
+def _as_batch(predict, predict_many, counter: _Counter, n_lines: int):
+    """A function list-of-values -> (n_sets, N) complex, counting evaluations."""
+
+    def many(values_list):
+        counter.calls += 1 if predict_many is not None else len(values_list)
+        counter.evaluations += len(values_list)
+        if predict_many is not None:
+            out = np.asarray(predict_many(values_list), dtype=complex)
+        else:
+            out = np.stack([np.asarray(predict(v), dtype=complex).reshape(-1) for v in values_list])
+        if out.shape != (len(values_list), n_lines):
+            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(len(values_list), n_lines)} "
+                            "(one complex value per data line and parameter set)")
+        return out
+
+    return many
+
+
+def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
+    """``n`` Latin-hypercube points in the scaled boxes (n, n_free), seeded."""
+    from scipy.stats import qmc
+
+    if n <= 0:
+        return np.empty((0, len(free)))
+    u = qmc.LatinHypercube(d=len(free), seed=seed).random(n)
+    lo = np.array([fp.z_bounds[0] for fp in free])
+    hi = np.array([fp.z_bounds[1] for fp in free])
+    return lo + u * (hi - lo)
+
+
+@dataclass
+class _Fit:
+    z: np.ndarray
+    cost: float
+    J: np.ndarray
+    r: np.ndarray
+    nfev: int
+    status: int
+    message: str
+
+
+def _solve(free, fixed: dict, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_step) -> _Fit:
+    """least_squares in the scaled space of ``free`` (others fixed); one batched call per Jacobian."""
+    lo = np.array([fp.z_bounds[0] for fp in free])
+    hi = np.array([fp.z_bounds[1] for fp in free])
+
+    def values_of(z):
+        v = dict(fixed)
+        for fp, zi in zip(free, z):
+            v[fp.name] = float(fp.from_z(zi))
+        return v
+
+    cache: dict = {}
+
+    def fun(z):
+        key = z.tobytes()
+        if key not in cache:
+            cache.clear()
+            G = many([values_of(z)])[0]
+            cache[key] = standardised_residuals(G, data, s_ln, s_ph)
+        return cache[key]
+
+    def jac(z):
+        f0 = fun(z)
+        steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
+        pts = []
+        for i in range(z.size):
+            zz = z.copy()
+            zz[i] += steps[i]
+            pts.append(values_of(zz))
+        G = many(pts)
+        R = standardised_residuals(G, data, s_ln, s_ph)
+        return ((R - f0[None, :]) / steps[:, None]).T
+
+    z0 = np.clip(np.asarray(z0, dtype=float), lo, hi)
+    sol = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0,
+                        ftol=ftol, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+    z = sol.x
+    r = fun(z)
+    J = jac(z)
+    msg = sol.message.rstrip(".") if sol.status > 0 else (
+        f"stopped after {sol.nfev} function evaluations (max_nfev={max_nfev}) before converging"
+        if sol.status == 0 else sol.message)
+    return _Fit(z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=int(sol.nfev), status=int(sol.status), message=msg)
+
+
+def _covariance(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Newton covariance (JᵀJ)⁻¹ via the SVD; returns (cov, singular values)."""
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    tiny = s.max() * 1e-14 if s.size and s.max() > 0 else 1e-300
+    inv = 1.0 / np.maximum(s, tiny) ** 2
+    return (Vt.T * inv) @ Vt, s
+
+
+def _sensitivity_peaks(free, values: dict, J: np.ndarray, data: FrequencySweep, probe: SensitivityProbe | None,
+                       many_counter: _Counter, fd_step: float):
+    """Per free parameter: (frequency of peak |∂lnG/∂z| [Hz], in-band max / overall max)."""
+    n = data.frequency_hz.size
+    out = {}
+    # in-band sensitivity from the weighted Jacobian converted back to |∂ ln G/∂z| per line
+    s_ln, s_ph, _ = noise_std(data)
+    in_band = np.sqrt((J[:n] * s_ln[:, None]) ** 2 + (J[n:] * s_ph[:, None]) ** 2)   # (N, n_free)
+    band_max = in_band.max(axis=0)
+    if probe is None:
+        for j, fp in enumerate(free):
+            out[fp.name] = (float(data.frequency_hz[np.argmax(in_band[:, j])]), 1.0)
+        return out
+    f = np.asarray(probe.frequency_hz, dtype=float)
+    pts = [dict(values)]
+    for fp in free:
+        v = dict(values)
+        z = float(fp.to_z(values[fp.name]))
+        step = fd_step * 100 if z + fd_step * 100 <= fp.z_bounds[1] else -fd_step * 100
+        v[fp.name] = float(fp.from_z(z + step))
+        pts.append((v, step))
+    G = np.asarray(probe.predict_many([pts[0]] + [p[0] for p in pts[1:]]), dtype=complex)
+    many_counter.calls += 1
+    many_counter.evaluations += len(pts)
+    base = np.log(G[0])
+    fmin, fmax = data.frequency_hz.min(), data.frequency_hz.max()
+    inside = (f >= fmin) & (f <= fmax)
+    for j, fp in enumerate(free):
+        sens = np.abs((np.log(G[j + 1]) - base) / pts[j + 1][1])
+        k = int(np.argmax(sens))
+        peak = float(sens[k])
+        frac = float(sens[inside].max() / peak) if np.any(inside) and peak > 0 else float(band_max[j] > 0)
+        out[fp.name] = (float(f[k]), frac)
+    return out
+
+
+def _identifiability(free, z, J, cov, values, data, probe, counter, fd_step):
+    """Flags and reasons for every free parameter of one fit (no holding here)."""
+    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
+    corr = cov / np.outer(d, d)
+    peaks = _sensitivity_peaks(free, values, J, data, probe, counter, fd_step)
+    fmin, fmax = float(data.frequency_hz.min()), float(data.frequency_hz.max())
+    report, badness = {}, {}
+    for j, fp in enumerate(free):
+        lo, hi = fp.z_bounds
+        width = 2 * Z95 * se[j]
+        if fp.scale == "log":
+            ratio = width / MAX_CI_DECADES
+            spread = f"its 95 % interval would span {width:.3g} decades"
+        else:
+            ratio = width / (hi - lo)
+            spread = f"its 95 % interval would be {ratio:.3g} times as wide as its bounds"
+        pinned = None
+        if z[j] - lo <= BOUND_TOL * (hi - lo):
+            pinned = "lower" if fp.scale == "linear" or fp.sign > 0 else "upper"
+        elif hi - z[j] <= BOUND_TOL * (hi - lo):
+            pinned = "upper" if fp.scale == "linear" or fp.sign > 0 else "lower"
+        peak_hz, frac = peaks[fp.name]
+        where = ""
+        if frac < 0.5:
+            side = "above" if peak_hz > fmax else "below" if peak_hz < fmin else "inside"
+            where = (f"sensitivity peaks at {_fmt_hz(peak_hz)}, {side} the measured band "
+                     f"{_fmt_hz(fmin)}–{_fmt_hz(fmax)} (in-band sensitivity {100 * frac:.2g} % of the peak)")
+        others = [(abs(corr[j, k]), free[k].name) for k in range(len(free)) if k != j and np.isfinite(corr[j, k])]
+        conf = max(others) if others else (0.0, "")
+        if pinned is not None:
+            reason = f"ended at its {pinned} bound ({getattr(fp, pinned):.4g}), so the data do not determine it inside its bounds"
+            if where:
+                reason += "; " + where
+            if np.isfinite(ratio) and ratio > 1.0:
+                reason += "; " + spread
+            report[fp.name] = Identifiability(False, reason, peak_hz, frac)
+            badness[fp.name] = np.inf
+        elif not np.isfinite(ratio) or ratio > 1.0:
+            parts = [spread]
+            if where:
+                parts.insert(0, where)
+            if conf[0] > 0.95:
+                parts.append(f"confounded with {conf[1]} (correlation {conf[0]:.3f})")
+            report[fp.name] = Identifiability(False, "; ".join(parts), peak_hz, frac)
+            badness[fp.name] = ratio if np.isfinite(ratio) else 1e300
+        else:
+            report[fp.name] = Identifiability(True, "determined by the data" + (f" ({where})" if where else ""),
+                                              peak_hz, frac)
+    return report, badness, se, corr
+
+
+def _fmt_hz(f: float) -> str:
+    if f >= 1e3:
+        return f"{f / 1e3:.3g} kHz"
+    return f"{f:.3g} Hz"
+
+
+def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray] | None,
+                   free: Sequence[FreeParameter], *, starts: int = 1, seed: int = 0,
+                   predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
+                   fixed: Values | None = None, max_nfev: int | None = None, ftol: float = 1e-10,
+                   identify: bool = True, hold_undetermined: bool = True,
+                   probe: SensitivityProbe | None = None, fd_step: float = FD_STEP,
+                   progress: Callable[[int], None] | None = None) -> CalibrationResult:
+    """Fit ``free`` parameters of a generic predictor to ``data`` by weighted least squares.
+
+    ``predict(values) -> (N,) complex`` at every line of ``data`` (same order and units);
+    ``predict_many(list of values) -> (n_sets, N)`` is used when given (one call per Jacobian).
+    ``fixed``: extra values passed to the predictor unchanged.  ``starts``: start 0 is each
+    parameter's ``initial`` (else the mid-point); the others are seeded Latin-hypercube points in
+    the scaled boxes; all are reported, the best is kept.  With ``identify`` undetermined parameters
+    are flagged (module doc) and, with ``hold_undetermined``, held at their start-0 value while the
+    others are refitted.  ``max_nfev``: residual evaluations per start (scipy's meaning).
+    ``progress(1)`` is called after each start.  ``parameters`` of the result is None (see
+    :func:`calibrate` for the physics wrapper).
+    """
+    t0 = time.perf_counter()
+    if not isinstance(data, FrequencySweep):
+        raise IPMCError(f"data must be a FrequencySweep, got {type(data).__name__}")
+    free = [fp if isinstance(fp, FreeParameter) else None for fp in free]
+    if not free or any(fp is None for fp in free):
+        raise ParameterError("free must be a non-empty sequence of FreeParameter")
+    names = [fp.name for fp in free]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise ParameterError(f"free parameter(s) {dup} given more than once")
+    if predict is None and predict_many is None:
+        raise IPMCError("give predict or predict_many")
+    if int(starts) < 1:
+        raise IPMCError(f"starts must be >= 1, got {starts}")
+    if max_nfev is not None and int(max_nfev) < 1:
+        raise IPMCError(f"max_nfev must be >= 1, got {max_nfev}")
+    fixed = dict(fixed or {})
+    s_ln, s_ph, estimated = noise_std(data)
+    n_lines = data.frequency_hz.size
+    if 2 * n_lines <= len(free):
+        raise IPMCError(f"{n_lines} lines (2 residuals each) cannot determine {len(free)} parameters")
+    counter = _Counter()
+    many = _as_batch(predict, predict_many, counter, n_lines)
+
+    x_init = [fp.initial if fp.initial is not None else fp.midpoint() for fp in free]
+    z_init = np.array([fp.to_z(x) for fp, x in zip(free, x_init)], float)
+    z_starts = np.vstack([z_init[None, :], _lhs_starts(free, int(starts) - 1, seed)])
+    records, fits = [], []
+    for i, z0 in enumerate(z_starts):
+        fit = _solve(free, fixed, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_step)
+        fits.append(fit)
+        initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
+        records.append(StartRecord(i, initial,
+                                   {fp.name: float(fp.from_z(v)) for fp, v in zip(free, fit.z)},
+                                   fit.cost, fit.nfev, fit.status, fit.message))
+        if progress:
+            progress(1)
+    best = min(range(len(fits)), key=lambda k: fits[k].cost)
+    fit = fits[best]
+    converged = fit.status > 0
+    message = f"best of {len(fits)} start(s) is start {best}: {fit.message}"
+
+    # identifiability: flag, hold the worst, refit the rest; repeat
+    active = list(range(len(free)))
+    z_full = fit.z.copy()
+    held: dict[str, Identifiability] = {}
+    report: dict = {}
+    while True:
+        act = [free[k] for k in active]
+        values = dict(fixed)
+        values.update({fp.name: (x_init[k] if fp.name in held else float(fp.from_z(z_full[k])))
+                       for k, fp in enumerate(free)})
+        cov, _ = _covariance(fit.J)
+        noise_scale = 1.0
+        dof = 2 * n_lines - len(act)
+        if estimated:
+            noise_scale = math.sqrt(2.0 * fit.cost / dof) if dof > 0 else float("nan")
+            cov = cov * noise_scale**2
+        if not (identify and converged and act):
+            report = {fp.name: Identifiability(True, "not assessed" if not identify else
+                                               "not assessed (the fit did not converge)") for fp in act}
+            se = np.sqrt(np.maximum(np.diag(cov), 0.0))
+            d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
+            corr = cov / np.outer(d, d)
+            break
+        report, badness, se, corr = _identifiability(act, fit.z, fit.J, cov, values, data, probe, counter, fd_step)
+        if not badness or not hold_undetermined:
+            break
+        pinned = [n for n, b in badness.items() if b == np.inf]
+        to_hold = pinned or [max(badness, key=badness.get)]
+        for n in to_hold:
+            held[n] = report[n]
+        active = [k for k in active if free[k].name not in held]
+        for k, fp in enumerate(free):
+            if fp.name in held:
+                z_full[k] = z_init[k]
+        if not active:
+            break
+        fixed_now = dict(fixed)
+        fixed_now.update({free[k].name: x_init[k] for k in range(len(free)) if free[k].name in held})
+        fit = _solve([free[k] for k in active], fixed_now, z_full[active], many, data, s_ln, s_ph,
+                     max_nfev, ftol, fd_step)
+        z_full[active] = fit.z
+        converged = fit.status > 0
+        message += f"; refit without {', '.join(to_hold)}: {fit.message}"
+
+    # assemble in the order of `free`
+    n_act = len(active)
+    values = {fp.name: (x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))) for k, fp in enumerate(free)}
+    stderr, lo_ci, hi_ci, ident = {}, {}, {}, {}
+    C = np.full((len(free), len(free)), np.nan)
+    pos = {k: i for i, k in enumerate(active)}
+    for k, fp in enumerate(free):
+        if fp.name in held:
+            stderr[fp.name] = lo_ci[fp.name] = hi_ci[fp.name] = float("nan")
+            ident[fp.name] = held[fp.name]
+            continue
+        i = pos[k]
+        zk, sk = z_full[k], se[i]
+        a, b = fp.from_z(zk - Z95 * sk), fp.from_z(zk + Z95 * sk)
+        lo_ci[fp.name], hi_ci[fp.name] = float(min(a, b)), float(max(a, b))
+        stderr[fp.name] = float(abs(values[fp.name]) * math.log(10) * sk if fp.scale == "log"
+                                else sk * (fp.upper - fp.lower))
+        ident[fp.name] = report[fp.name]
+        for k2 in active:
+            C[k, k2] = corr[i, pos[k2]]
+    if not active:
+        cost = float(0.5 * np.sum(standardised_residuals(many([dict(fixed, **values)])[0], data, s_ln, s_ph) ** 2))
+    else:
+        cost = fit.cost
+    expected = n_lines - n_act / 2.0
+    if held:
+        message += f"; undetermined and held at their start value: {', '.join(held)}"
+    return CalibrationResult(
+        names=names, values=values, parameters=None, stderr=stderr, ci_lower=lo_ci, ci_upper=hi_ci,
+        correlation=C, cost=cost, expected_cost=expected, cost_std=math.sqrt(max(expected, 0.0)),
+        n_lines=n_lines, n_evaluations=counter.evaluations, n_model_calls=counter.calls,
+        converged=bool(converged), message=message, starts=records, identifiability=ident,
+        noise_estimated=estimated, noise_scale=float(noise_scale), held=list(held), free=list(free),
+        band_hz=(float(data.frequency_hz.min()), float(data.frequency_hz.max())),
+        temperatures_c=data.temperatures().tolist(), elapsed_s=time.perf_counter() - t0,
+    )

@@ -1,0 +1,242 @@
+"""Records of the least-squares engine (:mod:`physmodel.estimation.lsq`): what is free
+(:class:`FreeParameter`), how a start went (:class:`StartRecord`), what the data determine
+(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`).  Physical units throughout.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+
+from ..data.files import atomic_write
+from ..errors import ParameterError
+from ..params import IPMCParameters
+
+Values = Mapping[str, float]
+
+# =============================================================================== free parameters
+@dataclass(frozen=True)
+class FreeParameter:
+    """A parameter to calibrate, with bounds in its physical unit.
+
+    ``scale``: ``"log"`` (fitted as log10 |x|; both bounds must have one sign, not zero) or
+    ``"linear"``; default ``"log"`` when ``lower > 0`` else ``"linear"``.  ``initial``: the start
+    value (default: the base value in :func:`calibrate`, else the geometric/arithmetic mid-point).
+    """
+
+    name: str
+    lower: float
+    upper: float
+    scale: str | None = None
+    initial: float | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ParameterError(f"a free parameter needs a non-empty name, got {self.name!r}")
+        for k in ("lower", "upper"):
+            v = getattr(self, k)
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) or not math.isfinite(v):
+                raise ParameterError(f"free parameter {self.name}: {k}={v!r} must be a finite number")
+            object.__setattr__(self, k, float(v))
+        if not self.lower < self.upper:
+            raise ParameterError(f"free parameter {self.name}: bounds reversed or empty, lower={self.lower!r} "
+                                 f"must be < upper={self.upper!r}")
+        scale = self.scale or ("log" if self.lower > 0 else "linear")
+        if scale not in ("log", "linear"):
+            raise ParameterError(f"free parameter {self.name}: scale={self.scale!r}; expected 'log' or 'linear'")
+        if scale == "log" and not (self.lower > 0 or self.upper < 0):
+            raise ParameterError(f"free parameter {self.name}: a log scale needs bounds of one sign, not "
+                                 f"crossing zero; got [{self.lower!r}, {self.upper!r}]")
+        object.__setattr__(self, "scale", scale)
+        if self.initial is not None:
+            v = self.initial
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) or not math.isfinite(v):
+                raise ParameterError(f"free parameter {self.name}: initial={v!r} must be a finite number")
+            if not self.lower <= v <= self.upper:
+                raise ParameterError(f"free parameter {self.name}: initial={v!r} lies outside its bounds "
+                                     f"[{self.lower!r}, {self.upper!r}]")
+            object.__setattr__(self, "initial", float(v))
+
+    # scaled coordinate ---------------------------------------------------------------------
+    @property
+    def sign(self) -> float:
+        return -1.0 if self.upper < 0 else 1.0
+
+    def to_z(self, x):
+        x = np.asarray(x, dtype=float)
+        if self.scale == "log":
+            return np.log10(np.abs(x))
+        return (x - self.lower) / (self.upper - self.lower)
+
+    def from_z(self, z):
+        z = np.asarray(z, dtype=float)
+        if self.scale == "log":
+            # clipped so that the interval of an undetermined parameter (huge se(z)) stays finite
+            return self.sign * 10.0 ** np.clip(z, -300.0, 300.0)
+        return self.lower + z * (self.upper - self.lower)
+
+    @property
+    def z_bounds(self) -> tuple[float, float]:
+        a, b = float(self.to_z(self.lower)), float(self.to_z(self.upper))
+        return (min(a, b), max(a, b))
+
+    def midpoint(self) -> float:
+        """Geometric (log) or arithmetic (linear) mid-point of the bounds."""
+        lo, hi = self.z_bounds
+        return float(self.from_z(0.5 * (lo + hi)))
+
+    def with_initial(self, value: float) -> "FreeParameter":
+        return replace(self, initial=float(value))
+
+# =============================================================================== results
+@dataclass(frozen=True)
+class StartRecord:
+    """One start of the multi-start search: where it began and where it ended."""
+
+    index: int
+    initial: dict
+    final: dict
+    cost: float
+    nfev: int
+    status: int
+    message: str
+
+
+@dataclass(frozen=True)
+class Identifiability:
+    """Whether the data determine one parameter, and why not.
+
+    ``sensitivity_peak_hz``: frequency where |∂ ln G/∂z| is largest (over the probe band when a
+    :class:`SensitivityProbe` was given, else over the data); ``in_band_fraction``: the largest
+    in-band sensitivity over that peak (1 = the peak is inside the measured band).
+    """
+
+    identifiable: bool
+    reason: str
+    sensitivity_peak_hz: float | None = None
+    in_band_fraction: float | None = None
+
+
+@dataclass(frozen=True)
+class SensitivityProbe:
+    """A wide-band evaluation used to locate where each parameter acts.
+
+    ``predict_many(list_of_value_dicts) -> (n_sets, n_f) complex`` at ``frequency_hz`` [Hz]
+    (one representative temperature).
+    """
+
+    frequency_hz: np.ndarray
+    predict_many: Callable[[Sequence[Values]], np.ndarray]
+
+
+@dataclass
+class CalibrationResult:
+    """Outcome of a calibration.  Physical units throughout; intervals are 95 %.
+
+    ``values``: fitted (or held) value of every free parameter; ``stderr``: standard error
+    (delta method for log parameters; NaN when held); ``ci_lower``/``ci_upper``: 95 % interval
+    (NaN when held); ``correlation``: (n, n) in the order of ``names`` (NaN rows for held ones);
+    ``cost`` = ½Σr², ``expected_cost`` = F − nθ/2, ``cost_std`` = sqrt(F − nθ/2);
+    ``held``: undetermined parameters kept at their start value.
+    """
+
+    names: list
+    values: dict
+    parameters: IPMCParameters | None
+    stderr: dict
+    ci_lower: dict
+    ci_upper: dict
+    correlation: np.ndarray
+    cost: float
+    expected_cost: float
+    cost_std: float
+    n_lines: int
+    n_evaluations: int
+    n_model_calls: int
+    converged: bool
+    message: str
+    starts: list
+    identifiability: dict
+    noise_estimated: bool
+    noise_scale: float
+    held: list
+    free: list
+    band_hz: tuple
+    temperatures_c: list
+    elapsed_s: float
+    metadata: dict = field(default_factory=dict)
+
+    @property
+    def determined(self) -> list:
+        return [n for n in self.names if n not in self.held]
+
+    def summary(self) -> str:
+        lines = [
+            f"calibration: {'converged' if self.converged else 'NOT CONVERGED'} ({self.message})",
+            f"  data: {self.n_lines} lines, {len(self.temperatures_c)} temperature(s), band "
+            f"{self.band_hz[0]:.4g}-{self.band_hz[1]:.4g} Hz; noise "
+            + ("estimated from the residuals (no per-line std in the data), scale "
+               f"{self.noise_scale:.3g}" if self.noise_estimated else "from the sweep's per-line std"),
+            f"  cost {self.cost:.4g} (expected {self.expected_cost:.4g} ± {self.cost_std:.3g}); "
+            f"{len(self.starts)} start(s); {self.n_evaluations} model evaluations in {self.n_model_calls} calls; "
+            f"{self.elapsed_s:.2f} s",
+            f"  {'parameter':34s} {'value':>12s} {'95 % interval':>27s}  status",
+        ]
+        for n in self.names:
+            ident = self.identifiability.get(n)
+            if n in self.held:
+                lines.append(f"  {n:34s} {self.values[n]:12.5g} {'(held)':>27s}  UNDETERMINED: {ident.reason}")
+            else:
+                ci = f"[{self.ci_lower[n]:.5g}, {self.ci_upper[n]:.5g}]"
+                lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci:>27s}  ok")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        def num(v):
+            v = float(v)
+            return v if math.isfinite(v) else None
+
+        corr = [[num(c) for c in row] for row in np.asarray(self.correlation, dtype=float)]
+        return {
+            "format": "ipmc-calibration", "version": 1,
+            "converged": bool(self.converged), "message": self.message,
+            "parameters": [
+                {"name": n, "value": num(self.values[n]), "stderr": num(self.stderr[n]),
+                 "ci95_lower": num(self.ci_lower[n]), "ci95_upper": num(self.ci_upper[n]),
+                 "held": n in self.held,
+                 "identifiable": bool(self.identifiability[n].identifiable) if n in self.identifiability else None,
+                 "reason": self.identifiability[n].reason if n in self.identifiability else "",
+                 "sensitivity_peak_hz": (num(self.identifiability[n].sensitivity_peak_hz)
+                                         if n in self.identifiability and self.identifiability[n].sensitivity_peak_hz is not None else None),
+                 "bounds": [fp.lower, fp.upper], "scale": fp.scale}
+                for n, fp in zip(self.names, self.free)
+            ],
+            "correlation": {"names": list(self.names), "matrix": corr},
+            "cost": num(self.cost), "expected_cost": num(self.expected_cost), "cost_std": num(self.cost_std),
+            "n_lines": int(self.n_lines), "n_evaluations": int(self.n_evaluations),
+            "n_model_calls": int(self.n_model_calls),
+            "noise_estimated": bool(self.noise_estimated), "noise_scale": num(self.noise_scale),
+            "band_hz": [float(self.band_hz[0]), float(self.band_hz[1])],
+            "temperatures_c": [float(t) for t in self.temperatures_c],
+            "starts": [{"index": s.index, "initial": s.initial, "final": s.final, "cost": num(s.cost),
+                        "nfev": s.nfev, "status": s.status, "message": s.message} for s in self.starts],
+            "elapsed_s": float(self.elapsed_s),
+            "metadata": {k: str(v) for k, v in self.metadata.items()},
+        }
+
+    def save(self, path) -> Path:
+        """Atomic JSON: a parameter-set payload (readable by :func:`physmodel.load_parameter_set`)
+        when ``parameters`` is known, plus the calibration record under ``"calibration"``."""
+        from ..parameter_sets import _FORMAT, _VERSION, _finite_json
+
+        payload: dict = {}
+        if self.parameters is not None:
+            payload = {"format": _FORMAT, "version": _VERSION, "parameters": _finite_json(self.parameters.to_dict())}
+        payload["calibration"] = self.to_dict()
+        text = json.dumps(payload, indent=2, allow_nan=False)
+        return atomic_write(Path(path), lambda fh: fh.write(text + "\n"))

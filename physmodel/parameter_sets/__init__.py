@@ -1,0 +1,125 @@
+"""Named parameter sets, one module per source, each with its source; look them up with
+:func:`get_parameter_set`.
+
+Modules: :mod:`~physmodel.parameter_sets.dev` (development values; ``dev``, ``seed000_sensor_dev``,
+``seed001_actuator_dev``), :mod:`~physmodel.parameter_sets.seed000` (``seed000_sensor``),
+:mod:`~physmodel.parameter_sets.seed001` (``seed001_actuator``),
+:mod:`~physmodel.parameter_sets.seed002` (``seed002_table2``, ``seed002_table3``);
+:mod:`~physmodel.parameter_sets.derivation` re-derives the calibrated sets
+(``python3 -m physmodel.parameter_sets.derivation``); :mod:`~physmodel.parameter_sets.published`
+holds the seed papers' printed numbers (``published.toml``, shipped with the package).
+
+A new source is one new module here that defines ``SETS = {name: factory}``; it is found
+automatically.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any, Callable
+
+from ..errors import ParameterError
+from ..params import IPMCParameters
+
+_FORMAT = "ipmc-parameter-set"
+_VERSION = 1
+
+
+
+#: Modules of this package that are not parameter-set sources.
+_NOT_SOURCES = ("derivation", "published")
+
+
+def _discover() -> dict[str, Callable[[], IPMCParameters]]:
+    """Every ``SETS`` mapping of the modules in this package (one module per source)."""
+    import importlib
+    import pkgutil
+
+    found: dict[str, Callable[[], IPMCParameters]] = {}
+    for info in pkgutil.iter_modules(__path__):
+        if info.name in _NOT_SOURCES:
+            continue
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        for name, factory in getattr(mod, "SETS", {}).items():
+            if name in found:
+                raise ParameterError(f"parameter set {name!r} is defined twice (module {info.name})")
+            found[name] = factory
+    return found
+
+
+_REGISTRY: dict[str, Callable[[], IPMCParameters]] = _discover()
+def available_parameter_sets() -> list[str]:
+    """Names accepted by :func:`get_parameter_set`."""
+    return sorted(_REGISTRY)
+
+
+def get_parameter_set(name: str | os.PathLike, **overrides: Any) -> IPMCParameters:
+    """The named parameter set, with any field overridden (``omega_n=`` adjusts ``rho``).
+
+    ``name`` may also be the path of a JSON parameter file (what ``ipmc calibrate`` writes, or
+    :func:`save_parameter_set`): any string ending in ``.json``, or an existing path.
+
+    >>> p = get_parameter_set("seed002_table3", W=2e-3)
+    """
+    text = os.fspath(name)
+    if text in _REGISTRY:
+        p = _REGISTRY[text]()
+    elif text.lower().endswith(".json") or Path(text).is_file():
+        p = load_parameter_set(text)
+    else:
+        raise ParameterError(f"unknown parameter set {text!r}; expected one of {available_parameter_sets()} "
+                             "or the path of a JSON parameter file")
+    return p.replace(**overrides) if overrides else p
+
+
+def save_parameter_set(params: IPMCParameters, path: str | os.PathLike) -> Path:
+    """Write ``params`` as a versioned JSON parameter file (atomically) and return its path."""
+    from ..data.files import atomic_write
+
+    path = Path(path)
+    payload = {"format": _FORMAT, "version": _VERSION, "parameters": _finite_json(params.to_dict())}
+    text = json.dumps(payload, indent=2, allow_nan=False)
+    atomic_write(path, lambda fh: fh.write(text + "\n"))
+    return path
+
+
+def load_parameter_set(path: str | os.PathLike) -> IPMCParameters:
+    """Read a JSON parameter file written by :func:`save_parameter_set` (or a bare parameter record)."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError(f"parameter file {str(path)!r} does not exist")
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from exc
+    if isinstance(data, dict) and "parameters" in data:
+        if data.get("format") != _FORMAT:
+            raise ParameterError(f"parameter file {str(path)!r} has format {data.get('format')!r}, "
+                                 f"expected {_FORMAT!r}")
+        if int(data.get("version", 0)) > _VERSION:
+            raise ParameterError(f"parameter file {str(path)!r} has version {data.get('version')}, "
+                                 f"this library reads up to {_VERSION}")
+        data = data["parameters"]
+    if not isinstance(data, dict):
+        raise ParameterError(f"parameter file {str(path)!r} holds {type(data).__name__}, expected an object")
+    return IPMCParameters.from_dict(data)
+
+
+def _finite_json(obj):
+    """Infinite values (Rp' = inf, validity ranges) as the strings "inf"/"-inf", which float() reads back."""
+    if isinstance(obj, dict):
+        return {k: _finite_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite_json(v) for v in obj]
+    if isinstance(obj, float) and obj in (float("inf"), float("-inf")):
+        return "inf" if obj > 0 else "-inf"
+    return obj
+
+
+def register_parameter_set(name: str, factory: Callable[[], IPMCParameters], *, overwrite: bool = False) -> None:
+    """Register a parameter set (e.g. a calibrated one) under ``name``."""
+    if name in _REGISTRY and not overwrite:
+        raise ParameterError(f"parameter set {name!r} exists; pass overwrite=True to replace it")
+    _REGISTRY[name] = factory
