@@ -1,11 +1,12 @@
 """Exceptions raised by :mod:`inversion`.
 
-Every error is a :class:`ValueError` subclass so that callers that only know about
-``ValueError`` still catch them; the message always names the offending value and what
-was expected instead.
+Every error is a :class:`physmodel.errors.IPMCError` (the library's one error root, a
+:class:`ValueError`); the message always names the offending value and what was expected instead.
 """
 
 from __future__ import annotations
+
+from physmodel.errors import IPMCError
 
 __all__ = [
     "InversionError",
@@ -17,7 +18,7 @@ __all__ = [
 ]
 
 
-class InversionError(ValueError):
+class InversionError(IPMCError):
     """Base class of every input error raised by :mod:`inversion`."""
 
 

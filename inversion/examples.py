@@ -10,6 +10,8 @@ from typing import Any
 
 import numpy as np
 
+from physmodel.parameter_sets.published import seed000_printed_model_35c
+
 __all__ = [
     "SEED000_NUM_35C",
     "SEED000_DEN_35C",
@@ -20,11 +22,10 @@ __all__ = [
     "released_cantilever",
 ]
 
-#: Seed 000, Sec. IV-A: 35 degC sensor model, tip displacement [mm] -> current [uA], s [rad/s].
-SEED000_NUM_35C = (-17.3, 2.2e4, -1.0e7, -9.4e8, 4.5e10)
-SEED000_DEN_35C = (1.0, 835.0, 6.3e5, 2.5e8, 4.4e10)
-#: Its zeros as printed (computed by the authors from the unrounded coefficients) [rad/s].
-SEED000_ZEROS_35C = (-106.7, 35.2, 662.2 + 498.3j, 662.2 - 498.3j)
+#: Seed 000, Sec. IV-A: 35 degC sensor model, tip displacement [mm] -> current [uA], s [rad/s], and its
+#: zeros as printed (computed by the authors from the unrounded coefficients) [rad/s]; the printed
+#: numbers live in :mod:`physmodel.parameter_sets.published`.
+SEED000_NUM_35C, SEED000_DEN_35C, SEED000_ZEROS_35C = seed000_printed_model_35c()
 
 
 def seed000_sensor_35c(form: str = "coefficients") -> Any:

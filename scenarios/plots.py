@@ -1,5 +1,8 @@
-"""Figures for reports: Bode plots of sweeps and time traces.  matplotlib with the Agg backend;
-every figure is written atomically (temporary file, then rename)."""
+"""Every figure of the library: Bode plots of sweeps, surrogate fits and calibrated or diagnosed
+models, pole/zero loci, time traces.  matplotlib ``Figure`` objects on an Agg canvas (no pyplot
+state, safe in threads and workers); every figure is written atomically (temporary file, then
+rename) through :func:`physmodel.data.files.atomic_write`.  The only module that imports matplotlib.
+"""
 
 from __future__ import annotations
 
@@ -7,24 +10,42 @@ from pathlib import Path
 
 import numpy as np
 
+from physmodel.errors import IPMCError
 
-def _plt():
+
+def _subplots(*args, figsize=None, **kw):
+    """A new ``Figure`` on an Agg canvas and its axes (like ``pyplot.subplots``, without pyplot state)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(*args, **kw)
+
+
+def _cmap(name: str):
     import matplotlib
 
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
+    return matplotlib.colormaps[name]
 
 
-def _save(fig, path) -> Path:
+def _normalize(vmin, vmax):
+    from matplotlib.colors import Normalize
+
+    return Normalize(vmin, vmax)
+
+
+def _scalar_mappable(**kw):
+    from matplotlib.cm import ScalarMappable
+
+    return ScalarMappable(**kw)
+
+
+def _save(fig, path, dpi: int = 120) -> Path:
     from physmodel.data.files import atomic_write
 
     path = Path(path)
-    try:
-        return atomic_write(path, lambda fh: fig.savefig(fh, format=path.suffix.lstrip(".") or "png", dpi=120), "wb")
-    finally:
-        _plt().close(fig)
+    return atomic_write(path, lambda fh: fig.savefig(fh, format=path.suffix.lstrip(".") or "png", dpi=dpi), "wb")
 
 
 def bode(sweeps, path, title: str = "", labels=None, styles=None) -> Path:
@@ -35,14 +56,13 @@ def bode(sweeps, path, title: str = "", labels=None, styles=None) -> Path:
     """
     from physmodel.data.sweep import FrequencySweep
 
-    plt = _plt()
     if isinstance(sweeps, FrequencySweep):
         sweeps = [sweeps]
     labels = labels or [""] * len(sweeps)
     styles = styles or ["-"] * len(sweeps)
-    fig, (ax_m, ax_p) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))
+    fig, (ax_m, ax_p) = _subplots(2, 1, sharex=True, figsize=(7, 6))
     temps = np.unique(np.concatenate([s.temperatures() for s in sweeps]))
-    cmap = plt.get_cmap("coolwarm")
+    cmap = _cmap("coolwarm")
     colors = {t: cmap(0.0 if temps.size == 1 else (t - temps.min()) / (temps.max() - temps.min())) for t in temps}
     for sw, lab, sty in zip(sweeps, labels, styles):
         mag, ph = sw.magnitude_db, sw.phase_deg
@@ -69,8 +89,7 @@ def bode(sweeps, path, title: str = "", labels=None, styles=None) -> Path:
 
 def traces(ts, path, title: str = "", output_scale: float = 1.0, output_label: str | None = None) -> Path:
     """Input and output of a :class:`~physmodel.data.timesim.TimeSeries`."""
-    plt = _plt()
-    fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(7, 5))
+    fig, (a1, a2) = _subplots(2, 1, sharex=True, figsize=(7, 5))
     a1.plot(ts.t, ts.input, lw=0.8)
     a1.set_ylabel(f"{ts.input_name} [{ts.input_unit}]")
     a2.plot(ts.t, ts.output * output_scale, lw=0.8, label="recorded")
@@ -88,8 +107,7 @@ def traces(ts, path, title: str = "", output_scale: float = 1.0, output_label: s
 
 def curves(x, ys: dict, path, xlabel: str, ylabel: str, title: str = "", logx: bool = True) -> Path:
     """Several curves y(x) on one axis (e.g. model orders)."""
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = _subplots(figsize=(7, 4))
     for lab, y in ys.items():
         (ax.semilogx if logx else ax.plot)(x, y, label=lab)
     ax.set_xlabel(xlabel)
@@ -103,11 +121,10 @@ def curves(x, ys: dict, path, xlabel: str, ylabel: str, title: str = "", logx: b
 
 def pole_zero_locus(model, temperatures_c, path, title: str = "") -> Path:
     """Poles (x) and zeros (o) of a scheduled surrogate across temperature, coloured by °C [rad/s]."""
-    plt = _plt()
     temps = np.asarray(temperatures_c, float)
-    fig, ax = plt.subplots(figsize=(7, 5))
-    cmap = plt.get_cmap("coolwarm")
-    norm = plt.Normalize(temps.min(), temps.max() if temps.max() > temps.min() else temps.min() + 1)
+    fig, ax = _subplots(figsize=(7, 5))
+    cmap = _cmap("coolwarm")
+    norm = _normalize(temps.min(), temps.max() if temps.max() > temps.min() else temps.min() + 1)
     for t in temps:
         z, p = model.zeros(t, extrapolate=True), model.poles(t, extrapolate=True)
         c = [cmap(norm(t))]
@@ -118,7 +135,7 @@ def pole_zero_locus(model, temperatures_c, path, title: str = "") -> Path:
     ax.set_xlabel("real part [rad/s] (symlog)")
     ax.set_ylabel("imaginary part [rad/s]")
     ax.grid(True, alpha=0.3)
-    sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
+    sm = _scalar_mappable(norm=norm, cmap=cmap)
     fig.colorbar(sm, ax=ax, label="temperature [°C]")
     ax.set_title(title or "poles (x) and zeros (o) vs temperature")
     fig.tight_layout()
@@ -129,8 +146,7 @@ def tracking(t, reference, achieved, path, title: str = "", unit: str = "mm",
              labels=("reference", "achieved"), window=None) -> Path:
     """Reference and achieved signals (top) and their error (bottom); ``window`` shades the
     interval over which the error bound is taken."""
-    plt = _plt()
-    fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(7, 5))
+    fig, (a1, a2) = _subplots(2, 1, sharex=True, figsize=(7, 5))
     a1.plot(t, reference, lw=1.0, label=labels[0])
     a1.plot(t, achieved, lw=0.8, ls="--", label=labels[1])
     a1.set_ylabel(f"[{unit}]")
@@ -146,3 +162,182 @@ def tracking(t, reference, achieved, path, title: str = "", unit: str = "mm",
     a1.set_title(title)
     fig.tight_layout()
     return _save(fig, path)
+
+
+# ---------------------------------------------------------------------------- surrogate fits
+def save_bode(model, data, temperature_c, path, title=None) -> None:
+    """Measured vs model magnitude [dB] and phase [deg] at one temperature."""
+    d = data if temperature_c is None else data.at_temperature(temperature_c)
+    order = np.argsort(d.frequency_hz)
+    f = d.frequency_hz[order]
+    hd = d.response[order]
+    fd = np.geomspace(f.min(), f.max(), 400)
+    t_eval = temperature_c if model.is_scheduled else None
+    hm = model.frequency_response(fd, t_eval)
+    fig, (ax1, ax2) = _subplots(2, 1, sharex=True, figsize=(6.4, 5.2))
+    ax1.semilogx(f, 20 * np.log10(np.abs(hd)), "o", ms=3.5, label="data")
+    ax1.semilogx(fd, 20 * np.log10(np.abs(hm)), "-", label="model")
+    ph_d = np.degrees(np.unwrap(np.angle(hd)))
+    ph_m = np.degrees(np.unwrap(np.angle(hm)))
+    hm_at_data = model.frequency_response(f, t_eval)
+    shift = 360.0 * np.round(np.mean(ph_d - np.degrees(np.unwrap(np.angle(hm_at_data)))) / 360.0)
+    ax2.semilogx(f, ph_d, "o", ms=3.5)
+    ax2.semilogx(fd, ph_m + shift, "-")
+    unit = data.output_unit + "/" + data.input_unit if data.output_unit or data.input_unit else ""
+    ax1.set_ylabel(f"magnitude [dB{(' ' + unit) if unit else ''}]")
+    ax2.set_ylabel("phase [deg]")
+    ax2.set_xlabel("frequency [Hz]")
+    ax1.legend(loc="best")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax2.grid(True, which="both", alpha=0.3)
+    if title:
+        ax1.set_title(title)
+    fig.tight_layout()
+    _save(fig, path, dpi=110)
+
+
+def save_poles_zeros_vs_temperature(model, path, per_temperature_models=None,
+                                    n_temperatures: int = 121) -> None:
+    """Real and imaginary parts of poles and zeros [rad/s] against temperature [°C]."""
+    if not model.is_scheduled:
+        raise IPMCError("pole/zero-vs-temperature plots need a scheduled model")
+    lo, hi = model.temperature_range_c
+    grid = np.linspace(lo, hi, n_temperatures)
+    fig, axes = _subplots(2, 2, sharex=True, figsize=(8.0, 6.0))
+    for col, (name, getter) in enumerate((("poles", model.poles), ("zeros", model.zeros))):
+        tt, vals = [], []
+        for t in grid:
+            r = getter(t)
+            tt += [t] * r.size
+            vals += list(r)
+        vals = np.asarray(vals, complex)
+        axes[0, col].plot(tt, vals.real, ".", ms=2, label="scheduled model")
+        axes[1, col].plot(tt, vals.imag, ".", ms=2)
+        if per_temperature_models:
+            pt, pv = [], []
+            for t, m in per_temperature_models.items():
+                r = m.poles() if name == "poles" else m.zeros()
+                pt += [t] * r.size
+                pv += list(r)
+            pv = np.asarray(pv, complex)
+            axes[0, col].plot(pt, pv.real, "x", ms=5, label="per-temperature fits")
+            axes[1, col].plot(pt, pv.imag, "x", ms=5)
+        axes[0, col].set_title(name)
+        axes[0, col].set_ylabel("real part [rad/s]")
+        axes[1, col].set_ylabel("imaginary part [rad/s]")
+        axes[1, col].set_xlabel("temperature [°C]")
+        for ax in axes[:, col]:
+            ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    _save(fig, path, dpi=110)
+
+
+# ---------------------------------------------------------------------------- calibration and diagnosis
+def calibration_figure(data, model, res, path) -> Path:
+    """Bode overlay (data markers, model lines) and standardised residuals, one colour per temperature."""
+    from physmodel.estimation.residuals import residuals
+
+    fig, axes = _subplots(2, 2, sharex=True, figsize=(11, 6.5))
+    (ax_m, ax_rm), (ax_p, ax_rp) = axes
+    r = residuals(model.response, data)
+    n = data.frequency_hz.size
+    temps = data.temperatures()
+    cmap = _cmap("viridis")
+    mag_d, ph_d, mag_m, ph_m = data.magnitude_db, data.phase_deg, model.magnitude_db, model.phase_deg
+    for t in temps:
+        m = data.temperature_c == t
+        c = cmap(0.0 if temps.size == 1 else 0.85 * (t - temps.min()) / (temps.max() - temps.min()))
+        f = data.frequency_hz[m]
+        ax_m.semilogx(f, mag_d[m], "o", ms=3, color=c, label=f"data {t:g} °C")
+        ax_m.semilogx(f, mag_m[m], "-", color=c)
+        # plot the model phase on the data's branch (same unwrap offset at the first line)
+        off = 360.0 * np.round((ph_d[m][0] - ph_m[m][0]) / 360.0)
+        ax_p.semilogx(f, ph_d[m], "o", ms=3, color=c)
+        ax_p.semilogx(f, ph_m[m] + off, "-", color=c)
+        ax_rm.semilogx(f, r[:n][m], ".-", ms=3, lw=0.6, color=c)
+        ax_rp.semilogx(f, r[n:][m], ".-", ms=3, lw=0.6, color=c)
+    for ax in (ax_rm, ax_rp):
+        ax.axhspan(-2, 2, color="0.92", zorder=0)
+        ax.axhline(0, color="k", lw=0.6)
+    ax_m.set_ylabel(f"magnitude [dB {data.output_unit}/{data.input_unit}]")
+    ax_p.set_ylabel("phase [deg]")
+    ax_rm.set_ylabel("log-magnitude residual / σ")
+    ax_rp.set_ylabel("phase residual / σ")
+    for ax in (ax_p, ax_rp):
+        ax.set_xlabel("frequency [Hz]")
+    for ax in axes.ravel():
+        ax.grid(True, which="both", alpha=0.3)
+    ax_m.legend(fontsize=7, ncol=2)
+    ax_m.set_title("data (markers) and calibrated model (lines)")
+    ax_rm.set_title(f"standardised residuals (band ±2); cost {res.cost:.4g}, expected {res.expected_cost:.4g}")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def residual_bode(path, data, G, title: str) -> Path:
+    """Data (±2σ bands) vs model and the standardised residuals, one colour per temperature."""
+    from physmodel.estimation.residuals import noise_std
+
+    s_ln, s_ph, _ = noise_std(data)
+    temps = data.temperatures()
+    fig, ax = _subplots(3, 1, figsize=(7, 9), sharex=True)
+    for i, t in enumerate(temps):
+        m = data.temperature_c == t
+        f = data.frequency_hz[m]
+        col = f"C{i % 10}"
+        mag_d = 20 * np.log10(np.abs(data.response[m]))
+        sd = s_ln[m] * 20 / np.log(10)
+        ax[0].fill_between(f, mag_d - 2 * sd, mag_d + 2 * sd, color=col, alpha=0.2)
+        ax[0].semilogx(f, mag_d, ".", color=col, ms=3)
+        ax[0].semilogx(f, 20 * np.log10(np.abs(G[m])), "-", color=col, label=f"{t:g} °C")
+        ph_d = np.degrees(np.unwrap(np.angle(data.response[m])))
+        ph_m = np.degrees(np.unwrap(np.angle(G[m])))
+        ph_m += 360 * np.round((ph_d[0] - ph_m[0]) / 360)
+        sp = np.degrees(s_ph[m])
+        ax[1].fill_between(f, ph_d - 2 * sp, ph_d + 2 * sp, color=col, alpha=0.2)
+        ax[1].semilogx(f, ph_d, ".", color=col, ms=3)
+        ax[1].semilogx(f, ph_m, "-", color=col)
+        lr = np.log(data.response[m] / G[m])
+        ax[2].semilogx(f, lr.real / s_ln[m], "-", color=col)
+        ax[2].semilogx(f, lr.imag / s_ph[m], "--", color=col)
+    ax[2].axhspan(-2, 2, color="0.85", zorder=0)
+    ax[0].set_ylabel(f"magnitude [dB {data.output_unit}/{data.input_unit}]")
+    ax[1].set_ylabel("phase [deg]")
+    ax[2].set_ylabel("std. residual (— mag, -- phase)")
+    ax[2].set_xlabel("frequency [Hz]")
+    ax[0].legend(fontsize=7)
+    ax[0].set_title(title + " — data ±2σ bands, model lines")
+    fig.tight_layout()
+    return _save(fig, path, dpi=90)
+
+
+
+
+def diagnosis_figures(diagnosis, folder) -> list[Path]:
+    """bode_before.png and bode_after.png of a :class:`~physmodel.estimation.discrepancy.Diagnosis`."""
+    folder = Path(folder)
+    return [residual_bode(folder / "bode_before.png", diagnosis.data, diagnosis.predicted_before, "baseline (before)"),
+            residual_bode(folder / "bode_after.png", diagnosis.data, diagnosis.predicted_after,
+                          "after: + " + (", ".join(diagnosis.final_effects) or "nothing"))]
+
+
+# ---------------------------------------------------------------------------- inversion
+def inversion_traces(path: str, t, u, y, ucol: str,
+          ref, refcol, title: str) -> Path:
+    """Input, reconstruction and (with a reference) its error against time."""
+    rows = 3 if ref is not None else 2
+    fig, axes = _subplots(rows, 1, sharex=True, figsize=(8, 2.4 * rows))
+    axes[0].plot(t, u, lw=0.8)
+    axes[0].set_ylabel(ucol)
+    axes[0].set_title(title)
+    axes[1].plot(t, y, lw=0.8, label="reconstruction")
+    if ref is not None:
+        axes[1].plot(t, ref, lw=0.8, ls="--", label=refcol)
+        axes[2].plot(t, y - ref, lw=0.8, color="C3")
+        axes[2].set_ylabel("error")
+    axes[1].set_ylabel("reconstruction")
+    axes[1].legend(loc="upper right", fontsize="small")
+    axes[-1].set_xlabel("time [s]")
+    fig.tight_layout()
+    return _save(fig, path, dpi=110)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .spec import Scenario, ScenarioError, load_scenario
+from .spec import Scenario, ScenarioError
 
 
 # ---------------------------------------------------------------------------- results
@@ -410,12 +410,11 @@ def step_blackbox(ctx: _Ctx):
 
 
 def step_discrepancy(ctx: _Ctx):
-    try:
-        from physmodel.estimation.discrepancy import diagnose
-        from physmodel.effects import EffectModel
-    except ModuleNotFoundError as exc:
-        raise ScenarioError(f"{ctx.spec.path}: [discrepancy] needs {exc.name}, which is not installed") from None
     from physmodel.data.sweep import synthesize_sweep
+    from physmodel.effects import EffectModel
+    from physmodel.estimation.discrepancy import diagnose
+
+    from . import plots
 
     cfg = ctx.spec.section("discrepancy")
     kind, q = ctx.spec.section("model")["kind"], _quantity(ctx)
@@ -435,6 +434,7 @@ def step_discrepancy(ctx: _Ctx):
         kw["kernel"] = kernel
     diag = diagnose(data, ctx.base_params, kind=kind, quantity=q, **kw)
     folder = diag.write_report(ctx.out / "discrepancy")
+    plots.diagnosis_figures(diag, folder)
     for p in sorted(Path(folder).iterdir()):
         if not p.name.startswith("."):
             ctx.file(p)
@@ -601,50 +601,4 @@ def summary_line(res: RunResult) -> str:
             f"{res.out / 'report.md'}" + (f"; FAILED: {', '.join(failed)}" if failed else ""))
 
 
-# ---------------------------------------------------------------------------- command line
-def add_parser(subparsers):
-    p = subparsers.add_parser(
-        "run", help="run a scenario file (scenarios/*.toml) into a report folder",
-        description="Run a scenario TOML (model, parameter set, temperatures, grid or stimulus, noise, steps, "
-                    "checks; schema in the README and scenarios/spec.py) and write data, surrogate JSON, PNG "
-                    "figures, metrics.json and report.md (last) to --out.  Exit 3 when a check fails.")
-    p.add_argument("scenario", nargs="?", help="scenario file, or the name of a bundled one (e.g. seed001_actuator)")
-    p.add_argument("--list", action="store_true", help="list the bundled scenarios and exit")
-    p.add_argument("--out", help="output folder (default ./ipmc-run-<name>)")
-    p.add_argument("--quick", action="store_true", help="apply the scenario's [quick] table (smaller grids)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
-    p.set_defaults(func=run)
-
-
-def resolve_scenario_path(text: str) -> Path:
-    from .spec import bundled_scenarios
-
-    p = Path(text)
-    if p.is_file():
-        return p
-    for b in bundled_scenarios():
-        if b.stem == text:
-            return b
-    raise ScenarioError(f"scenario {text!r} is neither a file nor a bundled scenario "
-                        f"({[b.stem for b in bundled_scenarios()]})")
-
-
-def run(args) -> int:
-    from .spec import bundled_scenarios
-
-    if args.list:
-        for p in bundled_scenarios():
-            sc = load_scenario(p)
-            print(f"{p.stem:20s} {sc.section('scenario').get('title', '')}")
-        return 0
-    if not args.scenario:
-        raise ScenarioError("name a scenario file or a bundled scenario (ipmc run --list shows them)")
-    spec = load_scenario(resolve_scenario_path(args.scenario), quick=args.quick)
-    res = run_scenario(spec, Path(args.out or f"ipmc-run-{spec.name}"), quiet=args.quiet)
-    if not args.quiet:
-        print(summary_line(res))
-    return res.exit_code
-
-
-__all__ = ["CheckResult", "RunResult", "run_scenario", "evaluate_checks", "summary_line", "add_parser", "run",
-           "resolve_scenario_path", "STEPS"]
+__all__ = ["CheckResult", "RunResult", "run_scenario", "evaluate_checks", "summary_line", "STEPS"]

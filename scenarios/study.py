@@ -38,7 +38,6 @@ from __future__ import annotations
 import copy
 import json
 import os
-import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -339,46 +338,4 @@ def _run_dask(spec, chunks, scheduler, tick):
             client.close()
 
 
-# ---------------------------------------------------------------------------- command line
-def add_parser(subparsers):
-    p = subparsers.add_parser(
-        "study", help="Monte Carlo / grid parameter study on local processes or a Dask cluster",
-        description="Evaluate a parameter study (parameters × temperatures × frequencies; schema in "
-                    "scenarios/study.py and the README) and write a tidy table, one row per sample × "
-                    "temperature × frequency.  Same seed → identical table on any backend.")
-    p.add_argument("spec", help="study TOML file")
-    p.add_argument("--out", required=True, help="output table (.csv or .npz)")
-    p.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://10.0.0.5:8786); default: local processes")
-    p.add_argument("--workers", type=int, help="local worker processes (default: number of CPUs)")
-    p.add_argument("--serial", action="store_true", help="evaluate in this process (no workers)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
-    p.set_defaults(func=run)
-
-
-def run(args) -> int:
-    spec = load_study(args.spec)
-    out = Path(args.out)
-    if out.suffix.lower() not in (".csv", ".npz"):
-        raise StudyError(f"--out {out}: use a .csv or .npz file name")
-    if args.workers is not None and args.workers < 1:
-        raise StudyError(f"--workers must be >= 1, got {args.workers}")
-    bar = None
-    if not args.quiet:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(_chunks(spec)), desc=spec["name"], unit="chunk", file=sys.stderr)
-    try:
-        table = run_study(spec, scheduler=args.scheduler, workers=args.workers,
-                          backend="serial" if args.serial else None, progress=bar.update if bar else None)
-    finally:
-        if bar is not None:
-            bar.close()
-    table.save(out)
-    if not args.quiet:
-        print(f"wrote {out}: {table.n_rows} rows ({spec['samples']} samples × {len(spec['temperatures_c'])} "
-              f"temperatures × {len(spec['frequencies_hz'])} frequencies) on {table.backend} in {table.elapsed_s:.1f} s")
-    return 0
-
-
-__all__ = ["parse_study", "load_study", "run_study", "evaluate_chunk", "sample_values", "StudyTable",
-           "StudyError", "add_parser", "run"]
+__all__ = ["parse_study", "load_study", "run_study", "evaluate_chunk", "sample_values", "StudyTable", "StudyError"]

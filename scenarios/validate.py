@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import json
 import math
-import sys
 import time
 from dataclasses import asdict, dataclass, field
 from functools import cached_property
@@ -32,7 +31,6 @@ from typing import Callable
 
 import numpy as np
 
-from physmodel.errors import IPMCError
 
 from physmodel.parameter_sets import derivation as sc
 from physmodel.parameter_sets import published as _published_module
@@ -760,49 +758,5 @@ def validate(*, quick: bool = False, progress=None, published=None) -> Validatio
     return ValidationReport(tuple(rows), bool(quick), str(path), time.perf_counter() - t0, meta)
 
 
-# ============================================================================ CLI plugin
-def add_parser(subparsers) -> None:
-    p = subparsers.add_parser(
-        "validate", help="check every published claim of the seed papers against the project's numbers",
-        description="Evaluate every claim in shared/data/published.toml (sensor study, actuator study, seed 002) "
-                    "with the calibrated seed parameter sets and write validation.md and validation.json. "
-                    "Exit 0 when every claim is reproduced or explained (not-reproduced / not-checkable rows "
-                    "are findings), 3 when a claim the project reproduces fails (regression).")
-    p.add_argument("--out", default="ipmc-validation", help="output folder (default ./ipmc-validation)")
-    p.add_argument("--quick", action="store_true", help="fewer temperatures in the surrogate fits (faster)")
-    p.add_argument("--published", help="path of published.toml (default: shared/data/published.toml)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
-
-
-def run(args) -> int:
-    from physmodel.data.files import atomic_write
-
-    from .cli import EXIT_FAILED, EXIT_OK
-
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise IPMCError(f"--out {out} exists and is not a folder")
-    n = len(published_claims(load_published(args.published)))
-    bar = None
-    if not args.quiet:
-        from tqdm import tqdm
-
-        bar = tqdm(total=n, desc="validate", unit="claim", file=sys.stderr)
-    try:
-        rep = validate(quick=args.quick, progress=bar.update if bar else None, published=args.published)
-    finally:
-        if bar is not None:
-            bar.close()
-    atomic_write(out / "validation.json", lambda fh: fh.write(rep.to_json() + "\n"))
-    atomic_write(out / "validation.md", lambda fh: fh.write(rep.to_markdown()))
-    if not args.quiet:
-        c = rep.counts
-        print(f"wrote {out / 'validation.md'} and {out / 'validation.json'}: "
-              + ", ".join(f"{c[s]} {s}" for s in STATUSES))
-        for r in rep.regressions:
-            print(f"REGRESSION {r.claim_id}: {r.ours} (criterion: {r.criterion})", file=sys.stderr)
-    return EXIT_FAILED if rep.regressions else EXIT_OK
-
-
 __all__ = ["ClaimRow", "ValidationReport", "validate", "published_claims", "load_published", "CHECKS",
-           "add_parser", "run"]
+           ]

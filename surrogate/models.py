@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from . import _structure as S
-from ._io import atomic_write_text
+from physmodel.data.files import atomic_write
 
 __all__ = ["Scaling", "StabilityCheck", "RationalModel", "load", "SCHEMA", "SCHEMA_VERSION"]
 
@@ -290,7 +290,8 @@ class RationalModel:
 
     def to_json(self, path) -> None:
         """Write the model as versioned JSON (atomically)."""
-        atomic_write_text(path, json.dumps(self.to_dict(), indent=2, allow_nan=False))
+        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
+        atomic_write(path, lambda fh: fh.write(text))
 
     @classmethod
     def from_dict(cls, d: dict) -> "RationalModel":

@@ -20,13 +20,20 @@ from .units import UNITS
 
 # ----------------------------------------------------------------------------------- I/O helpers
 def atomic_write(path, write_fn, mode: str = "w") -> Path:
-    """Write via a temporary file in the same folder, then rename: never a half-written file."""
+    """Write ``path`` via ``write_fn(fh)`` into a temporary file in the same folder, flushed to disk,
+    then renamed over ``path``: never a half-written file, even on Ctrl-C.  ``mode``: "w" (UTF-8 text,
+    no newline translation) or "wb".  The file gets the usual permissions (0666 less the umask)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=".part", dir=path.parent)
     try:
         with os.fdopen(fd, mode, **({"newline": "", "encoding": "utf-8"} if "b" not in mode else {})) as fh:
             write_fn(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)   # mkstemp creates 0600
         os.replace(tmp, path)
     except BaseException:
         try:

@@ -38,7 +38,6 @@ fallback (1 % per line); the report says so, and absolute gap tests are then rel
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import time
@@ -211,16 +210,14 @@ class Diagnosis:
         return "\n".join(L) + "\n"
 
     def write_report(self, folder) -> Path:
-        """report.json, summary.md, bode_before.png and bode_after.png in ``folder`` (atomic)."""
+        """report.json and summary.md in ``folder`` (atomic); the figures are drawn by the caller
+        (``scenarios.plots.diagnosis_figures``)."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
         atomic_write(folder / "report.json", lambda fh: fh.write(text + "\n"))
         summ = self.summary()
         atomic_write(folder / "summary.md", lambda fh: fh.write(summ))
-        _bode_png(folder / "bode_before.png", self.data, self.predicted_before, "baseline (before)")
-        _bode_png(folder / "bode_after.png", self.data, self.predicted_after,
-                  "after: + " + (", ".join(self.final_effects) or "nothing"))
         return folder
 
 
@@ -734,49 +731,6 @@ def _worst_cells(rows) -> str:
     parts = [f"{r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} Hz at {r['temperature_c']:g} °C ({r['part']})"
              for r in flagged[:3]]
     return ", ".join(parts)
-
-
-def _bode_png(path: Path, data: FrequencySweep, G, title: str) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    s_ln, s_ph, _ = noise_std(data)
-    temps = data.temperatures()
-    fig, ax = plt.subplots(3, 1, figsize=(7, 9), sharex=True)
-    for i, t in enumerate(temps):
-        m = data.temperature_c == t
-        f = data.frequency_hz[m]
-        col = f"C{i % 10}"
-        mag_d = 20 * np.log10(np.abs(data.response[m]))
-        sd = s_ln[m] * 20 / math.log(10)
-        ax[0].fill_between(f, mag_d - 2 * sd, mag_d + 2 * sd, color=col, alpha=0.2)
-        ax[0].semilogx(f, mag_d, ".", color=col, ms=3)
-        ax[0].semilogx(f, 20 * np.log10(np.abs(G[m])), "-", color=col, label=f"{t:g} °C")
-        ph_d = np.degrees(np.unwrap(np.angle(data.response[m])))
-        ph_m = np.degrees(np.unwrap(np.angle(G[m])))
-        ph_m += 360 * np.round((ph_d[0] - ph_m[0]) / 360)
-        sp = np.degrees(s_ph[m])
-        ax[1].fill_between(f, ph_d - 2 * sp, ph_d + 2 * sp, color=col, alpha=0.2)
-        ax[1].semilogx(f, ph_d, ".", color=col, ms=3)
-        ax[1].semilogx(f, ph_m, "-", color=col)
-        lr = np.log(data.response[m] / G[m])
-        ax[2].semilogx(f, lr.real / s_ln[m], "-", color=col)
-        ax[2].semilogx(f, lr.imag / s_ph[m], "--", color=col)
-    ax[2].axhspan(-2, 2, color="0.85", zorder=0)
-    ax[0].set_ylabel(f"magnitude [dB {data.output_unit}/{data.input_unit}]")
-    ax[1].set_ylabel("phase [deg]")
-    ax[2].set_ylabel("std. residual (— mag, -- phase)")
-    ax[2].set_xlabel("frequency [Hz]")
-    ax[0].legend(fontsize=7)
-    ax[0].set_title(title + " — data ±2σ bands, model lines")
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    plt.close(fig)
-    atomic_write(path, lambda fh: fh.write(buf.getvalue()), "wb")
-
 
 __all__ = ["diagnose", "Diagnosis", "CandidateResult", "VERDICTS", "gap_shrink", "CONFUSABLE_COSINE",
            "AMBIGUITY_AIC"]

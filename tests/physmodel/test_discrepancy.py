@@ -101,6 +101,9 @@ def test_report_folder(blind, tmp_path):
     assert {"a": "amplifier_bandwidth", "b": "time_delay"} in [{k: p[k] for k in ("a", "b")} for p in rep["confusable_pairs"]]
     assert all(p["what_separates"] for p in rep["confusable_pairs"])
     assert "NAMED" in (tmp_path / "rep" / "summary.md").read_text()
+    from scenarios.plots import diagnosis_figures
+
+    diagnosis_figures(d, tmp_path / "rep")
     for png in ("bode_before.png", "bode_after.png"):
         assert (tmp_path / "rep" / png).read_bytes()[:4] == b"\x89PNG"
     assert not list((tmp_path / "rep").glob("*.tmp*"))
@@ -146,7 +149,7 @@ def test_bad_input_is_named():
 
 
 def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
-    from physmodel import discrepancy_cli
+    from scenarios.commands import diagnose as discrepancy_cli
 
     data, _ = _hidden(7, lambda r: {"amplifier_bandwidth": {"time_constant": 2e-3}})
     data.to_csv(tmp_path / "sweep.csv")

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from inversion import invert
-from inversion.cli import add_parser, main, run
+from scenarios.cli import main
+from scenarios.commands.invert import add_parser
 from inversion.examples import SEED000_DEN_35C, SEED000_NUM_35C
 
 NUM = "--num=" + ",".join(str(c) for c in SEED000_NUM_35C)
@@ -41,8 +42,8 @@ def _read(path):
 def test_invert_writes_csv_and_plot(signal_csv, tmp_path):
     p, t, cur, ref = signal_csv
     out, png = tmp_path / "out.csv", tmp_path / "out.png"
-    rc = run(_args(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "auto",
-                    "--reference", "disp_mm", "--plot", str(png)]))
+    rc = main(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "auto",
+                    "--reference", "disp_mm", "--plot", str(png)])
     assert rc == 0
     header, data = _read(out)
     assert header == ["time_s", "current_uA", "reconstruction", "disp_mm", "error"]
@@ -50,7 +51,7 @@ def test_invert_writes_csv_and_plot(signal_csv, tmp_path):
     np.testing.assert_allclose(data[:, 2], expect, rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(data[:, 4], data[:, 2] - data[:, 3], rtol=1e-9, atol=1e-12)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert not list(tmp_path.glob(".*.tmp"))
+    assert not list(tmp_path.glob(".*.part"))
 
 
 def test_main_entry_point_and_preview_options(signal_csv, tmp_path):
@@ -79,7 +80,7 @@ def test_bad_input_exit_code_2(tmp_path, capsys, content, extra, match):
     p = tmp_path / "bad.csv"
     p.write_text(content)
     out = tmp_path / "o.csv"
-    rc = run(_args(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "inf", *extra]))
+    rc = main(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "inf", *extra])
     assert rc == 2
     assert match in capsys.readouterr().err
     assert not out.exists()
@@ -88,19 +89,19 @@ def test_bad_input_exit_code_2(tmp_path, capsys, content, extra, match):
 def test_bad_model_options_exit_code_2(signal_csv, tmp_path, capsys):
     p, *_ = signal_csv
     out = str(tmp_path / "o.csv")
-    assert run(_args(["invert", str(p), "-o", out, NUM])) == 2
+    assert main(["invert", str(p), "-o", out, NUM]) == 2
     assert "--num and --den" in capsys.readouterr().err
-    assert run(_args(["invert", str(p), "-o", out, "--num=100", "--den=1,14,100"])) == 2
+    assert main(["invert", str(p), "-o", out, "--num=100", "--den=1,14,100"]) == 2
     assert "improper" in capsys.readouterr().err
-    assert run(_args(["invert", str(p), "-o", out, "--num=100", "--den=1,14,100",
-                      "--improper", "filter", "--filter-bandwidth", "500", "--preview", "inf"])) == 0
-    assert run(_args(["invert", str(p), "-o", out, "--surrogate", "m.json"])) == 2
+    assert main(["invert", str(p), "-o", out, "--num=100", "--den=1,14,100",
+                      "--improper", "filter", "--filter-bandwidth", "500", "--preview", "inf"]) == 0
+    assert main(["invert", str(p), "-o", out, "--surrogate", "m.json"]) == 2
     assert "--temperature" in capsys.readouterr().err
-    assert run(_args(["invert", str(p), "-o", out, NUM, DEN, "--surrogate", "m.json",
-                      "--temperature", "35"])) == 2
-    assert run(_args(["invert", str(p), "-o", out, "--num=1,x", DEN])) == 2
+    assert main(["invert", str(p), "-o", out, NUM, DEN, "--surrogate", "m.json",
+                      "--temperature", "35"]) == 2
+    assert main(["invert", str(p), "-o", out, "--num=1,x", DEN]) == 2
     assert "'x'" in capsys.readouterr().err
-    assert run(_args(["invert", str(tmp_path / "missing.csv"), "-o", out, NUM, DEN])) == 2
+    assert main(["invert", str(tmp_path / "missing.csv"), "-o", out, NUM, DEN]) == 2
 
 
 def test_interrupted_write_leaves_previous_file_intact(signal_csv, tmp_path, monkeypatch):
@@ -113,6 +114,6 @@ def test_interrupted_write_leaves_previous_file_intact(signal_csv, tmp_path, mon
         raise OSError("disk full")
 
     monkeypatch.setattr(np, "savetxt", boom)
-    assert run(_args(["invert", str(p), "-o", str(out), NUM, DEN])) == 2
+    assert main(["invert", str(p), "-o", str(out), NUM, DEN]) == 2
     assert out.read_text() == "previous result\n"
-    assert not list(tmp_path.glob(".*.tmp"))
+    assert not list(tmp_path.glob(".*.part"))

@@ -19,14 +19,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ._data import FrequencyData
-from ._fit import WEIGHTINGS
-from ._io import atomic_write_text
-from ._nlp import ConvergenceError
+from physmodel.data.files import atomic_write
+from surrogate._data import FrequencyData
+from surrogate._fit import WEIGHTINGS
+from surrogate._nlp import ConvergenceError
 
-__all__ = ["add_parser", "run", "read_csv", "main"]
+from .. import plots
+from ._common import EXIT_BAD_INPUT, EXIT_OK
+from ._common import EXIT_FAILED as EXIT_NOT_CONVERGED
 
-EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED = 0, 2, 3
+__all__ = ["add_parser", "run", "read_csv"]
 
 
 def read_csv(path) -> FrequencyData:
@@ -37,7 +39,7 @@ def read_csv(path) -> FrequencyData:
     """
     from physmodel.data.files import read_sweep
 
-    from ._data import from_sweep
+    from surrogate._data import from_sweep
 
     return from_sweep(read_sweep(path))
 
@@ -59,6 +61,7 @@ def add_parser(subparsers):
                    help="temperatures [°C] held out of the fit and reported as validation")
     p.add_argument("--max-iter", type=int, default=500)
     p.add_argument("--out", default="fit-out", help="output directory (default fit-out)")
+    p.add_argument("--quiet", action="store_true", help="no summary line")
     p.set_defaults(func=run)
     return p
 
@@ -107,11 +110,7 @@ def _report(args, data, fit_data, res, held_out, figures) -> str:
 
 def run(args) -> int:
     """Execute ``fit``; returns the exit code (0 ok, 2 bad input, 3 not converged)."""
-    from .metrics import fit_percent, relative_rms_error
-    from ._fit import TemperatureError
-    from .plots import save_bode, save_poles_zeros_vs_temperature
-    from .rational import RationalFit
-    from .scheduled import ScheduledFit
+    from surrogate import RationalFit, ScheduledFit, TemperatureError, fit_percent, relative_rms_error
 
     try:
         data = read_csv(args.csv)
@@ -149,25 +148,15 @@ def run(args) -> int:
         extrap = model.is_scheduled and not (fit_temps.min() <= t <= fit_temps.max())
         if extrap:
             continue
-        save_bode(model, data, t, out / name, title=f"T = {t:g} °C" + (" (held out)" if t in excl else ""))
+        plots.save_bode(model, data, t, out / name, title=f"T = {t:g} °C" + (" (held out)" if t in excl else ""))
         figures.append(name)
     if model.is_scheduled:
-        save_poles_zeros_vs_temperature(model, out / "poles_zeros_vs_temperature.png",
+        plots.save_poles_zeros_vs_temperature(model, out / "poles_zeros_vs_temperature.png",
                                         res.per_temperature_models)
         figures.append("poles_zeros_vs_temperature.png")
     model.to_json(out / "model.json")
-    atomic_write_text(out / "report.md", _report(args, data, fit_data, res, held, figures))
-    print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")
+    report = _report(args, data, fit_data, res, held, figures)
+    atomic_write(out / "report.md", lambda fh: fh.write(report))
+    if not args.quiet:
+        print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")
     return EXIT_OK
-
-
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="ipmc")
-    sub = parser.add_subparsers(dest="command", required=True)
-    add_parser(sub)
-    args = parser.parse_args(argv)
-    return args.func(args)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

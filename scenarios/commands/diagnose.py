@@ -34,10 +34,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from ._cli import parse_assignments
-from .errors import IPMCError, ParameterError
+from .. import plots
+from ._common import EXIT_OK, parse_assignments
+from physmodel.errors import IPMCError, ParameterError
 
-EXIT_OK = 0
 _GEOMETRY = ("L", "W", "h")
 
 
@@ -98,9 +98,9 @@ def _parse_effect(item: str) -> tuple[str, dict]:
 
 
 def _free(spec: str, base, effects: dict):
-    from .estimation.records import FreeParameter
-    from .calibration_cli import parse_free
-    from .effects import get_effect
+    from physmodel.estimation.records import FreeParameter
+    from .calibrate import parse_free
+    from physmodel.effects import get_effect
 
     name = spec.split(":")[0].strip()
     if "." in name and not name.startswith("laws."):
@@ -116,9 +116,9 @@ def _free(spec: str, base, effects: dict):
 
 def build(args):
     """Resolve TOML + flags into ``(data, base, kwargs for diagnose, out folder, spec)``."""
-    from . import get_parameter_set
-    from .effects import normalize_effects
-    from .data.files import read_sweep
+    from physmodel import get_parameter_set
+    from physmodel.effects import normalize_effects
+    from physmodel.data.files import read_sweep
 
     spec = _load_toml(Path(args.experiment)) if args.experiment else {}
     pick = lambda flag, key, default=None: flag if flag is not None else spec.get(key, default)  # noqa: E731
@@ -148,7 +148,7 @@ def build(args):
     free_specs = list(args.free) if args.free else list(spec.get("free", ["alpha0"]))
     free = [_free(s, base, effects) for s in free_specs]
     names = {f.name for f in free}
-    from .effects import get_effect
+    from physmodel.effects import get_effect
 
     for n in fitted_effects:
         for p in get_effect(n).parameters:
@@ -169,7 +169,7 @@ def build(args):
 
 def run(args) -> int:
     """Execute ``ipmc diagnose``: 0 for any verdict; bad input raises IPMCError (exit 2)."""
-    from .estimation.discrepancy import diagnose, gap_shrink
+    from physmodel.estimation.discrepancy import diagnose, gap_shrink
 
     data, base, kw, out = build(args)
     bar = None
@@ -189,6 +189,7 @@ def run(args) -> int:
         if bar is not None:
             bar.close()
     d.write_report(out)
+    plots.diagnosis_figures(d, out)
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)

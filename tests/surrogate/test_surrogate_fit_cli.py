@@ -9,7 +9,7 @@ from surrogate_fixtures import noisy_sweep
 
 import surrogate
 from surrogate import RationalFit, ScheduledFit, load
-from surrogate.cli import add_parser, read_csv, run
+from scenarios.commands.fit import add_parser, read_csv, run
 
 
 @pytest.fixture(scope="module")

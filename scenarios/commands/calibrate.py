@@ -23,17 +23,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ._cli import parse_assignments
-from .errors import ParameterError
+from .. import plots
+from ._common import EXIT_FAILED, EXIT_OK, parse_assignments
+from physmodel.errors import ParameterError
 
-EXIT_OK, EXIT_FAILED = 0, 3
 
 
 def parse_free(spec: str, base):
     """A ``--free`` specification → FreeParameter (bare names get default bounds)."""
-    from .estimation.records import FreeParameter
-    from .parameter_paths import base_value, check_parameter_name
-    from .estimation.calibration import default_free_parameter
+    from physmodel.estimation.records import FreeParameter
+    from physmodel.parameter_paths import base_value, check_parameter_name
+    from physmodel.estimation.calibration import default_free_parameter
 
     parts = [p.strip() for p in spec.split(":")]
     name = parts[0]
@@ -87,9 +87,9 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     """Execute ``ipmc calibrate``; returns 0, or 3 when the fit did not converge (bad input raises)."""
-    from . import get_parameter_set
-    from .estimation.calibration import calibrate, model_sweep
-    from .data.files import read_sweep
+    from physmodel import get_parameter_set
+    from physmodel.estimation.calibration import calibrate, model_sweep
+    from physmodel.data.files import read_sweep
 
     if args.starts < 1:
         raise ParameterError(f"--starts must be >= 1, got {args.starts}")
@@ -115,7 +115,7 @@ def run(args) -> int:
             bar.close()
     res.metadata["sweep_file"] = str(args.sweep)
     out.mkdir(parents=True, exist_ok=True)
-    from .data.files import atomic_write
+    from physmodel.data.files import atomic_write
 
     res.save(out / "parameters.json")
     record = res.to_dict()
@@ -124,7 +124,7 @@ def run(args) -> int:
     text = json.dumps(record, indent=2, allow_nan=False)
     atomic_write(out / "calibration.json", lambda fh: fh.write(text + "\n"))
     model = model_sweep(res, data)
-    write_figure(data, model, res, out / "bode.png")
+    plots.calibration_figure(data, model, res, out / "bode.png")
     report = render_report(res, data, args)
     atomic_write(out / "report.md", lambda fh: fh.write(report))
     if not args.quiet:
@@ -134,50 +134,6 @@ def run(args) -> int:
         print(f"ipmc calibrate: the fit did not converge: {res.message}", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
-
-
-def write_figure(data, model, res, path) -> Path:
-    """Bode overlay (data markers, model lines) and standardised residuals, one colour per temperature."""
-    from scenarios.plots import _plt, _save
-
-    from .estimation.residuals import residuals
-
-    plt = _plt()
-    fig, axes = plt.subplots(2, 2, sharex=True, figsize=(11, 6.5))
-    (ax_m, ax_rm), (ax_p, ax_rp) = axes
-    r = residuals(model.response, data)
-    n = data.frequency_hz.size
-    temps = data.temperatures()
-    cmap = plt.get_cmap("viridis")
-    mag_d, ph_d, mag_m, ph_m = data.magnitude_db, data.phase_deg, model.magnitude_db, model.phase_deg
-    for t in temps:
-        m = data.temperature_c == t
-        c = cmap(0.0 if temps.size == 1 else 0.85 * (t - temps.min()) / (temps.max() - temps.min()))
-        f = data.frequency_hz[m]
-        ax_m.semilogx(f, mag_d[m], "o", ms=3, color=c, label=f"data {t:g} °C")
-        ax_m.semilogx(f, mag_m[m], "-", color=c)
-        # plot the model phase on the data's branch (same unwrap offset at the first line)
-        off = 360.0 * np.round((ph_d[m][0] - ph_m[m][0]) / 360.0)
-        ax_p.semilogx(f, ph_d[m], "o", ms=3, color=c)
-        ax_p.semilogx(f, ph_m[m] + off, "-", color=c)
-        ax_rm.semilogx(f, r[:n][m], ".-", ms=3, lw=0.6, color=c)
-        ax_rp.semilogx(f, r[n:][m], ".-", ms=3, lw=0.6, color=c)
-    for ax in (ax_rm, ax_rp):
-        ax.axhspan(-2, 2, color="0.92", zorder=0)
-        ax.axhline(0, color="k", lw=0.6)
-    ax_m.set_ylabel(f"magnitude [dB {data.output_unit}/{data.input_unit}]")
-    ax_p.set_ylabel("phase [deg]")
-    ax_rm.set_ylabel("log-magnitude residual / σ")
-    ax_rp.set_ylabel("phase residual / σ")
-    for ax in (ax_p, ax_rp):
-        ax.set_xlabel("frequency [Hz]")
-    for ax in axes.ravel():
-        ax.grid(True, which="both", alpha=0.3)
-    ax_m.legend(fontsize=7, ncol=2)
-    ax_m.set_title("data (markers) and calibrated model (lines)")
-    ax_rm.set_title(f"standardised residuals (band ±2); cost {res.cost:.4g}, expected {res.expected_cost:.4g}")
-    fig.tight_layout()
-    return _save(fig, path)
 
 
 def _g(v) -> str:

@@ -4,12 +4,12 @@ Input CSV: a header row, a ``time_s`` column (uniform steps) and one or more sig
 (the first non-time column is inverted unless ``--column`` names another).  Output CSV:
 ``time_s, <input column>, reconstruction`` plus ``<reference>, error`` when ``--reference``
 names a column holding the true signal (error = reconstruction - reference).  Files are
-written atomically (temporary file in the same directory, then ``os.replace``), so an
-interrupted run never leaves a half-written output.
+written atomically (:func:`physmodel.data.files.atomic_write`), so an interrupted run never
+leaves a half-written output.
 
 Examples::
 
-    ipmc invert current.csv -o displacement.csv \\
+    ipmc invert current.csv --out displacement.csv \\
         --num=-17.3,2.2e4,-1.0e7,-9.4e8,4.5e10 --den=1,835,6.3e5,2.5e8,4.4e10 \\
         --preview auto --plot displacement.png
 
@@ -18,10 +18,8 @@ Examples::
 
 Exit codes: 0 success, 2 bad input (unreadable/invalid CSV, invalid model or options).
 
-``add_parser(subparsers)`` registers the subcommand; ``run(args)`` executes it.  The
-surrogate hook (``--surrogate model.json --temperature T``) calls
-:func:`model_from_surrogate`, which uses the ``surrogate`` package once it provides a JSON
-loader.
+A surrogate JSON (``--surrogate model.json --temperature T``, what ``ipmc fit`` writes) can
+replace ``--num``/``--den``.
 """
 
 from __future__ import annotations
@@ -30,17 +28,17 @@ import argparse
 import csv
 import math
 import os
-import sys
-import tempfile
-from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from ._errors import InversionError
-from .batch import invert
+from inversion import InversionError, invert
+from physmodel.data.files import atomic_write
 
-__all__ = ["add_parser", "run", "main", "model_from_surrogate", "read_csv", "atomic_write"]
+from .. import plots
+from ._common import EXIT_OK
+
+__all__ = ["add_parser", "run", "model_from_surrogate", "read_csv"]
 
 
 def _floats(tokens: list[str]) -> list[float]:
@@ -64,7 +62,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         description=__doc__.split("\n\n")[0],
     )
     p.add_argument("input", help="input CSV with a header, a time_s column and signal columns")
-    p.add_argument("-o", "--output", required=True, help="output CSV path")
+    p.add_argument("-o", "--out", required=True, help="output CSV path")
+    p.add_argument("--quiet", action="store_true", help="no summary line")
     p.add_argument("--column", default=None,
                    help="signal column to invert (default: first column other than time_s)")
     p.add_argument("--time-column", default="time_s", help="time column name [s] (default time_s)")
@@ -90,27 +89,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def model_from_surrogate(path: str, temperature_c: float) -> Any:
-    """Load a surrogate JSON and evaluate it at ``temperature_c`` [degC] (hook).
+    """The surrogate JSON at ``path`` (``surrogate.load``) evaluated at ``temperature_c`` [°C]."""
+    import surrogate
 
-    Uses ``surrogate.load(path)`` (or ``surrogate.load_json``) returning an object with
-    ``.at(T)``; raises :class:`InversionError` with a clear message until that exists.
-    """
-    try:
-        import surrogate  # type: ignore[import-not-found]
-    except ImportError:
-        raise InversionError(
-            "--surrogate needs the 'surrogate' package, which is not available; pass the model "
-            "as --num/--den coefficients instead") from None
-    loader: Callable[[str], Any] | None = getattr(surrogate, "load", None) or getattr(
-        surrogate, "load_json", None)
-    if loader is None:
-        raise InversionError(
-            "the installed 'surrogate' package has no load()/load_json() yet; pass the model "
-            "as --num/--den coefficients instead")
-    model = loader(path)
-    if not hasattr(model, "at"):
-        raise InversionError(f"surrogate loaded from {path!r} has no .at(temperature) method")
-    return model.at(float(temperature_c))
+    return surrogate.load(path).at(float(temperature_c))
 
 
 def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
@@ -138,61 +120,8 @@ def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
     return header, data
 
 
-def atomic_write(path: str | os.PathLike[str], write: Callable[[Any], None], binary: bool = False) -> None:
-    """Write a file atomically: ``write(fh)`` into a temporary file beside it, then ``os.replace``."""
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "wb" if binary else "w", newline=None if binary else "") as fh:
-            write(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)   # mkstemp creates 0600; give the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-
-
-def _plot(path: str, t: np.ndarray, u: np.ndarray, y: np.ndarray, ucol: str,
-          ref: np.ndarray | None, refcol: str | None, title: str) -> None:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    rows = 3 if ref is not None else 2
-    fig = Figure(figsize=(8, 2.4 * rows), layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(rows, 1, sharex=True)
-    axes[0].plot(t, u, lw=0.8)
-    axes[0].set_ylabel(ucol)
-    axes[0].set_title(title)
-    axes[1].plot(t, y, lw=0.8, label="reconstruction")
-    if ref is not None:
-        axes[1].plot(t, ref, lw=0.8, ls="--", label=refcol)
-        axes[2].plot(t, y - ref, lw=0.8, color="C3")
-        axes[2].set_ylabel("error")
-    axes[1].set_ylabel("reconstruction")
-    axes[1].legend(loc="upper right", fontsize="small")
-    axes[-1].set_xlabel("time [s]")
-    atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=110), binary=True)
-
-
 def run(args: argparse.Namespace) -> int:
-    """Execute ``ipmc invert``; return 0 on success, 2 on bad input."""
-    try:
-        return _run(args)
-    except (InversionError, ValueError, OSError) as exc:
-        print(f"ipmc invert: error: {exc}", file=sys.stderr)
-        return 2
-
-
-def _run(args: argparse.Namespace) -> int:
+    """Execute ``ipmc invert``; 0 on success (bad input raises and ``ipmc`` exits 2)."""
     if args.surrogate is not None:
         if args.num is not None or args.den is not None:
             raise InversionError("give either --num/--den or --surrogate, not both")
@@ -231,21 +160,10 @@ def _run(args: argparse.Namespace) -> int:
         fh.write(",".join(cols) + "\n")
         np.savetxt(fh, arr, delimiter=",", fmt="%.12g")
 
-    atomic_write(args.output, write_csv)
+    atomic_write(args.out, write_csv)
+    prev = "infinite" if math.isinf(res.preview_s) else f"{res.preview_s:.4g} s"
     if args.plot:
-        prev = "infinite" if math.isinf(res.preview_s) else f"{res.preview_s:.4g} s"
-        _plot(args.plot, t, u, y, ucol, ref, args.reference, f"stable inversion, preview {prev}")
-    return 0
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Standalone entry point: ``python -m inversion.cli invert ...``."""
-    parser = argparse.ArgumentParser(prog="ipmc")
-    sub = parser.add_subparsers(dest="command", required=True)
-    add_parser(sub)
-    args = parser.parse_args(argv)
-    return int(args.func(args))
-
-
-if __name__ == "__main__":  # pragma: no cover
-    raise SystemExit(main())
+        plots.inversion_traces(args.plot, t, u, y, ucol, ref, args.reference, f"stable inversion, preview {prev}")
+    if not args.quiet:
+        print(f"ipmc invert: wrote {args.out} ({t.size} samples, preview {prev})")
+    return EXIT_OK
