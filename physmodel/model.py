@@ -169,6 +169,18 @@ class PhysicsModel:
         s = check_s(s)
         return evaluate_grid(self.state(temperature_c), s, self._kernel, qs, self.chunk_size, out, progress)
 
+    #: The model kind (see :mod:`physmodel.protocol`); set by each subclass.
+    kind: str = ""
+    #: The primary quantity returned by :meth:`response`.
+    primary_quantity: str = ""
+
+    def response(self, frequency_hz, temperature_c) -> np.ndarray:
+        """The primary quantity (:attr:`primary_quantity`) of the first parameter set, shape
+        (n_T, n_f), at ``frequency_hz`` [Hz] and ``temperature_c`` [°C]; the model protocol
+        (:mod:`physmodel.protocol`).  [SI: m/V for an actuator, A/m for a sensor]"""
+        q = self.primary_quantity
+        return self.frequency_response(frequency_hz, np.atleast_1d(temperature_c), quantities=(q,))[q][0]
+
     def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
                            progress=None) -> FrequencyResponse:
         """Frequency responses at ``frequency_hz`` [Hz] and ``temperature_c`` [°C]."""

@@ -1,0 +1,38 @@
+"""The one model interface of the library.
+
+Every model — the physics (:class:`~physmodel.actuator.ActuatorModel`,
+:class:`~physmodel.sensor.SensorModel`, the effect models of :mod:`physmodel.effects`) and the
+fitted surrogates (:class:`surrogate.RationalModel`) — has
+
+``kind``
+    ``"actuator"`` (voltage in, tip displacement out), ``"sensor"`` (tip displacement in, current
+    out) or ``"rational"`` (a fitted transfer function in the units of its data).
+``response(frequency_hz, temperature_c) -> ndarray``
+    the complex primary response, shape (n_T, n_f), at frequencies [Hz] and temperatures [°C]:
+    M [m/V] for an actuator, S = I/w [A/m] for a sensor, the fitted H [output/input] for a
+    rational model.
+
+so plots, comparisons and the command line treat them alike (``isinstance(m, FrequencyModel)``).
+Physics models also offer ``frequency_response(...)`` with every quantity (Z, H, G, M, I, S) and
+parameter set; rational models ``at(T)`` (a python-control ``TransferFunction``) for inversion.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+#: The kinds a model can declare.
+MODEL_KINDS = ("actuator", "sensor", "rational")
+
+
+@runtime_checkable
+class FrequencyModel(Protocol):
+    """Anything with a ``kind`` and a primary frequency ``response`` (see the module doc)."""
+
+    kind: str
+
+    def response(self, frequency_hz, temperature_c) -> np.ndarray:
+        """Complex primary response, shape (n_T, n_f). [SI of the model's quantity]"""
+        ...
