@@ -34,10 +34,13 @@ quasi-static deflection, mode n carries the participation
     π_n(x) = φ_n(1) Q_n(x)/(λ_n⁴ X(x)),   Q_n(x) = ∫0^1 cosh(x(1 − ξ))/cosh x · φ_n''(ξ) dξ,
 
 which for a uniform moment (x = 0) is 2 φ_n(1) φ_n'(1)/λ_n⁴ = 0.8908, 0.0788, 0.0165, 0.0060, …
-(Σ = 1).  ``second_mode`` uses M = H_qs [1/e + Σ_{n ≤ N} π_n (g_n − 1/e)] (modal sum with the
-static residual of the higher modes); without it the base folds every mode into the first,
-M = H_qs g_1 (seed 002 eq. 16).  g_n = 1/(e + 2ξ_n s/ω_n + (1 + μ)(s/ω_n)²) with e = E(s)/E (1
-unless viscoelastic creep) and μ an extra fluid load (1 + μ = 1 unless added fluid mass).
+(Σ = 1); with resistive electrodes the moment decays along z and π_n depends on s through x.
+``second_mode`` uses M = H_qs [1/ε + Σ_{n ≤ N} π_n(x) (g_n − 1/ε)] (modal sum with the
+quasi-static residual of the higher modes, :func:`modal_mechanics`); without it the base folds
+every mode into the first, M = H_qs g_1 (seed 002 eq. 16).  g_n = 1/(ε + 2ζ_n' s/ω_n +
+(1 + μ)(s/ω_n)²): Rayleigh damping split into a mass-proportional ζ_n' and a Kelvin–Voigt modulus
+ε = e + b s, e = E(s)/E (1 unless viscoelastic creep), μ an extra fluid load (0 unless added
+fluid mass).
 
 Parametrisation of the base (keys of the ``base`` dict, SI): L, W, h, d, C, eps, alpha, r1s [Ω],
 r2s [Ω·m²], Gp [S/m²] (leakage conductance per area; 0 = none), E [Pa], f1 [Hz] (first mode at T0),
