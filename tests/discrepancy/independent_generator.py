@@ -25,7 +25,7 @@ import math
 import numpy as np
 from scipy.optimize import least_squares
 
-from physmodel.sweep import FrequencySweep
+from physmodel.data.sweep import FrequencySweep
 
 try:                                      # imported as tests/discrepancy/independent_generator
     from . import independent_physics as ip
