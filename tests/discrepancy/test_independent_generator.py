@@ -266,12 +266,12 @@ def test_bad_labels_and_sizes():
 
 
 def test_generator_does_not_import_the_library_physics():
-    """Only the output record may come from physmodel (``physmodel.sweep.FrequencySweep``)."""
+    """Only the output record may come from physmodel (``physmodel.data.sweep.FrequencySweep``)."""
     for fname in ("independent_physics.py", "independent_generator.py", "oracles.py"):
         tree = ast.parse((HERE / fname).read_text())
         for node in ast.walk(tree):
             if isinstance(node, ast.Import):
                 assert not any(a.name.split(".")[0] == "physmodel" for a in node.names), fname
             elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("physmodel"):
-                assert fname == "independent_generator.py" and node.module == "physmodel.sweep", fname
+                assert fname == "independent_generator.py" and node.module == "physmodel.data.sweep", fname
                 assert [a.name for a in node.names] == ["FrequencySweep"]
