@@ -9,7 +9,7 @@
   ``window='boxcar'``, ``discard_s`` = the transient periods and ``frequencies_hz`` = its lines.
 * :func:`stepped_sine_plan` — frequencies, periods per step and settle time, each step starting on
   a sample at phase zero; the plan travels in the signal file's header so
-  :func:`~physmodel.estimation.frf.stepped_sine` can read the schedule back (``plan=``).
+  :func:`~physmodel.estimation.stepped.stepped_sine` can read the schedule back (``plan=``).
 * :func:`chirp` — a (repeated) linear or logarithmic sweep.
 
 The signal files are :class:`~physmodel.estimation.records.TimeRecord` files (``# ipmc-timeseries``

@@ -9,7 +9,7 @@ Estimators
     ``S_uu = Σ|U|²``, ``S_yy = Σ|Y|²`` and ``S_uy = Σ conj(U)·Y`` over the segments,
     ``H1 = S_uy/S_uu`` (unbiased for noise on the output), ``H2 = S_yy/conj(S_uy)`` (unbiased for
     noise on the input) and the coherence ``γ² = |S_uy|²/(S_uu S_yy)``.
-:func:`stepped_sine`
+:func:`physmodel.estimation.stepped.stepped_sine`
     One sinusoid per step: the transient of each step (``settle_s`` or ``settle_periods``) is
     discarded, then every whole period of the rest is fitted by a three-parameter sine fit
     (IEEE 1057: cos, sin and offset by least squares), which stays exact when a period is not an
@@ -30,8 +30,13 @@ via ×20/ln 10 and ×180/π):
   and imaginary parts give σ_ln and σ_φ (sample variance with P − 1 degrees of freedom, divided by P).
 
 Both σ are estimates with few degrees of freedom when averages are few, so ±2σ covers the truth a
-little less than 95 % of the time (Student t with ν degrees of freedom); see
-``tests/benchmarks/bench_frf.py`` for the measured coverage.
+little less than 95 % of the time (Student t with ν degrees of freedom).  Both are first-order
+(small-error) results: as a standard deviation the Welch σ holds down to γ² ≈ 0.02, but once σ of
+the magnitude exceeds about 1 dB the error of ln|H| = ln|1 + ε| is visibly skewed (a long tail
+where |1 + ε| → 0), so its ±2σ interval covers less; :meth:`FRFEstimate.to_sweep` can drop such
+lines (``max_std_db``).  Leakage (resolution) bias is not in σ: choose ``nperseg`` so the bin width
+is well below the half-power bandwidth of the sharpest resonance (the bias falls as Δf for a
+rectangular window, Δf² for Hann).  ``tests/benchmarks/bench_frf.py`` measures the coverage.
 """
 
 from __future__ import annotations
@@ -180,12 +185,14 @@ class FRFEstimate:
                        settings={**c.settings, "reciprocal": True})
 
     def to_sweep(self, temperature_c: float, output: str | int | None = None, *, min_coherence: float | None = None,
-                 band_hz: tuple | None = None, quantity: str | None = None,
+                 band_hz: tuple | None = None, max_std_db: float | None = None, quantity: str | None = None,
                  metadata: dict | None = None) -> FrequencySweep:
         """A :class:`~physmodel.sweep.FrequencySweep` of one channel at ``temperature_c`` [°C].
 
-        ``min_coherence`` and ``band_hz`` [Hz] drop lines (e.g. the unexcited bins of a multisine);
-        a kept line without a finite response and σ is an error naming its frequency.
+        ``min_coherence``, ``band_hz`` [Hz] and ``max_std_db`` [dB] drop lines (e.g. the unexcited
+        bins of a multisine, or lines whose log-magnitude error is too large to be Gaussian: beyond
+        about 1 dB the ±2σ interval of 20·log10|H| covers less than 95 %, see the module doc); a kept
+        line without a finite response and σ is an error naming its frequency.
         """
         if not math.isfinite(float(temperature_c)):
             raise IPMCError(f"temperature_c={temperature_c!r} must be a finite number [°C]")
@@ -202,8 +209,14 @@ class FRFEstimate:
                 raise IPMCError(f"min_coherence: a {self.method} estimate has no coherence; use band_hz")
             with np.errstate(invalid="ignore"):
                 keep &= self.coherence[i] >= float(min_coherence)
+        if max_std_db is not None:
+            if not float(max_std_db) > 0:
+                raise IPMCError(f"max_std_db={max_std_db!r} must be > 0 [dB]")
+            with np.errstate(invalid="ignore"):
+                keep &= self.magnitude_std_db[i] <= float(max_std_db)
         if not keep.any():
-            raise IPMCError(f"no lines left after band_hz={band_hz!r} and min_coherence={min_coherence!r}")
+            raise IPMCError(f"no lines left after band_hz={band_hz!r}, min_coherence={min_coherence!r} "
+                            f"and max_std_db={max_std_db!r}")
         H, sm, sp = self.response[i, keep], self.magnitude_std_db[i, keep], self.phase_std_deg[i, keep]
         bad = ~(np.isfinite(H) & (H != 0) & np.isfinite(sm) & np.isfinite(sp))
         if bad.any():
@@ -246,7 +259,15 @@ def _spectra(x: np.ndarray, nperseg: int, step: int, win: np.ndarray, detrend) -
         segs = segs - segs.mean(axis=1, keepdims=True)
     elif detrend == "linear":
         segs = signal.detrend(segs, axis=1, type="linear")
-    return sp_fft.rfft(segs * win, axis=1)
+    else:
+        segs = segs.copy()
+    segs *= win
+    return sp_fft.rfft(segs, axis=1, overwrite_x=True)
+
+
+def _power(X: np.ndarray) -> np.ndarray:
+    """Σ over segments of |X|² (no temporary of X's size)."""
+    return np.einsum("ij,ij->j", X.real, X.real) + np.einsum("ij,ij->j", X.imag, X.imag)
 
 
 def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = None, noverlap: int | None = None,
@@ -261,7 +282,8 @@ def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = Non
     u : (n,) array_like                  input samples (memory-mapped arrays are read in blocks)
     y : (n,) or (n_out, n) array_like, or a list of (n,) arrays   output channels
     estimator : "h1" | "h2"
-    nperseg : int    segment length [samples]; default the largest power of two giving ≥ 16 segments
+    nperseg : int    segment length [samples]; default the largest power of two giving ≥ 16
+        segments at the default overlap
     noverlap : int   overlap [samples]; default ``nperseg // 2``
     window : str, tuple or (nperseg,) array    as :func:`scipy.signal.get_window` (periodic)
     detrend : "constant" | "linear" | False     per segment, as :func:`scipy.signal.csd`
@@ -314,11 +336,13 @@ def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = Non
         k1 = min(K, k0 + B)
         a, b = start + k0 * step, start + (k1 - 1) * step + nperseg
         U = _spectra(_finite_block(u[a:b], "u", a), nperseg, step, win, detrend)
-        Suu += (U.real**2 + U.imag**2).sum(axis=0)
+        Suu += _power(U)
+        np.conjugate(U, out=U)
         for c, yc in enumerate(ys):
             Y = _spectra(_finite_block(yc[a:b], f"y[{c}]", a), nperseg, step, win, detrend)
-            Suy[c] += (U.conj() * Y).sum(axis=0)
-            Syy[c] += (Y.real**2 + Y.imag**2).sum(axis=0)
+            Suy[c] += np.einsum("ij,ij->j", U, Y)
+            Syy[c] += _power(Y)
+            del Y
     f = sp_fft.rfftfreq(nperseg, 1.0 / fs)[1:]            # DC carries no response after detrending
     Suu, Syy, Suy = Suu[1:], Syy[:, 1:], Suy[:, 1:]
     if frequencies_hz is not None:
@@ -355,144 +379,6 @@ def h2(t_or_fs, u, y, **kw) -> FRFEstimate:
     return welch_frf(t_or_fs, u, y, estimator="h2", **kw)
 
 
-# ----------------------------------------------------------------------------------- stepped sine
-def _per_step(x, name: str, shape, what: str) -> np.ndarray:
-    try:
-        v = np.broadcast_to(np.asarray(x, dtype=float), shape).copy()
-    except ValueError:
-        raise IPMCError(f"{name} has shape {np.shape(x)}; expected one value or one per step {shape}") from None
-    if not np.all(np.isfinite(v)):
-        raise IPMCError(f"{name} must be finite {what}")
-    return v
-
-
-def _period_phasors(chans: list, fs: float, t0: float, m0: float, f: float, P: int, block: int) -> np.ndarray:
-    """(P, n_channels) phasors (a − jb of a·cos + b·sin + c, phase from ``m0``) of P whole periods."""
-    n = len(chans[0])
-    a = max(int(math.ceil((m0 - t0) * fs - 1e-9)), 0)
-    b = min(int(math.ceil((m0 + P / f - t0) * fs - 1e-9)), n)
-    sums = np.zeros((6 + 3 * len(chans), P))
-    for a0 in range(a, b, block):
-        b0 = min(b, a0 + block)
-        tau = np.arange(a0, b0) / fs - (m0 - t0)
-        g = np.clip(np.floor(tau * f).astype(np.int64), 0, P - 1)
-        c, s = np.cos(2 * np.pi * f * tau), np.sin(2 * np.pi * f * tau)
-        w = [c * c, c * s, c, s * s, s, None]
-        for x_i, x in enumerate(chans):
-            xb = _finite_block(x[a0:b0], "u" if x_i == 0 else f"y[{x_i - 1}]", a0)
-            w += [xb * c, xb * s, xb]
-        for k, wk in enumerate(w):
-            sums[k] += np.bincount(g, weights=wk, minlength=P)
-    cc, cs, c1, ss, s1, n1 = sums[:6]
-    A = np.stack([np.stack([cc, cs, c1], -1), np.stack([cs, ss, s1], -1), np.stack([c1, s1, n1], -1)], -2)
-    R = sums[6:].reshape(len(chans), 3, P).transpose(2, 1, 0)           # (P, 3, n_channels)
-    coef = np.linalg.solve(A, R)
-    return coef[:, 0, :] - 1j * coef[:, 1, :]
-
-
-def stepped_sine(t_or_fs, u, y, frequencies_hz=None, step_start_s=None, step_stop_s=None, *, plan=None,
-                 settle_s=0.0, settle_periods=0.0, periods=None, block_samples: int = BLOCK_SAMPLES,
-                 input_name: str = "input", input_unit: str = "1", output_names: Sequence[str] | None = None,
-                 output_units: Sequence[str] | None = None) -> FRFEstimate:
-    """Stepped-sine estimate: per-period sine fits after each step's transient (see module doc).
-
-    Parameters
-    ----------
-    t_or_fs : float or (n,) array_like   sample rate [Hz] or uniform sample times [s]
-    u, y : as :func:`welch_frf`
-    frequencies_hz : (n_steps,) array_like   frequency of each step, distinct, at most fs/4. [Hz]
-    step_start_s : (n_steps,) array_like   start of each step on the record's time axis (the time of
-        sample 0 is ``t[0]``, or 0 when ``fs`` is given). [s]
-    step_stop_s : (n_steps,) array_like or None   end of each step; default the next step's start
-        and, for the last, the end of the record. [s]
-    plan : SteppedSinePlan or None   take frequencies, starts, stops, settle and periods from a plan
-        (:func:`physmodel.estimation.excitation.stepped_sine_plan`) instead.
-    settle_s, settle_periods : float or per step   transient discarded at each step's start: the
-        longer of ``settle_s`` [s] and ``settle_periods`` periods.
-    periods : int or per step or None   whole periods to use after settling; None uses every whole
-        period left in the step (a trailing partial period is not used).  Non-integer values are
-        refused: a fractional period would leak.
-    """
-    u = _as_signal(u, "u")
-    n = len(u)
-    ys = _as_outputs(y, n)
-    fs = sample_rate(t_or_fs, n, block_samples)
-    t0 = float(t_or_fs[0]) if np.ndim(t_or_fs) else 0.0
-    if plan is not None:
-        if frequencies_hz is not None or step_start_s is not None or step_stop_s is not None:
-            raise IPMCError("plan: give either a plan or frequencies_hz/step_start_s/step_stop_s, not both")
-        frequencies_hz, step_start_s, step_stop_s = plan.frequency_hz, plan.step_start_s + t0, plan.step_stop_s + t0
-        settle_s, settle_periods, periods = plan.settle_s, 0.0, plan.periods
-    if frequencies_hz is None or step_start_s is None:
-        raise IPMCError("frequencies_hz and step_start_s (or plan=) are required")
-    f = np.asarray(frequencies_hz, dtype=float)
-    if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)):
-        raise IPMCError(f"frequencies_hz must be a non-empty 1-D array of finite values, got {frequencies_hz!r}")
-    if np.any(f <= 0) or np.any(f > fs / 4):
-        raise IPMCError(f"frequencies_hz: {f[(f <= 0) | (f > fs / 4)][:5].tolist()} Hz are outside (0, fs/4 = "
-                        f"{fs / 4:g}] Hz; a sine fit needs at least 4 samples per period")
-    vals, counts = np.unique(f, return_counts=True)
-    if np.any(counts > 1):
-        raise IPMCError(f"frequencies_hz repeats {vals[counts > 1][:5].tolist()} Hz; give each frequency once")
-    starts = _per_step(step_start_s, "step_start_s", f.shape, "[s]")
-    t_end = t0 + n / fs
-    stops = (np.append(starts[1:], t_end) if step_stop_s is None
-             else _per_step(step_stop_s, "step_stop_s", f.shape, "[s]"))
-    bad = np.flatnonzero((stops <= starts) | (starts < t0 - 0.5 / fs) | (stops > t_end + 1e-9 * max(1.0, abs(t_end))))
-    if bad.size:
-        i = bad[0]
-        raise IPMCError(f"step {i} ({f[i]:g} Hz) runs from {starts[i]:g} to {stops[i]:g} s; steps must lie in the "
-                        f"record ({t0:g} to {t_end:g} s) and end after they start")
-    s_s = _per_step(settle_s, "settle_s", f.shape, ">= 0 [s]")
-    s_p = _per_step(settle_periods, "settle_periods", f.shape, ">= 0")
-    if np.any(s_s < 0) or np.any(s_p < 0):
-        raise IPMCError("settle_s and settle_periods must be >= 0")
-    settle = np.maximum(s_s, s_p / f)
-    m0 = starts + settle
-    avail = np.floor((stops - m0) * f + 1e-9)
-    if periods is None:
-        P = avail
-    else:
-        P = _per_step(periods, "periods", f.shape, "whole numbers")
-        if np.any(P != np.round(P)):
-            raise IPMCError(f"periods={periods!r}: a stepped sine is measured over whole periods; a fractional "
-                            f"period leaks the sine into the estimate.  Give whole numbers (or None for all "
-                            f"whole periods in each step)")
-        short = np.flatnonzero(P > avail)
-        if short.size:
-            i = short[0]
-            raise IPMCError(f"step {i} ({f[i]:g} Hz): periods={int(P[i])} need {P[i] / f[i]:g} s after the "
-                            f"{settle[i]:g} s settle, but the step leaves {max(stops[i] - m0[i], 0):g} s")
-    few = np.flatnonzero(P < 2)
-    if few.size:
-        i = few[0]
-        raise IPMCError(f"step {i} ({f[i]:g} Hz): {int(max(P[i], 0))} whole period(s) after the {settle[i]:g} s "
-                        f"settle; σ from the scatter between periods needs at least 2")
-    chans = [u, *ys]
-    H = np.empty((len(ys), f.size), dtype=complex)
-    sl = np.empty((len(ys), f.size))
-    sp = np.empty((len(ys), f.size))
-    for i in range(f.size):
-        Pi = int(P[i])
-        ph = _period_phasors(chans, fs, t0, m0[i], f[i], Pi, block_samples)
-        U, Y = ph[:, 0], ph[:, 1:]
-        if np.mean(U) == 0:
-            raise IPMCError(f"step {i} ({f[i]:g} Hz): the input has no component at this frequency")
-        Hi = Y.mean(axis=0) / U.mean()
-        with np.errstate(divide="ignore", invalid="ignore"):
-            z = (Y - Hi * U[:, None]) / Y.mean(axis=0)
-        H[:, i] = Hi
-        sl[:, i] = np.sqrt(np.sum(z.real**2, axis=0) / ((Pi - 1) * Pi))
-        sp[:, i] = np.sqrt(np.sum(z.imag**2, axis=0) / ((Pi - 1) * Pi))
-    order = np.argsort(f)
-    names, units = _names(output_names, output_units, len(ys), "output")
-    settings = {"fs_hz": fs, "steps": f.size, "settle_s_min": float(settle.min()), "settle_s_max": float(settle.max()),
-                "periods_min": int(P.min()), "periods_max": int(P.max()),
-                "unused_tail_s_max": float(np.max(stops - m0 - P / f))}
-    return FRFEstimate(f[order], H[:, order], NEPER_TO_DB * sl[:, order], np.degrees(sp[:, order]), None,
-                       P[order].astype(int), "stepped_sine", input_name, input_unit, names, units, settings)
-
-
 # ----------------------------------------------------------------------------------- records
 def estimate_record(record, input: str, outputs: Sequence[str] | None = None, method: str = "h1",
                     **kw) -> FRFEstimate:
@@ -500,8 +386,10 @@ def estimate_record(record, input: str, outputs: Sequence[str] | None = None, me
     :class:`~physmodel.estimation.records.TimeRecord`, in the record's units.
 
     ``method``: "h1", "h2" (keywords of :func:`welch_frf`) or "stepped_sine" (keywords of
-    :func:`stepped_sine`).
+    :func:`~physmodel.estimation.stepped.stepped_sine`).
     """
+    from .stepped import stepped_sine
+
     fns = {"h1": h1, "h2": h2, "stepped_sine": stepped_sine}
     if method not in fns:
         raise IPMCError(f"method={method!r}; expected one of {list(fns)}")

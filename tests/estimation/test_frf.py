@@ -11,7 +11,8 @@ import pytest
 from scipy import signal
 
 from physmodel.errors import IPMCError
-from physmodel.estimation.frf import FRFEstimate, effective_averages, estimate_record, frf_sweep, h1, h2, stepped_sine
+from physmodel.estimation.frf import FRFEstimate, effective_averages, estimate_record, frf_sweep, h1, h2
+from physmodel.estimation.stepped import stepped_sine
 from physmodel.estimation.records import TimeRecord
 
 import frf_oracle as orc
@@ -311,6 +312,9 @@ def test_unexcited_lines_are_flagged_by_coherence_and_unexcitable_ones_refused()
     assert np.all(e.coherence[0][lines] > 0.999) and np.all(e.coherence[0][~lines] < 0.9)
     sw = e.to_sweep(25.0, min_coherence=0.9)
     np.testing.assert_array_equal(sw.frequency_hz, [10.0, 20.0, 30.0])
+    sw = e.to_sweep(25.0, max_std_db=1.0)
+    np.testing.assert_array_equal(sw.frequency_hz, e.frequency_hz[e.magnitude_std_db[0] <= 1.0])
+    assert sw.magnitude_std_db.max() <= 1.0 and 10.0 in sw.frequency_hz
     flat = h1(FS, np.ones(4000), np.random.default_rng(1).standard_normal(4000), nperseg=1000)
     with pytest.raises(IPMCError, match="no finite response or σ"):
         flat.to_sweep(25.0)
