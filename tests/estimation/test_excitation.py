@@ -111,8 +111,11 @@ def test_stepped_plan_feeds_the_estimator():
     f = np.geomspace(0.3, 200, 9)
     plan = stepped_sine_plan(f, FS, periods=3, min_measure_s=0.5, settle_s=settle_time_s(sysc, 1e-11))
     rec = plan.record()
-    e = stepped_sine(rec.t, rec.channel("voltage"), orc.simulate(sysd, rec.channel("voltage")), plan=plan)
+    y = orc.simulate(sysd, rec.channel("voltage"))
+    e = stepped_sine(rec.t, rec.channel("voltage"), y, plan=plan)
     np.testing.assert_allclose(e.response[0], orc.truth(sysd, f, FS), rtol=1e-9)
+    late = stepped_sine(rec.t + 100.0, rec.channel("voltage"), y, plan=plan)   # a clock not starting at 0
+    np.testing.assert_allclose(late.response, e.response, rtol=1e-10)
 
 
 def test_settle_time_of_the_slowest_pole():
