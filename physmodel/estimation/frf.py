@@ -49,8 +49,8 @@ import numpy as np
 from scipy import fft as sp_fft
 from scipy import signal
 
-from physmodel.errors import IPMCError
-from physmodel.sweep import FrequencySweep
+from ..errors import IPMCError
+from ..data.sweep import FrequencySweep
 
 NEPER_TO_DB = 20.0 / math.log(10.0)
 BLOCK_SAMPLES = 1 << 20
@@ -408,7 +408,7 @@ def frf_sweep(estimates: Sequence[tuple[float, FRFEstimate]], output: str | int 
               **to_sweep_kw) -> FrequencySweep:
     """One :class:`FrequencySweep` from ``[(temperature_c, estimate), ...]`` (one estimate per
     temperature [°C]), each converted by :meth:`FRFEstimate.to_sweep`."""
-    from physmodel.calibration import merge_sweeps
+    from ..data.sweep import merge_sweeps
 
     items = list(estimates)
     if not items:

@@ -19,7 +19,7 @@ from typing import Sequence
 
 import numpy as np
 
-from physmodel.errors import IPMCError
+from ..errors import IPMCError
 
 from .frf import BLOCK_SAMPLES, NEPER_TO_DB, FRFEstimate, _as_outputs, _as_signal, _finite_block, _names, sample_rate
 

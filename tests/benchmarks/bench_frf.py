@@ -36,7 +36,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "estimation"))
 
 import frf_oracle as orc  # noqa: E402
-from physmodel.estimation.excitation import stepped_sine_plan  # noqa: E402
+from physmodel.data.excitation import stepped_sine_plan  # noqa: E402
 from physmodel.estimation.frf import h1, h2  # noqa: E402
 from physmodel.estimation.stepped import stepped_sine  # noqa: E402
 

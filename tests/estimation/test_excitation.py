@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from physmodel.errors import IPMCError
-from physmodel.estimation.excitation import (SteppedSinePlan, chirp, crest_factor, multisine, schroeder_phases,
+from physmodel.data.excitation import (SteppedSinePlan, chirp, crest_factor, multisine, schroeder_phases,
                                              settle_time_s, stepped_sine_plan)
 from physmodel.estimation.frf import h1
 from physmodel.estimation.stepped import stepped_sine
-from physmodel.estimation.records import read_record
+from physmodel.data.timerecord import read_record
 
 import frf_oracle as orc
 

@@ -13,7 +13,7 @@ from scipy import signal
 from physmodel.errors import IPMCError
 from physmodel.estimation.frf import FRFEstimate, effective_averages, estimate_record, frf_sweep, h1, h2
 from physmodel.estimation.stepped import stepped_sine
-from physmodel.estimation.records import TimeRecord
+from physmodel.data.timerecord import TimeRecord
 
 import frf_oracle as orc
 
@@ -160,7 +160,7 @@ def test_coarse_segments_bias_coherence_low_at_a_resonance():
 
 
 def test_lines_of_a_multisine_period_are_exact_without_noise():
-    from physmodel.estimation.excitation import multisine
+    from physmodel.data.excitation import multisine
 
     sysd = orc.resonant(FS)
     ms = multisine(np.arange(1, 301) * 1.0, FS, 1.0)
@@ -250,9 +250,9 @@ def test_stepped_sine_on_the_physics_model_matches_its_frequency_response():
     response.  A linearly interpolated input carries its sample-rate harmonic at sinc²(f/fs) of the
     sampled amplitude (the triangle kernel's transform), so the truth is M(jω)·sinc²(f/fs)."""
     from physmodel import ActuatorModel, get_parameter_set
-    from physmodel.timesim import model_realization, simulate
+    from physmodel.data.timesim import model_realization, simulate
 
-    from physmodel.estimation.excitation import settle_time_s, stepped_sine_plan
+    from physmodel.data.excitation import settle_time_s, stepped_sine_plan
 
     m = ActuatorModel(get_parameter_set("seed002_table3"))
     fs, T = 400.0, 25.0
@@ -274,8 +274,8 @@ def test_stepped_sine_on_the_physics_model_matches_its_frequency_response():
 
 # ------------------------------------------------------------------------------------- channels → sweeps
 def test_several_channels_give_m_and_z_sweeps_usable_by_calibration(tmp_path):
-    from physmodel.calibration import sweep_layout
-    from physmodel.sweep import read_sweep
+    from physmodel.estimation.calibration import sweep_layout
+    from physmodel.data.sweep import read_sweep
 
     rng = np.random.default_rng(5)
     adm = orc.resonant(FS, f_n=150.0, zeta=0.7, gain=0.02)           # current/voltage [A/V]
@@ -302,7 +302,7 @@ def test_several_channels_give_m_and_z_sweeps_usable_by_calibration(tmp_path):
 
 
 def test_unexcited_lines_are_flagged_by_coherence_and_unexcitable_ones_refused():
-    from physmodel.estimation.excitation import multisine
+    from physmodel.data.excitation import multisine
 
     ms = multisine([10.0, 20.0, 30.0], FS, 1.0)
     u = np.tile(ms.period(), 5)

@@ -7,7 +7,7 @@ import pytest
 
 from physmodel.errors import DataFormatError, IPMCError
 from physmodel.estimation.frf import estimate_record
-from physmodel.estimation.records import TimeRecord, read_record
+from physmodel.data.timerecord import TimeRecord, read_record
 
 
 def _record(n=2000):
@@ -32,7 +32,7 @@ def test_roundtrip(tmp_path, ext):
 
 def test_reads_what_timesim_writes(tmp_path):
     from physmodel import ActuatorModel, get_parameter_set
-    from physmodel.timesim import sine
+    from physmodel.data.timesim import sine
 
     ts = sine(ActuatorModel(get_parameter_set("dev")), 30.0, 1.0, 2.0, 3.0, 200.0, output_noise_rms=1e-6, seed=1)
     for ext in ("csv", "npz"):

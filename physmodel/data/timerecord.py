@@ -30,8 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from physmodel.errors import DataFormatError, IPMCError
-from physmodel.sweep import atomic_write, by_extension
+from ..errors import DataFormatError, IPMCError
+from .files import atomic_write, by_extension
 
 FORMAT = "ipmc-timeseries"
 FORMAT_VERSION = 1

@@ -26,9 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from physmodel.errors import IPMCError
+from ..errors import IPMCError
 
-from .records import TimeRecord
+from .timerecord import TimeRecord
 
 
 def _fs(fs_hz) -> float:
