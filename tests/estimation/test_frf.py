@@ -274,8 +274,8 @@ def test_stepped_sine_on_the_physics_model_matches_its_frequency_response():
 
 # ------------------------------------------------------------------------------------- channels → sweeps
 def test_several_channels_give_m_and_z_sweeps_usable_by_calibration(tmp_path):
-    from physmodel.estimation.calibration import sweep_layout
-    from physmodel.data.sweep import read_sweep
+    from physmodel.data.sweep import sweep_layout
+    from physmodel.data.files import read_sweep
 
     rng = np.random.default_rng(5)
     adm = orc.resonant(FS, f_n=150.0, zeta=0.7, gain=0.02)           # current/voltage [A/V]
