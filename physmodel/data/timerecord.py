@@ -24,6 +24,7 @@ present, must agree with their column.  NPZ files hold one array per column plus
 from __future__ import annotations
 
 import json
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,9 @@ import numpy as np
 
 from ..errors import DataFormatError, IPMCError
 from .files import atomic_write, by_extension
+
+#: Samples read per block when checking long (memory-mapped) time bases.
+TIME_BLOCK_SAMPLES = 1 << 20
 
 FORMAT = "ipmc-timeseries"
 FORMAT_VERSION = 1
@@ -49,6 +53,35 @@ def split_column(column: str, where: str = "") -> tuple[str, str]:
         raise DataFormatError(f"{where}column {column!r} must be named '<name>_<unit>' with a name of "
                               f"letters, digits and '_' and a unit of letters/digits, e.g. 'current_uA'")
     return name, unit
+
+
+
+def sample_rate(t_or_fs, n: int, block_samples: int = TIME_BLOCK_SAMPLES) -> float:
+    """Sample rate [Hz] from a scalar ``fs`` or from uniform sample times ``t`` [s] (checked in blocks).
+
+    A time base that strays from the uniform grid through its end points by more than 1e-3 of a
+    sample is refused.
+    """
+    if np.ndim(t_or_fs) == 0:
+        fs = float(t_or_fs)
+        if not (math.isfinite(fs) and fs > 0):
+            raise IPMCError(f"t_or_fs: sample rate {t_or_fs!r} Hz must be a finite number > 0")
+        return fs
+    t = t_or_fs
+    if np.ndim(t) != 1 or len(t) != n:
+        raise IPMCError(f"t_or_fs: time vector has shape {np.shape(t)}; expected ({n},) like the input")
+    t0, t1 = float(t[0]), float(t[-1])
+    h = (t1 - t0) / (n - 1)
+    if not (math.isfinite(h) and h > 0):
+        raise IPMCError(f"t_or_fs: time runs from {t0!r} to {t1!r} s; expected increasing finite times")
+    for a in range(0, n, block_samples):
+        b = min(n, a + block_samples)
+        dev = np.abs(np.asarray(t[a:b], dtype=float) - (t0 + np.arange(a, b) * h))
+        if not np.all(dev <= 1e-3 * h):
+            k = a + int(np.argmax(np.where(np.isfinite(dev), dev, np.inf)))
+            raise IPMCError(f"t_or_fs: sample {k} is at {float(t[k])!r} s, off the uniform grid "
+                            f"t0 + k·{h:.6g} s; resample the record to a uniform time base")
+    return 1.0 / h
 
 
 @dataclass(frozen=True)
@@ -91,8 +124,6 @@ class TimeRecord:
     @property
     def fs(self) -> float:
         """Sample rate [Hz] (the time base is checked to be uniform)."""
-        from .frf import sample_rate
-
         return sample_rate(self.t, self.t.size)
 
     def resolve(self, name: str) -> str:

@@ -51,40 +51,13 @@ from scipy import signal
 
 from ..errors import IPMCError
 from ..data.sweep import FrequencySweep
+from ..data.timerecord import sample_rate
 
 NEPER_TO_DB = 20.0 / math.log(10.0)
 BLOCK_SAMPLES = 1 << 20
 
 
 # ----------------------------------------------------------------------------------- inputs
-def sample_rate(t_or_fs, n: int, block_samples: int = BLOCK_SAMPLES) -> float:
-    """Sample rate [Hz] from a scalar ``fs`` or from uniform sample times ``t`` [s] (checked in blocks).
-
-    A time base that strays from the uniform grid through its end points by more than 1e-3 of a
-    sample is refused.
-    """
-    if np.ndim(t_or_fs) == 0:
-        fs = float(t_or_fs)
-        if not (math.isfinite(fs) and fs > 0):
-            raise IPMCError(f"t_or_fs: sample rate {t_or_fs!r} Hz must be a finite number > 0")
-        return fs
-    t = t_or_fs
-    if np.ndim(t) != 1 or len(t) != n:
-        raise IPMCError(f"t_or_fs: time vector has shape {np.shape(t)}; expected ({n},) like the input")
-    t0, t1 = float(t[0]), float(t[-1])
-    h = (t1 - t0) / (n - 1)
-    if not (math.isfinite(h) and h > 0):
-        raise IPMCError(f"t_or_fs: time runs from {t0!r} to {t1!r} s; expected increasing finite times")
-    for a in range(0, n, block_samples):
-        b = min(n, a + block_samples)
-        dev = np.abs(np.asarray(t[a:b], dtype=float) - (t0 + np.arange(a, b) * h))
-        if not np.all(dev <= 1e-3 * h):
-            k = a + int(np.argmax(np.where(np.isfinite(dev), dev, np.inf)))
-            raise IPMCError(f"t_or_fs: sample {k} is at {float(t[k])!r} s, off the uniform grid "
-                            f"t0 + k·{h:.6g} s; resample the record to a uniform time base")
-    return 1.0 / h
-
-
 def _as_signal(x, name: str, n: int | None = None):
     if np.ndim(x) != 1:
         raise IPMCError(f"{name} must be 1-D samples, got shape {np.shape(x)}")

@@ -21,7 +21,8 @@ import numpy as np
 
 from ..errors import IPMCError
 
-from .frf import BLOCK_SAMPLES, NEPER_TO_DB, FRFEstimate, _as_outputs, _as_signal, _finite_block, _names, sample_rate
+from ..data.timerecord import sample_rate
+from .frf import BLOCK_SAMPLES, NEPER_TO_DB, FRFEstimate, _as_outputs, _as_signal, _finite_block, _names
 
 
 def _per_step(x, name: str, shape, what: str) -> np.ndarray:
