@@ -47,7 +47,7 @@ from .parameter_sets import (available_parameter_sets, get_parameter_set, load_p
                              register_parameter_set, save_parameter_set)
 from .temperature import (ISOTHERMAL, Arrhenius, Constant, IonicResistance, Linear, LogLinear,
                           TemperatureLaws, WaterPermittivity)
-from .protocol import FrequencyModel
+from .protocol import FrequencyModel, physics_model
 from .model import FrequencyResponse
 from .actuator import ActuatorModel
 from .sensor import SensorModel, TransimpedanceChain
@@ -65,7 +65,7 @@ __all__ = [
     "register_parameter_set", "load_parameter_set", "save_parameter_set",
     "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear", "LogLinear", "WaterPermittivity",
     "ISOTHERMAL",
-    "FrequencyModel", "FrequencyResponse", "ActuatorModel", "SensorModel", "TransimpedanceChain",
+    "FrequencyModel", "physics_model", "FrequencyResponse", "ActuatorModel", "SensorModel", "TransimpedanceChain",
     "FrequencySweep", "synthesize_sweep", "MagnitudePhaseNoise", "ComplexGaussianNoise", "read_sweep",
     "write_sweep",
     "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult",

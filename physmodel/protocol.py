@@ -36,3 +36,22 @@ class FrequencyModel(Protocol):
     def response(self, frequency_hz, temperature_c) -> np.ndarray:
         """Complex primary response, shape (n_T, n_f). [SI of the model's quantity]"""
         ...
+
+
+#: Kinds of physics model and the primary quantity each responds with.
+PHYSICS_KINDS = {"actuator": "M", "sensor": "S"}
+
+
+def physics_model(kind: str, params, *, kernel: str = "boundary_charge", chunk_size: int | None = None):
+    """The physics model of ``kind`` ("actuator" or "sensor") for one or several parameter sets —
+    the one place a kind string becomes a model.  ``kernel`` applies to sensors only."""
+    from .actuator import ActuatorModel
+    from .errors import IPMCError
+    from .sensor import SensorModel
+
+    kw = {} if chunk_size is None else {"chunk_size": int(chunk_size)}
+    if kind == "actuator":
+        return ActuatorModel(params, **kw)
+    if kind == "sensor":
+        return SensorModel(params, kernel=kernel, **kw)
+    raise IPMCError(f"model kind {kind!r}; expected one of {sorted(PHYSICS_KINDS)}")
