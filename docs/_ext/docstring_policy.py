@@ -10,12 +10,20 @@ Names are the ones the API reference documents them under: the package-level nam
 package exports (``physmodel.Arrhenius.factor``), else the module path.
 """
 
-#: Public objects without a docstring (numpydoc GL08), measured on the pre-restructure tree.
+#: Public objects without a docstring: the docs build's GL08 failures (every rendered object,
+#: submodules and ``scenarios`` included) and ``tests/test_docstrings.py``'s (``__all__`` of
+#: physmodel, surrogate, inversion and the methods/properties of those classes; a dataclass whose
+#: only docstring is the one ``dataclasses`` writes counts as undocumented there).
 KNOWN_UNDOCUMENTED = {
+    "physmodel.ActuatorModel.state",
+    "physmodel.Arrhenius.check",
+    "physmodel.Arrhenius.describe",
     "physmodel.Arrhenius.factor",
     "physmodel.CalibrationResult.determined",
     "physmodel.CalibrationResult.summary",
     "physmodel.CalibrationResult.to_dict",
+    "physmodel.Constant.check",
+    "physmodel.Constant.describe",
     "physmodel.Constant.factor",
     "physmodel.Diagnosis.to_dict",
     "physmodel.FreeParameter.from_z",
@@ -26,13 +34,22 @@ KNOWN_UNDOCUMENTED = {
     "physmodel.IPMCParameters.from_dict",
     "physmodel.IPMCParameters.to_dict",
     "physmodel.IPMCParameters.units",
+    "physmodel.IonicResistance.check",
+    "physmodel.IonicResistance.describe",
     "physmodel.IonicResistance.factor",
+    "physmodel.Linear.check",
+    "physmodel.Linear.describe",
     "physmodel.Linear.factor",
+    "physmodel.LogLinear.check",
+    "physmodel.LogLinear.describe",
     "physmodel.LogLinear.factor",
+    "physmodel.SensorModel.state",
     "physmodel.TemperatureLaws.from_dict",
     "physmodel.TemperatureLaws.to_dict",
     "physmodel.TransimpedanceChain.response",
     "physmodel.TransimpedanceChain.transfer_function",
+    "physmodel.WaterPermittivity.check",
+    "physmodel.WaterPermittivity.describe",
     "physmodel.WaterPermittivity.factor",
     "physmodel.discrepancy.CandidateResult.to_dict",
     "physmodel.effects.Effect.applies_to",
@@ -111,6 +128,7 @@ KNOWN_UNDOCUMENTED = {
     "surrogate.OrderRow.mean_relative_rms_error",
     "surrogate.OrderRow.min_fit_percent",
     "surrogate.OrderRow.worst_relative_rms_error",
+    "surrogate.OrderSelectionReport",
     "surrogate.OrderSelectionReport.row",
     "surrogate.OrderSelectionReport.to_markdown",
     "surrogate.RationalFit.settings",
@@ -131,6 +149,103 @@ KNOWN_UNDOCUMENTED = {
     "surrogate.Structure.with_degree",
     "surrogate.Structure.with_form",
     "surrogate.cli.main",
+}
+
+#: Documented functions, methods and classes whose numpydoc ``Parameters`` (classes: also
+#: ``Attributes``) section misses signature parameters: {name: [missing parameters]}.
+KNOWN_PARAMETERS_UNDOCUMENTED = {
+    "inversion.InversionResult": ['t0', 'time_stamps'],
+    "inversion.ScheduledInversionResult": ['t0', 'time_stamps'],
+    "inversion.ScheduledStreamingInverter": ['improper', 'filter_bandwidth'],
+    "inversion.ScheduledStreamingInverter.push": ['chunk', 'temperature'],
+    "inversion.decode_sensor": ['model', 't', 'current', '**kwargs'],
+    "inversion.feedforward": ['model', 't', 'desired', '**kwargs'],
+    "inversion.invert_scheduled_to": ['model_at', 'dt', 'u', 'temperature', 'out', 'preview', 'grid_step', 'grid', 'improper', 'filter_bandwidth', 'chunk_size'],
+    "inversion.sampling_interval": ['t'],
+    "inversion.temperature_grid": ['t_min', 't_max', 'step'],
+    "physmodel.ActuatorModel": ['params', 'chunk_size'],
+    "physmodel.ActuatorModel.dc_gain": ['temperature_c'],
+    "physmodel.ActuatorModel.evaluate": ['s', 'temperature_c', 'quantities', 'out', 'progress'],
+    "physmodel.ActuatorModel.frequency_response": ['frequency_hz', 'temperature_c', 'quantities', 'out', 'progress'],
+    "physmodel.ActuatorModel.reduced": ['temperature_c', 'taylor_order', 'set_index', 'include_mode'],
+    "physmodel.Arrhenius": ['activation_energy', 'valid_c'],
+    "physmodel.CalibrationResult": ['names', 'values', 'parameters', 'stderr', 'ci_lower', 'ci_upper', 'correlation', 'cost', 'expected_cost', 'cost_std', 'n_lines', 'n_evaluations', 'n_model_calls', 'converged', 'message', 'starts', 'identifiability', 'noise_estimated', 'noise_scale', 'held', 'free', 'band_hz', 'temperatures_c', 'elapsed_s', 'metadata'],
+    "physmodel.CalibrationResult.save": ['path'],
+    "physmodel.Constant": ['valid_c'],
+    "physmodel.Diagnosis": ['verdict', 'named', 'message', 'kind', 'quantity', 'alpha', 'threshold', 'gap_threshold', 'baseline', 'final', 'final_effects', 'candidates', 'skipped', 'confusable', 'separation', 'localisation_before', 'localisation_after', 'gap_before', 'gap_after', 'null', 'noise_estimated', 'elapsed_s', 'data', 'predicted_before', 'predicted_after', 'metadata'],
+    "physmodel.Diagnosis.write_report": ['folder'],
+    "physmodel.EffectModel": ['base_params', 'kind', 'effects', 'kernel', 'chunk_size'],
+    "physmodel.FreeParameter": ['name', 'lower', 'upper', 'scale', 'initial'],
+    "physmodel.FrequencyResponse.magnitude_db": ['quantity', 'scale'],
+    "physmodel.FrequencyResponse.phase_deg": ['quantity'],
+    "physmodel.IPMCParameters": ['L', 'W', 'h', 'd', 'C_minus', 'kappa_e', 'alpha0', 'a0', 'r1_sheet', 'r2_specific', 'Rp_specific', 'E', 'rho', 'xi', 'T_ref', 'laws', 'name', 'source'],
+    "physmodel.IPMCParameters.replace": ['**changes'],
+    "physmodel.IonicResistance": ['valid_c'],
+    "physmodel.Linear": ['alpha', 'valid_c'],
+    "physmodel.LogLinear": ['slope', 'valid_c'],
+    "physmodel.SensorModel": ['params', 'kernel', 'chunk_size'],
+    "physmodel.SensorModel.evaluate": ['s', 'temperature_c', 'quantities', 'out', 'progress'],
+    "physmodel.SensorModel.frequency_response": ['frequency_hz', 'temperature_c', 'quantities', 'out', 'progress'],
+    "physmodel.TemperatureLaws": ['d', 'E', 'kappa_e', 'Rp_specific', 'r1_sheet', 'r2_specific', 'C_minus', 'h'],
+    "physmodel.TemperatureLaws.factors": ['T_K', 'T_ref_K'],
+    "physmodel.TemperatureLaws.with_": ['**laws'],
+    "physmodel.TransimpedanceChain": ['R1', 'R2', 'R3', 'bandwidth_hz'],
+    "physmodel.WaterPermittivity": ['valid_c'],
+    "physmodel.calibrate": ['data', 'base', 'free', 'kind', 'quantity', 'starts', 'seed', 'kernel', 'max_nfev', 'identify', 'hold_undetermined', 'name', 'progress', '**kwargs'],
+    "physmodel.describe": ['p'],
+    "physmodel.diagnose": ['data', 'base', 'kind', 'quantity', 'free', 'baseline_effects', 'candidates', 'alpha', 'null_draws', 'null_refits', 'seed', 'kernel', 'max_nfev', 'progress'],
+    "physmodel.fit_parameters": ['data', 'predict', 'free', 'starts', 'seed', 'predict_many', 'fixed', 'max_nfev', 'ftol', 'identify', 'hold_undetermined', 'probe', 'fd_step', 'progress'],
+    "physmodel.get_parameter_set": ['name', '**overrides'],
+    "physmodel.load_parameter_set": ['path'],
+    "physmodel.register_parameter_set": ['name', 'factory', 'overwrite'],
+    "physmodel.save_parameter_set": ['params', 'path'],
+    "physmodel.state_at": ['params', 'temperature_c'],
+    "surrogate.ConvergenceError": ['message', 'result'],
+    "surrogate.FitResult": ['model', 'converged', 'status', 'iterations', 'cost', 'weighted_rms', 'weighting', 'method', 'param_names', 'params', 'stderr', 'ci95_low', 'ci95_high', 'covariance_rank_deficient', 'at_bounds', 'per_temperature', 'stability', 'time_s', 'data_fingerprint', 'history', 'two_stage', 'per_temperature_models'],
+    "surrogate.FrequencyData.at_temperature": ['temperature_c'],
+    "surrogate.FrequencyData.select": ['mask'],
+    "surrogate.OrderRow": ['n_zeros', 'n_poles', 'n_params', 'temperatures_c', 'relative_rms_error', 'fit_percent', 'weighted_rms', 'converged', 'stable'],
+    "surrogate.RationalFit.fit": ['frequency_hz', 'temperature_c', 'response', 'magnitude_std_db', 'phase_std_deg'],
+    "surrogate.RationalFit.fit_data": ['data', 'theta0', 'stage'],
+    "surrogate.RationalModel.at": ['temperature_c', 'extrapolate'],
+    "surrogate.RationalModel.coefficients": ['temperature_c', 'extrapolate'],
+    "surrogate.RationalModel.confidence_intervals": ['level'],
+    "surrogate.RationalModel.frequency_response": ['frequency_hz', 'temperature_c', 'extrapolate'],
+    "surrogate.RationalModel.max_pole_real_part": ['temperature_c', 'extrapolate'],
+    "surrogate.RationalModel.poles": ['temperature_c', 'extrapolate'],
+    "surrogate.RationalModel.response_std": ['frequency_hz', 'temperature_c', 'extrapolate'],
+    "surrogate.RationalModel.stability_check": ['n_temperatures'],
+    "surrogate.RationalModel.to_json": ['path'],
+    "surrogate.RationalModel.zeros": ['temperature_c', 'extrapolate'],
+    "surrogate.Scaling": ['omega_ref_rad_s', 'gain_ref', 'temperature_center_c', 'temperature_scale_c'],
+    "surrogate.ScheduledFit.fit": ['frequency_hz', 'temperature_c', 'response', 'magnitude_std_db', 'phase_std_deg'],
+    "surrogate.ScheduledFit.fit_data": ['data'],
+    "surrogate.StabilityCheck": ['stable', 'max_pole_real_part_rad_s', 'worst_temperature_c', 'n_temperatures'],
+    "surrogate.Structure": ['form', 'n_zeros', 'n_poles', 'degree'],
+    "surrogate.Structure.bounds": ['w_min', 'w_max'],
+    "surrogate.Structure.slot_bounds": ['w_min', 'w_max', 'window'],
+    "surrogate.Structure.slot_matrix": ['theta'],
+    "surrogate.TemperatureError": ['temperature_c', 'n_lines', 'relative_rms_error', 'fit_percent'],
+    "surrogate.fit_percent": ['model', 'data'],
+    "surrogate.fit_sweep": ['sweep', 'n_zeros', 'n_poles', 'degree', 'form', '**settings'],
+    "surrogate.from_sweep": ['sweep'],
+    "surrogate.levy": ['w', 'h', 'n_zeros', 'n_poles', 'row_weight'],
+    "surrogate.load": ['path'],
+    "surrogate.log_rms_error": ['model', 'data'],
+    "surrogate.order_selection": ['frequency_hz', 'temperature_c', 'response', 'orders', 'magnitude_std_db', 'phase_std_deg', 'weighting', 'stable', 'max_iter'],
+    "surrogate.relative_rms_error": ['model', 'data'],
+}
+
+#: Documented numerical parameters (float, complex, array, ...) without a unit in square brackets
+#: (``[-]`` for dimensionless): {name: [parameters]}.
+KNOWN_UNITS_MISSING = {
+    "inversion.InverseSplit": ['A_u', 'B_u', 'C_u', 'den', 'derivative_coefficients', 'feedthrough', 'num'],
+    "inversion.ScheduledInversionResult": ['input', 'stable_part', 'unstable_part'],
+    "inversion.invert": ['u'],
+    "inversion.invert_scheduled": ['preview', 'u'],
+    "inversion.invert_to": ['out', 'u'],
+    "surrogate.RationalFit": ['tol'],
+    "surrogate.RationalModel": ['covariance', 'params'],
 }
 
 #: Docstrings written as plain text that is not valid reST (indented lists without blank lines,
@@ -157,7 +272,12 @@ UNDOCUMENTED_BASES = {
 
 
 def build_exclusions() -> set[str]:
-    """Regular expressions for ``numpydoc_validation_exclude`` (exact names)."""
+    """Regular expressions for ``numpydoc_validation_exclude``.
+
+    Each listed name is matched on its last two components (``Class.method`` or
+    ``module.function``), so that moving a module during the restructure does not turn the
+    listed debt into build errors; anything not listed is still checked.
+    """
     import re
 
-    return {"^" + re.escape(n) + "$" for n in KNOWN_UNDOCUMENTED}
+    return {r"(^|\.)" + re.escape(".".join(n.split(".")[-2:])) + "$" for n in KNOWN_UNDOCUMENTED}
