@@ -2,6 +2,8 @@
 
 * ``|x|`` (absolute value, used throughout the docstrings) is not a reST substitution: bars
   outside inline literals, roles and literal blocks are escaped before numpydoc parses the text.
+* The notes the docstrings cite, "physics.md §N" and "discrepancy.md §N", become links to those
+  sections of ``docs/physics.md`` and ``docs/discrepancy.md``.
 * Docstrings listed in :data:`docstring_policy.VERBATIM` are plain text that is not valid reST
   (indented lists without blank lines, ASCII layouts); they are shown as preformatted text so
   that the build stays strict for every other docstring.  The list is debt: fixing a docstring
@@ -18,10 +20,23 @@ import docstring_policy
 _QUOTED = re.compile(r"(``.*?``|(?::[\w:+-]+:)?`[^`]*`_{0,2})")
 
 
+_NOTE = re.compile(r"\b(physics|discrepancy)\.md(?: (§\s?(\d)))?")
+
+
+def _link_note(m: re.Match) -> str:
+    page, sec, num = m.group(1), m.group(2), m.group(3)
+    if sec:
+        return f":ref:`{page}.md {sec} <{page}-{num}>`"
+    return f":doc:`{page}.md </{page}>`"
+
+
 def escape_bars(line: str) -> str:
+    """Escape ``|`` outside literals and roles; link the notes the docstrings cite
+    (``physics.md §7`` → the section of docs/physics.md)."""
     parts = _QUOTED.split(line)
     for i in range(0, len(parts), 2):
         parts[i] = re.sub(r"(?<!\\)\|", r"\\|", parts[i])
+        parts[i] = _NOTE.sub(_link_note, parts[i])
     return "".join(parts)
 
 
