@@ -1,283 +1,152 @@
 """Docstring debt of the packages, measured, in one place: the docs build and
 ``tests/test_docstrings.py`` both read it.
 
-Every list here may only shrink.  Fixing a docstring means deleting its name below; the test
-``test_docstring_debt_is_current`` fails while a listed name already passes, so the lists cannot
-go stale.  A name that is not listed is checked strictly: a public function, class, method or
-property without a docstring fails the docs build (numpydoc GL08 under ``-W``) and the test.
+The lists live in ``docstring_debt.json`` next to this file and are written by this script from
+the code, never by hand::
 
-Names are the ones the API reference documents them under: the package-level name for what a
-package exports (``physmodel.Arrhenius.factor``), else the module path.
+    python docs/_ext/docstring_policy.py --update   # re-measure, rewrite the lists, print +/- names
+    python docs/_ext/docstring_policy.py --check    # exit 1 if the lists differ from the code
+
+Run ``--update`` after a merge that adds public names (it lists their debt) and after fixing
+docstrings (it removes the fixed names).  The test ``test_docstring_debt_is_current`` fails
+while a listed name already passes, so the lists cannot go stale, and a name that is not listed
+is checked strictly: a public function, class, method or property without a docstring fails the
+docs build and the test.
+
+Names are the ones the API reference documents them under (``docs/_ext/ipmc_apigen.py``: the
+package-level name for what a package exports, ``physmodel.ActuatorModel.state``; else the
+module path).  The lists:
+
+``undocumented``
+    Public objects without a docstring: what the build renders (Sphinx's ``getdoc``) and what the
+    test checks (``__all__`` of physmodel, surrogate, inversion and their classes' methods and
+    properties; a dataclass whose only docstring is the one ``dataclasses`` writes counts).
+``parameters_undocumented``
+    {name: signature parameters missing from the numpydoc ``Parameters`` (classes: also
+    ``Attributes``) section}.
+``units_missing``
+    {name: numerical parameters (float, complex, array, ...) documented without a unit in square
+    brackets (``[-]`` for dimensionless)}.
+``verbatim``
+    Docstrings written as plain text that is not valid reST (indented lists without blank lines,
+    ASCII layouts): the reference shows them preformatted instead of failing the build.
+``unresolved_references``
+    Cross-reference targets in docstrings that name nothing documented (mostly module paths from
+    before the issue-19 restructure): the reference shows them as plain text.
+``undocumented_bases``
+    Public base classes shown by ``show-inheritance`` that no page documents.
 """
 
-#: Public objects without a docstring: the docs build's GL08 failures (every rendered object,
-#: submodules and ``scenarios`` included) and ``tests/test_docstrings.py``'s (``__all__`` of
-#: physmodel, surrogate, inversion and the methods/properties of those classes; a dataclass whose
-#: only docstring is the one ``dataclasses`` writes counts as undocumented there).
-KNOWN_UNDOCUMENTED = {
-    "physmodel.ActuatorModel.state",
-    "physmodel.Arrhenius.check",
-    "physmodel.Arrhenius.describe",
-    "physmodel.Arrhenius.factor",
-    "physmodel.CalibrationResult.determined",
-    "physmodel.CalibrationResult.summary",
-    "physmodel.CalibrationResult.to_dict",
-    "physmodel.Constant.check",
-    "physmodel.Constant.describe",
-    "physmodel.Constant.factor",
-    "physmodel.Diagnosis.to_dict",
-    "physmodel.FreeParameter.from_z",
-    "physmodel.FreeParameter.sign",
-    "physmodel.FreeParameter.to_z",
-    "physmodel.FreeParameter.with_initial",
-    "physmodel.FreeParameter.z_bounds",
-    "physmodel.IPMCParameters.from_dict",
-    "physmodel.IPMCParameters.to_dict",
-    "physmodel.IPMCParameters.units",
-    "physmodel.IonicResistance.check",
-    "physmodel.IonicResistance.describe",
-    "physmodel.IonicResistance.factor",
-    "physmodel.Linear.check",
-    "physmodel.Linear.describe",
-    "physmodel.Linear.factor",
-    "physmodel.LogLinear.check",
-    "physmodel.LogLinear.describe",
-    "physmodel.LogLinear.factor",
-    "physmodel.SensorModel.state",
-    "physmodel.TemperatureLaws.from_dict",
-    "physmodel.TemperatureLaws.to_dict",
-    "physmodel.TransimpedanceChain.response",
-    "physmodel.TransimpedanceChain.transfer_function",
-    "physmodel.WaterPermittivity.check",
-    "physmodel.WaterPermittivity.describe",
-    "physmodel.WaterPermittivity.factor",
-    "physmodel.discrepancy.CandidateResult.to_dict",
-    "physmodel.effects.Effect.applies_to",
-    "physmodel.effects.Effect.describe",
-    "physmodel.effects.Effect.off",
-    "physmodel.effects.Effect.parameter",
-    "physmodel.effects.Effect.typical",
-    "physmodel.effects.EffectActuatorModel.dc_gain",
-    "physmodel.effects.EffectActuatorModel.reduced",
-    "physmodel.model.PhysicsModel.state",
-    "physmodel.model.check_s",
-    "physmodel.params.State.gamma0",
-    "physmodel.params.State.second_moment",
-    "physmodel.params.as_parameter_list",
-    "physmodel.sensor.sensor_kernel",
-    "physmodel.sweep.ComplexGaussianNoise.apply",
-    "physmodel.sweep.ComplexGaussianNoise.describe",
-    "physmodel.sweep.ComplexGaussianNoise.std",
-    "physmodel.sweep.FrequencySweep.magnitude_db",
-    "physmodel.sweep.FrequencySweep.omega",
-    "physmodel.sweep.FrequencySweep.to_csv",
-    "physmodel.sweep.FrequencySweep.to_mat",
-    "physmodel.sweep.FrequencySweep.to_npz",
-    "physmodel.sweep.MagnitudePhaseNoise.apply",
-    "physmodel.sweep.MagnitudePhaseNoise.describe",
-    "physmodel.sweep.MagnitudePhaseNoise.std",
-    "physmodel.sweep.read_mat",
-    "physmodel.sweep.read_npz",
-    "physmodel.sweep.write_npz",
-    "physmodel.timesim.Realization.frequency_response",
-    "physmodel.timesim.Realization.order",
-    "physmodel.timesim.TimeSeries.columns",
-    "physmodel.timesim.TimeSeries.save",
-    "physmodel.timesim.TimeSeries.to_csv",
-    "physmodel.timesim.TimeSeries.to_npz",
-    "physmodel.timesim.check_uniform_time",
-    "physmodel.timesim.time_grid",
-    "scenarios.cli.build_parser",
-    "scenarios.cli.cmd_sets",
-    "scenarios.cli.cmd_simulate",
-    "scenarios.cli.cmd_sweep",
-    "scenarios.cli.main",
-    "scenarios.runner.CheckResult.bound_text",
-    "scenarios.runner.RunResult.exit_code",
-    "scenarios.runner.RunResult.passed",
-    "scenarios.runner.add_parser",
-    "scenarios.runner.resolve_scenario_path",
-    "scenarios.runner.run",
-    "scenarios.runner.summary_line",
-    "scenarios.seed_calibration.actuator_base",
-    "scenarios.seed_calibration.actuator_trends",
-    "scenarios.seed_calibration.main",
-    "scenarios.spec.Scenario.has",
-    "scenarios.spec.Scenario.section",
-    "scenarios.spec.Scenario.steps",
-    "scenarios.study.StudyTable.n_rows",
-    "scenarios.study.StudyTable.save",
-    "scenarios.study.StudyTable.to_csv",
-    "scenarios.study.StudyTable.to_npz",
-    "scenarios.study.add_parser",
-    "scenarios.study.run",
-    "scenarios.validate.ValidationReport.claim_ids",
-    "scenarios.validate.ValidationReport.counts",
-    "scenarios.validate.ValidationReport.regressions",
-    "scenarios.validate.ValidationReport.to_dict",
-    "scenarios.validate.ValidationReport.to_json",
-    "scenarios.validate.ValidationReport.to_markdown",
-    "scenarios.validate.add_parser",
-    "scenarios.validate.load_published",
-    "scenarios.validate.run",
-    "surrogate.FitResult.summary",
-    "surrogate.FrequencyData.has_uncertainty",
-    "surrogate.FrequencyData.labels",
-    "surrogate.FrequencyData.n",
-    "surrogate.OrderRow.mean_fit_percent",
-    "surrogate.OrderRow.mean_relative_rms_error",
-    "surrogate.OrderRow.min_fit_percent",
-    "surrogate.OrderRow.worst_relative_rms_error",
-    "surrogate.OrderSelectionReport",
-    "surrogate.OrderSelectionReport.row",
-    "surrogate.OrderSelectionReport.to_markdown",
-    "surrogate.RationalFit.settings",
-    "surrogate.RationalModel.from_dict",
-    "surrogate.RationalModel.is_scheduled",
-    "surrogate.RationalModel.param_names",
-    "surrogate.RationalModel.parameter_table",
-    "surrogate.RationalModel.params",
-    "surrogate.RationalModel.stderr",
-    "surrogate.RationalModel.to_dict",
-    "surrogate.ScheduledFit.settings",
-    "surrogate.Structure.n_coef",
-    "surrogate.Structure.n_params",
-    "surrogate.Structure.param_names",
-    "surrogate.Structure.pole_slots",
-    "surrogate.Structure.slots",
-    "surrogate.Structure.to_dict",
-    "surrogate.Structure.with_degree",
-    "surrogate.Structure.with_form",
-    "surrogate.cli.main",
-}
+from __future__ import annotations
 
-#: Documented functions, methods and classes whose numpydoc ``Parameters`` (classes: also
-#: ``Attributes``) section misses signature parameters: {name: [missing parameters]}.
-KNOWN_PARAMETERS_UNDOCUMENTED = {
-    "inversion.InversionResult": ['t0', 'time_stamps'],
-    "inversion.ScheduledInversionResult": ['t0', 'time_stamps'],
-    "inversion.ScheduledStreamingInverter": ['improper', 'filter_bandwidth'],
-    "inversion.ScheduledStreamingInverter.push": ['chunk', 'temperature'],
-    "inversion.decode_sensor": ['model', 't', 'current', '**kwargs'],
-    "inversion.feedforward": ['model', 't', 'desired', '**kwargs'],
-    "inversion.invert_scheduled_to": ['model_at', 'dt', 'u', 'temperature', 'out', 'preview', 'grid_step', 'grid', 'improper', 'filter_bandwidth', 'chunk_size'],
-    "inversion.sampling_interval": ['t'],
-    "inversion.temperature_grid": ['t_min', 't_max', 'step'],
-    "physmodel.ActuatorModel": ['params', 'chunk_size'],
-    "physmodel.ActuatorModel.dc_gain": ['temperature_c'],
-    "physmodel.ActuatorModel.evaluate": ['s', 'temperature_c', 'quantities', 'out', 'progress'],
-    "physmodel.ActuatorModel.frequency_response": ['frequency_hz', 'temperature_c', 'quantities', 'out', 'progress'],
-    "physmodel.ActuatorModel.reduced": ['temperature_c', 'taylor_order', 'set_index', 'include_mode'],
-    "physmodel.Arrhenius": ['activation_energy', 'valid_c'],
-    "physmodel.CalibrationResult": ['names', 'values', 'parameters', 'stderr', 'ci_lower', 'ci_upper', 'correlation', 'cost', 'expected_cost', 'cost_std', 'n_lines', 'n_evaluations', 'n_model_calls', 'converged', 'message', 'starts', 'identifiability', 'noise_estimated', 'noise_scale', 'held', 'free', 'band_hz', 'temperatures_c', 'elapsed_s', 'metadata'],
-    "physmodel.CalibrationResult.save": ['path'],
-    "physmodel.Constant": ['valid_c'],
-    "physmodel.Diagnosis": ['verdict', 'named', 'message', 'kind', 'quantity', 'alpha', 'threshold', 'gap_threshold', 'baseline', 'final', 'final_effects', 'candidates', 'skipped', 'confusable', 'separation', 'localisation_before', 'localisation_after', 'gap_before', 'gap_after', 'null', 'noise_estimated', 'elapsed_s', 'data', 'predicted_before', 'predicted_after', 'metadata'],
-    "physmodel.Diagnosis.write_report": ['folder'],
-    "physmodel.EffectModel": ['base_params', 'kind', 'effects', 'kernel', 'chunk_size'],
-    "physmodel.FreeParameter": ['name', 'lower', 'upper', 'scale', 'initial'],
-    "physmodel.FrequencyResponse.magnitude_db": ['quantity', 'scale'],
-    "physmodel.FrequencyResponse.phase_deg": ['quantity'],
-    "physmodel.IPMCParameters": ['L', 'W', 'h', 'd', 'C_minus', 'kappa_e', 'alpha0', 'a0', 'r1_sheet', 'r2_specific', 'Rp_specific', 'E', 'rho', 'xi', 'T_ref', 'laws', 'name', 'source'],
-    "physmodel.IPMCParameters.replace": ['**changes'],
-    "physmodel.IonicResistance": ['valid_c'],
-    "physmodel.Linear": ['alpha', 'valid_c'],
-    "physmodel.LogLinear": ['slope', 'valid_c'],
-    "physmodel.SensorModel": ['params', 'kernel', 'chunk_size'],
-    "physmodel.SensorModel.evaluate": ['s', 'temperature_c', 'quantities', 'out', 'progress'],
-    "physmodel.SensorModel.frequency_response": ['frequency_hz', 'temperature_c', 'quantities', 'out', 'progress'],
-    "physmodel.TemperatureLaws": ['d', 'E', 'kappa_e', 'Rp_specific', 'r1_sheet', 'r2_specific', 'C_minus', 'h'],
-    "physmodel.TemperatureLaws.factors": ['T_K', 'T_ref_K'],
-    "physmodel.TemperatureLaws.with_": ['**laws'],
-    "physmodel.TransimpedanceChain": ['R1', 'R2', 'R3', 'bandwidth_hz'],
-    "physmodel.WaterPermittivity": ['valid_c'],
-    "physmodel.calibrate": ['data', 'base', 'free', 'kind', 'quantity', 'starts', 'seed', 'kernel', 'max_nfev', 'identify', 'hold_undetermined', 'name', 'progress', '**kwargs'],
-    "physmodel.describe": ['p'],
-    "physmodel.diagnose": ['data', 'base', 'kind', 'quantity', 'free', 'baseline_effects', 'candidates', 'alpha', 'null_draws', 'null_refits', 'seed', 'kernel', 'max_nfev', 'progress'],
-    "physmodel.fit_parameters": ['data', 'predict', 'free', 'starts', 'seed', 'predict_many', 'fixed', 'max_nfev', 'ftol', 'identify', 'hold_undetermined', 'probe', 'fd_step', 'progress'],
-    "physmodel.get_parameter_set": ['name', '**overrides'],
-    "physmodel.load_parameter_set": ['path'],
-    "physmodel.register_parameter_set": ['name', 'factory', 'overwrite'],
-    "physmodel.save_parameter_set": ['params', 'path'],
-    "physmodel.state_at": ['params', 'temperature_c'],
-    "surrogate.ConvergenceError": ['message', 'result'],
-    "surrogate.FitResult": ['model', 'converged', 'status', 'iterations', 'cost', 'weighted_rms', 'weighting', 'method', 'param_names', 'params', 'stderr', 'ci95_low', 'ci95_high', 'covariance_rank_deficient', 'at_bounds', 'per_temperature', 'stability', 'time_s', 'data_fingerprint', 'history', 'two_stage', 'per_temperature_models'],
-    "surrogate.FrequencyData.at_temperature": ['temperature_c'],
-    "surrogate.FrequencyData.select": ['mask'],
-    "surrogate.OrderRow": ['n_zeros', 'n_poles', 'n_params', 'temperatures_c', 'relative_rms_error', 'fit_percent', 'weighted_rms', 'converged', 'stable'],
-    "surrogate.RationalFit.fit": ['frequency_hz', 'temperature_c', 'response', 'magnitude_std_db', 'phase_std_deg'],
-    "surrogate.RationalFit.fit_data": ['data', 'theta0', 'stage'],
-    "surrogate.RationalModel.at": ['temperature_c', 'extrapolate'],
-    "surrogate.RationalModel.coefficients": ['temperature_c', 'extrapolate'],
-    "surrogate.RationalModel.confidence_intervals": ['level'],
-    "surrogate.RationalModel.frequency_response": ['frequency_hz', 'temperature_c', 'extrapolate'],
-    "surrogate.RationalModel.max_pole_real_part": ['temperature_c', 'extrapolate'],
-    "surrogate.RationalModel.poles": ['temperature_c', 'extrapolate'],
-    "surrogate.RationalModel.response_std": ['frequency_hz', 'temperature_c', 'extrapolate'],
-    "surrogate.RationalModel.stability_check": ['n_temperatures'],
-    "surrogate.RationalModel.to_json": ['path'],
-    "surrogate.RationalModel.zeros": ['temperature_c', 'extrapolate'],
-    "surrogate.Scaling": ['omega_ref_rad_s', 'gain_ref', 'temperature_center_c', 'temperature_scale_c'],
-    "surrogate.ScheduledFit.fit": ['frequency_hz', 'temperature_c', 'response', 'magnitude_std_db', 'phase_std_deg'],
-    "surrogate.ScheduledFit.fit_data": ['data'],
-    "surrogate.StabilityCheck": ['stable', 'max_pole_real_part_rad_s', 'worst_temperature_c', 'n_temperatures'],
-    "surrogate.Structure": ['form', 'n_zeros', 'n_poles', 'degree'],
-    "surrogate.Structure.bounds": ['w_min', 'w_max'],
-    "surrogate.Structure.slot_bounds": ['w_min', 'w_max', 'window'],
-    "surrogate.Structure.slot_matrix": ['theta'],
-    "surrogate.TemperatureError": ['temperature_c', 'n_lines', 'relative_rms_error', 'fit_percent'],
-    "surrogate.fit_percent": ['model', 'data'],
-    "surrogate.fit_sweep": ['sweep', 'n_zeros', 'n_poles', 'degree', 'form', '**settings'],
-    "surrogate.from_sweep": ['sweep'],
-    "surrogate.levy": ['w', 'h', 'n_zeros', 'n_poles', 'row_weight'],
-    "surrogate.load": ['path'],
-    "surrogate.log_rms_error": ['model', 'data'],
-    "surrogate.order_selection": ['frequency_hz', 'temperature_c', 'response', 'orders', 'magnitude_std_db', 'phase_std_deg', 'weighting', 'stable', 'max_iter'],
-    "surrogate.relative_rms_error": ['model', 'data'],
-}
+import json
+import sys
+from pathlib import Path
 
-#: Documented numerical parameters (float, complex, array, ...) without a unit in square brackets
-#: (``[-]`` for dimensionless): {name: [parameters]}.
-KNOWN_UNITS_MISSING = {
-    "inversion.InverseSplit": ['A_u', 'B_u', 'C_u', 'den', 'derivative_coefficients', 'feedthrough', 'num'],
-    "inversion.ScheduledInversionResult": ['input', 'stable_part', 'unstable_part'],
-    "inversion.invert": ['u'],
-    "inversion.invert_scheduled": ['preview', 'u'],
-    "inversion.invert_to": ['out', 'u'],
-    "surrogate.RationalFit": ['tol'],
-    "surrogate.RationalModel": ['covariance', 'params'],
-}
+HERE = Path(__file__).resolve().parent
+DEBT_FILE = HERE / "docstring_debt.json"
 
-#: Docstrings written as plain text that is not valid reST (indented lists without blank lines,
-#: ASCII layouts): the reference shows them preformatted instead of failing the build.
-VERBATIM = {
-    "inversion",
-    "surrogate",
-    "scenarios",
-    "physmodel.actuator",
-    "physmodel.discrepancy_cli",
-    "physmodel.effects",
-    "physmodel.parameter_sets",
-    "physmodel.temperature",
-    "scenarios.cli",
-    "scenarios.validate",
-    "physmodel.calibration.default_free_parameter",
-    "surrogate.FitResult",
-}
+#: Cross-reference targets that are not ours (no intersphinx: CI builds offline) or are type words
+#: of numpydoc parameter lines; the build does not check them ((role regex, target regex) pairs,
+#: Sphinx's ``nitpick_ignore_regex``).
+EXTERNAL_TARGETS = [
+    # private names (bases shown by show-inheritance, private modules) are not documented
+    (r"py:.*", r"(.*\.)?_[^.]*(\..*)?"),
+    (r"py:.*", r"(numpy|np|scipy|control|casadi|matplotlib|distributed|dask|pathlib|os|typing|"
+               r"collections|concurrent|argparse|io|json|datetime|dataclasses|enum)(\..*)?"),
+    (r"py:.*", r"(ndarray|array_like|array-like|ArrayLike|Path|PathLike|Callable|Mapping|Sequence|"
+               r"Iterable|Iterator|Any|Figure|Axes|Client|TransferFunction|StateSpace|"
+               r"FrequencyResponseData|Namespace|ArgumentParser|_SubParsersAction|Generator|"
+               r"SeedSequence|memmap|optional|default|callable|scalar|int|float|str|bool|dict|list|"
+               r"tuple|complex|object|None|type|set|bytes|function|iterable|sequence|mapping|"
+               r"array|arrays|path|file|float64|complex128|inf|nan|number|numbers|or|of|shape|"
+               r"\(.*|.*\)|\{.*|.*\}|.*\[.*|.*\]|.*'.*|.*\".*|.*,.*|[0-9].*|\.\.\.)"),
+]
 
-#: Public base classes that are not themselves documented (shown by ``show-inheritance``).
-UNDOCUMENTED_BASES = {
-    "inversion.batch.SampledRecord",
-}
+_KEYS = ("undocumented", "parameters_undocumented", "units_missing", "verbatim", "unresolved_references",
+         "undocumented_bases")
 
 
-def build_exclusions() -> set[str]:
-    """Regular expressions for ``numpydoc_validation_exclude``.
+def load() -> dict:
+    """The lists as stored (empty lists for a missing file or key)."""
+    data = json.loads(DEBT_FILE.read_text(encoding="utf-8")) if DEBT_FILE.exists() else {}
+    return {k: data.get(k, {} if k in ("parameters_undocumented", "units_missing") else []) for k in _KEYS}
 
-    Each listed name is matched on its last two components (``Class.method`` or
-    ``module.function``), so that moving a module during the restructure does not turn the
-    listed debt into build errors; anything not listed is still checked.
-    """
+
+_DEBT = load()
+KNOWN_UNDOCUMENTED: set[str] = set(_DEBT["undocumented"])
+KNOWN_PARAMETERS_UNDOCUMENTED: dict[str, list[str]] = dict(_DEBT["parameters_undocumented"])
+KNOWN_UNITS_MISSING: dict[str, list[str]] = dict(_DEBT["units_missing"])
+VERBATIM: set[str] = set(_DEBT["verbatim"])
+UNRESOLVED_REFERENCES: set[str] = set(_DEBT["unresolved_references"])
+UNDOCUMENTED_BASES: set[str] = set(_DEBT["undocumented_bases"])
+
+
+def is_external(target: str, role: str = "py:obj") -> bool:
+    """True for a cross-reference target the build does not check (:data:`EXTERNAL_TARGETS`)."""
     import re
 
-    return {r"(^|\.)" + re.escape(".".join(n.split(".")[-2:])) + "$" for n in KNOWN_UNDOCUMENTED}
+    return any(re.fullmatch(r, role) and re.fullmatch(t, target) for r, t in EXTERNAL_TARGETS)
+
+
+def _write(data: dict) -> None:
+    text = json.dumps({k: data[k] for k in _KEYS}, indent=1, ensure_ascii=False, sort_keys=False)
+    tmp = DEBT_FILE.with_suffix(".json.tmp")
+    tmp.write_text(text + "\n", encoding="utf-8")
+    tmp.replace(DEBT_FILE)
+
+
+def _names(value) -> set[str]:
+    return set(value) if not isinstance(value, dict) else {f"{k}: {', '.join(v)}" for k, v in value.items()}
+
+
+def diff(old: dict, new: dict) -> dict[str, tuple[list[str], list[str]]]:
+    """{list: (added, removed)} between two measurements."""
+    out = {}
+    for k in _KEYS:
+        a, b = _names(old.get(k, [])), _names(new.get(k, []))
+        out[k] = (sorted(b - a), sorted(a - b))
+    return out
+
+
+def main(argv=None) -> int:
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="python docs/_ext/docstring_policy.py",
+                                 description="Measure the packages' docstring debt and compare it with "
+                                             "docs/_ext/docstring_debt.json (or rewrite that file).")
+    ap.add_argument("--update", action="store_true", help="rewrite docstring_debt.json from the code")
+    ap.add_argument("--check", action="store_true", help="exit 1 if the file differs from the code")
+    ap.add_argument("-v", "--verbose", action="store_true", help="list every added and removed name")
+    args = ap.parse_args(argv)
+
+    root = HERE.parents[1]
+    sys.path.insert(0, str(root))      # measure this checkout's packages
+    sys.path.insert(0, str(HERE))
+    import docstring_audit
+
+    new = docstring_audit.measure()
+    changes = diff(_DEBT, new)
+    total_added = total_removed = 0
+    for k, (added, removed) in changes.items():
+        total_added += len(added)
+        total_removed += len(removed)
+        print(f"{k:24s} {len(new[k]):4d} listed   +{len(added)} added   -{len(removed)} removed")
+        if args.verbose or args.check or len(added) + len(removed) <= 40:
+            for n in added:
+                print(f"    + {n}")
+            for n in removed:
+                print(f"    - {n}")
+    print(f"total: +{total_added} added, -{total_removed} removed")
+    if args.update:
+        _write(new)
+        print(f"wrote {DEBT_FILE}")
+        return 0
+    if args.check and (total_added or total_removed):
+        print("docstring_debt.json differs from the code: run python docs/_ext/docstring_policy.py --update")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -7,12 +7,13 @@ At ``config-inited`` (before Sphinx lists the sources and autosummary writes its
   documented once, under the package's name: ``physmodel.ActuatorModel``);
 * for every public submodule (no component starting with ``_``; found with
   :func:`pkgutil.walk_packages`, so a restructure that moves modules needs no edit here) a page
-  with the module docstring and its public names that the package does not already export:
-  the module's ``__all__`` if it has one, else the functions and classes defined in it whose
-  names do not start with ``_``.
+  with the module docstring and its public names: the module's ``__all__`` if it has one, else
+  the functions and classes defined in it whose names do not start with ``_``.
 
-So every public name is documented exactly once, and a name that moves between modules moves
-in the reference by itself.  The generated files live in ``api/_auto/`` (not committed).
+Every function and class is documented once, at its home (:func:`plan`: the shallowest package
+that exports it, else its defining module); the other pages that list it link there.  A name
+that moves between modules moves in the reference by itself.  ``docstring_audit`` walks the
+same plan, so the docstring debt is measured on exactly what the reference renders.  The generated files live in ``api/_auto/`` (not committed).
 """
 
 from __future__ import annotations
@@ -71,44 +72,78 @@ def _autosummary(module_name: str, names: list[str]) -> str:
     return (f".. currentmodule:: {module_name}\n\n.. autosummary::\n   :toctree: generated/\n\n{body}\n")
 
 
-def _exported_ids(package) -> set[int]:
-    return {id(getattr(package, n)) for n in getattr(package, "__all__", ()) if hasattr(package, n)}
+def _is_routine_or_class(obj) -> bool:
+    return inspect.isroutine(obj) or inspect.isclass(obj)
+
+
+def _depth(name: str) -> int:
+    return name.count(".")
+
+
+def plan(package_name: str) -> list[tuple[str, list[str], dict[str, str]]]:
+    """What the reference documents for one package: ``[(module, own names, {name: home})]``.
+
+    The package comes first, then its public submodules.  Every function and class is
+    documented once, at its *home*: the shallowest package ``__init__`` that lists it in
+    ``__all__`` (``physmodel.FrequencySweep``, ``physmodel.data.read_npz``), else the module that
+    defines it; other modules that list it point there.  Constants are documented wherever they
+    are listed.
+    """
+    pkg = importlib.import_module(package_name)
+    modules = [package_name] + public_submodules(pkg)
+    listed = {m: module_public_names(importlib.import_module(m)) for m in modules}
+
+    def rank(module_name: str, obj) -> tuple:
+        mod = importlib.import_module(module_name)
+        is_pkg = hasattr(mod, "__path__") and module_name != getattr(obj, "__module__", None)
+        defines = getattr(obj, "__module__", None) == module_name
+        return (0 if is_pkg else 1 if defines else 2, _depth(module_name), module_name)
+
+    home: dict[int, str] = {}
+    for m in sorted(modules, key=lambda m: (_depth(m), m)):
+        mod = importlib.import_module(m)
+        for n in listed[m]:
+            obj = getattr(mod, n)
+            if not _is_routine_or_class(obj):
+                continue
+            key = id(obj)
+            if key not in home or rank(m, obj) < rank(home[key].rsplit(".", 1)[0], obj):
+                home[key] = f"{m}.{n}"
+    out = []
+    for m in modules:
+        mod = importlib.import_module(m)
+        own, again = [], {}
+        for n in listed[m]:
+            obj = getattr(mod, n)
+            where = home.get(id(obj)) if _is_routine_or_class(obj) else None
+            if where is None or where == f"{m}.{n}":
+                own.append(n)
+            else:
+                again[n] = where
+        out.append((m, own, again))
+    return out
 
 
 def package_pages(package_name: str) -> dict[str, str]:
     """{relative file name: reST text} for one package and its public submodules."""
-    pkg = importlib.import_module(package_name)
-    exported = _exported_ids(pkg)
     pages: dict[str, str] = {}
-    subs = public_submodules(pkg)
-    top = [_title(f"``{package_name}``"),
-           f".. automodule:: {package_name}\n   :no-members:\n"]
-    names = list(getattr(pkg, "__all__", ()))
-    if names:
-        top.append(_title("Public names", "-"))
-        top.append(f"Everything below is importable as ``from {package_name} import NAME``.\n")
-        top.append(_autosummary(package_name, names))
-    if subs:
-        top.append(_title("Modules", "-"))
-        top.append(".. toctree::\n   :maxdepth: 1\n\n" + "\n".join(f"   {s}" for s in subs) + "\n")
-    pages[f"{package_name}.rst"] = "\n".join(top)
-    for sub in subs:
-        mod = importlib.import_module(sub)
-        own = [n for n in module_public_names(mod)
-               if id(getattr(mod, n)) not in exported or not _is_routine_or_class(getattr(mod, n))]
-        again = [n for n in module_public_names(mod) if n not in own]
-        text = [_title(f"``{sub}``"), f".. automodule:: {sub}\n   :no-members:\n"]
+    entries = plan(package_name)
+    subs = [m for m, _, _ in entries[1:]]
+    for m, own, again in entries:
+        text = [_title(f"``{m}``"), f".. automodule:: {m}\n   :no-members:\n"]
+        if m == package_name:
+            if own or again:
+                text.append(_title("Public names", "-"))
+                text.append(f"Everything below is importable as ``from {package_name} import NAME``.\n")
         if again:
-            refs = ", ".join(f":obj:`{package_name}.{n}`" for n in again if hasattr(pkg, n))
-            if refs:
-                text.append(f"Also defined here and documented under the package: {refs}.\n")
-        text.append(_autosummary(sub, own))
-        pages[f"{sub}.rst"] = "\n".join(text)
+            refs = ", ".join(f":obj:`{n} <{where}>`" for n, where in again.items())
+            text.append(f"Also importable from here, documented where listed: {refs}.\n")
+        text.append(_autosummary(m, own))
+        if m == package_name and subs:
+            text.append(_title("Modules", "-"))
+            text.append(".. toctree::\n   :maxdepth: 1\n\n" + "\n".join(f"   {s}" for s in subs) + "\n")
+        pages[f"{m}.rst"] = "\n".join(text)
     return pages
-
-
-def _is_routine_or_class(obj) -> bool:
-    return inspect.isroutine(obj) or inspect.isclass(obj)
 
 
 def generate(app, config) -> None:

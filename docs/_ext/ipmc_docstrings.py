@@ -7,7 +7,11 @@
 * Docstrings listed in :data:`docstring_policy.VERBATIM` are plain text that is not valid reST
   (indented lists without blank lines, ASCII layouts); they are shown as preformatted text so
   that the build stays strict for every other docstring.  The list is debt: fixing a docstring
-  means deleting its name there (the build then checks it like the rest).
+  and running ``python docs/_ext/docstring_policy.py --update`` removes its name (the build then
+  checks it like the rest).
+* A public function, class, method or property without a docstring, and not listed in
+  :data:`docstring_policy.KNOWN_UNDOCUMENTED`, is a warning (an error under ``-W``) that names
+  it; the build ends with one summary of all of them.
 """
 
 from __future__ import annotations
@@ -16,6 +20,10 @@ import inspect
 import re
 
 import docstring_policy
+from sphinx.util import logging
+
+logger = logging.getLogger(__name__)
+_CHECKED_WHAT = {"function", "class", "exception", "method", "property", "classmethod", "staticmethod"}
 
 _QUOTED = re.compile(r"(``.*?``|(?::[\w:+-]+:)?`[^`]*`_{0,2})")
 
@@ -53,8 +61,15 @@ def verbatim(app, what, name, obj, options, lines):
 
 
 def process(app, what, name, obj, options, lines):
+    """Before numpydoc: escape ``|``, link the notes (not for docstrings shown verbatim)."""
     if name in docstring_policy.VERBATIM:
         return
+    rewrite(lines)
+
+
+def rewrite(lines: list[str]) -> None:
+    """Escape ``|`` and link the notes in docstring ``lines`` (in place), outside literal blocks
+    and doctests."""
     out = []
     literal_indent = None   # indentation of the paragraph that opened a literal block
     prev = ""
@@ -79,8 +94,37 @@ def process(app, what, name, obj, options, lines):
     lines[:] = out
 
 
+def undocumented(app, what, name, obj, options, lines):
+    """First of all handlers: a rendered public object without a docstring that is not listed as
+    debt is a warning naming it."""
+    if what not in _CHECKED_WHAT or any(ln.strip() for ln in lines):
+        return
+    if name in docstring_policy.KNOWN_UNDOCUMENTED:
+        return
+    _found(app).add(name)
+    logger.warning("undocumented public %s %s: write its docstring (numpydoc), or list it as debt with "
+                   "'python docs/_ext/docstring_policy.py --update'", what, name,
+                   type="ipmc", subtype="undocumented")
+
+
+def _found(app) -> set:
+    if not hasattr(app, "_ipmc_undocumented"):
+        app._ipmc_undocumented = set()
+    return app._ipmc_undocumented
+
+
+def summary(app, exception):
+    names = sorted(_found(app))
+    if names and exception is None:
+        logger.warning("%d public name(s) without a docstring (not listed in docs/_ext/docstring_debt.json):"
+                       "\n    %s", len(names), "\n    ".join(names), type="ipmc", subtype="undocumented")
+
+
 def setup(app):
+    app.connect("autodoc-process-docstring", undocumented, priority=100)
+    app.connect("build-finished", summary)
     # before numpydoc (priority 500) parses the sections
     app.connect("autodoc-process-docstring", process, priority=400)
     app.connect("autodoc-process-docstring", verbatim, priority=600)
+    # the summary collects across documents in one process: serial reading (the build's default)
     return {"parallel_read_safe": True, "parallel_write_safe": True}

@@ -1,75 +1,38 @@
 """Resolve the short and module-path cross-references the docstrings use.
 
-The packages' docstrings write ``:class:`State``` or ``:func:`physmodel.calibration.calibrate```
+The packages' docstrings write ``:class:`State``` or ``:func:`physmodel.estimation.calibration.calibrate```
 (the object's home module) while the reference documents each public object once, under the
 name users import it by (``physmodel.calibrate``).  For a Python reference Sphinx could not
-resolve, this resolver tries, in order:
+resolve, :func:`docstring_audit.resolve` tries the current class (with what it inherits) and
+module, the object the target names when imported (any documented name for the same object),
+and a unique documented name ending in ``.<target>`` (preferring the referring package).
 
-1. the object the target names when imported (``physmodel.calibration.calibrate``): if a
-   documented name is the same Python object, link there;
-2. a unique documented name ending in ``.<target>`` (``State`` → ``physmodel.params.State``).
-
-Anything still unresolved, or ambiguous, stays a warning (an error under ``-W``).
+A target listed in ``docstring_debt.json`` as an unresolved reference (a stale module path in a
+docstring) is shown as plain text.  Anything else still unresolved, or ambiguous, stays a warning
+(an error under ``-W``), and ``python docs/_ext/docstring_policy.py --update`` lists it as debt.
 """
 
 from __future__ import annotations
 
-import importlib
-
 from docutils import nodes
-from sphinx.util import logging
 
-logger = logging.getLogger(__name__)
-
-
-def _import(name: str):
-    parts = name.split(".")
-    for i in range(len(parts), 0, -1):
-        try:
-            obj = importlib.import_module(".".join(parts[:i]))
-        except Exception:
-            continue
-        try:
-            for attr in parts[i:]:
-                obj = getattr(obj, attr)
-        except AttributeError:
-            return None
-        return obj
-    return None
-
-
-def _index(env):
-    cache = getattr(env, "_ipmc_suffix_index", None)
-    objects = env.get_domain("py").objects
-    if cache is None or cache[0] != len(objects):
-        by_last: dict[str, list[str]] = {}
-        for full, entry in objects.items():
-            if getattr(entry, "aliased", False):   # ``:canonical:`` aliases of documented objects
-                continue
-            by_last.setdefault(full.rsplit(".", 1)[-1], []).append(full)
-        cache = (len(objects), by_last)
-        env._ipmc_suffix_index = cache
-    return objects, cache[1]
+import docstring_audit
+import docstring_policy
 
 
 def resolve(app, env, node, contnode):
     if node.get("refdomain") != "py":
         return None
-    target = node.get("reftarget", "")
+    target = node.get("reftarget", "").lstrip(".~!")
     if not target or target.startswith("_"):
         return None
-    objects, by_last = _index(env)
-    candidates = [n for n in by_last.get(target.rsplit(".", 1)[-1], []) if n == target or n.endswith("." + target)]
-    chosen = None
-    obj = _import(target) if "." in target else None
-    if obj is not None:
-        same = [n for n in by_last.get(target.rsplit(".", 1)[-1], []) if _import(n) is obj]
-        if len(same) >= 1:
-            # documented once; prefer the shortest (the package-level) name
-            chosen = min(same, key=len)
-    if chosen is None and len(candidates) == 1:
-        chosen = candidates[0]
-    if chosen is None:
+    module = node.get("py:module")
+    cls = node.get("py:class")
+    chosen = docstring_audit.resolve(target, module, f"{module}.{cls}" if module and cls else cls)
+    objects = env.get_domain("py").objects
+    if chosen is None or chosen not in objects:
+        if target in docstring_policy.UNRESOLVED_REFERENCES:
+            return contnode            # known debt: plain text until the docstring is fixed
         return None
     entry = objects[chosen]
     newnode = nodes.reference("", "", internal=True)

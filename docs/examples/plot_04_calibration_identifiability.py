@@ -18,8 +18,7 @@ data.
 # -----------------------------------------
 import numpy as np
 
-from physmodel import ActuatorModel, calibrate, get_parameter_set
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel import ActuatorModel, MagnitudePhaseNoise, calibrate, get_parameter_set, synthesize_sweep
 
 base = get_parameter_set("seed002_table3")
 truth = base.replace(d=1.4 * base.d, alpha0=1.2 * base.alpha0, r1_sheet=1.5 * base.r1_sheet, xi=0.22)

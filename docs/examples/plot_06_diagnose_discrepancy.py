@@ -19,8 +19,7 @@ time constant that the base model does not have.
 import matplotlib.pyplot as plt
 import numpy as np
 
-from physmodel import LIBRARY, EffectModel, diagnose, get_parameter_set
-from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel import LIBRARY, EffectModel, MagnitudePhaseNoise, diagnose, get_parameter_set, synthesize_sweep
 
 base = get_parameter_set("seed002_table3")
 print("candidate effects:", ", ".join(LIBRARY))

@@ -25,8 +25,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.io import loadmat, savemat
 
-from physmodel import ActuatorModel, get_parameter_set
-from physmodel.sweep import synthesize_sweep
+from physmodel import ActuatorModel, get_parameter_set, synthesize_sweep
 from surrogate import fit_sweep
 
 model = ActuatorModel(get_parameter_set("seed002_table3"))
