@@ -34,7 +34,21 @@ class FrequencyModel(Protocol):
     kind: str
 
     def response(self, frequency_hz, temperature_c) -> np.ndarray:
-        """Complex primary response, shape (n_T, n_f). [SI of the model's quantity]"""
+        """Complex primary response, shape (n_T, n_f). [SI of the model's quantity]
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies, shape (n_f,). [Hz]
+        temperature_c : float or array_like
+            Temperatures, shape (n_T,). [°C]
+
+        Returns
+        -------
+        ndarray
+            Complex, shape (n_T, n_f): M [m/V] (actuator), S [A/m] (sensor) or the fitted
+            output/input (rational).
+        """
         ...
 
 
@@ -44,7 +58,24 @@ PHYSICS_KINDS = {"actuator": "M", "sensor": "S"}
 
 def physics_model(kind: str, params, *, kernel: str = "boundary_charge", chunk_size: int | None = None):
     """The physics model of ``kind`` ("actuator" or "sensor") for one or several parameter sets —
-    the one place a kind string becomes a model.  ``kernel`` applies to sensors only."""
+    the one place a kind string becomes a model.
+
+    Parameters
+    ----------
+    kind : str
+        ``"actuator"`` (:class:`~physmodel.ActuatorModel`) or ``"sensor"``
+        (:class:`~physmodel.SensorModel`); anything else raises :class:`~physmodel.IPMCError`.
+    params : IPMCParameters or sequence of IPMCParameters
+        One parameter set or several (evaluated together, vectorised).
+    kernel : str
+        Sensor collection kernel, ``"boundary_charge"`` or ``"reciprocal"``; sensors only.
+    chunk_size : int or None
+        Frequencies evaluated per chunk (bounds the memory); None keeps the model's default.
+
+    Returns
+    -------
+    ActuatorModel or SensorModel
+    """
     from .actuator import ActuatorModel
     from .errors import IPMCError
     from .sensor import SensorModel

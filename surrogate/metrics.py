@@ -18,13 +18,29 @@ def _pair(model, data):
 
 
 def relative_rms_error(model, data) -> float:
-    """sqrt(mean(|H_model − H_data|² / |H_data|²)). [-]"""
+    """sqrt(mean(|H_model − H_data|² / |H_data|²)). [-]
+
+    Parameters
+    ----------
+    model : array_like
+        Model response, complex, any shape. [output/input]
+    data : array_like
+        Measured response, complex, the same number of values. [output/input]
+    """
     m, d = _pair(model, data)
     return float(np.sqrt(np.mean(np.abs(m - d) ** 2 / np.abs(d) ** 2)))
 
 
 def fit_percent(model, data) -> float:
-    """MATLAB-style fit 100·(1 − NRMSE), NRMSE = ‖H_model − H_data‖ / ‖H_data − mean H_data‖. [%]"""
+    """MATLAB-style fit 100·(1 − NRMSE), NRMSE = ‖H_model − H_data‖ / ‖H_data − mean H_data‖. [%]
+
+    Parameters
+    ----------
+    model : array_like
+        Model response, complex, any shape. [output/input]
+    data : array_like
+        Measured response, complex, the same number of values. [output/input]
+    """
     m, d = _pair(model, data)
     den = np.linalg.norm(d - d.mean())
     if den == 0:
@@ -33,7 +49,15 @@ def fit_percent(model, data) -> float:
 
 
 def log_rms_error(model, data) -> float:
-    """RMS of ln(H_model/H_data) (ln-magnitude [Np] and phase [rad] residuals together). [-]"""
+    """RMS of ln(H_model/H_data) (ln-magnitude [Np] and phase [rad] residuals together). [-]
+
+    Parameters
+    ----------
+    model : array_like
+        Model response, complex, any shape. [output/input]
+    data : array_like
+        Measured response, complex, the same number of values. [output/input]
+    """
     m, d = _pair(model, data)
     r = np.log(m / d)
     return float(np.sqrt(np.mean(r.real ** 2 + r.imag ** 2)))

@@ -25,9 +25,14 @@ SCHEMA_VERSION = 1
 class Scaling:
     """Scales that make the fit variables O(1).
 
-    omega_ref_rad_s : s̃ = s/omega_ref_rad_s. [rad/s]
-    gain_ref : response scale. [output_unit/input_unit]
-    temperature_center_c, temperature_scale_c : τ = (T − center)/scale. [°C]
+    Parameters
+    ----------
+    omega_ref_rad_s : float
+        Frequency scale: s̃ = s/omega_ref_rad_s. [rad/s]
+    gain_ref : float
+        Response scale. [output_unit/input_unit]
+    temperature_center_c, temperature_scale_c : float
+        Temperature scales: τ = (T − center)/scale. [°C]
     """
 
     omega_ref_rad_s: float
@@ -47,8 +52,16 @@ class Scaling:
 class StabilityCheck:
     """Independent check of the poles on a dense temperature grid.
 
-    max_pole_real_part_rad_s : largest real part of any pole over the grid. [rad/s]
-    worst_temperature_c : where it occurs. [°C]
+    Parameters
+    ----------
+    stable : bool
+        Every pole in the left half-plane at every grid temperature.
+    max_pole_real_part_rad_s : float
+        Largest real part of any pole over the grid. [rad/s]
+    worst_temperature_c : float or None
+        Where it occurs (None for an unscheduled model). [°C]
+    n_temperatures : int
+        Grid temperatures checked.
     """
 
     stable: bool
@@ -65,13 +78,14 @@ class RationalModel:
     structure : Structure
         Form, orders and polynomial degree in temperature (0: one temperature).
     params : array
-        Parameter vector in the structure's layout (see ``param_names``).
+        Parameter vector in the structure's layout (see ``param_names``), in the scaled
+        variables of ``scaling``. [-]
     scaling : Scaling
         Frequency, gain and temperature scales.
     temperature_range_c : (float, float) or None
         Validity range; evaluating outside it raises unless ``extrapolate=True``. [°C]
     covariance : array (p, p) or None
-        Parameter covariance from the fit.
+        Parameter covariance from the fit, in the scaled variables. [-]
     labels : dict
         ``input_name``, ``input_unit``, ``output_name``, ``output_unit``.
     info : dict
@@ -111,24 +125,34 @@ class RationalModel:
     # ------------------------------------------------------------ parameters
     @property
     def params(self) -> np.ndarray:
+        """The parameter vector (read-only), in the scaled variables. [-]"""
         return self._params
 
     @property
     def param_names(self) -> list[str]:
+        """Names of the entries of ``params``, in order."""
         return self.structure.param_names()
 
     @property
     def is_scheduled(self) -> bool:
+        """True when the coefficients depend on temperature (degree > 0)."""
         return self.structure.degree > 0
 
     @property
     def stderr(self) -> np.ndarray | None:
+        """Standard errors of ``params`` from the covariance, or None without one. [-]"""
         if self.covariance is None:
             return None
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
     def confidence_intervals(self, level: float = 0.95):
-        """Normal-approximation intervals ``(low, high)`` for ``params``, or None."""
+        """Normal-approximation intervals ``(low, high)`` for ``params``, or None.
+
+        Parameters
+        ----------
+        level : float
+            Coverage, in (0, 1). [-]
+        """
         if not 0 < level < 1:
             raise ValueError(f"level must be in (0, 1), got {level!r}")
         if self.covariance is None:
@@ -140,6 +164,7 @@ class RationalModel:
         return self._params - z * se, self._params + z * se
 
     def parameter_table(self) -> list[dict]:
+        """One dict per parameter: name, value and, with a covariance, stderr and the 95 % interval."""
         ci = self.confidence_intervals()
         rows = []
         for i, name in enumerate(self.param_names):
@@ -177,7 +202,17 @@ class RationalModel:
 
     # ------------------------------------------------------------ evaluation
     def frequency_response(self, frequency_hz, temperature_c=None, *, extrapolate=False):
-        """Complex response at ``frequency_hz`` [Hz] and ``temperature_c`` [°C] (broadcast)."""
+        """Complex response at ``frequency_hz`` [Hz] and ``temperature_c`` [°C] (broadcast).
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies. [Hz]
+        temperature_c : float, array_like or None
+            Temperatures, broadcast against ``frequency_hz``; None for an unscheduled model. [°C]
+        extrapolate : bool
+            Evaluate outside ``temperature_range_c`` instead of raising.
+        """
         f = np.asarray(frequency_hz, float)
         if not np.all(np.isfinite(f)):
             raise ValueError("frequency_hz must be finite")
@@ -193,7 +228,15 @@ class RationalModel:
 
     def response(self, frequency_hz, temperature_c=None) -> np.ndarray:
         """The model protocol (:mod:`physmodel.protocol`): the response at every temperature ×
-        frequency, shape (n_T, n_f) [output/input]; ``temperature_c`` None for an unscheduled model."""
+        frequency, shape (n_T, n_f) [output/input].
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies, shape (n_f,). [Hz]
+        temperature_c : float, array_like or None
+            Temperatures, shape (n_T,); None for an unscheduled model. [°C]
+        """
         f = np.atleast_1d(np.asarray(frequency_hz, float))
         if temperature_c is None:
             return self.frequency_response(f, None)[None, :]
@@ -204,7 +247,17 @@ class RationalModel:
         """Standard deviation of the complex response implied by the parameter covariance
         (delta method: sqrt(J Σ Jᴴ), J = ∂H/∂θ by central differences), same shape as
         ``frequency_response``. [output/input]  For a fit with weighting 'uncertainty' this is
-        the noise-induced error of the model itself, e.g. at a held-out temperature."""
+        the noise-induced error of the model itself, e.g. at a held-out temperature.
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Frequencies. [Hz]
+        temperature_c : float, array_like or None
+            Temperatures, broadcast against ``frequency_hz``; None for an unscheduled model. [°C]
+        extrapolate : bool
+            Evaluate outside ``temperature_range_c`` instead of raising.
+        """
         if self.covariance is None:
             raise ValueError("this model carries no parameter covariance (e.g. a two-stage model)")
         h0 = self.frequency_response(frequency_hz, temperature_c, extrapolate=extrapolate)
@@ -227,7 +280,15 @@ class RationalModel:
         return float(self._tau(temperature_c, (), extrapolate))
 
     def coefficients(self, temperature_c=None, *, extrapolate=False):
-        """(num, den) in descending powers of s [rad/s], den monic."""
+        """(num, den) in descending powers of s [rad/s], den monic.
+
+        Parameters
+        ----------
+        temperature_c : float or None
+            Temperature; None for an unscheduled model. [°C]
+        extrapolate : bool
+            Evaluate outside ``temperature_range_c`` instead of raising.
+        """
         tau = self._scalar_tau(temperature_c, extrapolate)
         num, den = S.polynomials(self.structure, self._params, tau)
         n = self.structure.n_poles
@@ -237,25 +298,57 @@ class RationalModel:
         return num_s[::-1], den_s[::-1]
 
     def at(self, temperature_c=None, *, extrapolate=False):
-        """python-control ``TransferFunction`` (s in rad/s) at ``temperature_c`` [°C]."""
+        """python-control ``TransferFunction`` (s in rad/s) at ``temperature_c`` [°C].
+
+        Parameters
+        ----------
+        temperature_c : float or None
+            Temperature; None for an unscheduled model. [°C]
+        extrapolate : bool
+            Evaluate outside ``temperature_range_c`` instead of raising.
+        """
         import control
 
         num, den = self.coefficients(temperature_c, extrapolate=extrapolate)
         return control.tf(num, den)
 
     def zeros(self, temperature_c=None, *, extrapolate=False) -> np.ndarray:
-        """Zeros at ``temperature_c`` [rad/s]."""
+        """Zeros at ``temperature_c`` [rad/s].
+
+        Parameters
+        ----------
+        temperature_c : float or None
+            Temperature; None for an unscheduled model. [°C]
+        extrapolate : bool
+            Evaluate outside ``temperature_range_c`` instead of raising.
+        """
         tau = self._scalar_tau(temperature_c, extrapolate)
         return self.scaling.omega_ref_rad_s * S.roots(self.structure, self._params, tau)[0]
 
     def poles(self, temperature_c=None, *, extrapolate=False) -> np.ndarray:
-        """Poles at ``temperature_c`` [rad/s]."""
+        """Poles at ``temperature_c`` [rad/s].
+
+        Parameters
+        ----------
+        temperature_c : float or None
+            Temperature; None for an unscheduled model. [°C]
+        extrapolate : bool
+            Evaluate outside ``temperature_range_c`` instead of raising.
+        """
         tau = self._scalar_tau(temperature_c, extrapolate)
         return self.scaling.omega_ref_rad_s * S.roots(self.structure, self._params, tau)[1]
 
     def max_pole_real_part(self, temperature_c=None, *, extrapolate=False) -> np.ndarray:
         """Largest pole real part at each temperature [rad/s] (shape of ``temperature_c``);
-        eigenvalues of the stacked companion matrices, one batched call."""
+        eigenvalues of the stacked companion matrices, one batched call.
+
+        Parameters
+        ----------
+        temperature_c : float, array_like or None
+            Temperatures; None for an unscheduled model. [°C]
+        extrapolate : bool
+            Evaluate outside ``temperature_range_c`` instead of raising.
+        """
         t = None if temperature_c is None else np.asarray(temperature_c, float)
         shape = () if t is None else t.shape
         taus = np.atleast_1d(self._tau(t, shape, extrapolate)).ravel()
@@ -268,7 +361,13 @@ class RationalModel:
         return re.reshape(shape)
 
     def stability_check(self, n_temperatures: int = 501) -> StabilityCheck:
-        """Largest pole real part over a dense grid of the validity range."""
+        """Largest pole real part over a dense grid of the validity range.
+
+        Parameters
+        ----------
+        n_temperatures : int
+            Grid points over ``temperature_range_c`` (scheduled models).
+        """
         if self.is_scheduled:
             lo, hi = self.temperature_range_c
             grid = np.linspace(lo, hi, int(n_temperatures))
@@ -282,6 +381,7 @@ class RationalModel:
 
     # ------------------------------------------------------------ persistence
     def to_dict(self) -> dict:
+        """The model as JSON-ready data (schema ``ipmc.surrogate.rational_model``, versioned)."""
         def clean(x):
             return None if x is None else np.asarray(x, float).tolist()
 
@@ -301,12 +401,26 @@ class RationalModel:
         }
 
     def to_json(self, path) -> None:
-        """Write the model as versioned JSON (atomically)."""
+        """Write the model as versioned JSON (atomically).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write.
+        """
         text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
         atomic_write(path, lambda fh: fh.write(text))
 
     @classmethod
     def from_dict(cls, d: dict) -> "RationalModel":
+        """The model from :meth:`to_dict` data; a wrong schema or version, or parameter names that
+        do not match the structure, raise ``ValueError`` naming them.
+
+        Parameters
+        ----------
+        d : dict
+            The data.
+        """
         if not isinstance(d, dict) or d.get("schema") != SCHEMA:
             raise ValueError(f"not a {SCHEMA} document (schema={d.get('schema') if isinstance(d, dict) else None!r})")
         if d.get("schema_version") != SCHEMA_VERSION:
@@ -329,7 +443,13 @@ class RationalModel:
 
 
 def load(path) -> RationalModel:
-    """Read a model written by ``RationalModel.to_json``."""
+    """Read a model written by ``RationalModel.to_json``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file.
+    """
     with open(path, encoding="utf-8") as fh:
         try:
             d = json.load(fh)

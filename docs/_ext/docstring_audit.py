@@ -360,7 +360,10 @@ def checked_objects() -> tuple[tuple[str, object, str], ...]:
 
 
 def signature_parameters(obj, kind) -> list[str]:
-    """Parameter names of the signature (``*args``/``**kw`` with their stars), without self/cls."""
+    """Parameter names of the signature (``*args``/``**kw`` with their stars), without self/cls.
+    A ``typing.Protocol`` class has none (it is never instantiated; its signature is a placeholder)."""
+    if inspect.isclass(obj) and getattr(obj, "_is_protocol", False):
+        return []
     try:
         sig = inspect.signature(obj)
     except (TypeError, ValueError):

@@ -24,9 +24,19 @@ Values = Mapping[str, float]
 class FreeParameter:
     """A parameter to calibrate, with bounds in its physical unit.
 
-    ``scale``: ``"log"`` (fitted as log10 |x|; both bounds must have one sign, not zero) or
-    ``"linear"``; default ``"log"`` when ``lower > 0`` else ``"linear"``.  ``initial``: the start
-    value (default: the base value in :func:`calibrate`, else the geometric/arithmetic mid-point).
+    Parameters
+    ----------
+    name : str
+        An :class:`~physmodel.IPMCParameters` field, ``"omega_n"`` or
+        ``"laws.<quantity>.<attribute>"`` (a temperature-law parameter).
+    lower, upper : float
+        Bounds, ``lower < upper``. [the parameter's SI unit]
+    scale : {"log", "linear"} or None
+        ``"log"`` fits log10 |x| (both bounds of one sign, not zero); default ``"log"`` when
+        ``lower > 0`` else ``"linear"``.
+    initial : float or None
+        Start value within the bounds; default the base value in :func:`~physmodel.calibrate`,
+        else the geometric (log) or arithmetic (linear) mid-point. [the parameter's SI unit]
     """
 
     name: str
@@ -65,15 +75,42 @@ class FreeParameter:
     # scaled coordinate ---------------------------------------------------------------------
     @property
     def sign(self) -> float:
+        """-1 for a log-scaled parameter with negative bounds, else +1. [-]"""
         return -1.0 if self.upper < 0 else 1.0
 
     def to_z(self, x):
+        """The fitted coordinate of physical values: log10 |x| (log scale) or the position in the
+        bounds, 0 to 1 (linear scale).
+
+        Parameters
+        ----------
+        x : float or array_like
+            Values. [the parameter's SI unit]
+
+        Returns
+        -------
+        ndarray
+            The coordinate z. [-]
+        """
         x = np.asarray(x, dtype=float)
         if self.scale == "log":
             return np.log10(np.abs(x))
         return (x - self.lower) / (self.upper - self.lower)
 
     def from_z(self, z):
+        """Physical values of the fitted coordinate (the inverse of :meth:`to_z`).
+
+        Parameters
+        ----------
+        z : float or array_like
+            Coordinate; log-scale exponents are clipped to ±300 so that the interval of an
+            undetermined parameter stays finite. [-]
+
+        Returns
+        -------
+        ndarray
+            Values. [the parameter's SI unit]
+        """
         z = np.asarray(z, dtype=float)
         if self.scale == "log":
             # clipped so that the interval of an undetermined parameter (huge se(z)) stays finite
@@ -82,6 +119,7 @@ class FreeParameter:
 
     @property
     def z_bounds(self) -> tuple[float, float]:
+        """The bounds in the fitted coordinate, (low, high). [-]"""
         a, b = float(self.to_z(self.lower)), float(self.to_z(self.upper))
         return (min(a, b), max(a, b))
 
@@ -91,6 +129,13 @@ class FreeParameter:
         return float(self.from_z(0.5 * (lo + hi)))
 
     def with_initial(self, value: float) -> "FreeParameter":
+        """A copy starting at ``value``.
+
+        Parameters
+        ----------
+        value : float
+            Start value within the bounds. [the parameter's SI unit]
+        """
         return replace(self, initial=float(value))
 
 # =============================================================================== results
@@ -138,11 +183,55 @@ class SensitivityProbe:
 class CalibrationResult:
     """Outcome of a calibration.  Physical units throughout; intervals are 95 %.
 
-    ``values``: fitted (or held) value of every free parameter; ``stderr``: standard error
-    (delta method for log parameters; NaN when held); ``ci_lower``/``ci_upper``: 95 % interval
-    (NaN when held); ``correlation``: (n, n) in the order of ``names`` (NaN rows for held ones);
-    ``cost`` = ½Σr², ``expected_cost`` = F − nθ/2, ``cost_std`` = sqrt(F − nθ/2);
-    ``held``: undetermined parameters kept at their start value.
+    Parameters
+    ----------
+    names : list of str
+        The free parameters, in fit order.
+    values : dict
+        Fitted (or held) value of every free parameter. [each parameter's SI unit]
+    parameters : IPMCParameters or None
+        The base set with the determined values (held ones at their base value).
+    stderr : dict
+        Standard error (delta method for log parameters; NaN when held). [each parameter's SI unit]
+    ci_lower, ci_upper : dict
+        95 % interval (NaN when held). [each parameter's SI unit]
+    correlation : ndarray
+        (n, n) correlation in the order of ``names`` (NaN rows for held ones). [-]
+    cost : float
+        ½ Σ r² of the weighted residuals at the optimum. [-]
+    expected_cost : float
+        What the noise alone explains, F − nθ/2 (F residual terms, nθ fitted parameters). [-]
+    cost_std : float
+        Its standard deviation, sqrt(F − nθ/2); a cost many of these above ``expected_cost``
+        means the model does not fit the data. [-]
+    n_lines : int
+        Frequency lines in the data.
+    n_evaluations, n_model_calls : int
+        Model evaluations (parameter sets) and the vectorised calls that made them.
+    converged : bool
+        Whether the best start converged.
+    message : str
+        The optimiser's message for the best start.
+    starts : list of StartRecord
+        Every start: where it began, where it ended.
+    identifiability : dict
+        {name: Identifiability}: whether the data determine the parameter, and why not.
+    noise_estimated : bool
+        True when the data had no per-line σ and the noise level was estimated from the residuals.
+    noise_scale : float
+        The estimated noise scale (1 when the sweep's σ were used). [-]
+    held : list of str
+        Undetermined parameters kept at their start value.
+    free : list of FreeParameter
+        The free parameters as fitted (bounds, scale).
+    band_hz : tuple of float
+        (lowest, highest) frequency of the data. [Hz]
+    temperatures_c : list of float
+        Temperatures of the data. [°C]
+    elapsed_s : float
+        Wall time of the calibration. [s]
+    metadata : dict
+        Provenance (data source, base set, settings).
     """
 
     names: list
@@ -173,9 +262,12 @@ class CalibrationResult:
 
     @property
     def determined(self) -> list:
+        """The free parameters the data determine (``names`` without ``held``)."""
         return [n for n in self.names if n not in self.held]
 
     def summary(self) -> str:
+        """A plain-text report: convergence, data, cost against its expectation, and each
+        parameter with its 95 % interval or the reason it was held."""
         lines = [
             f"calibration: {'converged' if self.converged else 'NOT CONVERGED'} ({self.message})",
             f"  data: {self.n_lines} lines, {len(self.temperatures_c)} temperature(s), band "
@@ -197,6 +289,8 @@ class CalibrationResult:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
+        """The record as JSON-ready data (format ``ipmc-calibration`` 1; non-finite numbers as
+        None)."""
         def num(v):
             v = float(v)
             return v if math.isfinite(v) else None
@@ -231,7 +325,18 @@ class CalibrationResult:
 
     def save(self, path) -> Path:
         """Atomic JSON: a parameter-set payload (readable by :func:`physmodel.load_parameter_set`)
-        when ``parameters`` is known, plus the calibration record under ``"calibration"``."""
+        when ``parameters`` is known, plus the calibration record under ``"calibration"``.
+
+        Parameters
+        ----------
+        path : str or Path
+            The JSON file to write.
+
+        Returns
+        -------
+        Path
+            The file written.
+        """
         from ..parameter_sets import _FORMAT, _VERSION, _finite_json
 
         payload: dict = {}
