@@ -180,6 +180,11 @@ def _as_rendered(entry: Entry, text: str) -> str:
 
 def invalid_rest() -> dict[str, str]:
     """{rendered name: first docutils problem} for docstrings that are not valid reST."""
+    return dict(_invalid_rest())
+
+
+@lru_cache(maxsize=None)
+def _invalid_rest() -> tuple:
     from docutils.core import publish_doctree
     from docutils.utils import SystemMessage
 
@@ -208,7 +213,7 @@ def invalid_rest() -> dict[str, str]:
             msgs = [m for m in tree.findall(nodes.system_message) if m["level"] >= 2]
             if msgs:
                 out[e.name] = msgs[0].astext().splitlines()[0]
-    return out
+    return tuple(out.items())
 
 
 # --------------------------------------------------------------------------- cross-references
