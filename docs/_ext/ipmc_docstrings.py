@@ -99,12 +99,21 @@ def undocumented(app, what, name, obj, options, lines):
     debt is a warning naming it."""
     if what not in _CHECKED_WHAT or any(ln.strip() for ln in lines):
         return
-    if name in docstring_policy.KNOWN_UNDOCUMENTED:
-        return
+    if name in docstring_policy.KNOWN_UNDOCUMENTED or name in _found(app):
+        return                     # autosummary's table and the object's page both ask: warn once
     _found(app).add(name)
     logger.warning("undocumented public %s %s: write its docstring (numpydoc), or list it as debt with "
                    "'python docs/_ext/docstring_policy.py --update'", what, name,
-                   type="ipmc", subtype="undocumented")
+                   type="ipmc", subtype="undocumented", location=_source(obj))
+
+
+def _source(obj) -> str | None:
+    """``file:line`` of an object's definition (for the warning), if Python knows it."""
+    target = obj.fget if isinstance(obj, property) else getattr(obj, "__func__", obj)
+    try:
+        return f"{inspect.getsourcefile(target)}:{inspect.getsourcelines(target)[1]}"
+    except (TypeError, OSError):
+        return None
 
 
 def _found(app) -> set:
