@@ -304,13 +304,32 @@ def unresolved_references(verbatim=None) -> dict[str, list[str]]:
         elif e.what in ("class", "exception"):
             cls = e.name
         module = e.name if e.what == "module" else e.module
-        for m in ROLE.finditer(doc):
-            role, target = "py:" + m.group(1), m.group(2).strip(".")
+        for role, target in _references(doc, e.what):
             if not target or docstring_policy.is_external(target, role):
                 continue
             if resolve(target, module, cls) is None:
                 out.setdefault(target, []).append(e.name)
     return out
+
+
+def _references(doc: str, what: str):
+    """(role, target) of the Python cross-references in a docstring: explicit roles and the
+    entries of a numpydoc ``See Also`` section (which numpydoc turns into references)."""
+    for m in ROLE.finditer(doc):
+        yield "py:" + m.group(1), m.group(2).strip(".")
+    if what == "module" or "See Also" not in doc:
+        return
+    from numpydoc import docscrape
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            parsed = docscrape.NumpyDocString(doc)
+        except Exception:
+            return
+    for funcs, _desc in parsed["See Also"]:
+        for name, role in funcs:
+            yield f"py:{role or 'obj'}", name.strip(".~")
 
 
 # ------------------------------------------------------------- the test's in-depth check
