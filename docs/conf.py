@@ -25,8 +25,9 @@ import docstring_policy  # noqa: E402  (docs/_ext)
 project = "ipmc"
 author = "the ipmc developers"
 copyright = "the ipmc developers (BSD-3-Clause)"
-release = "0.1.0"
-version = "0.1"
+from physmodel import __version__ as release  # noqa: E402  (one version, in the package)
+
+version = ".".join(release.split(".")[:2])
 
 # -- extensions ----------------------------------------------------------------------------
 extensions = [
@@ -91,7 +92,7 @@ sphinx_gallery_conf = {
 
 # -- HTML ----------------------------------------------------------------------------------
 html_theme = "pydata_sphinx_theme"
-html_title = "ipmc 0.1.0"
+html_title = f"ipmc {release}"
 html_static_path: list[str] = []
 html_theme_options = {
     "navigation_with_keys": False,

@@ -1,4 +1,5 @@
-"""The documentation's gallery examples run in the suite, not only in the docs build.
+"""The documentation's gallery examples run in the suite, not only in the docs build (and the
+citation file names the package's version).
 
 Each ``docs/examples/plot_*.py`` runs in a fresh interpreter with this checkout first on the
 path, the Agg backend and warnings as errors (the suite's rule), and must exit 0.  A new example
@@ -32,3 +33,15 @@ def test_example_runs(script, tmp_path):
     proc = subprocess.run([sys.executable, "-W", "error", str(script)], cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=TIMEOUT_S)
     assert proc.returncode == 0, f"{script.name} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-5000:]}"
+
+
+def test_citation_names_the_package_version():
+    """CITATION.cff is kept by hand; its version must be the one the package reports."""
+    import re
+
+    import physmodel
+
+    text = (ROOT / "CITATION.cff").read_text(encoding="utf-8")
+    found = re.findall(r"^version:\s*\"?([^\s\"]+)\"?\s*$", text, flags=re.M)
+    assert found == [physmodel.__version__], (found, physmodel.__version__)
+
