@@ -2,7 +2,7 @@
 
 Run ``python3 -m physmodel.parameter_sets.derivation`` (a few seconds) to re-derive the numbers stored in
 :mod:`physmodel.parameter_sets`; nothing here runs at import.  The trend metrics below are also
-what :mod:`scenarios.validate` and the tests use to check the stored sets against the seeds.
+what :mod:`scenarios.validation` and the tests use to check the stored sets against the seeds.
 
 Seed 000 sensor (18 × 6.5 × 0.21 mm Nafion-117)
     *Data.*  The only printed response is the 35 °C fourth-order model (Sec. IV-A); it is treated
@@ -26,12 +26,18 @@ Seed 001 actuator (45 mm free length × 11 × 0.3 mm, in water)
     *Data.*  The zpk schedules' numbers are not in the text; what is printed is the trend: the
     largest magnitude difference between 19 and 55 °C is about 7 dB near 3 Hz, 19 °C larger, and
     the resonance moves down with T.
-    *Fit.*  Only ``trends[1]`` of the published claims is used.  Two equations — D(3 Hz) = 7 dB and dD/dln f (3 Hz) = 0 with D = |M(19 °C)| − |M(55 °C)| in dB
-    — in two unknowns: the modulus at ``T_ref`` (sets the first mode) and the slope of a log-linear C⁻
+    *Fit.*  Only ``trends[1]`` of the published claims is used.  Two equations — D(3 Hz) = 7 dB and
+    dD/dln f (3 Hz) = 0 with D = |M(19 °C)| − |M(55 °C)| in dB — in two unknowns: the modulus at ``T_ref`` (sets the first mode) and the slope of a log-linear C⁻
     law (the only law-able knob that lowers the actuation gain with T; with default laws the gain near
     2 Hz rises with T because E falls and d rises).  The modulus keeps the physics.md default slope
     −0.75 %/K (DuPont), which moves the resonance down.  These are feature targets, not a response,
     so they are solved with ``scipy.optimize.least_squares`` directly (:func:`solve_actuator_trend`).
+    The resonance shift (from the modulus-law input), the order claims, the right-half-plane zero
+    pair, the 35/45 °C hold-out and the 45 °C tracking comparison are predictions.
+
+Which claims each set was calibrated on is recorded in the ``CALIBRATION`` table of its module
+(:mod:`~physmodel.parameter_sets.seed000`, :mod:`~physmodel.parameter_sets.seed001`); ``ipmc validate``
+gives every other row that uses the set the basis "independent" and these the basis "calibrated".
 """
 
 from __future__ import annotations
@@ -149,7 +155,7 @@ class SensorTrends:
 
     def monotone(self) -> dict:
         """Which published directions hold strictly at every step of rising temperature."""
-        d = lambda v: np.diff(np.asarray(v))  # noqa: E731
+        d = lambda v: np.diff(np.asarray(v))
         return {"cutoff_decreases": bool(np.all(d(self.cutoff_hz) < 0)),
                 "hf_gain_decreases": bool(np.all(d(self.hf_gain_db) < 0)),
                 "phase_lag_increases": bool(np.all(d(self.phase_lag_deg) > 0))}

@@ -7,8 +7,24 @@ claim checks (:mod:`~scenarios.validation.seed000`, :mod:`~scenarios.validation.
 """
 
 from . import seed000, seed001, seed002  # noqa: F401  (register their checks)
-from .framework import (BASES, CHECKS, DEFAULT_PUBLISHED, EXTRA_ROWS, KINDS, META_KEYS, STATUSES, Claim, ClaimRow,
-                        Context, Outcome, ValidationReport, claim_location, load_published, published_claims, validate)
+from .framework import (
+    BASES,
+    CHECKS,
+    DEFAULT_PUBLISHED,
+    EXTRA_ROWS,
+    KINDS,
+    META_KEYS,
+    STATUSES,
+    Claim,
+    ClaimRow,
+    Context,
+    Outcome,
+    ValidationReport,
+    claim_location,
+    load_published,
+    published_claims,
+    validate,
+)
 
 __all__ = ["BASES", "CHECKS", "DEFAULT_PUBLISHED", "EXTRA_ROWS", "KINDS", "META_KEYS", "STATUSES", "Claim", "ClaimRow",
            "Context", "Outcome", "ValidationReport", "claim_location", "load_published", "published_claims", "validate"]

@@ -37,10 +37,10 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Callable
 
 from physmodel.parameter_sets import published as _published_module
 
@@ -131,15 +131,15 @@ class ValidationReport:
         return json.dumps(self.to_dict(), indent=2, ensure_ascii=False, allow_nan=False)
 
     def to_markdown(self) -> str:
-        esc = lambda s: str(s).replace("|", "\\|").replace("\n", " ")  # noqa: E731
+        esc = lambda s: str(s).replace("|", "\\|").replace("\n", " ")
         cb = self.counts_by_basis
         lines = ["# Validation against the seed papers", "",
                  f"**{self.headline()}**" + (" (quick mode: fewer temperatures)" if self.quick else "") + ".",
                  f"Claims from `{self.published}`, {self.elapsed_s:.1f} s.", "",
-                 "Only `reproduced` rows of basis `independent` are evidence that the physics reproduces a paper: "
-                 "`calibrated` rows check that a fit hit its target, `input` rows re-read model inputs, `paper` rows "
-                 "check the paper against itself, `metadata` rows are bookkeeping.  `not-reproduced` is a finding "
-                 "about the physics (the reason says why); `fail` is a regression.", "",
+                 ("Only `reproduced` rows of basis `independent` are evidence that the physics reproduces a paper: "
+                  "`calibrated` rows check that a fit hit its target, `input` rows re-read model inputs, `paper` rows "
+                  "check the paper against itself, `metadata` rows are bookkeeping.  `not-reproduced` is a finding "
+                  "about the physics (the reason says why); `fail` is a regression."), "",
                  "| status \\ basis | " + " | ".join(BASES) + " | total |", "|---|" + "---|" * (len(BASES) + 1)]
         for s in STATUSES:
             lines.append(f"| {s} | " + " | ".join(str(cb[s][b]) for b in BASES) + f" | {sum(cb[s].values())} |")
@@ -276,14 +276,14 @@ def _basis(ctx, claim_id: str, claim: Claim) -> tuple[str, str]:
 
 def _judge(ctx, claim_id, source, location, printed, value, claim: Claim) -> ClaimRow:
     basis, note = _basis(ctx, claim_id, claim)
-    row = lambda ours, crit, status, reason: ClaimRow(claim_id, source, location, printed, ours, crit,  # noqa: E731
+    row = lambda ours, crit, status, reason: ClaimRow(claim_id, source, location, printed, ours, crit,
                                                       status, basis, reason, note)
     if claim.expect.startswith("not-checkable"):
         ours = claim.check(ctx, value).ours if claim.check is not None else "-"
         return row(ours, "-", "not-checkable", claim.expect.split(":", 1)[1].strip())
     try:
         out = claim.check(ctx, value)
-    except Exception as exc:  # a broken check is reported as a failing row, never skipped
+    except Exception as exc:  # noqa: BLE001 - a broken check is reported as a failing row, never skipped
         return row(f"error: {type(exc).__name__}: {exc}", "-", "fail", f"the check raised {type(exc).__name__}: {exc}")
     if out.ok:
         return row(out.ours, out.criterion, "reproduced", out.note)

@@ -112,7 +112,7 @@ def c_fit_temps(ctx, value):
 def c_order(ctx, value):
     """The order the physics needs: the lowest n/n reaching 5 % (and 1 %) relative RMS error."""
     err = {n: max(r.per_temperature[0].relative_rms_error for r in fits.values()) for n, fits in _fits(ctx).items()}
-    lowest = lambda tol: min((n for n in err if err[n] <= tol), default=None)  # noqa: E731
+    lowest = lambda tol: min((n for n in err if err[n] <= tol), default=None)
     return Outcome("worst relative RMS error of n/n fits to the physics (10-100 Hz): "
                    + ", ".join(f"{n}/{n} {e:.2g}" for n, e in err.items())
                    + f"; lowest order within 5 %: {lowest(0.05)}/{lowest(0.05)}, within 1 %: {lowest(0.01)}/{lowest(0.01)}",

@@ -19,15 +19,21 @@ import tomllib
 import numpy as np
 import pytest
 
-from physmodel import ActuatorModel, SensorModel, get_parameter_set, load_parameter_set, save_parameter_set
+from physmodel import (
+    ActuatorModel,
+    SensorModel,
+    get_parameter_set,
+    load_parameter_set,
+    save_parameter_set,
+)
+from physmodel.errors import IPMCError
+from physmodel.parameter_sets import derivation as sc
+from physmodel.parameter_sets.published import PUBLISHED_FILE
 from physmodel.parameter_sets.seed000 import CALIBRATION as CAL000
 from physmodel.parameter_sets.seed000 import SEED000_SENSOR_CAL
 from physmodel.parameter_sets.seed001 import CALIBRATION as CAL001
 from physmodel.parameter_sets.seed001 import SEED001_ACTUATOR_CAL
-from physmodel.errors import IPMCError
 from physmodel.temperature import LogLinear, TemperatureLaws
-from physmodel.parameter_sets import derivation as sc
-from physmodel.parameter_sets.published import PUBLISHED_FILE
 
 
 @pytest.fixture(scope="module")
@@ -91,7 +97,7 @@ def test_sensor_laws_are_chosen_on_the_declared_trends_only():
     """The stored slopes are what the grid search picks from the two declared directions; the
     phase-lag direction is not used (the validation table shows it as a held-out prediction)."""
     sen = get_parameter_set("seed000_sensor")
-    c, e, tr = sc.choose_sensor_laws(sen)
+    c, e, _ = sc.choose_sensor_laws(sen)
     assert (c, e) == (SEED000_SENSOR_CAL["C_minus_slope"], SEED000_SENSOR_CAL["E_slope"])
     assert sc.SENSOR_CALIBRATION_TRENDS == ("cutoff_decreases", "hf_gain_decreases")
     assert sorted(k for k in CAL000["seed000_sensor"] if "trends" in k) == [
@@ -105,7 +111,7 @@ def test_sensor_laws_are_chosen_on_the_declared_trends_only():
 
 
 def test_actuator_trend_solution_reproduces_stored_values():
-    p, sol = sc.solve_actuator_trend()
+    p, _ = sc.solve_actuator_trend()
     assert p.E == pytest.approx(SEED001_ACTUATOR_CAL["E"], rel=1e-4)
     assert p.laws.C_minus.slope == pytest.approx(SEED001_ACTUATOR_CAL["C_minus_slope"], rel=1e-3)
     assert list(CAL001["seed001_actuator"]) == ["actuator_seed001.trends[1]"]
