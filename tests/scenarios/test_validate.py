@@ -12,7 +12,7 @@ import json
 import pytest
 
 from physmodel.parameter_sets import derivation, seed000, seed001
-from scenarios import validate as V
+from scenarios import validation as V
 from scenarios.cli import main
 
 
