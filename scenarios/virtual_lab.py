@@ -19,10 +19,17 @@ Two known instrument factors are divided out of the estimate, each exactly:
 * the chain's transimpedance ``TransimpedanceChain.response(jω)`` [V/A] (a calibrated instrument);
 * the simulation's hold: a first-order-hold (linearly interpolated) input seen through its samples
   carries the factor ``sinc²(f/fs)`` (the triangle kernel's transform); a real record of a
-  continuous input does not, so ``hold_correction=True`` (default) removes it.  What stays is the
+  continuous input does not, so ``hold_correction=True`` (default) removes it (twice when the
+  chain has an amplifier pole: timesim runs that pole on the current's samples, again through a
+  first-order hold).  What stays is the
   aliasing of the hold's images, ``Σ_{n≠0} P(f − n fs) sinc²(f/fs − n) / P(f)``, made small by
   simulating on a grid ``oversample`` times finer than the DAQ's (see :func:`simulate_records`;
   ``tests/scenarios/test_virtual_lab.py`` checks it against the physics).
+
+The per-line σ of a multisine line is an estimate with ν = 2(P − 1) degrees of freedom for P
+measured periods (Student t; :mod:`physmodel.estimation.frf`); a calibration that weights by it as
+if it were known states intervals about sqrt(ν/(ν − 2)) too narrow — measure more periods when the
+intervals matter.
 
 Not in σ (stated, measured in ``tests/benchmarks/bench_virtual_lab.py``): the realisation error
 (≤ ``tol``, default 1e-4 relative), the transient left after ``transient_periods`` (choose them
@@ -316,8 +323,12 @@ def virtual_lab(model, excitation, temperatures_c: Sequence[float], measurement:
             notes["chain_divided_out"] = "yes"
         if hold_correction and rec.metadata.get("hold") == "foh":
             fsim = float(rec.metadata.get("simulation_fs_hz", fs))
-            factor *= np.sinc(e.frequency_hz / fsim) ** 2
-            notes["hold_correction"] = f"divided by sinc^2(f/{fsim:g} Hz) of the simulation's first-order hold"
+            # timesim runs the chain's amplifier pole on the current's samples through a second
+            # first-order hold: one more sinc² (a gain-only chain has none)
+            holds = 2 if measurement.chain is not None and measurement.chain.bandwidth_hz is not None else 1
+            factor *= np.sinc(e.frequency_hz / fsim) ** (2 * holds)
+            notes["hold_correction"] = (f"divided by sinc^{2 * holds}(f/{fsim:g} Hz) of the simulation's "
+                                        f"first-order hold{'s' if holds > 1 else ''}")
         out_unit = e.output_units[0]
         if measurement.chain is not None:      # V → A through the chain's V/A
             out_unit = "A"
