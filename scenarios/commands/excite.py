@@ -92,6 +92,24 @@ def _frequencies(args, grid: float | None) -> np.ndarray:
     return f
 
 
+#: Library argument names → the options that set them (error messages name the option).
+OPTIONS = {"frequencies_hz": "--frequencies", "fs_hz": "--fs", "period_s": "--period", "f0_hz": "--f0",
+           "f1_hz": "--f1", "sweep_s": "--sweep-s", "transient_periods": "--transient-periods",
+           "min_measure_s": "--min-measure-s", "settle_s": "--settle-s", "settle_periods": "--settle-periods",
+           "repeats": "--repeats", "amplitude": "--amplitude", "rms": "--rms", "seed": "--seed",
+           "iterations": "--iterations", "periods": "--periods"}
+
+
+def as_options(exc: Exception, options: dict, prefix: str = "") -> CLIError:
+    """``exc`` re-worded with the command-line options in place of the library's argument names."""
+    import re
+
+    text = prefix + str(exc)
+    for name in sorted(options, key=len, reverse=True):
+        text = re.sub(rf"(?<![\w-]){name}(?![\w])", options[name], text)
+    return CLIError(text)
+
+
 def _channel(args) -> tuple[str, str]:
     ch = args.channel or "voltage"
     unit = args.unit or ("mm" if ch == "tip_displacement" else "V")
@@ -99,7 +117,7 @@ def _channel(args) -> tuple[str, str]:
 
 
 def run(args) -> int:
-    from physmodel.data.excitation import chirp, crest_factor, multisine, stepped_sine_plan
+    from physmodel.data.excitation import crest_factor
     from physmodel.data.timerecord import split_column
 
     out = Path(args.out)
@@ -110,6 +128,28 @@ def run(args) -> int:
         split_column(f"{ch}_{unit}")
     except Exception as exc:                  # DataFormatError: name the options
         raise CLIError(f"--channel {ch!r} / --unit {unit!r}: {exc}") from None
+    from physmodel.errors import IPMCError
+
+    try:
+        rec, what = _design(args, ch, unit)
+    except CLIError:
+        raise
+    except IPMCError as exc:
+        raise as_options(exc, OPTIONS) from None
+    u = rec.channels[ch]
+    cf = crest_factor(u)
+    rec.metadata["crest_factor"] = f"{cf:.4f}"
+    rec.save(out)
+    if not args.quiet:
+        print(f"wrote {out}: {what}")
+        print(f"  {u.size} samples at {args.fs:g} Hz; expected duration {float(rec.metadata['expected_duration_s']):g} s; "
+              f"crest factor {cf:.3f} (peak {np.max(np.abs(u)):.4g} {unit}, RMS {np.sqrt(np.mean(u**2)):.4g} {unit})")
+    return EXIT_OK
+
+
+def _design(args, ch: str, unit: str):
+    from physmodel.data.excitation import chirp, multisine, stepped_sine_plan
+
     note = ""
     if args.design == "multisine":
         if args.period is None or not (np.isfinite(args.period) and args.period > 0):
@@ -136,12 +176,4 @@ def run(args) -> int:
         rec = chirp(args.f0, args.f1, args.sweep_s, args.fs, amplitude=args.amplitude, method=args.method,
                     repeats=args.repeats, channel=ch, unit=unit)
         what = f"{args.method} chirp {args.f0:g}-{args.f1:g} Hz, {args.sweep_s:g} s x {args.repeats}"
-    u = rec.channels[ch]
-    cf = crest_factor(u)
-    rec.metadata["crest_factor"] = f"{cf:.4f}"
-    rec.save(out)
-    if not args.quiet:
-        print(f"wrote {out}: {what}")
-        print(f"  {u.size} samples at {args.fs:g} Hz; expected duration {float(rec.metadata['expected_duration_s']):g} s; "
-              f"crest factor {cf:.3f} (peak {np.max(np.abs(u)):.4g} {unit}, RMS {np.sqrt(np.mean(u**2)):.4g} {unit})")
-    return EXIT_OK
+    return rec, what

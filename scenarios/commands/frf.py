@@ -39,8 +39,13 @@ import numpy as np
 from physmodel.errors import IPMCError
 
 from ._common import EXIT_OK, CLIError, _floats
+from .excite import as_options
 
 SUFFIXES = (".csv", ".npz", ".mat")
+#: Estimator argument names → the options that set them (error messages name the option).
+OPTIONS = {"frequencies_hz": "--frequencies", "nperseg": "--nperseg", "noverlap": "--noverlap", "window": "--window",
+           "discard_s": "--discard-s", "settle_s": "--settle-s", "settle_periods": "--settle-periods",
+           "periods": "--periods", "max_std_db": "--max-std-db", "band_hz": "--band", "min_coherence": "--min-coherence"}
 
 
 def add_parser(sub):
@@ -186,7 +191,7 @@ def _estimate(rec, path: str, args, kw: dict):
     try:
         return estimate_record(rec, args.input, args.output, **kw)
     except IPMCError as exc:
-        raise CLIError(f"{path}: {exc}") from None
+        raise as_options(exc, OPTIONS, f"{path}: ") from None
 
 
 def _out_paths(out: Path, outputs: list[str]) -> list[Path]:
@@ -239,7 +244,7 @@ def run(args) -> int:
             try:
                 sw = c.to_sweep(T, **keep, metadata={"record": Path(src).name})
             except IPMCError as exc:
-                raise CLIError(f"{src} ({o}): {exc}") from None
+                raise as_options(exc, OPTIONS, f"{src} ({o}): ") from None
             sweeps.append(sw)
             kept.append((c, T, np.isin(c.frequency_hz, sw.frequency_hz)))
             lines.append(f"  {Path(src).name} at {T:g} °C, {sw.output_name}/{sw.input_name}: {sw.frequency_hz.size} "
