@@ -346,4 +346,87 @@ def virtual_lab(model, excitation, temperatures_c: Sequence[float], measurement:
                             tuple(recs) if keep_records else (), timings, float(recs[0].t[-1] - recs[0].t[0] + 1 / fs))
 
 
-__all__ = ["Measurement", "VirtualLabResult", "simulate_records", "estimate", "virtual_lab"]
+
+
+# ---------------------------------------------------------------------------- scenario tables
+#: Keys of a scenario's ``[sweep]`` table read when ``source = "virtual_lab"`` (with defaults).
+SWEEP_KEYS = {"source": "virtual_lab", "temperatures_c": None, "fmin_hz": 0.1, "fmax_hz": 100.0, "points": 40,
+              "excitation": "multisine", "fs_hz": None, "period_s": None, "periods": 8, "transient_periods": 2,
+              "rms": 1.0, "amplitude": 1.0, "phases": "schroeder", "settle_s": 0.0, "settle_periods": 0.0,
+              "min_measure_s": 0.0, "oversample": 16, "estimator": "h1", "max_std_db": None,
+              "held_out_c": None, "plot_temperatures_c": None}
+#: Keys of the ``[noise]`` table for a virtual lab (SI units; ``kind = "time"``).
+NOISE_KEYS = {"kind": "time", "output_noise_rms": 0.0, "input_noise_rms": 0.0, "output_adc_step": 0.0,
+              "input_adc_step": 0.0, "chain": None, "chain_bandwidth_hz": None, "seed": None}
+
+
+def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") -> VirtualLabResult:
+    """Run the virtual lab described by a scenario's ``[sweep]`` and ``[noise]`` tables.
+
+    ``[sweep]``: ``temperatures_c`` (required), ``fmin_hz``, ``fmax_hz``, ``points`` (log-spaced
+    lines), ``excitation`` = "multisine" (``fs_hz``, ``period_s``, ``periods``,
+    ``transient_periods``, ``rms``, ``phases``) or "stepped" (``fs_hz``, ``amplitude``, ``periods``,
+    ``settle_s``, ``settle_periods``, ``min_measure_s``), ``oversample``, ``estimator``,
+    ``max_std_db``; amplitudes in V (actuator) or mm (sensor).  ``[noise]``: ``kind = "time"``,
+    ``output_noise_rms``, ``input_noise_rms``, ``output_adc_step``, ``input_adc_step`` (SI of the
+    recorded signal), ``chain = [R1, R2, R3]`` [Ω] and ``chain_bandwidth_hz`` (sensor), ``seed``.
+    Unknown keys and wrong types raise :class:`IPMCError` naming ``[table] key``.
+    """
+    from physmodel.data.excitation import multisine, stepped_sine_plan
+
+    sweep, noise = dict(sweep), dict(noise or {})
+    if sweep.get("source", "virtual_lab") != "virtual_lab":
+        raise IPMCError(f"{where}[sweep] source = {sweep['source']!r}; this reader handles 'virtual_lab'")
+    if noise.get("kind", "time") != "time":
+        raise IPMCError(f"{where}[noise] kind = {noise['kind']!r}: a virtual lab adds noise to the time records; "
+                        f"use kind = \"time\" with output_noise_rms, input_noise_rms, output_adc_step, ...")
+    for table, got, known in (("sweep", sweep, SWEEP_KEYS), ("noise", noise, NOISE_KEYS)):
+        bad = sorted(set(got) - set(known))
+        if bad:
+            raise IPMCError(f"{where}[{table}] {bad[0]}: not a virtual-lab key; expected one of {sorted(known)}")
+    cfg = {**SWEEP_KEYS, **sweep}
+    nz = {**NOISE_KEYS, **noise}
+    kind = _kind(model)
+    if cfg["temperatures_c"] is None:
+        raise IPMCError(f"{where}[sweep] temperatures_c: required (a list of bath temperatures [°C])")
+    if cfg["fs_hz"] is None:
+        raise IPMCError(f"{where}[sweep] fs_hz: required (the DAQ's sample rate [Hz])")
+    lo, hi, n = cfg["fmin_hz"], cfg["fmax_hz"], cfg["points"]
+    if not (isinstance(n, int) and n >= 1 and 0 < lo <= hi):
+        raise IPMCError(f"{where}[sweep] fmin_hz/fmax_hz/points: need 0 < fmin_hz <= fmax_hz and points >= 1, "
+                        f"got {lo!r}, {hi!r}, {n!r}")
+    ch, unit = ("voltage", "V") if kind == "actuator" else ("tip_displacement", "mm")
+    chain = None
+    if nz["chain"] is not None:
+        from physmodel.sensor import TransimpedanceChain
+
+        r = nz["chain"]
+        if not (isinstance(r, (list, tuple)) and len(r) == 3):
+            raise IPMCError(f"{where}[noise] chain: expected [R1, R2, R3] in ohm, got {r!r}")
+        chain = TransimpedanceChain(*map(float, r), bandwidth_hz=nz["chain_bandwidth_hz"])
+    try:
+        meas = Measurement(float(nz["output_noise_rms"]), float(nz["input_noise_rms"]), float(nz["output_adc_step"]),
+                           float(nz["input_adc_step"]), chain, nz["seed"])
+        if cfg["excitation"] == "multisine":
+            period = cfg["period_s"] if cfg["period_s"] is not None else max(10.0, 1.0 / lo)
+            f = np.unique(np.maximum(np.round(np.geomspace(lo, hi, n) * period), 1)) / period
+            exc = multisine(f, cfg["fs_hz"], period, rms=cfg["rms"], phases=cfg["phases"], channel=ch, unit=unit)
+            kw = dict(periods=cfg["periods"], transient_periods=cfg["transient_periods"])
+        elif cfg["excitation"] == "stepped":
+            exc = stepped_sine_plan(np.geomspace(lo, hi, n), cfg["fs_hz"], amplitude=cfg["amplitude"],
+                                    periods=cfg["periods"], min_measure_s=cfg["min_measure_s"],
+                                    settle_s=cfg["settle_s"], settle_periods=cfg["settle_periods"], channel=ch,
+                                    unit=unit)
+            kw = {}
+        else:
+            raise IPMCError(f"[sweep] excitation = {cfg['excitation']!r}; expected 'multisine' or 'stepped'")
+        return virtual_lab(model, exc, cfg["temperatures_c"], meas, estimator=cfg["estimator"],
+                           max_std_db=cfg["max_std_db"], oversample=cfg["oversample"], **kw)
+    except IPMCError as exc_:
+        raise IPMCError(f"{where}[sweep]/[noise] virtual lab: {exc_}") from None
+    except (TypeError, ValueError) as exc_:
+        raise IPMCError(f"{where}[sweep]/[noise] virtual lab: a value has the wrong type ({exc_})") from None
+
+
+__all__ = ["Measurement", "VirtualLabResult", "simulate_records", "estimate", "virtual_lab", "from_config",
+           "SWEEP_KEYS", "NOISE_KEYS"]

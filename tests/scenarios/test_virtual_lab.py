@@ -136,10 +136,12 @@ def test_calibration_on_the_virtual_lab_sweep_covers_the_simulated_truth():
     set and sees only the sweeps.  Over 30 noise draws its 95 % intervals must hold the simulated
     values as often as they can: the per-line σ are estimates with ν = 2(P − 1) degrees of freedom
     (see test_sigma_of_the_noisy_virtual_lab_is_calibrated) that calibrate treats as known, so the
-    actual scatter of an estimate exceeds its stated standard error by about sqrt(ν/(ν − 2)) and the
-    nominal 95 % interval covers about P(|Z| < 1.96·sqrt((ν − 2)/ν)) = 0.93 for P = 8.  Asserted:
-    coverage within 3 binomial sd of that, no bias beyond 4 sd of the mean standardised error, and
-    the Student-t cost."""
+    actual scatter of an estimate exceeds its stated standard error: by sqrt(ν/(ν − 2)) when one
+    line carries the information (z ~ t_ν), by sqrt(ν/(ν − 4)) when many comparable lines do
+    (E z² = E[c²]/E[c], c = σ²/σ̂² ~ ν/χ²_ν).  The nominal 95 % interval then covers between
+    P(|Z| < 1.96·sqrt((ν − 4)/ν)) = 0.90 and 0.93 for P = 8.  Asserted: coverage no more than 3
+    binomial sd below the lower value, no bias beyond 4 sd of the mean standardised error, and the
+    Student-t cost."""
     from physmodel.estimation.calibration import calibrate
     from scipy import stats
 
@@ -165,10 +167,10 @@ def test_calibration_on_the_virtual_lab_sweep_covers_the_simulated_truth():
         cost_t.append((res.cost, 0.5 * (n_terms - len(names)) * nu / (nu - 2),
                        0.25 * n_terms * 2 * nu**2 * (nu - 1) / ((nu - 2) ** 2 * (nu - 4))))
     inside, z = np.array(inside), np.array(z)
-    expect = 2 * stats.norm.cdf(1.96 * math.sqrt((nu - 2) / nu)) - 1
+    expect = 2 * stats.norm.cdf(1.96 * math.sqrt((nu - 4) / nu)) - 1
     band = 3 * math.sqrt(expect * (1 - expect) / draws)
     assert np.all(inside.mean(axis=0) >= expect - band), (inside.mean(axis=0), expect, band)
-    assert np.all(np.abs(z.mean(axis=0)) < 4 * math.sqrt(nu / (nu - 2) / draws)), z.mean(axis=0)
+    assert np.all(np.abs(z.mean(axis=0)) < 4 * math.sqrt(nu / (nu - 4) / draws)), z.mean(axis=0)
     c = np.array(cost_t)
     assert abs(c[:, 0].mean() - c[:, 1].mean()) < 4 * math.sqrt(c[:, 2].mean() / draws), c.mean(axis=0)
 
@@ -197,3 +199,27 @@ def test_measurement_validation():
         Measurement(output_adc_step=-1.0)
     with pytest.raises(IPMCError, match="model"):
         virtual_lab(object(), multisine([1.0], 100.0, 1.0), [25.0], periods=2)
+
+
+# ------------------------------------------------------------------------------------- scenario tables
+def test_from_config_reads_the_scenario_tables_and_names_bad_keys():
+    from scenarios.virtual_lab import from_config
+
+    m = ActuatorModel(get_parameter_set("seed001_actuator"))
+    sweep = {"source": "virtual_lab", "temperatures_c": [19.0, 55.0], "fmin_hz": 0.2, "fmax_hz": 9.0, "points": 12,
+             "fs_hz": 100.0, "period_s": 5.0, "periods": 3, "transient_periods": 2, "oversample": 2,
+             "held_out_c": [], "plot_temperatures_c": [19.0]}
+    noise = {"kind": "time", "output_noise_rms": 20e-6, "output_adc_step": 1.5e-7, "seed": 3}
+    r = from_config(m, sweep, noise)
+    np.testing.assert_array_equal(r.sweep.temperatures(), [19.0, 55.0])
+    lines = np.unique(np.round(np.geomspace(0.2, 9.0, 12) * 5.0)) / 5.0
+    np.testing.assert_allclose(r.sweep.select(19.0).frequency_hz, lines)
+    assert r.sweep.metadata["output_noise_rms"] == "2e-05"
+    with pytest.raises(IPMCError, match=r"\[sweep\] fmax: not a virtual-lab key"):
+        from_config(m, {**sweep, "fmax": 3.0}, noise)
+    with pytest.raises(IPMCError, match=r"\[noise\] kind = 'magphase'"):
+        from_config(m, sweep, {"kind": "magphase", "sigma_db": 0.2})
+    with pytest.raises(IPMCError, match=r"\[sweep\] fs_hz: required"):
+        from_config(m, {k: v for k, v in sweep.items() if k != "fs_hz"}, noise)
+    with pytest.raises(IPMCError, match="seed"):
+        from_config(m, sweep, {"output_noise_rms": 1e-6})
