@@ -46,8 +46,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import numpy as np
 
@@ -411,7 +411,7 @@ def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") 
             period = cfg["period_s"] if cfg["period_s"] is not None else max(10.0, 1.0 / lo)
             f = np.unique(np.maximum(np.round(np.geomspace(lo, hi, n) * period), 1)) / period
             exc = multisine(f, cfg["fs_hz"], period, rms=cfg["rms"], phases=cfg["phases"], channel=ch, unit=unit)
-            kw = dict(periods=cfg["periods"], transient_periods=cfg["transient_periods"])
+            kw = {"periods": cfg["periods"], "transient_periods": cfg["transient_periods"]}
         elif cfg["excitation"] == "stepped":
             exc = stepped_sine_plan(np.geomspace(lo, hi, n), cfg["fs_hz"], amplitude=cfg["amplitude"],
                                     periods=cfg["periods"], min_measure_s=cfg["min_measure_s"],
@@ -428,5 +428,13 @@ def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") 
         raise IPMCError(f"{where}[sweep]/[noise] virtual lab: a value has the wrong type ({exc_})") from None
 
 
-__all__ = ["Measurement", "VirtualLabResult", "simulate_records", "estimate", "virtual_lab", "from_config",
-           "SWEEP_KEYS", "NOISE_KEYS"]
+__all__ = [
+    "NOISE_KEYS",
+    "SWEEP_KEYS",
+    "Measurement",
+    "VirtualLabResult",
+    "estimate",
+    "from_config",
+    "simulate_records",
+    "virtual_lab",
+]

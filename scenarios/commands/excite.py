@@ -119,6 +119,7 @@ def _channel(args) -> tuple[str, str]:
 def run(args) -> int:
     from physmodel.data.excitation import crest_factor
     from physmodel.data.timerecord import split_column
+    from physmodel.errors import IPMCError
 
     out = Path(args.out)
     if out.suffix.lower() not in SUFFIXES:
@@ -126,9 +127,8 @@ def run(args) -> int:
     ch, unit = _channel(args)
     try:
         split_column(f"{ch}_{unit}")
-    except Exception as exc:                  # DataFormatError: name the options
+    except IPMCError as exc:                  # DataFormatError: name the options
         raise CLIError(f"--channel {ch!r} / --unit {unit!r}: {exc}") from None
-    from physmodel.errors import IPMCError
 
     try:
         rec, what = _design(args, ch, unit)

@@ -231,8 +231,8 @@ def run(args) -> int:
                     raise CLIError(f"{path}: {opt} {nm}: {exc}") from None
     kw, how = _estimator_kwargs(args, records)
     ests = [_estimate(rec, p, args, kw) for rec, p in zip(records, args.records)]
-    keep = dict(min_coherence=args.min_coherence, band_hz=tuple(args.band) if args.band else None,
-                max_std_db=args.max_std_db)
+    keep = {"min_coherence": args.min_coherence, "band_hz": tuple(args.band) if args.band else None,
+                "max_std_db": args.max_std_db}
     if args.method == "stepped" and args.min_coherence is not None:
         raise CLIError("--min-coherence: a stepped-sine estimate has no coherence; use --max-std-db or --band")
     written, lines = [], []

@@ -31,12 +31,12 @@ from scipy import stats
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from physmodel import ActuatorModel, get_parameter_set  # noqa: E402
-from physmodel.data.excitation import multisine, settle_time_s  # noqa: E402
-from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep  # noqa: E402
-from physmodel.data.timesim import model_realization, simulate, time_grid  # noqa: E402
-from physmodel.estimation.calibration import calibrate  # noqa: E402
-from scenarios.virtual_lab import Measurement, virtual_lab  # noqa: E402
+from physmodel import ActuatorModel, get_parameter_set
+from physmodel.data.excitation import multisine, settle_time_s
+from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
+from physmodel.data.timesim import model_realization, simulate, time_grid
+from physmodel.estimation.calibration import calibrate
+from scenarios.virtual_lab import Measurement, virtual_lab
 
 TEMPS = [19.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
 HELD = [35.0, 45.0]
@@ -50,7 +50,7 @@ def setup():
     truth = base.replace(d=base.d * 1.4, alpha0=base.alpha0 * 0.8, E=base.E * 1.15, name="virtual_strip")
     f = np.unique(np.round(np.geomspace(0.1, 9.0, 30) * PERIOD)) / PERIOD
     ms = multisine(f, FS, PERIOD, rms=1.0)
-    meas = lambda seed: Measurement(output_noise_rms=20e-6, output_adc_step=10e-3 / 2**16,  # noqa: E731
+    meas = lambda seed: Measurement(output_noise_rms=20e-6, output_adc_step=10e-3 / 2**16,
                                     input_adc_step=20.0 / 2**16, seed=seed)
     return base, truth, f, ms, meas
 
@@ -96,7 +96,7 @@ def chain(periods: int, oversample: int):
     tm = ActuatorModel(truth)
     real = model_realization(tm, TEMPS[0], FS, 100.0)
     settle = settle_time_s(real.poles, 1e-6)
-    tp = int(math.ceil(settle / PERIOD))
+    tp = math.ceil(settle / PERIOD)
     print(f"== whole chain: seed 001 actuator with d×1.4, alpha0×0.8, E×1.15 (the truth); {len(TEMPS)} temperatures; "
           f"multisine {f.size} lines {f[0]:g}-{f[-1]:g} Hz, period {PERIOD:g} s at {FS:g} Hz, crest factor "
           f"{ms.crest_factor:.2f}; {tp} transient period(s) (slowest pole settles to 1e-6 in {settle:.1f} s) + "
@@ -138,7 +138,7 @@ def chain(periods: int, oversample: int):
 
 
 def coverage(draws: int, periods: int, tp: int, oversample: int):
-    base, truth, f, ms, meas = setup()
+    base, truth, _f, ms, meas = setup()
     tm = ActuatorModel(truth)
     temps = [25.0, 45.0]
     nu = 2 * (periods - 1)
@@ -153,7 +153,7 @@ def coverage(draws: int, periods: int, tp: int, oversample: int):
     # σ̂ with ν dof used as known weights: one dominant line gives z ~ t_ν (sd sqrt(ν/(ν−2)));
     # many comparable lines give E z² = E[c²]/E[c] = ν/(ν−4) with c = σ²/σ̂² ~ ν/χ²_ν
     lo_sd, hi_sd = math.sqrt(nu / (nu - 2)), math.sqrt(nu / (nu - 4))
-    cov = lambda sd: 2 * stats.norm.cdf(1.96 / sd) - 1  # noqa: E731
+    cov = lambda sd: 2 * stats.norm.cdf(1.96 / sd) - 1
     band = 1.96 * math.sqrt(0.9 * 0.1 / draws)
     print(f"== calibration coverage over {draws} draws (2 temperatures, {periods} periods; {time.perf_counter() - t_all:.1f} s)")
     print(f"  expected with σ estimated on ν = {nu}: between {cov(hi_sd):.3f} and {cov(lo_sd):.3f} (±{band:.3f} "

@@ -142,8 +142,9 @@ def test_calibration_on_the_virtual_lab_sweep_covers_the_simulated_truth():
     P(|Z| < 1.96·sqrt((ν − 4)/ν)) = 0.90 and 0.93 for P = 8.  Asserted: coverage no more than 3
     binomial sd below the lower value, no bias beyond 4 sd of the mean standardised error, and the
     Student-t cost."""
-    from physmodel.estimation.calibration import calibrate
     from scipy import stats
+
+    from physmodel.estimation.calibration import calibrate
 
     base = get_parameter_set("seed001_actuator")
     truth = base.replace(d=base.d * 1.4, alpha0=base.alpha0 * 0.8, E=base.E * 1.15)
@@ -177,16 +178,16 @@ def test_calibration_on_the_virtual_lab_sweep_covers_the_simulated_truth():
 
 # ------------------------------------------------------------------------------------- bad input
 @pytest.mark.parametrize("kw, match", [
-    (dict(measurement=Measurement(chain=TransimpedanceChain())), "chain"),
-    (dict(temperatures_c=[25.0, 25.0]), "temperatures_c"),
-    (dict(periods=1), "periods"),
-    (dict(oversample=0), "oversample"),
-    (dict(excitation="multisine"), "excitation"),
-    (dict(excitation=multisine([1.0], 100.0, 1.0, unit="mm", channel="tip_displacement")), "excitation unit"),
+    ({"measurement": Measurement(chain=TransimpedanceChain())}, "chain"),
+    ({"temperatures_c": [25.0, 25.0]}, "temperatures_c"),
+    ({"periods": 1}, "periods"),
+    ({"oversample": 0}, "oversample"),
+    ({"excitation": "multisine"}, "excitation"),
+    ({"excitation": multisine([1.0], 100.0, 1.0, unit="mm", channel="tip_displacement")}, "excitation unit"),
 ])
 def test_bad_input_names_the_argument(kw, match):
     m = ActuatorModel(get_parameter_set("seed001_actuator"))
-    args = dict(excitation=multisine([1.0, 2.0], 100.0, 1.0), temperatures_c=[25.0], periods=2)
+    args = {"excitation": multisine([1.0, 2.0], 100.0, 1.0), "temperatures_c": [25.0], "periods": 2}
     args.update(kw)
     with pytest.raises(IPMCError, match=match):
         virtual_lab(m, **args)
