@@ -19,9 +19,9 @@ Two known instrument factors are divided out of the estimate, each exactly:
 * the chain's transimpedance ``TransimpedanceChain.response(jω)`` [V/A] (a calibrated instrument);
 * the simulation's hold: a first-order-hold (linearly interpolated) input seen through its samples
   carries the factor ``sinc²(f/fs)`` (the triangle kernel's transform); a real record of a
-  continuous input does not, so ``hold_correction=True`` (default) removes it (twice when the
-  chain has an amplifier pole: timesim runs that pole on the current's samples, again through a
-  first-order hold).  What stays is the
+  continuous input does not, so ``hold_correction=True`` (default) removes it; timesim runs the
+  chain's amplifier pole on the current's samples, again through a first-order hold, and that
+  discrete response is divided out exactly (:func:`chain_as_simulated`).  What stays is the
   aliasing of the hold's images, ``Σ_{n≠0} P(f − n fs) sinc²(f/fs − n) / P(f)``, made small by
   simulating on a grid ``oversample`` times finer than the DAQ's (see :func:`simulate_records`;
   ``tests/scenarios/test_virtual_lab.py`` checks it against the physics).
@@ -179,6 +179,24 @@ def _quantise(x: np.ndarray, step: float) -> np.ndarray:
     return np.round(x / step) * step if step > 0 else x
 
 
+def chain_as_simulated(chain, frequency_hz, fsim_hz: float) -> np.ndarray:
+    """The transimpedance chain [V/A] as :func:`physmodel.data.timesim.simulate` applies it: its
+    amplifier pole run on the current's samples at ``fsim_hz`` [Hz] through a first-order hold
+    (x[k+1] = e·x[k] + b0·u[k] + b1·u[k+1], exact for a linearly interpolated input), so at
+    z = exp(j2πf/fsim) the response is ``r (b1 + b0/z) / (1 − e/z)``; the continuous pole's
+    ``C(jω)`` times sinc²(f/fsim) only when the pole lies well below ``fsim``."""
+    f = np.asarray(frequency_hz, dtype=float)
+    if chain.bandwidth_hz is None:
+        return np.full(f.shape, complex(chain.gain))
+    a, h = -2 * np.pi * chain.bandwidth_hz, 1.0 / float(fsim_hz)
+    ah = a * h
+    e = math.exp(ah)
+    i0 = (e - 1) / a
+    i1 = (e - 1 - ah) / (a * ah)
+    zi = np.exp(-2j * np.pi * f * h)
+    return chain.gain * -a * ((i0 - i1) * zi + i1) / (1 - e * zi)
+
+
 def simulate_records(model, excitation, temperatures_c, measurement: Measurement = Measurement(), *,
                      periods: int | None = None, transient_periods: int | None = None, oversample: int = 16,
                      set_index: int = 0, tol: float = 1e-4, timings: dict | None = None) -> list[TimeRecord]:
@@ -320,17 +338,19 @@ def virtual_lab(model, excitation, temperatures_c: Sequence[float], measurement:
         ests.append((Tk, e))
         factor = np.ones(e.frequency_hz.size, dtype=complex)
         notes = {}
+        foh = hold_correction and rec.metadata.get("hold") == "foh"
+        fsim = float(rec.metadata.get("simulation_fs_hz", fs))
         if measurement.chain is not None:
-            factor *= measurement.chain.response(2j * np.pi * e.frequency_hz)
-            notes["chain_divided_out"] = "yes"
-        if hold_correction and rec.metadata.get("hold") == "foh":
-            fsim = float(rec.metadata.get("simulation_fs_hz", fs))
-            # timesim runs the chain's amplifier pole on the current's samples through a second
-            # first-order hold: one more sinc² (a gain-only chain has none)
-            holds = 2 if measurement.chain is not None and measurement.chain.bandwidth_hz is not None else 1
-            factor *= np.sinc(e.frequency_hz / fsim) ** (2 * holds)
-            notes["hold_correction"] = (f"divided by sinc^{2 * holds}(f/{fsim:g} Hz) of the simulation's "
-                                        f"first-order hold{'s' if holds > 1 else ''}")
+            c = measurement.chain
+            if foh and c.bandwidth_hz is not None:
+                factor *= chain_as_simulated(c, e.frequency_hz, fsim)
+                notes["chain_divided_out"] = f"as simulated: its pole discretised with a first-order hold at {fsim:g} Hz"
+            else:
+                factor *= c.response(2j * np.pi * e.frequency_hz)
+                notes["chain_divided_out"] = "yes"
+        if foh:
+            factor *= np.sinc(e.frequency_hz / fsim) ** 2
+            notes["hold_correction"] = f"divided by sinc^2(f/{fsim:g} Hz) of the simulation's first-order hold"
         out_unit = e.output_units[0]
         if measurement.chain is not None:      # V → A through the chain's V/A
             out_unit = "A"
@@ -434,6 +454,7 @@ __all__ = [
     "NOISE_KEYS",
     "SWEEP_KEYS",
     "Measurement",
+    "chain_as_simulated",
     "VirtualLabResult",
     "estimate",
     "from_config",

@@ -114,6 +114,39 @@ def test_sigma_of_the_noisy_virtual_lab_is_calibrated():
     assert abs(t2.mean() - mean) < band, (t2.mean(), mean, band)
 
 
+def test_sigma_of_a_noisy_sensor_behind_the_seed000_chain_is_calibrated():
+    """Seed 000 sensor, amplifier noise 20 mV on the recorded volts (R3 = 10 kΩ: 470 kV/A, pole at
+    2 kHz), 16-bit ADC: the chain is divided out (µA/mm) and σ still follows t with ν = 2(P − 1).
+    The oracle is the physics plus the simulation's hold images (computed from the physics as in
+    test_sensor_with_chain_leaves_only_the_hold_images_predicted_from_the_physics): at fs = 400 Hz
+    they reach 2e-3 at 40 Hz even oversampled ×16, above this σ."""
+    m = SensorModel(get_parameter_set("seed000_sensor"))
+    fs, R, temps = 400.0, 16, [20.0, 40.0]
+    f = _lines(0.5, 40.0, 16, 2.0)
+    ms = multisine(f, fs, 2.0, rms=0.5, channel="tip_displacement", unit="mm")
+    chain = TransimpedanceChain(R3=10e3, bandwidth_hz=2e3)
+    ex = synthesize_sweep(m, "S", f, temps)
+    n = np.array([k for k in range(-64, 65) if k])
+    fr = R * fs
+    ff = f[:, None] - n * fr
+    for T in temps:
+        S = m.frequency_response(np.abs(ff).ravel(), [T], quantities=("S",))["S"][0, 0].reshape(ff.shape)
+        S = np.where(ff < 0, np.conj(S), S)
+        St = m.frequency_response(f, [T], quantities=("S",))["S"][0, 0]
+        images = np.sum(S * np.sinc(f[:, None] / fr - n) ** 2, axis=1) / (St * np.sinc(f / fr) ** 2)
+        sel = ex.temperature_c == T
+        ex.response[sel] *= 1 + images
+    t2 = []
+    for seed in range(3):
+        meas = Measurement(output_noise_rms=20e-3, output_adc_step=20.0 / 2**16, chain=chain, seed=seed)
+        r = virtual_lab(m, ms, temps, meas, periods=8, transient_periods=2, oversample=R)
+        assert (r.sweep.input_unit, r.sweep.output_unit) == ("mm", "uA")
+        t2.append(_t_terms(r.sweep, ex) ** 2)
+    t2 = np.concatenate(t2)
+    mean, band = _t2_mean_band(14, t2.size)
+    assert abs(t2.mean() - mean) < band, (t2.mean(), mean, band)
+
+
 def test_records_carry_the_design_temperature_and_measurement(tmp_path):
     from physmodel.data.timerecord import read_record
 
