@@ -215,9 +215,10 @@ def simulate_records(model, excitation, temperatures_c, measurement: Measurement
         ideal reconstruction filter on the drive).  Simulating at ``fs`` itself feeds the plant the
         linear interpolation of the samples, whose images near multiples of ``fs`` alias back into
         the band weighted by the plant's response there: for the seed 000 sensor (S rises ~30× from
-        40 Hz to 1 kHz) at fs = 1 kHz the error at 40 Hz is 4.5 % unoversampled, 5e-3 with 4,
-        1.6e-3 with 8 and 4.5e-4 with the default 16 (about 1/oversample²); the simulation's cost
-        grows in proportion.
+        40 Hz to 1 kHz) at fs = 1 kHz the error at 40 Hz is 4.6 % unoversampled, 5.2e-3 with 4,
+        1.6e-3 with 8, 4.5e-4 with the default 16 and 1.2e-4 with 32 (about oversample^-1.8);
+        the seed 001 actuator's response falls with frequency and needs none (its error is the
+        realisation's, < 1e-4).  The simulation's cost grows in proportion.
     set_index : int                       parameter set of the model to simulate
     tol : float                           realisation accuracy (max relative error)
 
