@@ -30,7 +30,10 @@ via ×20/ln 10 and ×180/π):
   and imaginary parts give σ_ln and σ_φ (sample variance with P − 1 degrees of freedom, divided by P).
 
 Both σ are estimates with few degrees of freedom when averages are few, so ±2σ covers the truth a
-little less than 95 % of the time (Student t with ν degrees of freedom).  Both are first-order
+little less than 95 % of the time (Student t with ν degrees of freedom).  When the input repeats
+exactly in every segment (a multisine estimated over whole periods, P segments), the line's complex
+noise gives σ̂ two real degrees of freedom per period, ν = 2(P − 1)
+(``tests/scenarios/test_virtual_lab.py`` measures mean t² = 1.19 for P = 8, t₁₄: 1.17).  Both are first-order
 (small-error) results: as a standard deviation the Welch σ holds down to γ² ≈ 0.02, but once σ of
 the magnitude exceeds about 1 dB the error of ln|H| = ln|1 + ε| is visibly skewed (a long tail
 where |1 + ε| → 0), so its ±2σ interval covers less; :meth:`FRFEstimate.to_sweep` can drop such
