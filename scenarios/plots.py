@@ -205,21 +205,15 @@ def save_poles_zeros_vs_temperature(model, path, per_temperature_models=None,
     grid = np.linspace(lo, hi, n_temperatures)
     fig, axes = _subplots(2, 2, sharex=True, figsize=(8.0, 6.0))
     for col, (name, getter) in enumerate((("poles", model.poles), ("zeros", model.zeros))):
-        tt, vals = [], []
-        for t in grid:
-            r = getter(t)
-            tt += [t] * r.size
-            vals += list(r)
-        vals = np.asarray(vals, complex)
+        roots = [getter(t) for t in grid]
+        tt = np.repeat(grid, [r.size for r in roots])
+        vals = np.concatenate(roots).astype(complex) if roots else np.zeros(0, complex)
         axes[0, col].plot(tt, vals.real, ".", ms=2, label="scheduled model")
         axes[1, col].plot(tt, vals.imag, ".", ms=2)
         if per_temperature_models:
-            pt, pv = [], []
-            for t, m in per_temperature_models.items():
-                r = m.poles() if name == "poles" else m.zeros()
-                pt += [t] * r.size
-                pv += list(r)
-            pv = np.asarray(pv, complex)
+            roots_t = [(t, m.poles() if name == "poles" else m.zeros()) for t, m in per_temperature_models.items()]
+            pt = np.concatenate([np.full(r.size, t) for t, r in roots_t])
+            pv = np.concatenate([r for _, r in roots_t]).astype(complex)
             axes[0, col].plot(pt, pv.real, "x", ms=5, label="per-temperature fits")
             axes[1, col].plot(pt, pv.imag, "x", ms=5)
         axes[0, col].set_title(name)

@@ -58,6 +58,7 @@ from physmodel.data.sweep import FrequencySweep, merge_sweeps
 from physmodel.data.timerecord import TimeRecord
 from physmodel.data.units import QUANTITY_UNITS, UNITS, unit_scale
 from physmodel.errors import IPMCError
+from physmodel.sensor import TransimpedanceChain
 
 
 # ---------------------------------------------------------------------------- configuration
@@ -82,7 +83,7 @@ class Measurement:
     input_noise_rms: float = 0.0
     output_adc_step: float = 0.0
     input_adc_step: float = 0.0
-    chain: object = None
+    chain: TransimpedanceChain | None = None
     seed: int | None = None
 
     def __post_init__(self):
@@ -421,15 +422,14 @@ def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") 
     ch, unit = ("voltage", "V") if kind == "actuator" else ("tip_displacement", "mm")
     chain = None
     if nz["chain"] is not None:
-        from physmodel.sensor import TransimpedanceChain
-
         r = nz["chain"]
         if not (isinstance(r, (list, tuple)) and len(r) == 3):
             raise IPMCError(f"{where}[noise] chain: expected [R1, R2, R3] in ohm, got {r!r}")
-        chain = TransimpedanceChain(*map(float, r), bandwidth_hz=nz["chain_bandwidth_hz"])
+        chain = TransimpedanceChain(float(r[0]), float(r[1]), float(r[2]), bandwidth_hz=nz["chain_bandwidth_hz"])
     try:
         meas = Measurement(float(nz["output_noise_rms"]), float(nz["input_noise_rms"]), float(nz["output_adc_step"]),
                            float(nz["input_adc_step"]), chain, nz["seed"])
+        exc: Multisine | SteppedSinePlan
         if cfg["excitation"] == "multisine":
             period = cfg["period_s"] if cfg["period_s"] is not None else max(10.0, 1.0 / lo)
             f = np.unique(np.maximum(np.round(np.geomspace(lo, hi, n) * period), 1)) / period

@@ -46,15 +46,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 from scipy import fft as sp_fft
 from scipy import signal
 
-from ..errors import IPMCError
 from ..data.sweep import FrequencySweep
 from ..data.timerecord import sample_rate
+from ..errors import IPMCError
 
 NEPER_TO_DB = 20.0 / math.log(10.0)
 BLOCK_SAMPLES = 1 << 20
@@ -366,7 +366,7 @@ def estimate_record(record, input: str, outputs: Sequence[str] | None = None, me
     """
     from .stepped import stepped_sine
 
-    fns = {"h1": h1, "h2": h2, "stepped_sine": stepped_sine}
+    fns: dict[str, Callable[..., FRFEstimate]] = {"h1": h1, "h2": h2, "stepped_sine": stepped_sine}
     if method not in fns:
         raise IPMCError(f"method={method!r}; expected one of {list(fns)}")
     inp = record.resolve(input)

@@ -281,6 +281,8 @@ def _judge(ctx, claim_id, source, location, printed, value, claim: Claim) -> Cla
     if claim.expect.startswith("not-checkable"):
         ours = claim.check(ctx, value).ours if claim.check is not None else "-"
         return row(ours, "-", "not-checkable", claim.expect.split(":", 1)[1].strip())
+    if claim.check is None:
+        return row("-", "-", "fail", "the claim has no check (a regression)")
     try:
         out = claim.check(ctx, value)
     except Exception as exc:  # noqa: BLE001 - a broken check is reported as a failing row, never skipped
