@@ -523,7 +523,10 @@ def _metric_value(expr: str, metrics: dict, where: str) -> float:
     for t in terms:
         if t not in metrics:
             raise ScenarioError(f"{where}: metric {t!r} was not produced; available: {sorted(metrics)}")
-    return metrics[terms[0]] / metrics[terms[1]] if len(terms) == 2 else metrics[terms[0]]
+    if len(terms) == 1:
+        return metrics[terms[0]]
+    with np.errstate(divide="ignore", invalid="ignore"):   # a zero denominator is a failed check (inf/NaN)
+        return float(np.float64(metrics[terms[0]]) / np.float64(metrics[terms[1]]))
 
 
 def evaluate_checks(spec: Scenario, metrics: dict) -> list[CheckResult]:
@@ -543,13 +546,24 @@ def evaluate_checks(spec: Scenario, metrics: dict) -> list[CheckResult]:
     return out
 
 
-def run_scenario(spec: Scenario, out, *, quiet: bool = False) -> RunResult:
-    """Run every step of ``spec`` into folder ``out`` and write its report (last)."""
+def run_scenario(spec: Scenario, out, *, quiet: bool = False, force: bool = False) -> RunResult:
+    """Run every step of ``spec`` into folder ``out`` and write its report (last).
+
+    The folder is claimed for the run (:func:`physmodel.data.files.output_folder`): a second run
+    into it is refused while this one writes, and a folder holding another run's results is
+    refused unless ``force``.  An interrupt (even one a solver swallowed) ends the run before the
+    next step and before ``report.md``."""
+    from physmodel.data.files import output_folder
+
+    with output_folder(out, f"ipmc run {spec.name}", force=force) as folder:
+        return _run_scenario(spec, folder, quiet)
+
+
+def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:
+    from physmodel import interrupts
     from physmodel.data.files import atomic_write
 
     t0 = time.perf_counter()
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     (out / "report.md").unlink(missing_ok=True)         # a stale report must not vouch for new files
     say = (lambda *a: None) if quiet else (lambda *a: print(*a, file=sys.stderr))
     ctx = _Ctx(spec, out, say)
@@ -565,6 +579,7 @@ def run_scenario(spec: Scenario, out, *, quiet: bool = False) -> RunResult:
             if bar is not None:
                 bar.set_postfix_str(s)
             STEPS[s](ctx)
+            interrupts.check()
             if bar is not None:
                 bar.update(1)
     finally:
@@ -590,6 +605,7 @@ def run_scenario(spec: Scenario, out, *, quiet: bool = False) -> RunResult:
                          c.description) for c in checks]), "",
              f"{sum(c.passed for c in checks)}/{len(checks)} checks passed; ran in {elapsed:.1f} s.", "",
              "## Files", "", *[f"- `{f}`" for f in ctx.files], "- `report.md` (this file, written last)", ""]
+    interrupts.check()
     atomic_write(out / "report.md", lambda fh: fh.write("\n".join(lines)))
     return RunResult(spec.name, out, dict(ctx.metrics), checks, list(ctx.files), elapsed)
 

@@ -7,13 +7,15 @@ import csv
 import json
 import math
 import os
-import tempfile
+import secrets
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
 
+from .. import interrupts
 from ..errors import DataFormatError, IPMCError
 from .sweep import FORMAT_VERSION, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, FrequencySweep
 from .units import UNITS
@@ -25,23 +27,78 @@ def atomic_write(path, write_fn, mode: str = "w") -> Path:
     no newline translation) or "wb".  The file gets the usual permissions (0666 less the umask)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=".part", dir=path.parent)
+    # the name is fixed before the file exists, so an interrupt at any point after creation still
+    # finds and removes it (mkstemp's name is only known once it returns)
+    tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
     try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         with os.fdopen(fd, mode, **({"newline": "", "encoding": "utf-8"} if "b" not in mode else {})) as fh:
             write_fn(fh)
             fh.flush()
             os.fsync(fh.fileno())
         mask = os.umask(0)
         os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)   # mkstemp creates 0600
+        os.chmod(tmp, 0o666 & ~mask)   # created 0600
+        interrupts.check()             # an interrupt a solver swallowed must not commit a file
         os.replace(tmp, path)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
+        tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+#: Hidden files that :func:`output_folder` keeps in a claimed folder: the lock and the owner record.
+LOCK_NAME, OWNER_NAME = ".ipmc.lock", ".ipmc-owner.json"
+
+
+def _owner(folder: Path) -> str | None:
+    """Who wrote ``folder``: the identity in its owner record, a description of foreign files, or
+    None for an empty folder."""
+    rec = folder / OWNER_NAME
+    if rec.is_file():
+        try:
+            return str(json.loads(rec.read_text(encoding="utf-8"))["identity"])
+        except (OSError, ValueError, KeyError, TypeError):
+            return "an unreadable owner record"
+    others = sorted(p.name for p in folder.iterdir() if p.name not in (LOCK_NAME, OWNER_NAME))
+    return f"files not written by ipmc ({', '.join(others[:3])}{', ...' if len(others) > 3 else ''})" if others else None
+
+
+@contextmanager
+def output_folder(path, identity: str, *, force: bool = False, option: str = "--out"):
+    """Claim the folder ``path`` for one run (a context manager yielding it as a Path).
+
+    The folder is created if needed and locked (``fcntl.flock`` on a hidden ``.ipmc.lock``) for the
+    duration of the block, so a second run into the same folder is refused while the first one
+    writes.  A folder that holds the results of another run (its hidden owner record names another
+    ``identity``) or files ipmc did not write is refused unless ``force``; the same identity (the
+    same command or scenario run again) may replace its own results.  Errors are
+    :class:`~physmodel.errors.IPMCError` naming ``option`` and the folder.
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise IPMCError(f"{option} {path}: exists and is not a folder")
+    path.mkdir(parents=True, exist_ok=True)
+    fh = open(path / LOCK_NAME, "a+")
+    try:
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not POSIX: no lock, the owner record still applies
+            fcntl = None
+        if fcntl is not None:
+            try:
+                fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                raise IPMCError(f"{option} {path}: another ipmc run is writing into this folder; wait for it "
+                                "or choose another folder") from None
+        owner = _owner(path)
+        if owner is not None and owner != identity and not force:
+            raise IPMCError(f"{option} {path}: the folder holds {owner if owner.startswith(('files', 'an ')) else 'the results of ' + repr(owner)}, "
+                            f"not of {identity!r}; choose another folder or pass --force to write into it")
+        atomic_write(path / OWNER_NAME, lambda f: f.write(json.dumps({"identity": identity}) + "\n"))
+        yield path
+    finally:
+        fh.close()                     # closing the descriptor releases the lock
 
 
 def _columns(sw: FrequencySweep) -> dict[str, np.ndarray]:
