@@ -203,7 +203,11 @@ def step_surrogate(ctx: _Ctx):
     train = ctx.data.exclude(held) if held else ctx.data
     nz, npo = cfg.get("n_zeros", 3), cfg.get("n_poles", 3)
     kw = {k: cfg[k] for k in ("method", "weighting") if k in cfg}
-    fit = fit_sweep(train, nz, npo, cfg.get("degree", 2), form=cfg.get("form", "zpk"), raise_on_failure=False, **kw)
+    try:
+        fit = fit_sweep(train, nz, npo, cfg.get("degree", 2), form=cfg.get("form", "zpk"), raise_on_failure=False, **kw)
+    except ValueError as exc:        # the surrogate package refuses an order/degree the data cannot carry
+        raise ScenarioError(f"{ctx.spec.path}: [surrogate] n_zeros={nz}, n_poles={npo}, degree={cfg.get('degree', 2)}: "
+                            f"{exc}") from None
     ctx.fit = fit
     model = fit.model
     model.to_json(ctx.out / "surrogate.json")
@@ -396,7 +400,10 @@ def step_blackbox(ctx: _Ctx):
     sw = ctx.data.select(T)
     curves, rows = {"data": sw.magnitude_db}, []
     for nz, npo in cfg["orders"]:
-        r = RationalFit(nz, npo, raise_on_failure=False).fit(sw.frequency_hz, sw.temperature_c, sw.response)
+        try:
+            r = RationalFit(nz, npo, raise_on_failure=False).fit(sw.frequency_hz, sw.temperature_c, sw.response)
+        except ValueError as exc:
+            raise ScenarioError(f"{ctx.spec.path}: [blackbox] orders [{nz}, {npo}]: {exc}") from None
         g = r.model.frequency_response(sw.frequency_hz)
         fp = ctx.metric(f"blackbox.z{nz}_p{npo}.fit_percent", fit_percent(g, sw.response))
         ctx.metric(f"blackbox.z{nz}_p{npo}.converged", r.converged)

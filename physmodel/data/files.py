@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import interrupts
 from ..errors import DataFormatError, IPMCError
-from .sweep import FORMAT_VERSION, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, FrequencySweep
+from .sweep import FORMAT_VERSION, MAX_SWEEP_LINES, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, FrequencySweep
 from .units import UNITS
 
 # ----------------------------------------------------------------------------------- I/O helpers
@@ -45,6 +45,28 @@ def atomic_write(path, write_fn, mode: str = "w") -> Path:
         tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+def read_text(path, what: str = "file") -> str:
+    """The text of ``path`` decoded as UTF-8, a leading byte-order mark dropped (Excel writes one).
+
+    Every text reader of the library (sweep CSV, scenario/study/experiment TOML, parameter JSON,
+    signal CSV) goes through here, so a file that is not UTF-8 is a :class:`DataFormatError` naming
+    the file, the line and the byte, never a ``UnicodeDecodeError``.
+    """
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise DataFormatError(f"{what} {str(path)!r}: no such file") from None
+    except IsADirectoryError:
+        raise DataFormatError(f"{what} {str(path)!r} is a folder; expected a file") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise DataFormatError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
+                              "save the file as UTF-8") from None
 
 
 #: Hidden files that :func:`output_folder` keeps in a claimed folder: the lock and the owner record.
@@ -166,10 +188,7 @@ def write_csv(sw: FrequencySweep, path) -> Path:
 def read_csv(path) -> FrequencySweep:
     """Read the tidy CSV; a malformed file raises :class:`DataFormatError` naming the line."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
+    text = read_text(path, "sweep file")
     header: dict[str, str] = {}
     lines = text.splitlines()
     i = 0
@@ -256,24 +275,101 @@ def write_npz(sw: FrequencySweep, path) -> Path:
     return atomic_write(path, write, "wb")
 
 
-def read_npz(path) -> FrequencySweep:
+#: The arrays a sweep NPZ may hold (others are ignored without being decompressed).
+NPZ_ARRAYS = ("header",) + REQUIRED_COLUMNS + OPTIONAL_COLUMNS + ("response_real", "response_imag")
+#: Largest array accepted from a sweep file [bytes], checked before it is decompressed: 16 bytes
+#: (complex128) for each of MAX_SWEEP_LINES lines.
+MAX_ARRAY_BYTES = 16 * MAX_SWEEP_LINES + 4096
+
+
+def _column(v, key: str, where: str, *, allow_complex: bool = False) -> np.ndarray:
+    """``v`` as a 1-D float (or complex) array, or a DataFormatError naming ``key``."""
+    a = np.asarray(v)
+    kinds = "biufc" if allow_complex else "iuf"
+    if a.dtype.kind not in kinds:
+        what = "complex numbers" if a.dtype.kind == "c" else f"dtype {a.dtype}"
+        raise DataFormatError(f"{where}: {key} holds {what}; expected real numbers")
+    if a.ndim > 1 and max(a.shape) != a.size:
+        raise DataFormatError(f"{where}: {key} has shape {a.shape}; expected one value per line")
+    return a.reshape(-1).astype(complex if allow_complex and a.dtype.kind == "c" else float)
+
+
+def _sweep_from_arrays(cols: dict, header: dict, response, where: str) -> FrequencySweep:
+    """Check lengths, build the sweep, and name the file in any error of the record itself."""
+    n = {k: v.size for k, v in cols.items()}
+    if response is not None:
+        n["response"] = response.size
+    if len(set(n.values())) > 1:
+        raise DataFormatError(f"{where}: arrays differ in length {n}; expected one value per line in each")
     try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
+        sw = _from_columns(cols, header, where)
+        return replace(sw, response=response) if response is not None else sw
+    except DataFormatError:
+        raise
+    except IPMCError as exc:
+        raise DataFormatError(f"{where}: {exc}") from None
+
+
+def read_npz(path) -> FrequencySweep:
+    """Read a sweep NPZ.  Only the arrays of the format are read, each after its uncompressed size
+    is checked (an extra or oversized array cannot exhaust memory); never unpickles."""
+    import zipfile
+
+    where = str(path)
+    try:
+        zf = zipfile.ZipFile(path)
     except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    if "header" not in data:
-        raise DataFormatError(f"{path}: not an ipmc-sweep NPZ (no 'header')")
-    hdr = json.loads(str(data["header"]))
+        raise DataFormatError(f"{where}: no such file") from None
+    except (zipfile.BadZipFile, OSError, ValueError) as exc:
+        raise DataFormatError(f"{where}: not an NPZ archive ({exc})") from None
+    data = {}
+    with zf:
+        members = {n[:-4]: n for n in zf.namelist() if n.endswith(".npy")}
+        if "header" not in members:
+            raise DataFormatError(f"{where}: not an ipmc-sweep NPZ (no 'header' array)")
+        for key in NPZ_ARRAYS:
+            if key not in members:
+                continue
+            size = zf.getinfo(members[key]).file_size
+            if size > MAX_ARRAY_BYTES:
+                raise DataFormatError(f"{where}: array {key!r} holds {size} bytes; a sweep array holds at most "
+                                      f"{MAX_ARRAY_BYTES} ({MAX_SWEEP_LINES} lines)")
+            try:
+                with zf.open(members[key]) as fh:
+                    data[key] = np.lib.format.read_array(fh, allow_pickle=False)
+            except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+                raise DataFormatError(f"{where}: array {key!r} cannot be read: {exc}") from None
+    h = data["header"]
+    if h.dtype.kind != "U" or h.ndim != 0:
+        raise DataFormatError(f"{where}: 'header' must be one JSON string, got {h.dtype} with shape {h.shape}")
+    try:
+        hdr = json.loads(str(h))
+    except json.JSONDecodeError as exc:
+        raise DataFormatError(f"{where}: 'header' is not JSON: {exc}") from None
+    if not isinstance(hdr, dict):
+        raise DataFormatError(f"{where}: 'header' must be a JSON object, got {type(hdr).__name__}")
+    for key in ("input", "output"):
+        if not isinstance(hdr.get(key), str):
+            raise DataFormatError(f"{where}: header key {key!r} must be a string 'name [unit]', got {hdr.get(key)!r}")
+    meta = hdr.get("metadata", {})
+    if not isinstance(meta, dict):
+        raise DataFormatError(f"{where}: header key 'metadata' must be an object, got {meta!r}")
     missing = [c for c in REQUIRED_COLUMNS if c not in data]
     if missing:
-        raise DataFormatError(f"{path}: missing array(s) {missing}")
-    cols = {k: np.asarray(data[k], dtype=float) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
-    header = {"input": hdr["input"], "output": hdr["output"], **{k: str(v) for k, v in hdr.get("metadata", {}).items()}}
-    sw = _from_columns(cols, header, str(path))
-    if "response_real" in data:   # exact complex values, not rounded through dB/deg
-        sw = replace(sw, response=data["response_real"] + 1j * data["response_imag"])
-    return sw
+        raise DataFormatError(f"{where}: missing array(s) {missing}")
+    cols = {k: _column(data[k], k, where) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
+    parts = [k for k in ("response_real", "response_imag") if k in data]
+    if len(parts) == 1:
+        raise DataFormatError(f"{where}: has {parts[0]!r} but not its partner; give response_real and "
+                              "response_imag together, or neither")
+    response = None
+    if parts:
+        re_, im_ = (_column(data[k], k, where) for k in ("response_real", "response_imag"))
+        if re_.size != im_.size:
+            raise DataFormatError(f"{where}: response_real has {re_.size} values, response_imag {im_.size}")
+        response = re_ + 1j * im_      # exact complex values, not rounded through dB/deg
+    header = {"input": hdr["input"], "output": hdr["output"], **{str(k): str(v) for k, v in meta.items()}}
+    return _sweep_from_arrays(cols, header, response, where)
 
 
 def write_mat(sw: FrequencySweep, path) -> Path:
@@ -293,23 +389,49 @@ def write_mat(sw: FrequencySweep, path) -> Path:
     return atomic_write(path, write, "wb")
 
 
-def read_mat(path) -> FrequencySweep:
-    from scipy.io import loadmat
+def _mat_text(data: dict, key: str, where: str) -> str:
+    v = np.asarray(data[key])
+    if v.dtype.kind != "U" or v.size != 1:
+        raise DataFormatError(f"{where}: variable {key!r} must be a string, got {v.dtype} with shape {v.shape}")
+    return str(v.reshape(-1)[0])
 
-    try:
-        data = loadmat(path)
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    missing = [c for c in REQUIRED_COLUMNS if c not in data]
+
+def read_mat(path) -> FrequencySweep:
+    """Read a sweep .mat; variable sizes are checked (``whosmat``) before anything is loaded."""
+    from scipy.io import loadmat, whosmat
+
+    where = str(path)
+    if not Path(path).is_file():
+        raise DataFormatError(f"{where}: no such file")
+    wanted = REQUIRED_COLUMNS + OPTIONAL_COLUMNS + ("response", "input", "output", "metadata_json")
+    try:   # scipy's parser raises many exception types on a malformed file; all mean "not readable"
+        shapes = {name: shape for name, shape, _ in whosmat(path)}
+        for key in wanted:
+            if key in shapes and 16 * int(np.prod(shapes[key], dtype=np.int64)) > MAX_ARRAY_BYTES:
+                raise DataFormatError(f"{where}: variable {key!r} has shape {shapes[key]}; a sweep holds at most "
+                                      f"{MAX_SWEEP_LINES} lines")
+        data = loadmat(path, variable_names=[k for k in wanted if k in shapes])
+    except DataFormatError:
+        raise
+    except Exception as exc:  # noqa: BLE001
+        raise DataFormatError(f"{where}: not a readable MATLAB .mat file ({type(exc).__name__}: {exc})") from None
+    missing = [c for c in REQUIRED_COLUMNS + ("input", "output") if c not in data]
     if missing:
-        raise DataFormatError(f"{path}: missing variable(s) {missing}")
-    cols = {k: np.asarray(data[k], dtype=float).reshape(-1) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
-    meta = json.loads(str(data["metadata_json"][0])) if "metadata_json" in data else {}
-    header = {"input": str(data["input"][0]), "output": str(data["output"][0]), **{k: str(v) for k, v in meta.items()}}
-    sw = _from_columns(cols, header, str(path))
-    if "response" in data:
-        sw = replace(sw, response=np.asarray(data["response"], dtype=complex).reshape(-1))
-    return sw
+        raise DataFormatError(f"{where}: missing variable(s) {missing}")
+    cols = {k: _column(data[k], k, where) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
+    meta = {}
+    if "metadata_json" in data:
+        try:
+            meta = json.loads(_mat_text(data, "metadata_json", where))
+        except json.JSONDecodeError as exc:
+            raise DataFormatError(f"{where}: variable 'metadata_json' is not JSON: {exc}") from None
+        if not isinstance(meta, dict):
+            raise DataFormatError(f"{where}: variable 'metadata_json' must hold a JSON object")
+    header = {"input": _mat_text(data, "input", where), "output": _mat_text(data, "output", where),
+              **{str(k): str(v) for k, v in meta.items()}}
+    response = _column(data["response"], "response", where, allow_complex=True).astype(complex) \
+        if "response" in data else None
+    return _sweep_from_arrays(cols, header, response, where)
 
 
 def by_extension(path, handlers: Mapping[str, Callable], what: str) -> Callable:

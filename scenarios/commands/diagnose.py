@@ -72,10 +72,12 @@ def add_parser(subparsers):
 def _load_toml(path: Path) -> dict:
     import tomllib
 
+    from physmodel.data.files import read_text
+
     if not path.is_file():
         raise IPMCError(f"experiment file {str(path)!r} does not exist")
     try:
-        spec = tomllib.loads(path.read_text())
+        spec = tomllib.loads(read_text(path, "experiment file"))
     except tomllib.TOMLDecodeError as exc:
         raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
     known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
