@@ -69,58 +69,73 @@ def read_text(path, what: str = "file") -> str:
                               "save the file as UTF-8") from None
 
 
-#: Hidden files that :func:`output_folder` keeps in a claimed folder: the lock and the owner record.
-LOCK_NAME, OWNER_NAME = ".ipmc.lock", ".ipmc-owner.json"
+#: What each ipmc command leaves in its output folder, to recognise whose results a folder holds:
+#: (file, identity, or a function of the file's JSON giving the identity).
+OWNER_FILES = (("metrics.json", lambda d: f"ipmc run {d['scenario']}"), ("calibration.json", lambda d: "ipmc calibrate"),
+               ("model.json", lambda d: "ipmc fit"), ("report.json", lambda d: "ipmc diagnose"))
 
 
-def _owner(folder: Path) -> str | None:
-    """Who wrote ``folder``: the identity in its owner record, a description of foreign files, or
-    None for an empty folder."""
-    rec = folder / OWNER_NAME
-    if rec.is_file():
-        try:
-            return str(json.loads(rec.read_text(encoding="utf-8"))["identity"])
-        except (OSError, ValueError, KeyError, TypeError):
-            return "an unreadable owner record"
-    others = sorted(p.name for p in folder.iterdir() if p.name not in (LOCK_NAME, OWNER_NAME))
-    return f"files not written by ipmc ({', '.join(others[:3])}{', ...' if len(others) > 3 else ''})" if others else None
+def folder_owner(folder) -> str | None:
+    """Whose results ``folder`` holds: ``"ipmc run <scenario>"``, ``"ipmc calibrate"``, ``"ipmc fit"``,
+    ``"ipmc diagnose"``, a description of other files, or None when it is empty."""
+    folder = Path(folder)
+    entries = sorted(p.name for p in folder.iterdir())
+    if not entries:
+        return None
+    for name, identity in OWNER_FILES:
+        if name in entries:
+            try:
+                return identity(json.loads((folder / name).read_text(encoding="utf-8")))
+            except (OSError, ValueError, KeyError, TypeError):
+                continue
+    return f"files not written by a finished ipmc run ({', '.join(entries[:3])}{', ...' if len(entries) > 3 else ''})"
+
+
+def check_output_folder(path, identity: str, *, force: bool = False, option: str = "--out") -> Path:
+    """The refusals of :func:`output_folder` without creating or locking anything: for commands
+    that compute first and write at the end (they claim the folder then)."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise IPMCError(f"{option} {path}: exists and is not a folder")
+    owner = folder_owner(path) if path.is_dir() else None
+    if owner is not None and owner != identity and not force:
+        held = owner if owner.startswith("files") else f"the results of {owner!r}"
+        raise IPMCError(f"{option} {path}: the folder holds {held}, not of {identity!r}; choose another "
+                        "folder or pass --force to write into it")
+    return path
 
 
 @contextmanager
 def output_folder(path, identity: str, *, force: bool = False, option: str = "--out"):
     """Claim the folder ``path`` for one run (a context manager yielding it as a Path).
 
-    The folder is created if needed and locked (``fcntl.flock`` on a hidden ``.ipmc.lock``) for the
+    The folder is created if needed and locked (``fcntl.flock`` on the folder itself) for the
     duration of the block, so a second run into the same folder is refused while the first one
-    writes.  A folder that holds the results of another run (its hidden owner record names another
-    ``identity``) or files ipmc did not write is refused unless ``force``; the same identity (the
-    same command or scenario run again) may replace its own results.  Errors are
+    writes.  A folder that holds another run's results (:func:`folder_owner` differs from
+    ``identity``, e.g. another scenario, or files ipmc did not finish writing) is refused unless
+    ``force``; the same command or scenario may replace its own results.  Errors are
     :class:`~physmodel.errors.IPMCError` naming ``option`` and the folder.
     """
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise IPMCError(f"{option} {path}: exists and is not a folder")
     path.mkdir(parents=True, exist_ok=True)
-    fh = open(path / LOCK_NAME, "a+")
+    fd = os.open(path, os.O_RDONLY)
     try:
         try:
             import fcntl
-        except ImportError:  # pragma: no cover - not POSIX: no lock, the owner record still applies
+        except ImportError:  # pragma: no cover - not POSIX: no lock, the ownership check still applies
             fcntl = None
         if fcntl is not None:
             try:
-                fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
                 raise IPMCError(f"{option} {path}: another ipmc run is writing into this folder; wait for it "
                                 "or choose another folder") from None
-        owner = _owner(path)
-        if owner is not None and owner != identity and not force:
-            raise IPMCError(f"{option} {path}: the folder holds {owner if owner.startswith(('files', 'an ')) else 'the results of ' + repr(owner)}, "
-                            f"not of {identity!r}; choose another folder or pass --force to write into it")
-        atomic_write(path / OWNER_NAME, lambda f: f.write(json.dumps({"identity": identity}) + "\n"))
+        check_output_folder(path, identity, force=force, option=option)
         yield path
     finally:
-        fh.close()                     # closing the descriptor releases the lock
+        os.close(fd)                   # closing the descriptor releases the lock
 
 
 def _columns(sw: FrequencySweep) -> dict[str, np.ndarray]:

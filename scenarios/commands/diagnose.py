@@ -64,6 +64,8 @@ def add_parser(subparsers):
     p.add_argument("--null-refits", type=int, help="full-refit bootstrap draws under the null (default 4)")
     p.add_argument("--seed", type=int, help="seed of the null Monte Carlo (default 0)")
     p.add_argument("--out", help="report folder (default diagnosis)")
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
     return p
@@ -173,7 +175,10 @@ def run(args) -> int:
     """Execute ``ipmc diagnose``: 0 for any verdict; bad input raises IPMCError (exit 2)."""
     from physmodel.estimation.discrepancy import diagnose, gap_shrink
 
+    from physmodel.data.files import check_output_folder, output_folder
+
     data, base, kw, out = build(args)
+    check_output_folder(out, "ipmc diagnose", force=args.force)
     bar = None
     if not args.quiet:
         from tqdm import tqdm
@@ -190,8 +195,9 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    d.write_report(out)
-    plots.diagnosis_figures(d, out)
+    with output_folder(out, "ipmc diagnose", force=args.force):
+        d.write_report(out)
+        plots.diagnosis_figures(d, out)
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)
