@@ -4,6 +4,7 @@ atomic writer every file of the library goes through (temporary file, then renam
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import os
@@ -398,10 +399,14 @@ def write_mat(sw: FrequencySweep, path) -> Path:
     cols["format"] = f"ipmc-sweep {FORMAT_VERSION}"
     cols["metadata_json"] = json.dumps(sw.metadata)
 
-    def write(fh):
-        savemat(fh, cols, do_compression=True)
+    buf = io.BytesIO()
+    savemat(buf, cols, do_compression=True)
+    data = bytearray(buf.getvalue())
+    # the 116-byte descriptive text of a v5 header carries the creation time; a fixed text makes
+    # the file byte-reproducible like the CSV and NPZ (MATLAB ignores the text)
+    data[:116] = MAT_HEADER_TEXT
 
-    return atomic_write(path, write, "wb")
+    return atomic_write(path, lambda fh: fh.write(bytes(data)), "wb")
 
 
 def _mat_text(data: dict, key: str, where: str) -> str:
@@ -409,6 +414,10 @@ def _mat_text(data: dict, key: str, where: str) -> str:
     if v.dtype.kind != "U" or v.size != 1:
         raise DataFormatError(f"{where}: variable {key!r} must be a string, got {v.dtype} with shape {v.shape}")
     return str(v.reshape(-1)[0])
+
+
+#: The descriptive text at the start of every .mat file written here (no timestamp).
+MAT_HEADER_TEXT = f"MATLAB 5.0 MAT-file, written by ipmc (ipmc-sweep {FORMAT_VERSION})".encode("ascii").ljust(116)
 
 
 def read_mat(path) -> FrequencySweep:

@@ -87,12 +87,53 @@ def _load_toml(path: Path) -> dict:
     unknown = set(spec) - known
     if unknown:
         raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
+    _check_types(spec, path)
     for key in ("data", "set"):
         if key in spec and isinstance(spec[key], str):
             cand = path.parent / spec[key]
             if key == "data" or cand.suffix.lower() == ".json":
                 spec[key] = str(cand) if not Path(spec[key]).is_absolute() else spec[key]
     return spec
+
+
+def _is_num(v):
+    import math
+
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _is_int(v):
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_strs(v):
+    return isinstance(v, list) and all(isinstance(x, str) for x in v)
+
+
+#: Experiment-file keys: (check, what is expected).
+_TYPES = {"data": (lambda v: isinstance(v, str), "a file name"), "kind": (lambda v: v in ("actuator", "sensor"), "'actuator' or 'sensor'"),
+          "quantity": (lambda v: isinstance(v, str), "a quantity name (M, H, Z, I, S)"),
+          "kernel": (lambda v: v in ("boundary_charge", "reciprocal"), "'boundary_charge' or 'reciprocal'"),
+          "set": (lambda v: isinstance(v, str), "a parameter-set name or JSON file"),
+          "free": (lambda v: _is_strs(v) and len(v) > 0, "a non-empty list of strings NAME[:LOWER:UPPER...]"),
+          "candidates": (lambda v: _is_strs(v) or isinstance(v, str), "a list of effect names"),
+          "alpha": (lambda v: _is_num(v) and 0 < v < 1, "a number in (0, 1)"),
+          "seed": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
+          "out": (lambda v: isinstance(v, str), "a folder name"),
+          "null_draws": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
+          "null_refits": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
+          "geometry": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()), "a table of L, W, h [m] numbers"),
+          "parameters": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()), "a table of NAME = number (SI)"),
+          "baseline_effects": (lambda v: isinstance(v, dict) and all(isinstance(e, dict) and all(_is_num(x) for x in e.values())
+                                                                     for e in v.values()),
+                               "a table of [baseline_effects.NAME] tables of numbers")}
+
+
+def _check_types(spec: dict, path: Path) -> None:
+    for key, value in spec.items():
+        ok, what = _TYPES[key]
+        if not ok(value):
+            raise IPMCError(f"experiment file {str(path)!r}: {key} = {value!r}; expected {what}")
 
 
 def _parse_effect(item: str) -> tuple[str, dict]:
@@ -161,6 +202,12 @@ def build(args):
     cands = pick(args.candidates, "candidates")
     if isinstance(cands, str):
         cands = [c.strip() for c in cands.split(",") if c.strip()]
+    if cands is not None:
+        from physmodel.effects import ALL_EFFECTS
+
+        unknown = [c for c in cands if c not in ALL_EFFECTS]
+        if unknown:
+            raise IPMCError(f"candidates: unknown effect(s) {unknown}; expected names from {sorted(ALL_EFFECTS)}")
     kw = dict(kind=pick(args.kind, "kind", "actuator"), quantity=pick(args.quantity, "quantity"),
               free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
               null_draws=int(pick(args.null_draws, "null_draws", 4000)),

@@ -802,9 +802,9 @@ def gen_interop(rnd: random.Random, d: Path) -> Case:
 
         sim = d / "sim.csv"
         with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
-            main(["simulate", "--set", "seed002_table3", "--experiment", "sine", "--duration", "0.5", "--fs", 200,
+            main(["simulate", "--set", "seed002_table3", "--experiment", "sine", "--duration", "0.5", "--fs", "200",
                   "--out", str(sim), "--quiet"])
-        return Case("interop", which, ["invert", sim, "--num=1", "--den=1,1", "--out", d / "o.csv", "--quiet"],
+        return Case("interop", which, ["invert", sim, "--num=1,2", "--den=1,1", "--out", d / "o.csv", "--quiet"],
                     expect=(0,))
     if which == "params_roundtrip":
         from physmodel import get_parameter_set
@@ -822,7 +822,7 @@ def gen_interop(rnd: random.Random, d: Path) -> Case:
     if which == "bom_invert":
         f = d / "u.csv"
         f.write_bytes(bom + b"time_s,u\n0,0\n0.01,1\n0.02,0.5\n0.03,0\n")
-        return Case("interop", which, ["invert", f, "--num=1", "--den=1,1", "--out", d / "o.csv", "--quiet"], expect=(0,))
+        return Case("interop", which, ["invert", f, "--num=1,2", "--den=1,1", "--out", d / "o.csv", "--quiet"], expect=(0,))
     if which == "bom_json":
         f = d / "p.json"
         f.write_bytes(bom + json.dumps(_params_record()).encode())
