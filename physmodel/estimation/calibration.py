@@ -79,7 +79,7 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
               free: Sequence[FreeParameter | str], *, kind: str = "actuator", quantity: str | None = None,
               starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
               identify: bool = True, hold_undetermined: bool = True, name: str | None = None,
-              progress: Callable[[int], None] | None = None, accept_misfit: bool = False,
+              progress: Callable[[int], None] | None = None, misfit: str = "widen",
               **kwargs) -> CalibrationResult:
     """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
 
@@ -95,10 +95,13 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
 
     Goodness of fit (``result.goodness_of_fit``, :func:`~physmodel.estimation.residuals.goodness_of_fit`):
     when the cost is inconsistent with its χ² expectation (declared noise) or implies implausible
-    noise (estimated noise), the result says so (``adequate`` False, message) and its intervals are
-    withheld (NaN) and no parameter is reported as identifiable; with ``accept_misfit`` the
-    intervals are instead widened by the Birge ratio sqrt(χ²/dof).
+    noise (estimated noise), the result says so (``adequate`` False, message), no parameter is
+    reported as identifiable, and its intervals are widened by the Birge ratio sqrt(χ²/dof)
+    (``misfit="widen"``, the default) or withheld as NaN (``misfit="withhold"``, what ``ipmc
+    calibrate`` does unless ``--accept-misfit``).
     """
+    if misfit not in ("widen", "withhold"):
+        raise ParameterError(f"misfit must be 'widen' or 'withhold', got {misfit!r}")
     if not isinstance(base, IPMCParameters):
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
     data = merge_sweeps(data)
@@ -130,13 +133,13 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
     res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
                          "data_fingerprint": data.fingerprint(), "seed": seed})
     if not res.adequate:
-        apply_misfit_policy(res, accept_misfit)
+        apply_misfit_policy(res, widen=misfit == "widen")
     return res
 
 
-def apply_misfit_policy(res: CalibrationResult, accept_misfit: bool) -> CalibrationResult:
-    """For a result whose model does not fit its data: withhold the intervals (NaN) and the
-    identifiability verdicts, or with ``accept_misfit`` widen the intervals by the Birge ratio
+def apply_misfit_policy(res: CalibrationResult, widen: bool) -> CalibrationResult:
+    """For a result whose model does not fit its data: no identifiability verdict, and the
+    intervals withheld (NaN) or, with ``widen``, widened by the Birge ratio
     R = sqrt(χ²/dof) (in the fitted scale: log parameters multiplicatively).  In place; returned."""
     gof = res.goodness_of_fit
     R = math.sqrt(gof.reduced_chi2) if gof.reduced_chi2 > 0 and math.isfinite(gof.reduced_chi2) else float("nan")
@@ -144,7 +147,7 @@ def apply_misfit_policy(res: CalibrationResult, accept_misfit: bool) -> Calibrat
         if n in res.held:
             continue
         v, lo, hi = res.values[n], res.ci_lower[n], res.ci_upper[n]
-        if accept_misfit and math.isfinite(R):
+        if widen and math.isfinite(R):
             if fp.scale == "log" and v != 0 and lo * v > 0 and hi * v > 0:
                 lo, hi = v * (lo / v) ** R, v * (hi / v) ** R
             else:
@@ -155,7 +158,7 @@ def apply_misfit_policy(res: CalibrationResult, accept_misfit: bool) -> Calibrat
             res.ci_lower[n] = res.ci_upper[n] = res.stderr[n] = float("nan")
         res.identifiability[n] = Identifiability(False, "not assessed: the model does not fit the data (" + gof.reason + ")")
     res.message += ("; MODEL INADEQUATE: " + gof.reason
-                    + ("; intervals widened by the Birge ratio %.3g" % R if accept_misfit else "; intervals withheld"))
+                    + ("; intervals widened by the Birge ratio %.3g" % R if widen else "; intervals withheld"))
     return res
 
 

@@ -113,7 +113,8 @@ def run(args) -> int:
     try:
         res = calibrate(data, base, free, kind=args.kind, quantity=args.quantity, kernel=args.kernel,
                         starts=args.starts, seed=args.seed, max_nfev=args.max_nfev,
-                        hold_undetermined=not args.no_hold, name=args.name, accept_misfit=args.accept_misfit,
+                        hold_undetermined=not args.no_hold, name=args.name,
+                        misfit="widen" if args.accept_misfit else "withhold",
                         progress=bar.update if bar is not None else None)
     finally:
         if bar is not None:

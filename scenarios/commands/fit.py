@@ -129,6 +129,8 @@ def run(args) -> int:
             if not np.any(np.isclose(temps, t)):
                 raise ValueError(f"--exclude {t:g}: no data at that temperature (have {temps.tolist()})")
         keep = ~np.any(np.isclose(data.temperature_c[:, None], excl[None, :]), axis=1) if excl.size else np.ones(data.n, bool)
+        if not keep.any():
+            raise ValueError(f"--exclude {sorted(set(args.exclude))} leaves no temperature to fit (have {temps.tolist()})")
         fit_data = data.select(keep)
         fit_temps = fit_data.temperatures()
         if fit_temps.size == 1:

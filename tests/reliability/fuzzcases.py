@@ -584,7 +584,8 @@ def gen_scenario(rnd: random.Random, d: Path) -> Case:
             return "no report.md after a check that divides by zero"
         return ""
 
-    return Case("scenario", edit, ["run", f, "--out", out, "--quiet"], expect=expect, tokens=(key,), post=post)
+    tokens = ("n_zeros", "n_poles") if edit == "orders_0_0" else (key,)
+    return Case("scenario", edit, ["run", f, "--out", out, "--quiet"], expect=expect, tokens=tokens, post=post)
 
 
 def gen_scenario_name(rnd: random.Random, d: Path) -> Case:
@@ -676,9 +677,11 @@ def gen_cli_options(rnd: random.Random, d: Path) -> Case:
         return Case("cli_options", edit, ["sweep", "--points", 10 ** 9, "--out", d / "o.csv", "--quiet"],
                     tokens=("--points", "points"))
     if edit == "temps_cold":
-        return Case("cli_options", edit, sweep[:3] + ["-300", "--out", d / "o.csv", "--quiet"], tokens=("-300",))
+        return Case("cli_options", edit, ["sweep", "--points", 4, "--temperatures=-300", "--out", d / "o.csv", "--quiet"],
+                    tokens=("-300",))
     if edit == "temps_text":
-        return Case("cli_options", edit, sweep[:3] + ["20,abc", "--out", d / "o.csv", "--quiet"], tokens=("--temperatures",))
+        return Case("cli_options", edit, ["sweep", "--points", 4, "--temperatures", "20,abc", "--out", d / "o.csv",
+                                          "--quiet"], tokens=("--temperatures",))
     if edit == "sigma_neg":
         return Case("cli_options", edit, sweep + ["--noise", "magphase", "--sigma-db", "-1", "--seed", 1, "--out",
                                                   d / "o.csv"], tokens=("sigma",))
