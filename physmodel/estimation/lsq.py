@@ -97,6 +97,8 @@ def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
 
     if n <= 0:
         return np.empty((0, len(free)))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be a non-negative integer, got {seed!r}")
     u = qmc.LatinHypercube(d=len(free), seed=seed).random(n)
     lo = np.array([fp.z_bounds[0] for fp in free])
     hi = np.array([fp.z_bounds[1] for fp in free])
