@@ -57,6 +57,24 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """Run one ``ipmc`` command; returns its exit code.
+
+    SIGINT and SIGTERM are recorded and raise ``KeyboardInterrupt`` (:mod:`physmodel.interrupts`)
+    for the whole command, so an interrupt that a solver swallows (CasADi/IPOPT catches it and
+    reports a failed solve) still ends the command with 130: the runner checks between steps and
+    :func:`~physmodel.data.files.atomic_write` refuses to commit a file once one was recorded.
+    """
+    from physmodel import interrupts
+
+    with interrupts.handling():
+        code = _main(argv)
+        if interrupts.requested() is not None and code != EXIT_INTERRUPTED:
+            print("ipmc: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        return code
+
+
+def _main(argv) -> int:
     from physmodel.errors import IPMCError
 
     ap = build_parser()
