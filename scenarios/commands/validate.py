@@ -34,6 +34,9 @@ def run(args) -> int:
     if out.exists() and not out.is_dir():
         raise IPMCError(f"--out {out} exists and is not a folder")
     n = len(published_claims(load_published(args.published)))
+    if n == 0:
+        raise IPMCError(f"--published {args.published}: no claims found (expected tables like [sensor_seed000] "
+                        "with printed numbers)")
     bar = None
     if not args.quiet:
         from tqdm import tqdm

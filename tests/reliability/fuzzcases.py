@@ -226,7 +226,7 @@ def gen_encoding(rnd: random.Random, d: Path) -> Case:
                 "study": 'name = "s"\n' if False else '[study]\nkind = "actuator"\nset = "dev"\nseed = 1\n'
                          'temperatures_c = [20.0]\nsamples = 2\n[study.parameters.d]\ndistribution = "uniform"\n'
                          'low = 1e-11\nhigh = 2e-11\n',
-                "diagnose": f'data = "sweep.csv"\nkind = "actuator"\nset = "seed002_table3"\n'}[target].encode()
+                "diagnose": 'data = "sweep.csv"\nkind = "actuator"\nset = "seed002_table3"\n'}[target].encode()
         if target == "diagnose":
             valid_sweep(d)
         pos = rnd.randrange(len(text) + 1)

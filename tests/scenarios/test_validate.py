@@ -203,3 +203,11 @@ def test_cli_bad_input(tmp_path, capsys):
     f = tmp_path / "file"
     f.write_text("x")
     assert main(["validate", "--out", str(f), "--quiet", "--published", _mini_toml(tmp_path)]) == 2
+
+
+def test_a_claims_file_without_claims_is_refused(tmp_path, capsys):
+    empty = tmp_path / "empty.toml"
+    empty.write_text("# nothing printed here\n")
+    assert main(["validate", "--published", str(empty), "--out", str(tmp_path / "v"), "--quiet"]) == 2
+    assert "no claims found" in capsys.readouterr().err
+    assert not (tmp_path / "v" / "validation.md").exists()
