@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import math
 import operator
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import MISSING, dataclass, field, fields, replace
 from typing import Any, Sequence
 
 import numpy as np
 
 from .errors import ParameterError
-from .temperature import FARADAY, LAW_PARAMETERS, R_GAS, TemperatureLaws, celsius_to_kelvin
+from .temperature import FARADAY, LAW_PARAMETERS, R_GAS, TemperatureLaws, celsius_to_kelvin, real_number
 
 #: (β1 L)² for the first clamped-free bending mode (β1 L = 1.8751...).
 BETA1L_SQ = 1.8751040687119611**2
@@ -127,6 +127,10 @@ class IPMCParameters:
 
     @classmethod
     def from_dict(cls, data: dict) -> "IPMCParameters":
+        """The record :meth:`to_dict` writes; a missing, unknown or non-numeric entry (``null``,
+        ``true``, ``"abc"``) is a ParameterError naming the key."""
+        if not isinstance(data, dict):
+            raise ParameterError(f"a parameter record must be an object, got {type(data).__name__}")
         data = dict(data)
         laws = data.pop("laws", None)
         if laws is not None and not isinstance(laws, TemperatureLaws):
@@ -135,9 +139,21 @@ class IPMCParameters:
         unknown = set(data) - names
         if unknown:
             raise ParameterError(f"unknown parameter(s) {sorted(unknown)} in parameter record")
+        required = [f.name for f in fields(cls) if f.default is MISSING and f.default_factory is MISSING]
+        missing = [k for k in required if k not in data]
+        if missing:
+            raise ParameterError(f"parameter record misses {missing} (SI values)")
+        out = {}
+        for k, v in data.items():
+            if k in ("name", "source"):
+                if not isinstance(v, str):
+                    raise ParameterError(f"{k}: expected a string, got {v!r}")
+                out[k] = v
+            else:
+                out[k] = real_number(v, f"{k} [{cls.__dataclass_fields__[k].metadata['unit']}]")
         if laws is not None:
-            data["laws"] = laws
-        return cls(**{k: (float(v) if k not in ("name", "source", "laws") else v) for k, v in data.items()})
+            out["laws"] = laws
+        return cls(**out)
 
     @staticmethod
     def units() -> dict[str, str]:

@@ -160,7 +160,8 @@ class TimeRecord:
         """From ``{'time_s': t, '<name>_<unit>': samples, ...}`` (e.g. ``TimeSeries.columns()``)."""
         if TIME_COLUMN not in columns:
             raise DataFormatError(f"{where}no '{TIME_COLUMN}' column; found {list(columns)}")
-        chans, units = {}, {}
+        chans: dict[str, np.ndarray] = {}
+        units: dict[str, str] = {}
         for col, v in columns.items():
             if col == TIME_COLUMN:
                 continue

@@ -23,7 +23,7 @@ from scipy import constants
 
 import independent_generator as gen
 import independent_physics as ip
-import oracles
+import beam_circuit_oracles as oracles
 from physmodel import ActuatorModel, IPMCParameters
 
 HERE = Path(__file__).resolve().parent
@@ -267,7 +267,7 @@ def test_bad_labels_and_sizes():
 
 def test_generator_does_not_import_the_library_physics():
     """Only the output record may come from physmodel (``physmodel.data.sweep.FrequencySweep``)."""
-    for fname in ("independent_physics.py", "independent_generator.py", "oracles.py"):
+    for fname in ("independent_physics.py", "independent_generator.py", "beam_circuit_oracles.py"):
         tree = ast.parse((HERE / fname).read_text())
         for node in ast.walk(tree):
             if isinstance(node, ast.Import):
