@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import Plan
+from ._discrete import FOHFilter, Plan
 from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError, PreviewError
-from .split import InverseSplit, split_inverse
+from .split import DEFAULT_PREVIEW_TOL, InverseSplit, frequency_preview, split_inverse
 
 __all__ = [
     "InversionResult",
@@ -25,6 +25,9 @@ __all__ = [
     "decode_sensor",
     "feedforward",
     "resolve_preview",
+    "choose_preview",
+    "PreviewChoice",
+    "preview_rule",
     "sampling_interval",
     "DEFAULT_CHUNK",
 ]
@@ -71,11 +74,19 @@ class InversionResult(SampledRecord):
     r0 : float
         Real part of the least unstable inverse pole [1/s] (``inf`` if minimum phase).
     auto_preview_s : float
-        ``4/r0`` [s].
+        ``4/r0`` [s] (what the seed-000 rule ``preview="4/r0"`` uses; not the automatic preview).
     dt : float
         Sampling interval [s].
     split : InverseSplit
         The model pieces (polynomial part, feedthrough, stable and anti-stable realizations).
+    preview_rule : str
+        ``"auto"``, ``"4/r0"``, ``"inf"`` or ``"fixed"`` (a number of seconds was given).
+    preview_choice : PreviewChoice or None
+        For ``preview="auto"``: the tolerance, the achieved relative truncation error and
+        the bounds (see :func:`choose_preview`).
+    truncation_error, truncation_bound : float
+        Largest error the preview causes on this signal (exact) and its signal-independent
+        bound [output units].
     """
 
     input: np.ndarray
@@ -90,6 +101,26 @@ class InversionResult(SampledRecord):
     split: InverseSplit
     t0: float = 0.0
     time_stamps: np.ndarray | None = None
+    preview_rule: str = "fixed"
+    preview_choice: "PreviewChoice | None" = None
+
+    @cached_property
+    def truncation_error(self) -> float:
+        """Largest error the finite preview causes on this signal, ``max|y_Tp - y_inf|``
+        [output units] (exact for the sampled signal; 0 for infinite preview)."""
+        if self.preview_choice is not None:
+            return self.preview_choice.max_error
+        if self.preview_samples is None or self.split.n_unstable == 0:
+            return 0.0
+        plan = Plan(self.split, self.dt, None)
+        return float(np.max(np.abs(_truncation_errors(plan, self.input, [self.preview_samples])[0])))
+
+    @cached_property
+    def truncation_bound(self) -> float:
+        """Signal-independent bound on the preview error, ``tail_l1_norm(T_p) max|u|`` [output units]."""
+        if self.preview_samples is None:
+            return 0.0
+        return float(self.split.tail_l1_norm(self.preview_s)) * float(np.max(np.abs(self.input)))
 
 
     @cached_property
@@ -153,55 +184,216 @@ def sampling_interval(t: Any) -> float:
     return float(dt)
 
 
-def resolve_preview(preview: Any, split_or_auto: InverseSplit | float, dt: float,
-                    n_samples: int | None = None) -> tuple[int | None, float]:
-    """Turn a ``preview`` argument into ``(samples or None, seconds)``.
+#: Names of the 4/r0 rule (seed paper 000's Zou-Devasia choice), kept for its experiments.
+RULE_4_OVER_R0 = ("4/r0", "4/r_0", "zou-devasia")
+_INF_NAMES = ("inf", "infinite", "infinity", "none")
 
-    Parameters
-    ----------
-    preview : "auto", "inf", None, float
-        ``"auto"``: ``4/r0`` (0 for a minimum-phase model); ``"inf"``, ``None`` or ``math.inf``:
-        infinite preview; a number: preview [s] (>= 0).
-    split_or_auto : InverseSplit or float
-        Split (its ``auto_preview_s`` is used) or the automatic preview itself [s].
-    dt : float
-        Sampling interval [s].  The preview is rounded to ``round(preview/dt)`` samples.
-    n_samples : int, optional
-        Record length; a preview longer than the record (``N > n_samples - 1``) is an error.
-    """
-    auto = split_or_auto.auto_preview_s if isinstance(split_or_auto, InverseSplit) else float(split_or_auto)
+
+def preview_rule(preview: Any) -> str:
+    """``"auto"``, ``"4/r0"``, ``"inf"`` or ``"fixed"`` for a ``preview`` argument."""
+    if preview is None:
+        return "inf"
     if isinstance(preview, str):
         key = preview.strip().lower()
         if key == "auto":
-            seconds = auto
-        elif key in ("inf", "infinite", "infinity", "none"):
-            return None, math.inf
-        else:
-            try:
-                seconds = float(key)
-            except ValueError:
-                raise PreviewError(
-                    f"preview must be 'auto', 'inf' or a number of seconds; got {preview!r}") from None
-    elif preview is None:
+            return "auto"
+        if key in RULE_4_OVER_R0:
+            return "4/r0"
+        if key in _INF_NAMES:
+            return "inf"
+    try:
+        if math.isinf(float(preview)):
+            return "inf"
+    except (TypeError, ValueError):
+        pass
+    return "fixed"
+
+
+def resolve_preview(preview: Any, split_or_auto: InverseSplit | float, dt: float,
+                    n_samples: int | None = None, *,
+                    tol: float = DEFAULT_PREVIEW_TOL) -> tuple[int | None, float]:
+    """Turn a ``preview`` argument into ``(samples or None, seconds)`` without looking at a signal.
+
+    Parameters
+    ----------
+    preview : "auto", "4/r0", "inf", None, float
+        ``"auto"``: the signal-independent tolerance rule :func:`inversion.split.frequency_preview`
+        over ``[0, pi/dt]`` (the smallest preview whose truncation error is below ``tol`` of
+        the inverse for every sinusoid up to the Nyquist frequency; :func:`invert` instead
+        chooses it for the signal at hand); ``"4/r0"``: the Zou–Devasia rule of seed paper 000
+        (too short for large anticausal residues, e.g. the seed 001 actuator surrogates);
+        ``"inf"``, ``None`` or ``math.inf``: infinite preview; a number: preview [s] (>= 0).
+    split_or_auto : InverseSplit or float
+        Split, or an automatic preview already chosen by the caller [s] (used for both
+        ``"auto"`` and ``"4/r0"``).
+    dt : float
+        Sampling interval [s].  The preview is rounded to ``round(preview/dt)`` samples.
+    n_samples : int, optional
+        Record length; a numeric or 4/r0 preview longer than the record (``N > n_samples - 1``)
+        is an error; an automatic preview is capped at the record (where it equals ``inf``).
+    tol : float
+        Relative truncation tolerance of ``"auto"``.
+    """
+    rule = preview_rule(preview)
+    if rule == "inf":
         return None, math.inf
+    split = split_or_auto if isinstance(split_or_auto, InverseSplit) else None
+    if rule == "auto":
+        if split is None:
+            seconds = float(split_or_auto)
+        else:
+            seconds, _ = frequency_preview(split, tol, omega_max=math.pi / dt)
+    elif rule == "4/r0":
+        seconds = split.auto_preview_s if split is not None else float(split_or_auto)
     else:
         try:
-            seconds = float(preview)
+            seconds = float(preview.strip() if isinstance(preview, str) else preview)
         except (TypeError, ValueError):
             raise PreviewError(
-                f"preview must be 'auto', 'inf' or a number of seconds; got {preview!r}") from None
+                f"preview must be 'auto', '4/r0', 'inf' or a number of seconds; got {preview!r}") from None
     if math.isnan(seconds) or seconds < 0:
-        raise PreviewError(f"preview must be >= 0 seconds (or 'auto'/'inf'); got {preview!r}")
-    if math.isinf(seconds):
-        return None, math.inf
+        raise PreviewError(f"preview must be >= 0 seconds (or 'auto'/'4/r0'/'inf'); got {preview!r}")
     n = int(round(seconds / dt))
     if n_samples is not None and n > n_samples - 1:
+        if rule == "auto":   # the whole record ahead: identical to the infinite preview
+            return n_samples - 1, (n_samples - 1) * dt
         raise PreviewError(
             f"preview {seconds:.6g} s ({n} samples at dt = {dt:.6g} s"
-            f"{', the automatic 4/r0 rule' if isinstance(preview, str) and preview.strip().lower() == 'auto' else ''})"
+            f"{', the 4/r0 rule' if rule == '4/r0' else ''})"
             f" is longer than the record ({n_samples} samples = {(n_samples - 1) * dt:.6g} s); "
-            "use a longer record, a shorter preview, or preview='inf'")
+            "use a longer record, a shorter preview, or preview='auto' or 'inf'")
     return n, n * dt
+
+
+def _truncation_errors(plan_inf: Plan, u: np.ndarray, N: np.ndarray) -> np.ndarray:
+    """Exact truncation error ``e_N[k] = (C_r Phi**N) x[k+N]`` of the sampled signal for each
+    preview ``N`` (rows), ``x`` the anticausal FOH state (see :mod:`inversion._discrete`)."""
+    Phi, al, be, Cr = plan_inf.anti_phi, plan_inf.anti_alpha, plan_inf.anti_beta, plan_inf.anti_C
+    n = u.size
+    ur = u[::-1]
+    out = np.zeros((len(N), n))
+    for row, Nk in enumerate(N):
+        Nk = int(Nk)
+        if Nk >= n:
+            continue
+        C2 = Cr @ np.linalg.matrix_power(Phi, Nk)
+        if not np.any(C2):
+            continue
+        f = FOHFilter.build(Phi, al, be, C2)
+        o2 = f.run(ur, f.zi0())[0][::-1]
+        out[row, :n - Nk] = o2[Nk:]
+    return out
+
+
+@dataclass(frozen=True)
+class PreviewChoice:
+    """How an automatic preview was chosen for one signal (see :func:`choose_preview`).
+
+    Attributes
+    ----------
+    samples : int
+        Preview [samples].
+    seconds : float
+        Preview [s].
+    tolerance : float
+        Requested bound on the truncation error relative to the full inverse.
+    norm : str
+        ``"linf"`` (max |e| / max |y_inf|) or ``"l2"`` (||e||_2 / ||y_inf||_2).
+    relative_error : float
+        Achieved truncation error in that norm (exact for the sampled signal).
+    max_error : float
+        Largest absolute truncation error [output units].
+    tail_bound : float
+        Signal-independent bound ``tail_l1_norm(T) * max|u|`` [output units].
+    rule_4_over_r0_s : float
+        What the 4/r0 rule would have chosen [s], for comparison.
+    """
+
+    samples: int
+    seconds: float
+    tolerance: float
+    norm: str
+    relative_error: float
+    max_error: float
+    tail_bound: float
+    rule_4_over_r0_s: float
+
+
+def choose_preview(split: InverseSplit, dt: float, u: Any, *, tol: float = DEFAULT_PREVIEW_TOL,
+                   norm: str = "linf") -> PreviewChoice:
+    """Smallest preview whose truncation error on the signal ``u`` is below ``tol``.
+
+    The error of a preview of ``N`` samples is computed exactly for the sampled signal
+    (``e_N = y_N - y_inf``, one extra filter pass per candidate) and measured relative to
+    the full (infinite-preview) inverse ``y_inf`` in the chosen norm.  Candidates are the
+    previews ``0, 0.25/r0, 0.5/r0, ...`` up to the signal-independent bound
+    ``tail_l1_norm(T) max|u| <= tol max|y_inf|``; the chosen one is the first candidate from
+    which every longer candidate also meets ``tol``, refined to the sample by bisection.
+
+    Parameters
+    ----------
+    split : InverseSplit
+    dt : float
+        Sampling interval [s].
+    u : array_like
+        The signal to invert.
+    tol : float
+        Tolerance on the relative truncation error (> 0).
+    norm : {"linf", "l2"}
+    """
+    if not (isinstance(tol, float | int) and math.isfinite(tol) and tol > 0):
+        raise PreviewError(f"preview_tol must be a positive number; got {tol!r}")
+    if norm not in ("linf", "l2"):
+        raise PreviewError(f"preview_norm must be 'linf' or 'l2'; got {norm!r}")
+    ua = _signal(u)
+    dt = sampling_interval(dt)
+    n = ua.size
+    if split.n_unstable == 0:
+        return PreviewChoice(0, 0.0, float(tol), norm, 0.0, 0.0, 0.0, 0.0)
+    plan = Plan(split, dt, None)
+    y_inf = np.empty(n)
+    plan.forward(ua, n, n, lambda c0, c1, y, _x: y_inf.__setitem__(slice(c0, c1), y), check=False)
+    plan.backward(ua, n, n, lambda c0, c1, y, _x: y_inf.__setitem__(slice(c0, c1), y_inf[c0:c1] + y))
+
+    def size(e: np.ndarray) -> np.ndarray:
+        return np.max(np.abs(e), axis=-1) if norm == "linf" else np.sqrt(np.sum(e * e, axis=-1))
+
+    ref = float(size(y_inf))
+    if ref == 0.0:
+        return PreviewChoice(0, 0.0, float(tol), norm, 0.0, 0.0, 0.0, split.auto_preview_s)
+    umax = float(np.max(np.abs(ua)))
+    # signal-independent upper end: the L1 tail bound (for linf) meets tol
+    cap_t = 100.0 / split.r0
+    grid_t = np.linspace(0.0, cap_t, 4001)
+    tb = split.tail_l1_norm(grid_t) * umax
+    ok = np.flatnonzero(tb <= tol * float(np.max(np.abs(y_inf))))
+    t_hi = grid_t[ok[0]] if ok.size else cap_t
+    n_hi = min(n - 1, int(math.ceil(t_hi / dt)))
+    step = max(1, int(round(0.25 / (split.r0 * dt))))
+    cand = np.unique(np.concatenate((np.arange(0, n_hi, step), [n_hi])))
+    rel = size(_truncation_errors(plan, ua, cand)) / ref
+    bad = np.flatnonzero(rel > tol)
+    if bad.size == 0:
+        N = 0
+    else:
+        j = int(bad[-1])
+        if j + 1 >= cand.size:      # only the whole record ahead meets tol
+            N = n - 1
+        else:
+            lo, hi = int(cand[j]), int(cand[j + 1])   # lo fails, hi meets tol
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if size(_truncation_errors(plan, ua, [mid]))[0] / ref <= tol:
+                    hi = mid
+                else:
+                    lo = mid
+            N = hi
+    e = _truncation_errors(plan, ua, [N])[0]
+    return PreviewChoice(
+        samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
+        relative_error=float(size(e)) / ref, max_error=float(np.max(np.abs(e))),
+        tail_bound=float(split.tail_l1_norm(N * dt)) * umax,
+        rule_4_over_r0_s=split.auto_preview_s)
 
 
 def _as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:
@@ -245,7 +437,8 @@ def _disc_estimate(split: InverseSplit, u: np.ndarray, n_preview: int | None) ->
 
 def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str = "error",
            filter_bandwidth: float | None = None, t0: float = 0.0,
-           chunk_size: int | None = None) -> InversionResult:
+           chunk_size: int | None = None, preview_tol: float = DEFAULT_PREVIEW_TOL,
+           preview_norm: str = "linf") -> InversionResult:
     """Stable inversion ``y = G^{-1}[u]`` of a uniformly sampled signal.
 
     Parameters
@@ -258,10 +451,14 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         Uniform time stamps [s] (checked), or the sampling interval ``dt`` [s].
     u : array_like
         Signal to invert (sensor output, or desired actuator output), same length as ``t``.
-    preview : "auto", "inf", None or float
-        Preview time [s] for the anticausal part: ``"auto"`` = ``4/r0`` (Zou–Devasia rule
-        used in seed 000), ``"inf"``/``None`` = full noncausal inverse, or a number of
-        seconds (rounded to whole samples).  Must not exceed the record.
+    preview : "auto", "4/r0", "inf", None or float
+        Preview time [s] for the anticausal part: ``"auto"`` = the smallest preview whose
+        truncation error on this signal is below ``preview_tol`` of the full inverse (see
+        :func:`choose_preview`; the result reports it in ``preview_choice``); ``"4/r0"`` =
+        the Zou–Devasia rule used in seed 000 (far too short when the anticausal residues
+        are large, as for the seed 001 actuator surrogates); ``"inf"``/``None`` = full
+        noncausal inverse; or a number of seconds (rounded to whole samples, must not
+        exceed the record).
     improper : {"error", "filter", "differentiate"}
         Handling of a strictly proper model (see :func:`inversion.split_inverse`).
     filter_bandwidth : float, optional
@@ -272,6 +469,10 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         Samples per processing chunk.  Default: the whole record in one chunk (the result
         arrays are O(n) anyway); see :func:`invert_to` for bounded-memory processing.  The
         result does not depend on it beyond rounding.
+    preview_tol : float
+        Tolerance of ``preview="auto"``: truncation error relative to the full inverse.
+    preview_norm : {"linf", "l2"}
+        Norm in which ``preview_tol`` is measured.
 
     Returns
     -------
@@ -287,7 +488,13 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     split = _as_split(model, improper, filter_bandwidth)
     ua = _signal(u)
     ta, dt = time_base(t, ua)
-    n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
+    rule = preview_rule(preview)
+    choice = None
+    if rule == "auto":
+        choice = choose_preview(split, dt, ua, tol=preview_tol, norm=preview_norm)
+        n_prev, prev_s = choice.samples, choice.seconds
+    else:
+        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
     plan = Plan(split, dt, n_prev)
     if chunk_size is None:
         chunk_size = ua.size
@@ -334,7 +541,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         input=ua, output=output, stable_part=stable, unstable_part=unstable,
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
-        time_stamps=ta)
+        time_stamps=ta, preview_rule=rule, preview_choice=choice)
 
 
 @dataclass(frozen=True)
