@@ -103,6 +103,7 @@ class InversionResult(SampledRecord):
     time_stamps: np.ndarray | None = None
     preview_rule: str = "fixed"
     preview_choice: "PreviewChoice | None" = None
+    limit_report: Any = None
 
     @cached_property
     def truncation_error(self) -> float:
@@ -616,20 +617,38 @@ def invert_to(model: Any, dt: float, u: Any, out: Any, *, preview: Any = "auto",
                                    r0=split.r0, chunk_size=int(chunk_size))
 
 
-def decode_sensor(model: Any, t: Any, current: Any, **kwargs: Any) -> InversionResult:
+def _with_limits(res: InversionResult, limits: Any, what: str, unit: str) -> InversionResult:
+    from dataclasses import replace
+
+    from .limits import check_limits
+
+    report = check_limits(res.output, res.dt, limits, t0=float(res.t[0]), what=what, unit=unit)
+    return replace(res, limit_report=report)
+
+
+def decode_sensor(model: Any, t: Any, current: Any, *, limits: Any = None,
+                  **kwargs: Any) -> InversionResult:
     """Sensor decoding: recover the stimulus (e.g. tip displacement) from the sensor output.
 
     ``model`` maps stimulus -> sensor output (seed 000: displacement [mm] -> short-circuit
-    current [uA]).  Same code path and keyword arguments as :func:`invert`.
+    current [uA]).  Same code path and keyword arguments as :func:`invert`.  ``limits``
+    (:class:`inversion.limits.Limits`, e.g. ``Limits(output_range=(-2, 2))`` in mm) refuses
+    or flags a decoded signal outside the range the strip can reach; the peaks are always in
+    ``result.limit_report``.
     """
-    return invert(model, t, current, **kwargs)
+    return _with_limits(invert(model, t, current, **kwargs), limits, "decoded signal", "")
 
 
-def feedforward(model: Any, t: Any, desired: Any, **kwargs: Any) -> InversionResult:
+def feedforward(model: Any, t: Any, desired: Any, *, limits: Any = None,
+                **kwargs: Any) -> InversionResult:
     """Actuator feedforward: the input (e.g. voltage) that makes the output follow ``desired``.
 
     ``model`` maps actuator input -> output (seed 001: voltage [V] -> tip displacement [mm]).
     Same code path and keyword arguments as :func:`invert`; ``result.output`` is the
-    feedforward input.
+    feedforward input.  ``limits`` (:class:`inversion.limits.Limits`, e.g.
+    ``Limits(max_voltage=2.5, max_rate=50)``) refuses (``LimitError``) or warns with the
+    first violating sample; ``result.limit_report`` holds the peak voltage and rate.
+    Build ``desired`` with :mod:`inversion.references` (fade-in and fade-out) so that the
+    noncausal inverse does not see a jump to zero at the record's ends.
     """
-    return invert(model, t, desired, **kwargs)
+    return _with_limits(invert(model, t, desired, **kwargs), limits, "feedforward voltage", "V")
