@@ -220,6 +220,6 @@ def to_data(data, temperature_c=None) -> FrequencyData:
         return FrequencyData(sw.frequency_hz, None, sw.response)
     if isinstance(data, dict | list | tuple) or is_frd(data):
         return from_sweep(as_sweep(data, temperature_c))
-    raise IPMCError(f"expected FrequencyData, a physmodel FrequencySweep, a control.FrequencyResponseData "
-                    f"(or a mapping {{temperature_c: FRD}}) or (frequency_hz, response) arrays; got "
-                    f"{type(data).__name__}")
+    raise IPMCError(f"expected FrequencyData or a physmodel FrequencySweep, got {type(data).__name__} "
+                    "(also accepted: a control.FrequencyResponseData, a mapping {temperature_c: FRD} or "
+                    "(frequency_hz, response) arrays)")
