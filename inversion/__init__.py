@@ -26,6 +26,10 @@ Batch inversion (:mod:`inversion.batch`)
     choose_preview(split, dt, u, tol=1e-3, norm="linf") -> PreviewChoice   (the "auto" rule)
     sampling_interval(t) -> dt (checks uniform sampling)
 
+Automatic preview (:mod:`inversion.preview`)
+    choose_preview(split, dt, u, tol=1e-3, norm="linf") -> PreviewChoice (samples, seconds,
+        relative_error, max_error, tail_bound, rule_4_over_r0_s); TruncationModes (exact e_N)
+
 Model split (:mod:`inversion.split`)
     split_inverse(model, *, improper="error", filter_bandwidth=None) -> InverseSplit
     InverseSplit (feedthrough, derivative_coefficients, A_s/B_s/C_s, A_u/B_u/C_u, r0,

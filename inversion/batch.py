@@ -14,8 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import FOHFilter, Plan
+from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError, PreviewError
+from .preview import PreviewChoice, TruncationModes, choose_preview
 from .split import DEFAULT_PREVIEW_TOL, InverseSplit, frequency_preview, split_inverse
 
 __all__ = [
@@ -113,8 +114,8 @@ class InversionResult(SampledRecord):
             return self.preview_choice.max_error
         if self.preview_samples is None or self.split.n_unstable == 0:
             return 0.0
-        plan = Plan(self.split, self.dt, None)
-        return float(np.max(np.abs(_truncation_errors(plan, self.input, [self.preview_samples])[0])))
+        modes = TruncationModes(self.split, self.dt, self.input)
+        return float(np.max(np.abs(modes.error(self.preview_samples))))
 
     @cached_property
     def truncation_bound(self) -> float:
@@ -266,137 +267,6 @@ def resolve_preview(preview: Any, split_or_auto: InverseSplit | float, dt: float
     return n, n * dt
 
 
-def _truncation_errors(plan_inf: Plan, u: np.ndarray, N: np.ndarray) -> np.ndarray:
-    """Exact truncation error ``e_N[k] = (C_r Phi**N) x[k+N]`` of the sampled signal for each
-    preview ``N`` (rows), ``x`` the anticausal FOH state (see :mod:`inversion._discrete`)."""
-    Phi, al, be, Cr = plan_inf.anti_phi, plan_inf.anti_alpha, plan_inf.anti_beta, plan_inf.anti_C
-    n = u.size
-    ur = u[::-1]
-    out = np.zeros((len(N), n))
-    for row, Nk in enumerate(N):
-        Nk = int(Nk)
-        if Nk >= n:
-            continue
-        C2 = Cr @ np.linalg.matrix_power(Phi, Nk)
-        if not np.any(C2):
-            continue
-        f = FOHFilter.build(Phi, al, be, C2)
-        o2 = f.run(ur, f.zi0())[0][::-1]
-        out[row, :n - Nk] = o2[Nk:]
-    return out
-
-
-@dataclass(frozen=True)
-class PreviewChoice:
-    """How an automatic preview was chosen for one signal (see :func:`choose_preview`).
-
-    Attributes
-    ----------
-    samples : int
-        Preview [samples].
-    seconds : float
-        Preview [s].
-    tolerance : float
-        Requested bound on the truncation error relative to the full inverse.
-    norm : str
-        ``"linf"`` (max |e| / max |y_inf|) or ``"l2"`` (||e||_2 / ||y_inf||_2).
-    relative_error : float
-        Achieved truncation error in that norm (exact for the sampled signal).
-    max_error : float
-        Largest absolute truncation error [output units].
-    tail_bound : float
-        Signal-independent bound ``tail_l1_norm(T) * max|u|`` [output units].
-    rule_4_over_r0_s : float
-        What the 4/r0 rule would have chosen [s], for comparison.
-    """
-
-    samples: int
-    seconds: float
-    tolerance: float
-    norm: str
-    relative_error: float
-    max_error: float
-    tail_bound: float
-    rule_4_over_r0_s: float
-
-
-def choose_preview(split: InverseSplit, dt: float, u: Any, *, tol: float = DEFAULT_PREVIEW_TOL,
-                   norm: str = "linf") -> PreviewChoice:
-    """Smallest preview whose truncation error on the signal ``u`` is below ``tol``.
-
-    The error of a preview of ``N`` samples is computed exactly for the sampled signal
-    (``e_N = y_N - y_inf``, one extra filter pass per candidate) and measured relative to
-    the full (infinite-preview) inverse ``y_inf`` in the chosen norm.  Candidates are the
-    previews ``0, 0.25/r0, 0.5/r0, ...`` up to the signal-independent bound
-    ``tail_l1_norm(T) max|u| <= tol max|y_inf|``; the chosen one is the first candidate from
-    which every longer candidate also meets ``tol``, refined to the sample by bisection.
-
-    Parameters
-    ----------
-    split : InverseSplit
-    dt : float
-        Sampling interval [s].
-    u : array_like
-        The signal to invert.
-    tol : float
-        Tolerance on the relative truncation error (> 0).
-    norm : {"linf", "l2"}
-    """
-    if not (isinstance(tol, float | int) and math.isfinite(tol) and tol > 0):
-        raise PreviewError(f"preview_tol must be a positive number; got {tol!r}")
-    if norm not in ("linf", "l2"):
-        raise PreviewError(f"preview_norm must be 'linf' or 'l2'; got {norm!r}")
-    ua = _signal(u)
-    dt = sampling_interval(dt)
-    n = ua.size
-    if split.n_unstable == 0:
-        return PreviewChoice(0, 0.0, float(tol), norm, 0.0, 0.0, 0.0, 0.0)
-    plan = Plan(split, dt, None)
-    y_inf = np.empty(n)
-    plan.forward(ua, n, n, lambda c0, c1, y, _x: y_inf.__setitem__(slice(c0, c1), y), check=False)
-    plan.backward(ua, n, n, lambda c0, c1, y, _x: y_inf.__setitem__(slice(c0, c1), y_inf[c0:c1] + y))
-
-    def size(e: np.ndarray) -> np.ndarray:
-        return np.max(np.abs(e), axis=-1) if norm == "linf" else np.sqrt(np.sum(e * e, axis=-1))
-
-    ref = float(size(y_inf))
-    if ref == 0.0:
-        return PreviewChoice(0, 0.0, float(tol), norm, 0.0, 0.0, 0.0, split.auto_preview_s)
-    umax = float(np.max(np.abs(ua)))
-    # signal-independent upper end: the L1 tail bound (for linf) meets tol
-    cap_t = 100.0 / split.r0
-    grid_t = np.linspace(0.0, cap_t, 4001)
-    tb = split.tail_l1_norm(grid_t) * umax
-    ok = np.flatnonzero(tb <= tol * float(np.max(np.abs(y_inf))))
-    t_hi = grid_t[ok[0]] if ok.size else cap_t
-    n_hi = min(n - 1, int(math.ceil(t_hi / dt)))
-    step = max(1, int(round(0.25 / (split.r0 * dt))))
-    cand = np.unique(np.concatenate((np.arange(0, n_hi, step), [n_hi])))
-    rel = size(_truncation_errors(plan, ua, cand)) / ref
-    bad = np.flatnonzero(rel > tol)
-    if bad.size == 0:
-        N = 0
-    else:
-        j = int(bad[-1])
-        if j + 1 >= cand.size:      # only the whole record ahead meets tol
-            N = n - 1
-        else:
-            lo, hi = int(cand[j]), int(cand[j + 1])   # lo fails, hi meets tol
-            while hi - lo > 1:
-                mid = (lo + hi) // 2
-                if size(_truncation_errors(plan, ua, [mid]))[0] / ref <= tol:
-                    hi = mid
-                else:
-                    lo = mid
-            N = hi
-    e = _truncation_errors(plan, ua, [N])[0]
-    return PreviewChoice(
-        samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
-        relative_error=float(size(e)) / ref, max_error=float(np.max(np.abs(e))),
-        tail_bound=float(split.tail_l1_norm(N * dt)) * umax,
-        rule_4_over_r0_s=split.auto_preview_s)
-
-
 def _as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:
     if isinstance(model, InverseSplit):
         return model
@@ -492,7 +362,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     rule = preview_rule(preview)
     choice = None
     if rule == "auto":
-        choice = choose_preview(split, dt, ua, tol=preview_tol, norm=preview_norm)
+        choice = choose_preview(split, dt, ua, tol=preview_tol, norm=preview_norm, checked=True)
         n_prev, prev_s = choice.samples, choice.seconds
     else:
         n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
