@@ -33,7 +33,6 @@ from physmodel.errors import IPMCError
 from ._data import FrequencyData, to_data
 from ._fit import per_temperature_errors
 from ._nlp import ConvergenceError
-from .metrics import relative_rms_error
 
 __all__ = ["ScheduleWarning", "HeldOutError", "CrossValidation", "DegreeSelection", "DenseCheck",
            "ScheduleCheck", "cross_validate", "select_degree", "dense_check", "physics_reference",

@@ -155,7 +155,7 @@ def run(args) -> int:
              f"(limits: max_voltage {args.max_voltage}, max_rate {args.max_rate})"]
     disc = ff.discretisation_error_estimate * v_scale
     lines.append(f"- sampling: discretisation error of the inverse <= {disc:.3g} V at {1 / ref.dt:g} Hz"
-                 + (f" — **more than 1 % of the peak voltage: sample faster (--fs)**"
+                 + (" — **more than 1 % of the peak voltage: sample faster (--fs)**"
                     if disc > 0.01 * ff.limit_report.peak * v_scale else ""))
     if not ff.limit_report.ok:
         lines.append(f"- **LIMIT VIOLATED**: {ff.limit_report.message}")

@@ -8,10 +8,10 @@ unfaded reference compared with the faded one through the same inverse.
 import numpy as np
 import pytest
 
-from inversion import feedforward, decode_sensor
+from inversion import decode_sensor, feedforward
+from inversion import references as R
 from inversion.examples import toy_actuator
 from inversion.limits import LimitError, Limits, LimitWarning, check_limits
-from inversion import references as R
 from physmodel.errors import IPMCError
 
 DT = 1e-3

@@ -78,7 +78,7 @@ def test_feedforward_writes_voltage_checks_it_and_simulate_reproduces_it(model_j
 
 
 def test_voltage_over_the_limit_is_refused_with_the_first_sample(model_json, tmp_path, capsys):
-    path, _, model = model_json
+    path, _, _ = model_json
     out = tmp_path / "refused"
     rc = _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency", "1",
                "--max-voltage", "0.2", "--no-check", "--out", str(out)])
