@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 
 from ._discrete import Plan
-from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError, PreviewError
-from .preview import PreviewChoice, TruncationModes, choose_preview
-from .split import DEFAULT_PREVIEW_TOL, InverseSplit, frequency_preview, split_inverse
+from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
+from .preview import PreviewChoice, TruncationModes, choose_preview, preview_rule, resolve_preview
+from .split import DEFAULT_PREVIEW_TOL, InverseSplit, split_inverse
 
 __all__ = [
     "InversionResult",
@@ -184,87 +184,6 @@ def sampling_interval(t: Any) -> float:
             f"differs from the mean step {dt!r} s by {dev[i]:.3g} s (> {UNIFORM_RTOL:g} relative);"
             " resample the signal onto a uniform grid first")
     return float(dt)
-
-
-#: Names of the 4/r0 rule (seed paper 000's Zou-Devasia choice), kept for its experiments.
-RULE_4_OVER_R0 = ("4/r0", "4/r_0", "zou-devasia")
-_INF_NAMES = ("inf", "infinite", "infinity", "none")
-
-
-def preview_rule(preview: Any) -> str:
-    """``"auto"``, ``"4/r0"``, ``"inf"`` or ``"fixed"`` for a ``preview`` argument."""
-    if preview is None:
-        return "inf"
-    if isinstance(preview, str):
-        key = preview.strip().lower()
-        if key == "auto":
-            return "auto"
-        if key in RULE_4_OVER_R0:
-            return "4/r0"
-        if key in _INF_NAMES:
-            return "inf"
-    try:
-        if math.isinf(float(preview)):
-            return "inf"
-    except (TypeError, ValueError):
-        pass
-    return "fixed"
-
-
-def resolve_preview(preview: Any, split_or_auto: InverseSplit | float, dt: float,
-                    n_samples: int | None = None, *,
-                    tol: float = DEFAULT_PREVIEW_TOL) -> tuple[int | None, float]:
-    """Turn a ``preview`` argument into ``(samples or None, seconds)`` without looking at a signal.
-
-    Parameters
-    ----------
-    preview : "auto", "4/r0", "inf", None, float
-        ``"auto"``: the signal-independent tolerance rule :func:`inversion.split.frequency_preview`
-        over ``[0, pi/dt]`` (the smallest preview whose truncation error is below ``tol`` of
-        the inverse for every sinusoid up to the Nyquist frequency; :func:`invert` instead
-        chooses it for the signal at hand); ``"4/r0"``: the Zou–Devasia rule of seed paper 000
-        (too short for large anticausal residues, e.g. the seed 001 actuator surrogates);
-        ``"inf"``, ``None`` or ``math.inf``: infinite preview; a number: preview [s] (>= 0).
-    split_or_auto : InverseSplit or float
-        Split, or an automatic preview already chosen by the caller [s] (used for both
-        ``"auto"`` and ``"4/r0"``).
-    dt : float
-        Sampling interval [s].  The preview is rounded to ``round(preview/dt)`` samples.
-    n_samples : int, optional
-        Record length; a numeric or 4/r0 preview longer than the record (``N > n_samples - 1``)
-        is an error; an automatic preview is capped at the record (where it equals ``inf``).
-    tol : float
-        Relative truncation tolerance of ``"auto"``.
-    """
-    rule = preview_rule(preview)
-    if rule == "inf":
-        return None, math.inf
-    split = split_or_auto if isinstance(split_or_auto, InverseSplit) else None
-    if rule == "auto":
-        if split is None:
-            seconds = float(split_or_auto)
-        else:
-            seconds, _ = frequency_preview(split, tol, omega_max=math.pi / dt)
-    elif rule == "4/r0":
-        seconds = split.auto_preview_s if split is not None else float(split_or_auto)
-    else:
-        try:
-            seconds = float(preview.strip() if isinstance(preview, str) else preview)
-        except (TypeError, ValueError):
-            raise PreviewError(
-                f"preview must be 'auto', '4/r0', 'inf' or a number of seconds; got {preview!r}") from None
-    if math.isnan(seconds) or seconds < 0:
-        raise PreviewError(f"preview must be >= 0 seconds (or 'auto'/'4/r0'/'inf'); got {preview!r}")
-    n = int(round(seconds / dt))
-    if n_samples is not None and n > n_samples - 1:
-        if rule == "auto":   # the whole record ahead: identical to the infinite preview
-            return n_samples - 1, (n_samples - 1) * dt
-        raise PreviewError(
-            f"preview {seconds:.6g} s ({n} samples at dt = {dt:.6g} s"
-            f"{', the 4/r0 rule' if rule == '4/r0' else ''})"
-            f" is longer than the record ({n_samples} samples = {(n_samples - 1) * dt:.6g} s); "
-            "use a longer record, a shorter preview, or preview='auto' or 'inf'")
-    return n, n * dt
 
 
 def _as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:
