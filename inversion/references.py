@@ -297,12 +297,24 @@ def from_file(path: Any, *, column: str | None = None, fade_in_s: float = 0.0, f
 
 
 def edge_jump(y: Any) -> float:
-    """``max(|y[0]|, |y[-1]|) / max|y|``: how far a record is from rest at its ends (0 = at rest)."""
+    """How abruptly a record leaves and returns to rest (0 = smoothly, 1 = a full jump or kink).
+
+    The larger of ``|y|`` at the first and last nonzero samples relative to ``max|y|`` (a jump
+    from or to zero, including at the record's ends, where the inverse sees the signal drop to
+    zero) and the first differences there relative to the largest one (a kink: a sine started at
+    zero with its full slope).  A faded reference scores ~1e-6 or less.
+    """
     ya = np.asarray(y, dtype=float)
-    peak = float(np.max(np.abs(ya))) if ya.size else 0.0
-    if peak == 0.0:
+    nz = np.flatnonzero(ya)
+    if nz.size == 0:
         return 0.0
-    return max(abs(float(ya[0])), abs(float(ya[-1]))) / peak
+    peak = float(np.max(np.abs(ya)))
+    ext = np.concatenate(([0.0], ya, [0.0]))            # rest beyond both ends
+    d = np.abs(np.diff(ext))
+    i0, i1 = int(nz[0]), int(nz[-1])
+    value = max(abs(float(ya[i0])), abs(float(ya[i1]))) / peak
+    kink = max(d[i0 + 1], d[i1]) / float(np.max(d)) if ya.size > 1 else 0.0
+    return max(value, kink)
 
 
 def read_columns(path: Any) -> dict[str, np.ndarray]:

@@ -131,6 +131,13 @@ def run(args) -> int:
         raise CLIError(f"{args.surrogate}: expected an actuator surrogate (length per voltage), got "
                        f"{out_unit}/{in_unit}")
     ref = build_reference(args, out_unit)
+    from inversion.references import edge_jump
+
+    jump = edge_jump(ref.y)
+    if jump > 0.01:
+        print(f"ipmc feedforward: warning: the reference is at {100 * jump:.0f} % of its peak at a record end; "
+              "the noncausal inverse sees a jump to zero there (a voltage spike): use --fade and --lead/--tail",
+              file=sys.stderr)
     v_scale = unit_scale(in_unit)                       # surrogate input unit -> V
     limits = Limits(max_voltage=args.max_voltage / v_scale if args.max_voltage else None,
                     max_rate=args.max_rate / v_scale if args.max_rate else None, action=args.on_limit)
@@ -157,6 +164,8 @@ def run(args) -> int:
     lines.append(f"- sampling: discretisation error of the inverse <= {disc:.3g} V at {1 / ref.dt:g} Hz"
                  + (" — **more than 1 % of the peak voltage: sample faster (--fs)**"
                     if disc > 0.01 * ff.limit_report.peak * v_scale else ""))
+    if jump > 0.01:
+        lines.append(f"- **the reference ends away from rest ({100 * jump:.0f} % of its peak): expect spikes at the ends**")
     if not ff.limit_report.ok:
         lines.append(f"- **LIMIT VIOLATED**: {ff.limit_report.message}")
     status = EXIT_OK

@@ -74,7 +74,8 @@ def test_feedforward_and_decode_apply_limits():
 def test_sine_reference_fades_smoothly_to_rest():
     ref = R.sine(0.3, 1.0, 8.0, 1 / DT, lead_s=1.0, tail_s=1.5, unit="mm")
     t, y = ref.t, ref.y
-    assert t[-1] == pytest.approx(1.0 + 8.0 + 1.5) and R.edge_jump(y) == 0.0
+    assert t[-1] == pytest.approx(1.0 + 8.0 + 1.5) and R.edge_jump(y) < 1e-6
+    assert R.edge_jump(np.sin(2 * np.pi * t)) > 0.99                  # starts with its full slope
     assert np.all(y[t <= 1.0] == 0) and np.all(y[t >= 9.0] == 0)
     body = ref.body
     np.testing.assert_allclose(y[body], 0.3 * np.sin(2 * np.pi * (t[body] - 1.0)), atol=1e-12)

@@ -100,7 +100,7 @@ def test_voltage_over_the_limit_is_refused_with_the_first_sample(model_json, tmp
     assert "LIMIT VIOLATED" in (warn / "report.md").read_text()
 
 
-def test_reference_kinds_and_file(model_json, tmp_path):
+def test_reference_kinds_and_file(model_json, tmp_path, capsys):
     path, _, _ = model_json
     for extra in (["--reference", "multitone", "--amplitude", "0.1,0.05", "--frequency", "0.5,2"],
                   ["--reference", "steps", "--levels", "0.1,-0.1", "--hold", "1"]):
@@ -116,6 +116,16 @@ def test_reference_kinds_and_file(model_json, tmp_path):
     assert _run(["feedforward", str(path), "--temperature", "40", "--reference-file", str(ref), "--fade", "1",
                  "--no-check", "--quiet", "--out", str(out)]) == EXIT_OK
     assert _cols(out / "voltage.csv")["reference_mm"].size == t.size + 2000     # 1 s rest each side
+    # a record that starts and ends mid-swing, not faded: warned about, and its end spike is refused
+    np.savetxt(ref, np.c_[t, 0.2 * np.cos(2 * np.pi * t)], delimiter=",", header="time_s,target_mm", comments="")
+    argv = ["feedforward", str(path), "--temperature", "40", "--reference-file", str(ref), "--no-check",
+            "--quiet", "--out", str(tmp_path / "abrupt")]
+    assert _run(argv) == EXIT_FAILED
+    err = capsys.readouterr().err
+    assert "100 % of its peak at a record end" in err and "refused" in err
+    with pytest.warns(UserWarning, match="beyond max_voltage"):
+        assert _run([*argv, "--on-limit", "warn"]) == EXIT_OK
+    assert "ends away from rest" in (tmp_path / "abrupt" / "report.md").read_text()
 
 
 @pytest.mark.parametrize("argv, match", [

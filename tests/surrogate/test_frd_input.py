@@ -72,3 +72,16 @@ def test_fitters_take_frds_and_arrays(sweep):
     np.testing.assert_allclose(sched.model.frequency_response(F_HZ, 33.0),
                                sched_ref.model.frequency_response(F_HZ, 33.0), rtol=1e-6)
     assert to_data(_frd(sweep, 25.0)).temperature_c is None
+
+
+def test_calibration_takes_frds_through_as_sweep(sweep):
+    from physmodel.estimation.calibration import calibrate
+
+    truth = physmodel.get_parameter_set("seed001_actuator")
+    prior = truth.replace(E=3.6e8)
+    frds = {T: _frd(sweep, T) for T in TEMPS}
+    a = calibrate(as_sweep(frds, input_name="voltage", input_unit="V", output_name="tip_displacement",
+                           output_unit="mm"), prior, ["E"], starts=1)
+    b = calibrate(sweep, prior, ["E"], starts=1)
+    assert a.converged and a.values["E"] == pytest.approx(b.values["E"], rel=1e-9)
+    assert a.values["E"] == pytest.approx(truth.E, rel=1e-4)          # noise-free: the truth
