@@ -160,6 +160,12 @@ def run(args) -> int:
              + f"; truncation error {ff.truncation_error * v_scale:.3g} V (bound {ff.truncation_bound * v_scale:.3g} V)",
              f"- peak voltage {ff.limit_report.peak * v_scale:.4g} V, peak rate {ff.limit_report.peak_rate * v_scale:.4g} V/s "
              f"(limits: max_voltage {args.max_voltage}, max_rate {args.max_rate})"]
+    trunc_rel = ff.truncation_error / max(ff.limit_report.peak, 1e-300)
+    if trunc_rel > 0.01:
+        lines.append(f"- **preview too short: it changes the voltage by {100 * trunc_rel:.0f} % of its peak "
+                     "(use --preview auto or inf)**")
+        print(f"ipmc feedforward: warning: the {ff.preview_s:.3g} s preview changes the voltage by "
+              f"{100 * trunc_rel:.0f} % of its peak; use --preview auto or inf", file=sys.stderr)
     disc = ff.discretisation_error_estimate * v_scale
     lines.append(f"- sampling: discretisation error of the inverse <= {disc:.3g} V at {1 / ref.dt:g} Hz"
                  + (" — **more than 1 % of the peak voltage: sample faster (--fs)**"

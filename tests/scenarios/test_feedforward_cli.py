@@ -148,3 +148,12 @@ def test_simulate_input_errors(tmp_path):
         _run(["simulate", "--input", str(bad), "--out", str(tmp_path / "o.csv")])
     with pytest.raises(IPMCError, match="not both"):
         _run(["simulate", "--input", str(bad), "--experiment", "step", "--out", str(tmp_path / "o.csv")])
+
+
+def test_a_too_short_preview_is_flagged(model_json, tmp_path, capsys):
+    path, _, _ = model_json
+    out = tmp_path / "short"
+    assert _run(["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", "--no-check", "--quiet",
+                 "--out", str(out)]) == EXIT_OK
+    assert "preview too short" in (out / "report.md").read_text()
+    assert "changes the voltage by" in capsys.readouterr().err
