@@ -153,7 +153,11 @@ def test_simulate_input_errors(tmp_path):
 def test_a_too_short_preview_is_flagged(model_json, tmp_path, capsys):
     path, _, _ = model_json
     out = tmp_path / "short"
+    # the 4/r0 rule asks this 4/4 surrogate for more than 3 V (refused by default); lift the limit
+    # to see the preview itself flagged
     assert _run(["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", "--no-check", "--quiet",
-                 "--out", str(out)]) == EXIT_OK
+                 "--out", str(out)]) == EXIT_FAILED
+    assert _run(["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", "--max-voltage", "100",
+                 "--no-check", "--quiet", "--out", str(out)]) == EXIT_OK
     assert "preview too short" in (out / "report.md").read_text()
     assert "changes the voltage by" in capsys.readouterr().err
