@@ -15,7 +15,9 @@ seed 001 physics).  This module measures what happens between:
   "between";
 * :func:`check_schedule` — both, and a :class:`ScheduleWarning` when the error between fit
   temperatures exceeds ``factor`` times the error at them (or cannot be verified), with the
-  physics-calibrated route proposed when there are few temperatures.
+  physics-calibrated route proposed when there are few temperatures;
+* :func:`fit_checked` — fit (optionally choosing the degree by cross-validation) and check, in
+  one call; ``.to_markdown()`` for a fit report.
 
 Errors are relative RMS errors ``sqrt(mean |H_model/H_ref - 1|^2)`` over the sweep's frequencies [-].
 """
@@ -36,7 +38,7 @@ from ._nlp import ConvergenceError
 
 __all__ = ["ScheduleWarning", "HeldOutError", "CrossValidation", "DegreeSelection", "DenseCheck",
            "ScheduleCheck", "cross_validate", "select_degree", "dense_check", "physics_reference",
-           "check_schedule", "PHYSICS_ROUTE", "FEW_TEMPERATURES"]
+           "check_schedule", "PHYSICS_ROUTE", "FEW_TEMPERATURES", "CheckedFit", "fit_checked"]
 
 #: At most this many fit temperatures counts as "few": the physics-calibrated route is proposed.
 FEW_TEMPERATURES = 5
@@ -419,3 +421,51 @@ class _Wrap:
     def __init__(self, model: Any):
         self.model = model
         self.converged = True
+
+
+@dataclass(frozen=True)
+class CheckedFit:
+    """A scheduled fit with its trust check (see :func:`fit_checked`).
+
+    Attributes
+    ----------
+    result : FitResult
+        The fit on all temperatures (with the chosen degree).
+    selection : DegreeSelection or None
+        The cross-validated degree choice (None when the template's degree was kept).
+    check : ScheduleCheck
+        Leave-one-temperature-out (and dense physics) check of ``result``.
+    """
+
+    result: Any
+    selection: DegreeSelection | None
+    check: ScheduleCheck
+
+    def to_markdown(self) -> str:
+        parts = []
+        if self.selection is not None:
+            parts += ["### Degree chosen by leave-one-temperature-out", "", self.selection.to_markdown()]
+        parts += ["### Error between fit temperatures", "", self.check.cv.to_markdown(),
+                  ("OK: " if self.check.ok else "**WARNING**: ") + self.check.message, ""]
+        return "\n".join(parts)
+
+
+def fit_checked(template: Any, data: Any, *, degrees=None, physics: Any = None, factor: float = 2.0,
+                warn: bool = True) -> CheckedFit:
+    """Fit a schedule and check it between its temperatures in one call.
+
+    ``degrees``: candidate degrees to choose from by cross-validation (:func:`select_degree`);
+    ``None`` keeps the template's degree.  ``physics``: the data's physics for the dense check
+    (see :func:`check_schedule`).  A failed check warns (:class:`ScheduleWarning`) unless
+    ``warn=False``; the verdict is in ``.check``.
+    """
+    data = to_data(data)
+    selection = None
+    if degrees is not None:
+        selection = select_degree(template, data, degrees)
+        result = selection.result
+        template = _clone(template, selection.best_degree)
+    else:
+        result = _fit(template, data)
+    check = check_schedule(template, data, result.model, physics=physics, factor=factor, warn=warn)
+    return CheckedFit(result, selection, check)

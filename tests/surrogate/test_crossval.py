@@ -116,3 +116,15 @@ def test_dense_check_against_a_reference(plant):
     assert dc.errors[3] == pytest.approx(_truth_error(plant, model, 40.0), rel=1e-9)
     with pytest.raises(IPMCError, match="shape"):
         dense_check(model, lambda f, T: np.ones((1, 1)), F_HZ, [25.0, 55.0])
+
+
+def test_fit_checked_chooses_the_degree_and_reports(plant):
+    sw = synthesize_sweep(plant, "M", F_HZ, [20.0, 30.0, 40.0, 50.0, 60.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        cf = surrogate.crossval.fit_checked(surrogate.ScheduledFit("coefficients", 3, 3, 2), sw,
+                                            degrees=(1, 2), physics=plant)
+    assert cf.result.model.structure.degree == cf.selection.best_degree == cf.check.cv.degree
+    assert cf.check.ok
+    md = cf.to_markdown()
+    assert "Degree chosen" in md and "OK:" in md
