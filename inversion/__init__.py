@@ -88,6 +88,8 @@ from .batch import (
     resolve_preview,
     sampling_interval,
 )
+from . import references
+from .limits import LimitError, Limits, LimitWarning, check_limits
 from .scheduled import (
     ScheduledInversionResult,
     ScheduledStreamingInverter,
@@ -100,6 +102,11 @@ from .streaming import StreamingInverter
 
 __all__ = [
     "DEFAULT_PREVIEW_TOL",
+    "LimitError",
+    "LimitWarning",
+    "Limits",
+    "check_limits",
+    "references",
     "PreviewChoice",
     "choose_preview",
     "frequency_preview",
