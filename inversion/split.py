@@ -340,18 +340,23 @@ class InverseSplit:
         """
         T = np.atleast_1d(np.asarray(preview_s, dtype=float))
         w = np.atleast_1d(np.asarray(omega, dtype=float))
+        out = self._truncation_terms(T, w)
+        if self.n_unstable:
+            out = out * np.exp(1j * np.outer(np.where(np.isfinite(T), T, 0.0), w))
+        return out[0] if np.ndim(preview_s) == 0 else out
+
+    def _truncation_terms(self, T: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``C_u (j w I - A_u)^{-1} exp(-A_u T) B_u`` (the truncation response without its unit-
+        modulus factor ``exp(j w T)``), shape (T.size, w.size)."""
         if self.n_unstable == 0:
-            out = np.zeros((T.size, w.size), complex)
-            return out[0] if np.ndim(preview_s) == 0 else out
+            return np.zeros((T.size, w.size), complex)
         n = self.n_unstable
         # rows R(w) = C_u (j w I - A_u)^{-1}, one batched solve (transpose system)
         lhs = (1j * w)[:, None, None] * np.eye(n) - self.A_u
         R = np.linalg.solve(np.transpose(lhs, (0, 2, 1)),
                             np.broadcast_to(self.C_u.astype(complex), (w.size, n))[..., None])[..., 0]
-        V = np.stack([sla.expm(-self.A_u * Ti) @ self.B_u if np.isfinite(Ti) else np.zeros(n)
-                      for Ti in T])                                   # (m, n)
-        out = (V @ R.T) * np.exp(1j * np.outer(np.where(np.isfinite(T), T, 0.0), w))
-        return out[0] if np.ndim(preview_s) == 0 else out
+        V = _propagate(-self.A_u, self.B_u, T)                           # (m, n)
+        return V @ R.T
 
 
 def _to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
@@ -387,6 +392,29 @@ def _abs_impulse(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[float, np
         filled += m
         P = P @ P
     return step, np.abs(xs @ C)
+
+
+def _propagate(M: np.ndarray, B: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """Rows ``exp(M T_i) B`` (0 for infinite ``T_i``).  A uniform grid starting at 0 is filled by
+    repeated multiplication with one ``exp(M step)`` (vectorised doubling); otherwise one matrix
+    exponential per entry."""
+    n = M.shape[0]
+    out = np.zeros((T.size, n))
+    fin = np.isfinite(T)
+    Tf = T[fin]
+    if Tf.size > 2 and Tf[0] == 0.0 and np.allclose(np.diff(Tf), Tf[1], rtol=1e-12, atol=0.0):
+        xs = np.empty((Tf.size, n))
+        xs[0] = B
+        filled, P = 1, sla.expm(M * Tf[1])
+        while filled < Tf.size:
+            m = min(filled, Tf.size - filled)
+            xs[filled:filled + m] = xs[:m] @ P.T
+            filled += m
+            P = P @ P
+        out[fin] = xs
+    else:
+        out[fin] = np.stack([sla.expm(M * Ti) @ B for Ti in Tf]) if Tf.size else np.zeros((0, n))
+    return out
 
 
 def _l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
@@ -615,7 +643,7 @@ def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
     w, H = w[keep], H[keep]
     step = 0.05 / split.r0
     T = step * np.arange(2001)                    # up to 100/r0 (exp(-100) of the kernel)
-    ratio = np.max(np.abs(split.truncation_response(T, w)) / H, axis=1)
+    ratio = np.max(np.abs(split._truncation_terms(T, w)) / H, axis=1)
     bad = np.flatnonzero(ratio > tol)
     if bad.size == 0:
         return 0.0, float(ratio[0])
