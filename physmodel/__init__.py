@@ -1,55 +1,74 @@
-"""physmodel — the Chen-Tan physics of IPMC actuators and sensors, with temperature laws.
+"""physmodel — the Chen–Tan physics of IPMC actuators and sensors, with temperature laws, and the
+estimation built on it (calibration, discrepancy workflow).
+
+Layers (each imports only those above it in this list)
+    sub-models     errors, params, temperature, transport, electrode, beam, numerics
+    models         protocol (the one model interface), model, actuator, sensor, reduced, parameter_paths
+    sets           parameter_sets (one module per source; the seeds' printed numbers)
+    data           data.units, data.sweep (the one FrequencySweep record), data.files, data.timesim
+    effects        effects (candidate physical and measurement-chain effects, composable with any model)
+    estimation     estimation.residuals, .records, .lsq, .calibration, .discrepancy
 
 Public API
 ----------
 Parameters
     IPMCParameters, get_parameter_set, available_parameter_sets, register_parameter_set,
-    state_at, describe
+    load_parameter_set, save_parameter_set, state_at, describe
 Temperature laws (physmodel.temperature)
     TemperatureLaws, Arrhenius, LogLinear, Linear, WaterPermittivity, IonicResistance, Constant,
     ISOTHERMAL
 Models (frequency domain, vectorised over sets × temperatures × frequencies)
+    FrequencyModel — the model protocol: ``kind`` and ``response(frequency_hz, temperature_c)``
     ActuatorModel  — Z, H, G, M = H·G, I = 1/Z          (physmodel.actuator)
     SensorModel    — S = I/w, Z; kernels "boundary_charge" | "reciprocal"   (physmodel.sensor)
     TransimpedanceChain — seed 000 measurement circuit
     FrequencyResponse — result record
-Reduced models
-    reduced_actuator (physmodel.reduced) — seed 002 §2.2.4 Taylor model as control.TransferFunction
-Sweeps and data files (physmodel.sweep)
-    FrequencySweep, synthesize_sweep, MagnitudePhaseNoise, ComplexGaussianNoise,
-    read_csv / write_csv, read_npz / write_npz, read_mat / write_mat
-Time-domain virtual experiments (physmodel.data.timesim)
-    realize, simulate, sine, step, free_release, TimeSeries
-Calibration (physmodel.estimation.calibration)
+Data (physmodel.data)
+    FrequencySweep, synthesize_sweep, MagnitudePhaseNoise, ComplexGaussianNoise, read_sweep,
+    write_sweep; time-domain experiments in physmodel.data.timesim (simulate, sine, step,
+    free_release, TimeSeries)
+Calibration (physmodel.estimation)
     calibrate, fit_parameters, FreeParameter, CalibrationResult — weighted multi-start least squares
     with confidence intervals, correlations and an identifiability report; ``ipmc calibrate``
 Discrepancy workflow (physmodel.effects, physmodel.estimation.discrepancy)
-    EffectModel, LIBRARY — named candidate effects (electrode/contact resistance, leakage, second mode,
-    fluid mass, temperature laws, water uptake, amplifier, delay, CPE, ...) composable with any model;
+    EffectModel, LIBRARY — named candidate effects composable with any model;
     diagnose, Diagnosis — locate, name, add and refit; ``ipmc diagnose``
-Errors (physmodel.errors)
-    IPMCError, ParameterError, TemperatureRangeError, DataFormatError
+Errors (physmodel.errors) — the library's one error root
+    IPMCError (a ValueError), ParameterError, TemperatureRangeError, DataFormatError
 
 Units: SI inside (rad/s, K, m, V, A); Hz and °C at the edges, as the argument names say.
 """
 
+__version__ = "0.1.0"
+
 from .errors import DataFormatError, IPMCError, ParameterError, TemperatureRangeError
 from .params import IPMCParameters, describe, state_at
-from .parameter_sets import available_parameter_sets, get_parameter_set, load_parameter_set, register_parameter_set, save_parameter_set
+from .parameter_sets import (available_parameter_sets, get_parameter_set, load_parameter_set,
+                             register_parameter_set, save_parameter_set)
 from .temperature import (ISOTHERMAL, Arrhenius, Constant, IonicResistance, Linear, LogLinear,
                           TemperatureLaws, WaterPermittivity)
+from .protocol import FrequencyModel, physics_model
 from .model import FrequencyResponse
 from .actuator import ActuatorModel
 from .sensor import SensorModel, TransimpedanceChain
-from .estimation.records import CalibrationResult, FreeParameter
+from .data import (ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, read_sweep, synthesize_sweep,
+                   write_sweep)
 from .estimation.calibration import calibrate
 from .estimation.lsq import fit_parameters
+from .estimation.records import CalibrationResult, FreeParameter
 from .effects import LIBRARY, EffectModel
 from .estimation.discrepancy import Diagnosis, diagnose
 
 __all__ = [
+    "__version__",
     "IPMCParameters", "describe", "state_at", "available_parameter_sets", "get_parameter_set",
-    "register_parameter_set", "load_parameter_set", "save_parameter_set", "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear",
-    "LogLinear", "WaterPermittivity", "ISOTHERMAL", "FrequencyResponse", "ActuatorModel", "SensorModel",
-    "TransimpedanceChain", "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult", "EffectModel", "LIBRARY", "diagnose", "Diagnosis", "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
+    "register_parameter_set", "load_parameter_set", "save_parameter_set",
+    "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear", "LogLinear", "WaterPermittivity",
+    "ISOTHERMAL",
+    "FrequencyModel", "physics_model", "FrequencyResponse", "ActuatorModel", "SensorModel", "TransimpedanceChain",
+    "FrequencySweep", "synthesize_sweep", "MagnitudePhaseNoise", "ComplexGaussianNoise", "read_sweep",
+    "write_sweep",
+    "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult",
+    "EffectModel", "LIBRARY", "diagnose", "Diagnosis",
+    "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
 ]

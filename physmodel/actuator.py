@@ -79,6 +79,9 @@ class ActuatorModel(PhysicsModel):
     (1, 2, 2)
     """
 
+    kind = "actuator"
+    primary_quantity = "M"
+
     quantities = ("Z", "H", "G", "M", "I")
     units = UNITS
     descriptions = DESCRIPTIONS

@@ -23,9 +23,31 @@ DEFAULT_CHUNK = 16384
 Kernel = Callable[[Mapping[str, np.ndarray], np.ndarray, Sequence[str]], dict]
 
 
+def real_array(values, name: str, unit: str) -> np.ndarray:
+    """``values`` as a float array; complex, boolean or non-numeric input is an IPMCError naming
+    ``name`` (numpy would silently drop an imaginary part)."""
+    a = np.asarray(values)
+    if a.dtype.kind not in "iuf":
+        what = "complex" if a.dtype.kind == "c" else ("boolean" if a.dtype.kind == "b" else f"{a.dtype}")
+        raise IPMCError(f"{name} must be real numbers [{unit}], got {what} values {a.reshape(-1)[:3].tolist()}")
+    return a.astype(float)
+
+
+def check_finite_output(values: Mapping[str, np.ndarray], f_hz: np.ndarray, T_c: np.ndarray) -> None:
+    """An IPMCError naming the frequencies and temperatures where a quantity is not finite (the
+    model overflows double precision far outside 1e-9–1e12 Hz), instead of NaN with a warning."""
+    for q, v in values.items():
+        bad = ~np.isfinite(v)
+        if bad.any():
+            _, it, jf = np.nonzero(bad)
+            raise IPMCError(f"{q} is not finite in double precision at frequency_hz {np.unique(f_hz[jf])[:3].tolist()} "
+                            f"and temperature_c {np.unique(T_c[it])[:3].tolist()}; the model is evaluated "
+                            "reliably over 1e-9–1e12 Hz")
+
+
 def check_frequencies(frequency_hz) -> np.ndarray:
-    """Validate a 1-D array of strictly positive, finite frequencies [Hz]."""
-    f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
+    """Validate a 1-D array of strictly positive, finite, real frequencies [Hz]."""
+    f = np.atleast_1d(real_array(frequency_hz, "frequency_hz", "Hz"))
     if f.ndim != 1:
         raise IPMCError(f"frequency_hz must be 1-D, got shape {f.shape}")
     if f.size == 0:
@@ -169,13 +191,27 @@ class PhysicsModel:
         s = check_s(s)
         return evaluate_grid(self.state(temperature_c), s, self._kernel, qs, self.chunk_size, out, progress)
 
+    #: The model kind (see :mod:`physmodel.protocol`); set by each subclass.
+    kind: str = ""
+    #: The primary quantity returned by :meth:`response`.
+    primary_quantity: str = ""
+
+    def response(self, frequency_hz, temperature_c) -> np.ndarray:
+        """The primary quantity (:attr:`primary_quantity`) of the first parameter set, shape
+        (n_T, n_f), at ``frequency_hz`` [Hz] and ``temperature_c`` [°C]; the model protocol
+        (:mod:`physmodel.protocol`).  [SI: m/V for an actuator, A/m for a sensor]"""
+        q = self.primary_quantity
+        return self.frequency_response(frequency_hz, np.atleast_1d(temperature_c), quantities=(q,))[q][0]
+
     def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
                            progress=None) -> FrequencyResponse:
         """Frequency responses at ``frequency_hz`` [Hz] and ``temperature_c`` [°C]."""
         qs = self._check_quantities(quantities or self.quantities)
         f = check_frequencies(frequency_hz)
-        T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
-        vals = evaluate_grid(self.state(T), 2j * np.pi * f, self._kernel, qs, self.chunk_size, out, progress)
+        T = np.atleast_1d(real_array(temperature_c, "temperature_c", "°C"))
+        with np.errstate(all="ignore"):       # overflow far outside the valid band: checked below
+            vals = evaluate_grid(self.state(T), 2j * np.pi * f, self._kernel, qs, self.chunk_size, out, progress)
+        check_finite_output(vals, f, T)
         return FrequencyResponse(
             frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
             values=vals, units={q: self.units[q] for q in qs},

@@ -133,7 +133,7 @@ def line_kernels(x, want_xcoth: bool = True):
     if small is not None and np.any(small):
         x2 = x[small] ** 2
         X[small] = _poly_x2(_X_COEF, x2)
-        if want_xcoth:
+        if want_xcoth and xcoth is not None:
             xcoth[small] = _poly_x2(_XCOTH_COEF, x2)
     return X, xcoth
 

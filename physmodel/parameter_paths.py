@@ -10,7 +10,7 @@ the command line address parameters through these functions only.
 from __future__ import annotations
 
 from dataclasses import fields, replace
-from typing import Mapping
+from typing import Any, Mapping
 
 from .errors import ParameterError
 from .params import IPMCParameters
@@ -61,7 +61,9 @@ def base_value(base: IPMCParameters, name: str) -> float:
 
 def apply_values(base: IPMCParameters, values: Values) -> IPMCParameters:
     """``base`` with parameters (fields, ``omega_n``, ``laws.<q>.<attr>``) replaced by ``values``."""
-    plain, law_changes, wn = {}, {}, None
+    plain: dict[str, Any] = {}
+    law_changes: dict[str, dict[str, float]] = {}
+    wn: float | None = None
     for name, v in values.items():
         if name.startswith("laws."):
             q, attr, _ = _law_target(base, name)

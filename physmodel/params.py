@@ -15,13 +15,14 @@ Named sets live in :mod:`physmodel.parameter_sets`; variants come from :meth:`IP
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+import operator
+from dataclasses import MISSING, dataclass, field, fields, replace
 from typing import Any, Sequence
 
 import numpy as np
 
 from .errors import ParameterError
-from .temperature import FARADAY, LAW_PARAMETERS, R_GAS, TemperatureLaws, celsius_to_kelvin
+from .temperature import FARADAY, LAW_PARAMETERS, R_GAS, TemperatureLaws, celsius_to_kelvin, real_number
 
 #: (β1 L)² for the first clamped-free bending mode (β1 L = 1.8751...).
 BETA1L_SQ = 1.8751040687119611**2
@@ -126,6 +127,10 @@ class IPMCParameters:
 
     @classmethod
     def from_dict(cls, data: dict) -> "IPMCParameters":
+        """The record :meth:`to_dict` writes; a missing, unknown or non-numeric entry (``null``,
+        ``true``, ``"abc"``) is a ParameterError naming the key."""
+        if not isinstance(data, dict):
+            raise ParameterError(f"a parameter record must be an object, got {type(data).__name__}")
         data = dict(data)
         laws = data.pop("laws", None)
         if laws is not None and not isinstance(laws, TemperatureLaws):
@@ -134,9 +139,21 @@ class IPMCParameters:
         unknown = set(data) - names
         if unknown:
             raise ParameterError(f"unknown parameter(s) {sorted(unknown)} in parameter record")
+        required = [f.name for f in fields(cls) if f.default is MISSING and f.default_factory is MISSING]
+        missing = [k for k in required if k not in data]
+        if missing:
+            raise ParameterError(f"parameter record misses {missing} (SI values)")
+        out = {}
+        for k, v in data.items():
+            if k in ("name", "source"):
+                if not isinstance(v, str):
+                    raise ParameterError(f"{k}: expected a string, got {v!r}")
+                out[k] = v
+            else:
+                out[k] = real_number(v, f"{k} [{cls.__dataclass_fields__[k].metadata['unit']}]")
         if laws is not None:
-            data["laws"] = laws
-        return cls(**{k: (float(v) if k not in ("name", "source", "laws") else v) for k, v in data.items()})
+            out["laws"] = laws
+        return cls(**out)
 
     @staticmethod
     def units() -> dict[str, str]:
@@ -211,6 +228,11 @@ def as_parameter_list(params) -> list[IPMCParameters]:
     return out
 
 
+#: The numeric fields ``state_at`` reads, fetched with one attribute getter per set.
+_NUMERIC_STATE = ("L", "W", "alpha0", "a0", "rho", "xi") + tuple(LAW_PARAMETERS)
+_FIELD_GETTER = operator.attrgetter(*_NUMERIC_STATE)
+
+
 def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -> State:
     """Evaluate the temperature laws of one parameter set or a batch at ``temperature_c`` [°C].
 
@@ -220,23 +242,32 @@ def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -
     T = np.atleast_1d(celsius_to_kelvin(temperature_c)).astype(float)
     if T.ndim != 1:
         raise ParameterError(f"temperature_c must be a scalar or 1-D array, got shape {T.shape}")
-    cols: dict[str, list[np.ndarray]] = {k: [] for k in STATE_FIELDS}
-    for p in plist:
-        fac = p.laws.factors(T, p.T_ref)
-        vals = {}
-        for name in ("L", "W", "alpha0", "a0", "rho", "xi"):
-            vals[name] = np.full_like(T, getattr(p, name))
+    n = len(plist)
+    # the temperature laws once per (laws object, T_ref): sets made by ``replace`` share theirs
+    groups: dict[tuple, list[int]] = {}
+    for i, p in enumerate(plist):
+        groups.setdefault((id(p.laws), p.T_ref), []).append(i)
+    fac = {name: np.empty((n, T.size)) for name in LAW_PARAMETERS}
+    for members in groups.values():
+        first = plist[members[0]]
+        f = first.laws.factors(T, first.T_ref)
+        idx = slice(None) if len(members) == n else np.asarray(members)
         for name in LAW_PARAMETERS:
-            vals[name] = getattr(p, name) * fac[name]
-        vals["T"] = T.copy()
-        vals["r1"] = vals.pop("r1_sheet") / p.W
-        vals["r2"] = vals.pop("r2_specific") / p.W
-        vals["Rp"] = vals.pop("Rp_specific") / p.W
-        vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * T)
-        vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
-        for k in STATE_FIELDS:
-            cols[k].append(vals[k])
-    return State(**{k: np.stack(v)[:, :, None] for k, v in cols.items()})
+            fac[name][idx] = f[name]
+    names = ("L", "W", "alpha0", "a0", "rho", "xi") + tuple(LAW_PARAMETERS)
+    table = np.array([_FIELD_GETTER(p) for p in plist], dtype=float)          # (n, len(_NUMERIC_STATE))
+    col = {name: table[:, _NUMERIC_STATE.index(name)][:, None] for name in names}
+    W = col["W"]
+    vals = {name: np.broadcast_to(col[name], (n, T.size)) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
+    for name in LAW_PARAMETERS:
+        vals[name] = col[name] * fac[name]
+    vals["T"] = np.broadcast_to(T, (n, T.size))
+    vals["r1"] = vals.pop("r1_sheet") / W
+    vals["r2"] = vals.pop("r2_specific") / W
+    vals["Rp"] = vals.pop("Rp_specific") / W
+    vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * vals["T"])
+    vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
+    return State(**{k: np.array(vals[k], dtype=float)[:, :, None] for k in STATE_FIELDS})
 
 
 def describe(p: IPMCParameters) -> str:

@@ -64,8 +64,9 @@ def reduced_polynomials(st, taylor_order: int = 3, include_mode: bool = True):
     m = taylor_order
     num_X = np.zeros(1)
     den_X = np.zeros(1)
+    term: np.ndarray
     for n in range(m + 1):
-        term = P.polymul(P.polypow(c * N_A, n), P.polypow(D_A, m - n))
+        term = np.asarray(P.polymul(P.polypow(c * N_A, n), P.polypow(D_A, m - n)))
         num_X = P.polyadd(num_X, P_u[n] * term)
         den_X = P.polyadd(den_X, Q_u[n] * term)
     # f g = −(L² α0 W)/(2EI) K κe (γ0 − 1) · 2h / D_A   (γ0 s + K cancelled)

@@ -69,6 +69,9 @@ class SensorModel(PhysicsModel):
     ``kernel``: ``"boundary_charge"`` (Chen et al. 2007, default) or ``"reciprocal"``.
     """
 
+    kind = "sensor"
+    primary_quantity = "S"
+
     quantities = ("S", "Z")
     units = UNITS
     descriptions = DESCRIPTIONS

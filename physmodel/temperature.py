@@ -24,6 +24,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, replace
 from typing import Mapping
 
+import math
+
 import numpy as np
 from scipy import constants
 
@@ -201,17 +203,54 @@ class TemperatureLaws:
 
     @classmethod
     def from_dict(cls, data: Mapping) -> "TemperatureLaws":
+        """The laws from ``{quantity: {"law": NAME, parameter: value, "valid_c": [lo, hi]}}`` (what
+        :meth:`to_dict` writes); a wrong shape, name or value is a ParameterError naming the key."""
         kinds = {c.__name__: c for c in (Constant, Arrhenius, LogLinear, Linear, WaterPermittivity, IonicResistance)}
+        if not isinstance(data, Mapping):
+            raise ParameterError(f"laws must be an object {{quantity: {{'law': NAME, ...}}}}, got {data!r}")
+        names = [f.name for f in fields(cls)]
         laws = {}
         for name, spec in data.items():
+            if name not in names:
+                raise ParameterError(f"laws: unknown quantity {name!r}; expected one of {names}")
+            if not isinstance(spec, Mapping):
+                raise ParameterError(f"laws.{name}: expected an object with 'law' and its parameters, got {spec!r}")
             spec = dict(spec)
+            if "law" not in spec:
+                raise ParameterError(f"laws.{name}: missing 'law'; expected one of {sorted(kinds)}")
             kind = spec.pop("law")
-            if kind not in kinds:
+            if not isinstance(kind, str) or kind not in kinds:
                 raise ParameterError(f"unknown temperature law {kind!r} for {name}; expected one of {sorted(kinds)}")
-            if "valid_c" in spec:
-                spec["valid_c"] = tuple(spec["valid_c"])
+            allowed = {f.name for f in fields(kinds[kind])}
+            unknown = sorted(set(spec) - allowed)
+            if unknown:
+                raise ParameterError(f"laws.{name}: {kind} has no parameter(s) {unknown}; expected {sorted(allowed)}")
+            for k, v in spec.items():
+                where = f"laws.{name}.{k}"
+                if k == "valid_c":
+                    if not (isinstance(v, (list, tuple)) and len(v) == 2):
+                        raise ParameterError(f"{where}: expected [lowest, highest] °C, got {v!r}")
+                    lo, hi = (real_number(x, where) for x in v)
+                    if not lo < hi:
+                        raise ParameterError(f"{where}: expected lowest < highest, got {v!r}")
+                    spec[k] = (lo, hi)
+                else:
+                    spec[k] = real_number(v, where)
             laws[name] = kinds[kind](**spec)
         return cls(**laws)
+
+
+def real_number(v, where: str) -> float:
+    """``v`` as a float: a JSON/TOML number (not a boolean) or the strings "inf"/"-inf" that
+    parameter files use for infinities; a ParameterError naming ``where`` otherwise (NaN too)."""
+    if isinstance(v, str) and v.strip().lower() in ("inf", "+inf", "-inf", "infinity", "-infinity"):
+        return float(v)
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+        raise ParameterError(f"{where}: expected a number, got {v!r}")
+    v = float(v)
+    if math.isnan(v):
+        raise ParameterError(f"{where}: expected a number, got NaN")
+    return v
 
 
 #: Every parameter constant (for isothermal studies and for the width/Taylor checks).

@@ -6,6 +6,8 @@
     ipmc demo                       the flagship chain on embedded defaults → a report folder
     ipmc run SCENARIO               a scenario file or bundled scenario → data, figures, report.md
     ipmc study STUDY                Monte Carlo / grid parameter study (local processes or Dask)
+    ipmc excite KIND                excitation signal (multisine, stepped sine, chirp) for a DAQ
+    ipmc frf RECORD...              frequency response with per-line σ from time records
     ipmc fit SWEEP                  temperature-scheduled rational surrogate
     ipmc invert SIGNAL              stable (noncausal) inversion of a surrogate
     ipmc calibrate SWEEP            calibrate physical parameters to a measured sweep
@@ -23,12 +25,12 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .commands import (calibrate, demo, diagnose, fit, invert, run, sets, simulate, study, sweep,
+from .commands import (calibrate, demo, diagnose, excite, fit, frf, invert, run, sets, simulate, study, sweep,
                        validate)
 from .commands._common import EXIT_BAD_INPUT, EXIT_INTERRUPTED
 
 #: The subcommands, in the order ``ipmc --help`` lists them.
-COMMANDS = (sets, sweep, simulate, demo, run, study, fit, invert, calibrate, diagnose, validate)
+COMMANDS = (sets, sweep, simulate, excite, frf, demo, run, study, fit, invert, calibrate, diagnose, validate)
 
 
 def _version() -> str:
@@ -55,6 +57,24 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    """Run one ``ipmc`` command; returns its exit code.
+
+    SIGINT and SIGTERM are recorded and raise ``KeyboardInterrupt`` (:mod:`physmodel.interrupts`)
+    for the whole command, so an interrupt that a solver swallows (CasADi/IPOPT catches it and
+    reports a failed solve) still ends the command with 130: the runner checks between steps and
+    :func:`~physmodel.data.files.atomic_write` refuses to commit a file once one was recorded.
+    """
+    from physmodel import interrupts
+
+    with interrupts.handling():
+        code = _main(argv)
+        if interrupts.requested() is not None and code != EXIT_INTERRUPTED:
+            print("ipmc: interrupted", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        return code
+
+
+def _main(argv) -> int:
     from physmodel.errors import IPMCError
 
     ap = build_parser()

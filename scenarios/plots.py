@@ -205,21 +205,15 @@ def save_poles_zeros_vs_temperature(model, path, per_temperature_models=None,
     grid = np.linspace(lo, hi, n_temperatures)
     fig, axes = _subplots(2, 2, sharex=True, figsize=(8.0, 6.0))
     for col, (name, getter) in enumerate((("poles", model.poles), ("zeros", model.zeros))):
-        tt, vals = [], []
-        for t in grid:
-            r = getter(t)
-            tt += [t] * r.size
-            vals += list(r)
-        vals = np.asarray(vals, complex)
+        roots = [getter(t) for t in grid]
+        tt = np.repeat(grid, [r.size for r in roots])
+        vals = np.concatenate(roots).astype(complex) if roots else np.zeros(0, complex)
         axes[0, col].plot(tt, vals.real, ".", ms=2, label="scheduled model")
         axes[1, col].plot(tt, vals.imag, ".", ms=2)
         if per_temperature_models:
-            pt, pv = [], []
-            for t, m in per_temperature_models.items():
-                r = m.poles() if name == "poles" else m.zeros()
-                pt += [t] * r.size
-                pv += list(r)
-            pv = np.asarray(pv, complex)
+            roots_t = [(t, m.poles() if name == "poles" else m.zeros()) for t, m in per_temperature_models.items()]
+            pt = np.concatenate([np.full(r.size, t) for t, r in roots_t])
+            pv = np.concatenate([r for _, r in roots_t]).astype(complex)
             axes[0, col].plot(pt, pv.real, "x", ms=5, label="per-temperature fits")
             axes[1, col].plot(pt, pv.imag, "x", ms=5)
         axes[0, col].set_title(name)
@@ -341,3 +335,61 @@ def inversion_traces(path: str, t, u, y, ucol: str,
     axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
     return _save(fig, path, dpi=110)
+
+
+# ---------------------------------------------------------------------------- FRF estimates
+def frf_estimate(items, path, title: str = "") -> Path:
+    """An estimated frequency response with its ±2σ bands: magnitude, phase and the coherence
+    (H1/H2) or the magnitude σ (stepped sine), one colour per record.
+
+    ``items``: ``[(estimate, temperature_c, kept), ...]`` with a one-channel
+    :class:`~physmodel.estimation.frf.FRFEstimate`, its temperature [°C] and a boolean mask of the
+    lines written to the sweep (dropped lines are drawn as grey crosses).
+    """
+    items = list(items)
+    if not items:
+        raise IPMCError("frf_estimate: nothing to plot")
+    with_coh = all(e.coherence is not None for e, _, _ in items)
+    fig, (ax_m, ax_p, ax_c) = _subplots(3, 1, sharex=True, figsize=(7, 8.5))
+    for i, (e, T, kept) in enumerate(items):
+        col = f"C{i % 10}"
+        f, H = e.frequency_hz, e.response[0]
+        kept = np.asarray(kept, dtype=bool)
+        finite = np.isfinite(H) & (H != 0)
+        ok, off = kept & finite, ~kept & finite
+        mag = np.full(f.shape, np.nan)
+        mag[finite] = 20 * np.log10(np.abs(H[finite]))
+        ph = np.full(f.shape, np.nan)
+        if ok.any():
+            ph[ok] = np.degrees(np.unwrap(np.angle(H[ok])))
+        ph[off] = np.degrees(np.angle(H[off]))
+        sm, sp = e.magnitude_std_db[0], e.phase_std_deg[0]
+        band_m = np.where(ok & np.isfinite(sm), 2 * sm, np.nan)
+        band_p = np.where(ok & np.isfinite(sp), 2 * sp, np.nan)
+        ax_m.fill_between(f, mag - band_m, mag + band_m, color=col, alpha=0.25, lw=0)
+        ax_m.semilogx(f[ok], mag[ok], ".-", color=col, ms=3, lw=0.8, label=f"{T:g} °C")
+        ax_p.fill_between(f, ph - band_p, ph + band_p, color=col, alpha=0.25, lw=0)
+        ax_p.semilogx(f[ok], ph[ok], ".-", color=col, ms=3, lw=0.8)
+        if off.any():
+            ax_m.semilogx(f[off], mag[off], "x", color="0.6", ms=3)
+            ax_p.semilogx(f[off], ph[off], "x", color="0.6", ms=3)
+        if with_coh:
+            ax_c.semilogx(f, e.coherence[0], ".-", color=col, ms=2, lw=0.6)
+        else:
+            ax_c.semilogx(f[ok], sm[ok], ".-", color=col, ms=3, lw=0.6)
+    e0 = items[0][0]
+    ax_m.set_ylabel(f"magnitude [dB {e0.output_units[0]}/{e0.input_unit}]")
+    ax_p.set_ylabel("phase [deg]")
+    if with_coh:
+        ax_c.set_ylabel("coherence γ²")
+        ax_c.set_ylim(-0.02, 1.02)
+    else:
+        ax_c.set_ylabel("σ of magnitude [dB]")
+        ax_c.set_yscale("log")
+    ax_c.set_xlabel("frequency [Hz]")
+    for ax in (ax_m, ax_p, ax_c):
+        ax.grid(True, which="both", alpha=0.3)
+    ax_m.legend(fontsize=7, ncol=2)
+    ax_m.set_title((title + "\n" if title else "") + "estimate with ±2σ bands (grey x: lines dropped)", fontsize=10)
+    fig.tight_layout()
+    return _save(fig, path)

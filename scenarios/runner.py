@@ -203,7 +203,11 @@ def step_surrogate(ctx: _Ctx):
     train = ctx.data.exclude(held) if held else ctx.data
     nz, npo = cfg.get("n_zeros", 3), cfg.get("n_poles", 3)
     kw = {k: cfg[k] for k in ("method", "weighting") if k in cfg}
-    fit = fit_sweep(train, nz, npo, cfg.get("degree", 2), form=cfg.get("form", "zpk"), raise_on_failure=False, **kw)
+    try:
+        fit = fit_sweep(train, nz, npo, cfg.get("degree", 2), form=cfg.get("form", "zpk"), raise_on_failure=False, **kw)
+    except ValueError as exc:        # the surrogate package refuses an order/degree the data cannot carry
+        raise ScenarioError(f"{ctx.spec.path}: [surrogate] n_zeros={nz}, n_poles={npo}, degree={cfg.get('degree', 2)}: "
+                            f"{exc}") from None
     ctx.fit = fit
     model = fit.model
     model.to_json(ctx.out / "surrogate.json")
@@ -396,7 +400,10 @@ def step_blackbox(ctx: _Ctx):
     sw = ctx.data.select(T)
     curves, rows = {"data": sw.magnitude_db}, []
     for nz, npo in cfg["orders"]:
-        r = RationalFit(nz, npo, raise_on_failure=False).fit(sw.frequency_hz, sw.temperature_c, sw.response)
+        try:
+            r = RationalFit(nz, npo, raise_on_failure=False).fit(sw.frequency_hz, sw.temperature_c, sw.response)
+        except ValueError as exc:
+            raise ScenarioError(f"{ctx.spec.path}: [blackbox] orders [{nz}, {npo}]: {exc}") from None
         g = r.model.frequency_response(sw.frequency_hz)
         fp = ctx.metric(f"blackbox.z{nz}_p{npo}.fit_percent", fit_percent(g, sw.response))
         ctx.metric(f"blackbox.z{nz}_p{npo}.converged", r.converged)
@@ -523,7 +530,10 @@ def _metric_value(expr: str, metrics: dict, where: str) -> float:
     for t in terms:
         if t not in metrics:
             raise ScenarioError(f"{where}: metric {t!r} was not produced; available: {sorted(metrics)}")
-    return metrics[terms[0]] / metrics[terms[1]] if len(terms) == 2 else metrics[terms[0]]
+    if len(terms) == 1:
+        return metrics[terms[0]]
+    with np.errstate(divide="ignore", invalid="ignore"):   # a zero denominator is a failed check (inf/NaN)
+        return float(np.float64(metrics[terms[0]]) / np.float64(metrics[terms[1]]))
 
 
 def evaluate_checks(spec: Scenario, metrics: dict) -> list[CheckResult]:
@@ -543,13 +553,24 @@ def evaluate_checks(spec: Scenario, metrics: dict) -> list[CheckResult]:
     return out
 
 
-def run_scenario(spec: Scenario, out, *, quiet: bool = False) -> RunResult:
-    """Run every step of ``spec`` into folder ``out`` and write its report (last)."""
+def run_scenario(spec: Scenario, out, *, quiet: bool = False, force: bool = False) -> RunResult:
+    """Run every step of ``spec`` into folder ``out`` and write its report (last).
+
+    The folder is claimed for the run (:func:`physmodel.data.files.output_folder`): a second run
+    into it is refused while this one writes, and a folder holding another run's results is
+    refused unless ``force``.  An interrupt (even one a solver swallowed) ends the run before the
+    next step and before ``report.md``."""
+    from physmodel.data.files import output_folder
+
+    with output_folder(out, f"ipmc run {spec.name}", force=force) as folder:
+        return _run_scenario(spec, folder, quiet)
+
+
+def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:
+    from physmodel import interrupts
     from physmodel.data.files import atomic_write
 
     t0 = time.perf_counter()
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     (out / "report.md").unlink(missing_ok=True)         # a stale report must not vouch for new files
     say = (lambda *a: None) if quiet else (lambda *a: print(*a, file=sys.stderr))
     ctx = _Ctx(spec, out, say)
@@ -565,6 +586,7 @@ def run_scenario(spec: Scenario, out, *, quiet: bool = False) -> RunResult:
             if bar is not None:
                 bar.set_postfix_str(s)
             STEPS[s](ctx)
+            interrupts.check()
             if bar is not None:
                 bar.update(1)
     finally:
@@ -590,6 +612,7 @@ def run_scenario(spec: Scenario, out, *, quiet: bool = False) -> RunResult:
                          c.description) for c in checks]), "",
              f"{sum(c.passed for c in checks)}/{len(checks)} checks passed; ran in {elapsed:.1f} s.", "",
              "## Files", "", *[f"- `{f}`" for f in ctx.files], "- `report.md` (this file, written last)", ""]
+    interrupts.check()
     atomic_write(out / "report.md", lambda fh: fh.write("\n".join(lines)))
     return RunResult(spec.name, out, dict(ctx.metrics), checks, list(ctx.files), elapsed)
 

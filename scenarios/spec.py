@@ -46,6 +46,7 @@ errors (:class:`ScenarioError`, a :class:`physmodel.IPMCError`) naming the key a
 from __future__ import annotations
 
 import copy
+import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -74,13 +75,14 @@ class _T:
 
 
 def _is_num(v):
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
+    """A finite TOML number (TOML also spells nan and inf, which no scenario value may be)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-NUM = _T("a number", _is_num, float)
+NUM = _T("a finite number", _is_num, float)
 INT = _T("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool))
 STR = _T("a string", lambda v: isinstance(v, str))
-NUMS = _T("a non-empty list of numbers", lambda v: isinstance(v, list) and v and all(map(_is_num, v)),
+NUMS = _T("a non-empty list of finite numbers", lambda v: isinstance(v, list) and v and all(map(_is_num, v)),
           lambda v: [float(x) for x in v])
 INTS = _T("a non-empty list of integers", lambda v: isinstance(v, list) and v and all(
     isinstance(x, int) and not isinstance(x, bool) for x in v))
@@ -244,16 +246,136 @@ def parse_scenario(raw: dict, where: str = "<scenario>", *, quick: bool = False)
             if sec not in data or sec not in STEP_ORDER:
                 raise ScenarioError(f"{where}: [checks.{name}] metric {term.strip()!r} refers to [{sec}], "
                                     f"which this scenario does not run (steps: {[s for s in STEP_ORDER if s in data]})")
+    _check_values(data, where)
     return Scenario(data["scenario"]["name"], where, data, quick)
+
+
+#: Most samples of one time record (duration_s × fs_hz): checked before anything is allocated.
+MAX_TIME_SAMPLES = 20_000_000
+#: Most datasets a [fixtures] table may ask for.
+MAX_FIXTURES = 1000
+
+
+def _check_values(data: dict, where: str) -> None:
+    """The domain of each value (the schema only checks types): every refusal names the table and
+    key, the value and what is allowed, before the run allocates or computes anything."""
+    from physmodel.data.sweep import MAX_SWEEP_LINES
+
+    def need(ok, sec, key, value, expected):
+        if not ok:
+            raise ScenarioError(f"{where}: [{sec}] {key} = {value!r}: expected {expected}")
+
+    def grid(sec, cfg, n_temps=1):
+        lo, hi, n = cfg.get("fmin_hz", 1.0), cfg.get("fmax_hz", math.inf), cfg.get("points", 2)
+        need(lo > 0, sec, "fmin_hz", lo, "> 0 Hz")
+        need(hi > lo, sec, "fmax_hz", cfg.get("fmax_hz"), f"> fmin_hz ({lo:g} Hz)")
+        need(2 <= n <= MAX_SWEEP_LINES // max(n_temps, 1), sec, "points", n,
+             f"2 to {MAX_SWEEP_LINES // max(n_temps, 1)} (at most {MAX_SWEEP_LINES} lines over {n_temps} temperature(s))")
+
+    def temps(sec, key, values):
+        for t in values if isinstance(values, list) else [values]:
+            need(t > -273.15, sec, key, values, "temperatures above absolute zero (-273.15 °C)")
+
+    if "sweep" in data:
+        sw = data["sweep"]
+        for key in ("temperatures_c", "held_out_c", "plot_temperatures_c"):
+            if key in sw:
+                temps("sweep", key, sw[key])
+        grid("sweep", sw, len(sw["temperatures_c"]))
+        missing = [t for t in sw.get("held_out_c", []) if t not in sw["temperatures_c"]]
+        need(not missing, "sweep", "held_out_c", sw.get("held_out_c"), f"temperatures from temperatures_c {sw['temperatures_c']}")
+        need(len(set(sw["temperatures_c"]) - set(sw.get("held_out_c", []))) >= 1, "sweep", "held_out_c",
+             sw.get("held_out_c"), "at least one temperature left to fit")
+    nz = data.get("noise", {})
+    for key in ("sigma_db", "sigma_deg", "sigma"):
+        if key in nz:
+            need(nz[key] >= 0, "noise", key, nz[key], ">= 0")
+    if "seed" in nz:
+        need(nz["seed"] >= 0, "noise", "seed", nz["seed"], "a non-negative integer")
+    if "surrogate" in data:
+        from surrogate._fit import WEIGHTINGS
+
+        sg = data["surrogate"]
+        need(sg.get("n_zeros", 3) >= 0, "surrogate", "n_zeros", sg.get("n_zeros"), ">= 0")
+        need(sg.get("n_poles", 3) >= 1, "surrogate", "n_poles", sg.get("n_poles"), ">= 1")
+        need(sg.get("degree", 2) >= 0, "surrogate", "degree", sg.get("degree"), ">= 0 (polynomial degree in T)")
+        need(sg.get("weighting", "auto") in WEIGHTINGS, "surrogate", "weighting", sg.get("weighting"), f"one of {list(WEIGHTINGS)}")
+    if "inversion" in data:
+        inv = data["inversion"]
+        fs, dur = inv.get("fs_hz", 1000.0), inv.get("duration_s", 8.0)
+        need(fs > 0, "inversion", "fs_hz", fs, "> 0 Hz")
+        need(dur > 0, "inversion", "duration_s", dur, "> 0 s")
+        need(dur * fs <= MAX_TIME_SAMPLES, "inversion", "duration_s", dur,
+             f"at most {MAX_TIME_SAMPLES} samples at fs_hz = {fs:g} (duration_s × fs_hz = {dur * fs:.3g})")
+        for key in ("settle_s", "end_margin_s", "lead_s", "ramp_s"):
+            if key in inv:
+                need(0 <= inv[key] < dur, "inversion", key, inv[key], f"in [0, duration_s = {dur:g}) s")
+        pv = inv.get("preview", "inf")
+        if isinstance(pv, str):
+            need(pv in ("inf", "auto"), "inversion", "preview", pv, "'inf', 'auto' or seconds")
+        else:
+            need(0 < pv <= dur, "inversion", "preview", pv, f"seconds in (0, duration_s = {dur:g}]")
+        for i, exp in enumerate(inv.get("experiments", [])):
+            sec = f"inversion.experiments[{i}] ({exp['name']!r})"
+            need(exp["amplitude_mm"] > 0, sec, "amplitude_mm", exp["amplitude_mm"], "> 0 mm")
+            temps(sec, "temperature_c", exp["temperature_c"])
+            if "model_temperature_c" in exp:
+                temps(sec, "model_temperature_c", exp["model_temperature_c"])
+            for fr in exp.get("frequencies_hz", []):
+                need(0 < fr < fs / 2, sec, "frequencies_hz", exp["frequencies_hz"],
+                     f"in (0, {fs / 2:g}) Hz, below the Nyquist frequency of fs_hz = {fs:g}")
+            if "t_release_s" in exp:
+                need(0 < exp["t_release_s"] < dur, sec, "t_release_s", exp["t_release_s"], f"in (0, duration_s = {dur:g}) s")
+            if "noise_rms" in exp:
+                need(exp["noise_rms"] >= 0, sec, "noise_rms", exp["noise_rms"], ">= 0")
+            if "highpass_hz" in exp:
+                need(0 < exp["highpass_hz"] < fs / 2, sec, "highpass_hz", exp["highpass_hz"], f"in (0, {fs / 2:g}) Hz")
+            if "window_s" in exp:
+                w = exp["window_s"]
+                need(len(w) == 2 and 0 <= w[0] < w[1] <= dur, sec, "window_s", w, f"[t0, t1] with 0 <= t0 < t1 <= {dur:g} s")
+            if "seed" in exp:
+                need(exp["seed"] >= 0, sec, "seed", exp["seed"], "a non-negative integer")
+    if "widths" in data:
+        w = data["widths"]
+        need(all(x > 0 for x in w.get("widths_m", [1])), "widths", "widths_m", w.get("widths_m"), "widths > 0 m")
+        grid("widths", w)
+    if "taylor" in data:
+        t = data["taylor"]
+        need(all(1 <= k <= 12 for k in t.get("orders", [1])), "taylor", "orders", t.get("orders"), "orders 1 to 12")
+        grid("taylor", t)
+    if "blackbox" in data:
+        for nzb, npb in data["blackbox"]["orders"]:
+            need(nzb >= 0 and npb >= 1, "blackbox", "orders", data["blackbox"]["orders"], "[n_zeros >= 0, n_poles >= 1] pairs")
+    if "fixtures" in data:
+        fx = data["fixtures"]
+        need(1 <= fx.get("count", 3) <= MAX_FIXTURES, "fixtures", "count", fx.get("count"), f"1 to {MAX_FIXTURES}")
+        temps("fixtures", "temperatures_c", fx.get("temperatures_c", [25.0]))
+        grid("fixtures", fx, len(fx.get("temperatures_c", [25.0])))
+        fs, dur = fx.get("fs_hz", 500.0), fx.get("step_duration_s", 1.0)
+        need(fs > 0, "fixtures", "fs_hz", fs, "> 0 Hz")
+        need(0 < dur and dur * fs <= MAX_TIME_SAMPLES, "fixtures", "step_duration_s", dur,
+             f"> 0 s and at most {MAX_TIME_SAMPLES} samples at fs_hz = {fs:g}")
+        if "seed" in fx:
+            need(fx["seed"] >= 0, "fixtures", "seed", fx["seed"], "a non-negative integer")
+        if "noise_rms_mm" in fx:
+            need(fx["noise_rms_mm"] >= 0, "fixtures", "noise_rms_mm", fx["noise_rms_mm"], ">= 0")
+    for name, chk in data.get("checks", {}).items():
+        if "min" in chk and "max" in chk:
+            need(chk["min"] <= chk["max"], f"checks.{name}", "min", chk["min"], f"<= max ({chk['max']:g})")
 
 
 def read_toml(path, what: str, error: type[Exception]) -> dict:
     """The parsed TOML file at ``path``, or ``error`` naming the file (missing or not valid TOML)."""
+    from physmodel.data.files import read_text
+    from physmodel.errors import DataFormatError
+
     path = Path(path)
     if not path.is_file():
         raise error(f"{what} file {str(path)!r} does not exist")
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(read_text(path, f"{what} file"))
+    except DataFormatError as exc:
+        raise error(str(exc)) from None
     except tomllib.TOMLDecodeError as exc:
         raise error(f"{path}: not valid TOML: {exc}") from None
 

@@ -55,6 +55,10 @@ _DISTS = {"lognormal": ("median", "sigma"), "normal": ("mean", "std"), "uniform"
 _NOISE_KEYS = {"kind", "sigma_db", "sigma_deg", "sigma"}
 
 
+#: Most rows (samples × temperatures × frequencies) of one study table, checked before evaluation.
+MAX_STUDY_ROWS = 50_000_000
+
+
 class StudyError(ScenarioError):
     """A study file that does not follow the schema (exit code 2)."""
 
@@ -85,6 +89,9 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
     for k in ("kind", "set", "seed", "temperatures_c", "parameters"):
         if k not in s:
             raise StudyError(f"{where}: [study] missing required key {k!r}")
+    for k in ("name", "set", "quantity", "kernel", "method"):
+        if k in s and not isinstance(s[k], str):
+            raise StudyError(f"{where}: [study] {k} must be a string, got {s[k]!r}")
     if s["kind"] not in ("actuator", "sensor"):
         raise StudyError(f"{where}: [study] kind must be 'actuator' or 'sensor', got {s['kind']!r}")
     if not isinstance(s["seed"], int) or isinstance(s["seed"], bool) or s["seed"] < 0:
@@ -100,11 +107,15 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
     else:
         lo, hi = _num(s.get("fmin_hz", 0.1), "fmin_hz"), _num(s.get("fmax_hz", 100.0), "fmax_hz")
         n = s.get("points", 50)
-        if not (0 < lo < hi) or not isinstance(n, int) or n < 2:
-            raise StudyError(f"{where}: [study] need 0 < fmin_hz < fmax_hz and integer points >= 2")
+        if not (0 < lo < hi) or not isinstance(n, int) or isinstance(n, bool) or not 2 <= n <= MAX_STUDY_ROWS:
+            raise StudyError(f"{where}: [study] need 0 < fmin_hz < fmax_hz and integer points in [2, {MAX_STUDY_ROWS}]; "
+                             f"got fmin_hz = {lo!r}, fmax_hz = {hi!r}, points = {n!r}")
         f = np.geomspace(lo, hi, n).tolist()
     if min(f) <= 0:
         raise StudyError(f"{where}: [study] frequencies must be > 0 Hz")
+    cold = [t for t in s["temperatures_c"] if t <= -273.15]
+    if cold:
+        raise StudyError(f"{where}: [study] temperatures_c {cold}: below absolute zero (-273.15 °C)")
     s["frequencies_hz"] = f
     for k in ("fmin_hz", "fmax_hz", "points"):
         s.pop(k, None)
@@ -141,11 +152,18 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
         n = s.get("samples")
         if not isinstance(n, int) or isinstance(n, bool) or n < 1:
             raise StudyError(f"{where}: [study] samples must be a positive integer, got {n!r}")
+    rows = s["samples"] * len(s["temperatures_c"]) * len(s["frequencies_hz"])
+    if rows > MAX_STUDY_ROWS:
+        raise StudyError(f"{where}: [study] samples × temperatures_c × frequencies = {rows} rows; at most "
+                         f"{MAX_STUDY_ROWS} (split the study)")
     if "noise" in s:
         nz = s["noise"]
         if not isinstance(nz, dict) or not set(nz) <= _NOISE_KEYS or nz.get("kind") not in ("magphase", "complex"):
             raise StudyError(f"{where}: [study.noise] takes kind = 'magphase' | 'complex' and "
                              f"{sorted(_NOISE_KEYS - {'kind'})}, got {nz!r}")
+        for k in _NOISE_KEYS - {"kind"}:
+            if k in nz and _num(nz[k], f"{where}: [study.noise] {k}") < 0:
+                raise StudyError(f"{where}: [study.noise] {k} = {nz[k]!r}: expected >= 0")
     # fail now, not in a worker, on a bad set, parameter value or temperature
     _base(s)
     from physmodel.data.units import QUANTITY_UNITS
@@ -323,7 +341,11 @@ def _run_dask(spec, chunks, scheduler, tick):
     except ModuleNotFoundError:
         raise StudyError("the Dask backend needs dask[distributed]: pip install 'ipmc[dask]'") from None
     own = isinstance(scheduler, str)
-    client = Client(scheduler, timeout="20s") if own else (scheduler if isinstance(scheduler, Client) else Client(scheduler))
+    try:
+        client = Client(scheduler, timeout="20s") if own else (scheduler if isinstance(scheduler, Client) else Client(scheduler))
+    except (ValueError, TypeError, OSError, TimeoutError) as exc:   # malformed or unreachable address
+        raise StudyError(f"--scheduler {scheduler!r}: cannot connect to a Dask scheduler "
+                         f"({type(exc).__name__}: {exc}); expected an address such as tcp://HOST:8786") from None
     try:
         futs = [client.submit(evaluate_chunk, spec, c, key=f"ipmc-study-{spec['name']}-{spec['seed']}-{k}-{os.getpid()}",
                               pure=False) for k, c in enumerate(chunks)]

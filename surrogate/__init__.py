@@ -29,7 +29,8 @@ Fitters (estimator style: settings in the constructor, ``fit`` returns a FitResu
 Results and models
     FitResult        converged, status, params, stderr, ci95_low/high, per_temperature,
                      stability, history, two_stage, per_temperature_models, summary()
-    RationalModel    frequency_response(frequency_hz, temperature_c), at(T) -> control.TransferFunction,
+    RationalModel    kind = "rational", response(frequency_hz, temperature_c) (the model protocol),
+                     frequency_response(frequency_hz, temperature_c), at(T) -> control.TransferFunction,
                      coefficients(T), poles(T), zeros(T), stability_check(), parameter_table(),
                      confidence_intervals(), to_json(path)
     load(path) -> RationalModel                versioned JSON (schema ``ipmc.surrogate.rational_model``)
@@ -40,8 +41,7 @@ Metrics
     relative_rms_error, fit_percent (100·(1 − NRMSE)), log_rms_error
 Errors
     ConvergenceError (raised when IPOPT does not converge; ``.result`` holds the flagged result)
-Command line
-    surrogate.cli.add_parser(subparsers), surrogate.cli.run(args) -> exit code (0/2/3)
+Command line: ``ipmc fit`` (:mod:`scenarios.commands.fit`); figures: :mod:`scenarios.plots`.
 """
 
 from ._data import FrequencyData, from_sweep

@@ -188,6 +188,18 @@ class RationalModel:
         h = S.response(self.structure, self._params, w, tau)
         return (self.scaling.gain_ref * h).reshape(shape)
 
+    #: The model kind of the model protocol (:mod:`physmodel.protocol`).
+    kind = "rational"
+
+    def response(self, frequency_hz, temperature_c=None) -> np.ndarray:
+        """The model protocol (:mod:`physmodel.protocol`): the response at every temperature ×
+        frequency, shape (n_T, n_f) [output/input]; ``temperature_c`` None for an unscheduled model."""
+        f = np.atleast_1d(np.asarray(frequency_hz, float))
+        if temperature_c is None:
+            return self.frequency_response(f, None)[None, :]
+        t = np.atleast_1d(np.asarray(temperature_c, float))
+        return self.frequency_response(f[None, :], t[:, None])
+
     def response_std(self, frequency_hz, temperature_c=None, *, extrapolate=False) -> np.ndarray:
         """Standard deviation of the complex response implied by the parameter covariance
         (delta method: sqrt(J Σ Jᴴ), J = ∂H/∂θ by central differences), same shape as

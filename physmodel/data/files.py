@@ -4,18 +4,21 @@ atomic writer every file of the library goes through (temporary file, then renam
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import os
-import tempfile
+import secrets
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
 
+from .. import interrupts
 from ..errors import DataFormatError, IPMCError
-from .sweep import FORMAT_VERSION, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, FrequencySweep
+from .sweep import FORMAT_VERSION, MAX_SWEEP_LINES, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, FrequencySweep
 from .units import UNITS
 
 # ----------------------------------------------------------------------------------- I/O helpers
@@ -25,23 +28,115 @@ def atomic_write(path, write_fn, mode: str = "w") -> Path:
     no newline translation) or "wb".  The file gets the usual permissions (0666 less the umask)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=".part", dir=path.parent)
+    # the name is fixed before the file exists, so an interrupt at any point after creation still
+    # finds and removes it (mkstemp's name is only known once it returns)
+    tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
     try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         with os.fdopen(fd, mode, **({"newline": "", "encoding": "utf-8"} if "b" not in mode else {})) as fh:
             write_fn(fh)
             fh.flush()
             os.fsync(fh.fileno())
         mask = os.umask(0)
         os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)   # mkstemp creates 0600
+        os.chmod(tmp, 0o666 & ~mask)   # created 0600
+        interrupts.check()             # an interrupt a solver swallowed must not commit a file
         os.replace(tmp, path)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
+        tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+def read_text(path, what: str = "file") -> str:
+    """The text of ``path`` decoded as UTF-8, a leading byte-order mark dropped (Excel writes one).
+
+    Every text reader of the library (sweep CSV, scenario/study/experiment TOML, parameter JSON,
+    signal CSV) goes through here, so a file that is not UTF-8 is a :class:`DataFormatError` naming
+    the file, the line and the byte, never a ``UnicodeDecodeError``.
+    """
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise DataFormatError(f"{what} {str(path)!r}: no such file") from None
+    except IsADirectoryError:
+        raise DataFormatError(f"{what} {str(path)!r} is a folder; expected a file") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise DataFormatError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
+                              "save the file as UTF-8") from None
+
+
+#: What each ipmc command leaves in its output folder, to recognise whose results a folder holds:
+#: (file, identity, or a function of the file's JSON giving the identity).
+OWNER_FILES = (("metrics.json", lambda d: f"ipmc run {d['scenario']}"), ("calibration.json", lambda d: "ipmc calibrate"),
+               ("model.json", lambda d: "ipmc fit"), ("report.json", lambda d: "ipmc diagnose"))
+
+
+def folder_owner(folder) -> str | None:
+    """Whose results ``folder`` holds: ``"ipmc run <scenario>"``, ``"ipmc calibrate"``, ``"ipmc fit"``,
+    ``"ipmc diagnose"``, a description of other files, or None when it is empty."""
+    folder = Path(folder)
+    entries = sorted(p.name for p in folder.iterdir())
+    if not entries:
+        return None
+    for name, identity in OWNER_FILES:
+        if name in entries:
+            try:
+                return identity(json.loads((folder / name).read_text(encoding="utf-8")))
+            except (OSError, ValueError, KeyError, TypeError):
+                continue
+    return f"files not written by a finished ipmc run ({', '.join(entries[:3])}{', ...' if len(entries) > 3 else ''})"
+
+
+def check_output_folder(path, identity: str, *, force: bool = False, option: str = "--out") -> Path:
+    """The refusals of :func:`output_folder` without creating or locking anything: for commands
+    that compute first and write at the end (they claim the folder then)."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise IPMCError(f"{option} {path}: exists and is not a folder")
+    owner = folder_owner(path) if path.is_dir() else None
+    if owner is not None and owner != identity and not force:
+        held = owner if owner.startswith("files") else f"the results of {owner!r}"
+        raise IPMCError(f"{option} {path}: the folder holds {held}, not of {identity!r}; choose another "
+                        "folder or pass --force to write into it")
+    return path
+
+
+@contextmanager
+def output_folder(path, identity: str, *, force: bool = False, option: str = "--out"):
+    """Claim the folder ``path`` for one run (a context manager yielding it as a Path).
+
+    The folder is created if needed and locked (``fcntl.flock`` on the folder itself) for the
+    duration of the block, so a second run into the same folder is refused while the first one
+    writes.  A folder that holds another run's results (:func:`folder_owner` differs from
+    ``identity``, e.g. another scenario, or files ipmc did not finish writing) is refused unless
+    ``force``; the same command or scenario may replace its own results.  Errors are
+    :class:`~physmodel.errors.IPMCError` naming ``option`` and the folder.
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise IPMCError(f"{option} {path}: exists and is not a folder")
+    path.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not POSIX: no lock, the ownership check still applies
+            fcntl = None
+        if fcntl is not None:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                raise IPMCError(f"{option} {path}: another ipmc run is writing into this folder; wait for it "
+                                "or choose another folder") from None
+        check_output_folder(path, identity, force=force, option=option)
+        yield path
+    finally:
+        os.close(fd)                   # closing the descriptor releases the lock
 
 
 def _columns(sw: FrequencySweep) -> dict[str, np.ndarray]:
@@ -109,10 +204,7 @@ def write_csv(sw: FrequencySweep, path) -> Path:
 def read_csv(path) -> FrequencySweep:
     """Read the tidy CSV; a malformed file raises :class:`DataFormatError` naming the line."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
+    text = read_text(path, "sweep file")
     header: dict[str, str] = {}
     lines = text.splitlines()
     i = 0
@@ -199,24 +291,101 @@ def write_npz(sw: FrequencySweep, path) -> Path:
     return atomic_write(path, write, "wb")
 
 
-def read_npz(path) -> FrequencySweep:
+#: The arrays a sweep NPZ may hold (others are ignored without being decompressed).
+NPZ_ARRAYS = ("header",) + REQUIRED_COLUMNS + OPTIONAL_COLUMNS + ("response_real", "response_imag")
+#: Largest array accepted from a sweep file [bytes], checked before it is decompressed: 16 bytes
+#: (complex128) for each of MAX_SWEEP_LINES lines.
+MAX_ARRAY_BYTES = 16 * MAX_SWEEP_LINES + 4096
+
+
+def _column(v, key: str, where: str, *, allow_complex: bool = False) -> np.ndarray:
+    """``v`` as a 1-D float (or complex) array, or a DataFormatError naming ``key``."""
+    a = np.asarray(v)
+    kinds = "biufc" if allow_complex else "iuf"
+    if a.dtype.kind not in kinds:
+        what = "complex numbers" if a.dtype.kind == "c" else f"dtype {a.dtype}"
+        raise DataFormatError(f"{where}: {key} holds {what}; expected real numbers")
+    if a.ndim > 1 and max(a.shape) != a.size:
+        raise DataFormatError(f"{where}: {key} has shape {a.shape}; expected one value per line")
+    return a.reshape(-1).astype(complex if allow_complex and a.dtype.kind == "c" else float)
+
+
+def _sweep_from_arrays(cols: dict, header: dict, response, where: str) -> FrequencySweep:
+    """Check lengths, build the sweep, and name the file in any error of the record itself."""
+    n = {k: v.size for k, v in cols.items()}
+    if response is not None:
+        n["response"] = response.size
+    if len(set(n.values())) > 1:
+        raise DataFormatError(f"{where}: arrays differ in length {n}; expected one value per line in each")
     try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
+        sw = _from_columns(cols, header, where)
+        return replace(sw, response=response) if response is not None else sw
+    except DataFormatError:
+        raise
+    except IPMCError as exc:
+        raise DataFormatError(f"{where}: {exc}") from None
+
+
+def read_npz(path) -> FrequencySweep:
+    """Read a sweep NPZ.  Only the arrays of the format are read, each after its uncompressed size
+    is checked (an extra or oversized array cannot exhaust memory); never unpickles."""
+    import zipfile
+
+    where = str(path)
+    try:
+        zf = zipfile.ZipFile(path)
     except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    if "header" not in data:
-        raise DataFormatError(f"{path}: not an ipmc-sweep NPZ (no 'header')")
-    hdr = json.loads(str(data["header"]))
+        raise DataFormatError(f"{where}: no such file") from None
+    except (zipfile.BadZipFile, OSError, ValueError) as exc:
+        raise DataFormatError(f"{where}: not an NPZ archive ({exc})") from None
+    data = {}
+    with zf:
+        members = {n[:-4]: n for n in zf.namelist() if n.endswith(".npy")}
+        if "header" not in members:
+            raise DataFormatError(f"{where}: not an ipmc-sweep NPZ (no 'header' array)")
+        for key in NPZ_ARRAYS:
+            if key not in members:
+                continue
+            size = zf.getinfo(members[key]).file_size
+            if size > MAX_ARRAY_BYTES:
+                raise DataFormatError(f"{where}: array {key!r} holds {size} bytes; a sweep array holds at most "
+                                      f"{MAX_ARRAY_BYTES} ({MAX_SWEEP_LINES} lines)")
+            try:
+                with zf.open(members[key]) as fh:
+                    data[key] = np.lib.format.read_array(fh, allow_pickle=False)
+            except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+                raise DataFormatError(f"{where}: array {key!r} cannot be read: {exc}") from None
+    h = data["header"]
+    if h.dtype.kind != "U" or h.ndim != 0:
+        raise DataFormatError(f"{where}: 'header' must be one JSON string, got {h.dtype} with shape {h.shape}")
+    try:
+        hdr = json.loads(str(h))
+    except json.JSONDecodeError as exc:
+        raise DataFormatError(f"{where}: 'header' is not JSON: {exc}") from None
+    if not isinstance(hdr, dict):
+        raise DataFormatError(f"{where}: 'header' must be a JSON object, got {type(hdr).__name__}")
+    for key in ("input", "output"):
+        if not isinstance(hdr.get(key), str):
+            raise DataFormatError(f"{where}: header key {key!r} must be a string 'name [unit]', got {hdr.get(key)!r}")
+    meta = hdr.get("metadata", {})
+    if not isinstance(meta, dict):
+        raise DataFormatError(f"{where}: header key 'metadata' must be an object, got {meta!r}")
     missing = [c for c in REQUIRED_COLUMNS if c not in data]
     if missing:
-        raise DataFormatError(f"{path}: missing array(s) {missing}")
-    cols = {k: np.asarray(data[k], dtype=float) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
-    header = {"input": hdr["input"], "output": hdr["output"], **{k: str(v) for k, v in hdr.get("metadata", {}).items()}}
-    sw = _from_columns(cols, header, str(path))
-    if "response_real" in data:   # exact complex values, not rounded through dB/deg
-        sw = replace(sw, response=data["response_real"] + 1j * data["response_imag"])
-    return sw
+        raise DataFormatError(f"{where}: missing array(s) {missing}")
+    cols = {k: _column(data[k], k, where) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
+    parts = [k for k in ("response_real", "response_imag") if k in data]
+    if len(parts) == 1:
+        raise DataFormatError(f"{where}: has {parts[0]!r} but not its partner; give response_real and "
+                              "response_imag together, or neither")
+    response = None
+    if parts:
+        re_, im_ = (_column(data[k], k, where) for k in ("response_real", "response_imag"))
+        if re_.size != im_.size:
+            raise DataFormatError(f"{where}: response_real has {re_.size} values, response_imag {im_.size}")
+        response = re_ + 1j * im_      # exact complex values, not rounded through dB/deg
+    header = {"input": hdr["input"], "output": hdr["output"], **{str(k): str(v) for k, v in meta.items()}}
+    return _sweep_from_arrays(cols, header, response, where)
 
 
 def write_mat(sw: FrequencySweep, path) -> Path:
@@ -230,29 +399,63 @@ def write_mat(sw: FrequencySweep, path) -> Path:
     cols["format"] = f"ipmc-sweep {FORMAT_VERSION}"
     cols["metadata_json"] = json.dumps(sw.metadata)
 
-    def write(fh):
-        savemat(fh, cols, do_compression=True)
+    buf = io.BytesIO()
+    savemat(buf, cols, do_compression=True)
+    data = bytearray(buf.getvalue())
+    # the 116-byte descriptive text of a v5 header carries the creation time; a fixed text makes
+    # the file byte-reproducible like the CSV and NPZ (MATLAB ignores the text)
+    data[:116] = MAT_HEADER_TEXT
 
-    return atomic_write(path, write, "wb")
+    return atomic_write(path, lambda fh: fh.write(bytes(data)), "wb")
+
+
+def _mat_text(data: dict, key: str, where: str) -> str:
+    v = np.asarray(data[key])
+    if v.dtype.kind != "U" or v.size != 1:
+        raise DataFormatError(f"{where}: variable {key!r} must be a string, got {v.dtype} with shape {v.shape}")
+    return str(v.reshape(-1)[0])
+
+
+#: The descriptive text at the start of every .mat file written here (no timestamp).
+MAT_HEADER_TEXT = f"MATLAB 5.0 MAT-file, written by ipmc (ipmc-sweep {FORMAT_VERSION})".encode("ascii").ljust(116)
 
 
 def read_mat(path) -> FrequencySweep:
-    from scipy.io import loadmat
+    """Read a sweep .mat; variable sizes are checked (``whosmat``) before anything is loaded."""
+    from scipy.io import loadmat, whosmat
 
-    try:
-        data = loadmat(path)
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    missing = [c for c in REQUIRED_COLUMNS if c not in data]
+    where = str(path)
+    if not Path(path).is_file():
+        raise DataFormatError(f"{where}: no such file")
+    wanted = REQUIRED_COLUMNS + OPTIONAL_COLUMNS + ("response", "input", "output", "metadata_json")
+    try:   # scipy's parser raises many exception types on a malformed file; all mean "not readable"
+        shapes = {name: shape for name, shape, _ in whosmat(path)}
+        for key in wanted:
+            if key in shapes and 16 * int(np.prod(shapes[key], dtype=np.int64)) > MAX_ARRAY_BYTES:
+                raise DataFormatError(f"{where}: variable {key!r} has shape {shapes[key]}; a sweep holds at most "
+                                      f"{MAX_SWEEP_LINES} lines")
+        data = loadmat(path, variable_names=[k for k in wanted if k in shapes])
+    except DataFormatError:
+        raise
+    except Exception as exc:  # noqa: BLE001
+        raise DataFormatError(f"{where}: not a readable MATLAB .mat file ({type(exc).__name__}: {exc})") from None
+    missing = [c for c in REQUIRED_COLUMNS + ("input", "output") if c not in data]
     if missing:
-        raise DataFormatError(f"{path}: missing variable(s) {missing}")
-    cols = {k: np.asarray(data[k], dtype=float).reshape(-1) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
-    meta = json.loads(str(data["metadata_json"][0])) if "metadata_json" in data else {}
-    header = {"input": str(data["input"][0]), "output": str(data["output"][0]), **{k: str(v) for k, v in meta.items()}}
-    sw = _from_columns(cols, header, str(path))
-    if "response" in data:
-        sw = replace(sw, response=np.asarray(data["response"], dtype=complex).reshape(-1))
-    return sw
+        raise DataFormatError(f"{where}: missing variable(s) {missing}")
+    cols = {k: _column(data[k], k, where) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
+    meta = {}
+    if "metadata_json" in data:
+        try:
+            meta = json.loads(_mat_text(data, "metadata_json", where))
+        except json.JSONDecodeError as exc:
+            raise DataFormatError(f"{where}: variable 'metadata_json' is not JSON: {exc}") from None
+        if not isinstance(meta, dict):
+            raise DataFormatError(f"{where}: variable 'metadata_json' must hold a JSON object")
+    header = {"input": _mat_text(data, "input", where), "output": _mat_text(data, "output", where),
+              **{str(k): str(v) for k, v in meta.items()}}
+    response = _column(data["response"], "response", where, allow_complex=True).astype(complex) \
+        if "response" in data else None
+    return _sweep_from_arrays(cols, header, response, where)
 
 
 def by_extension(path, handlers: Mapping[str, Callable], what: str) -> Callable:

@@ -42,6 +42,9 @@ from .units import QUANTITY_UNITS, UNITS, unit_scale
 FORMAT_VERSION = 1
 REQUIRED_COLUMNS = ("temperature_c", "frequency_hz", "magnitude_db", "phase_deg")
 OPTIONAL_COLUMNS = ("magnitude_std_db", "phase_std_deg")
+#: Most lines (frequencies × temperatures) in one sweep: checked before anything is allocated, so
+#: a typo such as ``points = 100000000`` is a clear error, not a process killed for memory.
+MAX_SWEEP_LINES = 5_000_000
 
 # ----------------------------------------------------------------------------------- noise
 @dataclass(frozen=True)
@@ -141,6 +144,8 @@ class FrequencySweep:
             raise IPMCError(f"response contains NaN or inf at rows {np.flatnonzero(~np.isfinite(H))[:5].tolist()}")
         if np.any(f <= 0):
             raise IPMCError(f"frequencies must be > 0 Hz; got {f[f <= 0][:5].tolist()}")
+        if np.any(T <= -273.15):
+            raise IPMCError(f"temperature_c must be above absolute zero (-273.15 °C); got {T[T <= -273.15][:5].tolist()}")
         if np.any(H == 0):
             raise IPMCError(f"response is exactly 0 at rows {np.flatnonzero(H == 0)[:5].tolist()}; magnitude in dB undefined")
         object.__setattr__(self, "temperature_c", T)
@@ -276,6 +281,12 @@ def synthesize_sweep(model, quantity: str, frequency_hz, temperature_c, noise=No
                         f"{[q for k, q in QUANTITY_UNITS if k == kind]}")
     if noise is not None and seed is None:
         raise IPMCError("a noisy sweep needs an explicit integer seed (reproducibility)")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
+        raise IPMCError(f"seed must be a non-negative integer, got {seed!r}")
+    n_lines = int(np.size(frequency_hz)) * int(np.size(temperature_c))
+    if n_lines > MAX_SWEEP_LINES:
+        raise IPMCError(f"{np.size(frequency_hz)} frequencies × {np.size(temperature_c)} temperatures = {n_lines} "
+                        f"lines; a sweep holds at most {MAX_SWEEP_LINES} (split it)")
     in_name, in_unit, out_name, out_unit = QUANTITY_UNITS[key]
     resp = model.frequency_response(frequency_hz, temperature_c, quantities=(quantity,), progress=progress)
     H = resp[quantity][set_index] * (unit_scale(in_unit) / unit_scale(out_unit))     # (n_T, n_f)

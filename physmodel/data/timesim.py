@@ -382,6 +382,7 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
         output = "displacement" if is_act else "current"
     if (output_noise_rms or input_noise_rms) and seed is None:
         raise IPMCError("a noisy simulation needs an explicit integer seed (reproducibility)")
+    check_seed(seed)
     for k, v in (("output_noise_rms", output_noise_rms), ("input_noise_rms", input_noise_rms)):
         if not (np.isfinite(v) and v >= 0):
             raise IPMCError(f"{k}={v!r} must be a finite number >= 0")
@@ -415,11 +416,24 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
     return TimeSeries(t, u_meas, y_meas, in_name, in_unit, out_name, out_unit, y, u, meta)
 
 
+#: Most samples of one time record, checked before anything is allocated.
+MAX_TIME_SAMPLES = 20_000_000
+
+
+def check_seed(seed) -> None:
+    """A seed is None or a non-negative integer (numpy's generators refuse anything else)."""
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
+        raise IPMCError(f"seed must be a non-negative integer, got {seed!r}")
+
+
 def time_grid(duration: float, fs: float) -> np.ndarray:
     if not (np.isfinite(duration) and duration > 0):
         raise IPMCError(f"duration={duration!r} s must be > 0")
     if not (np.isfinite(fs) and fs > 0):
         raise IPMCError(f"fs={fs!r} Hz must be > 0")
+    if duration * fs > MAX_TIME_SAMPLES:
+        raise IPMCError(f"duration {duration:g} s at fs {fs:g} Hz is {duration * fs:.3g} samples; at most "
+                        f"{MAX_TIME_SAMPLES} per record")
     n = int(round(duration * fs)) + 1
     if n < 2:
         raise IPMCError(f"duration {duration} s at fs {fs} Hz gives fewer than 2 samples")
@@ -465,6 +479,11 @@ def free_release(model, temperature_c: float, w0: float, t_release: float, durat
     """
     from ..actuator import ActuatorModel
 
+    if not (np.isfinite(t_release) and 0 <= t_release < duration):
+        raise IPMCError(f"t_release = {t_release!r} s must lie in [0, duration = {duration!r} s): a release "
+                        "after the record ends leaves nothing to record")
+    if not (np.isfinite(w0) and w0 != 0):
+        raise IPMCError(f"w0 = {w0!r} m: the initial tip displacement must be finite and non-zero")
     st = model.state([temperature_c])
     wn = float(st.omega_n[set_index, 0, 0])
     xi = float(st.xi[set_index, 0, 0])

@@ -16,6 +16,7 @@ from ..errors import IPMCError, ParameterError
 from ..params import IPMCParameters
 from ..parameter_paths import apply_values, base_value, check_parameter_name
 from .lsq import CalibrationResult, FreeParameter, SensitivityProbe, fit_parameters
+from .records import Identifiability
 
 def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
     """Default bounds for a bare name (initial = base value):
@@ -78,7 +79,8 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
               free: Sequence[FreeParameter | str], *, kind: str = "actuator", quantity: str | None = None,
               starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
               identify: bool = True, hold_undetermined: bool = True, name: str | None = None,
-              progress: Callable[[int], None] | None = None, **kwargs) -> CalibrationResult:
+              progress: Callable[[int], None] | None = None, misfit: str = "widen",
+              **kwargs) -> CalibrationResult:
     """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
 
     ``free``: :class:`FreeParameter` records or bare names (default bounds: see
@@ -90,7 +92,16 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
     be of the matching kinds (mm/V, µA/mm, Ω, ...).  Returns a :class:`CalibrationResult` whose
     ``parameters`` is ``base`` with the determined values (held ones at their base value), named
     ``name`` (default ``"<base.name>_calibrated"``).
+
+    Goodness of fit (``result.goodness_of_fit``, :func:`~physmodel.estimation.residuals.goodness_of_fit`):
+    when the cost is inconsistent with its χ² expectation (declared noise) or implies implausible
+    noise (estimated noise), the result says so (``adequate`` False, message), no parameter is
+    reported as identifiable, and its intervals are widened by the Birge ratio sqrt(χ²/dof)
+    (``misfit="widen"``, the default) or withheld as NaN (``misfit="withhold"``, what ``ipmc
+    calibrate`` does unless ``--accept-misfit``).
     """
+    if misfit not in ("widen", "withhold"):
+        raise ParameterError(f"misfit must be 'widen' or 'withhold', got {misfit!r}")
     if not isinstance(base, IPMCParameters):
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
     data = merge_sweeps(data)
@@ -121,6 +132,33 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
     res.parameters = replace(apply_values(base, res.values), name=label, source=src)
     res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
                          "data_fingerprint": data.fingerprint(), "seed": seed})
+    if not res.adequate:
+        apply_misfit_policy(res, widen=misfit == "widen")
+    return res
+
+
+def apply_misfit_policy(res: CalibrationResult, widen: bool) -> CalibrationResult:
+    """For a result whose model does not fit its data: no identifiability verdict, and the
+    intervals withheld (NaN) or, with ``widen``, widened by the Birge ratio
+    R = sqrt(χ²/dof) (in the fitted scale: log parameters multiplicatively).  In place; returned."""
+    gof = res.goodness_of_fit
+    R = math.sqrt(gof.reduced_chi2) if gof.reduced_chi2 > 0 and math.isfinite(gof.reduced_chi2) else float("nan")
+    for n, fp in zip(res.names, res.free):
+        if n in res.held:
+            continue
+        v, lo, hi = res.values[n], res.ci_lower[n], res.ci_upper[n]
+        if widen and math.isfinite(R):
+            if fp.scale == "log" and v != 0 and lo * v > 0 and hi * v > 0:
+                lo, hi = v * (lo / v) ** R, v * (hi / v) ** R
+            else:
+                lo, hi = v - R * (v - lo), v + R * (hi - v)
+            res.ci_lower[n], res.ci_upper[n] = min(lo, hi), max(lo, hi)
+            res.stderr[n] = res.stderr[n] * R
+        else:
+            res.ci_lower[n] = res.ci_upper[n] = res.stderr[n] = float("nan")
+        res.identifiability[n] = Identifiability(False, "not assessed: the model does not fit the data (" + gof.reason + ")")
+    res.message += ("; MODEL INADEQUATE: " + gof.reason
+                    + ("; intervals widened by the Birge ratio %.3g" % R if widen else "; intervals withheld"))
     return res
 
 

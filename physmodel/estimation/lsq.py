@@ -53,7 +53,7 @@ from ..data.sweep import FrequencySweep
 from ..errors import IPMCError, ParameterError
 from .records import (CalibrationResult, FreeParameter, Identifiability, SensitivityProbe, StartRecord,
                       Values)
-from .residuals import noise_std, standardised_residuals
+from .residuals import goodness_of_fit, noise_std, standardised_residuals
 
 #: Two-sided 95 % normal quantile.
 Z95 = 1.959963984540054
@@ -97,6 +97,8 @@ def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
 
     if n <= 0:
         return np.empty((0, len(free)))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be a non-negative integer, got {seed!r}")
     u = qmc.LatinHypercube(d=len(free), seed=seed).random(n)
     lo = np.array([fp.z_bounds[0] for fp in free])
     hi = np.array([fp.z_bounds[1] for fp in free])
@@ -393,6 +395,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     expected = n_lines - n_act / 2.0
     if held:
         message += f"; undetermined and held at their start value: {', '.join(held)}"
+    gof = goodness_of_fit(cost, 2 * n_lines, n_act, estimated)
     return CalibrationResult(
         names=names, values=values, parameters=None, stderr=stderr, ci_lower=lo_ci, ci_upper=hi_ci,
         correlation=C, cost=cost, expected_cost=expected, cost_std=math.sqrt(max(expected, 0.0)),
@@ -400,5 +403,5 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
         converged=bool(converged), message=message, starts=records, identifiability=ident,
         noise_estimated=estimated, noise_scale=float(noise_scale), held=list(held), free=list(free),
         band_hz=(float(data.frequency_hz.min()), float(data.frequency_hz.max())),
-        temperatures_c=data.temperatures().tolist(), elapsed_s=time.perf_counter() - t0,
+        temperatures_c=data.temperatures().tolist(), elapsed_s=time.perf_counter() - t0, goodness_of_fit=gof,
     )

@@ -170,6 +170,12 @@ class CalibrationResult:
     temperatures_c: list
     elapsed_s: float
     metadata: dict = field(default_factory=dict)
+    goodness_of_fit: object = None    # physmodel.estimation.residuals.GoodnessOfFit
+
+    @property
+    def adequate(self) -> bool:
+        """The model fits the data (goodness-of-fit test passed, or not available)."""
+        return self.goodness_of_fit is None or bool(self.goodness_of_fit.adequate)
 
     @property
     def determined(self) -> list:
@@ -185,6 +191,8 @@ class CalibrationResult:
             f"  cost {self.cost:.4g} (expected {self.expected_cost:.4g} ± {self.cost_std:.3g}); "
             f"{len(self.starts)} start(s); {self.n_evaluations} model evaluations in {self.n_model_calls} calls; "
             f"{self.elapsed_s:.2f} s",
+            *([f"  goodness of fit: {'adequate' if self.adequate else 'INADEQUATE'} — {self.goodness_of_fit.reason}"]
+              if self.goodness_of_fit is not None else []),
             f"  {'parameter':34s} {'value':>12s} {'95 % interval':>27s}  status",
         ]
         for n in self.names:
@@ -193,7 +201,8 @@ class CalibrationResult:
                 lines.append(f"  {n:34s} {self.values[n]:12.5g} {'(held)':>27s}  UNDETERMINED: {ident.reason}")
             else:
                 ci = f"[{self.ci_lower[n]:.5g}, {self.ci_upper[n]:.5g}]"
-                lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci:>27s}  ok")
+                ok = n not in self.identifiability or self.identifiability[n].identifiable
+                lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci:>27s}  {'ok' if ok else 'NOT ASSESSED (model inadequate)'}")
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -226,6 +235,7 @@ class CalibrationResult:
             "starts": [{"index": s.index, "initial": s.initial, "final": s.final, "cost": num(s.cost),
                         "nfev": s.nfev, "status": s.status, "message": s.message} for s in self.starts],
             "elapsed_s": float(self.elapsed_s),
+            "goodness_of_fit": self.goodness_of_fit.to_dict() if self.goodness_of_fit is not None else None,
             "metadata": {k: str(v) for k, v in self.metadata.items()},
         }
 

@@ -9,6 +9,7 @@ model averages F − nθ/2 (F lines, nθ fitted parameters) with spread ≈ sqrt
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -63,3 +64,63 @@ def weighted_cost(model_response, data: FrequencySweep) -> float:
     """½·Σ r² of :func:`residuals`; for a correct model its mean is ≈ F − nθ/2 (F lines)."""
     r = residuals(model_response, data)
     return float(0.5 * np.sum(r * r))
+
+
+#: A cost whose χ² tail probability is below this is inconsistent with the declared noise.
+GOF_ALPHA = 1e-3
+#: With estimated noise (no per-line standard deviations) the residuals imply a relative noise per
+#: line; above this (20 %: 1.7 dB in magnitude, 11° in phase) the scatter is a misfit, not noise.
+MAX_ESTIMATED_RELATIVE_NOISE = 0.2
+
+
+@dataclass(frozen=True)
+class GoodnessOfFit:
+    """Whether a fitted model is consistent with its data.
+
+    ``chi2`` = 2·cost = Σr² of the standardised residuals on ``dof`` = (residuals − parameters)
+    degrees of freedom; ``reduced_chi2`` = chi2/dof (its square root is the Birge ratio that widens
+    intervals under ``accept_misfit``).  Declared noise: ``p_value`` = P(χ²_dof ≥ chi2) and
+    ``adequate`` = p ≥ ``alpha``.  Estimated noise (the fallback σ): χ² is not informative, so
+    ``relative_noise`` = FALLBACK_RELATIVE_STD·sqrt(reduced_chi2) is compared with
+    :data:`MAX_ESTIMATED_RELATIVE_NOISE` and ``p_value`` is None.
+    """
+
+    adequate: bool
+    chi2: float
+    dof: int
+    reduced_chi2: float
+    p_value: float | None
+    relative_noise: float | None
+    reason: str
+
+    def to_dict(self) -> dict:
+        num = lambda v: None if v is None or not math.isfinite(v) else float(v)  # noqa: E731
+        return {"adequate": bool(self.adequate), "chi2": num(self.chi2), "dof": int(self.dof),
+                "reduced_chi2": num(self.reduced_chi2), "p_value": num(self.p_value),
+                "relative_noise": num(self.relative_noise), "reason": self.reason}
+
+
+def goodness_of_fit(cost: float, n_residuals: int, n_parameters: int, noise_estimated: bool,
+                    alpha: float = GOF_ALPHA) -> GoodnessOfFit:
+    """Test a weighted least-squares cost ½Σr² against its χ² expectation (see :class:`GoodnessOfFit`)."""
+    from scipy.stats import chi2 as chi2_dist
+
+    dof = int(n_residuals - n_parameters)
+    x = 2.0 * float(cost)
+    if dof <= 0 or not math.isfinite(x):
+        return GoodnessOfFit(dof > 0 and math.isfinite(x), x, dof, float("nan"), None, None,
+                             "not testable: " + ("no residual degrees of freedom" if dof <= 0 else "the cost is not finite"))
+    red = x / dof
+    if not noise_estimated:
+        p = float(chi2_dist.sf(x, dof))
+        ok = p >= alpha
+        return GoodnessOfFit(ok, x, dof, red, p, None,
+                             f"chi2 = {x:.4g} on {dof} degrees of freedom (expected {dof} ± {math.sqrt(2 * dof):.3g}), "
+                             f"p = {p:.2g}: " + ("consistent with the declared noise" if ok else
+                                                 f"the model does not fit the data within the declared noise (p < {alpha:g})"))
+    rel = FALLBACK_RELATIVE_STD * math.sqrt(red)
+    ok = rel <= MAX_ESTIMATED_RELATIVE_NOISE
+    return GoodnessOfFit(ok, x, dof, red, None, rel,
+                         f"no per-line standard deviations: the residuals imply {rel:.3g} relative noise per line "
+                         f"(ln-magnitude, phase in rad); " + ("plausible as measurement noise" if ok else
+                         f"above {MAX_ESTIMATED_RELATIVE_NOISE:g} this is a misfit, not noise: the model does not fit the data"))

@@ -87,24 +87,36 @@ def save_parameter_set(params: IPMCParameters, path: str | os.PathLike) -> Path:
 
 def load_parameter_set(path: str | os.PathLike) -> IPMCParameters:
     """Read a JSON parameter file written by :func:`save_parameter_set` (or a bare parameter record)."""
+    from ..data.files import read_text
+    from ..errors import DataFormatError
+
     path = Path(path)
     if not path.is_file():
         raise ParameterError(f"parameter file {str(path)!r} does not exist")
     try:
-        data = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
-        raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from exc
+        data = json.loads(read_text(path, "parameter file"))
+    except DataFormatError as exc:
+        raise ParameterError(str(exc)) from None
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from None
     if isinstance(data, dict) and "parameters" in data:
         if data.get("format") != _FORMAT:
             raise ParameterError(f"parameter file {str(path)!r} has format {data.get('format')!r}, "
                                  f"expected {_FORMAT!r}")
-        if int(data.get("version", 0)) > _VERSION:
-            raise ParameterError(f"parameter file {str(path)!r} has version {data.get('version')}, "
+        version = data.get("version", 0)
+        if isinstance(version, bool) or not isinstance(version, int) or version < 0:
+            raise ParameterError(f"parameter file {str(path)!r}: version must be a non-negative integer, "
+                                 f"got {version!r}")
+        if version > _VERSION:
+            raise ParameterError(f"parameter file {str(path)!r} has version {version}, "
                                  f"this library reads up to {_VERSION}")
         data = data["parameters"]
     if not isinstance(data, dict):
         raise ParameterError(f"parameter file {str(path)!r} holds {type(data).__name__}, expected an object")
-    return IPMCParameters.from_dict(data)
+    try:
+        return IPMCParameters.from_dict(data)
+    except ParameterError as exc:
+        raise ParameterError(f"parameter file {str(path)!r}: {exc}") from None
 
 
 def _finite_json(obj):

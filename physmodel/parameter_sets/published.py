@@ -1,7 +1,9 @@
 """The seed papers' printed numbers and claims, shipped with the package (``published.toml``).
 
-Each table names its paper (``paper``: the seed file) and holds the numbers as printed (units
-as printed, e.g. s in rad/s, current in µA, displacement in mm).  :func:`load_published` returns
+Each table cites its paper (``citation``, short form ``cite_as``; ``paper``: the text the numbers
+were transcribed from), holds the numbers as printed (units as printed, e.g. s in rad/s, current in
+µA, displacement in mm) and, in its ``location`` sub-table, where each claim is printed (section /
+table / figure / equation, a list for a list of claims).  :func:`load_published` returns
 the parsed file; :func:`seed000_printed_model_35c` the one printed sensor model as coefficient
 tuples.  Nothing here reads anything outside the package.
 """

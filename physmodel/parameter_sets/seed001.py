@@ -1,12 +1,23 @@
 """Seed 001 actuator set.
 
 seed001_actuator
-    The seed 001 actuator: development values with E at T_ref = 23 °C and a log-linear C⁻ law
-    solved from the printed trend (largest 19-vs-55 °C difference 7 dB at 3 Hz, 19 °C larger, a
-    maximum there): E = 421.4 MPa, C⁻ slope −2.609 %/K; E keeps the default −0.75 %/K, which moves
-    the first mode from 2.79 Hz (19 °C) to 2.44 Hz (55 °C).  C⁻ is the law-able proxy for a coupling
-    that weakens with temperature (default laws make the gain near 2 Hz rise with T).  The zpk
-    schedules' numbers are not printed, so no response is fitted.
+    The seed 001 actuator (Dong and Tan, Smart Mater. Struct. 21, 065014, 2012; 45 mm free length
+    × 11 mm × 0.3 mm, in water): development values with E at T_ref = 23 °C and a log-linear C⁻ law
+    solved from one printed claim only, ``trends[1]`` (Sec. 2.2, Fig. 2): the largest 19-vs-55 °C
+    magnitude difference is about 7 dB, at about 3 Hz, 19 °C larger — two equations, D(3 Hz) = 7 dB
+    and dD/dln f (3 Hz) = 0, in two unknowns: E = 421.4 MPa, C⁻ slope −2.609 %/K.
+    E keeps the physics.md default slope −0.75 %/K (a literature input), which moves the first mode
+    from 2.79 Hz (19 °C) to 2.44 Hz (55 °C): the falling resonance (``trends[0]``) follows from that
+    input.  Predictions (not used): the order claims, the right-half-plane zero pair, the 35/45 °C
+    hold-out of the scheduled model and the 45 °C tracking comparison.
+
+    Plausibility: E = 421 MPa at 23 °C is of the order of the 300 MPa development value and above
+    the 154 MPa of seed 002's Table 2; it is fixed by the first mode (the added mass of water is in
+    ρ), so it is only as good as the beam model.  A C⁻ falling 2.6 %/K (−61 % over 19–55 °C) is a
+    stand-in, not a material property: C⁻ is set by the membrane's ion-exchange capacity, and is
+    used here only because the physics has no law-able coupling that weakens with T (with default
+    laws the gain near 2 Hz rises with T).
+    The zpk schedules' numbers are not printed, so no response is fitted.
     Derivation: ``python3 -m physmodel.parameter_sets.derivation``.
 """
 
@@ -30,3 +41,8 @@ def _seed001_actuator() -> IPMCParameters:
 
 
 SETS = {"seed001_actuator": _seed001_actuator}
+
+#: The published claims (``published.toml`` ids) the set was solved to; every other claim is a prediction.
+CALIBRATION = {"seed001_actuator": {
+    "actuator_seed001.trends[1]": "E at T_ref and the C- slope solved from D(3 Hz) = 7 dB, dD/dlnf(3 Hz) = 0",
+}}

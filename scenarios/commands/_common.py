@@ -46,17 +46,41 @@ def _floats(text: str, what: str) -> list[float]:
     return vals
 
 
+#: Figure formats the plots can write (matplotlib's savefig).
+PLOT_FORMATS = (".png", ".pdf", ".svg", ".svgz", ".eps", ".ps", ".jpg", ".jpeg", ".tif", ".tiff", ".webp")
+
+
+def check_plot_path(path, option: str = "--plot") -> Path:
+    """``path`` when its extension is a figure format, a CLIError naming it otherwise (checked
+    before any computation, so a typo does not cost a whole run)."""
+    p = Path(path)
+    if p.suffix.lower() not in PLOT_FORMATS:
+        raise CLIError(f"{option} {p}: unknown figure type {p.suffix or '(none)'!r}; use one of {', '.join(PLOT_FORMATS)}")
+    if p.is_dir():
+        raise CLIError(f"{option} {p} is a folder; expected a file name")
+    return p
+
+
+def check_out_file(path, suffixes, option: str = "--out") -> Path:
+    """An output file name with one of ``suffixes`` that is not an existing folder."""
+    p = Path(path)
+    if p.suffix.lower() not in suffixes:
+        raise CLIError(f"{option} {p}: use a {', '.join(suffixes)} file name")
+    if p.is_dir():
+        raise CLIError(f"{option} {p} is a folder; expected a file name")
+    return p
+
+
 def _load_params(args):
     from physmodel import get_parameter_set
-    from physmodel.params import IPMCParameters
-
     if getattr(args, "params_json", None):
-        import json
+        from physmodel.parameter_sets import load_parameter_set
 
         path = Path(args.params_json)
-        if not path.exists():
+        if not path.is_file():
             raise CLIError(f"--params-json {path}: no such file")
-        p = IPMCParameters.from_dict(json.loads(path.read_text()))
+        # the same reader as --set FILE.json: the versioned file ipmc calibrate writes, or a bare record
+        p = load_parameter_set(path)
         over = parse_assignments(args.param)
         return p.replace(**over) if over else p
     return get_parameter_set(args.set, **parse_assignments(args.param))

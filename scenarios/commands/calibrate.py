@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -78,6 +77,11 @@ def add_parser(subparsers):
     p.add_argument("--max-nfev", type=int, help="residual evaluations allowed per start (default: scipy's)")
     p.add_argument("--no-hold", action="store_true",
                    help="report undetermined parameters but do not hold them at their base value")
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="exit 0 even when the model does not fit the data (goodness-of-fit test failed); "
+                        "intervals are then widened by the Birge ratio instead of withheld")
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--name", help="name of the calibrated parameter set (default <base>_calibrated)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
@@ -88,7 +92,6 @@ def add_parser(subparsers):
 def run(args) -> int:
     """Execute ``ipmc calibrate``; returns 0, or 3 when the fit did not converge (bad input raises)."""
     from physmodel import get_parameter_set
-    from physmodel.estimation.calibration import calibrate, model_sweep
     from physmodel.data.files import read_sweep
 
     if args.starts < 1:
@@ -97,9 +100,10 @@ def run(args) -> int:
     over = parse_assignments(args.param)
     base = get_parameter_set(args.base_set, **over)
     free = [parse_free(s, base) for s in args.free]
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise ParameterError(f"--out {out} exists and is not a folder")
+    from physmodel.data.files import check_output_folder, output_folder
+    from physmodel.estimation.calibration import calibrate
+
+    out = check_output_folder(args.out, "ipmc calibrate", force=args.force)
     bar = None
     if not args.quiet:
         from tqdm import tqdm
@@ -109,13 +113,28 @@ def run(args) -> int:
         res = calibrate(data, base, free, kind=args.kind, quantity=args.quantity, kernel=args.kernel,
                         starts=args.starts, seed=args.seed, max_nfev=args.max_nfev,
                         hold_undetermined=not args.no_hold, name=args.name,
+                        misfit="widen" if args.accept_misfit else "withhold",
                         progress=bar.update if bar is not None else None)
     finally:
         if bar is not None:
             bar.close()
     res.metadata["sweep_file"] = str(args.sweep)
-    out.mkdir(parents=True, exist_ok=True)
+    with output_folder(out, "ipmc calibrate", force=args.force):
+        _write(res, data, args, out)
+    if not res.converged:
+        print(f"ipmc calibrate: the fit did not converge: {res.message}", file=sys.stderr)
+        return EXIT_FAILED
+    if not res.adequate:
+        print(f"ipmc calibrate: the model does not fit the data: {res.goodness_of_fit.reason}"
+              + ("" if args.accept_misfit else " (intervals withheld; --accept-misfit to exit 0 with widened intervals)"),
+              file=sys.stderr)
+        return EXIT_OK if args.accept_misfit else EXIT_FAILED
+    return EXIT_OK
+
+
+def _write(res, data, args, out):
     from physmodel.data.files import atomic_write
+    from physmodel.estimation.calibration import model_sweep
 
     res.save(out / "parameters.json")
     record = res.to_dict()
@@ -130,10 +149,6 @@ def run(args) -> int:
     if not args.quiet:
         print(res.summary())
         print(f"wrote {out}/parameters.json, calibration.json, report.md, bode.png")
-    if not res.converged:
-        print(f"ipmc calibrate: the fit did not converge: {res.message}", file=sys.stderr)
-        return EXIT_FAILED
-    return EXIT_OK
 
 
 def _g(v) -> str:
@@ -151,6 +166,8 @@ def render_report(res, data, args) -> str:
         f"- model: {res.metadata.get('kind')} quantity {res.metadata.get('quantity')}, base set `{args.base_set}`",
         f"- status: {'converged' if res.converged else '**NOT CONVERGED**'} — {res.message}",
         f"- weighted cost {res.cost:.5g}; expected for a correct model {res.expected_cost:.5g} ± {res.cost_std:.3g}",
+        "- goodness of fit: " + ("n/a" if res.goodness_of_fit is None else
+                                 ("adequate" if res.adequate else "**INADEQUATE**") + f" — {res.goodness_of_fit.reason}"),
         "- noise: " + ("**estimated** from the residuals (the sweep has no per-line standard deviations); "
                         f"intervals scaled by {res.noise_scale:.3g}" if res.noise_estimated
                         else "per-line standard deviations from the sweep"),
@@ -164,7 +181,8 @@ def render_report(res, data, args) -> str:
     ]
     for n, fp in zip(res.names, res.free):
         st = res.identifiability[n]
-        status = "determined" if n not in res.held else f"**undetermined** (held at base): {st.reason}"
+        status = ("determined" if st.identifiable else f"**not assessed**: {st.reason}") if n not in res.held \
+            else f"**undetermined** (held at base): {st.reason}"
         ci = "–" if n in res.held else f"[{_g(res.ci_lower[n])}, {_g(res.ci_upper[n])}]"
         lines.append(f"| `{n}` | {_g(res.values[n])} | {_g(res.stderr[n])} | {ci} | "
                      f"[{fp.lower:.4g}, {fp.upper:.4g}] | {fp.scale} | {status} |")

@@ -64,6 +64,8 @@ def add_parser(subparsers):
     p.add_argument("--null-refits", type=int, help="full-refit bootstrap draws under the null (default 4)")
     p.add_argument("--seed", type=int, help="seed of the null Monte Carlo (default 0)")
     p.add_argument("--out", help="report folder (default diagnosis)")
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
     return p
@@ -72,10 +74,12 @@ def add_parser(subparsers):
 def _load_toml(path: Path) -> dict:
     import tomllib
 
+    from physmodel.data.files import read_text
+
     if not path.is_file():
         raise IPMCError(f"experiment file {str(path)!r} does not exist")
     try:
-        spec = tomllib.loads(path.read_text())
+        spec = tomllib.loads(read_text(path, "experiment file"))
     except tomllib.TOMLDecodeError as exc:
         raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
     known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
@@ -83,12 +87,53 @@ def _load_toml(path: Path) -> dict:
     unknown = set(spec) - known
     if unknown:
         raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
+    _check_types(spec, path)
     for key in ("data", "set"):
         if key in spec and isinstance(spec[key], str):
             cand = path.parent / spec[key]
             if key == "data" or cand.suffix.lower() == ".json":
                 spec[key] = str(cand) if not Path(spec[key]).is_absolute() else spec[key]
     return spec
+
+
+def _is_num(v):
+    import math
+
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _is_int(v):
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_strs(v):
+    return isinstance(v, list) and all(isinstance(x, str) for x in v)
+
+
+#: Experiment-file keys: (check, what is expected).
+_TYPES = {"data": (lambda v: isinstance(v, str), "a file name"), "kind": (lambda v: v in ("actuator", "sensor"), "'actuator' or 'sensor'"),
+          "quantity": (lambda v: isinstance(v, str), "a quantity name (M, H, Z, I, S)"),
+          "kernel": (lambda v: v in ("boundary_charge", "reciprocal"), "'boundary_charge' or 'reciprocal'"),
+          "set": (lambda v: isinstance(v, str), "a parameter-set name or JSON file"),
+          "free": (lambda v: _is_strs(v) and len(v) > 0, "a non-empty list of strings NAME[:LOWER:UPPER...]"),
+          "candidates": (lambda v: _is_strs(v) or isinstance(v, str), "a list of effect names"),
+          "alpha": (lambda v: _is_num(v) and 0 < v < 1, "a number in (0, 1)"),
+          "seed": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
+          "out": (lambda v: isinstance(v, str), "a folder name"),
+          "null_draws": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
+          "null_refits": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
+          "geometry": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()), "a table of L, W, h [m] numbers"),
+          "parameters": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()), "a table of NAME = number (SI)"),
+          "baseline_effects": (lambda v: isinstance(v, dict) and all(isinstance(e, dict) and all(_is_num(x) for x in e.values())
+                                                                     for e in v.values()),
+                               "a table of [baseline_effects.NAME] tables of numbers")}
+
+
+def _check_types(spec: dict, path: Path) -> None:
+    for key, value in spec.items():
+        ok, what = _TYPES[key]
+        if not ok(value):
+            raise IPMCError(f"experiment file {str(path)!r}: {key} = {value!r}; expected {what}")
 
 
 def _parse_effect(item: str) -> tuple[str, dict]:
@@ -157,6 +202,12 @@ def build(args):
     cands = pick(args.candidates, "candidates")
     if isinstance(cands, str):
         cands = [c.strip() for c in cands.split(",") if c.strip()]
+    if cands is not None:
+        from physmodel.effects import ALL_EFFECTS
+
+        unknown = [c for c in cands if c not in ALL_EFFECTS]
+        if unknown:
+            raise IPMCError(f"candidates: unknown effect(s) {unknown}; expected names from {sorted(ALL_EFFECTS)}")
     kw = dict(kind=pick(args.kind, "kind", "actuator"), quantity=pick(args.quantity, "quantity"),
               free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
               null_draws=int(pick(args.null_draws, "null_draws", 4000)),
@@ -171,7 +222,10 @@ def run(args) -> int:
     """Execute ``ipmc diagnose``: 0 for any verdict; bad input raises IPMCError (exit 2)."""
     from physmodel.estimation.discrepancy import diagnose, gap_shrink
 
+    from physmodel.data.files import check_output_folder, output_folder
+
     data, base, kw, out = build(args)
+    check_output_folder(out, "ipmc diagnose", force=args.force)
     bar = None
     if not args.quiet:
         from tqdm import tqdm
@@ -188,8 +242,9 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    d.write_report(out)
-    plots.diagnosis_figures(d, out)
+    with output_folder(out, "ipmc diagnose", force=args.force):
+        d.write_report(out)
+        plots.diagnosis_figures(d, out)
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)

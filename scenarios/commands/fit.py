@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -60,6 +59,10 @@ def add_parser(subparsers):
     p.add_argument("--exclude", type=float, nargs="*", default=[], metavar="T",
                    help="temperatures [°C] held out of the fit and reported as validation")
     p.add_argument("--max-iter", type=int, default=500)
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="exit 0 even when the model does not fit the data (goodness-of-fit test failed)")
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--out", default="fit-out", help="output directory (default fit-out)")
     p.add_argument("--quiet", action="store_true", help="no summary line")
     p.set_defaults(func=run)
@@ -70,7 +73,7 @@ def _fmt(v, spec=".4g"):
     return "n/a" if v is None else format(v, spec)
 
 
-def _report(args, data, fit_data, res, held_out, figures) -> str:
+def _report(args, data, fit_data, res, held_out, figures, verdict=None) -> str:
     m = res.model
     st = m.structure
     lines = [
@@ -82,6 +85,8 @@ def _report(args, data, fit_data, res, held_out, figures) -> str:
         f"- status: {'converged' if res.converged else 'NOT CONVERGED'} (`{res.status}`, "
         f"{res.iterations} IPOPT iterations, {res.time_s:.2f} s)",
         f"- weighted RMS residual: {res.weighted_rms:.4g}",
+        f"- goodness of fit: {'adequate' if verdict is None or verdict.adequate else '**INADEQUATE**'}"
+        + (f" — {verdict.reason}" if verdict is not None else ""),
         f"- stability: {'stable' if res.stability.stable else 'UNSTABLE'} on {res.stability.n_temperatures} "
         f"temperatures (max pole real part {res.stability.max_pole_real_part_rad_s:.4g} rad/s)",
         f"- units: response in {data.output_unit or '?'}/{data.input_unit or '?'}, s in rad/s",
@@ -110,8 +115,11 @@ def _report(args, data, fit_data, res, held_out, figures) -> str:
 
 def run(args) -> int:
     """Execute ``fit``; returns the exit code (0 ok, 2 bad input, 3 not converged)."""
-    from surrogate import RationalFit, ScheduledFit, TemperatureError, fit_percent, relative_rms_error
+    from surrogate import RationalFit, ScheduledFit
 
+    from physmodel.data.files import check_output_folder
+
+    check_output_folder(args.out, "ipmc fit", force=args.force)     # refuse before the fit, not after
     try:
         data = read_csv(args.csv)
         temps = data.temperatures()
@@ -120,6 +128,8 @@ def run(args) -> int:
             if not np.any(np.isclose(temps, t)):
                 raise ValueError(f"--exclude {t:g}: no data at that temperature (have {temps.tolist()})")
         keep = ~np.any(np.isclose(data.temperature_c[:, None], excl[None, :]), axis=1) if excl.size else np.ones(data.n, bool)
+        if not keep.any():
+            raise ValueError(f"--exclude {sorted(set(args.exclude))} leaves no temperature to fit (have {temps.tolist()})")
         fit_data = data.select(keep)
         fit_temps = fit_data.temperatures()
         if fit_temps.size == 1:
@@ -132,10 +142,28 @@ def run(args) -> int:
         print(f"ipmc fit: {exc}", file=sys.stderr)
         return EXIT_NOT_CONVERGED
     except (ValueError, OSError) as exc:
-        print(f"ipmc fit: bad input: {exc}", file=sys.stderr)
+        print(f"ipmc fit: bad input: {args.csv}: {exc}" if str(args.csv) not in str(exc) else f"ipmc fit: bad input: {exc}",
+              file=sys.stderr)
         return EXIT_BAD_INPUT
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    from physmodel.data.files import output_folder
+    from surrogate.adequacy import assess
+
+    verdict = assess(res)
+    with output_folder(args.out, "ipmc fit", force=args.force) as out:
+        _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict)
+    if not res.converged:
+        print(f"ipmc fit: the fit did not converge (IPOPT status {res.status!r})", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
+    if not verdict.adequate:
+        print(f"ipmc fit: the model does not fit the data: {verdict.reason}"
+              + ("" if args.accept_misfit else " (--accept-misfit to exit 0)"), file=sys.stderr)
+        return EXIT_OK if args.accept_misfit else EXIT_NOT_CONVERGED
+    return EXIT_OK
+
+
+def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict):
+    from surrogate import TemperatureError, fit_percent, relative_rms_error
+
     model = res.model
     held = []
     for t in excl:
@@ -155,8 +183,7 @@ def run(args) -> int:
                                         res.per_temperature_models)
         figures.append("poles_zeros_vs_temperature.png")
     model.to_json(out / "model.json")
-    report = _report(args, data, fit_data, res, held, figures)
+    report = _report(args, data, fit_data, res, held, figures, verdict)
     atomic_write(out / "report.md", lambda fh: fh.write(report))
     if not args.quiet:
         print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")
-    return EXIT_OK

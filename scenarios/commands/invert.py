@@ -36,7 +36,7 @@ from inversion import InversionError, invert
 from physmodel.data.files import atomic_write
 
 from .. import plots
-from ._common import EXIT_OK
+from ._common import EXIT_OK, check_plot_path
 
 __all__ = ["add_parser", "run", "model_from_surrogate", "read_csv"]
 
@@ -89,31 +89,49 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def model_from_surrogate(path: str, temperature_c: float) -> Any:
-    """The surrogate JSON at ``path`` (``surrogate.load``) evaluated at ``temperature_c`` [°C]."""
-    import surrogate
+    """The surrogate JSON at ``path`` (``surrogate.load``) evaluated at ``temperature_c`` [°C].
 
-    return surrogate.load(path).at(float(temperature_c))
+    A file that is not a complete surrogate document (not JSON, missing ``structure`` or
+    ``params``, wrong types) is an InversionError naming the file, whatever the loader raised."""
+    import json
+
+    import surrogate
+    from physmodel.data.files import read_text
+
+    read_text(path, "--surrogate")           # missing file, folder, not UTF-8: a clear message
+    try:
+        return surrogate.load(path).at(float(temperature_c))
+    except (ValueError, KeyError, TypeError, IndexError, AttributeError, json.JSONDecodeError) as exc:
+        what = f"missing key {exc}" if isinstance(exc, KeyError) else f"{type(exc).__name__}: {exc}"
+        raise InversionError(f"--surrogate {path}: not a usable surrogate model JSON ({what})") from None
 
 
 def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
-    """Read a numeric CSV with a header row; return (column names, 2-D float array)."""
-    with open(path, newline="") as fh:
-        reader = csv.reader(fh)
+    """Read a numeric CSV with a header row; return (column names, 2-D float array).
+
+    Lines starting with ``#`` (the ``# key: value`` header of ``ipmc simulate`` and of sweep
+    files) and blank lines are skipped; a UTF-8 byte-order mark is dropped; every value must be a
+    finite number."""
+    from physmodel.data.files import read_text
+
+    lines = [(i, ln) for i, ln in enumerate(read_text(path, "signal file").splitlines(), start=1)
+             if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InversionError(f"{path}: empty file (expected a header row)")
+    parsed = csv.reader([ln for _, ln in lines])
+    header = [h.strip() for h in next(parsed)]
+    rows = []
+    for (lineno, _), row in zip(lines[1:], parsed):
+        if len(row) != len(header):
+            raise InversionError(f"{path}:{lineno}: expected {len(header)} fields like the header, got {len(row)}")
         try:
-            header = [h.strip() for h in next(reader)]
-        except StopIteration:
-            raise InversionError(f"{path}: empty file (expected a header row)") from None
-        rows = []
-        for lineno, row in enumerate(reader, start=2):
-            if not row or all(not c.strip() for c in row):
-                continue
-            if len(row) != len(header):
-                raise InversionError(
-                    f"{path}:{lineno}: expected {len(header)} fields like the header, got {len(row)}")
-            try:
-                rows.append([float(c) for c in row])
-            except ValueError:
-                raise InversionError(f"{path}:{lineno}: non-numeric field in {row!r}") from None
+            vals = [float(c) for c in row]
+        except ValueError:
+            raise InversionError(f"{path}:{lineno}: non-numeric field in {row!r}") from None
+        bad = [h for h, v in zip(header, vals) if not math.isfinite(v)]
+        if bad:
+            raise InversionError(f"{path}:{lineno}: {bad[0]} = {row[header.index(bad[0])].strip()!r}; expected a finite number")
+        rows.append(vals)
     if len(set(header)) != len(header):
         raise InversionError(f"{path}: duplicate column names in header {header}")
     data = np.array(rows, dtype=float).reshape(len(rows), len(header))
@@ -133,6 +151,8 @@ def run(args: argparse.Namespace) -> int:
             raise InversionError("the model is missing: give --num and --den (or --surrogate)")
         model = (_floats(args.num), _floats(args.den))
     preview: Any = args.preview
+    if args.plot:
+        check_plot_path(args.plot)
     header, data = read_csv(args.input)
     if args.time_column not in header:
         raise InversionError(f"{args.input}: no time column {args.time_column!r} in header {header}")
@@ -148,6 +168,12 @@ def run(args: argparse.Namespace) -> int:
     res = invert(model, t, u, preview=preview, improper=args.improper,
                  filter_bandwidth=args.filter_bandwidth)
     y = res.output
+    if not np.all(np.isfinite(y)):
+        # the CLI boundary guard: the library should refuse this itself (see the issue-13 report)
+        k = int(np.flatnonzero(~np.isfinite(y))[0])
+        raise InversionError(f"{args.input}: the inversion of column {ucol!r} overflows double precision "
+                             f"({np.count_nonzero(~np.isfinite(y))} non-finite outputs from t = {t[k]:.6g} s; "
+                             f"largest |input| {np.max(np.abs(u)):.3g}); scale the signal or check the model")
     ref = data[:, header.index(args.reference)] if args.reference is not None else None
     cols = [args.time_column, ucol, "reconstruction"]
     table = [t, u, y]

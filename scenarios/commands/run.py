@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from ..runner import run_scenario, summary_line
@@ -18,6 +19,8 @@ def add_parser(subparsers):
     p.add_argument("--list", action="store_true", help="list the bundled scenarios and exit")
     p.add_argument("--out", help="output folder (default ./ipmc-run-<name>)")
     p.add_argument("--quick", action="store_true", help="apply the scenario's [quick] table (smaller grids)")
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
 
@@ -33,6 +36,13 @@ def resolve_scenario_path(text: str) -> Path:
                         f"({[b.stem for b in bundled_scenarios()]})")
 
 
+def default_folder(name: str) -> str:
+    """``ipmc-run-<name>`` with every character outside [A-Za-z0-9._-] replaced, so a scenario name
+    such as ``/../../tmp/x`` cannot place the default folder outside the working directory."""
+    slug = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "scenario"
+    return f"ipmc-run-{slug}"
+
+
 def run(args) -> int:
     if args.list:
         for p in bundled_scenarios():
@@ -42,7 +52,7 @@ def run(args) -> int:
     if not args.scenario:
         raise ScenarioError("name a scenario file or a bundled scenario (ipmc run --list shows them)")
     spec = load_scenario(resolve_scenario_path(args.scenario), quick=args.quick)
-    res = run_scenario(spec, Path(args.out or f"ipmc-run-{spec.name}"), quiet=args.quiet)
+    res = run_scenario(spec, Path(args.out or default_folder(spec.name)), quiet=args.quiet, force=args.force)
     if not args.quiet:
         print(summary_line(res))
     return res.exit_code

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
-from ._common import EXIT_OK, CLIError, _add_model_args, _floats, _load_params, _model, _Progress
+from ._common import (EXIT_OK, CLIError, _add_model_args, _floats, _load_params, _model, _Progress, check_out_file,
+                      check_plot_path)
 
 
 def add_parser(sub):
@@ -33,13 +33,24 @@ def run(args) -> int:
     from physmodel.data.files import write_sweep
 
     temps = _floats(args.temperatures, "--temperatures")
-    if not (0 < args.fmin < args.fmax):
+    if not (np.isfinite(args.fmin) and np.isfinite(args.fmax) and 0 < args.fmin < args.fmax):
         raise CLIError(f"need 0 < --fmin < --fmax, got {args.fmin} and {args.fmax}")
-    if args.points < 2:
-        raise CLIError(f"--points must be >= 2, got {args.points}")
-    out = Path(args.out)
-    if out.suffix.lower() not in (".csv", ".npz", ".mat"):
-        raise CLIError(f"--out {out}: use a .csv, .npz or .mat file name")
+    from physmodel.data.sweep import MAX_SWEEP_LINES
+
+    if not 2 <= args.points <= MAX_SWEEP_LINES // len(temps):
+        raise CLIError(f"--points must be 2 to {MAX_SWEEP_LINES // len(temps)} (at most {MAX_SWEEP_LINES} lines over "
+                       f"{len(temps)} temperature(s)), got {args.points}")
+    bad = [t for t in temps if t <= -273.15]
+    if bad:
+        raise CLIError(f"--temperatures {bad}: below absolute zero (-273.15 °C)")
+    if args.seed is not None and args.seed < 0:
+        raise CLIError(f"--seed must be a non-negative integer, got {args.seed}")
+    for opt, v in (("--sigma-db", args.sigma_db), ("--sigma-deg", args.sigma_deg), ("--sigma", args.sigma)):
+        if not (np.isfinite(v) and v >= 0):
+            raise CLIError(f"{opt} must be a finite number >= 0, got {v}")
+    out = check_out_file(args.out, (".csv", ".npz", ".mat"))
+    if args.plot:
+        check_plot_path(args.plot)
     model = _model(args, _load_params(args))
     quantity = args.quantity or ("M" if args.kind == "actuator" else "S")
     noise = None

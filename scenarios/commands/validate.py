@@ -7,20 +7,23 @@ from pathlib import Path
 
 from physmodel.errors import IPMCError
 
-from ..validate import STATUSES, load_published, published_claims, validate
+from ..validation import load_published, published_claims, validate
 from ._common import EXIT_FAILED, EXIT_OK
 
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
         "validate", help="check every published claim of the seed papers against the project's numbers",
-        description="Evaluate every claim in shared/data/published.toml (sensor study, actuator study, seed 002) "
-                    "with the calibrated seed parameter sets and write validation.md and validation.json. "
-                    "Exit 0 when every claim is reproduced or explained (not-reproduced / not-checkable rows "
-                    "are findings), 3 when a claim the project reproduces fails (regression).")
+        description="Evaluate every claim printed by the seed papers (the published.toml shipped in "
+                    "physmodel.parameter_sets: sensor study, actuator study, seed 002) with the seed parameter sets "
+                    "and write validation.md and validation.json.  Each row has a status (reproduced, "
+                    "not-reproduced, not-checkable, fail) and a basis (independent, calibrated, input, paper, "
+                    "metadata); the headline counts only independent reproductions.  Exit 0 when every claim is "
+                    "reproduced or explained (not-reproduced / not-checkable rows are findings), 3 when a claim "
+                    "the project reproduces fails (regression).")
     p.add_argument("--out", default="ipmc-validation", help="output folder (default ./ipmc-validation)")
     p.add_argument("--quick", action="store_true", help="fewer temperatures in the surrogate fits (faster)")
-    p.add_argument("--published", help="path of published.toml (default: shared/data/published.toml)")
+    p.add_argument("--published", help="path of a TOML file of printed claims (default: the one shipped in the package)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
 
 
@@ -31,6 +34,9 @@ def run(args) -> int:
     if out.exists() and not out.is_dir():
         raise IPMCError(f"--out {out} exists and is not a folder")
     n = len(published_claims(load_published(args.published)))
+    if n == 0:
+        raise IPMCError(f"--published {args.published}: no claims found (expected tables like [sensor_seed000] "
+                        "with printed numbers)")
     bar = None
     if not args.quiet:
         from tqdm import tqdm
@@ -44,9 +50,7 @@ def run(args) -> int:
     atomic_write(out / "validation.json", lambda fh: fh.write(rep.to_json() + "\n"))
     atomic_write(out / "validation.md", lambda fh: fh.write(rep.to_markdown()))
     if not args.quiet:
-        c = rep.counts
-        print(f"wrote {out / 'validation.md'} and {out / 'validation.json'}: "
-              + ", ".join(f"{c[s]} {s}" for s in STATUSES))
+        print(f"wrote {out / 'validation.md'} and {out / 'validation.json'}: {rep.headline()}")
         for r in rep.regressions:
             print(f"REGRESSION {r.claim_id}: {r.ours} (criterion: {r.criterion})", file=sys.stderr)
     return EXIT_FAILED if rep.regressions else EXIT_OK

@@ -1,7 +1,9 @@
-"""Seed paper 000 (IPMC sensor, 35 degC model): preview rule, preview claims, free vibration.
+"""Seed paper 000 (Ganley et al. 2011, IPMC sensor, 35 degC model): preview rule, preview claims,
+free vibration.
 
-Published numbers (shared/data/published.toml, [sensor_seed000]):
-* zeros -106.7, 35.2, 662.2 +/- 498.3j; T_p* = 4/r0 = 4/35.2 = 0.114 s;
+Printed (Sec. IV-A and V; physmodel/parameter_sets/published.toml, [sensor_seed000]):
+* the 35 degC model's coefficients (2-3 significant figures) and its zeros -106.7, 35.2,
+  662.2 +/- 498.3j (from unrounded coefficients); T_p* = 4/r0 = 4/35.2 = 0.114 s;
 * with T_p = T_p* the error is comparable to infinite preview (largest error ~0.2 mm,
   20 Hz, 35 degC); with T_p = 0.5 T_p* it increases about threefold.
 
@@ -11,6 +13,14 @@ only the truncation of eq. (6).  Its steady-state amplitude has the closed form
 ``|E(jw)| |G(jw)| d0`` with ``E(jw) = sum_i r_i exp((jw - p_i) T_p)/(jw - p_i)`` over the
 right-half-plane poles p_i (residues r_i) of 1/G — the tail of the anticausal kernel beyond
 T_p — computed here with scipy.signal.residue, independently of the package.
+
+Neither preview claim is reproduced model-exact, and the tests assert the measured disagreement:
+the T_p* error is ~1800x the infinite-preview error (not 'comparable'), and halving the preview
+multiplies it by exp(r0 T_p*/2) = e^2 = 7.4 (not 'threefold').  Both printed statements need an
+experimental error of ~0.2 mm common to both previews, which a model-exact experiment has not
+and whose size relative to the (unprinted) stimulus amplitude we do not know.  The preview is
+always passed in seconds, T_p = 4/r0 computed here, so these tests do not depend on the
+package's default preview rule.
 """
 
 import numpy as np
@@ -40,21 +50,42 @@ def _tail_gain(G, w, Tp):
     return abs(np.sum(r[rhp] * np.exp((1j * w - p[rhp]) * Tp) / (1j * w - p[rhp])))
 
 
-def test_auto_preview_is_4_over_r0_from_the_printed_zeros():
+def _tp_star(G):
+    """T_p* = 4/r0 [s], r0 from the zeros of G (numpy, not the package)."""
+    num, _ = _coeffs(G)
+    z = np.roots(num)
+    return 4.0 / z[z.real > 0].real.min()
+
+
+def test_split_finds_the_printed_r0_and_the_printed_rule_gives_0114():
     sp = split_inverse(seed000_sensor_35c("zeros"))
     assert float(f"{sp.r0:.3g}") == 35.2
-    assert float(f"{sp.auto_preview_s:.3g}") == 0.114
+    assert float(f"{4.0 / sp.r0:.3g}") == 0.114                      # the printed T_p*, 3 significant figures
     z = np.sort_complex(sp.zeros)
     np.testing.assert_allclose(z, np.sort_complex(np.array(SEED000_ZEROS_35C)), rtol=1e-12)
 
 
-def test_printed_coefficients_give_the_printed_zeros_to_their_precision():
-    # the coefficients are printed to 2-3 significant figures: their zeros differ from the
-    # printed ones (computed from unrounded coefficients) by up to ~4 %, and r0 by 0.8 %
-    sp = split_inverse(seed000_sensor_35c("coefficients"))
-    z = np.sort_complex(sp.zeros)
-    np.testing.assert_allclose(z, np.sort_complex(np.array(SEED000_ZEROS_35C)), rtol=0.05)
-    assert sp.auto_preview_s == pytest.approx(0.114, rel=0.015)
+# half a unit of the last printed digit of -17.3, 2.2e4, -1.0e7, -9.4e8, 4.5e10
+NUM_ROUNDING = np.array([0.05, 0.05e4, 0.05e7, 0.05e8, 0.05e10])
+
+
+def test_printed_zeros_lie_within_the_rounding_of_the_printed_coefficients():
+    """The printed coefficients do not give the printed zeros (r0 = 35.49, T_p* = 0.113 s, not 35.2 and
+    0.114 s), but every printed zero lies within the spread of the zeros over the 32 corners of the
+    coefficients' rounding box: the paper is consistent at its printed precision."""
+    import itertools
+
+    G = seed000_sensor_35c("coefficients")
+    num, _ = _coeffs(G)
+    sp = split_inverse(G)
+    assert float(f"{sp.r0:.4g}") == 35.49 and float(f"{4 / sp.r0:.3g}") == 0.113     # measured, != printed
+    z0 = np.roots(num)
+    corners = np.array([np.roots(num + np.array(sg) * NUM_ROUNDING) for sg in itertools.product((-1, 1), repeat=5)])
+    for zp in SEED000_ZEROS_35C:
+        i = int(np.argmin(np.abs(z0 - zp)))
+        spread = max(np.min(np.abs(c - z0[i])) for c in corners)
+        assert abs(z0[i] - zp) <= spread, (zp, z0[i], spread)
+        assert abs(z0[i] - zp) > 1e-3 * abs(zp)                   # but they are not the same numbers
 
 
 @pytest.fixture(scope="module")
@@ -68,7 +99,7 @@ def preview_experiment():
     g = np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
     current = abs(g) * d0 * np.sin(w * t + np.angle(g))
     disp = d0 * np.sin(w * t)
-    Tstar = split_inverse(G).auto_preview_s
+    Tstar = _tp_star(G)
     m = (t > 0.6) & (t < 2.0 - 0.7)   # away from both record edges
     errs = {}
     for name, pv in (("inf", "inf"), ("star", Tstar), ("half", 0.5 * Tstar)):
@@ -85,23 +116,17 @@ def test_preview_errors_match_the_truncated_kernel(preview_experiment):
         assert err == pytest.approx(_tail_gain(G, w, Tp) * iamp, rel=0.01)
 
 
-def test_seed000_preview_claims(preview_experiment):
-    """T_p*: error stays well below the paper's ~0.2 mm floor; 0.5 T_p*: >= threefold."""
+def test_seed000_preview_claims_are_not_reproduced_model_exact(preview_experiment):
+    """Measured disagreement with both printed preview claims (see the module docstring)."""
     _, _, _, errs = preview_experiment
-    e_star, e_half = errs["star"][0], errs["half"][0]
-    # truncation error per mm of stimulus: 2.7 % at T_p*, so below the 0.2 mm
-    # infinite-preview error of the experiment for any stimulus up to ~7 mm
-    assert e_star < 0.05
-    # halving the preview multiplies the truncation error by ~exp(r0 T_p*/2) = e^2 = 7.4
-    # (model-exact); with the paper's 0.2 mm floor added the total rises ~3x for a 3 mm
-    # stimulus, as reported
-    assert 3.0 < e_half / e_star < 10.0
-    assert e_half / e_star == pytest.approx(np.exp(2.0), rel=0.05)
-    floor, amp = 0.2, 3.0
-    total_star = np.hypot(floor, amp * e_star)
-    total_half = np.hypot(floor, amp * e_half)
-    assert total_star < 1.25 * floor                     # "comparable to infinite preview"
-    assert 2.5 < total_half / total_star < 3.5           # "about threefold"
+    e_inf, e_star, e_half = errs["inf"][0], errs["star"][0], errs["half"][0]
+    # 'comparable to infinite preview': model-exact the T_p* error is the kernel tail, 2.7 % of the
+    # 1 mm amplitude, against a discretisation-only infinite-preview error (measured ratio ~1800)
+    assert e_star > 100 * e_inf
+    # 'threefold': halving the preview multiplies the truncation error by exp(r0 T_p*/2) = e^2
+    ratio = e_half / e_star
+    assert ratio == pytest.approx(np.exp(2.0), rel=0.05)
+    assert not 2.5 <= ratio <= 3.5                       # 'about threefold' at one significant figure
 
 
 def _released_current(G, t, w0, t_release, f_n, zeta, fine=10):
@@ -143,13 +168,13 @@ def test_free_vibration_matched_model_has_no_preactuation_error(free_vibration):
     assert np.max(np.abs(e_inf[pre])) < 5e-4                       # mm, for w0 = 1 mm
     post = (t >= tr) & (t < 1.5)
     assert np.max(np.abs(e_inf[post])) < 5e-3                      # (w dt)^2/12 at 25 Hz ~ 2e-3
-    r_auto = invert(G, t, current, preview="auto")
-    e_auto = r_auto.output - disp
+    r_star = invert(G, t, current, preview=_tp_star(G))
+    e_star = r_star.output - disp
     num, den = _coeffs(G)
-    expected_bias = -_tail_gain_signed(G, 0.0, r_auto.preview_s) * (num[-1] / den[-1]) * kw["w0"]
-    assert np.mean(e_auto[hold]) == pytest.approx(expected_bias, rel=0.02)
-    assert np.ptp(e_auto[hold]) < 1e-6                               # constant while held
-    assert np.max(np.abs(e_auto[pre])) < 0.05
+    expected_bias = -_tail_gain_signed(G, 0.0, r_star.preview_s) * (num[-1] / den[-1]) * kw["w0"]
+    assert np.mean(e_star[hold]) == pytest.approx(expected_bias, rel=0.02)
+    assert np.ptp(e_star[hold]) < 1e-6                               # constant while held
+    assert np.max(np.abs(e_star[pre])) < 0.05
 
 
 def _tail_gain_signed(G, w, Tp):

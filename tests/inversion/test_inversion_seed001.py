@@ -1,6 +1,6 @@
 """Seed paper 001 (IPMC actuator under changing temperature): open-loop tracking at 45 degC.
 
-Published claims (shared/data/published.toml, [actuator_seed001]): a proper third-order model
+Published claims (Dong and Tan 2012, Sec. 3; physmodel/parameter_sets/published.toml, [actuator_seed001]): a proper third-order model
 (3 zeros, 3 poles; k, zeros and poles quadratic in T, fitted on 8 of the 10 bath temperatures,
 35 and 45 degC held out) is inverted with the stable noncausal algorithm to track 0.65 mm
 references at 45 degC: a 0.5 Hz sine, a 2 Hz sine and 0.325 (sin(pi t) + sin(4 pi t)) mm.
@@ -27,18 +27,19 @@ Virtual experiment (the oracle is independent of the package under test):
   stop).
 
 Measured (mm; error bound scheme 1 / scheme 2, ratio):
-  0.5 Hz    0.126 / 0.068    0.54   -> "scheme 2 only slightly better" reproduced
+  0.5 Hz    0.126 / 0.068    0.54   -> "scheme 2 only slightly better" NOT reproduced
   2 Hz      0.203 / 0.066    0.33   -> "less than half" reproduced
   two-tone  0.162 / 0.067    0.41   -> "less than half" reproduced
-With the development set and default temperature laws (``seed001_actuator_dev``, whose gain
-near 2 Hz RISES with T, opposite to the paper) the 0.5 Hz claim failed (0.031 / 0.082 mm): there
-the 19 -> 45 degC change at 0.5 Hz was no larger than the structural error of a 3/3 fit and the
-19 degC fit's bias cancelled it.  The claims hold once the plant has the paper's temperature
-trend.
+The plant was calibrated on the 19-vs-55 degC trend only (7 dB at 3 Hz), so the 2 Hz and two-tone
+results are predictions.  At 0.5 Hz scheme 2 nearly halves the error as well: the physics'
+19 -> 45 degC change of |M| there (~10 %, about half the 2 Hz change) is as large as the 3/3 fits'
+structural error, and the scheduled model removes it.  "Only slightly better" is read against the
+paper's "significantly better ... less than half" at 2 Hz as an improvement of at most a quarter
+(ratio >= 0.75); the test asserts the measured disagreement.
 
 Also checked: the time-domain error bounds of the sines equal the steady-state prediction
 A |P(jw)/G(jw) - 1| from the physics frequency response (oracle consistency), and the
-package's automatic preview 4/r0 is far too short for these surrogates: their anti-stable
+preview rule T_p = 4/r0 (passed in seconds) is far too short for these surrogates: their anti-stable
 residues are large (|r| ~ 3.7e3 V/mm/s at |z| ~ 76 rad/s, i.e. |r|/|z| ~ 48 V/mm against
 |1/G| ~ 0.3-0.6 V/mm), so even the exp(-4) tail exceeds the inverse itself (0.77 V error
 on a 4.1 V feedforward at 2 Hz); the feedforward error then matches the closed-form
@@ -137,13 +138,12 @@ def test_scheduled_model_predicts_the_held_out_temperature_like_a_direct_fit(fit
 
 
 def test_temperature_effect_is_much_larger_at_2hz_than_at_half_hz(plant):
-    # the paper's explanation of the tracking results, checked on the plant itself
+    # the paper's explanation of the tracking results (Sec. 3, 'much more pronounced at 2 Hz than at
+    # 0.5 Hz'), checked on the plant itself; 'much more' read as at least 1.5x (measured 1.8x:
+    # 0.096 and 0.175)
     eff = {f: abs(_plant_mm_per_v(plant, f, T_TRACK)[0] / _plant_mm_per_v(plant, f, 19.0)[0] - 1)
            for f in (0.5, 2.0)}
-    # measured 0.096 and 0.175 (1.8x) with the calibrated set; the development set gave 0.18
-    # and 0.91 but the wrong sign of the trend
     assert eff[2.0] > 1.5 * eff[0.5]
-    assert 0.05 < eff[0.5] < 0.15 and 0.12 < eff[2.0] < 0.3
 
 
 @pytest.mark.parametrize("ref, f_hz", [("0.5 Hz", 0.5), ("2 Hz", 2.0)])
@@ -166,14 +166,16 @@ def test_scheme2_error_bound_is_less_than_half_of_scheme1(tracking, ref):
     assert e2 < 0.2 * AMP_MM                        # measured 0.066 and 0.067 mm
 
 
-def test_scheme2_no_worse_at_half_hz(tracking):
+def test_half_hz_only_slightly_better_is_not_reproduced(tracking):
+    """Printed: 'at 0.5 Hz scheme 2 is only slightly better'.  Measured: better, but by nearly half
+    (ratio 0.54), i.e. not 'slightly' (ratio >= 0.75, see the module docstring)."""
     _, _, bounds, _ = tracking
     e1, e2 = bounds["0.5 Hz", "scheme 1"], bounds["0.5 Hz", "scheme 2"]
-    # "only slightly better": scheme 2 at least as good, allowing 10 % for the measurement
-    assert e2 <= 1.1 * e1, f"0.5 Hz: scheme 1 {e1:.4f} mm, scheme 2 {e2:.4f} mm"
+    assert e2 < e1                                   # scheme 2 is better ...
+    assert e2 < 0.75 * e1, "the 0.5 Hz claim now holds: update the docstring and ipmc validate"
 
 
-def test_auto_preview_is_too_short_for_these_surrogates(fits, tracking):
+def test_4_over_r0_preview_is_too_short_for_these_surrogates(fits, tracking):
     # T_p* = 4/r0 bounds the neglected tail by exp(-4) of the anti-stable *kernel*, but here
     # |r_i|/|p_i| ~ 48 V/mm against |1/G(jw)| ~ 0.3-0.6 V/mm, so the truncation error exceeds
     # the inverse itself.

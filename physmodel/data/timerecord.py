@@ -1,0 +1,332 @@
+"""Multi-channel time records (measured or designed) and their files.
+
+A :class:`TimeRecord` is a uniform time base and any number of named channels, each with a unit,
+kept in the units of the file (V, A, mm, s, ...) — the frequency responses estimated from it are in
+those units.  The files are the ``ipmc-timeseries`` format that
+:class:`physmodel.timesim.TimeSeries` writes, so virtual experiments and laboratory records read the
+same way::
+
+    # ipmc-timeseries 1
+    # voltage_V: voltage [V]              one line per channel: column, name and unit
+    # tip_displacement_mm: tip_displacement [mm]
+    # temperature_c: 25                   any other '# key: value' line is metadata
+    time_s,voltage_V,tip_displacement_mm
+    0.0,0.0,0.0
+    ...
+
+Column names are ``time_s`` and ``<name>_<unit>`` (the unit after the last underscore); the
+per-channel header lines are optional when reading (TimeSeries files do not write them) and, when
+present, must agree with their column.  NPZ files hold one array per column plus a JSON ``header``
+(format, version, metadata); MATLAB ``.mat`` files one column vector per column plus
+``metadata_json``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataFormatError, IPMCError
+from .files import atomic_write, by_extension
+
+#: Samples read per block when checking long (memory-mapped) time bases.
+TIME_BLOCK_SAMPLES = 1 << 20
+
+FORMAT = "ipmc-timeseries"
+FORMAT_VERSION = 1
+TIME_COLUMN = "time_s"
+_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+_UNIT = re.compile(r"^[A-Za-zµΩ0-9]+$")
+
+
+def split_column(column: str, where: str = "") -> tuple[str, str]:
+    """``'tip_displacement_mm'`` → ``('tip_displacement', 'mm')``; the unit follows the last ``_``."""
+    if "_" not in column:
+        raise DataFormatError(f"{where}column {column!r} must be named '<name>_<unit>', e.g. 'voltage_V'")
+    name, unit = column.rsplit("_", 1)
+    if not (_NAME.match(name) and _UNIT.match(unit)):
+        raise DataFormatError(f"{where}column {column!r} must be named '<name>_<unit>' with a name of "
+                              f"letters, digits and '_' and a unit of letters/digits, e.g. 'current_uA'")
+    return name, unit
+
+
+
+def sample_rate(t_or_fs, n: int, block_samples: int = TIME_BLOCK_SAMPLES) -> float:
+    """Sample rate [Hz] from a scalar ``fs`` or from uniform sample times ``t`` [s] (checked in blocks).
+
+    A time base that strays from the uniform grid through its end points by more than 1e-3 of a
+    sample is refused.
+    """
+    if np.ndim(t_or_fs) == 0:
+        fs = float(t_or_fs)
+        if not (math.isfinite(fs) and fs > 0):
+            raise IPMCError(f"t_or_fs: sample rate {t_or_fs!r} Hz must be a finite number > 0")
+        return fs
+    t = t_or_fs
+    if np.ndim(t) != 1 or len(t) != n:
+        raise IPMCError(f"t_or_fs: time vector has shape {np.shape(t)}; expected ({n},) like the input")
+    t0, t1 = float(t[0]), float(t[-1])
+    h = (t1 - t0) / (n - 1)
+    if not (math.isfinite(h) and h > 0):
+        raise IPMCError(f"t_or_fs: time runs from {t0!r} to {t1!r} s; expected increasing finite times")
+    for a in range(0, n, block_samples):
+        b = min(n, a + block_samples)
+        dev = np.abs(np.asarray(t[a:b], dtype=float) - (t0 + np.arange(a, b) * h))
+        if not np.all(dev <= 1e-3 * h):
+            k = a + int(np.argmax(np.where(np.isfinite(dev), dev, np.inf)))
+            raise IPMCError(f"t_or_fs: sample {k} is at {float(t[k])!r} s, off the uniform grid "
+                            f"t0 + k·{h:.6g} s; resample the record to a uniform time base")
+    return 1.0 / h
+
+
+@dataclass(frozen=True)
+class TimeRecord:
+    """Uniformly sampled channels in the units of their file.
+
+    Attributes
+    ----------
+    t : (n,) ndarray            sample times [s]
+    channels : dict[str, ndarray]   channel name → (n,) samples, in ``units[name]``
+    units : dict[str, str]      channel name → unit (e.g. ``'V'``, ``'mm'``, ``'uA'``)
+    metadata : dict             provenance, e.g. ``temperature_c``
+    """
+
+    t: np.ndarray
+    channels: dict
+    units: dict
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        t = np.asarray(self.t, dtype=float)
+        if t.ndim != 1 or t.size < 2:
+            raise IPMCError(f"t must be 1-D with at least 2 samples, got shape {t.shape}")
+        if not self.channels:
+            raise IPMCError("a time record needs at least one channel")
+        if set(self.channels) != set(self.units):
+            raise IPMCError(f"channels {sorted(self.channels)} and units {sorted(self.units)} must name the same channels")
+        chans = {}
+        for name, v in self.channels.items():
+            split_column(f"{name}_{self.units[name]}", "")
+            v = np.asarray(v, dtype=float)
+            if v.shape != t.shape:
+                raise IPMCError(f"channel {name!r} has shape {v.shape}; t has shape {t.shape}")
+            chans[name] = v
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "channels", chans)
+        object.__setattr__(self, "units", dict(self.units))
+
+    # ------------------------------------------------------------------ views
+    @property
+    def fs(self) -> float:
+        """Sample rate [Hz] (the time base is checked to be uniform)."""
+        return sample_rate(self.t, self.t.size)
+
+    def resolve(self, name: str) -> str:
+        """The channel called ``name`` or stored in column ``name`` (``'<name>_<unit>'``)."""
+        if name in self.channels:
+            return name
+        for k, u in self.units.items():
+            if name == f"{k}_{u}":
+                return k
+        raise IPMCError(f"no channel {name!r}; the record has {self.columns_names()}")
+
+    def channel(self, name: str) -> np.ndarray:
+        """Samples of channel ``name`` (or of its column ``<name>_<unit>``)."""
+        return self.channels[self.resolve(name)]
+
+    def columns_names(self) -> list[str]:
+        return [f"{k}_{u}" for k, u in self.units.items()]
+
+    def temperature_c(self) -> float | None:
+        """The ``temperature_c`` metadata entry [°C], if the record has one."""
+        v = self.metadata.get("temperature_c")
+        if v is None:
+            return None
+        try:
+            return float(v)
+        except (TypeError, ValueError):
+            raise DataFormatError(f"metadata temperature_c = {v!r} is not a number") from None
+
+    def columns(self) -> dict:
+        return {TIME_COLUMN: self.t, **{f"{k}_{self.units[k]}": v for k, v in self.channels.items()}}
+
+    @classmethod
+    def from_columns(cls, columns: dict, metadata: dict | None = None, where: str = "") -> "TimeRecord":
+        """From ``{'time_s': t, '<name>_<unit>': samples, ...}`` (e.g. ``TimeSeries.columns()``)."""
+        if TIME_COLUMN not in columns:
+            raise DataFormatError(f"{where}no '{TIME_COLUMN}' column; found {list(columns)}")
+        chans: dict[str, np.ndarray] = {}
+        units: dict[str, str] = {}
+        for col, v in columns.items():
+            if col == TIME_COLUMN:
+                continue
+            name, unit = split_column(col, where)
+            if name in chans:
+                raise DataFormatError(f"{where}channel {name!r} appears twice (columns {name}_{units[name]}, {col})")
+            chans[name], units[name] = v, unit
+        return cls(columns[TIME_COLUMN], chans, units, dict(metadata or {}))
+
+    # ------------------------------------------------------------------ files
+    def header_lines(self) -> list[str]:
+        lines = [f"{FORMAT} {FORMAT_VERSION}"]
+        lines += [f"{k}_{u}: {k} [{u}]" for k, u in self.units.items()]
+        lines += [f"{k}: {str(v).replace(chr(10), ' ')}" for k, v in self.metadata.items()]
+        return lines
+
+    def to_csv(self, path) -> Path:
+        cols = self.columns()
+        data = np.column_stack(list(cols.values()))
+
+        def write(fh):
+            for line in self.header_lines():
+                fh.write(f"# {line}\n")
+            fh.write(",".join(cols) + "\n")
+            np.savetxt(fh, data, delimiter=",", fmt="%.17g")
+
+        return atomic_write(path, write)
+
+    def to_npz(self, path) -> Path:
+        header = json.dumps({"format": FORMAT, "version": FORMAT_VERSION, "metadata": self.metadata})
+
+        def write(fh):
+            np.savez(fh, header=np.array(header), **self.columns())
+
+        return atomic_write(path, write, "wb")
+
+    def to_mat(self, path) -> Path:
+        from scipy.io import savemat
+
+        cols = {k: v.reshape(-1, 1) for k, v in self.columns().items()}
+        cols["format"] = f"{FORMAT} {FORMAT_VERSION}"
+        cols["metadata_json"] = json.dumps(self.metadata)
+
+        def write(fh):
+            savemat(fh, cols, do_compression=True)
+
+        return atomic_write(path, write, "wb")
+
+    def save(self, path) -> Path:
+        """Write by extension (.csv, .npz, .mat), atomically."""
+        return by_extension(path, {".csv": self.to_csv, ".npz": self.to_npz, ".mat": self.to_mat}, "time-record")(path)
+
+
+# ----------------------------------------------------------------------------------- reading
+def _check_finite(cols: dict, where: str) -> None:
+    for k, v in cols.items():
+        bad = np.flatnonzero(~np.isfinite(v))
+        if bad.size:
+            raise DataFormatError(f"{where}column {k} is not finite at samples {bad[:5].tolist()}")
+
+
+def _check_version(text: str, where: str) -> None:
+    parts = text.split()
+    if len(parts) > 1 and parts[1] != str(FORMAT_VERSION):
+        raise DataFormatError(f"{where}{FORMAT} version {parts[1]!r} is not supported; expected {FORMAT_VERSION}")
+
+
+def _apply_channel_headers(rec_cols: dict, header: dict, where: str) -> dict:
+    """Metadata without the per-channel lines, after checking them against their columns."""
+    meta = {}
+    for k, v in header.items():
+        if k in rec_cols and k != TIME_COLUMN:
+            name, unit = split_column(k, where)
+            if v.replace(" ", "") != f"{name}[{unit}]":
+                raise DataFormatError(f"{where}header '{k}: {v}' disagrees with its column; expected '{name} [{unit}]'")
+        else:
+            meta[k] = v
+    return meta
+
+
+def read_csv(path) -> TimeRecord:
+    """Read an ``ipmc-timeseries`` CSV (see module doc)."""
+    path = Path(path)
+    where = f"{path}: "
+    header: dict[str, str] = {}
+    n_head = 0
+    try:
+        with open(path, encoding="utf-8") as fh:
+            for line in fh:
+                s = line.strip()
+                if s.startswith("#") or not s:
+                    body = s.lstrip("#").strip()
+                    if body.startswith(FORMAT):
+                        _check_version(body, where)
+                    elif ":" in body:
+                        k, v = body.split(":", 1)
+                        header[k.strip()] = v.strip()
+                    n_head += 1
+                    continue
+                names = [c.strip() for c in s.split(",")]
+                break
+            else:
+                raise DataFormatError(f"{where}no column header line after the '#' header")
+    except FileNotFoundError:
+        raise DataFormatError(f"{path}: no such file") from None
+    if len(set(names)) != len(names):
+        raise DataFormatError(f"{path}:{n_head + 1}: repeated column names in {names}")
+    try:
+        data = np.loadtxt(path, delimiter=",", comments="#", skiprows=n_head + 1, ndmin=2)
+    except ValueError as exc:
+        raise DataFormatError(f"{where}{exc}") from None
+    if data.shape[0] == 0:
+        raise DataFormatError(f"{where}no data rows")
+    if data.shape[1] != len(names):
+        raise DataFormatError(f"{where}{data.shape[1]} values per row but {len(names)} columns {names}")
+    cols = {n: data[:, i] for i, n in enumerate(names)}
+    _check_finite(cols, where)
+    meta = _apply_channel_headers(cols, header, where)
+    return _build(cols, meta, where)
+
+
+def _build(cols: dict, meta: dict, where: str) -> TimeRecord:
+    try:
+        return TimeRecord.from_columns(cols, meta, where)
+    except DataFormatError:
+        raise
+    except IPMCError as exc:
+        raise DataFormatError(f"{where}{exc}") from None
+
+
+def read_npz(path) -> TimeRecord:
+    where = f"{path}: "
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            data = {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise DataFormatError(f"{path}: no such file") from None
+    meta = {}
+    if "header" in data:
+        hdr = json.loads(str(data.pop("header")))
+        if hdr.get("format") != FORMAT:
+            raise DataFormatError(f"{where}header format {hdr.get('format')!r} is not {FORMAT!r}")
+        _check_version(f"{FORMAT} {hdr.get('version')}", where)
+        meta = {k: str(v) for k, v in hdr.get("metadata", {}).items()}
+    cols = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items()}
+    _check_finite(cols, where)
+    return _build(cols, meta, where)
+
+
+def read_mat(path) -> TimeRecord:
+    from scipy.io import loadmat
+
+    where = f"{path}: "
+    try:
+        data = loadmat(path)
+    except FileNotFoundError:
+        raise DataFormatError(f"{path}: no such file") from None
+    meta = json.loads(str(data["metadata_json"][0])) if "metadata_json" in data else {}
+    skip = {"format", "metadata_json"}
+    cols = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items()
+            if not k.startswith("__") and k not in skip}
+    _check_finite(cols, where)
+    return _build(cols, {k: str(v) for k, v in meta.items()}, where)
+
+
+def read_record(path) -> TimeRecord:
+    """Read a time record by extension (.csv, .npz, .mat)."""
+    return by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "time-record")(path)

@@ -1,0 +1,73 @@
+"""A process-wide record of SIGINT/SIGTERM, so that an interrupt swallowed inside a solver still
+ends the run.
+
+CasADi's IPOPT interface catches the ``KeyboardInterrupt`` raised by Python's signal handler
+during a solve, prints ``KeyboardInterruptException`` and returns the status
+``NonIpopt_Exception_Thrown``: the caller sees an ordinary failed solve and carries on.  With
+:func:`handling` installed (``ipmc`` does this for every command), each SIGINT/SIGTERM is recorded
+here *and* raises ``KeyboardInterrupt``; code that must not continue after an interrupt (between
+steps of a run, before a file is committed by :func:`physmodel.data.files.atomic_write`) calls
+:func:`check`, which raises ``KeyboardInterrupt`` again when one was recorded.
+
+>>> from physmodel import interrupts
+>>> interrupts.check()          # nothing recorded: returns
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from contextlib import contextmanager
+
+_requested: int | None = None
+
+#: The signals :func:`handling` turns into ``KeyboardInterrupt``.
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def request(signum: int = signal.SIGINT) -> None:
+    """Record an interrupt (what the signal handler does)."""
+    global _requested
+    _requested = int(signum)
+
+
+def requested() -> int | None:
+    """The signal number recorded since the last :func:`reset`, or None."""
+    return _requested
+
+
+def reset() -> None:
+    """Forget a recorded interrupt."""
+    global _requested
+    _requested = None
+
+
+def check() -> None:
+    """Raise ``KeyboardInterrupt`` when an interrupt was recorded (even if a solver swallowed it)."""
+    if _requested is not None:
+        raise KeyboardInterrupt(f"interrupted by {signal.Signals(_requested).name}")
+
+
+def _handler(signum, frame):
+    request(signum)
+    raise KeyboardInterrupt(f"interrupted by {signal.Signals(signum).name}")
+
+
+@contextmanager
+def handling():
+    """Within the block, SIGINT and SIGTERM are recorded and raise ``KeyboardInterrupt``; the
+    record starts empty and the previous handlers are restored afterwards.  Outside the main
+    thread (where Python cannot install handlers) it only resets the record."""
+    reset()
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.signal(s, _handler) for s in SIGNALS}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+
+
+__all__ = ["request", "requested", "reset", "check", "handling", "SIGNALS"]

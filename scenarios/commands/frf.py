@@ -1,0 +1,271 @@
+"""``ipmc frf`` — frequency responses with per-line σ from time records → a sweep file.
+
+    ipmc frf RECORD [RECORD ...] --out sweep.csv --input voltage --output tip_displacement
+             [--output current] [--method h1|h2|stepped] [--temperature T ...]
+             [--nperseg N] [--noverlap N] [--window hann] [--discard-s S]
+             [--lines SIGNAL | --frequencies F1,F2,...] [--plan SIGNAL]
+             [--settle-s S] [--settle-periods P] [--periods P]
+             [--min-coherence G] [--max-std-db D] [--band LO HI] [--reciprocal] [--plot fig.png] [--quiet]
+
+One record per temperature (``--temperature``, one value per record; default each record's
+``temperature_c`` header).  Channels are named as in the record (``voltage`` or the column
+``voltage_V``); the sweep is in the record's units.  Several ``--output`` channels give one sweep
+file per channel, ``<out stem>_<channel><suffix>``.
+
+Methods (physmodel.estimation.frf / .stepped):
+
+* ``h1`` (default) / ``h2``: Welch-averaged spectra, σ from the coherence.  ``--lines SIGNAL``
+  takes a multisine's lines from its signal file (``ipmc excite multisine``) and sets
+  ``--nperseg`` = one period, ``--noverlap 0``, ``--window boxcar`` and ``--discard-s`` = its
+  transient periods unless given; a record whose own header holds the multisine uses it without
+  ``--lines``.
+* ``stepped``: per-period sine fits after each step's transient, σ from the scatter between
+  periods; the schedule comes from ``--plan SIGNAL`` (``ipmc excite stepped``) or the record's own
+  header; ``--settle-s``/``--settle-periods``/``--periods`` override the plan's.
+
+``--min-coherence``, ``--max-std-db`` and ``--band`` drop lines; ``--reciprocal`` writes
+input/output (e.g. impedance V/A from a current channel).  ``--plot`` draws magnitude and phase
+with their ±2σ bands and the coherence (H1/H2) or σ (stepped).  Exit codes: 0 written, 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from physmodel.errors import IPMCError
+
+from ._common import EXIT_OK, CLIError, _floats
+from .excite import as_options
+
+SUFFIXES = (".csv", ".npz", ".mat")
+#: Estimator argument names → the options that set them (error messages name the option).
+OPTIONS = {"frequencies_hz": "--frequencies", "nperseg": "--nperseg", "noverlap": "--noverlap", "window": "--window",
+           "discard_s": "--discard-s", "settle_s": "--settle-s", "settle_periods": "--settle-periods",
+           "periods": "--periods", "max_std_db": "--max-std-db", "band_hz": "--band", "min_coherence": "--min-coherence"}
+
+
+def add_parser(sub):
+    p = sub.add_parser("frf", help="estimate frequency responses with per-line σ from time records -> sweep",
+                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("records", nargs="+", metavar="RECORD", help="time records (.csv, .npz, .mat; ipmc-timeseries)")
+    p.add_argument("--out", required=True, help="sweep file (.csv, .npz or .mat)")
+    p.add_argument("--input", required=True, help="input (reference) channel, e.g. voltage")
+    p.add_argument("--output", action="append", required=True, help="output channel (repeatable)")
+    p.add_argument("--method", choices=("h1", "h2", "stepped"), default="h1", help="estimator (default h1)")
+    p.add_argument("--temperature", action="append",
+                   help="bath temperature [°C], one per record (repeatable or comma-separated); "
+                        "default each record's temperature_c header")
+    g = p.add_argument_group("Welch (h1, h2)")
+    g.add_argument("--nperseg", type=int, help="segment length [samples]")
+    g.add_argument("--noverlap", type=int, help="segment overlap [samples] (default nperseg/2)")
+    g.add_argument("--window", help="window name (scipy.signal.get_window; default hann)")
+    g.add_argument("--discard-s", type=float, help="leading transient not used [s] (default 0)")
+    g.add_argument("--lines", metavar="SIGNAL", help="multisine signal file: use its lines and period")
+    g.add_argument("--frequencies", help="comma-separated lines to keep [Hz] (bins of the segment)")
+    s = p.add_argument_group("stepped sine")
+    s.add_argument("--plan", metavar="SIGNAL", help="stepped-sine signal file: its schedule")
+    s.add_argument("--settle-s", type=float, help="transient discarded per step [s] (overrides the plan)")
+    s.add_argument("--settle-periods", type=float, help="transient discarded per step [periods]")
+    s.add_argument("--periods", type=int, help="whole periods used per step (default: all whole periods)")
+    k = p.add_argument_group("lines kept")
+    k.add_argument("--min-coherence", type=float, help="drop lines with coherence below this (h1/h2)")
+    k.add_argument("--max-std-db", type=float, help="drop lines whose magnitude σ exceeds this [dB]")
+    k.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="keep lines in [LO, HI] Hz")
+    p.add_argument("--reciprocal", action="store_true", help="write input/output instead of output/input")
+    p.add_argument("--plot", help="figure of the estimate with ±2σ bands and coherence (PNG)")
+    p.add_argument("--quiet", action="store_true", help="no summary")
+    p.set_defaults(func=run)
+    return p
+
+
+# ---------------------------------------------------------------------------- inputs
+def _read(path: str, option: str):
+    from physmodel.data.timerecord import read_record
+
+    if not Path(path).exists():
+        raise CLIError(f"{option} {path}: no such file")
+    return read_record(path)
+
+
+def _temperatures(args, records) -> list[float]:
+    if args.temperature:
+        temps = [v for item in args.temperature for v in _floats(item, "--temperature")]
+        if len(temps) != len(records):
+            raise CLIError(f"--temperature: {len(temps)} value(s) for {len(records)} record(s); give one per record")
+        return temps
+    temps = []
+    for path, rec in zip(args.records, records):
+        T = rec.temperature_c()
+        if T is None:
+            raise CLIError(f"{path}: no 'temperature_c' header; give --temperature (one per record)")
+        temps.append(T)
+    return temps
+
+
+def _multisine(args, records):
+    """The multisine design from --lines, or from the records' own header (None if neither)."""
+    from physmodel.data.excitation import Multisine
+
+    if args.lines:
+        src, where = _read(args.lines, "--lines").metadata, f"--lines {args.lines}"
+    elif "multisine" in records[0].metadata and args.frequencies is None:
+        src, where = records[0].metadata, f"{args.records[0]}"
+    else:
+        return None
+    if "multisine" not in src:
+        raise CLIError(f"{where}: no 'multisine' header (write the signal with 'ipmc excite multisine')")
+    try:
+        ms = Multisine.from_dict(json.loads(src["multisine"]))
+        tp = int(src.get("transient_periods", 1))
+    except (ValueError, KeyError, TypeError) as exc:
+        raise CLIError(f"{where}: malformed 'multisine' header ({exc})") from None
+    return ms, tp
+
+
+def _plan(args, records):
+    from physmodel.data.excitation import SteppedSinePlan
+
+    if args.plan:
+        rec, where = _read(args.plan, "--plan"), f"--plan {args.plan}"
+    elif "stepped_sine_plan" in records[0].metadata:
+        rec, where = records[0], args.records[0]
+    else:
+        raise CLIError("--plan: a stepped-sine estimate needs the schedule; give the signal file written by "
+                       "'ipmc excite stepped' (or records whose header holds 'stepped_sine_plan')")
+    try:
+        return SteppedSinePlan.from_record(rec)
+    except IPMCError as exc:
+        raise CLIError(f"{where}: {exc}") from None
+
+
+def _estimator_kwargs(args, records) -> tuple[dict, str]:
+    """Keyword arguments of estimate_record and a description of where they came from."""
+    if args.method == "stepped":
+        bad = [o for o in ("nperseg", "noverlap", "window", "discard_s", "lines", "frequencies", "min_coherence")
+               if getattr(args, o) is not None]
+        if bad:
+            raise CLIError(f"--{bad[0].replace('_', '-')} applies to h1/h2, not to --method stepped")
+        plan = _plan(args, records)
+        over = {k: getattr(args, k) for k in ("settle_s", "settle_periods", "periods") if getattr(args, k) is not None}
+        if not over:
+            return {"method": "stepped_sine", "plan": plan}, f"plan of {plan.frequency_hz.size} steps"
+        return ({"method": "stepped_sine", "plan": None, "_plan": plan, **over},
+                f"plan of {plan.frequency_hz.size} steps, overrides {over}")
+    bad = [o for o in ("plan", "settle_s", "settle_periods", "periods") if getattr(args, o) is not None]
+    if bad:
+        raise CLIError(f"--{bad[0].replace('_', '-')} applies to --method stepped, not to {args.method}")
+    kw = {"method": args.method}
+    found = _multisine(args, records)
+    how = "Welch"
+    if found is not None:
+        ms, tp = found
+        kw.update(nperseg=ms.n_samples, noverlap=0, window="boxcar", discard_s=tp * ms.period_s,
+                  frequencies_hz=ms.frequency_hz)
+        how = f"multisine lines ({ms.lines.size} lines, period {ms.period_s:g} s, {tp} transient period(s))"
+        for rec, path in zip(records, args.records):
+            if abs(rec.fs - ms.fs_hz) > 1e-9 * ms.fs_hz:
+                raise CLIError(f"{path}: sampled at {rec.fs:g} Hz but the multisine was designed at {ms.fs_hz:g} Hz")
+    elif args.frequencies is not None:
+        kw["frequencies_hz"] = _floats(args.frequencies, "--frequencies")
+    for opt in ("nperseg", "noverlap", "window", "discard_s"):
+        v = getattr(args, opt)
+        if v is not None:
+            kw[opt] = v
+    return kw, how
+
+
+def _estimate(rec, path: str, args, kw: dict):
+    from physmodel.estimation.frf import estimate_record
+
+    kw = dict(kw)
+    plan = kw.pop("_plan", None)
+    if plan is not None:                    # a plan with overridden settle/periods: explicit schedule
+        t0 = float(rec.t[0])
+        kw.pop("plan")
+        kw.update(frequencies_hz=plan.frequency_hz, step_start_s=plan.step_start_s + t0,
+                  step_stop_s=plan.step_stop_s + t0)
+    try:
+        return estimate_record(rec, args.input, args.output, **kw)
+    except IPMCError as exc:
+        raise as_options(exc, OPTIONS, f"{path}: ") from None
+
+
+def _out_paths(out: Path, outputs: list[str]) -> list[Path]:
+    if len(outputs) == 1:
+        return [out]
+    return [out.with_name(f"{out.stem}_{o}{out.suffix}") for o in outputs]
+
+
+# ---------------------------------------------------------------------------- run
+def run(args) -> int:
+    from physmodel.data.files import write_sweep
+    from physmodel.data.sweep import merge_sweeps
+
+    out = Path(args.out)
+    if out.suffix.lower() not in SUFFIXES:
+        raise CLIError(f"--out {out}: use a .csv, .npz or .mat file name")
+    if args.plot and Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
+        raise CLIError(f"--plot {args.plot}: use a .png, .pdf or .svg file name")
+    if len(set(args.output)) != len(args.output):
+        raise CLIError(f"--output repeats a channel: {args.output}")
+    if args.band is not None and not (0 <= args.band[0] <= args.band[1]):
+        raise CLIError(f"--band {args.band[0]:g} {args.band[1]:g}: need 0 <= LO <= HI [Hz]")
+    if args.min_coherence is not None and not 0 <= args.min_coherence <= 1:
+        raise CLIError(f"--min-coherence {args.min_coherence}: must lie in [0, 1]")
+    if args.max_std_db is not None and not args.max_std_db > 0:
+        raise CLIError(f"--max-std-db {args.max_std_db}: must be > 0 [dB]")
+    records = [_read(p, "RECORD") for p in args.records]
+    temps = _temperatures(args, records)
+    if len(set(temps)) != len(temps):
+        raise CLIError(f"--temperature: records at the same temperature {temps}; one record per temperature")
+    for rec, path in zip(records, args.records):
+        for opt, names in (("--input", [args.input]), ("--output", args.output)):
+            for nm in names:
+                try:
+                    rec.resolve(nm)
+                except IPMCError as exc:
+                    raise CLIError(f"{path}: {opt} {nm}: {exc}") from None
+    kw, how = _estimator_kwargs(args, records)
+    ests = [_estimate(rec, p, args, kw) for rec, p in zip(records, args.records)]
+    keep = {"min_coherence": args.min_coherence, "band_hz": tuple(args.band) if args.band else None,
+                "max_std_db": args.max_std_db}
+    if args.method == "stepped" and args.min_coherence is not None:
+        raise CLIError("--min-coherence: a stepped-sine estimate has no coherence; use --max-std-db or --band")
+    written, lines = [], []
+    for o, path in zip(args.output, _out_paths(out, args.output)):
+        sweeps, kept = [], []
+        for T, e, src in zip(temps, ests, args.records):
+            c = e.channel(o if o in e.output_names else e.output_names[args.output.index(o)])
+            c = c.reciprocal() if args.reciprocal else c
+            try:
+                sw = c.to_sweep(T, **keep, metadata={"record": Path(src).name})
+            except IPMCError as exc:
+                raise as_options(exc, OPTIONS, f"{src} ({o}): ") from None
+            sweeps.append(sw)
+            kept.append((c, T, np.isin(c.frequency_hz, sw.frequency_hz)))
+            lines.append(f"  {Path(src).name} at {T:g} °C, {sw.output_name}/{sw.input_name}: {sw.frequency_hz.size} "
+                         f"of {c.frequency_hz.size} lines kept, median σ {np.median(sw.magnitude_std_db):.3g} dB / "
+                         f"{np.median(sw.phase_std_deg):.3g}°")
+        sweep = merge_sweeps(sweeps)
+        write_sweep(sweep, path)
+        written.append(path)
+        if args.plot:
+            from .. import plots
+
+            ppath = Path(args.plot)
+            if len(args.output) > 1:
+                ppath = ppath.with_name(f"{ppath.stem}_{o}{ppath.suffix}")
+            plots.frf_estimate(kept, ppath, title=f"{sweep.output_name} [{sweep.output_unit}] / "
+                                                  f"{sweep.input_name} [{sweep.input_unit}], {args.method}")
+            written.append(ppath)
+    if not args.quiet:
+        st = ests[0].settings
+        print(f"{args.method} from {len(records)} record(s), {how}; settings: "
+              + ", ".join(f"{k}={v}" for k, v in st.items()))
+        print("\n".join(lines))
+        print("wrote " + ", ".join(str(p) for p in written))
+    return EXIT_OK

@@ -1,0 +1,30 @@
+"""``ipmc validate``: every claim printed by the seed papers next to the project's own number.
+
+:mod:`~scenarios.validation.framework` enumerates the claims of the shipped ``published.toml``, judges
+each check and writes the report (status × basis, see there); one module per seed paper holds its
+claim checks (:mod:`~scenarios.validation.seed000`, :mod:`~scenarios.validation.seed001`,
+:mod:`~scenarios.validation.seed002`).
+"""
+
+from . import seed000, seed001, seed002  # noqa: F401  (register their checks)
+from .framework import (
+    BASES,
+    CHECKS,
+    DEFAULT_PUBLISHED,
+    EXTRA_ROWS,
+    KINDS,
+    META_KEYS,
+    STATUSES,
+    Claim,
+    ClaimRow,
+    Context,
+    Outcome,
+    ValidationReport,
+    claim_location,
+    load_published,
+    published_claims,
+    validate,
+)
+
+__all__ = ["BASES", "CHECKS", "DEFAULT_PUBLISHED", "EXTRA_ROWS", "KINDS", "META_KEYS", "STATUSES", "Claim", "ClaimRow",
+           "Context", "Outcome", "ValidationReport", "claim_location", "load_published", "published_claims", "validate"]

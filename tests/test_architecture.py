@@ -1,0 +1,96 @@
+"""The layered house (CONTRIBUTING.md): imports only run down, modules stay small, one model
+interface.  Read from the source files with ``ast`` (nothing is imported to decide)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("physmodel", "surrogate", "inversion", "scenarios")
+#: What each package may import from the project.
+ALLOWED = {
+    "physmodel": {"physmodel"},
+    "surrogate": {"physmodel", "surrogate"},
+    "inversion": {"physmodel", "inversion"},
+    "scenarios": {"physmodel", "surrogate", "inversion", "scenarios"},
+}
+MAX_LINES = 500
+
+
+def _modules():
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            yield pkg, path
+
+
+def _imported_top_levels(path: Path, pkg: str) -> set[tuple[str, int]]:
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found |= {(a.name.split(".")[0], node.lineno) for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:          # relative: stays inside the package, or climbs out of it
+                rel = path.relative_to(ROOT).parts
+                if node.level > len(rel) - 1:
+                    found.add(("<beyond the package>", node.lineno))
+                else:
+                    found.add((rel[0], node.lineno))
+            elif node.module:
+                found.add((node.module.split(".")[0], node.lineno))
+    return found
+
+
+def test_no_import_runs_up_a_layer():
+    bad = []
+    for pkg, path in _modules():
+        for top, line in _imported_top_levels(path, pkg):
+            if top in PACKAGES and top not in ALLOWED[pkg]:
+                bad.append(f"{path.relative_to(ROOT)}:{line} imports {top}")
+    assert bad == [], "imports that run up a layer:\n" + "\n".join(sorted(bad))
+
+
+def test_only_scenarios_plots_draws():
+    users = sorted(str(path.relative_to(ROOT)) for pkg, path in _modules()
+                   if any(top == "matplotlib" for top, _ in _imported_top_levels(path, pkg)))
+    assert users == ["scenarios/plots.py"]
+
+
+def test_no_module_is_over_the_size_limit():
+    big = {str(p.relative_to(ROOT)): n for _, p in _modules()
+           if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
+    assert big == {}, f"modules over {MAX_LINES} lines: {big}"
+
+
+def test_one_error_root():
+    from inversion import InversionError
+    from physmodel.errors import IPMCError
+    from scenarios.commands._common import CLIError
+    from surrogate import ConvergenceError
+
+    for exc in (InversionError, CLIError):
+        assert issubclass(exc, IPMCError)
+    assert issubclass(ConvergenceError, IPMCError)
+
+
+@pytest.mark.parametrize("which", ["actuator", "sensor", "rational"])
+def test_every_model_satisfies_the_model_protocol(which):
+    from physmodel import ActuatorModel, FrequencyModel, SensorModel, get_parameter_set
+    from surrogate import RationalFit
+
+    f = np.array([1.0, 3.0, 10.0])
+    if which == "actuator":
+        m = ActuatorModel(get_parameter_set("seed002_table3"))
+    elif which == "sensor":
+        m = SensorModel(get_parameter_set("seed000_sensor_dev"))
+    else:
+        act = ActuatorModel(get_parameter_set("seed002_table3"))
+        fg = np.logspace(-1, 1.5, 40)
+        m = RationalFit(2, 3).fit(fg, 27.0, act.response(fg, 27.0)[0]).model
+    assert isinstance(m, FrequencyModel) and m.kind == which
+    r = m.response(f, [20.0, 30.0] if which != "rational" else None)
+    assert r.shape == ((2, 3) if which != "rational" else (1, 3)) and np.all(np.isfinite(r))
