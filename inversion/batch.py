@@ -327,6 +327,12 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             np.add(stable[c0:c1], y, out=output[c0:c1])
 
         plan.backward(ua, n, chunk, put_u)
+    bad = ~np.isfinite(output)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise NonFiniteSignalError(
+            f"the inverse overflowed: output sample {i} is {output[i]!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
+            "scale the signal to the model's units")
     return InversionResult(
         input=ua, output=output, stable_part=stable, unstable_part=unstable,
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,

@@ -26,15 +26,9 @@ import warnings
 
 import numpy as np
 
-from .spec import INT, NUM, NUMS, STR, STRS, ScenarioError, _choice, _Map
+from .spec import ScenarioError
 
-__all__ = ["CONTROL_ROUTE_SCHEMA", "step_control_route"]
-
-CONTROL_ROUTE_SCHEMA = {"free": STRS, "prior": _Map(NUM), "starts": INT, "seed": INT, "dense_temperatures_c": NUMS,
-                        "form": _choice("zpk", "coefficients", "sections"), "n_zeros": INT, "n_poles": INT,
-                        "degree": INT, "temperature_c": NUM, "frequency_hz": NUM, "amplitude_mm": NUM,
-                        "fs_hz": NUM, "duration_s": NUM, "max_voltage_v": NUM, "note": STR}
-
+__all__ = ["step_control_route"]
 
 def _dense_vs(model, physics_model, f, temps):
     from surrogate.crossval import dense_check, physics_reference
