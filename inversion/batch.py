@@ -15,8 +15,9 @@ from typing import Any
 import numpy as np
 
 from ._discrete import Plan
-from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError, PreviewError
-from .split import InverseSplit, split_inverse
+from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
+from .preview import PreviewChoice, TruncationModes, choose_preview, preview_rule, resolve_preview
+from .split import DEFAULT_PREVIEW_TOL, InverseSplit, split_inverse
 
 __all__ = [
     "InversionResult",
@@ -25,6 +26,9 @@ __all__ = [
     "decode_sensor",
     "feedforward",
     "resolve_preview",
+    "choose_preview",
+    "PreviewChoice",
+    "preview_rule",
     "sampling_interval",
     "DEFAULT_CHUNK",
 ]
@@ -71,11 +75,19 @@ class InversionResult(SampledRecord):
     r0 : float
         Real part of the least unstable inverse pole [1/s] (``inf`` if minimum phase).
     auto_preview_s : float
-        ``4/r0`` [s].
+        ``4/r0`` [s] (what the seed-000 rule ``preview="4/r0"`` uses; not the automatic preview).
     dt : float
         Sampling interval [s].
     split : InverseSplit
         The model pieces (polynomial part, feedthrough, stable and anti-stable realizations).
+    preview_rule : str
+        ``"auto"``, ``"4/r0"``, ``"inf"`` or ``"fixed"`` (a number of seconds was given).
+    preview_choice : PreviewChoice or None
+        For ``preview="auto"``: the tolerance, the achieved relative truncation error and
+        the bounds (see :func:`choose_preview`).
+    truncation_error, truncation_bound : float
+        Largest error the preview causes on this signal (exact) and its signal-independent
+        bound [output units].
     """
 
     input: np.ndarray
@@ -90,6 +102,27 @@ class InversionResult(SampledRecord):
     split: InverseSplit
     t0: float = 0.0
     time_stamps: np.ndarray | None = None
+    preview_rule: str = "fixed"
+    preview_choice: "PreviewChoice | None" = None
+    limit_report: Any = None
+
+    @cached_property
+    def truncation_error(self) -> float:
+        """Largest error the finite preview causes on this signal, ``max|y_Tp - y_inf|``
+        [output units] (exact for the sampled signal; 0 for infinite preview)."""
+        if self.preview_choice is not None:
+            return self.preview_choice.max_error
+        if self.preview_samples is None or self.split.n_unstable == 0:
+            return 0.0
+        modes = TruncationModes(self.split, self.dt, self.input)
+        return float(np.max(np.abs(modes.error(self.preview_samples))))
+
+    @cached_property
+    def truncation_bound(self) -> float:
+        """Signal-independent bound on the preview error, ``tail_l1_norm(T_p) max|u|`` [output units]."""
+        if self.preview_samples is None:
+            return 0.0
+        return float(self.split.tail_l1_norm(self.preview_s)) * float(np.max(np.abs(self.input)))
 
 
     @cached_property
@@ -153,57 +186,6 @@ def sampling_interval(t: Any) -> float:
     return float(dt)
 
 
-def resolve_preview(preview: Any, split_or_auto: InverseSplit | float, dt: float,
-                    n_samples: int | None = None) -> tuple[int | None, float]:
-    """Turn a ``preview`` argument into ``(samples or None, seconds)``.
-
-    Parameters
-    ----------
-    preview : "auto", "inf", None, float
-        ``"auto"``: ``4/r0`` (0 for a minimum-phase model); ``"inf"``, ``None`` or ``math.inf``:
-        infinite preview; a number: preview [s] (>= 0).
-    split_or_auto : InverseSplit or float
-        Split (its ``auto_preview_s`` is used) or the automatic preview itself [s].
-    dt : float
-        Sampling interval [s].  The preview is rounded to ``round(preview/dt)`` samples.
-    n_samples : int, optional
-        Record length; a preview longer than the record (``N > n_samples - 1``) is an error.
-    """
-    auto = split_or_auto.auto_preview_s if isinstance(split_or_auto, InverseSplit) else float(split_or_auto)
-    if isinstance(preview, str):
-        key = preview.strip().lower()
-        if key == "auto":
-            seconds = auto
-        elif key in ("inf", "infinite", "infinity", "none"):
-            return None, math.inf
-        else:
-            try:
-                seconds = float(key)
-            except ValueError:
-                raise PreviewError(
-                    f"preview must be 'auto', 'inf' or a number of seconds; got {preview!r}") from None
-    elif preview is None:
-        return None, math.inf
-    else:
-        try:
-            seconds = float(preview)
-        except (TypeError, ValueError):
-            raise PreviewError(
-                f"preview must be 'auto', 'inf' or a number of seconds; got {preview!r}") from None
-    if math.isnan(seconds) or seconds < 0:
-        raise PreviewError(f"preview must be >= 0 seconds (or 'auto'/'inf'); got {preview!r}")
-    if math.isinf(seconds):
-        return None, math.inf
-    n = int(round(seconds / dt))
-    if n_samples is not None and n > n_samples - 1:
-        raise PreviewError(
-            f"preview {seconds:.6g} s ({n} samples at dt = {dt:.6g} s"
-            f"{', the automatic 4/r0 rule' if isinstance(preview, str) and preview.strip().lower() == 'auto' else ''})"
-            f" is longer than the record ({n_samples} samples = {(n_samples - 1) * dt:.6g} s); "
-            "use a longer record, a shorter preview, or preview='inf'")
-    return n, n * dt
-
-
 def _as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:
     if isinstance(model, InverseSplit):
         return model
@@ -245,7 +227,8 @@ def _disc_estimate(split: InverseSplit, u: np.ndarray, n_preview: int | None) ->
 
 def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str = "error",
            filter_bandwidth: float | None = None, t0: float = 0.0,
-           chunk_size: int | None = None) -> InversionResult:
+           chunk_size: int | None = None, preview_tol: float = DEFAULT_PREVIEW_TOL,
+           preview_norm: str = "linf") -> InversionResult:
     """Stable inversion ``y = G^{-1}[u]`` of a uniformly sampled signal.
 
     Parameters
@@ -258,10 +241,14 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         Uniform time stamps [s] (checked), or the sampling interval ``dt`` [s].
     u : array_like
         Signal to invert (sensor output, or desired actuator output), same length as ``t``.
-    preview : "auto", "inf", None or float
-        Preview time [s] for the anticausal part: ``"auto"`` = ``4/r0`` (Zou–Devasia rule
-        used in seed 000), ``"inf"``/``None`` = full noncausal inverse, or a number of
-        seconds (rounded to whole samples).  Must not exceed the record.
+    preview : "auto", "4/r0", "inf", None or float
+        Preview time [s] for the anticausal part: ``"auto"`` = the smallest preview whose
+        truncation error on this signal is below ``preview_tol`` of the full inverse (see
+        :func:`choose_preview`; the result reports it in ``preview_choice``); ``"4/r0"`` =
+        the Zou–Devasia rule used in seed 000 (far too short when the anticausal residues
+        are large, as for the seed 001 actuator surrogates); ``"inf"``/``None`` = full
+        noncausal inverse; or a number of seconds (rounded to whole samples, must not
+        exceed the record).
     improper : {"error", "filter", "differentiate"}
         Handling of a strictly proper model (see :func:`inversion.split_inverse`).
     filter_bandwidth : float, optional
@@ -272,6 +259,10 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         Samples per processing chunk.  Default: the whole record in one chunk (the result
         arrays are O(n) anyway); see :func:`invert_to` for bounded-memory processing.  The
         result does not depend on it beyond rounding.
+    preview_tol : float
+        Tolerance of ``preview="auto"``: truncation error relative to the full inverse.
+    preview_norm : {"linf", "l2"}
+        Norm in which ``preview_tol`` is measured.
 
     Returns
     -------
@@ -287,7 +278,13 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     split = _as_split(model, improper, filter_bandwidth)
     ua = _signal(u)
     ta, dt = time_base(t, ua)
-    n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
+    rule = preview_rule(preview)
+    choice = None
+    if rule == "auto":
+        choice = choose_preview(split, dt, ua, tol=preview_tol, norm=preview_norm, checked=True)
+        n_prev, prev_s = choice.samples, choice.seconds
+    else:
+        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
     plan = Plan(split, dt, n_prev)
     if chunk_size is None:
         chunk_size = ua.size
@@ -330,11 +327,17 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             np.add(stable[c0:c1], y, out=output[c0:c1])
 
         plan.backward(ua, n, chunk, put_u)
+    bad = ~np.isfinite(output)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise NonFiniteSignalError(
+            f"the inverse overflowed: output sample {i} is {output[i]!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
+            "scale the signal to the model's units")
     return InversionResult(
         input=ua, output=output, stable_part=stable, unstable_part=unstable,
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
-        time_stamps=ta)
+        time_stamps=ta, preview_rule=rule, preview_choice=choice)
 
 
 @dataclass(frozen=True)
@@ -409,20 +412,38 @@ def invert_to(model: Any, dt: float, u: Any, out: Any, *, preview: Any = "auto",
                                    r0=split.r0, chunk_size=int(chunk_size))
 
 
-def decode_sensor(model: Any, t: Any, current: Any, **kwargs: Any) -> InversionResult:
+def _with_limits(res: InversionResult, limits: Any, what: str, unit: str) -> InversionResult:
+    from dataclasses import replace
+
+    from .limits import check_limits
+
+    report = check_limits(res.output, res.dt, limits, t0=float(res.t[0]), what=what, unit=unit)
+    return replace(res, limit_report=report)
+
+
+def decode_sensor(model: Any, t: Any, current: Any, *, limits: Any = None,
+                  **kwargs: Any) -> InversionResult:
     """Sensor decoding: recover the stimulus (e.g. tip displacement) from the sensor output.
 
     ``model`` maps stimulus -> sensor output (seed 000: displacement [mm] -> short-circuit
-    current [uA]).  Same code path and keyword arguments as :func:`invert`.
+    current [uA]).  Same code path and keyword arguments as :func:`invert`.  ``limits``
+    (:class:`inversion.limits.Limits`, e.g. ``Limits(output_range=(-2, 2))`` in mm) refuses
+    or flags a decoded signal outside the range the strip can reach; the peaks are always in
+    ``result.limit_report``.
     """
-    return invert(model, t, current, **kwargs)
+    return _with_limits(invert(model, t, current, **kwargs), limits, "decoded signal", "")
 
 
-def feedforward(model: Any, t: Any, desired: Any, **kwargs: Any) -> InversionResult:
+def feedforward(model: Any, t: Any, desired: Any, *, limits: Any = None,
+                **kwargs: Any) -> InversionResult:
     """Actuator feedforward: the input (e.g. voltage) that makes the output follow ``desired``.
 
     ``model`` maps actuator input -> output (seed 001: voltage [V] -> tip displacement [mm]).
     Same code path and keyword arguments as :func:`invert`; ``result.output`` is the
-    feedforward input.
+    feedforward input.  ``limits`` (:class:`inversion.limits.Limits`, e.g.
+    ``Limits(max_voltage=2.5, max_rate=50)``) refuses (``LimitError``) or warns with the
+    first violating sample; ``result.limit_report`` holds the peak voltage and rate.
+    Build ``desired`` with :mod:`inversion.references` (fade-in and fade-out) so that the
+    noncausal inverse does not see a jump to zero at the record's ends.
     """
-    return invert(model, t, desired, **kwargs)
+    return _with_limits(invert(model, t, desired, **kwargs), limits, "feedforward voltage", "V")

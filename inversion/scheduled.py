@@ -23,7 +23,9 @@ Properties:
 * cost and memory are those of m fixed inversions; each node is processed by chunks, so
   :func:`invert_scheduled_to` works in bounded memory like :func:`inversion.invert_to`.
 
-The automatic preview is the largest ``4/r0(T_i)`` over the grid.
+The automatic preview is the largest signal-independent tolerance preview over the grid
+(:func:`inversion.split.frequency_preview`: truncation error below 1e-3 of the inverse for every
+sinusoid up to the Nyquist frequency); ``preview="4/r0"`` is the largest ``4/r0(T_i)``.
 """
 
 from __future__ import annotations
@@ -36,8 +38,9 @@ import numpy as np
 
 from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .batch import DEFAULT_CHUNK, SampledRecord, _signal, resolve_preview, sampling_interval, time_base
-from .split import InverseSplit, split_inverse
+from .batch import (DEFAULT_CHUNK, SampledRecord, _signal, preview_rule, resolve_preview, sampling_interval,
+                    time_base)
+from .split import DEFAULT_PREVIEW_TOL, InverseSplit, frequency_preview, split_inverse
 from .streaming import StreamingInverter
 
 __all__ = [
@@ -108,8 +111,15 @@ def _splits(model_at: Callable[[float], Any], grid: np.ndarray, improper: str,
     return out
 
 
-def _auto(splits: list[InverseSplit]) -> float:
-    return max(s.auto_preview_s for s in splits)
+def _auto(splits: list[InverseSplit], preview: Any, dt: float, tol: float = DEFAULT_PREVIEW_TOL) -> float:
+    """The preview the named rule gives over the grid [s]: the largest over the grid models
+    (``"4/r0"``: the largest 4/r0; ``"auto"``: the largest signal-independent tolerance
+    preview, :func:`inversion.split.frequency_preview` up to the Nyquist frequency)."""
+    if preview_rule(preview) == "4/r0":
+        return max(s.auto_preview_s for s in splits)
+    if preview_rule(preview) != "auto":
+        return 0.0   # unused
+    return max(frequency_preview(s, tol, omega_max=math.pi / dt)[0] for s in splits)
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,7 +201,8 @@ def invert_scheduled(model_at: Callable[[float], Any], t: Any, u: Any, temperatu
     temperature : array_like or float
         Temperature at each sample [degC] (a scalar means constant).
     preview : "auto", "inf", None or float
-        As in :func:`inversion.invert`; ``"auto"`` is the largest ``4/r0`` over the grid.
+        As in :func:`inversion.invert`; ``"auto"`` is the largest signal-independent
+        tolerance preview over the grid, ``"4/r0"`` the largest ``4/r0``.
     grid_step : float
         Spacing of the temperature grid [degC] (ignored when ``grid`` is given).
     grid : array_like, optional
@@ -213,7 +224,7 @@ def invert_scheduled(model_at: Callable[[float], Any], t: Any, u: Any, temperatu
     ta, dt = time_base(t, ua)
     g = _grid(grid, Ta, grid_step)
     splits = _splits(model_at, g, improper, filter_bandwidth)
-    n_prev, prev_s = resolve_preview(preview, _auto(splits), dt, n)
+    n_prev, prev_s = resolve_preview(preview, _auto(splits, preview, dt), dt, n)
     chunk = n if chunk_size is None else int(chunk_size)
     if chunk <= 0:
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
@@ -269,7 +280,7 @@ def invert_scheduled_to(model_at: Callable[[float], Any], dt: float, u: Any, tem
     else:
         g = _grid(grid, np.array([lo, hi]), grid_step)
     splits = _splits(model_at, g, improper, filter_bandwidth)
-    n_prev, _ = resolve_preview(preview, _auto(splits), dt, n)
+    n_prev, _ = resolve_preview(preview, _auto(splits, preview, dt), dt, n)
     for c0 in range(0, n, chunk_size):
         out[c0:c0 + chunk_size] = 0.0
 
@@ -292,7 +303,7 @@ class ScheduledStreamingInverter:
     temperature_range : (float, float)
         Range the temperature will stay in [degC] (the grid must be fixed up front).
     preview : "auto" or float
-        [s]; ``"auto"`` = largest ``4/r0`` over the grid.
+        [s]; ``"auto"`` = largest tolerance preview over the grid, ``"4/r0"`` = largest ``4/r0``.
     grid_step : float
         [degC]
     """
@@ -305,7 +316,7 @@ class ScheduledStreamingInverter:
                                        grid_step)
         splits = _splits(model_at, self.grid_c, improper, filter_bandwidth)
         dt = sampling_interval(dt)
-        n_prev, prev_s = resolve_preview(preview, _auto(splits), dt)
+        n_prev, prev_s = resolve_preview(preview, _auto(splits, preview, dt), dt)
         if n_prev is None:
             raise PreviewError(
                 f"a streaming inverter needs a finite preview (seconds or 'auto'); got {preview!r}")

@@ -51,7 +51,8 @@ import scipy.linalg as sla
 
 from ._errors import ImproperInverseError, InversionError, NonHyperbolicModelError
 
-__all__ = ["InverseSplit", "split_inverse", "model_coefficients", "IMPROPER_MODES"]
+__all__ = ["InverseSplit", "split_inverse", "model_coefficients", "IMPROPER_MODES", "frequency_preview",
+           "DEFAULT_PREVIEW_TOL"]
 
 IMPROPER_MODES = ("error", "filter", "differentiate")
 
@@ -284,6 +285,79 @@ class InverseSplit:
         """
         return _l1_norm(self.A_s, self.B_s, self.C_s), _l1_norm(-self.A_u, self.B_u, self.C_u)
 
+    def tail_l1_norm(self, preview_s: Any) -> np.ndarray:
+        """L1 norm of the anticausal kernel beyond the preview, ``int_T^inf |h_u(-sigma)| d sigma``.
+
+        A preview ``T`` neglects exactly this part of the kernel, so for any input the
+        truncation error is at most ``tail_l1_norm(T) * max|u|`` [output units].
+
+        Parameters
+        ----------
+        preview_s : float or array_like
+            Preview(s) ``T`` >= 0 [s]; ``inf`` gives 0.
+
+        Returns
+        -------
+        ndarray
+            Same shape as ``preview_s`` [output units per input unit * s / s].
+        """
+        T = np.asarray(preview_s, dtype=float)
+        if self.n_unstable == 0:
+            return np.zeros(T.shape)
+        curve_t, curve = self._tail_curve
+        return np.interp(T, curve_t, curve, right=0.0)
+
+    @property
+    def _tail_curve(self) -> tuple[np.ndarray, np.ndarray]:
+        cached = self.__dict__.get("_tail_cache")
+        if cached is None:
+            step, h = _abs_impulse(-self.A_u, self.B_u, self.C_u)
+            # cumulative trapezoid from the far end: tail[i] = int_{t_i}^{horizon} |h|
+            seg = 0.5 * step * (h[1:] + h[:-1])
+            tail = np.concatenate((np.cumsum(seg[::-1])[::-1], [0.0]))
+            cached = (step * np.arange(h.size), tail)
+            object.__setattr__(self, "_tail_cache", cached)
+        return cached
+
+    def truncation_response(self, preview_s: Any, omega: Any) -> np.ndarray:
+        """Frequency response of the error caused by truncating the anticausal part at ``T``.
+
+        ``E_T(j w) = C_u (j w I - A_u)^{-1} exp(-A_u T) B_u exp(j w T)``: the part of
+        ``H_u(j w)`` the preview ``T`` discards (``E_0 = H_u``, ``E_inf = 0``).  For a sinusoid
+        of angular frequency ``w`` and amplitude ``A`` the steady-state truncation error is
+        ``A |E_T(j w)|``.
+
+        Parameters
+        ----------
+        preview_s : float or array_like, shape (m,)
+            Previews [s].
+        omega : array_like, shape (k,)
+            Angular frequencies [rad/s].
+
+        Returns
+        -------
+        ndarray of complex, shape (m, k)  (squeezed for scalar ``preview_s``)
+        """
+        T = np.atleast_1d(np.asarray(preview_s, dtype=float))
+        w = np.atleast_1d(np.asarray(omega, dtype=float))
+        out = self._truncation_terms(T, w)
+        if self.n_unstable:
+            out = out * np.exp(1j * np.outer(np.where(np.isfinite(T), T, 0.0), w))
+        return out[0] if np.ndim(preview_s) == 0 else out
+
+    def _truncation_terms(self, T: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``C_u (j w I - A_u)^{-1} exp(-A_u T) B_u`` (the truncation response without its unit-
+        modulus factor ``exp(j w T)``), shape (T.size, w.size)."""
+        if self.n_unstable == 0:
+            return np.zeros((T.size, w.size), complex)
+        n = self.n_unstable
+        # rows R(w) = C_u (j w I - A_u)^{-1}, one batched solve (transpose system)
+        lhs = (1j * w)[:, None, None] * np.eye(n) - self.A_u
+        R = np.linalg.solve(np.transpose(lhs, (0, 2, 1)),
+                            np.broadcast_to(self.C_u.astype(complex), (w.size, n))[..., None])[..., 0]
+        V = _propagate(-self.A_u, self.B_u, T)                           # (m, n)
+        return V @ R.T
+
 
 def _to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
     if A.shape[0] == 0:
@@ -295,11 +369,10 @@ def _to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
     return control.tf(np.atleast_1d(b[0]), a)
 
 
-def _l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
-    """``int_0^inf |C exp(M t) B| dt`` for a stable ``M`` (trapezoid on a fine grid)."""
+def _abs_impulse(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[float, np.ndarray]:
+    """``(step, |C exp(M t_i) B|)`` on a uniform grid ``t_i = i*step`` covering the response
+    of a stable ``M`` down to ``exp(-40)`` of its slowest mode."""
     n = M.shape[0]
-    if n == 0:
-        return 0.0
     lam = np.linalg.eigvals(M)
     slow = float(np.min(-lam.real))
     fast = float(np.max(np.abs(lam)))
@@ -318,7 +391,37 @@ def _l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
         xs[filled:filled + m] = xs[:m] @ P.T
         filled += m
         P = P @ P
-    h = np.abs(xs @ C)
+    return step, np.abs(xs @ C)
+
+
+def _propagate(M: np.ndarray, B: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """Rows ``exp(M T_i) B`` (0 for infinite ``T_i``).  A uniform grid starting at 0 is filled by
+    repeated multiplication with one ``exp(M step)`` (vectorised doubling); otherwise one matrix
+    exponential per entry."""
+    n = M.shape[0]
+    out = np.zeros((T.size, n))
+    fin = np.isfinite(T)
+    Tf = T[fin]
+    if Tf.size > 2 and Tf[0] == 0.0 and np.allclose(np.diff(Tf), Tf[1], rtol=1e-12, atol=0.0):
+        xs = np.empty((Tf.size, n))
+        xs[0] = B
+        filled, P = 1, sla.expm(M * Tf[1])
+        while filled < Tf.size:
+            m = min(filled, Tf.size - filled)
+            xs[filled:filled + m] = xs[:m] @ P.T
+            filled += m
+            P = P @ P
+        out[fin] = xs
+    else:
+        out[fin] = np.stack([sla.expm(M * Ti) @ B for Ti in Tf]) if Tf.size else np.zeros((0, n))
+    return out
+
+
+def _l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
+    """``int_0^inf |C exp(M t) B| dt`` for a stable ``M`` (trapezoid on a fine grid)."""
+    if M.shape[0] == 0:
+        return 0.0
+    step, h = _abs_impulse(M, B, C)
     return float(step * (h.sum() - 0.5 * (h[0] + h[-1])))
 
 
@@ -486,3 +589,67 @@ def _equalise(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, 
         f = math.sqrt(nc / nb)
         return A, B * f, C / f
     return A, B, C
+
+
+#: Default tolerance of the automatic preview: truncation error relative to the full inverse.
+DEFAULT_PREVIEW_TOL = 1e-3
+
+
+def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
+                      omega_max: float, omega_min: float | None = None,
+                      n_omega: int = 256) -> tuple[float, float]:
+    """Smallest preview whose truncation error is below ``tol`` for every sinusoid in a band.
+
+    Signal-independent rule (used where the signal is not known in advance: streaming,
+    bounded-memory and scheduled inversion): the smallest ``T`` on a grid of step
+    ``0.05/r0`` such that, for it and every longer grid preview,
+
+        max_w |E_T(j w)| / |H(j w)|  <=  tol      for w in {0} U [omega_min, omega_max],
+
+    with ``E_T`` the discarded part of the anticausal kernel
+    (:meth:`InverseSplit.truncation_response`) and ``H`` the full inverse.  By Parseval the
+    same ratio bounds the L2 truncation error of any signal in the band relative to the L2
+    norm of its full inverse (edge transients of the record aside).
+
+    Parameters
+    ----------
+    split : InverseSplit
+    tol : float
+        Relative tolerance (> 0).
+    omega_max : float
+        Top of the band [rad/s] (e.g. the Nyquist frequency ``pi/dt``).
+    omega_min : float, optional
+        Bottom of the logarithmic part of the band [rad/s]; default ``1e-3 min(|zeros|)``.
+    n_omega : int
+        Frequencies on the logarithmic grid.
+
+    Returns
+    -------
+    (preview_s, bound) : (float, float)
+        The preview [s] and the relative error bound it achieves (0 for minimum phase).
+    """
+    if not (isinstance(tol, float | int) and math.isfinite(tol) and tol > 0):
+        raise InversionError(f"preview tolerance must be a positive number; got {tol!r}")
+    if split.n_unstable == 0:
+        return 0.0, 0.0
+    zmag = np.abs(split.zeros[np.abs(split.zeros) > 0])
+    lo = float(omega_min) if omega_min is not None else 1e-3 * float(np.min(zmag))
+    hi = float(omega_max)
+    if not (0 < lo < hi and math.isfinite(hi)):
+        raise InversionError(f"frequency band must satisfy 0 < omega_min < omega_max; got {lo!r}, {hi!r}")
+    w = np.concatenate(([0.0], np.logspace(math.log10(lo), math.log10(hi), n_omega)))
+    H = np.abs(split.frequency_response(w))
+    keep = H > 1e-12 * float(np.max(H))           # a zero of H (pole of G) carries no signal
+    w, H = w[keep], H[keep]
+    step = 0.05 / split.r0
+    T = step * np.arange(2001)                    # up to 100/r0 (exp(-100) of the kernel)
+    ratio = np.max(np.abs(split._truncation_terms(T, w)) / H, axis=1)
+    bad = np.flatnonzero(ratio > tol)
+    if bad.size == 0:
+        return 0.0, float(ratio[0])
+    i = int(bad[-1]) + 1
+    if i >= T.size:
+        raise InversionError(
+            f"no finite preview up to 100/r0 = {T[-1]:.4g} s brings the truncation error below "
+            f"{tol:g} of the inverse (best {ratio[-1]:.3g}); use preview='inf'")
+    return float(T[i]), float(np.max(ratio[i:]))

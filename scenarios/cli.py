@@ -10,6 +10,7 @@
     ipmc frf RECORD...              frequency response with per-line σ from time records
     ipmc fit SWEEP                  temperature-scheduled rational surrogate
     ipmc invert SIGNAL              stable (noncausal) inversion of a surrogate
+    ipmc feedforward ...            actuator voltage for a reference, checked on the physics
     ipmc calibrate SWEEP            calibrate physical parameters to a measured sweep
     ipmc diagnose                   discrepancy workflow: locate, name, add, refit
     ipmc validate                   every printed claim of the seed papers vs our number
@@ -25,12 +26,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .commands import (calibrate, demo, diagnose, excite, fit, frf, invert, run, sets, simulate, study, sweep,
-                       validate)
+from .commands import (calibrate, demo, diagnose, excite, feedforward, fit, frf, invert, run, sets, simulate, study,
+                       sweep, validate)
 from .commands._common import EXIT_BAD_INPUT, EXIT_INTERRUPTED
 
 #: The subcommands, in the order ``ipmc --help`` lists them.
-COMMANDS = (sets, sweep, simulate, excite, frf, demo, run, study, fit, invert, calibrate, diagnose, validate)
+COMMANDS = (sets, sweep, simulate, excite, frf, demo, run, study, fit, invert, feedforward, calibrate, diagnose,
+            validate)
 
 
 def _version() -> str:

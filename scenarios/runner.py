@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .spec import Scenario, ScenarioError
+from .steps_control import step_control_route
 
 
 # ---------------------------------------------------------------------------- results
@@ -278,8 +279,9 @@ def step_inversion(ctx: _Ctx):
     settle, margin = cfg.get("settle_s", dur / 3), cfg.get("end_margin_s", 0.5)
     lead, ramp = cfg.get("lead_s", 0.0), cfg.get("ramp_s", 0.0)
     preview = cfg.get("preview", "inf")
-    if isinstance(preview, str) and preview not in ("inf", "auto"):
-        raise ScenarioError(f"{ctx.spec.path}: [inversion] preview must be 'inf', 'auto' or seconds, got {preview!r}")
+    if isinstance(preview, str) and preview not in ("inf", "auto", "4/r0"):
+        raise ScenarioError(f"{ctx.spec.path}: [inversion] preview must be 'inf', 'auto', '4/r0' or seconds, "
+                            f"got {preview!r}")
     if not settle < dur - margin:
         raise ScenarioError(f"{ctx.spec.path}: [inversion] settle_s={settle} leaves no error window in {dur} s")
     is_act = ctx.spec.section("model")["kind"] == "actuator"
@@ -518,8 +520,9 @@ def step_fixtures(ctx: _Ctx):
                 f"each; read-back relative error {worst:.1e}; `fixtures/manifest.json` lists seeds and fingerprints.")
 
 
-STEPS = {"sweep": step_sweep, "surrogate": step_surrogate, "inversion": step_inversion, "widths": step_widths,
-         "taylor": step_taylor, "blackbox": step_blackbox, "discrepancy": step_discrepancy, "fixtures": step_fixtures}
+STEPS = {"sweep": step_sweep, "surrogate": step_surrogate, "control_route": step_control_route,
+         "inversion": step_inversion, "widths": step_widths, "taylor": step_taylor, "blackbox": step_blackbox,
+         "discrepancy": step_discrepancy, "fixtures": step_fixtures}
 
 
 # ---------------------------------------------------------------------------- checks and report

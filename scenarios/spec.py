@@ -20,7 +20,7 @@ Schema (units in the key names; SI otherwise)::
     [noise]      kind = "none" | "magphase" | "complex", sigma_db, sigma_deg, sigma, seed (int)
     [surrogate]  form = "zpk" | "coefficients" | "sections", n_zeros, n_poles, degree,
                  method = "joint" | "two-stage", weighting
-    [inversion]  preview = "inf" | "auto" | seconds, fs_hz, duration_s, settle_s, end_margin_s,
+    [inversion]  preview = "inf" | "auto" | "4/r0" | seconds, fs_hz, duration_s, settle_s, end_margin_s,
                  lead_s, ramp_s (sine references are zero for lead_s, then faded in over ramp_s),
                  [[inversion.experiments]] name, temperature_c, stimulus = "sine" | "release",
                  amplitude_mm, frequencies_hz (list; a multisine splits the amplitude equally),
@@ -54,7 +54,7 @@ from pathlib import Path
 from physmodel.errors import IPMCError
 
 #: The order in which the runner executes the step tables.
-STEP_ORDER = ("sweep", "surrogate", "inversion", "widths", "taylor", "blackbox", "discrepancy", "fixtures")
+STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy", "fixtures")
 
 
 class ScenarioError(IPMCError):
@@ -111,7 +111,13 @@ class _List:
 
 
 _SWEEP_GRID = {"fmin_hz": NUM, "fmax_hz": NUM, "points": INT}
+#: [control_route]: the physics-calibrated route vs a direct schedule (scenarios/steps_control.py).
+CONTROL_ROUTE_SCHEMA = {"free": STRS, "prior": _Map(NUM), "starts": INT, "seed": INT, "dense_temperatures_c": NUMS,
+                        "form": _choice("zpk", "coefficients", "sections"), "n_zeros": INT, "n_poles": INT,
+                        "degree": INT, "temperature_c": NUM, "frequency_hz": NUM, "amplitude_mm": NUM,
+                        "fs_hz": NUM, "duration_s": NUM, "max_voltage_v": NUM, "note": STR}
 SECTIONS = {
+    "control_route": CONTROL_ROUTE_SCHEMA,
     "scenario": {"name": STR, "title": STR, "description": STR, "source": STR},
     "model": {"kind": _choice("actuator", "sensor"), "set": STR, "quantity": STR,
               "kernel": _choice("boundary_charge", "reciprocal"), "params": _Map(NUM)},
@@ -232,7 +238,7 @@ def parse_scenario(raw: dict, where: str = "<scenario>", *, quick: bool = False)
     for sec in ("sweep",):
         if sec in data:
             _require(data[sec], REQUIRED[sec], f"{where}: [{sec}]")
-    for dep, need in (("surrogate", "sweep"), ("inversion", "surrogate"), ("blackbox", "sweep"),
+    for dep, need in (("surrogate", "sweep"), ("control_route", "sweep"), ("inversion", "surrogate"), ("blackbox", "sweep"),
                       ("discrepancy", "sweep")):
         if dep in data and need not in data:
             raise ScenarioError(f"{where}: [{dep}] needs a [{need}] table")
@@ -312,7 +318,7 @@ def _check_values(data: dict, where: str) -> None:
                 need(0 <= inv[key] < dur, "inversion", key, inv[key], f"in [0, duration_s = {dur:g}) s")
         pv = inv.get("preview", "inf")
         if isinstance(pv, str):
-            need(pv in ("inf", "auto"), "inversion", "preview", pv, "'inf', 'auto' or seconds")
+            need(pv in ("inf", "auto", "4/r0"), "inversion", "preview", pv, "'inf', 'auto', '4/r0' or seconds")
         else:
             need(0 < pv <= dur, "inversion", "preview", pv, f"seconds in (0, duration_s = {dur:g}]")
         for i, exp in enumerate(inv.get("experiments", [])):

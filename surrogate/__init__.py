@@ -35,6 +35,10 @@ Results and models
                      confidence_intervals(), to_json(path)
     load(path) -> RationalModel                versioned JSON (schema ``ipmc.surrogate.rational_model``)
     Structure, Scaling, StabilityCheck, TemperatureError
+Trusting a schedule between its temperatures (:mod:`surrogate.crossval`)
+    cross_validate (leave one temperature out), select_degree, dense_check / physics_reference
+    (against the physics on a dense temperature grid), check_schedule -> ScheduleCheck (warns with
+    ScheduleWarning and proposes the physics-calibrated route), fit_checked (fit + check)
 Order selection
     order_selection(frequency_hz, temperature_c, response, orders, ...) -> OrderSelectionReport
 Metrics
@@ -54,12 +58,16 @@ from .models import RationalModel, Scaling, StabilityCheck, load
 from .rational import RationalFit
 from .scheduled import ScheduledFit
 from .selection import OrderRow, OrderSelectionReport, order_selection
+from .crossval import (CrossValidation, ScheduleCheck, ScheduleWarning, check_schedule, cross_validate, dense_check,
+                       fit_checked, physics_reference, select_degree)
 
 __all__ = [
     "FrequencyData", "from_sweep", "RationalFit", "ScheduledFit", "fit_sweep", "levy",
     "FitResult", "TemperatureError", "RationalModel", "Scaling", "StabilityCheck", "Structure",
     "load", "order_selection", "OrderRow", "OrderSelectionReport", "relative_rms_error",
     "fit_percent", "log_rms_error", "ConvergenceError",
+    "cross_validate", "select_degree", "check_schedule", "fit_checked", "dense_check", "physics_reference",
+    "CrossValidation", "ScheduleCheck", "ScheduleWarning",
 ]
 
 

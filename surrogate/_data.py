@@ -8,7 +8,9 @@ frequencies per temperature, both-or-neither standard deviations): ``__post_init
 ``FrequencySweep`` and keeps its arrays; the only check added here is that standard deviations
 are > 0 (they become weights 1/σ).
 
-Hz and °C at the edges; the fitters convert to ω = 2πf [rad/s] inside.
+Hz and °C at the edges; the fitters convert to ω = 2πf [rad/s] inside.  ``to_data`` also takes
+python-control ``FrequencyResponseData`` objects and arrays (through
+:func:`physmodel.data.interop.as_sweep`).
 """
 
 from __future__ import annotations
@@ -199,11 +201,25 @@ def from_sweep(sweep) -> FrequencyData:
     )
 
 
-def to_data(data) -> FrequencyData:
-    """What every fitter's ``fit_data`` accepts: a ``FrequencyData`` (returned as is) or a
-    ``FrequencySweep`` / sweep-like object (converted by :func:`from_sweep`)."""
+def to_data(data, temperature_c=None) -> FrequencyData:
+    """What every fitter's ``fit_data`` accepts: a ``FrequencyData`` (returned as is), a
+    ``FrequencySweep`` / sweep-like object (converted by :func:`from_sweep`), or anything
+    :func:`physmodel.data.interop.as_sweep` reads — a ``control.FrequencyResponseData``, a mapping
+    ``{temperature_c: FRD or (frequency_hz, response)}``, a list of FRDs with ``temperature_c``, or
+    ``(frequency_hz, response)`` arrays.  An FRD or arrays without ``temperature_c`` are one
+    unspecified temperature (enough for ``RationalFit``)."""
     if isinstance(data, FrequencyData):
         return data
     if isinstance(data, FrequencySweep) or all(hasattr(data, a) for a in _SWEEP_ATTRS):
         return from_sweep(data)
-    raise IPMCError(f"expected FrequencyData or a physmodel FrequencySweep, got {type(data).__name__}")
+    from physmodel.data.interop import as_sweep, is_frd
+
+    if temperature_c is None and (is_frd(data) or (isinstance(data, tuple | list) and len(data) == 2
+                                                   and not is_frd(data[0]))):
+        sw = as_sweep(data, 0.0)        # one unspecified temperature
+        return FrequencyData(sw.frequency_hz, None, sw.response)
+    if isinstance(data, dict | list | tuple) or is_frd(data):
+        return from_sweep(as_sweep(data, temperature_c))
+    raise IPMCError(f"expected FrequencyData or a physmodel FrequencySweep, got {type(data).__name__} "
+                    "(also accepted: a control.FrequencyResponseData, a mapping {temperature_c: FRD} or "
+                    "(frequency_hz, response) arrays)")

@@ -6,6 +6,7 @@ units     UNITS, unit_scale, QUANTITY_UNITS — file units as multiples of SI; e
           quantity's input/output names and display units
 sweep     FrequencySweep (tidy frequency-response record with per-line σ), MagnitudePhaseNoise,
           ComplexGaussianNoise, synthesize_sweep, sweep_layout, merge_sweeps
+interop   as_sweep — a FrequencySweep from a sweep, python-control FRD objects or arrays
 files     read_sweep / write_sweep (.csv, .npz, .mat by extension) and the per-format readers and
           writers; atomic_write (the library's one atomic writer)
 timesim   realize, simulate, sine, step, free_release, TimeSeries — time-domain virtual experiments
@@ -15,9 +16,10 @@ from .files import (atomic_write, by_extension, read_csv, read_mat, read_npz, re
                     write_npz, write_sweep)
 from .sweep import (ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, SweepLayout, merge_sweeps,
                     sweep_layout, synthesize_sweep)
+from .interop import as_sweep
 from .units import QUANTITY_UNITS, UNITS, unit_scale
 
-__all__ = ["FrequencySweep", "MagnitudePhaseNoise", "ComplexGaussianNoise", "synthesize_sweep", "SweepLayout",
+__all__ = ["as_sweep", "FrequencySweep", "MagnitudePhaseNoise", "ComplexGaussianNoise", "synthesize_sweep", "SweepLayout",
            "sweep_layout", "merge_sweeps", "read_sweep", "write_sweep", "read_csv", "write_csv", "read_npz",
            "write_npz", "read_mat", "write_mat", "atomic_write", "by_extension", "UNITS", "unit_scale",
            "QUANTITY_UNITS"]

@@ -11,7 +11,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..data.sweep import FrequencySweep, merge_sweeps, sweep_layout
+from ..data.interop import as_sweep
+from ..data.sweep import FrequencySweep, sweep_layout
 from ..errors import IPMCError, ParameterError
 from ..params import IPMCParameters
 from ..parameter_paths import apply_values, base_value, check_parameter_name
@@ -104,7 +105,7 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
         raise ParameterError(f"misfit must be 'widen' or 'withhold', got {misfit!r}")
     if not isinstance(base, IPMCParameters):
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
-    data = merge_sweeps(data)
+    data = as_sweep(data)
     fps = []
     for item in free:
         if isinstance(item, str):

@@ -149,8 +149,16 @@ def run(args) -> int:
     from surrogate.adequacy import assess
 
     verdict = assess(res)
+    schedule = None
+    if res.model.is_scheduled:
+        from surrogate import check_schedule
+
+        schedule = check_schedule(fitter, fit_data, res.model, warn=False)     # leave-one-temperature-out
+        if not schedule.ok:
+            print(f"ipmc fit: WARNING: {schedule.message}" + (f" {schedule.proposal}" if schedule.proposal else ""),
+                  file=sys.stderr)
     with output_folder(args.out, "ipmc fit", force=args.force) as out:
-        _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict)
+        _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, schedule)
     if not res.converged:
         print(f"ipmc fit: the fit did not converge (IPOPT status {res.status!r})", file=sys.stderr)
         return EXIT_NOT_CONVERGED
@@ -161,7 +169,7 @@ def run(args) -> int:
     return EXIT_OK
 
 
-def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict):
+def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, schedule=None):
     from surrogate import TemperatureError, fit_percent, relative_rms_error
 
     model = res.model
@@ -184,6 +192,10 @@ def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict):
         figures.append("poles_zeros_vs_temperature.png")
     model.to_json(out / "model.json")
     report = _report(args, data, fit_data, res, held, figures, verdict)
+    if schedule is not None:
+        report += ("\n## Between the fit temperatures (leave-one-temperature-out)\n\n" + schedule.cv.to_markdown()
+                   + "\n" + ("OK: " if schedule.ok else "**WARNING**: ") + schedule.message
+                   + (f"\n\n{schedule.proposal}" if schedule.proposal else "") + "\n")
     atomic_write(out / "report.md", lambda fh: fh.write(report))
     if not args.quiet:
         print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")

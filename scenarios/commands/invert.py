@@ -78,7 +78,10 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                    help="surrogate model JSON (needs --temperature); hook for the surrogate package")
     p.add_argument("--temperature", type=float, default=None, help="temperature [degC] for --surrogate")
     p.add_argument("--preview", default="auto",
-                   help="preview: 'auto' (4/r0), 'inf' (full noncausal inverse) or seconds")
+                   help="'auto' (smallest preview whose truncation error < --preview-tol of the inverse; default), "
+                        "'4/r0' (the seed-000 rule), 'inf' (full noncausal inverse) or seconds")
+    p.add_argument("--preview-tol", type=float, default=1e-3,
+                   help="relative truncation error allowed by --preview auto (default 1e-3)")
     p.add_argument("--improper", choices=("error", "filter", "differentiate"), default="error",
                    help="handling of a strictly proper model (improper inverse)")
     p.add_argument("--filter-bandwidth", type=float, default=None,
@@ -165,7 +168,9 @@ def run(args: argparse.Namespace) -> int:
         raise InversionError(f"{args.input}: no reference column {args.reference!r} in header {header}")
     t = data[:, it]
     u = data[:, header.index(ucol)]
-    res = invert(model, t, u, preview=preview, improper=args.improper,
+    if not (math.isfinite(args.preview_tol) and 0 < args.preview_tol < 1):
+        raise InversionError(f"--preview-tol must be in (0, 1), got {args.preview_tol!r}")
+    res = invert(model, t, u, preview=preview, preview_tol=args.preview_tol, improper=args.improper,
                  filter_bandwidth=args.filter_bandwidth)
     y = res.output
     if not np.all(np.isfinite(y)):

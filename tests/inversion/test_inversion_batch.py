@@ -185,7 +185,7 @@ def test_finite_preview_equals_truncated_integral_by_quadrature():
 def test_chunked_processing_equals_single_pass():
     rng = np.random.default_rng(1)
     u = rng.standard_normal(5000)
-    for preview in ("inf", "auto", 0.02, 0.5):
+    for preview in ("inf", "4/r0", 0.02, 0.5):
         a = invert(NMP, 1e-3, u, preview=preview)
         b = invert(NMP, 1e-3, u, preview=preview, chunk_size=777)
         np.testing.assert_allclose(b.output, a.output, rtol=0, atol=1e-12 * np.max(np.abs(a.output)))
@@ -199,7 +199,7 @@ def test_invert_to_memmap_bounded_memory_equals_invert(tmp_path):
     src = np.lib.format.open_memmap(tmp_path / "u.npy", mode="w+", dtype=float, shape=(n,))
     src[:] = rng.standard_normal(n)
     dst = np.lib.format.open_memmap(tmp_path / "y.npy", mode="w+", dtype=float, shape=(n,))
-    for preview in ("auto", "inf"):
+    for preview in ("4/r0", "inf"):
         summary = invert_to(NMP, 1e-3, src, dst, preview=preview, chunk_size=1500)
         ref = invert(NMP, 1e-3, np.asarray(src), preview=preview).output
         np.testing.assert_allclose(np.asarray(dst), ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
@@ -212,12 +212,12 @@ def test_invert_to_memmap_bounded_memory_equals_invert(tmp_path):
 def test_time_stamps_and_result_fields():
     t = 2.0 + 1e-3 * np.arange(500)
     u = np.sin(2 * np.pi * 20 * t)
-    r = invert(NMP, t, u, preview="auto")
+    r = invert(NMP, t, u, preview="4/r0")
     np.testing.assert_array_equal(r.t, t)
     assert r.dt == pytest.approx(1e-3)
     assert r.preview_samples == round(r.auto_preview_s / 1e-3) == 113
     np.testing.assert_allclose(r.output, r.stable_part + r.unstable_part, rtol=0, atol=1e-15)
-    r2 = invert(NMP, 1e-3, u, t0=2.0)
+    r2 = invert(NMP, 1e-3, u, t0=2.0, preview="4/r0")
     np.testing.assert_allclose(r2.t, t, rtol=0, atol=1e-12)
     # same signal, dt from the stamps differs from 1e-3 by rounding only
     np.testing.assert_allclose(r2.output, r.output, rtol=0, atol=1e-11)
@@ -233,7 +233,7 @@ def test_time_stamps_and_result_fields():
         (dict(preview=-0.1), PreviewError, ">= 0"),
         (dict(preview="soon"), PreviewError, "auto"),
         (dict(preview=0.01), PreviewError, "longer than the record"),
-        (dict(preview="auto"), PreviewError, "4/r0"),
+        (dict(preview="4/r0"), PreviewError, "4/r0"),
         (dict(u=np.zeros((2, 3))), InversionError, "1-D"),
         (dict(t=np.arange(4) * 1e-3), InversionError, "same length"),
     ],

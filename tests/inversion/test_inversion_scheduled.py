@@ -37,8 +37,8 @@ def test_temperature_grid():
 
 def test_constant_temperature_equals_fixed_inverse():
     u = np.sin(2 * np.pi * 20 * DT * np.arange(2000))
-    fixed = invert(toy_scheduled_sensor(37.0), DT, u, preview="auto").output
-    r = invert_scheduled(toy_scheduled_sensor, DT, u, 37.0, preview="auto")
+    fixed = invert(toy_scheduled_sensor(37.0), DT, u, preview="4/r0").output
+    r = invert_scheduled(toy_scheduled_sensor, DT, u, 37.0, preview="4/r0")
     np.testing.assert_array_equal(r.grid_c, [37.0])
     np.testing.assert_allclose(r.output, fixed, rtol=0, atol=1e-13)
     # between two nodes it is the linear interpolation of the two node inverses
@@ -80,7 +80,7 @@ def test_drifting_bath_scheduled_inverse_beats_fixed_temperature(drift):
     assert e_s < 3e-3            # mm for a 1 mm stimulus (frozen-time + grid + discretisation)
     assert e_f / e_s > 20.0      # measured ~90x
     # with the automatic preview both include the same truncation error: still far better
-    sched_a = invert_scheduled(toy_scheduled_sensor, t, i, T, preview="auto")
+    sched_a = invert_scheduled(toy_scheduled_sensor, t, i, T, preview="4/r0")
     fixed_a = invert(toy_scheduled_sensor(30.0), t, i, preview=sched_a.preview_s)
     assert sched_a.preview_s == pytest.approx(max(4 / r for r in sched_a.r0), abs=DT / 2)
     assert np.max(np.abs(fixed_a.output[m] - d[m])) > 2 * np.max(np.abs(sched_a.output[m] - d[m]))

@@ -37,7 +37,7 @@ def _close(a, b):
     np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.max(np.abs(b)))
 
 
-@pytest.mark.parametrize("preview", ["auto", 0.01, 0.05, 0.5], ids=["auto", "fir", "blocks50", "blocks500"])
+@pytest.mark.parametrize("preview", ["4/r0", 0.01, 0.05, 0.5], ids=["auto", "fir", "blocks50", "blocks500"])
 @pytest.mark.parametrize("sizes", [[3000], [1] * 3000, [113] * 30, [7, 1000, 2, 2, 500, 1]],
                          ids=["whole", "ones", "preview-sized", "mixed"])
 def test_streaming_equals_batch(preview, sizes):
@@ -58,7 +58,7 @@ def test_streaming_equals_batch_any_chunking(sizes, preview):
 
 
 def test_output_is_delayed_by_exactly_the_preview():
-    inv = StreamingInverter(G, DT, "auto")
+    inv = StreamingInverter(G, DT, "4/r0")
     assert inv.delay_samples == inv.preview_samples == 113
     assert inv.delay_s == pytest.approx(0.113)
     assert inv.push(U[:100]).size == 0
@@ -69,7 +69,7 @@ def test_output_is_delayed_by_exactly_the_preview():
 
 
 def test_state_stays_bounded_with_long_streams():
-    inv = StreamingInverter(G, DT, "auto")
+    inv = StreamingInverter(G, DT, "4/r0")
     u = np.sin(np.arange(200_000) * 0.05)
     for i in range(0, u.size, 100):
         inv.push(u[i:i + 100])

@@ -1,0 +1,26 @@
+"""The physics-calibrated route scenario (``scenarios/control_route.toml``), run with the step
+registered the way the merge will register it.  The checks inside the scenario compare with the
+true physics (seed001_actuator) and with the steady-state prediction A|P/G - 1|."""
+
+import pytest
+
+from scenarios import runner, spec
+from scenarios.steps_control import CONTROL_ROUTE_SCHEMA, step_control_route
+
+
+@pytest.fixture
+def registered(monkeypatch):
+    monkeypatch.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("control_route",))
+    monkeypatch.setitem(spec.SECTIONS, "control_route", CONTROL_ROUTE_SCHEMA)
+    monkeypatch.setitem(runner.STEPS, "control_route", step_control_route)
+
+
+def test_control_route_scenario_passes_its_checks(registered, tmp_path):
+    path = spec.bundled_scenarios()[0].parent / "control_route.toml"
+    res = runner.run_scenario(spec.load_scenario(path), tmp_path, quiet=True)
+    failed = [(c.name, c.value) for c in res.checks if not c.passed]
+    assert not failed, failed
+    m = res.metrics
+    assert m["control_route.direct_between_error"] > 20 * m["control_route.route_max_error"]
+    assert (tmp_path / "control_route_feedforward.png").exists() and (tmp_path / "report.md").exists()
+    assert "Physics-calibrated route" in (tmp_path / "report.md").read_text()
