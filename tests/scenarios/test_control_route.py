@@ -5,7 +5,8 @@ true physics (seed001_actuator) and with the steady-state prediction A|P/G - 1|.
 import pytest
 
 from scenarios import runner, spec
-from scenarios.steps_control import CONTROL_ROUTE_SCHEMA, step_control_route
+from scenarios.spec import CONTROL_ROUTE_SCHEMA
+from scenarios.steps_control import step_control_route
 
 
 @pytest.fixture
