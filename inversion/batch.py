@@ -331,7 +331,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise NonFiniteSignalError(
-            f"the inverse overflowed: output sample {i} is {output[i]!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
+            f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
             "scale the signal to the model's units")
     return InversionResult(
         input=ua, output=output, stable_part=stable, unstable_part=unstable,

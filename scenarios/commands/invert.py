@@ -170,8 +170,11 @@ def run(args: argparse.Namespace) -> int:
     u = data[:, header.index(ucol)]
     if not (math.isfinite(args.preview_tol) and 0 < args.preview_tol < 1):
         raise InversionError(f"--preview-tol must be in (0, 1), got {args.preview_tol!r}")
-    res = invert(model, t, u, preview=preview, preview_tol=args.preview_tol, improper=args.improper,
-                 filter_bandwidth=args.filter_bandwidth)
+    try:
+        res = invert(model, t, u, preview=preview, preview_tol=args.preview_tol, improper=args.improper,
+                     filter_bandwidth=args.filter_bandwidth)
+    except InversionError as exc:
+        raise InversionError(f"{args.input}: {exc}") from None
     y = res.output
     if not np.all(np.isfinite(y)):
         # the CLI boundary guard: the library should refuse this itself (see the issue-13 report)
