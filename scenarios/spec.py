@@ -121,9 +121,18 @@ SECTIONS = {
     "scenario": {"name": STR, "title": STR, "description": STR, "source": STR},
     "model": {"kind": _choice("actuator", "sensor"), "set": STR, "quantity": STR,
               "kernel": _choice("boundary_charge", "reciprocal"), "params": _Map(NUM)},
-    "sweep": {"temperatures_c": NUMS, **_SWEEP_GRID, "held_out_c": NUMS, "plot_temperatures_c": NUMS},
-    "noise": {"kind": _choice("none", "magphase", "complex"), "sigma_db": NUM, "sigma_deg": NUM,
-              "sigma": NUM, "seed": INT},
+    "sweep": {"temperatures_c": NUMS, **_SWEEP_GRID, "held_out_c": NUMS, "plot_temperatures_c": NUMS,
+              # source = "virtual_lab": the sweep is estimated from simulated time records
+              # (scenarios/virtual_lab.py, which validates the values of these keys)
+              "source": _choice("synthetic", "virtual_lab"), "excitation": _choice("multisine", "stepped"),
+              "fs_hz": NUM, "period_s": NUM, "periods": INT, "transient_periods": INT, "rms": NUM, "amplitude": NUM,
+              "phases": STR, "settle_s": NUM, "settle_periods": NUM, "min_measure_s": NUM, "oversample": INT,
+              "estimator": _choice("h1", "h2"), "max_std_db": NUM},
+    "noise": {"kind": _choice("none", "magphase", "complex", "time"), "sigma_db": NUM, "sigma_deg": NUM,
+              "sigma": NUM, "seed": INT,
+              # kind = "time" (virtual lab): noise and quantisation of the recorded signals [SI]
+              "output_noise_rms": NUM, "input_noise_rms": NUM, "output_adc_step": NUM, "input_adc_step": NUM,
+              "chain": NUMS, "chain_bandwidth_hz": NUM},
     "surrogate": {"form": _choice("zpk", "coefficients", "sections"), "n_zeros": INT, "n_poles": INT,
                   "degree": INT, "method": _choice("joint", "two-stage"), "weighting": STR},
     "inversion": {"preview": NUM_OR_STR, "fs_hz": NUM, "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM,

@@ -168,53 +168,16 @@ def coverage(draws: int, periods: int, tp: int, oversample: int):
               f"sd {z[:, i].std(ddof=1):.3f} (expected {lo_sd:.3f}-{hi_sd:.3f})")
 
 
-def virtual_lab_sweep_step(ctx):
-    """The proposed ``step_sweep`` branch for ``[sweep] source = "virtual_lab"`` (runner internals)."""
-    from scenarios import plots, runner
-    from scenarios.virtual_lab import from_config
-
-    cfg = ctx.spec.section("sweep")
-    lab = from_config(ctx.model, cfg, ctx.spec.section("noise"), where=f"{ctx.spec.path}: ")
-    q, temps = runner._quantity(ctx), cfg["temperatures_c"]
-    ctx.data = lab.sweep
-    ctx.exact = synthesize_sweep(ctx.model, q, np.unique(ctx.data.frequency_hz), temps)
-    ctx.file(ctx.data.to_csv(ctx.out / "data" / "sweep.csv"))
-    ctx.file(ctx.exact.to_csv(ctx.out / "data" / "sweep_exact.csv"))
-    shown = cfg.get("plot_temperatures_c", temps)
-    ctx.file(plots.bode([runner._subset(ctx.data, shown), runner._subset(ctx.exact, shown)], ctx.out / "bode.png",
-                        labels=["virtual lab", "physics"], styles=["o", "-"]))
-    f0, T, H = ctx.exact.grid()
-    ddb = 20 * np.log10(np.abs(H[0]) / np.abs(H[-1]))
-    k = int(np.argmax(np.abs(ddb)))
-    fd = np.geomspace(f0[0], f0[-1], 4000)
-    Hd = ctx.model.frequency_response(fd, [T[0], T[-1]], quantities=(q,))[q][0]
-    pk = [runner._resonance_hz(fd, h) for h in Hd]
-    ctx.metric("sweep.lines", ctx.data.frequency_hz.size)
-    ctx.metric("sweep.cold_minus_hot_db_at_max", ddb[k])
-    ctx.metric("sweep.peak_frequency_shift_hz", pk[1] - pk[0])
-    ctx.metric("sweep.lab_duration_s", lab.duration_s)
-    ctx.metric("sweep.median_std_db", float(np.median(ctx.data.magnitude_std_db)))
-    ctx.section("Frequency sweeps (virtual lab)", f"{lab.duration_s:g} s of records per temperature; "
-                f"{ctx.data.frequency_hz.size} lines; timings {lab.timings_s}")
-
-
 def demo():
     import tempfile
-    from dataclasses import replace
 
     from scenarios import runner
     from scenarios.demo import DEMO_SCENARIO
     from scenarios.spec import load_scenario
 
-    runner.STEPS["sweep"] = virtual_lab_sweep_step
-    spec = load_scenario(DEMO_SCENARIO)
-    data = dict(spec.data)
-    data["sweep"] = {**data["sweep"], "source": "virtual_lab", "fs_hz": 500.0, "period_s": 10.0, "periods": 8,
-                     "transient_periods": 2, "rms": 1.0, "oversample": 8, "max_std_db": 1.0}
-    data["noise"] = {"kind": "time", "output_noise_rms": 20e-6, "output_adc_step": 10e-3 / 2**16,
-                     "input_adc_step": 20.0 / 2**16, "seed": 2}
+    spec = load_scenario(DEMO_SCENARIO)          # its [sweep] source is the virtual lab
     with tempfile.TemporaryDirectory() as out:
-        res = runner.run_scenario(replace(spec, data=data), out, quiet=True)
+        res = runner.run_scenario(spec, out, quiet=True)
         print("== flagship demo with its sweep from the virtual lab (seed001_actuator, 20 µm laser noise, 16-bit ADCs)")
         print("  " + runner.summary_line(res))
         for c in res.checks:
