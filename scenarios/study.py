@@ -206,7 +206,7 @@ def sample_values(spec: dict, i: int) -> tuple[dict, np.random.Generator]:
 
 def evaluate_chunk(spec: dict, indices) -> dict:
     """Rows for samples ``indices`` (a task; runs in any worker).  Returns column arrays."""
-    from physmodel import ActuatorModel, SensorModel
+    from physmodel import physics_model
     from physmodel.data.units import QUANTITY_UNITS, unit_scale
     from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise
 
@@ -218,7 +218,7 @@ def evaluate_chunk(spec: dict, indices) -> dict:
             sets.append(base.replace(**vals))
         except IPMCError as exc:
             raise IPMCError(f"study sample with {vals}: {exc}") from None
-    model = ActuatorModel(sets) if spec["kind"] == "actuator" else SensorModel(sets, kernel=spec.get("kernel", "boundary_charge"))
+    model = physics_model(spec["kind"], sets, kernel=spec.get("kernel", "boundary_charge"))
     q = spec["quantity"]
     f, T = np.asarray(spec["frequencies_hz"]), np.asarray(spec["temperatures_c"])
     _, in_u, _, out_u = QUANTITY_UNITS[(spec["kind"], q)]

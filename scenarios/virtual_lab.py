@@ -132,14 +132,10 @@ class VirtualLabResult:
 
 # ---------------------------------------------------------------------------- pieces
 def _kind(model) -> str:
-    from physmodel.actuator import ActuatorModel
-    from physmodel.sensor import SensorModel
-
-    if isinstance(model, ActuatorModel):
-        return "actuator"
-    if isinstance(model, SensorModel):
-        return "sensor"
-    raise IPMCError(f"model must be a physmodel ActuatorModel or SensorModel, got {type(model).__name__}")
+    kind = getattr(model, "kind", None)
+    if kind in ("actuator", "sensor"):
+        return kind
+    raise IPMCError(f"model must be a physics model (kind 'actuator' or 'sensor'), got {type(model).__name__}")
 
 
 def _drive(excitation, periods: int | None, transient_periods: int | None, oversample: int = 1) -> TimeRecord:

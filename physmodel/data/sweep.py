@@ -272,9 +272,9 @@ def synthesize_sweep(model, quantity: str, frequency_hz, temperature_c, noise=No
     The sweep carries the noise's per-line standard deviations.  Units: mm/V for actuation,
     µA/mm for sensing, Ω for impedance.
     """
-    from ..actuator import ActuatorModel
-
-    kind = "actuator" if isinstance(model, ActuatorModel) else "sensor"
+    kind = getattr(model, "kind", None)
+    if kind not in ("actuator", "sensor"):
+        raise IPMCError(f"model kind {kind!r}: synthesize_sweep needs a physics model (kind 'actuator' or 'sensor')")
     key = (kind, quantity)
     if key not in QUANTITY_UNITS:
         raise IPMCError(f"{kind} quantity {quantity!r} cannot be swept; expected one of "

@@ -341,9 +341,7 @@ def model_realization(model, temperature_c: float, fs: float, duration: float, o
     """Realise the model's main transfer function at one temperature for a simulation at ``fs`` [Hz]
     lasting ``duration`` [s].  ``output``: actuator "displacement" (M) or "current" (1/Z);
     sensor "current" (S)."""
-    from ..actuator import ActuatorModel
-
-    is_act = isinstance(model, ActuatorModel)
+    is_act = getattr(model, "kind", None) == "actuator"
     if output == "auto":
         output = "displacement" if is_act else "current"
     f_lo = min(1e-3, 0.01 / duration)
@@ -373,11 +371,9 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
     (output becomes volts).  Noise: white Gaussian of the given RMS added to the recorded output
     and input (the laser/voltage measurement), seeded.
     """
-    from ..actuator import ActuatorModel
-
     t = np.asarray(t, dtype=float)
     dt = check_uniform_time(t)
-    is_act = isinstance(model, ActuatorModel)
+    is_act = getattr(model, "kind", None) == "actuator"
     if output == "auto":
         output = "displacement" if is_act else "current"
     if (output_noise_rms or input_noise_rms) and seed is None:
@@ -477,8 +473,6 @@ def free_release(model, temperature_c: float, w0: float, t_release: float, durat
     steady state of the held tip.  Actuator: the electrodes are shorted (V = 0) and the output is
     the displacement itself.
     """
-    from ..actuator import ActuatorModel
-
     if not (np.isfinite(t_release) and 0 <= t_release < duration):
         raise IPMCError(f"t_release = {t_release!r} s must lie in [0, duration = {duration!r} s): a release "
                         "after the record ends leaves nothing to record")
@@ -489,7 +483,7 @@ def free_release(model, temperature_c: float, w0: float, t_release: float, durat
     xi = float(st.xi[set_index, 0, 0])
     t = time_grid(duration, fs)
     w = released_tip_displacement(t, w0, t_release, wn, xi)
-    if isinstance(model, ActuatorModel):
+    if getattr(model, "kind", None) == "actuator":
         meta = {"model": "ActuatorModel (electrodes shorted)", "parameter_set": model.params[set_index].name,
                 "temperature_c": f"{temperature_c:g}", "experiment": "free release"}
         return TimeSeries(t, np.zeros_like(t), w, "voltage", "V", "tip_displacement", "m", w, np.zeros_like(t), meta)

@@ -52,8 +52,7 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
     """``predict_many(list of values) -> (n_sets, N)`` in the sweep's units, plus a wide-band
     :class:`SensitivityProbe` at the median data temperature.  One model call per batch
     (sets × temperatures × union of frequencies)."""
-    from ..actuator import ActuatorModel
-    from ..sensor import SensorModel
+    from ..protocol import physics_model
 
     lay = sweep_layout(data, kind, quantity)
     q, factor, fu, inv_f, Tu, inv_T = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,
@@ -61,7 +60,7 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
 
     def model_of(values_list):
         plist = [apply_values(base, v) for v in values_list]
-        return ActuatorModel(plist) if kind == "actuator" else SensorModel(plist, kernel=kernel)
+        return physics_model(kind, plist, kernel=kernel)
 
     def predict_many(values_list):
         R = model_of(values_list).frequency_response(fu, Tu, quantities=(q,))[q]

@@ -87,11 +87,9 @@ def _load_params(args):
 
 
 def _model(args, params):
-    from physmodel import ActuatorModel, SensorModel
+    from physmodel import physics_model
 
-    if args.kind == "actuator":
-        return ActuatorModel(params)
-    return SensorModel(params, kernel=args.kernel)
+    return physics_model(args.kind, params, kernel=args.kernel)
 
 
 def _add_model_args(p):
