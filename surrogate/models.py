@@ -12,6 +12,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from physmodel.errors import IPMCError
+
 from . import _structure as S
 from physmodel.data.files import atomic_write
 
@@ -422,17 +424,31 @@ class RationalModel:
             The data.
         """
         if not isinstance(d, dict) or d.get("schema") != SCHEMA:
-            raise ValueError(f"not a {SCHEMA} document (schema={d.get('schema') if isinstance(d, dict) else None!r})")
+            raise IPMCError(f"not a {SCHEMA} document (schema={d.get('schema') if isinstance(d, dict) else None!r})")
         if d.get("schema_version") != SCHEMA_VERSION:
-            raise ValueError(
+            raise IPMCError(
                 f"unsupported schema_version {d.get('schema_version')!r}; this code reads {SCHEMA_VERSION}"
             )
-        st = S.Structure(**d["structure"])
-        names = d["params"]["names"]
-        if names != st.param_names():
-            raise ValueError("parameter names in the file do not match its structure")
-        return cls(st, d["params"]["values"], Scaling(**d["scaling"]),
-                   d.get("temperature_range_c"), d["params"].get("covariance"),
+        for key, kind in (("structure", dict), ("params", dict), ("scaling", dict)):
+            if not isinstance(d.get(key), kind):
+                raise IPMCError(f"key {key!r}: expected an object, got {type(d.get(key)).__name__}")
+        params = d["params"]
+        for key in ("names", "values"):
+            if not isinstance(params.get(key), list):
+                raise IPMCError(f"key 'params.{key}': expected a list, got {type(params.get(key)).__name__}")
+        try:
+            st = S.Structure(**d["structure"])
+            scaling = Scaling(**d["scaling"])
+        except TypeError as exc:
+            raise IPMCError(f"key 'structure' or 'scaling': {exc}") from None
+        if params["names"] != st.param_names():
+            raise IPMCError("key 'params.names': the parameter names do not match the structure "
+                            f"(expected {st.param_names()})")
+        values = np.asarray(params["values"], dtype=object)
+        if values.shape != (len(params["names"]),) or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) for v in values):
+            raise IPMCError(f"key 'params.values': expected {len(params['names'])} finite numbers")
+        return cls(st, params["values"], scaling, d.get("temperature_range_c"), params.get("covariance"),
                    d.get("labels"), d.get("info"))
 
     def __repr__(self):
@@ -450,9 +466,13 @@ def load(path) -> RationalModel:
     path : str or Path
         The JSON file.
     """
-    with open(path, encoding="utf-8") as fh:
-        try:
-            d = json.load(fh)
-        except json.JSONDecodeError as exc:
-            raise ValueError(f"{path}: not valid JSON ({exc})") from None
-    return RationalModel.from_dict(d)
+    from physmodel.data.files import read_text
+
+    try:
+        d = json.loads(read_text(path))
+    except json.JSONDecodeError as exc:
+        raise IPMCError(f"{path}: not valid JSON ({exc})") from None
+    try:
+        return RationalModel.from_dict(d)
+    except IPMCError as exc:
+        raise IPMCError(f"{path}: {exc}") from None
