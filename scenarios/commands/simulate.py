@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 
-from ._common import EXIT_OK, CLIError, _add_model_args, _floats, _load_params, _model
+from ._common import EXIT_OK, CLIError, _add_model_args, _floats, _load_params, _model, check_plot_path
 
 
 def add_parser(sub):
@@ -49,6 +49,8 @@ def run(args) -> int:
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".npz"):
         raise CLIError(f"--out {out}: use a .csv or .npz file name")
+    if args.plot:
+        check_plot_path(args.plot)
     model = _model(args, _load_params(args))
     kw = dict(output_noise_rms=args.noise_rms, input_noise_rms=args.input_noise_rms, seed=args.seed)
     if args.chain:
