@@ -403,3 +403,20 @@ def load_scenario(path, *, quick: bool = False) -> Scenario:
 def bundled_scenarios() -> list[Path]:
     """The scenario files shipped with the package (``scenarios/*.toml``)."""
     return sorted(Path(__file__).parent.glob("*.toml"))
+
+
+def bundled_studies() -> list[Path]:
+    """The study files shipped with the package (``scenarios/studies/*.toml``)."""
+    return sorted((Path(__file__).parent / "studies").glob("*.toml"))
+
+
+def resolve_bundled(text: str, what: str = "scenario") -> Path:
+    """A file path, or the name of a bundled scenario (``what="scenario"``) or study (``"study"``)."""
+    p = Path(text)
+    if p.is_file():
+        return p
+    found = bundled_scenarios() if what == "scenario" else bundled_studies()
+    for b in found:
+        if b.stem == text:
+            return b
+    raise ScenarioError(f"{what} {text!r} is neither a file nor a bundled {what} ({[b.stem for b in found]})")

@@ -155,8 +155,7 @@ def run(args) -> int:
 
         schedule = check_schedule(fitter, fit_data, res.model, warn=False)     # leave-one-temperature-out
         if not schedule.ok:
-            print(f"ipmc fit: WARNING: {schedule.message}" + (f" {schedule.proposal}" if schedule.proposal else ""),
-                  file=sys.stderr)
+            print(f"ipmc fit: WARNING: {schedule.message}", file=sys.stderr)
     with output_folder(args.out, "ipmc fit", force=args.force) as out:
         _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, schedule)
     if not res.converged:
@@ -195,7 +194,7 @@ def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, sche
     if schedule is not None:
         report += ("\n## Between the fit temperatures (leave-one-temperature-out)\n\n" + schedule.cv.to_markdown()
                    + "\n" + ("OK: " if schedule.ok else "**WARNING**: ") + schedule.message
-                   + (f"\n\n{schedule.proposal}" if schedule.proposal else "") + "\n")
+                   + "\n")
     atomic_write(out / "report.md", lambda fh: fh.write(report))
     if not args.quiet:
         print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")

@@ -6,7 +6,7 @@ import re
 from pathlib import Path
 
 from ..runner import run_scenario, summary_line
-from ..spec import ScenarioError, bundled_scenarios, load_scenario
+from ..spec import ScenarioError, bundled_scenarios, load_scenario, resolve_bundled
 
 
 def add_parser(subparsers):
@@ -26,14 +26,8 @@ def add_parser(subparsers):
 
 
 def resolve_scenario_path(text: str) -> Path:
-    p = Path(text)
-    if p.is_file():
-        return p
-    for b in bundled_scenarios():
-        if b.stem == text:
-            return b
-    raise ScenarioError(f"scenario {text!r} is neither a file nor a bundled scenario "
-                        f"({[b.stem for b in bundled_scenarios()]})")
+    """A scenario file, or a bundled scenario by name."""
+    return resolve_bundled(text, "scenario")
 
 
 def default_folder(name: str) -> str:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from ..spec import resolve_bundled
 from ..study import StudyError, _chunks, load_study, run_study
 
 
@@ -14,7 +15,7 @@ def add_parser(subparsers):
         description="Evaluate a parameter study (parameters × temperatures × frequencies; schema in "
                     "scenarios/study.py and the README) and write a tidy table, one row per sample × "
                     "temperature × frequency.  Same seed → identical table on any backend.")
-    p.add_argument("spec", help="study TOML file")
+    p.add_argument("spec", help="study TOML file, or the name of a bundled study (e.g. actuator_mc)")
     p.add_argument("--out", required=True, help="output table (.csv or .npz)")
     p.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://10.0.0.5:8786); default: local processes")
     p.add_argument("--workers", type=int, help="local worker processes (default: number of CPUs)")
@@ -24,7 +25,7 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
-    spec = load_study(args.spec)
+    spec = load_study(resolve_bundled(args.spec, "study"))
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".npz"):
         raise StudyError(f"--out {out}: use a .csv or .npz file name")
