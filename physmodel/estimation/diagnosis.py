@@ -14,6 +14,7 @@ import numpy as np
 from ..data.files import atomic_write
 from ..data.sweep import FrequencySweep
 from ..effects import LIBRARY, get_effect
+from ..errors import ParameterError
 from .records import CalibrationResult
 
 VERDICTS = ("none", "named", "ambiguous", "at_bound", "unexplained")
@@ -332,6 +333,52 @@ def resolve_laws(base, laws):
             raise ParameterError(f"laws: {exc}") from None
         return replace(base, laws=chosen), f"{start!r} with changes: {describe_laws(chosen)}"
     raise ParameterError(f"laws must be None, a name, a mapping or TemperatureLaws; got {type(laws).__name__}")
+
+
+def _candidate_overrides(candidate_bounds, candidate_starts) -> tuple[dict, dict]:
+    """``{"effect.param": (lo, hi) | {"lower"|"upper"|"typical": v}}`` → {effect: {param: {...}}};
+    ``{"effect.param": value}`` → {effect: {param: value}}."""
+    bounds: dict = {}
+    for key, v in (candidate_bounds or {}).items():
+        if "." not in key:
+            raise ParameterError(f"candidate bound {key!r}: expected 'effect.parameter'")
+        e, p = key.split(".", 1)
+        get_effect(e).parameter(p)
+        if isinstance(v, Mapping):
+            spec = dict(v)
+        else:
+            try:
+                lo, hi = (float(x) for x in v)
+            except (TypeError, ValueError):
+                raise ParameterError(f"candidate bound {key!r}: expected (lower, upper) or a table of "
+                                     f"lower/upper/typical, got {v!r}") from None
+            spec = {"lower": lo, "upper": hi}
+        bounds.setdefault(get_effect(e).name, {})[p] = spec
+    starts: dict = {}
+    for key, v in (candidate_starts or {}).items():
+        if "." not in key:
+            raise ParameterError(f"candidate start {key!r}: expected 'effect.parameter'")
+        e, p = key.split(".", 1)
+        get_effect(e).parameter(p)
+        try:
+            starts.setdefault(get_effect(e).name, {})[p] = float(v)
+        except (TypeError, ValueError):
+            raise ParameterError(f"candidate start {key!r} = {v!r}: expected a number") from None
+    return bounds, starts
+
+
+def _hard_sides(cpars: dict) -> dict:
+    """Bounds that are physical limits or the effect's off value (no reason to widen)."""
+    out = {}
+    for c, pars in cpars.items():
+        for p in pars:
+            sides = set(p.limits)
+            if p.off == p.lower:
+                sides.add("lower")
+            if p.off == p.upper:
+                sides.add("upper")
+            out[f"{c}.{p.name}"] = tuple(sides)
+    return out
 
 
 def _named_msg(c: str, cr: CandidateResult) -> str:

@@ -6,7 +6,7 @@ user's free parameters, and:
 1. calibrates the baseline model (the project's one engine,
    :func:`physmodel.estimation.lsq.fit_parameters`, multi-start) with the free base parameters
    held to their plausible ranges (:mod:`physmodel.plausible`) by soft walls
-   (:mod:`physmodel.estimation.priors`: zero penalty inside, a Gaussian wall of 0.05 decade
+   (:mod:`physmodel.estimation.priors`: zero penalty inside, a Gaussian wall of 0.02 decade
    outside), and audits it: parameters at or near a bound, outside their plausible range, and the
    multi-start spread; it tabulates where the standardised residuals exceed their band;
 2. refits the full model with each candidate effect of :data:`physmodel.effects.LIBRARY` switched
@@ -23,7 +23,8 @@ user's free parameters, and:
    baseline Jacobian projected out) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`;
 5. decides: ``none``, ``named`` (one significant candidate that closes the gap; else the best
    pair among the :data:`PAIR_POOL` most significant candidates whose members are each
-   significant on top of the other and that closes the gap), ``ambiguous`` (several closers
+   significant on top of the other and that closes the gap; pairs are drawn from the most
+   significant candidates and from those that best explain what the best one leaves), ``ambiguous`` (several closers
    within :data:`AMBIGUITY_AIC`), ``at_bound`` (the named effect closes the gap only with a
    parameter at its candidate bound: "widen the bound, or the effect is larger than allowed" —
    never a confident name), ``unexplained`` (a significant gap nothing closes).  The gap test
@@ -52,15 +53,17 @@ from ..parameter_paths import base_value
 from ..plausible import plausible_ranges
 from .calibration import default_free_parameter
 from .diagnosis import (AMBIGUITY_AIC, CONFUSABLE_COSINE, GAP_ALPHA_DIVISOR, MIN_SIGNATURE_LR, VERDICTS,
-                        CandidateResult, Diagnosis, _named_msg, _worst_cells, gap_shrink, resolve_laws)
-from .priors import (PenalisedProblem, bound_audit, cost_warning, multistart_spread, penalties_for,
+                        CandidateResult, Diagnosis, _candidate_overrides, _hard_sides, _named_msg, _worst_cells,
+                        gap_shrink, resolve_laws)
+from .priors import (WALL_DECADES, PenalisedProblem, bound_audit, cost_warning, multistart_spread, penalties_for,
                      plausible_audit)
 from .records import CalibrationResult, FreeParameter
 from .residuals import standardised_residuals
 from .signatures import (_constrained_lr, _gap, _localise, _orth, _project_out, _separation, _signature,
                          _z_jacobian)
 
-#: Pairs of two effects are searched among this many most significant candidates.
+#: Pairs of two effects: every pair among this many most significant candidates, and each of the
+#: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
 PAIR_POOL = 4
 
 
@@ -92,55 +95,9 @@ def _free_list(base: IPMCParameters, free, effects: dict) -> list:
     return out
 
 
-def _candidate_overrides(candidate_bounds, candidate_starts) -> tuple[dict, dict]:
-    """``{"effect.param": (lo, hi) | {"lower"|"upper"|"typical": v}}`` → {effect: {param: {...}}};
-    ``{"effect.param": value}`` → {effect: {param: value}}."""
-    bounds: dict = {}
-    for key, v in (candidate_bounds or {}).items():
-        if "." not in key:
-            raise ParameterError(f"candidate bound {key!r}: expected 'effect.parameter'")
-        e, p = key.split(".", 1)
-        get_effect(e).parameter(p)
-        if isinstance(v, Mapping):
-            spec = dict(v)
-        else:
-            try:
-                lo, hi = (float(x) for x in v)
-            except (TypeError, ValueError):
-                raise ParameterError(f"candidate bound {key!r}: expected (lower, upper) or a table of "
-                                     f"lower/upper/typical, got {v!r}") from None
-            spec = {"lower": lo, "upper": hi}
-        bounds.setdefault(get_effect(e).name, {})[p] = spec
-    starts: dict = {}
-    for key, v in (candidate_starts or {}).items():
-        if "." not in key:
-            raise ParameterError(f"candidate start {key!r}: expected 'effect.parameter'")
-        e, p = key.split(".", 1)
-        get_effect(e).parameter(p)
-        try:
-            starts.setdefault(get_effect(e).name, {})[p] = float(v)
-        except (TypeError, ValueError):
-            raise ParameterError(f"candidate start {key!r} = {v!r}: expected a number") from None
-    return bounds, starts
-
-
 def _simulated(G, e, s_ln, s_ph):
     N = G.size
     return G * np.exp(e[:N] * s_ln + 1j * e[N:] * s_ph)
-
-
-def _hard_sides(cpars: dict) -> dict:
-    """Bounds that are physical limits or the effect's off value (no reason to widen)."""
-    out = {}
-    for c, pars in cpars.items():
-        for p in pars:
-            sides = set(p.limits)
-            if p.off == p.lower:
-                sides.add("lower")
-            if p.off == p.upper:
-                sides.add("upper")
-            out[f"{c}.{p.name}"] = tuple(sides)
-    return out
 
 
 # =============================================================================== main entry
@@ -364,6 +321,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     final_effects: list[str] = []
     final_fit: CalibrationResult | None = None
     pair_tried: list = []
+    named2: list = []
     where = _worst_cells(_localise(data, r0, alpha))
     if not sig:
         if gap0_sig:
@@ -376,6 +334,41 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                        f"{max([c.lr for c in cres.values()], default=0.0):.3g} ≤ threshold {T:.3g}, and the "
                        f"baseline cost {cost0:.4g} is within its null band.")
     else:
+        def explainers(a, pool):
+            """Candidates of ``pool`` that best explain what a leaves (linearised LR on its residual)."""
+            r_a = standardised_residuals(pm([fits[a].values])[0], data, s_ln, s_ph)
+            Qa = _orth(np.hstack([J0, sigs[a]]))
+            sc = {b: float(_constrained_lr(_project_out(Qa, sigs[b]), sided[b], -_project_out(Qa, r_a[:, None]))[0])
+                  for b in pool if b != a}
+            return [b for b in sorted(sc, key=lambda k: -sc[k])[:PAIR_POOL - 1]], r_a, Qa
+
+        def pair_fits(pairs):
+            out = []
+            for a, b in pairs:
+                va = {**fits[a].values, **{k: v for k, v in fits[b].values.items() if k.startswith(b + ".")}}
+                _, r_a, Qa = explainers(a, [])
+                res2 = refit([a, b], va, [None, {b: lin_start(b, r_a, Qa)}])
+                lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)   # each on top
+                closes = 2 * res2.metadata["data_cost"] <= gap_thr([a, b])
+                pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
+                                   "lr_second_on_top": lr_b, "closes_gap": closes})
+                if min(lr_a, lr_b) > T:
+                    out.append(((a, b), res2, lr_a, lr_b, closes))
+            return sorted(out, key=lambda x: x[1].cost)
+
+        def name_pair(ok):
+            best2 = ok[0]
+            a, b = best2[0]
+            alt = [x[0] for x in ok[1:] if x[4] and 2 * (x[1].cost - best2[1].cost) < AMBIGUITY_AIC]
+            msg = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
+                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T:.3g}); the gap closes.")
+            if alt:
+                return ("ambiguous", sorted({a, b} | {c for x in alt for c in x}), list(best2[0]), best2[1],
+                        msg.replace("Named two effects", "Ambiguous: best pair")
+                        + " Other pairs fit as well (AIC within %g): " % AMBIGUITY_AIC
+                        + "; ".join(f"{x[0]} + {x[1]}" for x in alt) + ".")
+            return "named", [a, b], list(best2[0]), best2[1], msg
+
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
@@ -388,37 +381,31 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                 message = (f"Ambiguous between {', '.join(amb)} (AIC within {AMBIGUITY_AIC:g}; {'; '.join(pairs)}). "
                            "Separate them with a wider band, more temperatures, or magnitude vs phase.")
             else:
-                verdict = "named"
-                message = _named_msg(top, cres[top])
+                verdict, message = "named", _named_msg(top, cres[top])
+            # forward step: a second significant candidate (not one of the closers, not confusable
+            # with the first) that is significant on top of it
+            pool = [c for c in sig if c not in amb and frozenset((top, c)) not in conf_set]
+            ok = pair_fits([(top, b) for b in explainers(top, pool)[0]]) if pool else []
+            if ok:
+                v2, n2, final_effects, final_fit, m2 = name_pair(ok)
+                if verdict == "ambiguous":       # the first effect stays ambiguous
+                    v2, n2 = "ambiguous", sorted(set(n2) | set(amb))
+                    m2 += f" The first effect is ambiguous between {', '.join(amb)}."
+                verdict, named2, message = v2, n2, m2
         else:
-            # two effects: every pair among the most significant candidates, refitted jointly
-            pool = sig[:PAIR_POOL] + [c for c in sigs if c not in sig][:max(0, 2 - len(sig))]
-            best2 = None
-            for a, b in combinations(pool, 2):
-                if a not in sig and b not in sig:
-                    continue
-                va = {**fits[a].values, **{k: v for k, v in fits[b].values.items() if k.startswith(b + ".")}}
-                r_a = standardised_residuals(pm([fits[a].values])[0], data, s_ln, s_ph)
-                Qa = _orth(np.hstack([J0, sigs[a]]))
-                res2 = refit([a, b], va, [None, {b: lin_start(b, r_a, Qa)}])
-                lr_a = 2 * (fits[b].cost - res2.cost)        # a on top of b
-                lr_b = 2 * (fits[a].cost - res2.cost)        # b on top of a
-                closes = 2 * res2.metadata["data_cost"] <= gap_thr([a, b])
-                pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
-                                   "lr_second_on_top": lr_b, "closes_gap": closes})
-                if min(lr_a, lr_b) > T and (best2 is None or res2.cost < best2[1].cost):
-                    best2 = ((a, b), res2, lr_a, lr_b, closes)
-            if best2 is not None and best2[4]:
-                verdict = "named"
-                final_effects, final_fit = list(best2[0]), best2[1]
-                a, b = best2[0]
-                message = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
-                           f"{best2[2]:.4g}, {best2[3]:.4g} > {T:.3g}); the gap closes.")
+            # two effects: every pair among the most significant candidates and each of the two best
+            # with the candidates that best explain what it leaves, refitted jointly
+            pairs = [tuple(x) for x in combinations(sig[:PAIR_POOL], 2)]
+            for a in sig[:2]:
+                pairs += [(a, b) for b in explainers(a, sigs)[0] if (a, b) not in pairs and (b, a) not in pairs]
+            ok = pair_fits(pairs)
+            if ok and ok[0][4]:
+                verdict, named2, final_effects, final_fit, message = name_pair(ok)
             else:
                 best = sig[0]
                 verdict = "unexplained"
-                final_effects = [best] + ([c for c in best2[0] if c != best][:1] if best2 else [])
-                final_fit = best2[1] if best2 else fits[best]
+                final_effects = list(ok[0][0]) if ok else [best]
+                final_fit = ok[0][1] if ok else fits[best]
                 message = (f"Unexplained: the best candidate {best} (LR {cres[best].lr:.4g}) reduces the cost but a "
                            f"significant gap remains (2·cost {2 * final_fit.metadata['data_cost']:.4g} > "
                            f"{gap_thr(final_effects):.4g}) in {where}; no candidate or pair of candidates in the "
@@ -430,13 +417,26 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     at_bound = [a for a in final_bounds if a["status"] == "at"]
     widen = [a for a in at_bound if not a["hard"] and "." in a["name"] and not a["name"].startswith("laws.")
              and a["name"].split(".", 1)[0] in final_effects]
+    # a significant candidate confusable with a named effect that stopped at a widenable bound: its
+    # LR there is only a lower bound, so it might beat the named effect once the bound is widened
+    widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
+              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")]
     if verdict in ("named", "ambiguous") and widen:
         verdict = "at_bound"
         message = ("At bound — widen or the effect is larger than allowed: " + "; ".join(
             f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in widen)
-            + ". The gap closes only there, so this is not a confident name (raise the bound with "
+            + ". The gap closes only there, or a confusable candidate stopped there, so this is not a confident "
+            "name (raise the bound with "
             "candidate_bounds / --candidate-bound, or the effect is outside the physical range assumed). "
             + message)
+    if verdict == "unexplained" and final_effects:
+        stuck = [a for c in final_effects for a in cres[c].at_bound if c in cres and a["status"] == "at"
+                 and not a["hard"] and a["name"].startswith(c + ".")] if len(final_effects) == 1 else [
+            a for a in at_bound if not a["hard"] and a["name"].split(".", 1)[0] in final_effects]
+        if stuck:
+            message += (" The best candidate ended at its bound (" + "; ".join(
+                f"{a['name']} = {a['value']:.4g}, {a['side']} bound {a['bound']:.4g}" for a in stuck)
+                + "): widen it — the effect may be larger than allowed.")
     other_bounds = [a for a in at_bound if a not in widen and not a["hard"]]
     if other_bounds:
         message += (" Parameters at a bound in the final fit: " + "; ".join(
@@ -457,8 +457,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         message += f" Candidate refits that did not converge: {', '.join(bad)}."
     named = list(final_effects) if verdict in ("named", "ambiguous", "at_bound") else []
     if verdict == "ambiguous":
-        best_aic = min(cres[x].aic for x in sig if cres[x].closes_gap)
-        named = [c for c in sig if cres[c].closes_gap and cres[c].aic - best_aic < AMBIGUITY_AIC]
+        named = named2 if named2 else amb
     if final_fit is not None:
         Gf = pm([final_fit.values])[0]
         n_free_after = len(final_fit.names)
@@ -487,7 +486,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         metadata={"base": base.name, "free": names0, "baseline_effects": beff, "candidates": cand,
                   "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried,
                   "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
-                  "prior": "soft walls of 0.05 decade outside the plausible ranges" if prior else "none"},
+                  "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
         cost_warning=warn,
     )

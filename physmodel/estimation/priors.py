@@ -8,8 +8,9 @@ that line, so its residual is exactly ρ_k (phase residual 0) and the engine min
     ½ Σ r_data² + ½ Σ_k ρ_k²,   ρ_k = max(0, log10(lower/|x|), log10(|x|/upper)) / w
 
 — a flat prior inside the plausible range [lower, upper] and a Gaussian wall of width
-``w`` = :data:`WALL_DECADES` decade outside it (leaving the range by 0.1 decade costs 2, i.e. a
-χ² of 4).  Inside the range the penalty and its gradient are exactly zero, so fits and the
+``w`` = :data:`WALL_DECADES` decade outside it (leaving the range by 0.1 decade costs 12.5, i.e. a
+χ² of 25: the ranges are broad, the wall is steep).  Inside the range the penalty and its
+gradient are exactly zero, so fits and the
 linearised null statistics of a baseline inside its range are unchanged.  ``data_cost`` and
 ``penalty`` are reported apart in the result's ``metadata``.
 """
@@ -29,7 +30,7 @@ from .records import CalibrationResult, FreeParameter
 from .residuals import noise_std, standardised_residuals
 
 #: Width of the soft wall outside a plausible range [decades].
-WALL_DECADES = 0.05
+WALL_DECADES = 0.02
 _SIGMA_LN_DB = 20.0 / math.log(10.0)            # σ_ln = 1 Np in dB
 
 
