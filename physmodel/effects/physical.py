@@ -60,8 +60,14 @@ def _p_contact(st, T_ref, v):
 
 
 def _p_leakage(st, T_ref, v):
+    tf = 1.0 + v["tcr"] * (st["T"] - T_ref)                  # resistance of the path ∝ 1 + tcr ΔT
+    if np.any(tf <= 0):
+        from ..errors import ParameterError
+
+        raise ParameterError(f"leakage.tcr={v['tcr']!r} /K makes the leakage resistance non-positive in the "
+                             "requested temperature range")
     with np.errstate(divide="ignore"):
-        g = 1.0 / st["Rp"] + v["conductance"] * st["W"]      # 1/Rp [S/m] per slice
+        g = 1.0 / st["Rp"] + v["conductance"] * st["W"] / tf  # 1/Rp [S/m] per slice
         st["Rp"] = np.where(g > 0, 1.0 / np.where(g > 0, g, 1.0), np.inf)
     return st
 
@@ -147,12 +153,14 @@ EFFECTS = [
            bounds_doc="r2' in [0, 5·2h/(κe K)]: up to five times the polymer's own through-thickness "
                       "area resistance at T_ref (1.2e-2 Ω·m² for seed 002); typical 0.2× it."),
     Effect("leakage", "polymer leakage",
-           "A temperature-independent (electronic) leakage conductance through the polymer, 1/Rp' "
-           "added to the base's (ionic) leakage at every temperature: a resistive path in parallel with "
-           "the double layers, visible at low frequency (impedance) and through the electrode line.",
-           "Chen & Tan 2008; seed 002 eq. (11)", "parameter",
-           (P("conductance", "S/m^2", 0.0, 0.0, 1e5, 50.0, "added leakage conductance 1/Rp'"),),
-           apply=_p_leakage, fit_bounds=_leakage_bounds,
+           "An electronic leakage conductance through the polymer (metal particles bridging the "
+           "electrodes), 1/Rp' at T_ref added to the base's (ionic) leakage, its resistance changing "
+           "as 1 + tcr (T − T_ref) (metallic paths: tcr > 0; Pt 3.9e-3 /K): a resistive path in "
+           "parallel with the double layers, visible at low frequency and through the electrode line.",
+           "Chen & Tan 2008; seed 002 eq. (11); Pt resistivity coefficient (CRC Handbook)", "parameter",
+           (P("conductance", "S/m^2", 0.0, 0.0, 1e5, 50.0, "added leakage conductance 1/Rp' at T_ref"),
+            P("tcr", "1/K", 0.0, -0.01, 0.01, 3.9e-3, "temperature coefficient of the path's resistance")),
+           apply=_p_leakage, fit_bounds=_leakage_bounds, switch="conductance",
            bounds_doc="1/Rp' in [0, 3·κe K/(2h)]: up to three times the polymer's own ionic conductance "
                       "per area at T_ref (≈ 1300 S/m² for seed 002); typical 0.1× it."),
     Effect("second_mode", "higher bending modes (Euler-Bernoulli modal expansion)",

@@ -441,6 +441,10 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     if other_bounds:
         message += (" Parameters at a bound in the final fit: " + "; ".join(
             f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in other_bounds) + ".")
+    b0 = [a for a in audit0["at_bound"] if a["status"] == "at"]
+    if b0 and verdict in ("none", "unexplained"):
+        message += " Baseline parameters at a fit bound: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in b0) + "."
     if audit0["implausible"]:
         bad0 = ", ".join(f"{x['name']} = {x['value']:.3g} {x['unit']} (plausible [{x['lower']:.3g}, {x['upper']:.3g}])"
                          for x in audit0["implausible"])

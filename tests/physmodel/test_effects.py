@@ -217,6 +217,20 @@ def test_composition_commutes_and_multiplies():
     np.testing.assert_allclose(act(c)["M"], prod, rtol=1e-9)   # response-level effects compose as products
 
 
+def test_leakage_resistance_follows_its_temperature_coefficient():
+    g0, tcr, t = 40.0, 3.9e-3, 60.0
+    dT = t + 273.15 - P.T_ref
+    got = EffectModel(P, "actuator", {"leakage": {"conductance": g0, "tcr": tcr}}).frequency_response(F, [t])
+    same = EffectModel(P, "actuator", {"leakage": {"conductance": g0 / (1 + tcr * dT)}}).frequency_response(F, [t])
+    for q in ("M", "Z"):
+        np.testing.assert_allclose(got[q], same[q], rtol=1e-12)
+    with pytest.raises(ParameterError, match="tcr"):
+        from physmodel.temperature import ISOTHERMAL
+
+        EffectModel(P.replace(laws=ISOTHERMAL), "actuator",
+                    {"leakage": {"conductance": g0, "tcr": -0.01}}).frequency_response(F, [150.0])
+
+
 def test_series_elements_add_as_one_impedance():
     """Series resistance and interface CPE: Z = Z0 + Rs + S'/(W L) (jω)^−n; every driven quantity
     is divided by (Z0 + Rs + Z_cpe)/Z0 (a direct evaluation of the circuit)."""
@@ -245,7 +259,7 @@ def test_candidate_bounds_scale_with_the_strip():
     ra = 2 * P.h / (P.kappa_e * K)
     assert ra == pytest.approx(2.3e-3, rel=0.05)                 # the issue's 1.2e-2 / 5 for seed 002
     (r2,) = LIBRARY["contact_resistance"].candidate_parameters(P)
-    (g,) = LIBRARY["leakage"].candidate_parameters(P)
+    g = LIBRARY["leakage"].candidate_parameters(P)[0]
     assert r2.upper == pytest.approx(5 * ra, rel=1e-12) and g.upper == pytest.approx(3 / ra, rel=1e-12)
     thin = P.replace(h=P.h / 2)
     assert LIBRARY["contact_resistance"].candidate_parameters(thin)[0].upper == pytest.approx(r2.upper / 2, rel=1e-12)
