@@ -26,7 +26,7 @@ _MEAS = ("M", "H", "Z", "I", "S")
 
 
 def _r_amplifier(q, ctx, v):
-    return 1.0 / (1.0 + ctx.s * v["time_constant"])
+    return 1.0 / ((1.0 + ctx.s * v["time_constant"]) * (1.0 + ctx.s * v["second_time_constant"]))
 
 
 def _r_delay(q, ctx, v):
@@ -79,9 +79,12 @@ def _cpe_bounds(p):
 
 EFFECTS = [
     Effect("amplifier_bandwidth", "measurement-amplifier bandwidth",
-           "A first-order pole 1/(1 + s τa) of the measuring amplifier (transimpedance or "
-           "displacement sensor); independent of temperature.", "seed 000 Fig. 4 (op-amp chain)",
-           "response", (P("time_constant", "s", 0.0, 0.0, 0.05, 1.5e-3, "τa = 1/ωa"),),
+           "The poles of the measuring amplifier (transimpedance or displacement sensor), "
+           "1/((1 + s τa)(1 + s τb)): a dominant pole and a non-dominant one (0 = single pole); "
+           "independent of temperature.", "seed 000 Fig. 4 (op-amp chain); Franco, Design with "
+           "Operational Amplifiers (two-pole open-loop response)",
+           "response", (P("time_constant", "s", 0.0, 0.0, 0.05, 1.5e-3, "τa = 1/ωa"),
+                        P("second_time_constant", "s", 0.0, 0.0, 0.05, 3e-4, "τb of a second pole")),
            quantities=_MEAS, apply=_r_amplifier),
     Effect("time_delay", "acquisition time delay",
            "A pure delay e^{-sτ} between excitation and acquisition channels: phase −ωτ, magnitude "

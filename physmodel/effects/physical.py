@@ -79,20 +79,26 @@ def _p_fluid(st, T_ref, v):
     return st
 
 
+def _curved(st, T_ref, v):
+    """exp(c2 (T − T_ref)²): the second-order term of any smooth law in ln(factor) — another
+    author's linear-in-T, Q10 or VTF law differs from the log-linear / Arrhenius law by it."""
+    return np.exp(v["curvature"] * (st["T"] - T_ref) ** 2)
+
+
 def _p_modulus_T(st, T_ref, v):
-    st["E"] = st["E"] * LogLinear(slope=v["slope"]).factor(st["T"], T_ref)
+    st["E"] = st["E"] * LogLinear(slope=v["slope"]).factor(st["T"], T_ref) * _curved(st, T_ref, v)
     return st
 
 
 def _p_diffusivity_T(st, T_ref, v):
-    fac = Arrhenius(activation_energy=v["activation_energy"]).factor(st["T"], T_ref)
+    fac = Arrhenius(activation_energy=v["activation_energy"]).factor(st["T"], T_ref) * _curved(st, T_ref, v)
     st["d"] = st["d"] * fac
     st["Rp"] = st["Rp"] / fac            # Nernst-Einstein: ionic resistance ∝ T/d (T part in the base law)
     return st
 
 
 def _p_permittivity_T(st, T_ref, v):
-    st["kappa_e"] = st["kappa_e"] * LogLinear(slope=v["slope"]).factor(st["T"], T_ref)
+    st["kappa_e"] = st["kappa_e"] * LogLinear(slope=v["slope"]).factor(st["T"], T_ref) * _curved(st, T_ref, v)
     return st
 
 
@@ -134,6 +140,8 @@ def _leakage_bounds(p):
     g = 1.0 / polymer_area_resistance(p)          # κe K/(2h)
     return {"conductance": (0.0, min(3.0 * g, 1e5), 0.1 * g)}
 
+
+_CURV = P("curvature", "1/K^2", 0.0, -2e-3, 2e-3, 1e-4, "second-order term c2 of ln(factor)")
 
 EFFECTS = [
     Effect("electrode_resistance", "distributed electrode resistance",
@@ -186,20 +194,24 @@ EFFECTS = [
             P("damping_ratio", "1", 0.0, 0.0, 1.0, 0.1, "added damping ratio")),
            kinds=("actuator",), quantities=("M",), apply=_p_fluid),
     Effect("modulus_temperature", "temperature dependence of the modulus",
-           "An extra log-linear slope of E with temperature (physmodel.temperature.LogLinear), "
-           "E → E·exp(c (T − T_ref)): gain and resonance move with T.",
+           "An extra log-linear slope of E with temperature (physmodel.temperature.LogLinear) and a "
+           "curvature, E → E·exp(c (T − T_ref) + c2 (T − T_ref)²): gain and resonance move with T "
+           "(c2 covers a law of another shape, e.g. linear in T).",
            "physics.md §7; seed 000 Fig. 6, seed 001 (resonance falls with T)",
-           "parameter", (P("slope", "1/K", 0.0, -0.03, 0.03, -0.01, "extra d ln E / dT"),),
+           "parameter", (P("slope", "1/K", 0.0, -0.03, 0.03, -0.01, "extra d ln E / dT"), _CURV),
            quantities=("M", "H", "S"), needs_temperatures=True, apply=_p_modulus_T),
     Effect("diffusivity_temperature", "temperature dependence of the diffusivity",
            "An extra Arrhenius activation energy for d (physmodel.temperature.Arrhenius; and Rp by "
-           "Nernst-Einstein): the charge dynamics speed up with T.", "physics.md §7 (Nafion 10.5-18 kJ/mol)",
-           "parameter", (P("activation_energy", "J/mol", 0.0, -60e3, 60e3, 20e3, "extra activation energy of d"),),
+           "Nernst-Einstein) and a curvature exp(c2 (T − T_ref)²) (a Q10 or VTF law of another author): "
+           "the charge dynamics speed up with T.", "physics.md §7 (Nafion 10.5-18 kJ/mol)",
+           "parameter", (P("activation_energy", "J/mol", 0.0, -60e3, 60e3, 20e3, "extra activation energy of d"),
+                         _CURV),
            needs_temperatures=True, apply=_p_diffusivity_T),
     Effect("permittivity_temperature", "temperature dependence of the permittivity",
-           "An extra log-linear slope of κe with temperature, κe → κe·exp(c (T − T_ref)).",
+           "An extra log-linear slope of κe with temperature and a curvature, "
+           "κe → κe·exp(c (T − T_ref) + c2 (T − T_ref)²).",
            "physics.md §7 (water permittivity, Malmberg & Maryott 1956)", "parameter",
-           (P("slope", "1/K", 0.0, -0.05, 0.05, 0.015, "extra d ln κe / dT"),),
+           (P("slope", "1/K", 0.0, -0.05, 0.05, 0.015, "extra d ln κe / dT"), _CURV),
            needs_temperatures=True, apply=_p_permittivity_T),
     Effect("water_uptake", "water uptake with temperature",
            "Swelling through the thickness h → h (1 + u ΔT) with the fixed anions diluted, "

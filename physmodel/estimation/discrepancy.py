@@ -24,7 +24,8 @@ user's free parameters, and:
 5. decides: ``none``, ``named`` (one significant candidate that closes the gap; else the best
    pair among the :data:`PAIR_POOL` most significant candidates whose members are each
    significant on top of the other and that closes the gap; pairs are drawn from the most
-   significant candidates and from those that best explain what the best one leaves), ``ambiguous`` (several closers
+   significant candidates and from those that best explain what the best one leaves, never a
+   declared-confusable pair), ``ambiguous`` (several closers
    within :data:`AMBIGUITY_AIC`), ``at_bound`` (the named effect closes the gap only with a
    parameter at its candidate bound: "widen the bound, or the effect is larger than allowed" —
    never a confident name), ``unexplained`` (a significant gap nothing closes).  The gap test
@@ -283,7 +284,6 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             bounds={p.name: [p.lower, p.upper] for p in cpars[c]}, at_bound=ab, implausible=imp,
             penalty=res.metadata["penalty"])
     say(f"{len(cres)} candidates refitted")
-
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
     full_max, lin_used = [], []
     for b in range(int(null_refits)):
@@ -398,7 +398,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             pairs = [tuple(x) for x in combinations(sig[:PAIR_POOL], 2)]
             for a in sig[:2]:
                 pairs += [(a, b) for b in explainers(a, sigs)[0] if (a, b) not in pairs and (b, a) not in pairs]
-            ok = pair_fits(pairs)
+            ok = pair_fits([x for x in pairs if frozenset(x) not in conf_set])
             if ok and ok[0][4]:
                 verdict, named2, final_effects, final_fit, message = name_pair(ok)
             else:

@@ -120,6 +120,26 @@ def test_temperature_effects_equal_modified_laws_and_vanish_at_T_ref():
             np.testing.assert_allclose(m, ActuatorModel(P).frequency_response(F, t_ref)["M"], rtol=1e-13)
 
 
+def test_temperature_effects_curvature_is_a_quadratic_in_ln_factor():
+    c, c2 = 0.004, -8e-5
+    st0 = ActuatorModel(P).state(T)
+    dT = np.asarray(T) + 273.15 - P.T_ref
+    for name, field in (("modulus_temperature", "E"), ("permittivity_temperature", "kappa_e")):
+        st = EffectModel(P, "actuator", {name: {"slope": c, "curvature": c2}}).state(T)
+        np.testing.assert_allclose((getattr(st, field) / getattr(st0, field)).ravel(), np.exp(c * dT + c2 * dT**2),
+                                   rtol=1e-13)
+    st = EffectModel(P, "actuator", {"diffusivity_temperature": {"curvature": c2}}).state(T)
+    np.testing.assert_allclose((st.d / st0.d).ravel(), np.exp(c2 * dT**2), rtol=1e-13)
+    np.testing.assert_allclose((st.Rp * st.d / (st0.Rp * st0.d)).ravel(), 1.0, rtol=1e-13)   # Nernst-Einstein
+
+
+def test_amplifier_second_pole_multiplies():
+    t1, t2 = 2e-3, 4e-4
+    got, base = act({"amplifier_bandwidth": {"time_constant": t1, "second_time_constant": t2}}), act({})
+    s = 2j * np.pi * F
+    np.testing.assert_allclose(got["M"], base["M"] / ((1 + s * t1) * (1 + s * t2)), rtol=1e-12)
+
+
 def test_water_uptake_equals_swollen_strip_at_one_temperature():
     u, t = 0.004, 60.0
     sw = 1 + u * (t + 273.15 - P.T_ref)
