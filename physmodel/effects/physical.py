@@ -103,14 +103,18 @@ def _p_permittivity_T(st, T_ref, v):
 
 
 def _p_water_uptake(st, T_ref, v):
-    sw = 1.0 + v["swelling"] * (st["T"] - T_ref)
-    if np.any(sw <= 0):
+    sw = 1.0 + v["swelling"] * (st["T"] - T_ref)                         # thickness
+    sp = 1.0 + v["in_plane_share"] * v["swelling"] * (st["T"] - T_ref)   # length and width
+    if np.any(sw <= 0) or np.any(sp <= 0):
         from ..errors import ParameterError
 
-        raise ParameterError(f"water_uptake.swelling={v['swelling']!r} /K makes the thickness non-positive "
+        raise ParameterError(f"water_uptake.swelling={v['swelling']!r} /K makes the strip's size non-positive "
                              "in the requested temperature range")
     st["h"] = st["h"] * sw
-    st["C_minus"] = st["C_minus"] / sw   # fixed charges diluted by the absorbed water
+    st["L"], st["W"] = st["L"] * sp, st["W"] * sp
+    for k in ("r1", "r2", "Rp"):         # per-length values of the sheet/area-specific ones: ∝ 1/W
+        st[k] = st[k] / sp
+    st["C_minus"] = st["C_minus"] / (sw * sp * sp)   # fixed charges diluted by the absorbed water
     return st
 
 
@@ -214,11 +218,14 @@ EFFECTS = [
            (P("slope", "1/K", 0.0, -0.05, 0.05, 0.015, "extra d ln κe / dT"), _CURV),
            needs_temperatures=True, apply=_p_permittivity_T),
     Effect("water_uptake", "water uptake with temperature",
-           "Swelling through the thickness h → h (1 + u ΔT) with the fixed anions diluted, "
-           "C⁻ → C⁻/(1 + u ΔT): stiffness, Debye length and gain change with T.",
+           "Swelling h → h (1 + u ΔT) through the thickness and L, W → ·(1 + s u ΔT) in the plane "
+           "(s = 0: thickness only, s = 1: isotropic) with the fixed anions diluted by the volume, "
+           "C⁻ → C⁻/((1 + u ΔT)(1 + s u ΔT)²): stiffness, resonance, Debye length and gain change with T.",
            "Nafion water uptake (Hinatsu et al. 1994, J. Electrochem. Soc. 141:1493)", "parameter",
-           (P("swelling", "1/K", 0.0, -0.008, 0.008, 0.004, "relative thickness change per kelvin"),),
-           needs_temperatures=True, apply=_p_water_uptake),
+           (P("swelling", "1/K", 0.0, -0.008, 0.008, 0.004, "relative thickness change per kelvin"),
+            P("in_plane_share", "1", 0.0, 0.0, 1.0, 0.5, "in-plane over through-thickness swelling",
+              limits=("lower", "upper"))),
+           needs_temperatures=True, apply=_p_water_uptake, switch="swelling"),
     Effect("fractional_transport", "fractional-order charge transport (constant phase inside the polymer)",
            "Anomalous (fractional, order β) charge relaxation in the polymer: every s of the "
            "transport sub-model becomes ω_c (s/ω_c)^β, a constant-phase double layer inside the "

@@ -24,6 +24,10 @@ CONFUSABLE_COSINE = 0.9
 AMBIGUITY_AIC = 6.0
 #: The gap test runs at α / GAP_ALPHA_DIVISOR.
 GAP_ALPHA_DIVISOR = 5.0
+#: An effect also "closes the gap" when what it leaves above the gap threshold is at most this
+#: fraction of the baseline's excess over it (another author's parametrisation of the same effect
+#: leaves a residual that grows with the effect; the report gives the remaining share).
+CLOSE_FRACTION = 0.005
 #: A candidate whose largest possible (linearised) LR over its bounds is below this is skipped.
 MIN_SIGNATURE_LR = 1.0
 

@@ -24,7 +24,12 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 
 from ..data.sweep import FrequencySweep
+from ..effects import get_effect
+from ..errors import ParameterError
+from ..params import IPMCParameters
+from ..parameter_paths import base_value
 from ..plausible import PlausibleRange
+from .calibration import default_free_parameter
 from .lsq import fit_parameters
 from .records import CalibrationResult, FreeParameter
 from .residuals import noise_std, standardised_residuals
@@ -110,6 +115,35 @@ def penalties_for(free: Sequence[FreeParameter], ranges: Mapping[str, PlausibleR
                   wall: float = WALL_DECADES) -> list[RangePenalty]:
     """One :class:`RangePenalty` per free parameter that has a plausible range."""
     return [RangePenalty(fp.name, ranges[fp.name], wall) for fp in free if fp.name in ranges]
+
+
+# =============================================================================== free parameters
+def _free_list(base: IPMCParameters, free, effects: dict) -> list:
+    out = []
+    for item in free:
+        if isinstance(item, FreeParameter):
+            fp = item
+        elif isinstance(item, str):
+            if "." in item and not item.startswith("laws."):
+                e, p = item.split(".", 1)
+                if e not in effects:
+                    raise ParameterError(f"free parameter {item!r} belongs to effect {e!r}, which is not among "
+                                         f"the baseline effects {sorted(effects)}")
+                par = get_effect(e).parameter(p)
+                fp = FreeParameter(item, par.lower, par.upper, "linear", effects[e][p])
+            else:
+                fp = default_free_parameter(base, item)
+        else:
+            raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
+        if fp.initial is None:
+            if "." in fp.name and not fp.name.startswith("laws."):
+                e, p = fp.name.split(".", 1)
+                v = effects[e][p]
+            else:
+                v = base_value(base, fp.name)
+            fp = fp.with_initial(min(max(v, fp.lower), fp.upper))
+        out.append(fp)
+    return out
 
 
 # =============================================================================== audits

@@ -220,15 +220,16 @@ def outcome(r):
 
 
 def correct(r, confident_only=True):
-    """Exact name(s), or ambiguous among pairs the report itself declares confusable."""
+    """Exact name(s), or ambiguous among names the report itself declares confusable with a true one."""
     truth = r["expected"]
     if not truth:
         return False
     if r["verdict"] == "named" or (r["verdict"] == "at_bound" and not confident_only):
         return r["named"] == truth
-    if r["verdict"] == "ambiguous" and len(truth) == 1:
-        t = truth[0]
-        return t in r["named"] and all(frozenset((t, o)) in r["declared"] for o in r["named"] if o != t)
+    if r["verdict"] == "ambiguous":
+        # every true effect among the names, every other name declared confusable with a true one
+        return all(t in r["named"] for t in truth) and all(
+            any(frozenset((t, o)) in r["declared"] for t in truth) for o in r["named"] if o not in truth)
     return False
 
 
@@ -365,6 +366,8 @@ def main(argv=None):
     ap.add_argument("--n-per-label", type=int, default=2, help="independent: cases per label (default 2)")
     ap.add_argument("--null", type=int, default=12, help="independent: null cases in all (default 12)")
     ap.add_argument("--library-reps", type=int, default=1, help="library: cases per effect and noise level")
+    ap.add_argument("--library-null", type=int, default=0,
+                    help="library: extra null cases (noise levels in turn; seeds apart from the main plan)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--real-only", action="store_true", help="only the published-model runs")
     ap.add_argument("--no-real", action="store_true", help="skip the published-model runs")
@@ -375,6 +378,8 @@ def main(argv=None):
             plan += independent_plan(args.n_per_label, args.null)
         if args.generator in ("library", "both"):
             plan += [(g, lab, (i, lev)) for i, (g, lab, lev) in enumerate(library_plan(args.library_reps))]
+            levels = list(NOISE)
+            plan += [("library", "none", (10_000 + k, levels[k % 3])) for k in range(args.library_null)]
         rows = run_all(plan, args.workers)
         report([r for r in rows if r["generator"] == "library"], "library generator (the library's own effects)")
         report([r for r in rows if r["generator"] == "independent"], "independent generator (tests/discrepancy)")

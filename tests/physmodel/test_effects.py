@@ -146,6 +146,13 @@ def test_water_uptake_equals_swollen_strip_at_one_temperature():
     oracle = ActuatorModel(P.replace(h=P.h * sw, C_minus=P.C_minus / sw)).frequency_response(F, [t])["M"]
     got = EffectModel(P, "actuator", {"water_uptake": {"swelling": u}}).frequency_response(F, [t])["M"]
     np.testing.assert_allclose(got, oracle, rtol=1e-12)
+    # isotropic swelling: the strip scaled in all three directions, anions diluted by the volume
+    iso = ActuatorModel(P.replace(h=P.h * sw, L=P.L * sw, W=P.W * sw, C_minus=P.C_minus / sw**3)).frequency_response(
+        F, [t], quantities=("M", "Z"))
+    got = EffectModel(P, "actuator", {"water_uptake": {"swelling": u, "in_plane_share": 1.0}}).frequency_response(
+        F, [t], quantities=("M", "Z"))
+    for q in ("M", "Z"):
+        np.testing.assert_allclose(got[q], iso[q], rtol=1e-12)
 
 
 def test_added_fluid_mass_lowers_the_resonance_by_sqrt_one_plus_mu():
