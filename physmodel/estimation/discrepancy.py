@@ -21,12 +21,14 @@ user's free parameters, and:
    on ``null_refits`` parametric-bootstrap draws (clipped to [1, 3]);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
    baseline Jacobian projected out) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`;
-5. decides: ``none``, ``named`` (one significant candidate that closes the gap; else the best
+5. decides: ``none``, ``named`` (one significant candidate that closes the gap, plus a second one
+   significant on top of it if any — a forward step; else the best
    pair among the :data:`PAIR_POOL` most significant candidates whose members are each
    significant on top of the other and that closes the gap; pairs are drawn from the most
    significant candidates and from those that best explain what the best one leaves, never a
-   declared-confusable pair), ``ambiguous`` (several closers
-   within :data:`AMBIGUITY_AIC`), ``at_bound`` (the named effect closes the gap only with a
+   declared-confusable pair; each member must carry more than :data:`CLOSE_FRACTION` of the
+   baseline's excess), ``ambiguous`` (several closers within :data:`AMBIGUITY_AIC` or declared
+   confusable), ``at_bound`` (the named effect closes the gap only with a
    parameter at its candidate bound: "widen the bound, or the effect is larger than allowed" —
    never a confident name), ``unexplained`` (a significant gap nothing closes).  The gap test
    compares 2·cost (data lines only) with the (1 − α/5) quantile of its null distribution; an
@@ -329,7 +331,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                 closes = closes_gap(res2.metadata["data_cost"], [a, b])
                 pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
                                    "lr_second_on_top": lr_b, "closes_gap": closes})
-                if min(lr_a, lr_b) > T:
+                if min(lr_a, lr_b) > T2:
                     out.append(((a, b), res2, lr_a, lr_b, closes))
             return sorted(out, key=lambda x: x[1].cost)
 
@@ -338,7 +340,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             a, b = best2[0]
             alt = [x[0] for x in ok[1:] if x[4] and 2 * (x[1].cost - best2[1].cost) < AMBIGUITY_AIC]
             msg = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
-                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T:.3g}); the gap closes.")
+                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T2:.3g}); the gap closes.")
             if alt:
                 return ("ambiguous", sorted({a, b} | {c for x in alt for c in x}), list(best2[0]), best2[1],
                         msg.replace("Named two effects", "Ambiguous: best pair")
@@ -346,16 +348,21 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                         + "; ".join(f"{x[0]} + {x[1]}" for x in alt) + ".")
             return "named", [a, b], list(best2[0]), best2[1], msg
 
+        # a second effect must be significant and carry more than the share of the excess that a
+        # closing effect may leave (the tolerance for another author's parametrisation)
+        T2 = max(T, CLOSE_FRACTION * max(2 * cost0 - gap_thr0, 0.0))
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            amb = [c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC]
+            amb = [c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC
+                   or frozenset((top, c)) in conf_set]          # declared confusable and also closing
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
                 verdict = "ambiguous"
                 pairs = [f"{a}~{b}" + ("" if frozenset((a, b)) in conf_set else " (not declared confusable)")
                          for a, b in combinations(amb, 2)]
-                message = (f"Ambiguous between {', '.join(amb)} (AIC within {AMBIGUITY_AIC:g}; {'; '.join(pairs)}). "
+                message = (f"Ambiguous between {', '.join(amb)} (each closes the gap; AIC within {AMBIGUITY_AIC:g} or "
+                           f"declared confusable; {'; '.join(pairs)}; lowest AIC: {top}). "
                            "Separate them with a wider band, more temperatures, or magnitude vs phase.")
             else:
                 verdict, message = "named", _named_msg(top, cres[top])
