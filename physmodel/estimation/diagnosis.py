@@ -7,21 +7,27 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 
 from ..data.files import atomic_write
 from ..data.sweep import FrequencySweep
 from ..effects import LIBRARY, get_effect
+from ..errors import ParameterError
 from .records import CalibrationResult
 
-VERDICTS = ("none", "named", "ambiguous", "unexplained")
+VERDICTS = ("none", "named", "ambiguous", "at_bound", "unexplained")
 #: Candidates whose signatures have a canonical correlation at least this high are confusable.
 CONFUSABLE_COSINE = 0.9
 #: Significant candidates within this AIC difference of the best are reported as ambiguous.
 AMBIGUITY_AIC = 6.0
 #: The gap test runs at α / GAP_ALPHA_DIVISOR.
 GAP_ALPHA_DIVISOR = 5.0
+#: An effect also "closes the gap" when what it leaves above the gap threshold is at most this
+#: fraction of the baseline's excess over it (another author's parametrisation of the same effect
+#: leaves a residual that grows with the effect; the report gives the remaining share).
+CLOSE_FRACTION = 0.005
 #: A candidate whose largest possible (linearised) LR over its bounds is below this is skipped.
 MIN_SIGNATURE_LR = 1.0
 
@@ -48,18 +54,29 @@ class CandidateResult:
     signature_norm: float
     lr_linearised: float = float("nan")
     note: str = ""
+    bounds: dict = field(default_factory=dict)
+    at_bound: list = field(default_factory=list)
+    implausible: list = field(default_factory=list)
+    penalty: float = 0.0
 
     def to_dict(self) -> dict:
         return {"name": self.name, "values": self.values, "ci95_lower": self.ci_lower,
                 "ci95_upper": self.ci_upper, "cost": self.cost, "lr": self.lr, "aic": self.aic,
                 "bic": self.bic, "n_parameters": self.n_parameters, "significant": self.significant,
                 "closes_gap": self.closes_gap, "converged": self.converged,
-                "signature_norm": self.signature_norm, "lr_linearised": self.lr_linearised, "note": self.note}
+                "signature_norm": self.signature_norm, "lr_linearised": self.lr_linearised, "note": self.note,
+                "candidate_bounds": self.bounds, "at_or_near_bound": self.at_bound,
+                "outside_plausible_range": self.implausible, "penalty": self.penalty}
 
 
 @dataclass
 class Diagnosis:
-    """Outcome of :func:`diagnose`.  ``verdict`` ∈ :data:`VERDICTS`; ``named``: effect names."""
+    """Outcome of :func:`diagnose`.  ``verdict`` ∈ :data:`VERDICTS`; ``named``: effect names.
+
+    ``laws``: the temperature laws used (stated choice); ``baseline_audit``: the baseline's
+    parameters at/near a bound, outside their plausible range, the multi-start spread and the
+    penalty; ``final_at_bound``/``final_implausible``: the same for the final fit;
+    ``cost_warning``: '' or why the weighted cost is inconsistent with the declared noise."""
 
     verdict: str
     named: list
@@ -87,11 +104,16 @@ class Diagnosis:
     predicted_before: np.ndarray = field(repr=False)
     predicted_after: np.ndarray = field(repr=False)
     metadata: dict = field(default_factory=dict)
+    laws: str = ""
+    baseline_audit: dict = field(default_factory=dict)
+    final_at_bound: list = field(default_factory=list)
+    final_implausible: list = field(default_factory=list)
+    cost_warning: str = ""
 
     # ---------------------------------------------------------------- views
     def named_effect(self) -> dict | None:
         """The named effect(s) with fitted values and 95 % intervals (None unless verdict is named)."""
-        if self.verdict != "named" or self.final is None:
+        if self.verdict not in ("named", "at_bound") or self.final is None:
             return None
         out = {}
         for n in self.named:
@@ -132,7 +154,25 @@ class Diagnosis:
             "localisation_after": self.localisation_after,
             "gap_before": self.gap_before, "gap_after": self.gap_after,
             "null": self.null, "elapsed_s": self.elapsed_s, "metadata": self.metadata,
+            "temperature_laws": self.laws, "baseline_audit": self.baseline_audit,
+            "baseline_parameters": self._baseline_rows(), "final_at_bound": self.final_at_bound,
+            "final_outside_plausible_range": self.final_implausible, "cost_warning": self.cost_warning,
         })
+
+    def _baseline_rows(self) -> list:
+        b = self.baseline
+        rng = self.baseline_audit.get("plausible_ranges", {})
+        flags = {a["name"]: f"{a['status']} {a['side']} bound" for a in self.baseline_audit.get("at_bound", [])}
+        out_r = {a["name"] for a in self.baseline_audit.get("implausible", [])}
+        spread = self.baseline_audit.get("multistart", {}).get("ranges", {})
+        rows = []
+        for fp in b.free:
+            n = fp.name
+            rows.append({"name": n, "value": b.values[n], "ci95": [b.ci_lower.get(n), b.ci_upper.get(n)],
+                         "bounds": [fp.lower, fp.upper], "plausible": rng.get(n, "none"),
+                         "flag": "; ".join(x for x in (flags.get(n, ""), "outside plausible range" if n in out_r else "")
+                                           if x), "multistart_range": spread.get(n)})
+        return rows
 
     def summary(self) -> str:
         """A readable Markdown summary."""
@@ -140,6 +180,24 @@ class Diagnosis:
         if self.noise_estimated:
             L += ["*The data carry no per-line uncertainty: 1 % per line was assumed; absolute gap "
                   "tests are relative to that assumption.*", ""]
+        if self.cost_warning:
+            L += [f"**Cost vs declared noise — {self.cost_warning}.**", ""]
+        L += [f"Temperature laws: {self.laws}", ""]
+        L += ["## Baseline parameters", "", "| parameter | value | 95 % CI | fit bounds | plausible range | flag | "
+              "multi-start range |", "|---|---|---|---|---|---|---|"]
+        for r in self._baseline_rows():
+            ci = r["ci95"]
+            ms = r["multistart_range"]
+            L.append(f"| {r['name']} | {r['value']:.4g} | [{_g(ci[0])}, {_g(ci[1])}] | [{r['bounds'][0]:.3g}, "
+                     f"{r['bounds'][1]:.3g}] | {r['plausible']} | {r['flag'] or '–'} | "
+                     + (f"[{ms[0]:.4g}, {ms[1]:.4g}]" if ms else "–") + " |")
+        ms = self.baseline_audit.get("multistart", {})
+        if ms.get("n_starts"):
+            L += ["", f"Multi-start: {ms['n_at_best']} of {ms['n_starts']} starts reach the best cost (within "
+                      f"{ms['tolerance']:g}); start costs " + ", ".join(f"{c:.4g}" for c in ms["costs"]) + "."]
+        if self.baseline_audit.get("penalty", 0) > 0:
+            L += ["", f"Plausible-range penalty of the baseline: {self.baseline_audit['penalty']:.4g} (cost units)."]
+        L += [""]
         gb, ga = self.gap_before, self.gap_after
         L += ["## Gap before / after", "",
               "| | weighted cost | expected | z | " + " | ".join(f"{t:g} °C dB / deg" for t in gb["temperatures_c"]) + " |",
@@ -150,13 +208,28 @@ class Diagnosis:
         L += ["", f"Gap shrink (cost − expected, before / after): {gap_shrink(self):.3g}×", "",
               f"LR threshold (family-wise α = {self.alpha:g}, Monte Carlo under the null): {self.threshold:.3g}; "
               f"gap threshold on 2·cost: {self.gap_threshold:.4g}", "",
-              "## Candidates", "", "| effect | LR | significant | closes gap | AIC | BIC | fitted values |",
-              "|---|---|---|---|---|---|---|"]
+              "## Candidates", "", "| effect | LR | significant | closes gap | AIC | BIC | fitted values "
+              "[candidate bounds] | at/near a bound, outside plausible range |",
+              "|---|---|---|---|---|---|---|---|"]
         for c in sorted(self.candidates.values(), key=lambda c: -c.lr):
-            vals = ", ".join(f"{k} = {v:.4g} [{c.ci_lower[k]:.3g}, {c.ci_upper[k]:.3g}]"
+            vals = ", ".join(f"{k} = {v:.4g} (CI [{c.ci_lower[k]:.3g}, {c.ci_upper[k]:.3g}]; bounds "
+                             f"[{c.bounds.get(k, [float('nan')] * 2)[0]:.3g}, {c.bounds.get(k, [float('nan')] * 2)[1]:.3g}])"
                              for k, v in c.values.items())
+            flags = "; ".join([f"{a['name']} {a['status']} {a['side']} bound {a['bound']:.3g}"
+                               + (" (physical limit)" if a["hard"] else "") for a in c.at_bound]
+                              + [f"{a['name']} = {a['value']:.3g} outside [{a['lower']:.3g}, {a['upper']:.3g}]"
+                                 for a in c.implausible]) or "–"
             L.append(f"| {c.name} | {c.lr:.4g} | {'yes' if c.significant else 'no'} | "
-                     f"{'yes' if c.closes_gap else 'no'} | {c.aic:.4g} | {c.bic:.4g} | {vals} |")
+                     f"{'yes' if c.closes_gap else 'no'} | {c.aic:.4g} | {c.bic:.4g} | {vals} | {flags} |")
+        pt = self.metadata.get("pairs_tried", [])
+        if pt:
+            L += ["", "Pairs refitted jointly: " + "; ".join(
+                f"{p['pair'][0]} + {p['pair'][1]}: cost {p['cost']:.4g}, LR on top {p['lr_first_on_top']:.3g} / "
+                f"{p['lr_second_on_top']:.3g}{', closes the gap' if p['closes_gap'] else ''}" for p in pt)]
+        if self.final_at_bound:
+            L += ["", "Final fit, parameters at a bound: " + "; ".join(
+                f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g}"
+                + (", physical limit)" if a["hard"] else ")") for a in self.final_at_bound)]
         if self.skipped:
             L += ["", "Not testable on these data: " + "; ".join(f"{k} ({v})" for k, v in self.skipped.items())]
         L += ["", "## Confusable pairs (signature cosine ≥ %.2g)" % CONFUSABLE_COSINE, ""]
@@ -202,6 +275,114 @@ def _loc_lines(rows) -> list:
 
 
 # =============================================================================== internals
+
+
+def _g(x) -> str:
+    return "–" if x is None or not math.isfinite(x) else f"{x:.3g}"
+
+
+def describe_laws(laws) -> str:
+    """One line per non-constant law, e.g. ``d Arrhenius(activation_energy=15000)``."""
+    from dataclasses import fields
+
+    parts = []
+    for f in fields(laws):
+        law = getattr(laws, f.name)
+        kind = type(law).__name__
+        if kind == "Constant":
+            continue
+        args = ", ".join(f"{k.name}={getattr(law, k.name):g}" for k in fields(law) if k.name != "valid_c")
+        parts.append(f"{f.name} {kind}({args})")
+    return "; ".join(parts) if parts else "every parameter constant (isothermal)"
+
+
+def resolve_laws(base, laws):
+    """``(base with the chosen laws, a sentence stating the choice)``.
+
+    ``laws``: None or ``"set"`` (the laws of ``base``), ``"isothermal"`` (every parameter
+    constant), ``"default"`` (physics.md §7: Arrhenius d 15 kJ/mol, log-linear E −0.75 %/K, water
+    permittivity, ionic leakage), a :class:`~physmodel.temperature.TemperatureLaws`, or a mapping
+    ``{"base": one of those names, <quantity>: {"law": name, <parameter>: value} | name}``."""
+    from dataclasses import replace
+
+    from ..errors import ParameterError
+    from ..temperature import ISOTHERMAL, TemperatureLaws
+
+    named = {"isothermal": ISOTHERMAL, "default": TemperatureLaws(), "set": None}
+    if laws is None:
+        return base, f"those of the parameter set {base.name!r}: {describe_laws(base.laws)}"
+    if isinstance(laws, TemperatureLaws):
+        return replace(base, laws=laws), f"given: {describe_laws(laws)}"
+    if isinstance(laws, str):
+        if laws not in named:
+            raise ParameterError(f"laws = {laws!r}; expected one of {sorted(named)}, a table of laws, or TemperatureLaws")
+        chosen = named[laws] or base.laws
+        return replace(base, laws=chosen), f"{laws!r}: {describe_laws(chosen)}"
+    if isinstance(laws, Mapping):
+        spec = dict(laws)
+        start = spec.pop("base", "set")
+        if start not in named:
+            raise ParameterError(f"laws.base = {start!r}; expected one of {sorted(named)}")
+        cur = (named[start] or base.laws).to_dict()
+        for k, v in spec.items():
+            if k not in cur:
+                raise ParameterError(f"laws: no temperature law for {k!r}; expected one of {sorted(cur)}")
+            cur[k] = {"law": v} if isinstance(v, str) else dict(v)
+            if "law" not in cur[k]:
+                raise ParameterError(f"laws.{k} = {v!r}: give the law's name, e.g. {{law = \"Arrhenius\", "
+                                     "activation_energy = 15e3}")
+        try:
+            chosen = TemperatureLaws.from_dict(cur)
+        except TypeError as exc:
+            raise ParameterError(f"laws: {exc}") from None
+        return replace(base, laws=chosen), f"{start!r} with changes: {describe_laws(chosen)}"
+    raise ParameterError(f"laws must be None, a name, a mapping or TemperatureLaws; got {type(laws).__name__}")
+
+
+def _candidate_overrides(candidate_bounds, candidate_starts) -> tuple[dict, dict]:
+    """``{"effect.param": (lo, hi) | {"lower"|"upper"|"typical": v}}`` → {effect: {param: {...}}};
+    ``{"effect.param": value}`` → {effect: {param: value}}."""
+    bounds: dict = {}
+    for key, v in (candidate_bounds or {}).items():
+        if "." not in key:
+            raise ParameterError(f"candidate bound {key!r}: expected 'effect.parameter'")
+        e, p = key.split(".", 1)
+        get_effect(e).parameter(p)
+        if isinstance(v, Mapping):
+            spec = dict(v)
+        else:
+            try:
+                lo, hi = (float(x) for x in v)
+            except (TypeError, ValueError):
+                raise ParameterError(f"candidate bound {key!r}: expected (lower, upper) or a table of "
+                                     f"lower/upper/typical, got {v!r}") from None
+            spec = {"lower": lo, "upper": hi}
+        bounds.setdefault(get_effect(e).name, {})[p] = spec
+    starts: dict = {}
+    for key, v in (candidate_starts or {}).items():
+        if "." not in key:
+            raise ParameterError(f"candidate start {key!r}: expected 'effect.parameter'")
+        e, p = key.split(".", 1)
+        get_effect(e).parameter(p)
+        try:
+            starts.setdefault(get_effect(e).name, {})[p] = float(v)
+        except (TypeError, ValueError):
+            raise ParameterError(f"candidate start {key!r} = {v!r}: expected a number") from None
+    return bounds, starts
+
+
+def _hard_sides(cpars: dict) -> dict:
+    """Bounds that are physical limits or the effect's off value (no reason to widen)."""
+    out = {}
+    for c, pars in cpars.items():
+        for p in pars:
+            sides = set(p.limits)
+            if p.off == p.lower:
+                sides.add("lower")
+            if p.off == p.upper:
+                sides.add("upper")
+            out[f"{c}.{p.name}"] = tuple(sides)
+    return out
 
 
 def _named_msg(c: str, cr: CandidateResult) -> str:

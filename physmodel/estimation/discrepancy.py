@@ -3,37 +3,43 @@
 :func:`diagnose` (discrepancy.md) takes frequency-response data, a base parameter set and the
 user's free parameters, and:
 
-1. calibrates the baseline model (:func:`physmodel.estimation.calibration.fit_parameters`, the project's one
-   calibration engine) and tabulates where the standardised residuals exceed their band
-   (frequency band × temperature × magnitude/phase, and the trend with temperature);
+1. calibrates the baseline model (the project's one engine,
+   :func:`physmodel.estimation.lsq.fit_parameters`, multi-start) with the free base parameters
+   held to their plausible ranges (:mod:`physmodel.plausible`) by soft walls
+   (:mod:`physmodel.estimation.priors`: zero penalty inside, a Gaussian wall of 0.02 decade
+   outside), and audits it: parameters at or near a bound, outside their plausible range, and the
+   multi-start spread; it tabulates where the standardised residuals exceed their band;
 2. refits the full model with each candidate effect of :data:`physmodel.effects.LIBRARY` switched
-   on (nested, full nonlinear refits) and scores it by the likelihood-ratio statistic
-   LR = 2 (cost_baseline − cost_candidate), with AIC/BIC alongside;
+   on (nested, full nonlinear refits, starting from off, from a linearised estimate, from a
+   typical size and from any user start), within *candidate bounds* scaled to the strip
+   (:meth:`physmodel.effects.Effect.candidate_parameters`; user-adjustable) and scores it by
+   LR = 2 (cost_baseline − cost_candidate) of the penalised costs, with AIC/BIC alongside;
 3. sets the acceptance threshold by Monte Carlo under the null (no effect), so that the
-   *family-wise* false-positive rate of "max over candidates of LR" is α:
-
-   * a linearised Gaussian null at the fitted baseline: standardised noise e ~ N(0, I) with the
-     baseline Jacobian projected out, and for each candidate the exact constrained LR of the
-     linearised problem (parameters whose "off" value is a bound enter one-sided, which gives the
-     χ̄² mixture), ``null_draws`` draws (default 4000, milliseconds);
-   * a parametric bootstrap with full nonlinear refits (simulate from the fitted baseline with the
-     data's noise, refit baseline and every candidate) on the first ``null_refits`` of the same
-     noise draws (default 4): the ratio Σ LR_full / Σ LR_lin over these draws (clipped to
-     [1, 3]) scales the linearised threshold, correcting it for nonlinearity at the cost of a
-     few refits;
-
+   *family-wise* false-positive rate of "max over candidates of LR" is α: a linearised Gaussian
+   null at the fitted baseline (constrained LR per candidate: χ̄² mixtures for effects whose off
+   value is a bound), ``null_draws`` draws, scaled by the ratio of full-refit to linearised LR
+   on ``null_refits`` parametric-bootstrap draws (clipped to [1, 3]);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
    baseline Jacobian projected out) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`;
-5. decides: ``none`` (no significant LR and no significant gap), ``named`` (one significant
-   candidate that closes the gap, or a greedy second effect when the first leaves a significant
-   gap), ``ambiguous`` (several significant candidates that close the gap and whose AIC differ by
-   less than :data:`AMBIGUITY_AIC`), ``unexplained`` (a significant gap that no candidate, or
-   pair, closes).  The gap test compares 2·cost with the (1 − α/5) quantile of its null
-   distribution from the same Monte Carlo (stricter than α: a false "unexplained" costs a name).
+5. decides: ``none``, ``named`` (one significant candidate that closes the gap, plus a second one
+   significant on top of it if any — a forward step; else the best
+   pair among the :data:`PAIR_POOL` most significant candidates whose members are each
+   significant on top of the other and that closes the gap; pairs are drawn from the most
+   significant candidates and from those that best explain what the best one leaves, never a
+   declared-confusable pair; each member must carry more than :data:`CLOSE_FRACTION` of the
+   baseline's excess), ``ambiguous`` (several closers within :data:`AMBIGUITY_AIC` or declared
+   confusable), ``at_bound`` (the named effect closes the gap only with a
+   parameter at its candidate bound: "widen the bound, or the effect is larger than allowed" —
+   never a confident name), ``unexplained`` (a significant gap nothing closes).  The gap test
+   compares 2·cost (data lines only) with the (1 − α/5) quantile of its null distribution; an
+   effect that leaves at most :data:`CLOSE_FRACTION` of the baseline's excess above it also
+   closes the gap (the message then states the remaining share).
 
-Residuals are those of :func:`physmodel.estimation.calibration.residuals`: ln-magnitude/σ_ln and wrapped
-phase/σ_φ per line.  Data without per-line standard deviations use the calibration module's
-fallback (1 % per line); the report says so, and absolute gap tests are then relative to that.
+The report also states the temperature laws used, warns when the weighted cost is inconsistent
+with the declared noise (too low or too high, with the factor), and says when the baseline fits
+only by leaving its plausible range (evidence of a missing effect).  Residuals are those of
+:func:`physmodel.estimation.residuals.standardised_residuals`; data without per-line standard
+deviations use the 1 % fallback and the report says so.
 """
 from __future__ import annotations
 
@@ -48,53 +54,20 @@ from ..data.sweep import FrequencySweep
 from ..effects import DEFAULT_QUANTITY, LIBRARY, EffectModel, candidates_for, get_effect, normalize_effects
 from ..errors import IPMCError, ParameterError
 from ..params import IPMCParameters
-from ..parameter_paths import base_value
-from .calibration import default_free_parameter
-from .lsq import fit_parameters
+from ..plausible import plausible_ranges
+from .diagnosis import (AMBIGUITY_AIC, CLOSE_FRACTION, CONFUSABLE_COSINE, GAP_ALPHA_DIVISOR, MIN_SIGNATURE_LR, VERDICTS,
+                        CandidateResult, Diagnosis, _candidate_overrides, _hard_sides, _named_msg, _worst_cells,
+                        gap_shrink, resolve_laws)
+from .priors import (WALL_DECADES, PenalisedProblem, _free_list, bound_audit, cost_warning, multistart_spread, penalties_for,
+                     plausible_audit)
 from .records import CalibrationResult, FreeParameter
-from .residuals import noise_std, standardised_residuals
-
-from .diagnosis import (AMBIGUITY_AIC, CONFUSABLE_COSINE, GAP_ALPHA_DIVISOR, MIN_SIGNATURE_LR, VERDICTS,
-                        CandidateResult, Diagnosis, _named_msg, _worst_cells, gap_shrink)
+from .residuals import standardised_residuals
 from .signatures import (_constrained_lr, _gap, _localise, _orth, _project_out, _separation, _signature,
                          _z_jacobian)
 
-
-def _free_list(base: IPMCParameters, free, effects: dict) -> list:
-    out = []
-    for item in free:
-        if isinstance(item, FreeParameter):
-            fp = item
-        elif isinstance(item, str):
-            if "." in item and not item.startswith("laws."):
-                e, p = item.split(".", 1)
-                if e not in effects:
-                    raise ParameterError(f"free parameter {item!r} belongs to effect {e!r}, which is not among "
-                                         f"the baseline effects {sorted(effects)}")
-                par = get_effect(e).parameter(p)
-                fp = FreeParameter(item, par.lower, par.upper, "linear", effects[e][p])
-            else:
-                fp = default_free_parameter(base, item)
-        else:
-            raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
-        if fp.initial is None:
-            if "." in fp.name and not fp.name.startswith("laws."):
-                e, p = fp.name.split(".", 1)
-                v = effects[e][p]
-            else:
-                v = base_value(base, fp.name)
-            fp = fp.with_initial(min(max(v, fp.lower), fp.upper))
-        out.append(fp)
-    return out
-
-
-def _effect_free(effect: str, start: Mapping[str, float] | None = None) -> list:
-    e = LIBRARY[effect]
-    out = []
-    for p in e.parameters:
-        v = p.off if start is None else float(np.clip(start[p.name], p.lower, p.upper))
-        out.append(FreeParameter(f"{effect}.{p.name}", p.lower, p.upper, "linear", v))
-    return out
+#: Pairs of two effects: every pair among this many most significant candidates, and each of the
+#: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
+PAIR_POOL = 4
 
 
 def _simulated(G, e, s_ln, s_ph):
@@ -108,6 +81,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
              baseline_effects: Mapping[str, Mapping[str, float]] | Sequence[str] = (),
              candidates: Sequence[str] | None = None, alpha: float = 0.05, null_draws: int = 4000,
              null_refits: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int = 200,
+             laws=None, candidate_bounds: Mapping | None = None, candidate_starts: Mapping | None = None,
+             plausible: Mapping | None = None, prior: bool = True, baseline_starts: int = 3,
              progress: Callable[[str], None] | None = None) -> Diagnosis:
     """Diagnose the discrepancy between ``data`` and the ``base`` model (see module docstring).
 
@@ -115,9 +90,16 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     baseline effect, or :class:`FreeParameter`).  ``baseline_effects``: effects already in the model
     (``{name: {param: value}}``; a bare name means all its parameters free from their off value).
     ``candidates``: library names to test (default: all that apply to ``kind``/``quantity`` and are
-    not in the baseline).  ``alpha``: family-wise false-positive rate.  ``null_draws``: linearised
-    null Monte Carlo draws; ``null_refits``: full nonlinear bootstrap refits (see module doc).
-    ``progress(message)`` is called after each stage.
+    not in the baseline).  ``alpha``: family-wise false-positive rate.  ``null_draws``/``null_refits``:
+    linearised null draws and full bootstrap refits.  ``laws``: temperature laws —
+    None/``"set"`` (those of ``base``), ``"isothermal"``, ``"default"`` (physics.md §7), a
+    :class:`~physmodel.temperature.TemperatureLaws` or a mapping (see
+    :func:`~physmodel.estimation.diagnosis.resolve_laws`); the report states the choice.
+    ``candidate_bounds``: ``{"effect.param": (lower, upper) or {"lower", "upper", "typical"}}``
+    replacing the strip-scaled candidate bounds; ``candidate_starts``: ``{"effect.param": value}``
+    extra start values.  ``plausible``: ``{field: (lower, upper)}`` replacing default plausible
+    ranges; ``prior``: hold the free base parameters to them (soft walls).  ``baseline_starts``:
+    multi-start count of the baseline fit.  ``progress(message)`` is called after each stage.
     """
     t0 = time.perf_counter()
     if not isinstance(data, FrequencySweep):
@@ -130,6 +112,9 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         raise IPMCError(f"null_draws={null_draws!r} is too small for a {1 - alpha:g} quantile; use >= 200")
     if int(null_refits) < 0:
         raise IPMCError(f"null_refits={null_refits!r} must be >= 0")
+    if int(baseline_starts) < 1:
+        raise IPMCError(f"baseline_starts={baseline_starts!r} must be >= 1")
+    base, laws_note = resolve_laws(base, laws)
     q = quantity or DEFAULT_QUANTITY.get(kind, "")
     say = progress or (lambda msg: None)
     if isinstance(baseline_effects, Mapping):
@@ -138,39 +123,53 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     else:
         beff = normalize_effects({n: {} for n in baseline_effects})
         extra_free = [f"{n}.{p.name}" for n in beff for p in get_effect(n).parameters]
+    cbounds, cstarts = _candidate_overrides(candidate_bounds, candidate_starts)
     model0 = EffectModel(base, kind, beff, kernel=kernel)
-    predict = model0.predictor(data, q)
-    pm = predict.many
+    pm = model0.predictor(data, q).many
     free0 = _free_list(base, list(free) + [f for f in extra_free if f not in free], beff)
     names0 = [fp.name for fp in free0]
-    s_ln, s_ph, estimated = noise_std(data)
+    ranges = plausible_ranges(base, plausible)
+    prob = PenalisedProblem(data, pm, penalties_for(free0, ranges) if prior else [])
+    s_ln, s_ph, estimated = prob.s_ln, prob.s_ph, prob.estimated
     N = data.frequency_hz.size
     n_temps = data.temperatures().size
 
+    def fit(free_list, sim=None, starts=1, identify=True):
+        pr = prob if sim is None else PenalisedProblem(sim, pm, prob.penalties)
+        return pr.fit(free_list, starts=starts, seed=seed, max_nfev=max_nfev, identify=identify,
+                      hold_undetermined=False)
+
     # ---- 1. baseline
-    res0 = fit_parameters(data, None, free0, predict_many=pm, max_nfev=max_nfev, identify=True,
-                          hold_undetermined=False, seed=seed)
+    res0 = fit(free0, starts=int(baseline_starts))
     v0 = dict(res0.values)
     G0 = pm([v0])[0]
     r0 = standardised_residuals(G0, data, s_ln, s_ph)
-    say(f"baseline fitted: cost {res0.cost:.4g} (expected {res0.expected_cost:.4g})")
+    cost0 = res0.metadata["data_cost"]
+    audit0 = {"at_bound": bound_audit(res0, free0), "implausible": plausible_audit(v0, ranges),
+              "multistart": multistart_spread(res0), "penalty": res0.metadata["penalty"],
+              "plausible_ranges": {k: ranges[k].describe() for k in names0 if k in ranges}}
+    say(f"baseline fitted: cost {cost0:.4g} (expected {res0.expected_cost:.4g})")
 
     # ---- 2. signatures, confusability
-    cand = list(candidates) if candidates is not None else [
+    cand = [get_effect(c).name for c in candidates] if candidates is not None else [
         c for c in candidates_for(kind, q, n_temps) if c not in beff]
     for c in cand:
         if c not in LIBRARY:
             raise ParameterError(f"unknown candidate effect {c!r}; expected library names {sorted(LIBRARY)}")
         if not LIBRARY[c].applies_to(kind, q):
             raise ParameterError(f"candidate {c!r} does not apply to {kind} quantity {q}")
+    bad = sorted(set(cbounds) - set(cand)) + sorted(set(cstarts) - set(cand))
+    if bad:
+        raise ParameterError(f"candidate bounds/starts given for {bad}, which are not candidates here ({cand})")
+    cpars = {c: LIBRARY[c].candidate_parameters(base, cbounds.get(c)) for c in cand}
+    hard = _hard_sides(cpars)
     J0 = _z_jacobian(pm, v0, free0, r0, data, s_ln, s_ph)
     Q0 = _orth(J0)
     sigs, sided, skipped, first_order, raw_sigs = {}, {}, {}, {}, {}
     for c in cand:
-        S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph)
+        S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
         Sp = _project_out(Q0, S)
-        e = LIBRARY[c]
-        reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in e.parameters])
+        reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in cpars[c]])
         max_lr = float(np.sum((np.linalg.norm(Sp, axis=0) * reach) ** 2))
         if not np.all(np.isfinite(S)) or np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
             skipped[c] = "no signature on these data (cannot change the cost by the noise level)"
@@ -202,7 +201,14 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     say(f"linearised null: LR threshold {T_lin:.3g} from {E.shape[1]} draws")
 
     # ---- 4. candidate refits
-    def refit(effects_on: Sequence[str], start_vals: dict, eff_starts: list[dict | None]):
+    def eff_free(c, start=None):
+        out = []
+        for p in cpars[c]:
+            v = p.off if start is None else float(np.clip(start.get(p.name, p.off), p.lower, p.upper))
+            out.append(FreeParameter(f"{c}.{p.name}", p.lower, p.upper, "linear", v))
+        return out
+
+    def refit(effects_on: Sequence[str], start_vals: dict, eff_starts: list, sim=None, identify=True):
         best = None
         for starts in eff_starts:
             fr = [fp.with_initial(min(max(start_vals[fp.name], fp.lower), fp.upper)) for fp in free0]
@@ -210,9 +216,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                 st = None if starts is None else starts.get(c)
                 if st is None and any(k.startswith(c + ".") for k in start_vals):
                     st = {k.split(".", 1)[1]: v for k, v in start_vals.items() if k.startswith(c + ".")}
-                fr += _effect_free(c, st)
-            res = fit_parameters(data, None, fr, predict_many=pm, max_nfev=max_nfev, identify=True,
-                                 hold_undetermined=False, seed=seed)
+                fr += eff_free(c, st)
+            res = fit(fr, sim=sim, identify=identify)
             if best is None or res.cost < best.cost:
                 best = res
         return best
@@ -221,39 +226,50 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         """Linearised estimate of the effect's values from the current residual."""
         S = _project_out(Qb, sigs[c])
         d, *_ = np.linalg.lstsq(S, -r_now, rcond=None)
-        e = LIBRARY[c]
-        return {p.name: p.off + d[j] * (p.typical - p.off) for j, p in enumerate(e.parameters)}
+        return {p.name: p.off + d[j] * (p.typical - p.off) for j, p in enumerate(cpars[c])}
+
+    def starts_for(c, r_now, Qb):
+        out = [None, {c: lin_start(c, r_now, Qb)}, {c: {p.name: p.typical for p in cpars[c]}}]
+        if c in cstarts:
+            out.append({c: {**{p.name: p.typical for p in cpars[c]}, **cstarts[c]}})
+        return out
+
+    def audit(res, extra_free):
+        fl = free0 + extra_free
+        return bound_audit(res, fl, hard), plausible_audit({k: res.values[k] for k in names0}, ranges)
 
     cres: dict[str, CandidateResult] = {}
     fits: dict[str, CalibrationResult] = {}
     k0 = len(free0)
     n_res = 2 * N
     for c in sigs:
-        res = refit([c], v0, [None, {c: lin_start(c, r0, Q0)}, {c: LIBRARY[c].typical}])
+        res = refit([c], v0, starts_for(c, r0, Q0))
         fits[c] = res
-        k = len(LIBRARY[c].parameters)
+        k = len(cpars[c])
         lr = max(0.0, 2 * (res0.cost - res.cost))
-        ev = {p.name: res.values[f"{c}.{p.name}"] for p in LIBRARY[c].parameters}
+        ev = {p.name: res.values[f"{c}.{p.name}"] for p in cpars[c]}
+        dc = res.metadata["data_cost"]
+        ab, imp = audit(res, eff_free(c))
         cres[c] = CandidateResult(
             c, ev, {p: res.ci_lower[f"{c}.{p}"] for p in ev}, {p: res.ci_upper[f"{c}.{p}"] for p in ev},
-            res.cost, lr, 2 * res.cost + 2 * (k0 + k), 2 * res.cost + (k0 + k) * math.log(n_res), k,
+            dc, lr, 2 * res.cost + 2 * (k0 + k), 2 * res.cost + (k0 + k) * math.log(n_res), k,
             False, False, res.converged, float(np.linalg.norm(sigs[c])),
-            float(_constrained_lr(sigs[c], sided[c], -_project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""))
+            float(_constrained_lr(sigs[c], sided[c], -_project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""),
+            bounds={p.name: [p.lower, p.upper] for p in cpars[c]}, at_bound=ab, implausible=imp,
+            penalty=res.metadata["penalty"])
     say(f"{len(cres)} candidates refitted")
-
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
     full_max, lin_used = [], []
     for b in range(int(null_refits)):
         e = E[:, b]
         sim = FrequencySweep(data.temperature_c, data.frequency_hz, _simulated(G0, e, s_ln, s_ph),
-                             data.magnitude_std_db, data.phase_std_deg, data.input_name, data.input_unit,
-                             data.output_name, data.output_unit)
-        fr0 = [fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0]
-        rb = fit_parameters(sim, None, fr0, predict_many=pm, max_nfev=max_nfev, identify=False)
+                             np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
+                             data.input_unit, data.output_name, data.output_unit)
+        rb = fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
+                 identify=False)
         m = 0.0
         for c in sigs:
-            fr = [fp.with_initial(min(max(rb.values[fp.name], fp.lower), fp.upper)) for fp in free0] + _effect_free(c)
-            rc = fit_parameters(sim, None, fr, predict_many=pm, max_nfev=max_nfev, identify=False)
+            rc = refit([c], rb.values, [None], sim=sim, identify=False)
             m = max(m, 2 * (rb.cost - rc.cost))
         full_max.append(m)
         lin_used.append(float(lin_max[b]))
@@ -267,85 +283,185 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     def gap_thr(effs: Sequence[str]) -> float:
         if not effs:
             return gap_thr0
-        S = np.hstack([sigs[c] for c in effs])
-        Qs = _orth(S)
+        Qs = _orth(np.hstack([sigs[c] for c in effs]))
         after = cost2_null - np.sum((Qs.T @ Ep) ** 2, axis=0)
         return float(np.quantile(after, 1 - alpha_gap))
 
+    def closes_gap(cost, effs) -> bool:
+        """2·cost within its null band, or above it by at most CLOSE_FRACTION of the baseline's excess."""
+        thr = gap_thr(effs)
+        return 2 * cost <= thr or 2 * cost - thr <= CLOSE_FRACTION * max(2 * cost0 - gap_thr0, 0.0)
+
     for c, cr in cres.items():
         cr.significant = cr.lr > T
-        cr.closes_gap = 2 * cr.cost <= gap_thr([c])
-    gap0_sig = 2 * res0.cost > gap_thr0
+        cr.closes_gap = closes_gap(cr.cost, [c])
+    gap0_sig = 2 * cost0 > gap_thr0
     sig = sorted((c for c in cres if cres[c].significant), key=lambda c: -cres[c].lr)
     final_effects: list[str] = []
     final_fit: CalibrationResult | None = None
+    pair_tried: list = []
+    named2: list = []
     where = _worst_cells(_localise(data, r0, alpha))
     if not sig:
         if gap0_sig:
             verdict = "unexplained"
-            message = (f"The baseline leaves a significant gap (2·cost {2 * res0.cost:.4g} > {gap_thr0:.4g}) "
+            message = (f"The baseline leaves a significant gap (2·cost {2 * cost0:.4g} > {gap_thr0:.4g}) "
                        f"that no library candidate reduces significantly; the gap remains in {where}.")
         else:
             verdict = "none"
             message = (f"No significant discrepancy: best candidate LR "
                        f"{max([c.lr for c in cres.values()], default=0.0):.3g} ≤ threshold {T:.3g}, and the "
-                       f"baseline cost {res0.cost:.4g} is within its null band.")
+                       f"baseline cost {cost0:.4g} is within its null band.")
     else:
-        best = sig[0]
+        def explainers(a, pool):
+            """Candidates of ``pool`` that best explain what a leaves (linearised LR on its residual)."""
+            r_a = standardised_residuals(pm([fits[a].values])[0], data, s_ln, s_ph)
+            Qa = _orth(np.hstack([J0, sigs[a]]))
+            sc = {b: float(_constrained_lr(_project_out(Qa, sigs[b]), sided[b], -_project_out(Qa, r_a[:, None]))[0])
+                  for b in pool if b != a}
+            return [b for b in sorted(sc, key=lambda k: -sc[k])[:PAIR_POOL - 1]], r_a, Qa
+
+        def pair_fits(pairs):
+            out = []
+            for a, b in pairs:
+                va = {**fits[a].values, **{k: v for k, v in fits[b].values.items() if k.startswith(b + ".")}}
+                _, r_a, Qa = explainers(a, [])
+                res2 = refit([a, b], va, [{b: {p.name: p.off for p in cpars[b]}}, {b: lin_start(b, r_a, Qa)}])
+                lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)   # each on top
+                closes = closes_gap(res2.metadata["data_cost"], [a, b])
+                pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
+                                   "lr_second_on_top": lr_b, "closes_gap": closes})
+                if min(lr_a, lr_b) > T2:
+                    out.append(((a, b), res2, lr_a, lr_b, closes))
+            return sorted(out, key=lambda x: x[1].cost)
+
+        def name_pair(ok):
+            best2 = ok[0]
+            a, b = best2[0]
+            alt = [x[0] for x in ok[1:] if x[4] and 2 * (x[1].cost - best2[1].cost) < AMBIGUITY_AIC]
+            msg = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
+                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T2:.3g}); the gap closes.")
+            if alt:
+                return ("ambiguous", sorted({a, b} | {c for x in alt for c in x}), list(best2[0]), best2[1],
+                        msg.replace("Named two effects", "Ambiguous: best pair")
+                        + " Other pairs fit as well (AIC within %g): " % AMBIGUITY_AIC
+                        + "; ".join(f"{x[0]} + {x[1]}" for x in alt) + ".")
+            return "named", [a, b], list(best2[0]), best2[1], msg
+
+        # a second effect must be significant and carry more than the share of the excess that a
+        # closing effect may leave (the tolerance for another author's parametrisation)
+        T2 = max(T, CLOSE_FRACTION * max(2 * cost0 - gap_thr0, 0.0))
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            amb = [c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC]
+            amb = [c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC
+                   or frozenset((top, c)) in conf_set]          # declared confusable and also closing
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
                 verdict = "ambiguous"
                 pairs = [f"{a}~{b}" + ("" if frozenset((a, b)) in conf_set else " (not declared confusable)")
                          for a, b in combinations(amb, 2)]
-                message = (f"Ambiguous between {', '.join(amb)} (AIC within {AMBIGUITY_AIC:g}; {'; '.join(pairs)}). "
+                message = (f"Ambiguous between {', '.join(amb)} (each closes the gap; AIC within {AMBIGUITY_AIC:g} or "
+                           f"declared confusable; {'; '.join(pairs)}; lowest AIC: {top}). "
                            "Separate them with a wider band, more temperatures, or magnitude vs phase.")
-                final_effects = amb[:1]
             else:
-                verdict = "named"
-                message = _named_msg(top, cres[top])
+                verdict, message = "named", _named_msg(top, cres[top])
+            # forward step: a second significant candidate (not one of the closers, not confusable
+            # with the first) that is significant on top of it
+            pool = [c for c in sig if c not in amb and frozenset((top, c)) not in conf_set]
+            ok = pair_fits([(top, b) for b in explainers(top, pool)[0]]) if pool else []
+            if ok:
+                v2, n2, final_effects, final_fit, m2 = name_pair(ok)
+                if verdict == "ambiguous":       # the first effect stays ambiguous
+                    v2, n2 = "ambiguous", sorted(set(n2) | set(amb))
+                    m2 += f" The first effect is ambiguous between {', '.join(amb)}."
+                verdict, named2, message = v2, n2, m2
         else:
-            # greedy second effect on top of the best
-            r1 = standardised_residuals(pm([fits[best].values])[0], data, s_ln, s_ph)
-            Q1 = _orth(np.hstack([J0, sigs[best]]))
-            best2 = None
-            for c2 in sigs:
-                if c2 == best:
-                    continue
-                res2 = refit([best, c2], fits[best].values,
-                             [None, {c2: lin_start(c2, r1, Q1)}, {c2: LIBRARY[c2].typical}])
-                lr2 = max(0.0, 2 * (fits[best].cost - res2.cost))
-                if lr2 > T and (best2 is None or res2.cost < best2[1].cost):
-                    best2 = (c2, res2, lr2)
-            if best2 is not None and 2 * best2[1].cost <= gap_thr([best, best2[0]]):
-                verdict = "named"
-                final_effects, final_fit = [best, best2[0]], best2[1]
-                message = (f"Named two effects (greedy): {best} (LR {cres[best].lr:.4g}) then {best2[0]} "
-                           f"(LR {best2[2]:.4g} on top); the gap closes.")
+            # two effects: every pair among the most significant candidates and each of the two best
+            # with the candidates that best explain what it leaves, refitted jointly
+            pairs = [tuple(x) for x in combinations(sig[:PAIR_POOL], 2)]
+            for a in sig[:2]:
+                pairs += [(a, b) for b in explainers(a, sigs)[0] if (a, b) not in pairs and (b, a) not in pairs]
+            ok = pair_fits([x for x in pairs if frozenset(x) not in conf_set])
+            if ok and ok[0][4]:
+                verdict, named2, final_effects, final_fit, message = name_pair(ok)
             else:
+                best = sig[0]
                 verdict = "unexplained"
-                final_effects = [best] + ([best2[0]] if best2 else [])
-                final_fit = best2[1] if best2 else fits[best]
+                final_effects = list(ok[0][0]) if ok else [best]
+                final_fit = ok[0][1] if ok else fits[best]
                 message = (f"Unexplained: the best candidate {best} (LR {cres[best].lr:.4g}) reduces the cost but a "
-                           f"significant gap remains (2·cost {2 * final_fit.cost:.4g} > "
-                           f"{gap_thr(final_effects):.4g}) in {where}; nothing in the library explains it.")
+                           f"significant gap remains (2·cost {2 * final_fit.metadata['data_cost']:.4g} > "
+                           f"{gap_thr(final_effects):.4g}) in {where}; no candidate or pair of candidates in the "
+                           "library explains it.")
+    if verdict in ("named", "ambiguous") and final_fit is not None:
+        thr_f = gap_thr(final_effects)
+        if 2 * final_fit.metadata["data_cost"] > thr_f:
+            message += (f" A small residual misfit remains ({100 * (2 * final_fit.metadata['data_cost'] - thr_f) / max(2 * cost0 - gap_thr0, 1e-300):.2g} % "
+                        "of the baseline's excess over the gap threshold): the data's own law for this effect "
+                        "differs slightly from the library's parametrisation.")
+    # ---- 7. audits of the final model
+    final_bounds, final_implausible = ([], [])
+    if final_fit is not None:
+        final_bounds, final_implausible = audit(final_fit, [fp for c in final_effects for fp in eff_free(c)])
+    at_bound = [a for a in final_bounds if a["status"] == "at"]
+    widen = [a for a in at_bound if not a["hard"] and "." in a["name"] and not a["name"].startswith("laws.")
+             and a["name"].split(".", 1)[0] in final_effects]
+    # a significant candidate confusable with a named effect that stopped at a widenable bound: its
+    # LR there is only a lower bound, so it might beat the named effect once the bound is widened
+    widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
+              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")]
+    if verdict in ("named", "ambiguous") and widen:
+        verdict = "at_bound"
+        message = ("At bound — widen or the effect is larger than allowed: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in widen)
+            + ". The gap closes only there, or a confusable candidate stopped there, so this is not a confident "
+            "name (raise the bound with "
+            "candidate_bounds / --candidate-bound, or the effect is outside the physical range assumed). "
+            + message)
+    if verdict == "unexplained" and final_effects:
+        stuck = [a for c in final_effects for a in cres[c].at_bound if c in cres and a["status"] == "at"
+                 and not a["hard"] and a["name"].startswith(c + ".")] if len(final_effects) == 1 else [
+            a for a in at_bound if not a["hard"] and a["name"].split(".", 1)[0] in final_effects]
+        if stuck:
+            message += (" The best candidate ended at its bound (" + "; ".join(
+                f"{a['name']} = {a['value']:.4g}, {a['side']} bound {a['bound']:.4g}" for a in stuck)
+                + "): widen it — the effect may be larger than allowed.")
+    other_bounds = [a for a in at_bound if a not in widen and not a["hard"]]
+    if other_bounds:
+        message += (" Parameters at a bound in the final fit: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in other_bounds) + ".")
+    b0 = [a for a in audit0["at_bound"] if a["status"] == "at"]
+    if b0 and verdict in ("none", "unexplained"):
+        message += " Baseline parameters at a fit bound: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in b0) + "."
+    if audit0["implausible"]:
+        bad0 = ", ".join(f"{x['name']} = {x['value']:.3g} {x['unit']} (plausible [{x['lower']:.3g}, {x['upper']:.3g}])"
+                         for x in audit0["implausible"])
+        message += (f" The baseline fits only by leaving the plausible range of {bad0}: that is itself evidence of a "
+                    "missing effect" + ("." if verdict != "none" else "; consider the candidates above or "
+                                        "revise the plausible range if it does not apply to this strip."))
+    if final_implausible:
+        message += " In the final fit outside the plausible range: " + ", ".join(
+            f"{x['name']} = {x['value']:.3g} {x['unit']}" for x in final_implausible) + "."
     if not res0.converged:
         message += f" WARNING: the baseline calibration did not converge ({res0.message})."
     bad = [c for c, cr in cres.items() if not cr.converged]
     if bad:
         message += f" Candidate refits that did not converge: {', '.join(bad)}."
-    named = final_effects if verdict in ("named", "ambiguous") else []
+    named = list(final_effects) if verdict in ("named", "ambiguous", "at_bound") else []
     if verdict == "ambiguous":
-        named = [c for c in sig if cres[c].closes_gap and cres[c].aic - min(cres[x].aic for x in sig if cres[x].closes_gap) < AMBIGUITY_AIC]
+        named = named2 if named2 else amb
     if final_fit is not None:
         Gf = pm([final_fit.values])[0]
         n_free_after = len(final_fit.names)
     else:
         Gf, n_free_after = G0, k0
     rf = standardised_residuals(Gf, data, s_ln, s_ph)
+    cost_f = float(0.5 * rf @ rf)
+    warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
+    if warn:
+        message += f" Cost vs declared noise: {warn}."
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
@@ -362,9 +478,13 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
         metadata={"base": base.name, "free": names0, "baseline_effects": beff, "candidates": cand,
-                  "data_fingerprint": data.fingerprint()},
+                  "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried,
+                  "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
+                  "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
+        laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
+        cost_warning=warn,
     )
 
 
 __all__ = ["diagnose", "Diagnosis", "CandidateResult", "VERDICTS", "gap_shrink", "CONFUSABLE_COSINE",
-           "AMBIGUITY_AIC"]
+           "AMBIGUITY_AIC", "PAIR_POOL"]

@@ -33,12 +33,12 @@ def _z_jacobian(predict_many, values: dict, params: Sequence[FreeParameter], r0,
     return ((R - r0[None, :]) / np.array(steps)[:, None]).T
 
 
-def _signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph):
+def _signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph, params=None):
     """Columns d r/d δ at "off" for each effect parameter, δ in units of (typical − off);
-    and which are one-sided (off at a bound)."""
-    e = LIBRARY[effect]
+    and which are one-sided (off at a bound).  ``params``: the effect's parameters with their
+    candidate bounds (default: the library's)."""
     pts, steps, one_sided = [], [], []
-    for p in e.parameters:
+    for p in (params if params is not None else LIBRARY[effect].parameters):
         span = p.typical - p.off
         h = 1e-3
         v = dict(values)

@@ -20,10 +20,29 @@ EXPERIMENT.toml (paths relative to the TOML file; SI units for parameters)::
     W = 2e-3
     [baseline_effects.time_delay]      # effects already in the model (values SI; {} = fitted)
     delay = 1e-3
+    laws = "isothermal"                # temperature laws: "set" (the set's own), "isothermal",
+                                       # "default" (physics.md §7), or a table (below); REQUIRED
+                                       # when `set` is a JSON file without "laws"
+    # [laws]                           # a table instead: start from `base`, change some laws
+    # base = "isothermal"
+    # d = { law = "Arrhenius", activation_energy = 15e3 }
+    # E = "Constant"
+    [candidate_bounds]                 # candidate bounds (SI), replacing the strip-scaled ones
+    "contact_resistance.r2_specific" = [0.0, 0.05]
+    "leakage.conductance" = { upper = 2000.0, typical = 100.0 }
+    [candidate_starts]                 # extra start values of candidate parameters
+    "series_cpe.n" = 0.7
+    [plausible]                        # plausible ranges replacing the defaults (physmodel.plausible)
+    kappa_e = [1e-7, 1e-5]
+    prior = true                       # hold the free base parameters to their plausible ranges
+    baseline_starts = 3                # multi-start count of the baseline fit
 
 Writes report.json (verdict none / named / ambiguous / unexplained, the named effect with its fitted
 value and interval, every candidate's statistics, localisation tables, gap before/after, confusable
 pairs, null calibration), summary.md, bode_before.png and bode_after.png.
+
+Flags: --laws NAME, --law QUANTITY=LAW[:P=V,...] (repeatable), --candidate-bound EFFECT.PARAM=LO:HI,
+--candidate-start EFFECT.PARAM=V, --plausible NAME=LO:HI, --no-prior, --baseline-starts N.
 
 Exit codes: 0 for any verdict, 2 bad input, 130 interrupted.
 """
@@ -63,6 +82,18 @@ def add_parser(subparsers):
     p.add_argument("--null-draws", type=int, help="linearised null Monte Carlo draws (default 4000)")
     p.add_argument("--null-refits", type=int, help="full-refit bootstrap draws under the null (default 4)")
     p.add_argument("--seed", type=int, help="seed of the null Monte Carlo (default 0)")
+    p.add_argument("--laws", help="temperature laws: set (the set's own), isothermal, default (physics.md §7)")
+    p.add_argument("--law", action="append", metavar="QUANTITY=LAW[:P=V,...]",
+                   help="change one law, e.g. d=Arrhenius:activation_energy=20e3 or E=Constant (repeatable)")
+    p.add_argument("--candidate-bound", action="append", metavar="EFFECT.PARAM=LO:HI",
+                   help="candidate bounds (SI) replacing the strip-scaled ones (repeatable)")
+    p.add_argument("--candidate-start", action="append", metavar="EFFECT.PARAM=V",
+                   help="extra start value of a candidate parameter (repeatable)")
+    p.add_argument("--plausible", action="append", metavar="NAME=LO:HI",
+                   help="plausible range of a base parameter replacing the default (repeatable)")
+    p.add_argument("--no-prior", action="store_true",
+                   help="do not hold the free base parameters to their plausible ranges")
+    p.add_argument("--baseline-starts", type=int, help="multi-start count of the baseline fit (default 3)")
     p.add_argument("--out", help="report folder (default diagnosis)")
     p.add_argument("--force", "--overwrite", action="store_true",
                    help="write into a folder that holds another run's results")
@@ -83,7 +114,8 @@ def _load_toml(path: Path) -> dict:
     except tomllib.TOMLDecodeError as exc:
         raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
     known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
-             "geometry", "parameters", "baseline_effects", "null_draws", "null_refits"}
+             "geometry", "parameters", "baseline_effects", "null_draws", "null_refits", "laws",
+             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts"}
     unknown = set(spec) - known
     if unknown:
         raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
@@ -126,7 +158,14 @@ _TYPES = {"data": (lambda v: isinstance(v, str), "a file name"), "kind": (lambda
           "parameters": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()), "a table of NAME = number (SI)"),
           "baseline_effects": (lambda v: isinstance(v, dict) and all(isinstance(e, dict) and all(_is_num(x) for x in e.values())
                                                                      for e in v.values()),
-                               "a table of [baseline_effects.NAME] tables of numbers")}
+                               "a table of [baseline_effects.NAME] tables of numbers"),
+          "laws": (lambda v: isinstance(v, (str, dict)), "a name (set, isothermal, default) or a [laws] table"),
+          "candidate_bounds": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
+          "candidate_starts": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()),
+                               "a table of NAME = number"),
+          "plausible": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
+          "prior": (lambda v: isinstance(v, bool), "true or false"),
+          "baseline_starts": (lambda v: _is_int(v) and v >= 1, "a positive integer")}
 
 
 def _check_types(spec: dict, path: Path) -> None:
@@ -134,6 +173,45 @@ def _check_types(spec: dict, path: Path) -> None:
         ok, what = _TYPES[key]
         if not ok(value):
             raise IPMCError(f"experiment file {str(path)!r}: {key} = {value!r}; expected {what}")
+def _range(item: str, option: str) -> tuple[str, tuple[float, float]]:
+    name, sep, rest = item.partition("=")
+    parts = rest.split(":")
+    try:
+        if not sep or len(parts) != 2:
+            raise ValueError
+        return name.strip(), (float(parts[0]), float(parts[1]))
+    except ValueError:
+        raise IPMCError(f"{option} {item!r}: expected NAME=LOWER:UPPER (SI)") from None
+
+
+def _laws(spec: dict, args, set_name) -> object:
+    """The laws choice from TOML ``laws`` and ``--laws``/``--law``; a JSON set without laws needs one."""
+    import json
+
+    laws = args.laws if args.laws is not None else spec.get("laws")
+    if args.law:
+        table = dict(laws) if isinstance(laws, dict) else {"base": laws or "set"}
+        for item in args.law:
+            q, sep, rest = item.partition("=")
+            law, _, params = rest.partition(":")
+            if not sep or not law.strip():
+                raise IPMCError(f"--law {item!r}: expected QUANTITY=LAW[:P=V,...], e.g. d=Arrhenius:activation_energy=2e4")
+            table[q.strip()] = {"law": law.strip(),
+                                **parse_assignments([x for x in params.split(",") if x.strip()], option=f"--law {item!r}:")}
+        laws = table
+    if laws is not None and not isinstance(laws, (str, dict)):
+        raise IPMCError(f"laws = {laws!r}: expected a name (set, isothermal, default) or a table")
+    if str(set_name).lower().endswith(".json") and Path(set_name).is_file():
+        try:
+            has_laws = "laws" in json.loads(Path(set_name).read_text())
+        except (OSError, ValueError) as exc:
+            raise IPMCError(f"parameter file {set_name!r} cannot be read: {exc}") from None
+        base_choice = laws.get("base", "set") if isinstance(laws, dict) else laws
+        if not has_laws and base_choice in (None, "set"):
+            raise IPMCError(f"parameter file {set_name!r} has no 'laws': choose the temperature laws explicitly "
+                            "with laws = \"isothermal\" | \"default\" (physics.md §7) or a [laws] table "
+                            "(--laws / --law); they are stated in the report")
+    return laws
 
 
 def _parse_effect(item: str) -> tuple[str, dict]:
@@ -208,7 +286,21 @@ def build(args):
         unknown = [c for c in cands if c not in ALL_EFFECTS]
         if unknown:
             raise IPMCError(f"candidates: unknown effect(s) {unknown}; expected names from {sorted(ALL_EFFECTS)}")
+    cb = dict(spec.get("candidate_bounds", {}))
+    cb.update(dict(_range(x, "--candidate-bound") for x in args.candidate_bound or []))
+    cs = dict(spec.get("candidate_starts", {}))
+    cs.update(parse_assignments(args.candidate_start, option="--candidate-start"))
+    pl = dict(spec.get("plausible", {}))
+    pl.update(dict(_range(x, "--plausible") for x in args.plausible or []))
+    for key, tab in (("candidate_bounds", cb), ("candidate_starts", cs), ("plausible", pl)):
+        if not isinstance(tab, dict):
+            raise IPMCError(f"[{key}] must be a table")
+    prior = False if args.no_prior else spec.get("prior", True)
+    if not isinstance(prior, bool):
+        raise IPMCError(f"prior = {prior!r}: expected true or false")
     kw = dict(kind=pick(args.kind, "kind", "actuator"), quantity=pick(args.quantity, "quantity"),
+              laws=_laws(spec, args, set_name), candidate_bounds=cb or None, candidate_starts=cs or None,
+              plausible=pl or None, prior=prior, baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
               free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
               null_draws=int(pick(args.null_draws, "null_draws", 4000)),
               null_refits=int(pick(args.null_refits, "null_refits", 4)), seed=int(pick(args.seed, "seed", 0)),

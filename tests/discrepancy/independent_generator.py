@@ -90,12 +90,12 @@ EFFECT_SPECS: dict[str, tuple] = {
     "time_delay": ("time_delay", {"skew_s": ("log", 1e-5, 5e-3), "dac_period_s": ("log", 1e-5, 1e-3)},
                    {"skew_s": 0.0, "dac_period_s": 0.0}),
     "series_resistance": ("series_resistance", {"resistance": ("log", 0.5, 200.0)}, {"resistance": 0.0}),
-    # The library's constant_phase_element mechanism (fractional transport) with a free reference.
-    "fractional_transport": ("constant_phase_element", {"beta": ("lin", 0.995, 0.7), "f_ref_hz": ("log", 1.0, 30.0)},
+    # The library's fractional_transport mechanism with a free reference frequency.
+    "fractional_transport": ("fractional_transport", {"beta": ("lin", 0.995, 0.7), "f_ref_hz": ("log", 1.0, 30.0)},
                              {"beta": 1.0, "f_ref_hz": 10.0}),
     # Interface CPE in series, Q = q_area·W·L; n 0.95-0.6 (rough/porous metal electrodes, CPE
     # exponent n = 1/(D − 1) for fractal dimension D), q_area 2000-2 F s^(n−1)/m² around the
-    # strip's own double layer κe/(2λ) ≈ 20 F/m² (seed 002).  Not yet a library candidate.
+    # strip's own double layer κe/(2λ) ≈ 20 F/m² (seed 002); the library's series_cpe.
     "series_cpe": ("series_cpe", {"n": ("lin", 0.95, 0.6), "q_area": ("log", 2000.0, 2.0)},
                    {"n": 0.8, "q_area": math.inf}),
     # out of library

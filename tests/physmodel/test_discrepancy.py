@@ -35,11 +35,11 @@ def blind():
     cases = {
         "none": lambda r: {},
         "time_delay": lambda r: {"time_delay": {"delay": r.uniform(1.5e-3, 4e-3)}},
-        "constant_phase_element": lambda r: {"constant_phase_element": {"beta": r.uniform(0.85, 0.92)}},
+        "fractional_transport": lambda r: {"fractional_transport": {"beta": r.uniform(0.85, 0.92)}},
         "fixture_resonance": lambda r: {"fixture_resonance": {"frequency_hz": r.uniform(1.0, 20.0),
                                                               "depth": r.uniform(0.5, 0.8), "damping": 0.05}},
         "two": lambda r: {"time_delay": {"delay": r.uniform(1.5e-3, 3e-3)},
-                          "constant_phase_element": {"beta": r.uniform(0.85, 0.9)}},
+                          "fractional_transport": {"beta": r.uniform(0.85, 0.9)}},
     }
     out = {}
     for i, (label, fn) in enumerate(cases.items()):
@@ -63,7 +63,7 @@ def test_null_data_give_no_discrepancy(blind):
     assert max(c.lr for c in d.candidates.values()) <= d.threshold
 
 
-@pytest.mark.parametrize("truth", ["time_delay", "constant_phase_element"])
+@pytest.mark.parametrize("truth", ["time_delay", "fractional_transport"])
 def test_hidden_library_effect_is_named_and_the_gap_shrinks(blind, truth):
     d = blind[truth]
     assert _named_ok(d, truth), (d.verdict, d.named, d.message)
@@ -85,7 +85,7 @@ def test_out_of_library_effect_ends_unexplained(blind):
 def test_two_hidden_effects_are_named_greedily(blind):
     d = blind["two"]
     assert d.verdict == "named", d.message
-    assert sorted(d.named) == ["constant_phase_element", "time_delay"]
+    assert sorted(d.named) == ["fractional_transport", "time_delay"]
 
 
 def test_report_folder(blind, tmp_path):
@@ -93,14 +93,20 @@ def test_report_folder(blind, tmp_path):
     d.write_report(tmp_path / "rep")
     rep = json.loads((tmp_path / "rep" / "report.json").read_text())
     assert rep["verdict"] in VERDICTS and rep["named_effect"]
-    assert set(rep["candidates"]) >= {"time_delay", "amplifier_bandwidth", "constant_phase_element"}
+    assert set(rep["candidates"]) >= {"time_delay", "amplifier_bandwidth", "fractional_transport", "series_cpe"}
+    assert rep["temperature_laws"].startswith("those of the parameter set")
+    assert [r["name"] for r in rep["baseline_parameters"]] == list(FREE)
+    assert all(r["plausible"] != "none" for r in rep["baseline_parameters"] if r["name"] != "alpha0")
+    assert rep["baseline_audit"]["multistart"]["n_starts"] == 3
     for key in ("lr", "aic", "bic", "significant", "values", "ci95_lower"):
         assert key in rep["candidates"]["time_delay"]
     assert rep["gap_before"]["cost"] > rep["gap_after"]["cost"]
     assert len(rep["gap_after"]["rms_db"]) == len(T) and rep["localisation_before"]
     assert {"a": "amplifier_bandwidth", "b": "time_delay"} in [{k: p[k] for k in ("a", "b")} for p in rep["confusable_pairs"]]
     assert all(p["what_separates"] for p in rep["confusable_pairs"])
-    assert "NAMED" in (tmp_path / "rep" / "summary.md").read_text()
+    summ = (tmp_path / "rep" / "summary.md").read_text()
+    assert "NAMED" in summ and "## Baseline parameters" in summ and "Multi-start" in summ
+    assert "Temperature laws:" in summ
     from scenarios.plots import diagnosis_figures
 
     diagnosis_figures(d, tmp_path / "rep")
@@ -136,6 +142,66 @@ def test_linearised_null_gives_the_chi_bar_squared_boundary_mixture():
     assert np.quantile(_constrained_lr(S2, np.array([True, True]), E), 0.95) == pytest.approx(4.231, abs=0.15)
 
 
+def test_a_candidate_at_its_bound_is_never_a_confident_name():
+    """Hidden contact resistance 3e-3 Ω·m² with the candidate bound set to 1e-3 (issue 11, cause 1):
+    diffusivity_temperature (declared confusable) then closes the gap, but the report says that
+    contact_resistance stopped at its bound (widen it) instead of naming confidently; with the
+    strip-scaled bound contact_resistance is named."""
+    data, _ = _hidden(21, lambda r: {"contact_resistance": {"r2_specific": 3e-3}})
+    tight = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0,
+                     candidate_bounds={"contact_resistance.r2_specific": (0.0, 1e-3)})
+    assert tight.verdict in ("at_bound", "unexplained"), tight.message
+    assert frozenset(("contact_resistance", "diffusivity_temperature")) in {frozenset(c[:2]) for c in tight.confusable}
+    assert tight.candidates["contact_resistance"].values["r2_specific"] == pytest.approx(1e-3, rel=1e-3)
+    assert "contact_resistance.r2_specific" in tight.message and "bound" in tight.message and "widen" in tight.message
+    free = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0)
+    assert _named_ok(free, "contact_resistance"), free.message
+    cr = free.candidates["contact_resistance"]
+    assert cr.ci_lower["r2_specific"] <= 3e-3 <= cr.ci_upper["r2_specific"] and not cr.at_bound
+
+
+def test_temperature_laws_are_chosen_and_stated():
+    from physmodel.temperature import ISOTHERMAL
+
+    iso = P.replace(laws=ISOTHERMAL)
+    data = synthesize_sweep(EffectModel(iso, "actuator"), "M", F, T, MagnitudePhaseNoise(0.2, 1.0), seed=5)
+    d = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0, laws="isothermal")
+    assert d.verdict == "none", d.message
+    assert "isothermal" in d.laws
+    d2 = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0,
+                  laws={"base": "isothermal", "d": {"law": "Arrhenius", "activation_energy": 20e3}})
+    assert "Arrhenius(activation_energy=20000)" in d2.laws and d2.verdict != "none"   # the wrong law shows
+    with pytest.raises(ParameterError, match="laws"):
+        diagnose(data, P, free=FREE, laws="warm")
+    with pytest.raises(ParameterError, match="no temperature law"):
+        diagnose(data, P, free=FREE, laws={"viscosity": "Constant"})
+
+
+def test_cost_inconsistent_with_the_declared_noise_is_reported_with_its_factor():
+    data = synthesize_sweep(EffectModel(P, "actuator"), "M", F, T, MagnitudePhaseNoise(0.05, 0.3), seed=8)
+    big = type(data)(**{**data.__dict__, "magnitude_std_db": data.magnitude_std_db * 10,
+                        "phase_std_deg": data.phase_std_deg * 10})
+    d = diagnose(big, P, kind="actuator", free=FREE, seed=0, null_refits=0)
+    assert d.cost_warning.startswith("too low") and "Cost vs declared noise" in d.message
+    factor = float(d.cost_warning.split("about ")[1].split("×")[0])
+    assert 7 < factor < 14                               # the declared σ is 10× the true one
+    ok = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0)
+    assert ok.cost_warning == ""
+
+
+def test_a_baseline_outside_its_plausible_range_is_reported():
+    """Data from a strip damped at ξ = 3 (outside the plausible [0.01, 1]): the baseline can only
+    fit by leaving the range, and the report says that this is evidence of a missing effect."""
+    from physmodel.estimation.records import FreeParameter
+
+    data = synthesize_sweep(EffectModel(P.replace(xi=3.0), "actuator"), "M", F, T, MagnitudePhaseNoise(0.2, 1.0), seed=9)
+    d = diagnose(data, P, kind="actuator", free=("alpha0", "d", FreeParameter("xi", 0.01, 10.0, "log", 0.18)),
+                 seed=0, null_refits=0, candidates=["time_delay", "leakage"])
+    names = [x["name"] for x in d.baseline_audit["implausible"]]
+    assert names == ["xi"] and "plausible range of xi" in d.message
+    assert d.baseline_audit["penalty"] > 0
+
+
 def test_bad_input_is_named():
     data = synthesize_sweep(EffectModel(P, "actuator"), "M", F[:10], [25.0], MagnitudePhaseNoise(0.1, 1.0), seed=1)
     with pytest.raises(IPMCError, match="alpha"):
@@ -146,6 +212,12 @@ def test_bad_input_is_named():
         diagnose(data, P, candidates=["coupling_compliance"])
     with pytest.raises(IPMCError, match="null_draws"):
         diagnose(data, P, null_draws=10)
+    with pytest.raises(ParameterError, match="absolute bounds"):
+        diagnose(data, P, candidate_bounds={"contact_resistance.r2_specific": (0.0, 50.0)})
+    with pytest.raises(ParameterError, match="expected 'effect.parameter'"):
+        diagnose(data, P, candidate_starts={"leakage": 3.0})
+    with pytest.raises(ParameterError, match="plausible range"):
+        diagnose(data, P, plausible={"kappa_e": (1e-5, 1e-7)})
 
 
 def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
@@ -164,6 +236,24 @@ def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
     assert args.func(args) == 0
     rep = json.loads((tmp_path / "out" / "report.json").read_text())
     assert rep["verdict"] in ("named", "ambiguous") and "amplifier_bandwidth" in rep["named"]
+    args = parser.parse_args(["diagnose", str(tmp_path / "exp.toml"), "--quiet", "--laws", "isothermal",
+                              "--law", "d=Arrhenius:activation_energy=15e3", "--candidate-bound",
+                              "electrode_resistance.r1_sheet=0:500", "--candidate-start", "time_delay.delay=1e-3",
+                              "--plausible", "d=1e-12:1e-10", "--baseline-starts", "2", "--out", str(tmp_path / "o2")])
+    assert args.func(args) == 0
+    rep = json.loads((tmp_path / "o2" / "report.json").read_text())
+    assert "Arrhenius(activation_energy=15000)" in rep["temperature_laws"] and "E LogLinear" not in rep["temperature_laws"]
+    assert rep["candidates"]["electrode_resistance"]["candidate_bounds"]["r1_sheet"] == [0.0, 500.0]
+    assert rep["baseline_audit"]["plausible_ranges"]["d"].startswith("[1e-12, 1e-10]")
+    import json as _json
+
+    d = P.to_dict()
+    d.pop("laws")
+    (tmp_path / "nolaws.json").write_text(_json.dumps({k: v for k, v in d.items()}))
+    bad = parser.parse_args(["diagnose", "--data", str(tmp_path / "sweep.csv"), "--set", str(tmp_path / "nolaws.json"),
+                             "--quiet"])
+    with pytest.raises(IPMCError, match="no 'laws'"):
+        bad.func(bad)
     bad = parser.parse_args(["diagnose", "--data", str(tmp_path / "missing.csv"), "--set", "seed002_table3", "--quiet"])
     with pytest.raises(IPMCError):
         bad.func(bad)
