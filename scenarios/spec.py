@@ -82,6 +82,7 @@ def _is_num(v):
 NUM = _T("a finite number", _is_num, float)
 INT = _T("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool))
 STR = _T("a string", lambda v: isinstance(v, str))
+BOOL = _T("true or false", lambda v: isinstance(v, bool))
 NUMS = _T("a non-empty list of finite numbers", lambda v: isinstance(v, list) and v and all(map(_is_num, v)),
           lambda v: [float(x) for x in v])
 INTS = _T("a non-empty list of integers", lambda v: isinstance(v, list) and v and all(
@@ -145,7 +146,8 @@ SECTIONS = {
     "taylor": {"orders": INTS, "temperature_c": NUM, **_SWEEP_GRID, "band_hz": NUMS},
     "blackbox": {"orders": PAIRS, "temperature_c": NUM},
     "discrepancy": {"effects": _Map(_Map(NUM)), "free": STRS, "null_draws": INT, "null_refits": INT, "alpha": NUM,
-                    "seed": INT},
+                    "seed": INT, "laws": STR, "candidate_bounds": _Map(NUMS), "candidate_starts": _Map(NUM),
+                    "plausible": _Map(NUMS), "prior": BOOL, "baseline_starts": INT},
     "fixtures": {"count": INT, "seed": INT, "formats": STRS, "temperatures_c": NUMS, **_SWEEP_GRID,
                  "step_duration_s": NUM, "fs_hz": NUM, "noise_rms_mm": NUM},
     "checks": _Map({"metric": STR, "min": NUM, "max": NUM, "description": STR}),

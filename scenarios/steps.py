@@ -381,7 +381,14 @@ def step_discrepancy(ctx: _Ctx):
     f = ctx.data.frequency_hz[ctx.data.temperature_c == ctx.data.temperatures()[0]]
     data = synthesize_sweep(truth, q, f, list(ctx.data.temperatures()), noise, seed)
     ctx.file(data.to_csv(ctx.out / "data" / "discrepancy_sweep.csv"))
-    kw = {k: cfg[k] for k in ("null_draws", "null_refits", "alpha", "seed") if k in cfg}
+    kw = {k: cfg[k] for k in ("null_draws", "null_refits", "alpha", "seed", "laws", "candidate_starts", "prior",
+                              "baseline_starts") if k in cfg}
+    for key in ("candidate_bounds", "plausible"):          # NAME = [LOWER, UPPER]
+        if key in cfg:
+            bad = [n for n, v in cfg[key].items() if len(v) != 2]
+            if bad:
+                raise ScenarioError(f"{ctx.spec.path}: [discrepancy] {key}.{bad[0]}: expected [LOWER, UPPER]")
+            kw[key] = {n: (float(v[0]), float(v[1])) for n, v in cfg[key].items()}
     if "free" in cfg:
         kw["free"] = tuple(cfg["free"])
     if kind == "sensor":

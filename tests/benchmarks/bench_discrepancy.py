@@ -294,7 +294,7 @@ def report(rows, title):
         c = Counter(r["verdict"] for r in oo)
         vis = [r for r in oo if r["verdict"] != "none"]
         conf = [r for r in oo if r["verdict"] == "named"]
-        print(f"\n=== Out of library ===\n  outcomes: " + ", ".join(f"{k} {v}" for k, v in c.items())
+        print("\n=== Out of library ===\n  outcomes: " + ", ".join(f"{k} {v}" for k, v in c.items())
               + f"\n  unexplained among all: {_rate(sum(r['verdict'] == 'unexplained' for r in oo), len(oo))}"
               f"\n  unexplained among those not 'none': {_rate(sum(r['verdict'] == 'unexplained' for r in vis), len(vis))}"
               f"\n  confident wrong names: {len(conf)}" + "".join(f"\n    {r['label']} -> {outcome(r)}" for r in conf))
@@ -309,7 +309,7 @@ def report(rows, title):
               f"share ≥ 5× {np.mean(gs >= 5):.2f}")
     warn = Counter(r["cost_warning"].split(":")[0] for r in rows if r["cost_warning"])
     if warn:
-        print(f"\n=== Cost-vs-noise warnings: " + ", ".join(f"{k} {v}" for k, v in warn.items()) + " ===")
+        print("\n=== Cost-vs-noise warnings: " + ", ".join(f"{k} {v}" for k, v in warn.items()) + " ===")
     ts = np.array([r["t"] for r in rows])
     print(f"\n=== Time per diagnosis: mean {ts.mean():.1f} s, median {np.median(ts):.1f} s, max {ts.max():.1f} s "
           f"(n = {ts.size}, wall per process on a shared 2-core machine) ===")

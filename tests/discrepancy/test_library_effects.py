@@ -15,7 +15,7 @@ import pytest
 
 import independent_generator as gen
 import independent_physics as ip
-import oracles
+import beam_circuit_oracles as oracles
 from physmodel import ActuatorModel, IPMCParameters, beam, electrode, get_parameter_set
 from physmodel.effects import EffectModel
 from physmodel.params import STATE_FIELDS
