@@ -120,7 +120,7 @@ class Structure:
         (zeros within about 2Z): poles and zeros far outside the data band are not
         identifiable and would only drift towards 0 or ∞ (a monic zero section cannot reach
         a zero at infinity, so without a bound the gain and the section drift together and
-        IPOPT runs out of iterations).
+        the solver runs out of iterations).
         """
         out = {}
         if w_min is None:
