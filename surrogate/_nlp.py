@@ -276,13 +276,36 @@ def get_solver(structure: Structure, n_points: int, kind: str, *, max_iter: int,
     return solver
 
 
+def _r_factor(a: np.ndarray) -> np.ndarray:
+    """Triangular factor of a = QR by modified Gram–Schmidt (backward stable for R), with
+    element-wise numpy operations only (no BLAS/LAPACK call on the tall matrix)."""
+    q = np.array(a.T, dtype=float, order="C")          # columns of a as rows
+    p = q.shape[0]
+    r = np.zeros((p, p))
+    for j in range(p):
+        nrm = float(np.sqrt(np.einsum("i,i->", q[j], q[j])))
+        r[j, j] = nrm
+        if nrm == 0.0:
+            continue
+        q[j] /= nrm
+        if j + 1 < p:
+            proj = np.einsum("ij,j->i", q[j + 1:], q[j])
+            r[j, j + 1:] = proj
+            q[j + 1:] -= proj[:, None] * q[j]
+    return r
+
+
 def covariance(jac: np.ndarray, resid: np.ndarray, scale: bool):
     """Gauss–Newton covariance (JᵀJ)⁻¹·s², s² = reduced χ² when ``scale`` (else 1).
 
     Returns ``(cov, rank_deficient)``; a rank-deficient Jacobian gives the pseudo-inverse.
     """
     n_res, n_par = jac.shape
-    u, s, vt = np.linalg.svd(jac, full_matrices=False)
+    # SVD of the triangular factor R (jac = QR): the same singular values and right vectors,
+    # but the only LAPACK call is on the small R.  LAPACK on the tall jac runs matrix-vector
+    # products on several OpenBLAS threads, which on a busy machine wait for each other (up to
+    # 0.7 s for 4800 x 21, against 2 ms here).
+    s, vt = np.linalg.svd(_r_factor(jac), full_matrices=False)[1:]
     keep = s > s[0] * 1e-12 if s.size else s.astype(bool)
     inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 0.0)
     cov = (vt.T * inv_s2) @ vt

@@ -320,6 +320,27 @@ def polynomials(structure: Structure, theta, tau: float = 0.0):
     return np.asarray(num, float), np.asarray(den, float)
 
 
+def denominators(structure: Structure, theta, taus) -> np.ndarray:
+    """Monic denominator coefficients in s̃ (ascending) at many scaled temperatures at once,
+    shape (len(taus), n_poles + 1); the same numbers as ``polynomials(...)[1]`` per τ."""
+    taus = np.atleast_1d(np.asarray(taus, float))
+    vals = structure.slot_matrix(theta) @ (taus[None, :] ** np.arange(structure.n_coef)[:, None])
+    v = dict(zip(structure.slots, vals))                       # slot -> (K,)
+    n, k = structure.n_poles, taus.size
+    if structure.form == "coefficients":
+        return np.column_stack([v[f"a{j}"] for j in range(n)] + [np.ones(k)])
+    den = np.ones((k, 1))
+    sections = [(np.exp(v[f"log_a0_{i}"]), np.exp(v[f"log_a1_{i}"]), np.ones(k)) for i in range(n // 2)]
+    if n % 2:
+        sections.append((np.exp(v["log_c"]), np.ones(k)))
+    for sec in sections:
+        out = np.zeros((k, den.shape[1] + len(sec) - 1))
+        for j, c in enumerate(sec):
+            out[:, j:j + den.shape[1]] += den * c[:, None]
+        den = out
+    return den
+
+
 def _factor_roots(poly_asc) -> np.ndarray:
     if len(poly_asc) == 3:
         c0, c1 = poly_asc[0], poly_asc[1]
