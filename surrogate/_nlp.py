@@ -81,10 +81,16 @@ class Problem:
     def n_residuals(self) -> int:
         return 2 * self.n_points
 
-    def line_data(self) -> np.ndarray:
-        """(w̃, τ, Re h, Im h, 1/σ_a, 1/σ_b) of every line, line after line (6N,)."""
-        return np.column_stack([self.w, self.tau, self.h.real, self.h.imag,
-                                self.inv_sig_a, self.inv_sig_b]).ravel()
+    def line_data(self, n_lines: int | None = None) -> np.ndarray:
+        """(w̃, τ, Re h, Im h, 1/σ_a, 1/σ_b) of every line, line after line (6N,); padded to
+        ``n_lines`` with copies of the first line at zero weight (zero residuals)."""
+        d = np.column_stack([self.w, self.tau, self.h.real, self.h.imag,
+                             self.inv_sig_a, self.inv_sig_b])
+        if n_lines is not None and n_lines > d.shape[0]:
+            pad = np.repeat(d[:1], n_lines - d.shape[0], axis=0)
+            pad[:, 4:] = 0.0
+            d = np.vstack([d, pad])
+        return d.ravel()
 
     def residual(self, theta) -> np.ndarray:
         return residual(self.structure, np.asarray(theta, float), self.w, self.tau, self.h.real,
@@ -117,26 +123,42 @@ _CACHE: dict = {}
 _CACHE_MAX = 64
 
 
+#: lines per block of the IPOPT problem: the data are padded to whole blocks, so the CasADi
+#: graph maps a block function (built once per structure) over ceil(N/BLOCK_LINES) blocks
+BLOCK_LINES = 128
+
+
 @lru_cache(maxsize=64)
-def _line_functions(structure: Structure, kind: str):
-    """Residual of one frequency line, r(θ; w̃, τ, Re h, Im h, 1/σ_a, 1/σ_b) ∈ R², and the
-    Hessian of ½‖r‖² in θ, as CasADi functions: built once per structure and residual kind,
-    mapped over any number of lines."""
+def _block_functions(structure: Structure, kind: str):
+    """Residuals of one block of ``BLOCK_LINES`` frequency lines, r(θ; data) ∈ R^(2×B) with
+    data (w̃, τ, Re h, Im h, 1/σ_a, 1/σ_b) as a 6×B matrix, and the Hessian of ½‖r‖² in θ
+    summed over the block, as CasADi functions: one per-line residual and its exact Hessian,
+    mapped over the block.  Built once per structure and residual kind; mapping them over
+    the blocks of any data set costs little (mapping a p×p output over thousands of single
+    lines does not: CasADi's map then costs time proportional to the lines)."""
     import casadi as ca
 
     x = ca.SX.sym("x", structure.n_params)
     d = ca.SX.sym("d", 6)
     r = residual(structure, x, d[0], d[1], d[2], d[3], d[4], d[5], kind, CasadiBackend())
-    hess = ca.hessian(0.5 * ca.sumsqr(r), x)[0]
-    return (ca.Function("line_residual", [x, d], [r]),
-            ca.Function("line_hessian", [x, d], [hess]))
+    line_r = ca.Function("line_residual", [x, d], [r])
+    line_h = ca.Function("line_hessian", [x, d], [ca.hessian(0.5 * ca.sumsqr(r), x)[0]])
+    xm = ca.MX.sym("x", structure.n_params)
+    dm = ca.MX.sym("d", 6, BLOCK_LINES)
+    block_r = ca.Function("block_residual", [xm, dm],
+                          [line_r.map("lines", "serial", BLOCK_LINES, [0], [])(xm, dm)])
+    block_h = ca.Function("block_hessian", [xm, dm],
+                          [line_h.map("lines_h", "serial", BLOCK_LINES, [0], [0])(xm, dm)])
+    return block_r, block_h
 
 
 class Solver:
     """IPOPT on ½·mean(r(θ; data)²) with the data as NLP parameters.
 
-    The objective is one per-line residual function mapped over the lines (CasADi ``map``),
-    so building a solver costs the same whatever the number of lines; solvers are cached per
+    The objective is one per-line residual function mapped over blocks of lines (CasADi
+    ``map``, see :func:`_block_functions`), and the Hessian of the Lagrangian is assembled from
+    the per-line Hessians the same way, so building a solver costs about the same whatever
+    the number of lines; solvers are cached per
     structure, number of lines, residual kind and constraint set (:func:`get_solver`).  The
     fitters use it only where constraints are needed (Levenberg–Marquardt in
     :mod:`surrogate._lsq` does the unconstrained solves).
@@ -158,11 +180,12 @@ class Solver:
         st = self.structure = structure
         self.n_points = int(n_points)
         n = self.n_points
+        self.n_blocks = nb = -(-n // BLOCK_LINES)
         x = ca.MX.sym("x", st.n_params)
-        p = ca.MX.sym("p", 6 * n)          # line after line (Problem.line_data)
-        data = ca.reshape(p, 6, n)
-        line_r, line_hess = _line_functions(st, kind)
-        r = line_r.map("lines", "serial", n, [0], [])(x, data)
+        p = ca.MX.sym("p", 6 * nb * BLOCK_LINES)      # line after line, see line_data
+        data = ca.reshape(p, 6, nb * BLOCK_LINES)
+        block_r, block_h = _block_functions(st, kind)
+        r = block_r.map("blocks", "serial", nb, [0], [])(x, data)
         f = 0.5 * ca.sumsqr(r) / (2 * n)
         xs = ca.SX.sym("x", st.n_params)
         g, self._g_kinds = [], []
@@ -190,7 +213,7 @@ class Solver:
         # differentiating the mapped objective instead costs time proportional to the lines)
         lam_f = ca.MX.sym("lam_f")
         lam_g = ca.MX.sym("lam_g", gs.shape[0])
-        h_f = line_hess.map("lines_hessian", "serial", n, [0], [0])(x, data) / (2 * n)
+        h_f = block_h.map("blocks_h", "serial", nb, [0], [0])(x, data) / (2 * n)
         hess = ca.Function("lagrangian_hessian", [x, p, lam_f, lam_g],
                            [ca.triu(lam_f * h_f + g_hess(x, lam_g))],
                            ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
@@ -241,7 +264,7 @@ class Solver:
         w_min, w_max = float(problem.w.min()), float(problem.w.max())
         lbx, ubx = st.bounds(w_min, w_max)
         theta0 = np.clip(np.asarray(theta0, float), lbx + 1e-9, ubx - 1e-9)
-        args = {"x0": theta0, "lbx": lbx, "ubx": ubx, "p": problem.line_data()}
+        args = {"x0": theta0, "lbx": lbx, "ubx": ubx, "p": problem.line_data(self.n_blocks * BLOCK_LINES)}
         if self._g_kinds:
             sb = st.slot_bounds(w_min, w_max)
             lbg = [sb[k][0] if k in sb else self.hurwitz_margin for k in self._g_kinds]

@@ -239,8 +239,11 @@ class ScheduledFit:
         history += [F.history_entry("joint", name, out) for name, out in outcomes]
         F.resume_slowest(outcomes, None, history, "joint", self.max_iter)
         final, setups = [], {}
-        for name, out in outcomes:
-            if out.status == STATUS_STOPPED:
+        # constrained re-solves, cheapest outcome first; an outcome whose (unconstrained) cost
+        # is already above a settled one cannot win and keeps its unconstrained answer
+        settled = np.inf
+        for name, out in sorted(outcomes, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf):
+            if out.status == STATUS_STOPPED or not out.cost < settled:
                 final.append((name, out))
                 continue
             if outside_slot_bounds(out.theta):
@@ -260,6 +263,8 @@ class ScheduledFit:
                         break
                     grid, th = np.union1d(grid, (dense_t[bad] - c) / sc), out.theta
             final.append((name, out))
+            if out.converged:
+                settled = min(settled, out.cost)
         # a constrained (IPOPT) solve that ran out of iterations is resumed like the others
         low = min(final, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)[0]
         if low in setups:
