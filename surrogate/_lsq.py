@@ -187,29 +187,34 @@ class Evaluator:
         return c
 
 
-#: rows per block of the products with the Jacobian: OpenBLAS runs larger products on
-#: several threads, which on a machine whose other cores are busy wait for each other (a
-#: joint fit at 2400 lines ran 5–10x slower); blocks this small stay on one thread
-BLOCK_ROWS = 512
+def block_rows(p: int) -> int:
+    """Rows per block of the products with a Jacobian of ``p`` columns.  OpenBLAS runs a
+    matrix product on several threads above about 2.6e5 multiply-adds (a matrix-vector
+    product above 9216 entries), and on a machine whose other cores are busy those threads
+    wait for each other (a joint fit ran 5–15x slower); blocks below both limits stay on
+    one thread."""
+    return int(max(16, min(512, 9216 // max(p, 1), 250_000 // max(p * p, 1))))
 
 
 def _normal_equations(J: np.ndarray, r: np.ndarray):
-    """JᵀJ (S, p, p) and Jᵀr (S, p), summed over blocks of ``BLOCK_ROWS`` residuals."""
+    """JᵀJ (S, p, p) and Jᵀr (S, p), summed over blocks of rows (see ``block_rows``)."""
     a = g = None
-    for i in range(0, J.shape[1], BLOCK_ROWS):
-        jb = J[:, i:i + BLOCK_ROWS]
+    rows = block_rows(J.shape[2])
+    for i in range(0, J.shape[1], rows):
+        jb = J[:, i:i + rows]
         jt = jb.transpose(0, 2, 1)
-        ab, gb = jt @ jb, (jt @ r[:, i:i + BLOCK_ROWS, None])[..., 0]
+        ab, gb = jt @ jb, (jt @ r[:, i:i + rows, None])[..., 0]
         a, g = (ab, gb) if a is None else (a + ab, g + gb)
     return a, g
 
 
 def _matvec(J: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """J x (S, m), block by block (see ``BLOCK_ROWS``)."""
-    if J.shape[1] <= BLOCK_ROWS:
+    """J x (S, m), block by block (see ``block_rows``)."""
+    rows = block_rows(J.shape[2])
+    if J.shape[1] <= rows:
         return (J @ x[..., None])[..., 0]
-    return np.concatenate([(J[:, i:i + BLOCK_ROWS] @ x[..., None])[..., 0]
-                           for i in range(0, J.shape[1], BLOCK_ROWS)], axis=1)
+    return np.concatenate([(J[:, i:i + rows] @ x[..., None])[..., 0]
+                           for i in range(0, J.shape[1], rows)], axis=1)
 
 
 class LevenbergMarquardt:
