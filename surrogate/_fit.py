@@ -234,6 +234,7 @@ WARM_MARGIN = 0.02
 def _outcome(lm: LevenbergMarquardt, i: int, time_s: float) -> SolveOutcome:
     def resume(n):
         t0 = time.perf_counter()
+        lm.revive(i)
         lm.run(n, only=[i])
         return _outcome(lm, i, time.perf_counter() - t0)
 

@@ -284,6 +284,13 @@ class LevenbergMarquardt:
     def n_starts(self) -> int:
         return self.theta.shape[0]
 
+    def revive(self, i: int) -> None:
+        """Let a start that was stopped (or ran out of iterations) run again; it is no longer
+        stopped in favour of the others."""
+        if self.status[i] in (STATUS_STOPPED, STATUS_MAXITER):
+            self.running[i], self.status[i], self.converged[i] = True, "", False
+            self.margins[i] = np.inf
+
     def _end(self, i: int, status: str, converged: bool) -> None:
         self.running[i] = False
         self.status[i] = status

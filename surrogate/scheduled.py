@@ -234,25 +234,35 @@ class ScheduledFit:
         const[:, 0] = th0 if st0.form == st.form else convert(st0, th0, st.form)
         evaluator = Evaluator(problem)
         lb, ub = st.bounds()
-        outcomes = F.race_starts(evaluator, [("two-stage", theta2), ("constant", const.ravel())], self.max_iter, self.tol, lb, ub,
+        starts = {"two-stage": theta2, "constant": const.ravel()}
+        outcomes = F.race_starts(evaluator, list(starts.items()), self.max_iter, self.tol, lb, ub,
                                  prefer=None)
         history += [F.history_entry("joint", name, out) for name, out in outcomes]
         F.resume_slowest(outcomes, None, history, "joint", self.max_iter)
         final, setups = [], {}
         # constrained re-solves, cheapest outcome first; an outcome whose (unconstrained) cost
-        # is already above a settled one cannot win and keeps its unconstrained answer
+        # is already above a settled one cannot win and keeps its unconstrained answer; a
+        # start stopped in favour of one whose constrained answer turned out costlier is
+        # finished now and treated the same way
         settled = np.inf
         for name, out in sorted(outcomes, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf):
-            if out.status == STATUS_STOPPED or not out.cost < settled:
+            if not out.cost < settled:
                 final.append((name, out))
                 continue
+            if out.status == STATUS_STOPPED:
+                out = out.resume(self.max_iter)
+                history.append(F.history_entry("joint (continued)", name, out))
+                if not out.cost < settled:
+                    final.append((name, out))
+                    continue
             if outside_slot_bounds(out.theta):
                 setups[name] = (taus, False)
                 out = solver_for(taus, False).solve(problem, out.theta)
                 history.append(F.history_entry(
                     f"joint (section bounds at {taus.size} temperatures)", name, out))
             if out.converged and hurwitz and unstable(out.theta).any():
-                grid, th = taus, out.theta
+                start = starts[name]          # a stable start is the better way in
+                grid, th = taus, (start if not unstable(start).any() else out.theta)
                 for _ in range(_MAX_REFINE + 1):
                     setups[name] = (grid, True)
                     out = solver_for(grid, True).solve(problem, th)
