@@ -338,8 +338,83 @@ def build_section(args):
             print(f"| {label} | {lines} | {first:.2f} | {again:.2f} | {first / again:.2f} | {conv} | {ipopt} |")
 
 
+# ============================================================================ stream
+def _median_interleaved(fns: dict, reps: int) -> dict:
+    times = {k: [] for k in fns}
+    for _ in range(reps):
+        for k, f in fns.items():
+            gc.collect()
+            t0 = time.perf_counter()
+            f()
+            times[k].append(time.perf_counter() - t0)
+    return {k: float(np.median(v)) for k, v in times.items()}
+
+
+def stream_section(args):
+    import scipy.signal as ss
+    from inversion import StreamingInverter, invert
+    from inversion.examples import seed000_sensor_35c
+
+    G = seed000_sensor_35c("coefficients")
+    reps = 3 if args.quick else 7
+    print("\n## Streaming and finite-preview batch inversion (seed 000 35 °C sensor model, 4th order)\n")
+    dt = 1e-3
+    rng = np.random.default_rng(0)
+    b4, a4 = ss.butter(4, 0.1)
+    n1 = 5_000 if args.quick else 20_000
+    u1 = np.sin(2 * np.pi * 20 * dt * np.arange(n1)) + 0.1 * rng.standard_normal(n1)
+    zi0 = ss.lfilter_zi(b4, a4) * 0.0
+
+    def stream(u, chunk):
+        inv = StreamingInverter(G, dt, "auto")
+        for i in range(0, u.size, chunk):
+            inv.push(u[i:i + chunk])
+
+    def lfilter_carried(u):
+        zi = zi0
+        for i in range(u.size):
+            _, zi = ss.lfilter(b4, a4, u[i:i + 1], zi=zi)
+
+    t = _median_interleaved({"stream": lambda: stream(u1, 1), "lfilter": lambda: lfilter_carried(u1)}, reps)
+    print(f"dt = 1 ms, preview auto ({StreamingInverter(G, dt, 'auto').preview_samples} samples).\n")
+    print("| chunk | streaming [ns/sample] | reference | reference [ns/sample] | streaming / reference | goal |")
+    print("|--:|--:|:--|--:|--:|:--|")
+    r1 = t["stream"] / t["lfilter"]
+    print(f"| 1 | {1e9 * t['stream'] / n1:.0f} | lfilter (4th order) with carried state, one sample per call | "
+          f"{1e9 * t['lfilter'] / n1:.0f} | {r1:.2f} | ≤ 5 µs/sample: "
+          f"{'met' if t['stream'] / n1 <= 5e-6 else 'NOT met'} |")
+    n2 = 1 << (18 if args.quick else 20)
+    u2 = np.sin(2 * np.pi * 20 * dt * np.arange(n2)) + 0.1 * rng.standard_normal(n2)
+    t = _median_interleaved({"stream": lambda: stream(u2, 4096),
+                             "batch": lambda: invert(G, dt, u2, preview="auto")}, reps)
+    r2 = t["stream"] / t["batch"]
+    print(f"| 4096 | {1e9 * t['stream'] / n2:.1f} | batch `invert(..., preview='auto')` of the whole record | "
+          f"{1e9 * t['batch'] / n2:.1f} | {r2:.2f} | ≤ 1.5× batch: {'met' if r2 <= 1.5 else 'NOT met'} |")
+    print("\nFinite-preview batch throughput as a ratio to `scipy.signal.lfilter` (4th-order Butterworth) "
+          "over the same samples, 2^21 samples:\n")
+    print("| sampling rate | preview [samples] | anticausal filter | invert [ns/sample] | lfilter [ns/sample] | "
+          "ratio (lfilter time / invert time) | goal ≥ 0.3 |")
+    print("|--:|--:|:--|--:|--:|--:|:--|")
+    n3 = 1 << (19 if args.quick else 21)
+    from inversion import split_inverse
+    from inversion._discrete import Plan
+
+    sp = split_inverse(G)
+    for fs in (1e3, 5e3, 20e3):
+        d = 1.0 / fs
+        u3 = np.sin(2 * np.pi * 20 * d * np.arange(n3)) + 0.1 * rng.standard_normal(n3)
+        t = _median_interleaved({"invert": lambda: invert(sp, d, u3, preview="auto"),
+                                 "lfilter": lambda: ss.lfilter(b4, a4, u3)}, reps)
+        plan = Plan(sp, d, int(round(sp.auto_preview_s / d)))
+        kind = "fused" if getattr(plan, "fused", None) is not None else (
+            plan.anti.kind if plan.anti is not None else "none")
+        ratio = t["lfilter"] / t["invert"]
+        print(f"| {fs / 1e3:g} kHz | {plan.n_preview} | {kind} | {1e9 * t['invert'] / n3:.1f} | "
+              f"{1e9 * t['lfilter'] / n3:.1f} | {ratio:.2f} | {'met' if ratio >= 0.3 else 'NOT met'} |")
+
+
 # ============================================================================ main
-SECTIONS = {"fit": fit_section, "build": build_section, "joint": joint_section}
+SECTIONS = {"fit": fit_section, "build": build_section, "joint": joint_section, "stream": stream_section}
 
 
 def main(argv=None):
