@@ -124,7 +124,7 @@ def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolat
     temps = [None] if data.temperature_c is None else list(data.temperatures())
     out = []
     for t in temps:
-        k = slice(None) if t is None else np.isclose(data.temperature_c, t, rtol=0, atol=1e-9)
+        k = slice(None) if (t is None or len(temps) == 1) else np.isclose(data.temperature_c, t, rtol=0, atol=1e-9)
         hm, hd = h[k], data.response[k]
         try:
             fp = fit_percent(hm, hd)

@@ -84,7 +84,7 @@ def _stable_sections_theta(w, h, n_zeros, den_roots, num=None):
     stable = stabilise_roots(rts)
     quads, single = group_roots(stable)
     poles_part = pole_slots_from_groups(quads, single)
-    if num is None or not np.allclose(stable, rts, rtol=1e-12, atol=0):
+    if num is None or np.any(stable != rts):
         den = np.real(np.poly(stable)[::-1])
         num = numerator_ls(w, h, n_zeros, den)
     return np.concatenate([num, poles_part])
@@ -105,21 +105,23 @@ def spread_poles(w, n_poles: int, damping: float = 0.5) -> np.ndarray:
 
 
 def _sk_costs(sk, structure, costs):
-    """Cost of each SK iterate as it stands (coefficient form, one batched evaluation);
-    +inf where a pole is unstable (those would be reflected before use)."""
+    """Cost of each SK iterate as it stands (coefficient form, one batched evaluation),
+    +inf where a pole is unstable (those would be reflected before use), and the poles of
+    every iterate (one batched eigenvalue call; NaN where the denominator is not finite)."""
     n = structure.n_poles
     dens = np.array([den for _, den in sk])                   # (k, n+1), monic
     comp = np.zeros((len(sk), n, n))
     comp[:, 0, :] = -dens[:, -2::-1]
     comp[:, np.arange(1, n), np.arange(n - 1)] = 1.0
     ok = np.all(np.isfinite(comp), axis=(1, 2))
-    stable = np.zeros(len(sk), bool)
+    poles = np.full((len(sk), n), np.nan, complex)
     if ok.any():
-        stable[ok] = np.all(np.linalg.eigvals(comp[ok]).real < 0, axis=1)
+        poles[ok] = np.linalg.eigvals(comp[ok])
+    stable = np.all(poles.real < 0, axis=1)
     coef = structure.with_form("coefficients")
     thetas = np.array([np.concatenate([num, den[:-1]]) for num, den in sk])
     c = np.asarray(costs(coef, thetas), float)
-    return np.where(stable & np.isfinite(c), c, np.inf)
+    return np.where(stable & np.isfinite(c), c, np.inf), poles
 
 
 def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.ndarray]]:
@@ -138,16 +140,16 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
             for i, (num, den) in enumerate(sk):
                 cands.append(("levy" if i == 0 else f"sk{i}", np.concatenate([num, den[:-1]])))
         else:
+            raw, poles = _sk_costs(sk, structure, costs)
             picks = list(range(len(sk)))
             if len(sk) > 1:
-                raw = _sk_costs(sk[1:], structure, costs)
-                j = int(np.argmin(raw))
+                j = 1 + int(np.argmin(raw[1:]))
                 if np.isfinite(raw[j]):   # else: no stable SK iterate, convert them all
-                    picks = [0, 1 + j]
+                    picks = [0, j]
             for i in picks:
                 num, den = sk[i]
-                if np.all(np.isfinite(den)):
-                    theta = _stable_sections_theta(w, h, m, np.roots(den[::-1]), num)
+                if np.all(np.isfinite(poles[i])):
+                    theta = _stable_sections_theta(w, h, m, poles[i], num)
                     cands.append(("levy" if i == 0 else f"sk{i}", theta))
             cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n))))
     cands = [(name, th) for name, th in cands if np.all(np.isfinite(th))]

@@ -86,6 +86,8 @@ class Evaluator:
         self.s2 = self.s * self.s
         m, n = st.n_zeros, st.n_poles
         self.spow = (1j * w)[:, None] ** np.arange(max(m, n) + 1)
+        self._sp_num_t = np.ascontiguousarray(self.spow[:, :m + 1].T)
+        self._sp_den_t = np.ascontiguousarray(self.spow[:, :n].T)
         self.tpow = np.asarray(problem.tau, float)[:, None] ** np.arange(st.n_coef)
         self.inv_h = 1.0 / np.asarray(problem.h, complex)
         self.weights = np.concatenate([np.asarray(problem.inv_sig_a, float),
@@ -124,12 +126,19 @@ class Evaluator:
                 num = num * e
                 if grad:
                     g[..., lay["ze"]] = 1.0 / e
+        elif v.shape[1] == 1:                     # one temperature: a matrix product
+            num = v[:, 0, lay["b"]] @ self._sp_num_t
+            if grad:
+                g[..., lay["b"]] = sp[:, :m + 1] / num[..., None]
         else:
             num = (v[..., lay["b"]] * sp[:, :m + 1]).sum(axis=-1)
             if grad:
                 g[..., lay["b"]] = sp[:, :m + 1] / num[..., None]
         if lay["form"] == "coefficients":
-            den = sp[:, n] + (v[..., lay["a"]] * sp[:, :n]).sum(axis=-1)
+            if v.shape[1] == 1:
+                den = sp[:, n] + v[:, 0, lay["a"]] @ self._sp_den_t
+            else:
+                den = sp[:, n] + (v[..., lay["a"]] * sp[:, :n]).sum(axis=-1)
             if grad:
                 g[..., lay["a"]] = -sp[:, :n] / den[..., None]
         else:
@@ -157,12 +166,16 @@ class Evaluator:
         theta = np.asarray(theta, float)
         single = theta.ndim == 1
         th = theta[None, :] if single else theta
+        n = self.n_lines
         with np.errstate(all="ignore"):
             q, g = self._model(th, jacobian)
+            r = np.empty((th.shape[0], 2 * n))
             if self.kind == "log":
-                r = np.concatenate([np.log(np.abs(q)), np.angle(q)], axis=-1)
+                np.log(np.abs(q), out=r[:, :n])
+                np.arctan2(q.imag, q.real, out=r[:, n:])
             else:
-                r = np.concatenate([q.real - 1.0, q.imag], axis=-1)
+                np.subtract(q.real, 1.0, out=r[:, :n])
+                r[:, n:] = q.imag
             r *= self.weights
             if not jacobian:
                 return r[0] if single else r
@@ -171,8 +184,9 @@ class Evaluator:
             nc = self.structure.n_coef
             if nc > 1:
                 g = (g[..., None] * self.tpow[:, None, :]).reshape(g.shape[0], self.n_lines, -1)
-            jac = np.concatenate([g.real, g.imag], axis=1)
-            jac *= self.weights[:, None]
+            jac = np.empty((g.shape[0], 2 * n, g.shape[2]))
+            np.multiply(g.real, self.weights[:n, None], out=jac[:, :n])
+            np.multiply(g.imag, self.weights[n:, None], out=jac[:, n:])
         return (r[0], jac[0]) if single else (r, jac)
 
     def cost(self, theta) -> float:
@@ -252,6 +266,7 @@ class LevenbergMarquardt:
     CATCH_UP_WINDOW = 5
     CATCH_UP_ITERATIONS = 10
     BEATEN_RATIO = 0.2
+    SAME_ANSWER = 1e-6
 
     def __init__(self, evaluator: Evaluator, starts, lb, ub, tol: float = 1e-10, margins=None):
         t0 = time.perf_counter()
@@ -276,6 +291,7 @@ class LevenbergMarquardt:
         self.iterations = np.zeros(S, int)
         self.traces = [[float(c)] for c in self.cost]
         self._scale = np.zeros((S, p))
+        self._bounded = bool(np.isfinite(lb).any() or np.isfinite(ub).any())
         self._mu = np.full(S, np.nan)
         self._nu = np.full(S, 2.0)
         self.time_s = time.perf_counter() - t0
@@ -316,69 +332,72 @@ class LevenbergMarquardt:
         ends or ``budget`` iterations are used; write the state back; return the count."""
         ev, tol = self.ev, self.tol
         lb, ub = self.lb, self.ub
-        bounded = bool(np.isfinite(lb).any() or np.isfinite(ub).any())
+        bounded = self._bounded
         x, r, J, rr = self.theta[act], self._r[act], self._J[act], self._rr[act]
         scale, mu, nu = self._scale[act], self._mu[act], self._nu[act]
-        p = x.shape[1]
-        idx = np.arange(p)
         sqrt_tol = np.sqrt(tol)
+        w = self.ACCEPTABLE_WINDOW
         done = 0
         ended = False
         while done < budget and not ended:
             done += 1
             a, g = _normal_equations(J, r)
-            cn = np.sqrt(a[:, idx, idx])
+            diag = np.einsum("sii->si", a)                    # a view
+            cn = np.sqrt(diag)
             np.maximum(scale, cn, out=scale)
             d = np.where(scale > 0, scale, 1.0)
             cos = np.abs(g) / np.where(cn > 0, cn, 1.0)
             free = None
             if bounded:
-                free = ~(((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0)))
-                if free.all():
-                    free = None
-                else:
+                at_bound = (x <= lb) | (x >= ub)
+                if at_bound.any():
+                    free = ~(at_bound & (((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))))
                     cos = np.where(free, cos, 0.0)
             stationary = cos.max(axis=1) <= sqrt_tol * np.sqrt(rr)
             a /= d[:, :, None] * d[:, None, :]
             b = g / d
             if np.isnan(mu).any():
-                mu = np.where(np.isnan(mu), 1e-3 * np.maximum(a[:, idx, idx].max(axis=1), 1e-300), mu)
+                mu = np.where(np.isnan(mu), 1e-3 * np.maximum(diag.max(axis=1), 1e-300), mu)
             if free is None:
-                a[:, idx, idx] += mu[:, None]
+                diag += mu[:, None]
             else:
                 a = np.where(free[:, :, None] & free[:, None, :], a, 0.0)
                 b = np.where(free, b, 0.0)
-                a[:, idx, idx] = np.where(free, a[:, idx, idx] + mu[:, None], 1.0)
+                np.einsum("sii->si", a)[...] = np.where(free, np.einsum("sii->si", a) + mu[:, None], 1.0)
             step = np.linalg.solve(a, b[..., None])[..., 0]
             step /= -d
             xt = x + step
             if bounded:
-                np.clip(xt, lb, ub, out=xt)
+                np.maximum(xt, lb, out=xt)
+                np.minimum(xt, ub, out=xt)
             dx = xt - x
             lin = r + _matvec(J, dx)
             pred = rr - np.einsum("si,si->s", lin, lin)
             rt, jt_new = ev.residual(xt, jacobian=True)   # the Jacobian serves if accepted
             rrt = np.einsum("si,si->s", rt, rt)
-            rrt[~np.isfinite(rrt)] = np.inf
-            actual = rr - rrt
-            rho = np.where(pred > 0, actual / np.where(pred > 0, pred, 1.0), -1.0)
+            actual = rr - rrt                               # NaN where rt is not finite
+            rho = actual / np.where(pred > 0, pred, np.nan)
             acc = (rho > 1e-4) & ~stationary
             mu = np.where(acc, mu * np.maximum(1 / 3, 1 - (2 * rho - 1) ** 3), mu * nu)
             nu = np.where(acc, 2.0, nu * 2.0)
-            self.iterations[act] += 1
-            stuck = ~acc & ((mu > 1e30) | ~dx.any(axis=1))
-            for j in np.flatnonzero(stationary | stuck):
-                # first-order optimal, or no decrease along any damped direction
-                self._end(act[j], STATUS_OK, True)
+            end_now = stationary | (~acc & ((mu > 1e30) | ~dx.any(axis=1)))
+            if end_now.any():
+                for j in np.flatnonzero(end_now):
+                    # first-order optimal, or no decrease along any damped direction
+                    self._end(act[j], STATUS_OK, True)
                 ended = True
             if acc.any():
-                ja = np.flatnonzero(acc)
-                J_new = jt_new[ja]
-                x[ja], r[ja], J[ja], rr[ja] = xt[ja], rt[ja], J_new, rrt[ja]
-                bad = ~np.isfinite(J_new).all(axis=(1, 2))
+                if acc.all():
+                    ja = slice(None)
+                    x, r, J, rr = xt, rt, jt_new, rrt
+                    idx = range(act.size)
+                else:
+                    ja = np.flatnonzero(acc)
+                    x[ja], r[ja], J[ja], rr[ja] = xt[ja], rt[ja], jt_new[ja], rrt[ja]
+                    idx = ja
+                bad = ~np.isfinite(np.einsum("sij->s", jt_new[ja]))
                 small = (actual[ja] <= tol * rrt[ja]) & (pred[ja] <= tol * rrt[ja])
-                w = self.ACCEPTABLE_WINDOW
-                for k, j in enumerate(ja):
+                for k, j in enumerate(idx):
                     i = act[j]
                     tr = self.traces[i]
                     tr.append(0.5 * float(rrt[j]) / self._m)
@@ -397,19 +416,26 @@ class LevenbergMarquardt:
         self.theta[act], self._r[act], self._J[act], self._rr[act] = x, r, J, rr
         self._scale[act], self._mu[act], self._nu[act] = scale, mu, nu
         self.cost[act] = 0.5 * rr / self._m
+        self.iterations[act] += done
         return done
 
     def _stop_losers(self) -> bool:
         """Stop every running start that another start has beaten: one has converged with a
         cost c, the running start's cost exceeds c·(1 + margin), and either exceeds it by more
         than ``BEATEN_RATIO`` or, at the rate it fell over its last ``CATCH_UP_WINDOW``
-        steps, would need more than ``CATCH_UP_ITERATIONS`` more iterations to reach c."""
+        steps, would need more than ``CATCH_UP_ITERATIONS`` more iterations to reach c.
+        A start within ``SAME_ANSWER`` (relative) above c has reached the same answer and is
+        stopped too, whatever its margin."""
         if not self.converged.any() or not self.running.any():
             return False
         c = self.cost[self.converged].min()
         stopped = False
         w = self.CATCH_UP_WINDOW
         for i in np.flatnonzero(self.running):
+            if 0.0 < self.cost[i] - c <= self.SAME_ANSWER * c:
+                self._end(i, STATUS_STOPPED, False)
+                stopped = True
+                continue
             gap = self.cost[i] - c * (1.0 + self.margins[i])
             if gap <= 0:
                 continue

@@ -328,7 +328,8 @@ def covariance(jac: np.ndarray, resid: np.ndarray, scale: bool):
     # but the only LAPACK call is on the small R.  LAPACK on the tall jac runs matrix-vector
     # products on several OpenBLAS threads, which on a busy machine wait for each other (up to
     # 0.7 s for 4800 x 21, against 2 ms here).
-    s, vt = np.linalg.svd(_r_factor(jac), full_matrices=False)[1:]
+    small = jac.size <= 20_000                  # below OpenBLAS's threading thresholds
+    s, vt = np.linalg.svd(jac if small else _r_factor(jac), full_matrices=False)[1:]
     keep = s > s[0] * 1e-12 if s.size else s.astype(bool)
     inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 0.0)
     cov = (vt.T * inv_s2) @ vt

@@ -27,6 +27,7 @@ Forms
 
 from __future__ import annotations
 
+import functools
 import itertools
 from dataclasses import dataclass
 
@@ -145,6 +146,10 @@ class Structure:
         """Parameter bounds: degree 0 applies ``slot_bounds`` directly; otherwise only a
         generous box on the log slots (the scheduled fitter imposes ``slot_bounds`` on a
         temperature grid)."""
+        lo, hi = _bounds(self, None if w_min is None else float(w_min), None if w_max is None else float(w_max))
+        return lo.copy(), hi.copy()
+
+    def _bounds(self, w_min, w_max):
         lo = np.full(self.n_params, -np.inf)
         hi = np.full(self.n_params, np.inf)
         sb = self.slot_bounds(w_min, w_max) if self.degree == 0 else self.slot_bounds()
@@ -168,6 +173,11 @@ class Structure:
     def slot_matrix(self, theta) -> np.ndarray:
         """Parameters as an array (n_slots, degree+1) (numpy only)."""
         return np.asarray(theta, float).reshape(len(self.slots), self.n_coef)
+
+
+@functools.lru_cache(maxsize=256)
+def _bounds(structure: Structure, w_min, w_max):
+    return structure._bounds(w_min, w_max)
 
 
 # ----------------------------------------------------------------- backends
@@ -342,10 +352,19 @@ def denominators(structure: Structure, theta, taus) -> np.ndarray:
 
 
 def _factor_roots(poly_asc) -> np.ndarray:
+    """Roots of c0 + c1 s + s² (or c0 + s); real pairs by the cancellation-free formula
+    q = −(c1 + sign(c1)·√disc)/2, roots q and c0/q (a root much smaller than the other is
+    otherwise lost to rounding and can come out as exactly 0)."""
     if len(poly_asc) == 3:
-        c0, c1 = poly_asc[0], poly_asc[1]
-        disc = np.sqrt(complex(c1 * c1 - 4 * c0))
-        return np.array([(-c1 + disc) / 2, (-c1 - disc) / 2])
+        c0, c1 = float(poly_asc[0]), float(poly_asc[1])
+        disc = c1 * c1 - 4 * c0
+        if disc < 0:
+            im = np.sqrt(-disc) / 2
+            return np.array([complex(-c1 / 2, im), complex(-c1 / 2, -im)])
+        q = -(c1 + np.copysign(np.sqrt(disc), c1)) / 2
+        if q == 0.0:
+            return np.zeros(2, complex)
+        return np.array([complex(q), complex(c0 / q)])
     return np.array([-poly_asc[0] + 0j])
 
 

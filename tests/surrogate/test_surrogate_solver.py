@@ -56,7 +56,7 @@ def test_jacobian_matches_finite_differences_and_casadi(form, m, n, deg, kind):
     np.testing.assert_allclose(jac, ad, rtol=0, atol=1e-12 * np.max(np.abs(ad)))
     # a stack of parameter vectors gives the stack of Jacobians
     r2, j2 = ev.residual(np.stack([theta, 0.5 * theta]), jacobian=True)
-    np.testing.assert_array_equal(r2[0], r)
+    np.testing.assert_allclose(r2[0], r, rtol=1e-14, atol=1e-14)
     np.testing.assert_allclose(j2[1], ev.residual(0.5 * theta, jacobian=True)[1], rtol=1e-14, atol=1e-14)
 
 
