@@ -262,7 +262,7 @@ def _init_time(d, m, n, reps):
         pr, _ = F.make_problem(st, d, sc, "auto")
         ev = Evaluator(pr)
         initial_candidates(st, pr.w, pr.h,
-                           lambda s2, th: (ev if s2 == st else Evaluator(replace(pr, structure=s2))).costs(th))
+                           lambda s2, th, ev=ev, pr=pr: (ev if s2 == st else Evaluator(replace(pr, structure=s2))).costs(th))
         ts.append(time.perf_counter() - t0)
     return float(np.median(ts))
 
@@ -388,6 +388,7 @@ def _median_interleaved(fns: dict, reps: int) -> dict:
 
 def stream_section(args):
     import scipy.signal as ss
+
     from inversion import StreamingInverter, invert
     from inversion.examples import seed000_sensor_35c
 
@@ -439,9 +440,9 @@ def stream_section(args):
     for fs in (1e3, 5e3, 20e3):
         d = 1.0 / fs
         u3 = np.sin(2 * np.pi * 20 * d * np.arange(n3)) + 0.1 * rng.standard_normal(n3)
-        t = _median_interleaved({"invert": lambda: invert(sp, d, u3, preview="auto"),
-                                 "lfilter": lambda: ss.lfilter(b4, a4, u3)}, reps)
-        plan = Plan(sp, d, int(round(sp.auto_preview_s / d)))
+        t = _median_interleaved({"invert": lambda d=d, u3=u3: invert(sp, d, u3, preview="auto"),
+                                 "lfilter": lambda u3=u3: ss.lfilter(b4, a4, u3)}, reps)
+        plan = Plan(sp, d, round(sp.auto_preview_s / d))
         kind = "fused" if getattr(plan, "fused", None) is not None else (
             plan.anti.kind if plan.anti is not None else "none")
         ratio = t["lfilter"] / t["invert"]

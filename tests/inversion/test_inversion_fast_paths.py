@@ -43,7 +43,7 @@ def _window_sum_oracle(split, dt, n_prev, u):
 def test_factored_fused_pass_equals_the_window_sum(fs):
     split = split_inverse(G35)
     dt = 1.0 / fs
-    n_prev = int(round(split.auto_preview_s / dt))
+    n_prev = round(split.auto_preview_s / dt)
     plan = Plan(split, dt, n_prev)
     # the single transfer function is not accurate enough here: the factored form is used
     assert plan.anti.kind == "sos" and plan.fused is not None and plan.fused.sos is not None
