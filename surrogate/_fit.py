@@ -116,11 +116,15 @@ class TemperatureError:
     fit_percent: float
 
 
-def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolate=False):
+def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolate=False,
+                           response=None):
     """Fit quality at each temperature of ``data`` (one evaluation of the model over all
-    lines, split by temperature)."""
-    tt = data.temperature_c if (model.is_scheduled and data.temperature_c is not None) else None
-    h = model.frequency_response(data.frequency_hz, tt, extrapolate=extrapolate)
+    lines, split by temperature).  ``response``: the model's response on the lines of
+    ``data`` if already at hand."""
+    if response is None:
+        tt = data.temperature_c if (model.is_scheduled and data.temperature_c is not None) else None
+        response = model.frequency_response(data.frequency_hz, tt, extrapolate=extrapolate)
+    h = response
     temps = [None] if data.temperature_c is None else list(data.temperatures())
     out = []
     for t in temps:
@@ -304,7 +308,9 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
     }
     model = RationalModel(structure, theta, scaling, temperature_range, cov, data.labels(), info)
     stability = model.stability_check(stability_grid)
-    errs = per_temperature_errors(model, data)
+    # the model's response on the data lines: H_model = R · H_data, R from the residual model
+    errs = per_temperature_errors(model, data, response=None if evaluator is None
+                                  else evaluator.ratio(theta) * data.response)
     ci = model.confidence_intervals()
     res = FitResult(
         model=model, converged=outcome.converged, status=outcome.status,

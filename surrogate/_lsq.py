@@ -189,6 +189,11 @@ class Evaluator:
             np.multiply(g.imag, self.weights[n:, None], out=jac[:, n:])
         return (r[0], jac[0]) if single else (r, jac)
 
+    def ratio(self, theta) -> np.ndarray:
+        """R = H_model/H_data on every line, at one parameter vector."""
+        with np.errstate(all="ignore"):
+            return self._model(np.asarray(theta, float)[None, :], False)[0][0]
+
     def cost(self, theta) -> float:
         """½·mean(r²) at one parameter vector; +inf where the model cannot be evaluated."""
         return float(self.costs(np.asarray(theta, float)[None, :])[0])
@@ -312,7 +317,7 @@ class LevenbergMarquardt:
         self.status[i] = status
         self.converged[i] = converged
 
-    def run(self, max_iterations: int, only=None) -> "LevenbergMarquardt":
+    def run(self, max_iterations: int, only=None) -> LevenbergMarquardt:
         """Advance the running starts (or those in ``only``) by up to ``max_iterations``."""
         t0 = time.perf_counter()
         allowed = np.ones(self.n_starts, bool) if only is None else np.isin(np.arange(self.n_starts), only)

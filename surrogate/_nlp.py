@@ -232,8 +232,9 @@ class Solver:
 
     @staticmethod
     def _hurwitz_constraints(st: Structure, x, taus, shift: float = 0.0):
-        import casadi as ca
         from math import comb
+
+        import casadi as ca
 
         n, nc = st.n_poles, st.n_coef
         # Taylor shift D(s) → D(s − shift): q_i = Σ_{k≥i} a_k C(k, i) (−shift)^(k−i), a_n = 1

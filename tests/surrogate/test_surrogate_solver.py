@@ -166,3 +166,24 @@ def test_joint_zpk_fourth_order_converges_at_five_temperatures():
     for temp in (26.3, 39.7, 48.1):
         exact = synthesize_sweep(model, "M", f_hz, [temp], None).response
         assert relative_rms_error(res.model.frequency_response(f_hz, temp), exact) < 0.02
+
+
+def test_reported_errors_equal_the_saved_models_own_response():
+    """finish() takes the model's response from the residual model (R · H_data); it must be
+    what the fitted RationalModel itself evaluates."""
+    from surrogate_fixtures import FIT_TEMPS, TRUE_SCALING, TRUE_THETA, noisy_sweep
+
+    from surrogate import RationalFit, RationalModel, ScheduledFit, fit_percent, relative_rms_error
+
+    truth = RationalModel(Structure("zpk", 2, 3, 2), TRUE_THETA, TRUE_SCALING, (19.0, 55.0))
+    f, t, h, sm, sp = noisy_sweep(truth, FIT_TEMPS, np.geomspace(0.1, 30, 40))
+    res = ScheduledFit("zpk", 2, 3, 2).fit(f, t, h, sm, sp)
+    for e in res.per_temperature:
+        k = t == e.temperature_c
+        hm = res.model.frequency_response(f[k], e.temperature_c)
+        assert e.relative_rms_error == pytest.approx(relative_rms_error(hm, h[k]), rel=1e-12)
+        assert e.fit_percent == pytest.approx(fit_percent(hm, h[k]), rel=1e-12)
+    k = t == FIT_TEMPS[0]
+    one = RationalFit(2, 3).fit(f[k], None, h[k])
+    assert one.per_temperature[0].relative_rms_error == pytest.approx(
+        relative_rms_error(one.model.frequency_response(f[k]), h[k]), rel=1e-12)
