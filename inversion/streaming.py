@@ -14,20 +14,27 @@ The truncated anticausal output at sample k depends only on the inputs ``u[k .. 
 
 where ``x`` is the backward FOH state of *any* record that contains ``u[k .. k+N]`` (the
 difference of the two sums is the window sum, whatever lies beyond).  So once ``u[k+N]`` has
-arrived, output k is computed from the retained inputs alone, in one of two ways:
+arrived, output k is computed from the retained inputs, in one of three ways, whichever is
+cheapest for the L outputs a push makes final:
 
-* few outputs at a time (small chunks): the (N+1)-tap kernel ``taps`` applied directly, one
-  dot product per output (for a one-sample push this is the whole anticausal work);
-* many outputs (large chunks): the batch finite-preview pass of
-  :meth:`inversion._discrete.Plan.anticausal` over the segment ``u[k_lo .. k_hi+N)`` taken as
-  a record of its own, i.e. the same filters as :func:`~inversion.invert` on the chunk plus N
-  samples.
+* the (N+1)-tap kernel ``taps`` applied directly (``L·(N+1)`` below :data:`KERNEL_WORK`; a
+  one-sample push is one dot product);
+* the batch finite-preview pass of :meth:`inversion._discrete.Plan.anticausal` over the
+  segment ``u[k_lo .. k_hi+N)`` taken as a record of its own (large chunks: the same filters
+  as :func:`~inversion.invert` on the chunk plus N samples);
+* block sums (long previews, N > :data:`BLOCK_RATIO` · L): with the time axis cut into
+  blocks of N samples, for k in block j (``jN <= k < a = (j+1)N``)
+
+      F_k = S_k + Phi^(a-k) R_(k-jN),
+      S_k = sum_{i=k}^{a-1} Phi^(i-k) g_i,   R_p = sum_{i=0}^{p-1} Phi^i g_(a+i),
+
+  one backward pass per block and a running sum as samples arrive (the "two-stack" sliding
+  window), O(n_u^2) per sample; only decaying powers of ``Phi``, so every step is stable.
 
 The causal part (stable filter with its carried state, feedthrough, finite differences) runs
 as in the batch inverse; a one-sample push steps the filter state in plain Python instead of
-calling ``scipy.signal.lfilter``.  The cost per sample is bounded by the smaller of the two
-anticausal costs, O(N) for a one-sample push and O(1 + N/L) for a chunk of L samples,
-independent of the history; the retained state is the last ``delay + h`` inputs.
+calling ``scipy.signal.lfilter``.  The cost per sample is independent of the history, and the
+retained state is at most the current block, the delay and one chunk of inputs.
 """
 
 from __future__ import annotations
@@ -43,9 +50,13 @@ from .batch import _as_split, resolve_preview, sampling_interval
 
 __all__ = ["StreamingInverter"]
 
-#: A push emitting at most this many outputs per kernel tap... (see ``_use_kernel``): the
-#: kernel is applied directly when outputs × (N+1) is below this many multiply-adds.
+#: The (N+1)-tap kernel is applied directly when outputs × (N+1) is below this many
+#: multiply-adds.
 KERNEL_WORK = 1 << 15
+#: Above this ratio of preview to outputs per push (and from ``MIN_BLOCK`` samples of preview
+#: on), the two-stack block sums are cheaper than the batch pass over chunk + N samples.
+BLOCK_RATIO = 2
+MIN_BLOCK = 32
 #: Initial capacity of the sample buffers (they grow for larger chunks).
 BUFFER = 1 << 12
 
@@ -111,6 +122,7 @@ class StreamingInverter:
         h, d = p.h, self.delay_samples
         # the anticausal kernel: y_u[k] = sum_q anti_taps[q] u[k+q], q = 0..N
         self._anti_taps = None
+        self._blocks_ok = False
         if p.anti is not None:
             N = n_prev
             rows = _left_powers(p.anti_C, p.anti_phi, N + 1)        # C_r Phi^q
@@ -118,6 +130,12 @@ class StreamingInverter:
             taps[:N] += rows[:N] @ p.anti_alpha
             taps[1:] += rows[:N] @ p.anti_beta
             self._anti_taps = taps
+            if N >= MIN_BLOCK:
+                self._blocks_ok = True
+                self._Wr = rows                                      # C_r Phi^q
+                self._Wa = rows @ p.anti_alpha                       # C_r Phi^q alpha
+                self._Pa = _left_powers(p.anti_alpha, p.anti_phi.T, N)   # Phi^i alpha
+                self._Pb = _left_powers(p.anti_beta, p.anti_phi.T, N)    # Phi^i beta
         # one kernel for a single output: anticausal taps and the difference stencil over
         # the window u[k-h .. k+delay]
         kern = np.zeros(h + d + 1)
@@ -158,11 +176,19 @@ class StreamingInverter:
         """Number of output samples emitted so far."""
         return self._n_out
 
+    def _keep(self) -> int:
+        """Index of the oldest input later outputs still need (the block start for the
+        block sums)."""
+        keep = self._n_out - self._plan.h
+        if self._blocks_ok:
+            N = self.preview_samples
+            keep = min(keep, (self._n_out // N) * N)
+        return max(keep, self._base)
+
     @property
     def _hist(self) -> np.ndarray:
         """Retained inputs (those later outputs still need), a view."""
-        lo = max(self._n_out - self._plan.h, self._base)
-        return self._u[lo - self._base:self._n_in - self._base]
+        return self._u[self._keep() - self._base:self._n_in - self._base]
 
     @property
     def _ys(self) -> np.ndarray:
@@ -183,6 +209,13 @@ class StreamingInverter:
         st = self._plan.stable
         self._zi = st.zi0() if st is not None else None    # lfilter/sosfilt state (array)
         self._zl = None                                      # the same state as a list
+        self._reset_blocks()
+
+    def _reset_blocks(self) -> None:
+        """Forget the running sums of the block in progress (recomputed from its start)."""
+        self._S: np.ndarray | None = None
+        self._R = np.zeros(self._plan.anti_phi.shape[0])
+        self._p_last = 0
 
     # ------------------------------------------------------------------------------------
     def push(self, chunk: Any) -> np.ndarray:
@@ -230,7 +263,7 @@ class StreamingInverter:
         pos = self._n_in - self._base
         if pos + count <= self._u.size:
             return pos
-        keep = self._n_out - self._plan.h            # the oldest sample still needed
+        keep = self._keep()                          # the oldest sample still needed
         live = self._n_in - keep
         size = max(BUFFER, 4 * (self.delay_samples + self._plan.h + 1), 2 * (live + count))
         if size > self._u.size or size < self._u.size // 4:
@@ -275,6 +308,8 @@ class StreamingInverter:
         if self._n_in - self.delay_samples <= k:
             return np.zeros(0)
         out = self._y[k - self._base]
+        if self._S is not None or self._p_last:
+            self._reset_blocks()
         if self._kernel is not None:
             w0 = k - p.h - self._base
             out += float(self._kernel @ self._u[w0:w0 + self._kernel.size])
@@ -308,7 +343,84 @@ class StreamingInverter:
             seg = self._u[k_lo - b:k_hi + taps.size - 1 - b]
             if n_out * taps.size <= KERNEL_WORK:
                 out += np.correlate(seg, taps, mode="valid")
+                self._reset_blocks()
+            elif self._blocks_ok and taps.size - 1 > BLOCK_RATIO * n_out:
+                out += self._blocks(k_lo, k_hi)
             else:
                 out += p.anticausal(seg)[:n_out]
+                self._reset_blocks()
         self._n_out = k_hi
+        return out
+
+    # -- the two-stack block sums ---------------------------------------------------------
+    def _ur(self, lo: int, hi: int) -> np.ndarray:
+        """Retained inputs [lo, hi) (lo >= 0)."""
+        return self._u[lo - self._base:hi - self._base]
+
+    def _blocks(self, k_lo: int, k_hi: int) -> np.ndarray:
+        """Anticausal outputs k_lo .. k_hi-1 from the block sums (module doc of the old
+        block method: F_k = S_k + Phi^(a-k) R_(k-jN), both pieces with decaying powers)."""
+        N = self.preview_samples
+        pieces = []
+        k = k_lo
+        # a block already started (partially emitted): continue it incrementally
+        if k % N or self._S is not None or self._p_last:
+            k_end = min(k_hi, (k // N + 1) * N)
+            pieces.append(self._one_block(k, k_end))
+            k = k_end
+        # whole blocks, vectorised in groups of at most ~64k samples
+        group = max(1, (1 << 16) // N)
+        while k_hi - k >= N:
+            nb = min((k_hi - k) // N, group)
+            pieces.append(self._whole_blocks(k, nb))
+            k += nb * N
+        if k < k_hi:
+            pieces.append(self._one_block(k, k_hi))
+        return np.concatenate(pieces) if len(pieces) > 1 else pieces[0]
+
+    def _whole_blocks(self, k: int, nb: int) -> np.ndarray:
+        """Outputs of ``nb`` complete blocks starting at the block boundary ``k``."""
+        p = self._plan
+        N = self.preview_samples
+        u = self._ur(k, k + (nb + 1) * N)            # blocks + the following block
+        win = np.lib.stride_tricks.sliding_window_view(u, N + 1)[: nb * N: N]  # (nb, N+1)
+        o = p.anti.run_rows(np.ascontiguousarray(win[:, ::-1]))[:, ::-1]
+        S = o[:, :N] - self._Wa[N:0:-1][None, :] * win[:, N:N + 1]
+        nxt = u[N:].reshape(nb, N)                  # u_{a+i}, i = 0..N-1, per block
+        terms = (self._Pa[None, :N - 1, :] * nxt[:, :N - 1, None]
+                 + self._Pb[None, :N - 1, :] * nxt[:, 1:, None])
+        R = np.zeros((nb, N, terms.shape[2]))
+        np.cumsum(terms, axis=1, out=R[:, 1:, :])
+        tail = np.einsum("pj,bpj->bp", self._Wr[N - np.arange(N)], R)
+        return (S + tail).ravel()
+
+    def _one_block(self, k: int, k_end: int) -> np.ndarray:
+        """Outputs k .. k_end-1 inside one block, keeping the running state of that block."""
+        p = self._plan
+        N = self.preview_samples
+        Wr, Wa, Pa, Pb = self._Wr, self._Wa, self._Pa, self._Pb
+        base = (k // N) * N
+        a = base + N
+        if self._S is None:
+            seg = self._ur(base, a + 1)                # N + 1 samples, u_a last
+            o, _ = p.anti.run(seg[::-1], p.anti.zi0())
+            o = o[::-1]
+            self._S = o[:N] - Wa[N:0:-1] * seg[N]      # C_r S_k = o'_k - C_r Phi^(a-k) alpha u_a
+        P_lo, P_hi = k - base, k_end - base
+        # R_p for p in [p_last, P_hi - 1]
+        i0, i1 = self._p_last, P_hi - 1
+        if i1 > i0:
+            useg = self._ur(a + i0, a + i1 + 1)
+            terms = Pa[i0:i1] * useg[:-1, None] + Pb[i0:i1] * useg[1:, None]
+            Rs = np.vstack((self._R, self._R + np.cumsum(terms, axis=0)))
+        else:
+            Rs = self._R[None, :]
+        sel = Rs[P_lo - i0:]
+        ps = np.arange(P_lo, P_hi)
+        tail = np.einsum("ij,ij->i", Wr[N - ps], sel)
+        out = self._S[P_lo:P_hi] + tail
+        self._R = Rs[-1].copy()
+        self._p_last = max(i1, i0)
+        if k_end == a:
+            self._reset_blocks()
         return out

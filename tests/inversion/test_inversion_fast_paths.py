@@ -107,3 +107,20 @@ def test_large_chunks_use_the_batch_pass_and_equal_it():
     ref = invert(G35, 1e-3, u, preview="auto").output
     y = _stream(StreamingInverter(G35, 1e-3, "auto"), u, 4096)
     np.testing.assert_allclose(y, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+def test_long_preview_switches_between_kernel_block_sums_and_batch_pass():
+    """N = 1000: one-sample and 5-sample pushes use the kernel, 257–300-sample pushes the
+    two-stack block sums (N > 2 L), 2000-sample pushes the batch pass; any order of them
+    must give the batch inverse."""
+    u = np.random.default_rng(10).standard_normal(12_000)
+    ref = invert(G35, 1e-3, u, preview=1.0).output
+    inv = StreamingInverter(G35, 1e-3, 1.0)
+    outs, i = [], 0
+    for size in [1] * 40 + [300, 5, 2000] + [257] * 3 + [1] * 10 + [300] * 4 + [2000, 7, 300]:
+        outs.append(inv.push(u[i:i + size]))
+        i += size
+        assert inv._hist.size <= 2 * inv.preview_samples + 2000
+    outs.append(inv.push(u[i:]))
+    outs.append(inv.flush())
+    np.testing.assert_allclose(np.concatenate(outs), ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
