@@ -15,8 +15,8 @@ a fit) are evaluated in one call.
 :class:`LevenbergMarquardt` minimises ½·mean(r²) from several starts *in lockstep*: one
 batched evaluation serves all starts, each start keeps its own damping, and the linear
 systems are solved together.  Variables are scaled by the Jacobian's column norms (Moré's
-scaling), bounds are kept by projection.  When a start converges, every still-running start
-whose cost is above the converged one (plus a margin) is stopped: losing starts end early.
+scaling), bounds are kept by projection.  When a start converges, the still-running starts it
+has beaten are stopped (see ``margins``): losing starts end early.
 """
 
 from __future__ import annotations
@@ -259,7 +259,8 @@ class LevenbergMarquardt:
         c·(1 + margin) is stopped (status ``Stopped_Early``) if it is more than
         ``BEATEN_RATIO`` above c or would need more than ``CATCH_UP_ITERATIONS`` iterations to
         reach c at its recent rate: a losing start ends early, one still falling fast towards
-        c is let through.  Default 0 for every start.
+        c is let through.  A start within ``SAME_ANSWER`` above c has reached the same answer
+        and is stopped whatever its margin.  Default 0 for every start.
 
     ``run(k)`` takes at most ``k`` more iterations (every running start advances by one
     trial step per iteration); ``theta``, ``cost``, ``status``, ``converged``,
@@ -282,7 +283,7 @@ class LevenbergMarquardt:
         width = np.where(np.isfinite(ub - lb), ub - lb, 1.0)
         self.lb, self.ub = lb, ub
         self.theta = np.clip(x, lb + 1e-9 * width, ub - 1e-9 * width)
-        self.margins = np.zeros(S) if margins is None else np.asarray(margins, float)
+        self.margins = np.zeros(S) if margins is None else np.array(margins, float)
         self._r, self._J = evaluator.residual(self.theta, jacobian=True)
         self._m = self._r.shape[1]
         self._rr = (self._r * self._r).sum(axis=1)
