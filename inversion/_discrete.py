@@ -47,7 +47,11 @@ transfer-function pairs the batch pass is therefore fused into one recursion,
 i.e. in forward time ``q[k] = sum_i b1[i] u[k+i] - sum_i b2[i] u[k+N+i]`` (two short
 correlations) followed by a single backward all-pole pass, block by block so that the
 intermediate ``q`` stays in cache (:data:`FUSED_BLOCK`).  Same polynomials as the two
-separate passes; the results agree to rounding.
+separate passes; the results agree to rounding.  When the poles cluster near z = 1 (fast
+sampling) and a single denominator polynomial is not accurate enough, the all-pole pass runs
+as second-order sections with the same correlations in front (:class:`FusedPass`,
+:mod:`inversion._sections`); only if that, too, fails the accuracy check are the two passes
+run separately as sections.
 """
 
 from __future__ import annotations
@@ -56,13 +60,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.signal as sig
 
+from ._sections import FusedPass, _sos
 from .split import InverseSplit
 
-__all__ = ["foh_matrices", "expm_small", "FOHFilter", "Plan", "central_difference_kernel",
-           "FUSED_BLOCK"]
+__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan",
+           "central_difference_kernel", "FUSED_BLOCK"]
 
 #: Samples per block of the fused finite-preview backward pass (intermediates stay in cache).
 FUSED_BLOCK = 1 << 16
@@ -177,6 +181,13 @@ class FOHFilter:
     def order(self) -> int:
         return int(self.Phi.shape[0])
 
+    def response(self, zs: np.ndarray) -> np.ndarray:
+        """Exact frequency response ``C (zI - Phi)^-1 Bd + Dd`` at the points ``zs``."""
+        n = self.order
+        rhs = np.broadcast_to((self.Phi @ self.alpha + self.beta).astype(complex)[:, None],
+                              (zs.size, n, 1))
+        return np.linalg.solve(zs[:, None, None] * np.eye(n) - self.Phi, rhs)[..., 0] @ self.C + self.D
+
     @property
     def kind(self) -> str:
         """``"ba"`` (lfilter) or ``"sos"`` (sosfilt)."""
@@ -197,34 +208,6 @@ class FOHFilter:
         if self.sos is None:
             return sig.lfilter(self.b, self.a, X, axis=1)
         return sig.sosfilt(self.sos, X, axis=1)
-
-
-def _sos(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray,
-         exact: np.ndarray) -> np.ndarray:
-    n = Phi.shape[0]
-    poles = np.linalg.eigvals(Phi)
-    pencil_a = np.block([[Phi, Bd.reshape(n, 1)], [C.reshape(1, n), np.array([[Dd]])]])
-    pencil_b = np.zeros((n + 1, n + 1))
-    pencil_b[:n, :n] = np.eye(n)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        zz = sla.eigvals(pencil_a, pencil_b)
-    zeros = zz[np.isfinite(zz) & (np.abs(zz) < 1e8)]
-    zeros = _conjugate_clean(zeros)
-    poles = _conjugate_clean(poles)
-    prod = np.array([np.prod(z - zeros) / np.prod(z - poles) for z in zs])
-    i = int(np.argmax(np.abs(prod)))
-    k = float(np.real(exact[i] / prod[i]))
-    if k == 0.0:
-        return np.array([[0.0, 0.0, 0.0, 1.0, 0.0, 0.0]])
-    return np.ascontiguousarray(sig.zpk2sos(zeros, poles, k))
-
-
-def _conjugate_clean(r: np.ndarray) -> np.ndarray:
-    """Make nearly-real roots exactly real so that zpk2sos pairs conjugates cleanly."""
-    r = np.asarray(r, complex).copy()
-    small = np.abs(r.imag) <= 1e-12 * np.maximum(1.0, np.abs(r))
-    r[small] = r[small].real
-    return r
 
 
 def central_difference_kernel(coeffs: np.ndarray, dt: float) -> tuple[np.ndarray, int]:
@@ -297,17 +280,20 @@ class Plan:
                 C2 = Cr @ np.linalg.matrix_power(Phi, n_preview)
                 if np.any(C2 != 0):
                     self.anti_tail = FOHFilter.build(Phi, al, be, C2)
-        #: ``(b1, b2, a)`` of the fused finite-preview backward pass, or None (see module doc)
-        self.fused: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        #: the fused finite-preview backward pass (:class:`FusedPass`), or None (module doc)
+        self.fused: FusedPass | None = None
         t1, t2 = self.anti, self.anti_tail
-        if (t1 is not None and t2 is not None and t1.sos is None and t2.sos is None
-                and t1.a.size == t2.a.size and np.array_equal(t1.a, t2.a)):
-            p = max(t1.b.size, t2.b.size)
-            b1 = np.zeros(p)
-            b1[:t1.b.size] = t1.b
-            b2 = np.zeros(p)
-            b2[:t2.b.size] = t2.b
-            self.fused = (b1, b2, np.array(t1.a, dtype=float))
+        if t1 is not None and t2 is not None:
+            if (t1.sos is None and t2.sos is None and t1.a.size == t2.a.size
+                    and np.array_equal(t1.a, t2.a)):
+                p = max(t1.b.size, t2.b.size)
+                b1 = np.zeros(p)
+                b1[:t1.b.size] = t1.b
+                b2 = np.zeros(p)
+                b2[:t2.b.size] = t2.b
+                self.fused = FusedPass([b1], [b2], np.array(t1.a, dtype=float), None)
+            else:
+                self.fused = FusedPass.factored(t1, t2)
 
     # -- chunked passes -------------------------------------------------------------------
     def forward(self, src: Any, n: int, chunk: int, sink: Any, check: bool = True) -> None:
@@ -366,21 +352,35 @@ class Plan:
                     tail = np.concatenate((o2, tail[:N - L]))
             sink(c0, c1, yu, x)
 
+    def anticausal(self, u: np.ndarray) -> np.ndarray:
+        """Anticausal part for the in-memory record ``u`` (zero beyond its end), as an array.
+
+        With a finite preview, output k depends only on ``u[k .. k+N]``, so the first
+        ``len(u) - N`` values are exact whatever follows the record (the streaming inverter
+        relies on this)."""
+        n = u.size
+        out = np.zeros(n)
+
+        def sink(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+            out[c0:c1] = y
+
+        self.backward(u, n, max(n, 1), sink)
+        return out
+
     def _backward_fused(self, src: Any, n: int, block: int, sink: Any) -> None:
         """Finite-preview anticausal pass as one all-pole recursion (see module doc)."""
-        b1, b2, a = self.fused
+        fp = self.fused
         N = self.n_preview
-        h = b1.size - 1                 # correlation reach beyond the block
-        one = np.ones(1)
-        zi = np.zeros(a.size - 1)
+        h1, h2 = fp.reach(fp.fir1), fp.reach(fp.fir2)   # correlation reach beyond the block
+        zi = fp.zi0()
         for c1 in range(n, 0, -block):
             c0 = max(0, c1 - block)
             # q[k] = sum_i b1[i] u[k+i] - sum_i b2[i] u[k+N+i], k in [c0, c1), u = 0 past n
-            seg = _read_padded(src, n, c0, c1 + h)
-            q = np.correlate(seg, b1, "valid")
+            seg = _read_padded(src, n, c0, c1 + h1)
+            q = fp.correlate(seg, fp.fir1)
             if c0 + N < n:
-                q -= np.correlate(_read_padded(src, n, c0 + N, c1 + N + h), b2, "valid")
-            w, zi = sig.lfilter(one, a, q[::-1], zi=zi)
+                q -= fp.correlate(_read_padded(src, n, c0 + N, c1 + N + h2), fp.fir2)
+            w, zi = fp.all_pole(q[::-1], zi)
             sink(c0, c1, w[::-1], seg[:c1 - c0])
 
 

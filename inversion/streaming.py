@@ -7,26 +7,39 @@ delayed by exactly ``N = round(T_p/dt)`` samples (plus the stencil half-width in
 
 How the anticausal part is computed causally
 --------------------------------------------
-The truncated anticausal state at sample k is (see :mod:`inversion._discrete`)
+The truncated anticausal output at sample k depends only on the inputs ``u[k .. k+N]``
+(see :mod:`inversion._discrete`):
 
-    F_k = sum_{i=k}^{k+N-1} Phi^(i-k) g_i,     g_i = alpha u_i + beta u_{i+1},
+    y_u[k] = C_r (x[k] - Phi^N x[k+N]) = sum_{q=0}^{N} taps[q] u[k+q],
 
-an exponentially weighted window sum.  Updating it forward in time needs ``Phi^-1`` and is
-numerically unstable.  Instead the time axis is cut into blocks of N samples; for k in block
-j (``jN <= k < a = (j+1)N``)
+where ``x`` is the backward FOH state of *any* record that contains ``u[k .. k+N]`` (the
+difference of the two sums is the window sum, whatever lies beyond).  So once ``u[k+N]`` has
+arrived, output k is computed from the retained inputs, in one of three ways, whichever is
+cheapest for the L outputs a push makes final:
 
-    F_k = S_k + Phi^(a-k) R_(k-jN),
-    S_k     = sum_{i=k}^{a-1} Phi^(i-k) g_i          (backward pass over block j, once per block)
-    R_p     = sum_{i=0}^{p-1} Phi^i g_(a+i)          (running sum over block j+1, as samples arrive)
+* the (N+1)-tap kernel ``taps`` applied directly (``L·(N+1)`` below :data:`KERNEL_WORK`; a
+  one-sample push is one dot product);
+* the batch finite-preview pass of :meth:`inversion._discrete.Plan.anticausal` over the
+  segment ``u[k_lo .. k_hi+N)`` taken as a record of its own (large chunks: the same filters
+  as :func:`~inversion.invert` on the chunk plus N samples);
+* block sums (long previews, N > :data:`BLOCK_RATIO` · L): with the time axis cut into
+  blocks of N samples, for k in block j (``jN <= k < a = (j+1)N``)
 
-(the "two-stack" sliding-window trick).  Both pieces use only decaying powers of ``Phi``, so
-every operation is stable, and each input sample enters one backward pass and one running
-sum: the cost per sample is O(n_u^2), independent of the history and of N.  For short
-previews (``N < 32``) the exact (N+1)-tap FIR form of the truncated kernel is used instead.
+      F_k = S_k + Phi^(a-k) R_(k-jN),
+      S_k = sum_{i=k}^{a-1} Phi^(i-k) g_i,   R_p = sum_{i=0}^{p-1} Phi^i g_(a+i),
+
+  one backward pass per block and a running sum as samples arrive (the "two-stack" sliding
+  window), O(n_u^2) per sample; only decaying powers of ``Phi``, so every step is stable.
+
+The causal part (stable filter with its carried state, feedthrough, finite differences) runs
+as in the batch inverse; a one-sample push steps the filter state in plain Python instead of
+calling ``scipy.signal.lfilter``.  The cost per sample is independent of the history, and the
+retained state is at most the current block, the delay and one chunk of inputs.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -37,8 +50,15 @@ from .batch import _as_split, resolve_preview, sampling_interval
 
 __all__ = ["StreamingInverter"]
 
-#: Below this preview (in samples) the truncated kernel is applied as an FIR filter.
-FIR_MAX_TAPS = 32
+#: The (N+1)-tap kernel is applied directly when outputs × (N+1) is below this many
+#: multiply-adds.
+KERNEL_WORK = 1 << 15
+#: Above this ratio of preview to outputs per push (and from ``MIN_BLOCK`` samples of preview
+#: on), the two-stack block sums are cheaper than the batch pass over chunk + N samples.
+BLOCK_RATIO = 2
+MIN_BLOCK = 32
+#: Initial capacity of the sample buffers (they grow for larger chunks).
+BUFFER = 1 << 12
 
 
 def _left_powers(row: np.ndarray, Phi: np.ndarray, count: int) -> np.ndarray:
@@ -54,11 +74,6 @@ def _left_powers(row: np.ndarray, Phi: np.ndarray, count: int) -> np.ndarray:
         filled += m
         P = P @ P
     return out
-
-
-def _right_powers(vec: np.ndarray, Phi: np.ndarray, count: int) -> np.ndarray:
-    """Rows ``Phi**i @ vec`` for i = 0..count-1 (by doubling)."""
-    return _left_powers(vec, Phi.T, count)
 
 
 class StreamingInverter:
@@ -101,27 +116,43 @@ class StreamingInverter:
                 f"a streaming inverter needs a finite preview (seconds or 'auto'); got {preview!r}")
         self.preview_samples: int = n_prev
         self.preview_s: float = prev_s
-        self._plan = Plan(self.split, self.dt, n_prev)
+        self._plan = p = Plan(self.split, self.dt, n_prev)
         #: output delay [samples]: the preview, or the finite-difference half-width if larger
-        self.delay_samples: int = max(n_prev, self._plan.h)
-        self._mode = "none"
-        p = self._plan
+        self.delay_samples: int = max(n_prev, p.h)
+        h, d = p.h, self.delay_samples
+        # the anticausal kernel: y_u[k] = sum_q anti_taps[q] u[k+q], q = 0..N
+        self._anti_taps = None
+        self._blocks_ok = False
         if p.anti is not None:
             N = n_prev
-            Phi, al, be, Cr = p.anti_phi, p.anti_alpha, p.anti_beta, p.anti_C
-            if N < FIR_MAX_TAPS:
-                self._mode = "fir"
-                rows = _left_powers(Cr, Phi, N + 1)  # C_r Phi^q, q = 0..N
-                taps = np.zeros(N + 1)
-                taps[:N] += rows[:N] @ al
-                taps[1:] += rows[:N] @ be
-                self._taps = taps
+            rows = _left_powers(p.anti_C, p.anti_phi, N + 1)        # C_r Phi^q
+            taps = np.zeros(N + 1)
+            taps[:N] += rows[:N] @ p.anti_alpha
+            taps[1:] += rows[:N] @ p.anti_beta
+            self._anti_taps = taps
+            if N >= MIN_BLOCK:
+                self._blocks_ok = True
+                self._Wr = rows                                      # C_r Phi^q
+                self._Wa = rows @ p.anti_alpha                       # C_r Phi^q alpha
+                self._Pa = _left_powers(p.anti_alpha, p.anti_phi.T, N)   # Phi^i alpha
+                self._Pb = _left_powers(p.anti_beta, p.anti_phi.T, N)    # Phi^i beta
+        # one kernel for a single output: anticausal taps and the difference stencil over
+        # the window u[k-h .. k+delay]
+        kern = np.zeros(h + d + 1)
+        if self._anti_taps is not None:
+            kern[h:h + n_prev + 1] += self._anti_taps
+        if h:
+            kern[:2 * h + 1] += p.kernel
+        self._kernel = kern if np.any(kern) else None
+        # the stable filter for one-sample steps (transposed direct form II, as lfilter)
+        self._step_ba = self._step_sos = None
+        if p.stable is not None:
+            if p.stable.kind == "ba":
+                b, a = p.stable.b / p.stable.a[0], p.stable.a / p.stable.a[0]
+                n = max(a.size, b.size)
+                self._step_ba = (np.pad(b, (0, n - b.size)).tolist(), np.pad(a, (0, n - a.size)).tolist())
             else:
-                self._mode = "blocks"
-                self._Wr = _left_powers(Cr, Phi, N + 1)        # C_r Phi^q
-                self._Wa = self._Wr @ al                       # C_r Phi^q alpha
-                self._Pa = _right_powers(al, Phi, N)           # Phi^i alpha
-                self._Pb = _right_powers(be, Phi, N)           # Phi^i beta
+                self._step_sos = [(r[:3] / r[3]).tolist() + (r[3:] / r[3]).tolist() for r in p.stable.sos]
         self.reset()
 
     # ------------------------------------------------------------------------------------
@@ -145,22 +176,48 @@ class StreamingInverter:
         """Number of output samples emitted so far."""
         return self._n_out
 
+    def _keep(self) -> int:
+        """Index of the oldest input later outputs still need (the block start for the
+        block sums)."""
+        keep = self._n_out - self._plan.h
+        if self._blocks_ok:
+            N = self.preview_samples
+            keep = min(keep, (self._n_out // N) * N)
+        return max(keep, self._base)
+
+    @property
+    def _hist(self) -> np.ndarray:
+        """Retained inputs (those later outputs still need), a view."""
+        return self._u[self._keep() - self._base:self._n_in - self._base]
+
+    @property
+    def _ys(self) -> np.ndarray:
+        """Causal part of the outputs not yet emitted, a view."""
+        return self._y[self._n_out - self._base:self._n_in - self._base]
+
     def reset(self) -> None:
         """Forget all history (start a new signal)."""
-        p = self._plan
+        h = self._plan.h
         self._n_in = 0
         self._n_out = 0
         self._closed = False
-        self._end: int | None = None
-        self._hist = np.zeros(0)
-        self._hist0 = 0
-        self._zi = p.stable.zi0() if p.stable is not None else None
-        self._ys = np.zeros(0)   # causal part for indices [n_out, n_in)
-        n_u = p.anti_phi.shape[0]
+        # inputs (and causal outputs) of sample k live at index k - base; the h samples
+        # before the signal are zeros (for the difference stencil)
+        self._base = -h
+        self._u = np.zeros(max(BUFFER, 4 * (self.delay_samples + h + 1)))
+        self._y = np.zeros_like(self._u)
+        st = self._plan.stable
+        self._zi = st.zi0() if st is not None else None    # lfilter/sosfilt state (array)
+        self._zl = None                                      # the same state as a list
+        self._reset_blocks()
+
+    def _reset_blocks(self) -> None:
+        """Forget the running sums of the block in progress (recomputed from its start)."""
         self._S: np.ndarray | None = None
-        self._R = np.zeros(n_u)
+        self._R = np.zeros(self._plan.anti_phi.shape[0])
         self._p_last = 0
 
+    # ------------------------------------------------------------------------------------
     def push(self, chunk: Any) -> np.ndarray:
         """Consume samples; return the newly final output samples (possibly none).
 
@@ -177,7 +234,14 @@ class StreamingInverter:
         """
         if self._closed:
             raise InversionError("the stream was flushed; call reset() before pushing again")
-        x = np.asarray(chunk, dtype=float).ravel()
+        x = np.asarray(chunk, dtype=float)
+        if x.size == 1:
+            v = x.item()
+            if not math.isfinite(v):
+                raise NonFiniteSignalError(
+                    f"the signal must be finite; sample {self._n_in} (chunk index 0) is {v!r}")
+            return self._consume_one(v)
+        x = x.ravel()
         if x.size and not np.all(np.isfinite(x)):
             i = int(np.flatnonzero(~np.isfinite(x))[0])
             raise NonFiniteSignalError(
@@ -194,54 +258,108 @@ class StreamingInverter:
         return out[:max(0, end - (self._n_out - out.size))]
 
     # ------------------------------------------------------------------------------------
+    def _room(self, count: int) -> int:
+        """Make space for ``count`` more samples; return the buffer index of the next one."""
+        pos = self._n_in - self._base
+        if pos + count <= self._u.size:
+            return pos
+        keep = self._keep()                          # the oldest sample still needed
+        live = self._n_in - keep
+        size = max(BUFFER, 4 * (self.delay_samples + self._plan.h + 1), 2 * (live + count))
+        if size > self._u.size or size < self._u.size // 4:
+            u, y = np.zeros(size), np.zeros(size)
+        else:
+            u, y = self._u, self._y
+        s = keep - self._base
+        u[:live] = self._u[s:s + live]
+        y[:live] = self._y[s:s + live]
+        self._u, self._y, self._base = u, y, keep
+        return live
+
+    def _consume_one(self, v: float) -> np.ndarray:
+        """One sample: the stable filter stepped in plain Python, one kernel dot product."""
+        pos = self._room(1)
+        self._u[pos] = v
+        p = self._plan
+        if self._step_ba is not None or self._step_sos is not None:
+            z = self._zl
+            if z is None:
+                z = self._zl = [float(c) for c in np.ravel(self._zi)]
+                self._zi = None
+            if self._step_ba is not None:
+                b, a = self._step_ba
+                y = b[0] * v + z[0]
+                n = len(z)
+                for i in range(n - 1):
+                    z[i] = z[i + 1] + b[i + 1] * v - a[i + 1] * y
+                z[n - 1] = b[n] * v - a[n] * y
+            else:
+                y = v
+                for k, (b0, b1, b2, _, a1, a2) in enumerate(self._step_sos):
+                    xi = y
+                    y = b0 * xi + z[2 * k]
+                    z[2 * k] = b1 * xi - a1 * y + z[2 * k + 1]
+                    z[2 * k + 1] = b2 * xi - a2 * y
+        else:
+            y = p.D * v
+        self._y[pos] = y
+        self._n_in += 1
+        k = self._n_out
+        if self._n_in - self.delay_samples <= k:
+            return np.zeros(0)
+        out = self._y[k - self._base]
+        if self._S is not None or self._p_last:
+            self._reset_blocks()
+        if self._kernel is not None:
+            w0 = k - p.h - self._base
+            out += float(self._kernel @ self._u[w0:w0 + self._kernel.size])
+        self._n_out = k + 1
+        return np.array([out])
+
     def _consume(self, x: np.ndarray) -> np.ndarray:
         p = self._plan
         if x.size:
-            if self._zi is not None:
-                ys, self._zi = p.stable.run(x, self._zi)
+            pos = self._room(x.size)
+            self._u[pos:pos + x.size] = x
+            if p.stable is not None:
+                if self._zl is not None:
+                    zi = np.asarray(self._zl, float)
+                    self._zi, self._zl = zi.reshape(p.stable.zi0().shape), None
+                ys, self._zi = p.stable.run(x, self._zi)   # includes D * x
             else:
                 ys = p.D * x
-            self._ys = np.concatenate((self._ys, ys))
-            self._hist = np.concatenate((self._hist, x))
+            self._y[pos:pos + x.size] = ys
             self._n_in += x.size
         k_lo, k_hi = self._n_out, self._n_in - self.delay_samples
         if k_hi <= k_lo:
             return np.zeros(0)
-        out = self._ys[:k_hi - k_lo].copy()
+        b = self._base
+        out = self._y[k_lo - b:k_hi - b].copy()
+        n_out = k_hi - k_lo
         if p.h:
-            out += self._deriv(k_lo, k_hi)
-        if self._mode == "fir":
-            N = self.preview_samples
-            seg = self._u(k_lo, k_hi + N)
-            out += np.correlate(seg, self._taps, mode="valid")
-        elif self._mode == "blocks":
-            out += self._blocks(k_lo, k_hi)
+            out += np.correlate(self._u[k_lo - p.h - b:k_hi + p.h - b], p.kernel, mode="valid")
+        taps = self._anti_taps
+        if taps is not None:
+            seg = self._u[k_lo - b:k_hi + taps.size - 1 - b]
+            if n_out * taps.size <= KERNEL_WORK:
+                out += np.correlate(seg, taps, mode="valid")
+                self._reset_blocks()
+            elif self._blocks_ok and taps.size - 1 > BLOCK_RATIO * n_out:
+                out += self._blocks(k_lo, k_hi)
+            else:
+                out += p.anticausal(seg)[:n_out]
+                self._reset_blocks()
         self._n_out = k_hi
-        self._ys = self._ys[k_hi - k_lo:]
-        # trim history to what later outputs still need
-        keep = k_hi - p.h
-        if self._mode == "blocks":
-            N = self.preview_samples
-            keep = min(keep, (k_hi // N) * N)
-        keep = max(keep, 0)
-        if keep > self._hist0:
-            self._hist = self._hist[keep - self._hist0:]
-            self._hist0 = keep
         return out
 
-    def _u(self, lo: int, hi: int) -> np.ndarray:
-        """Input samples [lo, hi) with zeros before index 0."""
-        if lo >= self._hist0:
-            return self._hist[lo - self._hist0:hi - self._hist0]
-        pad = np.zeros(self._hist0 - lo)
-        return np.concatenate((pad, self._hist[:hi - self._hist0]))
-
-    def _deriv(self, k_lo: int, k_hi: int) -> np.ndarray:
-        h = self._plan.h
-        seg = self._u(k_lo - h, k_hi + h)
-        return np.correlate(seg, self._plan.kernel, mode="valid")
+    # -- the two-stack block sums ---------------------------------------------------------
+    def _ur(self, lo: int, hi: int) -> np.ndarray:
+        """Retained inputs [lo, hi) (lo >= 0)."""
+        return self._u[lo - self._base:hi - self._base]
 
     def _blocks(self, k_lo: int, k_hi: int) -> np.ndarray:
+        """Anticausal outputs k_lo .. k_hi-1 from the block sums (module doc of the old
+        block method: F_k = S_k + Phi^(a-k) R_(k-jN), both pieces with decaying powers)."""
         N = self.preview_samples
         pieces = []
         k = k_lo
@@ -264,7 +382,7 @@ class StreamingInverter:
         """Outputs of ``nb`` complete blocks starting at the block boundary ``k``."""
         p = self._plan
         N = self.preview_samples
-        u = self._u(k, k + (nb + 1) * N)            # blocks + the following block
+        u = self._ur(k, k + (nb + 1) * N)            # blocks + the following block
         win = np.lib.stride_tricks.sliding_window_view(u, N + 1)[: nb * N: N]  # (nb, N+1)
         o = p.anti.run_rows(np.ascontiguousarray(win[:, ::-1]))[:, ::-1]
         S = o[:, :N] - self._Wa[N:0:-1][None, :] * win[:, N:N + 1]
@@ -281,11 +399,10 @@ class StreamingInverter:
         p = self._plan
         N = self.preview_samples
         Wr, Wa, Pa, Pb = self._Wr, self._Wa, self._Pa, self._Pb
-        j = k // N
-        base = j * N
+        base = (k // N) * N
         a = base + N
         if self._S is None:
-            seg = self._u(base, a + 1)                 # N + 1 samples, u_a last
+            seg = self._ur(base, a + 1)                # N + 1 samples, u_a last
             o, _ = p.anti.run(seg[::-1], p.anti.zi0())
             o = o[::-1]
             self._S = o[:N] - Wa[N:0:-1] * seg[N]      # C_r S_k = o'_k - C_r Phi^(a-k) alpha u_a
@@ -293,7 +410,7 @@ class StreamingInverter:
         # R_p for p in [p_last, P_hi - 1]
         i0, i1 = self._p_last, P_hi - 1
         if i1 > i0:
-            useg = self._u(a + i0, a + i1 + 1)
+            useg = self._ur(a + i0, a + i1 + 1)
             terms = Pa[i0:i1] * useg[:-1, None] + Pb[i0:i1] * useg[1:, None]
             Rs = np.vstack((self._R, self._R + np.cumsum(terms, axis=0)))
         else:
@@ -305,7 +422,5 @@ class StreamingInverter:
         self._R = Rs[-1].copy()
         self._p_last = max(i1, i0)
         if k_end == a:
-            self._S = None
-            self._R = np.zeros_like(self._R)
-            self._p_last = 0
+            self._reset_blocks()
         return out

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ._data import FrequencyData, to_data
-from ._nlp import ConvergenceError, Problem, SolveOutcome, Solver, covariance
+from ._lsq import LevenbergMarquardt
+from ._nlp import ConvergenceError, Problem, SolveOutcome, covariance
 from ._structure import Structure
 from .metrics import fit_percent, relative_rms_error
 from .models import RationalModel, Scaling, StabilityCheck
@@ -114,19 +116,26 @@ class TemperatureError:
     fit_percent: float
 
 
-def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolate=False):
-    out = []
+def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolate=False,
+                           response=None):
+    """Fit quality at each temperature of ``data`` (one evaluation of the model over all
+    lines, split by temperature).  ``response``: the model's response on the lines of
+    ``data`` if already at hand."""
+    if response is None:
+        tt = data.temperature_c if (model.is_scheduled and data.temperature_c is not None) else None
+        response = model.frequency_response(data.frequency_hz, tt, extrapolate=extrapolate)
+    h = response
     temps = [None] if data.temperature_c is None else list(data.temperatures())
+    out = []
     for t in temps:
-        d = data if t is None else data.at_temperature(t)
-        tt = d.temperature_c if model.is_scheduled else None
-        h = model.frequency_response(d.frequency_hz, tt, extrapolate=extrapolate)
+        k = slice(None) if (t is None or len(temps) == 1) else np.isclose(data.temperature_c, t, rtol=0, atol=1e-9)
+        hm, hd = h[k], data.response[k]
         try:
-            fp = fit_percent(h, d.response)
+            fp = fit_percent(hm, hd)
         except ValueError:  # a single line per temperature: NRMSE undefined
             fp = float("nan")
-        out.append(TemperatureError(None if t is None else float(t), d.n,
-                                    relative_rms_error(h, d.response), fp))
+        out.append(TemperatureError(None if t is None else float(t), int(hd.size),
+                                    relative_rms_error(hm, hd), fp))
     return out
 
 
@@ -134,7 +143,8 @@ def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolat
 class FitResult:
     """What a fit returns.  Every array is in the model's parameter layout.
 
-    converged : IPOPT reported success (``status`` holds its return status).
+    converged : the solver reported success (``status`` holds its return status, in IPOPT's
+        names whichever solver ran: Levenberg–Marquardt, or IPOPT for constrained solves).
     cost : ½·mean of squared weighted residuals at the solution. [-]
     weighted_rms : sqrt(2·cost), RMS weighted residual (≈1 for a correct model and
         correct uncertainties with weighting 'uncertainty'). [-]
@@ -217,36 +227,74 @@ def best_outcome(outcomes, prefer: str | None = None, rel_tol: float = 0.02):
 
 #: iteration budget (× max_iter) of the one resumed solve, see :func:`resume_slowest`
 RESUME_FACTOR = 6
+#: smallest ``max_iter`` for which a solve that ran out of iterations is resumed; a smaller
+#: limit is taken as a deliberate hard cap
+RESUME_MIN_ITER = 50
+#: a warm start (continuation across temperatures) keeps running while its cost is within
+#: this fraction of a converged start's, so it is kept unless another start is clearly better
+WARM_MARGIN = 0.02
 
 
-def resume_slowest(outcomes: list, solve_long, history: list, stage: str) -> None:
+def _outcome(lm: LevenbergMarquardt, i: int, time_s: float) -> SolveOutcome:
+    def resume(n):
+        t0 = time.perf_counter()
+        lm.revive(i)
+        lm.run(n, only=[i])
+        return _outcome(lm, i, time.perf_counter() - t0)
+
+    return SolveOutcome(lm.theta[i].copy(), float(lm.cost[i]), lm.status[i], bool(lm.converged[i]),
+                        int(lm.iterations[i]), time_s, list(lm.traces[i]), resume)
+
+
+def race_starts(evaluator, starts, max_iter: int, tol: float, lb, ub, prefer: str | None = "warm") -> list:
+    """Levenberg–Marquardt from every start in lockstep (one batched evaluation per
+    iteration serves them all); when one converges, the starts whose cost is higher are
+    stopped (status ``Stopped_Early``), except the start named ``prefer`` (a warm start),
+    which keeps running while within ``WARM_MARGIN`` of it.  Returns ``[(name, SolveOutcome)]``
+    (the time of the lockstep run is shared equally among the starts)."""
+    names = [name for name, _ in starts]
+    margins = [WARM_MARGIN if name == prefer else 0.0 for name in names]
+    lm = LevenbergMarquardt(evaluator, np.array([th for _, th in starts]), lb, ub, tol, margins)
+    lm.run(max_iter)
+    share = lm.time_s / len(names)
+    return [(name, _outcome(lm, i, share)) for i, name in enumerate(names)]
+
+
+def resume_slowest(outcomes: list, solve_long, history: list, stage: str, max_iter: int = 0) -> None:
     """If the lowest-cost outcome ran out of iterations, resume it once from where it stopped
-    with ``solve_long(theta)`` (a solver with ``RESUME_FACTOR × max_iter`` iterations) and
-    append the new outcome.  Slow is not failed: poles and zeros far outside the data band
-    are weakly determined and IPOPT can need over a thousand iterations to settle them; a
-    fresh solve restarts the barrier, so only one long resume is tried."""
+    and append the new outcome: in place with ``RESUME_FACTOR × max_iter`` more iterations
+    when the outcome can be continued (Levenberg–Marquardt), else with ``solve_long(theta)``
+    (a solver with ``RESUME_FACTOR × max_iter`` iterations), unless ``max_iter`` is below
+    ``RESUME_MIN_ITER`` (a hard cap).  Slow is not failed: poles and
+    zeros far outside the data band are weakly determined and can need over a thousand
+    iterations to settle; only one long resume is tried."""
     name, low = min(outcomes, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)
-    if low.converged or low.status != "Maximum_Iterations_Exceeded":
+    if low.converged or low.status != "Maximum_Iterations_Exceeded" or max_iter < RESUME_MIN_ITER:
         return
-    out = solve_long(low.theta)
+    if low.resume is not None:
+        out = low.resume(RESUME_FACTOR * max_iter)
+    else:
+        out = solve_long(low.theta)
     history.append(history_entry(f"{stage} (resumed, {RESUME_FACTOR}× max_iter)", name, out))
     outcomes.append((name, out))
 
 
-def finish(structure, problem: Problem, solver: Solver | None, outcome: SolveOutcome, scaling: Scaling,
+def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scaling: Scaling,
            data: FrequencyData, *, weighting_name: str, method: str, settings: dict,
            scale_covariance: bool, history: list, time_s: float, temperature_range,
            compute_covariance: bool = True, two_stage=None, per_temperature_models=None,
            raise_on_failure: bool = True, stability_grid: int = 501) -> FitResult:
     theta = outcome.theta
-    r = problem.residual(theta)
     cov, rank_def = None, False
     at_bounds = []
-    if compute_covariance and solver is not None:
-        cov, rank_def = covariance(solver.jacobian(problem, theta), r, scale_covariance)
+    if compute_covariance and evaluator is not None:
+        r, jac = evaluator.residual(theta, jacobian=True)
+        cov, rank_def = covariance(jac, r, scale_covariance)
         lo, hi = structure.bounds(float(problem.w.min()), float(problem.w.max()))
         names = structure.param_names()
         at_bounds = [names[i] for i in np.flatnonzero((theta <= lo + 1e-6) | (theta >= hi - 1e-6))]
+    else:
+        r = (evaluator or problem).residual(theta)
     info = {
         "method": method,
         "settings": settings,
@@ -260,7 +308,9 @@ def finish(structure, problem: Problem, solver: Solver | None, outcome: SolveOut
     }
     model = RationalModel(structure, theta, scaling, temperature_range, cov, data.labels(), info)
     stability = model.stability_check(stability_grid)
-    errs = per_temperature_errors(model, data)
+    # the model's response on the data lines: H_model = R · H_data, R from the residual model
+    errs = per_temperature_errors(model, data, response=None if evaluator is None
+                                  else evaluator.ratio(theta) * data.response)
     ci = model.confidence_intervals()
     res = FitResult(
         model=model, converged=outcome.converged, status=outcome.status,
@@ -274,7 +324,7 @@ def finish(structure, problem: Problem, solver: Solver | None, outcome: SolveOut
     )
     if not outcome.converged and raise_on_failure:
         raise ConvergenceError(
-            f"{method} fit did not converge: IPOPT status {outcome.status!r} after "
+            f"{method} fit did not converge: status {outcome.status!r} after "
             f"{outcome.iterations} iterations (raise_on_failure=False returns the flagged result)",
             res,
         )

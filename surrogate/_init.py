@@ -56,24 +56,37 @@ def numerator_ls(w, h, n_zeros: int, den, relative: bool = True):
 
 def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8):
     """SK iterations (relative weighting); returns every iterate, Levy's first."""
+    w = np.asarray(w, float)
+    h = np.asarray(h, complex)
+    jw = 1j * w
+    vd = jw[:, None] ** np.arange(n_poles + 1)
+    a = np.hstack([vd[:, :n_zeros + 1] if n_zeros <= n_poles else jw[:, None] ** np.arange(n_zeros + 1),
+                   -h[:, None] * vd[:, :n_poles]])
+    rhs = h * vd[:, n_poles]
     rel = 1.0 / np.abs(h)
-    num, den = levy(w, h, n_zeros, n_poles, rel)
-    out = [(num, den)]
-    jw = 1j * np.asarray(w, float)
-    for _ in range(n_iter):
-        d = np.abs(np.polynomial.polynomial.polyval(jw, den))
+    wt, out = rel, []
+    for _ in range(n_iter + 1):
+        sol = _solve_weighted(a, rhs, wt)
+        den = np.append(sol[n_zeros + 1:], 1.0)
+        out.append((sol[:n_zeros + 1], den))
+        d = np.abs(vd @ den)
         if not np.all(np.isfinite(d)) or np.any(d == 0):
             break
-        num, den = levy(w, h, n_zeros, n_poles, rel / d)
-        out.append((num, den))
+        wt = rel / d
     return out
 
 
-def _stable_sections_theta(w, h, n_zeros, den_roots):
-    quads, single = group_roots(stabilise_roots(den_roots))
+def _stable_sections_theta(w, h, n_zeros, den_roots, num=None):
+    """Sections parameters for the given poles (unstable ones reflected).  ``num`` (the
+    numerator that came with these poles) is kept when no pole had to be moved; otherwise
+    the numerator is refitted by linear least squares."""
+    rts = np.asarray(den_roots, complex)
+    stable = stabilise_roots(rts)
+    quads, single = group_roots(stable)
     poles_part = pole_slots_from_groups(quads, single)
-    den = np.real(np.poly(stabilise_roots(den_roots))[::-1])
-    num = numerator_ls(w, h, n_zeros, den)
+    if num is None or np.any(stable != rts):
+        den = np.real(np.poly(stable)[::-1])
+        num = numerator_ls(w, h, n_zeros, den)
     return np.concatenate([num, poles_part])
 
 
@@ -91,8 +104,34 @@ def spread_poles(w, n_poles: int, damping: float = 0.5) -> np.ndarray:
     return np.array(rts, complex)
 
 
-def initial_candidates(structure: Structure, w, h, problem_cost) -> list[tuple[str, np.ndarray]]:
-    """Distinct starting points, best (lowest ``problem_cost``) first."""
+def _sk_costs(sk, structure, costs):
+    """Cost of each SK iterate as it stands (coefficient form, one batched evaluation),
+    +inf where a pole is unstable (those would be reflected before use), and the poles of
+    every iterate (one batched eigenvalue call; NaN where the denominator is not finite)."""
+    n = structure.n_poles
+    dens = np.array([den for _, den in sk])                   # (k, n+1), monic
+    comp = np.zeros((len(sk), n, n))
+    comp[:, 0, :] = -dens[:, -2::-1]
+    comp[:, np.arange(1, n), np.arange(n - 1)] = 1.0
+    ok = np.all(np.isfinite(comp), axis=(1, 2))
+    poles = np.full((len(sk), n), np.nan, complex)
+    if ok.any():
+        poles[ok] = np.linalg.eigvals(comp[ok])
+    stable = np.all(poles.real < 0, axis=1)
+    coef = structure.with_form("coefficients")
+    thetas = np.array([np.concatenate([num, den[:-1]]) for num, den in sk])
+    c = np.asarray(costs(coef, thetas), float)
+    return np.where(stable & np.isfinite(c), c, np.inf), poles
+
+
+def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.ndarray]]:
+    """Distinct starting points, best first: Levy's answer, the best Sanathanan–Koerner
+    iterate and (stable forms) poles log-spread over the band.
+
+    ``costs(structure, thetas)`` scores a stack of parameter vectors (k, p) of a structure
+    with these orders (the fit's own, or the coefficient form for ranking the raw SK
+    iterates, so that only the best stable one is converted to sections).
+    """
     m, n = structure.n_zeros, structure.n_poles
     cands = []
     sk = sanathanan_koerner(w, h, m, n)
@@ -101,21 +140,29 @@ def initial_candidates(structure: Structure, w, h, problem_cost) -> list[tuple[s
             for i, (num, den) in enumerate(sk):
                 cands.append(("levy" if i == 0 else f"sk{i}", np.concatenate([num, den[:-1]])))
         else:
-            for i, (num, den) in enumerate(sk):
-                if np.all(np.isfinite(den)):
-                    theta = _stable_sections_theta(w, h, m, np.roots(den[::-1]))
+            raw, poles = _sk_costs(sk, structure, costs)
+            picks = list(range(len(sk)))
+            if len(sk) > 1:
+                j = 1 + int(np.argmin(raw[1:]))
+                if np.isfinite(raw[j]):   # else: no stable SK iterate, convert them all
+                    picks = [0, j]
+            for i in picks:
+                num, den = sk[i]
+                if np.all(np.isfinite(poles[i])):
+                    theta = _stable_sections_theta(w, h, m, poles[i], num)
                     cands.append(("levy" if i == 0 else f"sk{i}", theta))
             cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n))))
-    scored = []
-    for name, th in cands:
-        if np.all(np.isfinite(th)):
-            scored.append((problem_cost(th), name, th))
-    scored.sort(key=lambda t: t[0])
+    cands = [(name, th) for name, th in cands if np.all(np.isfinite(th))]
+    if not cands:
+        return []
+    c = np.asarray(costs(structure, np.array([th for _, th in cands])), float)
+    order = np.argsort(np.where(np.isfinite(c), c, np.inf), kind="stable")
     # keep Levy (the classic answer), the best SK iterate and the log-spread start
     keep, seen = [], set()
-    for c, name, th in scored:
+    for i in order:
+        name, th = cands[i]
         tag = "sk" if name.startswith("sk") else name
-        if tag not in seen and np.isfinite(c):
+        if tag not in seen and np.isfinite(c[i]):
             seen.add(tag)
             keep.append((name, th))
     return keep

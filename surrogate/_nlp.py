@@ -1,4 +1,4 @@
-"""CasADi/IPOPT problem builder: weighted residuals, solver with captured status, Jacobian.
+"""Residuals, the constrained CasADi/IPOPT solver, outcomes and the covariance.
 
 Residuals compare the model with the data through the ratio R = H_model/H_data:
 
@@ -7,14 +7,17 @@ Residuals compare the model with the data through the ratio R = H_model/H_data:
                 principal value, so no phase unwrapping of the data is needed;
 * ``relative``: (Re R − 1, Im R), i.e. (H_model − H_data)/H_data.
 
-The objective is ½·mean(r²); the Jacobian of r at the optimum gives the Gauss–Newton
-covariance used for confidence intervals.
+The objective is ½·mean(r²); the Jacobian of r at the optimum (:mod:`surrogate._lsq`) gives
+the Gauss–Newton covariance used for confidence intervals.  Unconstrained fits are solved by
+Levenberg–Marquardt in :mod:`surrogate._lsq`; :class:`Solver` (IPOPT) handles the fits that
+need constraints.
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -78,9 +81,16 @@ class Problem:
     def n_residuals(self) -> int:
         return 2 * self.n_points
 
-    def data_vector(self) -> np.ndarray:
-        return np.concatenate([self.w, self.tau, self.h.real, self.h.imag,
-                               self.inv_sig_a, self.inv_sig_b])
+    def line_data(self, n_lines: int | None = None) -> np.ndarray:
+        """(w̃, τ, Re h, Im h, 1/σ_a, 1/σ_b) of every line, line after line (6N,); padded to
+        ``n_lines`` with copies of the first line at zero weight (zero residuals)."""
+        d = np.column_stack([self.w, self.tau, self.h.real, self.h.imag,
+                             self.inv_sig_a, self.inv_sig_b])
+        if n_lines is not None and n_lines > d.shape[0]:
+            pad = np.repeat(d[:1], n_lines - d.shape[0], axis=0)
+            pad[:, 4:] = 0.0
+            d = np.vstack([d, pad])
+        return d.ravel()
 
     def residual(self, theta) -> np.ndarray:
         return residual(self.structure, np.asarray(theta, float), self.w, self.tau, self.h.real,
@@ -104,17 +114,54 @@ class SolveOutcome:
     iterations: int
     time_s: float
     objective_trace: list = field(default_factory=list)
+    #: ``resume(n)`` continues this solve for up to n more iterations and returns the new
+    #: outcome (None when the solver cannot be continued in place)
+    resume: object = field(default=None, repr=False, compare=False)
 
 
 _CACHE: dict = {}
 _CACHE_MAX = 64
 
 
+#: lines per block of the IPOPT problem: the data are padded to whole blocks, so the CasADi
+#: graph maps a block function (built once per structure) over ceil(N/BLOCK_LINES) blocks
+BLOCK_LINES = 128
+
+
+@lru_cache(maxsize=64)
+def _block_functions(structure: Structure, kind: str):
+    """Residuals of one block of ``BLOCK_LINES`` frequency lines, r(θ; data) ∈ R^(2×B) with
+    data (w̃, τ, Re h, Im h, 1/σ_a, 1/σ_b) as a 6×B matrix, and the Hessian of ½‖r‖² in θ
+    summed over the block, as CasADi functions: one per-line residual and its exact Hessian,
+    mapped over the block.  Built once per structure and residual kind; mapping them over
+    the blocks of any data set costs little (mapping a p×p output over thousands of single
+    lines does not: CasADi's map then costs time proportional to the lines)."""
+    import casadi as ca
+
+    x = ca.SX.sym("x", structure.n_params)
+    d = ca.SX.sym("d", 6)
+    r = residual(structure, x, d[0], d[1], d[2], d[3], d[4], d[5], kind, CasadiBackend())
+    line_r = ca.Function("line_residual", [x, d], [r])
+    line_h = ca.Function("line_hessian", [x, d], [ca.hessian(0.5 * ca.sumsqr(r), x)[0]])
+    xm = ca.MX.sym("x", structure.n_params)
+    dm = ca.MX.sym("d", 6, BLOCK_LINES)
+    block_r = ca.Function("block_residual", [xm, dm],
+                          [line_r.map("lines", "serial", BLOCK_LINES, [0], [])(xm, dm)])
+    block_h = ca.Function("block_hessian", [xm, dm],
+                          [line_h.map("lines_h", "serial", BLOCK_LINES, [0], [0])(xm, dm)])
+    return block_r, block_h
+
+
 class Solver:
     """IPOPT on ½·mean(r(θ; data)²) with the data as NLP parameters.
 
-    One compiled solver serves every problem with the same structure, number of lines and
-    residual kind (e.g. all temperatures of a two-stage fit); use :func:`get_solver`.
+    The objective is one per-line residual function mapped over blocks of lines (CasADi
+    ``map``, see :func:`_block_functions`), and the Hessian of the Lagrangian is assembled from
+    the per-line Hessians the same way, so building a solver costs about the same whatever
+    the number of lines; solvers are cached per
+    structure, number of lines, residual kind and constraint set (:func:`get_solver`).  The
+    fitters use it only where constraints are needed (Levenberg–Marquardt in
+    :mod:`surrogate._lsq` does the unconstrained solves).
 
     ``grid_taus`` (scheduled models): the log pole-section slots (and the 'zpk' zero-section
     slots) are kept inside ``Structure.slot_bounds`` at these scaled temperatures (linear
@@ -131,12 +178,16 @@ class Solver:
         import casadi as ca
 
         st = self.structure = structure
-        be = CasadiBackend()
-        x = ca.SX.sym("x", st.n_params)
-        p = ca.SX.sym("p", 6 * n_points)
-        parts = [p[i * n_points:(i + 1) * n_points] for i in range(6)]
-        r = residual(st, x, *parts, kind, be)
-        f = 0.5 * ca.sumsqr(r) / (2 * n_points)
+        self.n_points = int(n_points)
+        n = self.n_points
+        self.n_blocks = nb = -(-n // BLOCK_LINES)
+        x = ca.MX.sym("x", st.n_params)
+        p = ca.MX.sym("p", 6 * nb * BLOCK_LINES)      # line after line, see line_data
+        data = ca.reshape(p, 6, nb * BLOCK_LINES)
+        block_r, block_h = _block_functions(st, kind)
+        r = block_r.map("blocks", "serial", nb, [0], [])(x, data)
+        f = 0.5 * ca.sumsqr(r) / (2 * n)
+        xs = ca.SX.sym("x", st.n_params)
         g, self._g_kinds = [], []
         taus = np.asarray([] if grid_taus is None else grid_taus, float)
         if taus.size and st.degree > 0:
@@ -144,16 +195,29 @@ class Solver:
             for s_name in [s for s in st.slots if s.startswith("log_")] + st.zero_slots:
                 j = st.slots.index(s_name) * nc
                 for tau in taus:
-                    g.append(ca.dot(x[j:j + nc], ca.DM(tau ** np.arange(nc))))
+                    g.append(ca.dot(xs[j:j + nc], ca.DM(tau ** np.arange(nc))))
                     self._g_kinds.append(s_name)
         if hurwitz and taus.size:
             if st.form != "coefficients":
                 raise ValueError("Hurwitz constraints apply to the 'coefficients' form only")
-            h = self._hurwitz_constraints(st, x, taus, pole_margin)
+            h = self._hurwitz_constraints(st, xs, taus, pole_margin)
             g += h
             self._g_kinds += ["hurwitz"] * len(h)
         self.hurwitz_margin = hurwitz_margin
-        nlp = {"x": x, "p": p, "f": f, "g": ca.vertcat(*g) if g else ca.SX(0, 1)}
+        gs = ca.vertcat(*g) if g else ca.SX(0, 1)
+        lam_gs = ca.SX.sym("lam_g", gs.shape[0])
+        g_hess = ca.Function("g_hess", [xs, lam_gs], [ca.hessian(ca.dot(lam_gs, gs), xs)[0]
+                                                     if g else ca.SX(st.n_params, st.n_params)])
+        gx = ca.Function("constraints", [xs], [gs])(x)
+        # exact Hessian of the Lagrangian, assembled from per-line Hessians (mapped and summed:
+        # differentiating the mapped objective instead costs time proportional to the lines)
+        lam_f = ca.MX.sym("lam_f")
+        lam_g = ca.MX.sym("lam_g", gs.shape[0])
+        h_f = block_h.map("blocks_h", "serial", nb, [0], [0])(x, data) / (2 * n)
+        hess = ca.Function("lagrangian_hessian", [x, p, lam_f, lam_g],
+                           [ca.triu(lam_f * h_f + g_hess(x, lam_g))],
+                           ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
+        nlp = {"x": x, "p": p, "f": f, "g": gx}
         opts = {
             "print_time": False,
             "error_on_fail": False,
@@ -162,14 +226,15 @@ class Solver:
             "ipopt.max_iter": int(max_iter),
             "ipopt.tol": float(tol),
             "ipopt.constr_viol_tol": 1e-9,
+            "hess_lag": hess,
         }
         self._solver = ca.nlpsol("surrogate_fit", "ipopt", nlp, opts)
-        self._jac = ca.Function("residual_jacobian", [x, p], [ca.jacobian(r, x)])
 
     @staticmethod
     def _hurwitz_constraints(st: Structure, x, taus, shift: float = 0.0):
-        import casadi as ca
         from math import comb
+
+        import casadi as ca
 
         n, nc = st.n_poles, st.n_coef
         # Taylor shift D(s) → D(s − shift): q_i = Σ_{k≥i} a_k C(k, i) (−shift)^(k−i), a_n = 1
@@ -200,7 +265,7 @@ class Solver:
         w_min, w_max = float(problem.w.min()), float(problem.w.max())
         lbx, ubx = st.bounds(w_min, w_max)
         theta0 = np.clip(np.asarray(theta0, float), lbx + 1e-9, ubx - 1e-9)
-        args = {"x0": theta0, "lbx": lbx, "ubx": ubx, "p": problem.data_vector()}
+        args = {"x0": theta0, "lbx": lbx, "ubx": ubx, "p": problem.line_data(self.n_blocks * BLOCK_LINES)}
         if self._g_kinds:
             sb = st.slot_bounds(w_min, w_max)
             lbg = [sb[k][0] if k in sb else self.hurwitz_margin for k in self._g_kinds]
@@ -217,9 +282,6 @@ class Solver:
         trace = [float(v) for v in stats.get("iterations", {}).get("obj", [])]
         return SolveOutcome(theta, cost, status, bool(ok), int(stats.get("iter_count", -1)),
                             elapsed, trace)
-
-    def jacobian(self, problem: Problem, theta) -> np.ndarray:
-        return np.asarray(self._jac(np.asarray(theta, float), problem.data_vector()), float)
 
 
 def get_solver(structure: Structure, n_points: int, kind: str, *, max_iter: int, tol: float,
@@ -238,13 +300,37 @@ def get_solver(structure: Structure, n_points: int, kind: str, *, max_iter: int,
     return solver
 
 
+def _r_factor(a: np.ndarray) -> np.ndarray:
+    """Triangular factor of a = QR by modified Gram–Schmidt (backward stable for R), with
+    element-wise numpy operations only (no BLAS/LAPACK call on the tall matrix)."""
+    q = np.array(a.T, dtype=float, order="C")          # columns of a as rows
+    p = q.shape[0]
+    r = np.zeros((p, p))
+    for j in range(p):
+        nrm = float(np.sqrt(np.einsum("i,i->", q[j], q[j])))
+        r[j, j] = nrm
+        if nrm == 0.0:
+            continue
+        q[j] /= nrm
+        if j + 1 < p:
+            proj = np.einsum("ij,j->i", q[j + 1:], q[j])
+            r[j, j + 1:] = proj
+            q[j + 1:] -= proj[:, None] * q[j]
+    return r
+
+
 def covariance(jac: np.ndarray, resid: np.ndarray, scale: bool):
     """Gauss–Newton covariance (JᵀJ)⁻¹·s², s² = reduced χ² when ``scale`` (else 1).
 
     Returns ``(cov, rank_deficient)``; a rank-deficient Jacobian gives the pseudo-inverse.
     """
     n_res, n_par = jac.shape
-    u, s, vt = np.linalg.svd(jac, full_matrices=False)
+    # SVD of the triangular factor R (jac = QR): the same singular values and right vectors,
+    # but the only LAPACK call is on the small R.  LAPACK on the tall jac runs matrix-vector
+    # products on several OpenBLAS threads, which on a busy machine wait for each other (up to
+    # 0.7 s for 4800 x 21, against 2 ms here).
+    small = jac.size <= 20_000                  # below OpenBLAS's threading thresholds
+    s, vt = np.linalg.svd(jac if small else _r_factor(jac), full_matrices=False)[1:]
     keep = s > s[0] * 1e-12 if s.size else s.astype(bool)
     inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 0.0)
     cov = (vt.T * inv_s2) @ vt

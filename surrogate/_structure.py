@@ -27,6 +27,7 @@ Forms
 
 from __future__ import annotations
 
+import functools
 import itertools
 from dataclasses import dataclass
 
@@ -120,7 +121,7 @@ class Structure:
         (zeros within about 2Z): poles and zeros far outside the data band are not
         identifiable and would only drift towards 0 or ∞ (a monic zero section cannot reach
         a zero at infinity, so without a bound the gain and the section drift together and
-        IPOPT runs out of iterations).
+        the solver runs out of iterations).
         """
         out = {}
         if w_min is None:
@@ -145,6 +146,10 @@ class Structure:
         """Parameter bounds: degree 0 applies ``slot_bounds`` directly; otherwise only a
         generous box on the log slots (the scheduled fitter imposes ``slot_bounds`` on a
         temperature grid)."""
+        lo, hi = _bounds(self, None if w_min is None else float(w_min), None if w_max is None else float(w_max))
+        return lo.copy(), hi.copy()
+
+    def _bounds(self, w_min, w_max):
         lo = np.full(self.n_params, -np.inf)
         hi = np.full(self.n_params, np.inf)
         sb = self.slot_bounds(w_min, w_max) if self.degree == 0 else self.slot_bounds()
@@ -168,6 +173,11 @@ class Structure:
     def slot_matrix(self, theta) -> np.ndarray:
         """Parameters as an array (n_slots, degree+1) (numpy only)."""
         return np.asarray(theta, float).reshape(len(self.slots), self.n_coef)
+
+
+@functools.lru_cache(maxsize=256)
+def _bounds(structure: Structure, w_min, w_max):
+    return structure._bounds(w_min, w_max)
 
 
 # ----------------------------------------------------------------- backends
@@ -320,11 +330,41 @@ def polynomials(structure: Structure, theta, tau: float = 0.0):
     return np.asarray(num, float), np.asarray(den, float)
 
 
+def denominators(structure: Structure, theta, taus) -> np.ndarray:
+    """Monic denominator coefficients in s̃ (ascending) at many scaled temperatures at once,
+    shape (len(taus), n_poles + 1); the same numbers as ``polynomials(...)[1]`` per τ."""
+    taus = np.atleast_1d(np.asarray(taus, float))
+    vals = structure.slot_matrix(theta) @ (taus[None, :] ** np.arange(structure.n_coef)[:, None])
+    v = dict(zip(structure.slots, vals))                       # slot -> (K,)
+    n, k = structure.n_poles, taus.size
+    if structure.form == "coefficients":
+        return np.column_stack([v[f"a{j}"] for j in range(n)] + [np.ones(k)])
+    den = np.ones((k, 1))
+    sections = [(np.exp(v[f"log_a0_{i}"]), np.exp(v[f"log_a1_{i}"]), np.ones(k)) for i in range(n // 2)]
+    if n % 2:
+        sections.append((np.exp(v["log_c"]), np.ones(k)))
+    for sec in sections:
+        out = np.zeros((k, den.shape[1] + len(sec) - 1))
+        for j, c in enumerate(sec):
+            out[:, j:j + den.shape[1]] += den * c[:, None]
+        den = out
+    return den
+
+
 def _factor_roots(poly_asc) -> np.ndarray:
+    """Roots of c0 + c1 s + s² (or c0 + s); real pairs by the cancellation-free formula
+    q = −(c1 + sign(c1)·√disc)/2, roots q and c0/q (a root much smaller than the other is
+    otherwise lost to rounding and can come out as exactly 0)."""
     if len(poly_asc) == 3:
-        c0, c1 = poly_asc[0], poly_asc[1]
-        disc = np.sqrt(complex(c1 * c1 - 4 * c0))
-        return np.array([(-c1 + disc) / 2, (-c1 - disc) / 2])
+        c0, c1 = float(poly_asc[0]), float(poly_asc[1])
+        disc = c1 * c1 - 4 * c0
+        if disc < 0:
+            im = np.sqrt(-disc) / 2
+            return np.array([complex(-c1 / 2, im), complex(-c1 / 2, -im)])
+        q = -(c1 + np.copysign(np.sqrt(disc), c1)) / 2
+        if q == 0.0:
+            return np.zeros(2, complex)
+        return np.array([complex(q), complex(c0 / q)])
     return np.array([-poly_asc[0] + 0j])
 
 

@@ -354,7 +354,7 @@ class RationalModel:
         t = None if temperature_c is None else np.asarray(temperature_c, float)
         shape = () if t is None else t.shape
         taus = np.atleast_1d(self._tau(t, shape, extrapolate)).ravel()
-        den = np.array([S.polynomials(self.structure, self._params, tau)[1] for tau in taus])
+        den = S.denominators(self.structure, self._params, taus)
         n = den.shape[1] - 1
         comp = np.zeros((taus.size, n, n))
         comp[:, 0, :] = -den[:, -2::-1] / den[:, -1:]

@@ -1,15 +1,17 @@
-"""Rational fit at one temperature: IPOPT on a stable-by-construction parametrisation."""
+"""Rational fit at one temperature: Levenberg–Marquardt on a stable-by-construction
+parametrisation, several starts raced in lockstep."""
 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
 from . import _fit as F
 from ._data import FrequencyData, to_data
 from ._init import initial_candidates
-from ._nlp import get_solver
+from ._lsq import Evaluator
 from ._structure import Structure
 
 __all__ = ["RationalFit"]
@@ -35,15 +37,17 @@ class RationalFit:
         given, else 'log'.
     init : {'auto', 'sk', 'levy', 'spread'}
         Starting point(s): Levy's linear least squares, the best Sanathanan–Koerner iterate,
-        poles log-spread over the band; 'auto' starts IPOPT from each and keeps the best.
+        poles log-spread over the band; 'auto' runs Levenberg–Marquardt from each in
+        lockstep, stops the starts another has beaten and keeps the best.
     max_iter : int
-        IPOPT iteration limit per start.
+        Iteration limit per start (a best start that runs out is resumed once with 6×
+        more, see ``_fit.resume_slowest``).
     tol : float
-        IPOPT convergence tolerance.
+        Convergence tolerance (relative cost decrease; see ``_lsq.LevenbergMarquardt``).
     omega_ref_rad_s, gain_ref : float, optional
         Frequency [rad/s] and gain scales (default: geometric means over the data).
     raise_on_failure : bool
-        Raise ``ConvergenceError`` (carrying the flagged result) if IPOPT does not converge;
+        Raise ``ConvergenceError`` (carrying the flagged result) if the fit does not converge;
         with False the result has ``converged=False``.
     scale_covariance : bool
         Scale the Gauss–Newton covariance by the reduced χ².
@@ -52,7 +56,7 @@ class RationalFit:
     --------------------------
     model_ : RationalModel
     result_ : FitResult
-    history_ : list of dict, one per IPOPT run.
+    history_ : list of dict, one per start (and resumed solve).
     """
 
     def __init__(self, n_zeros: int, n_poles: int, *, stable: bool = True, weighting: str = "auto",
@@ -117,7 +121,13 @@ class RationalFit:
             if theta0.shape != (st.n_params,):
                 raise ValueError(f"theta0 must have {st.n_params} entries, got shape {theta0.shape}")
             starts.append(("warm", theta0))
-        cands = initial_candidates(st, problem.w, problem.h, problem.cost)
+        evaluator = Evaluator(problem)
+
+        def costs(structure, thetas):
+            ev = evaluator if structure == st else Evaluator(replace(problem, structure=structure))
+            return ev.costs(thetas)
+
+        cands = initial_candidates(st, problem.w, problem.h, costs)
         if self.init == "auto":
             starts += cands
         else:
@@ -125,21 +135,13 @@ class RationalFit:
             starts += chosen[:1] or cands[:1]
         if not starts:
             raise ValueError("no finite initial guess could be formed from these data")
-        solver = get_solver(st, problem.n_points, problem.kind, max_iter=self.max_iter, tol=self.tol)
-        history, outcomes = [], []
-        for name, th in starts:
-            out = solver.solve(problem, th)
-            history.append(F.history_entry(stage, name, out))
-            outcomes.append((name, out))
-
-        def solve_long(theta):
-            return get_solver(st, problem.n_points, problem.kind, tol=self.tol,
-                              max_iter=F.RESUME_FACTOR * self.max_iter).solve(problem, theta)
-
-        F.resume_slowest(outcomes, solve_long, history, stage)
+        lb, ub = st.bounds(float(problem.w.min()), float(problem.w.max()))
+        outcomes = F.race_starts(evaluator, starts, self.max_iter, self.tol, lb, ub)
+        history = [F.history_entry(stage, name, out) for name, out in outcomes]
+        F.resume_slowest(outcomes, None, history, stage, self.max_iter)
         _, best = F.best_outcome(outcomes, prefer="warm")
         temp_range = None if not temps.size else (float(temps[0]), float(temps[0]))
-        res = F.finish(st, problem, solver, best, scaling, data, weighting_name=wname,
+        res = F.finish(st, problem, evaluator, best, scaling, data, weighting_name=wname,
                        method="rational", settings=self.settings(),
                        scale_covariance=self.scale_covariance, history=history,
                        time_s=time.perf_counter() - t_start, temperature_range=temp_range,

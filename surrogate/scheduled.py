@@ -1,10 +1,11 @@
-"""Temperature-scheduled fits: the papers' two-stage method and the joint CasADi fit.
+"""Temperature-scheduled fits: the papers' two-stage method and the joint fit.
 
 Two-stage (seed 000, seed 001): fit each temperature, then fit each coefficient / gain,
-zero and pole entry with a polynomial in T.  Joint: one NLP over all temperatures whose
-unknowns are the polynomial coefficients themselves, started from the two-stage answer and
-from a constant schedule (the lower converged cost wins, unless an unconverged solve is
-cheaper: then that one is returned, flagged).
+zero and pole entry with a polynomial in T.  Joint: one least-squares problem over all
+temperatures whose unknowns are the polynomial coefficients themselves, started from the
+two-stage answer and from a constant schedule and solved by Levenberg–Marquardt (the lower
+converged cost wins, unless an unconverged solve is cheaper: then that one is returned,
+flagged); CasADi/IPOPT re-solves with constraints where a bound or stability needs them.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from . import _fit as F
 from ._data import FrequencyData, to_data
 from ._init import levy
+from ._lsq import STATUS_STOPPED, Evaluator
 from ._nlp import SolveOutcome, get_solver
 from ._structure import Structure, convert
 from .models import RationalModel, Scaling
@@ -53,7 +55,7 @@ class ScheduledFit:
     weighting, max_iter, tol, raise_on_failure, scale_covariance
         As in ``RationalFit``.
     per_temperature : {'nlp', 'levy'}
-        First stage of the two-stage method: our stable IPOPT fit at each temperature
+        First stage of the two-stage method: our stable least-squares fit at each temperature
         ('nlp', default) or Levy's linear least squares ('levy', the papers' ``invfreqs``;
         unstable Levy poles are reflected when converting to the 'zpk' form).
     enforce_stability : bool
@@ -135,7 +137,7 @@ class ScheduledFit:
     def _per_temperature(self, data: FrequencyData, scaling, history):
         """Per-temperature fits in ascending T.
 
-        'nlp': stable IPOPT fits, each warm-started from its neighbour (kept unless a fresh
+        'nlp': stable ``RationalFit`` fits, each warm-started from its neighbour (kept unless a fresh
         start is >2 % better, so sections are tracked continuously).  'levy': Levy's linear
         least squares (Octave ``invfreqs`` without iterations), the papers' first stage.
         Returns {T: (structure, params, converged)}.
@@ -182,25 +184,31 @@ class ScheduledFit:
         return np.asarray(coef, float).T.ravel()
 
     def _joint(self, problem, scaling, t_range, per_t, theta2, history):
-        """One NLP over all temperatures from two starts (two-stage answer; constant schedule
-        of the mid-range per-T fit).  Returns ``(solver, outcome)``.
+        """One least-squares problem over all temperatures from two starts (the two-stage
+        answer; a constant schedule of the mid-range per-T fit).  Returns
+        ``(evaluator, outcome)``.
 
-        * form 'coefficients': a converged solve with a pole at or right of the axis anywhere
-          on the 501-point grid is re-solved with Liénard–Chipart constraints (margin
-          ``stability_margin``) on ``stability_grid`` temperatures, refined where the dense
-          check still fails;
-        * every start is solved (a converged two-stage start can be a poor local minimum:
-          sensor zpk 2/2, cost 112 vs 0.49), and the lowest converged cost wins;
-        * if the lowest cost belongs to a solve that ran out of iterations (slow, not failed:
-          far-out zeros are weakly determined), it is resumed once with
+        * Levenberg–Marquardt runs both starts in lockstep (``_fit.race_starts``); a start
+          is stopped when the other has converged to a lower cost (a converged two-stage
+          start can be a poor local minimum: sensor zpk 2/2, cost 112 vs 0.49);
+        * if the lowest cost belongs to a solve that ran out of iterations (slow, not
+          failed: far-out zeros are weakly determined), it is resumed once with
           ``RESUME_FACTOR × max_iter`` iterations (``_fit.resume_slowest``); if it still
-          does not converge, the result is that solve, flagged (``_fit.best_outcome``).
+          does not converge, the result is that solve, flagged (``_fit.best_outcome``);
+        * a solution whose pole or zero sections leave ``Structure.slot_bounds`` at one of
+          the ``stability_grid`` temperatures is re-solved by IPOPT with those bounds as
+          constraints (``_nlp.Solver``);
+        * form 'coefficients': a converged solution with a pole at or right of the axis
+          anywhere on the 501-point grid is re-solved by IPOPT with Liénard–Chipart
+          constraints (margin ``stability_margin``) on ``stability_grid`` temperatures,
+          refined where the dense check still fails.
         """
         st = self.structure
         c, sc = scaling.temperature_center_c, scaling.temperature_scale_c
         taus = np.linspace((t_range[0] - c) / sc, (t_range[1] - c) / sc, self.stability_grid)
         dense_t = np.linspace(t_range[0], t_range[1], _DENSE_CHECK)
         hurwitz = st.form == "coefficients" and self.enforce_stability
+        w_min, w_max = float(problem.w.min()), float(problem.w.max())
 
         def solver_for(grid, constrained, budget=1):
             return get_solver(st, problem.n_points, problem.kind, max_iter=budget * self.max_iter,
@@ -210,18 +218,53 @@ class ScheduledFit:
         def unstable(theta):
             return RationalModel(st, theta, scaling, t_range).max_pole_real_part(dense_t) >= 0
 
+        def outside_slot_bounds(theta) -> bool:
+            bounds = st.slot_bounds(w_min, w_max)
+            if not bounds:
+                return False
+            vals = st.slot_matrix(theta) @ (taus[None, :] ** np.arange(st.n_coef)[:, None])
+            for j, name in enumerate(st.slots):
+                if name in bounds and (np.any(vals[j] < bounds[name][0]) or np.any(vals[j] > bounds[name][1])):
+                    return True
+            return False
+
         mid = min(per_t, key=lambda t: abs(t - c))
         st0, th0 = per_t[mid][:2]
         const = np.zeros((len(st.slots), st.n_coef))
         const[:, 0] = th0 if st0.form == st.form else convert(st0, th0, st.form)
-        outcomes, setups = [], {}
-        for name, th in (("two-stage", theta2), ("constant", const.ravel())):
-            grid, constrained = taus, False
-            out = solver_for(grid, False).solve(problem, th)
-            history.append(F.history_entry("joint", name, out))
+        evaluator = Evaluator(problem)
+        lb, ub = st.bounds()
+        starts = {"two-stage": theta2, "constant": const.ravel()}
+        outcomes = F.race_starts(evaluator, list(starts.items()), self.max_iter, self.tol, lb, ub,
+                                 prefer=None)
+        history += [F.history_entry("joint", name, out) for name, out in outcomes]
+        F.resume_slowest(outcomes, None, history, "joint", self.max_iter)
+        final, setups = [], {}
+        # constrained re-solves, cheapest outcome first; an outcome whose (unconstrained) cost
+        # is already above a settled one cannot win and keeps its unconstrained answer; a
+        # start stopped in favour of one whose constrained answer turned out costlier is
+        # finished now and treated the same way
+        settled = np.inf
+        for name, out in sorted(outcomes, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf):
+            if not out.cost < settled:
+                final.append((name, out))
+                continue
+            if out.status == STATUS_STOPPED:
+                out = out.resume(self.max_iter)
+                history.append(F.history_entry("joint (continued)", name, out))
+                if not out.cost < settled:
+                    final.append((name, out))
+                    continue
+            if outside_slot_bounds(out.theta):
+                setups[name] = (taus, False)
+                out = solver_for(taus, False).solve(problem, out.theta)
+                history.append(F.history_entry(
+                    f"joint (section bounds at {taus.size} temperatures)", name, out))
             if out.converged and hurwitz and unstable(out.theta).any():
-                constrained, th = True, (th if not unstable(th).any() else out.theta)
+                start = starts[name]          # a stable start is the better way in
+                grid, th = taus, (start if not unstable(start).any() else out.theta)
                 for _ in range(_MAX_REFINE + 1):
+                    setups[name] = (grid, True)
                     out = solver_for(grid, True).solve(problem, th)
                     history.append(F.history_entry(
                         f"joint (Hurwitz constraints at {grid.size} temperatures)", name, out))
@@ -229,13 +272,15 @@ class ScheduledFit:
                     if not out.converged or not bad.any():
                         break
                     grid, th = np.union1d(grid, (dense_t[bad] - c) / sc), out.theta
-            outcomes.append((name, out))
-            setups[name] = (grid, constrained)
-        low = min(outcomes, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)[0]
-        F.resume_slowest(outcomes, lambda th: solver_for(*setups[low], F.RESUME_FACTOR).solve(problem, th),
-                         history, "joint")
-        name, best = F.best_outcome(outcomes)
-        return solver_for(*setups[name]), best
+            final.append((name, out))
+            if out.converged:
+                settled = min(settled, out.cost)
+        # a constrained (IPOPT) solve that ran out of iterations is resumed like the others
+        low = min(final, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)[0]
+        if low in setups:
+            F.resume_slowest(final, lambda th: solver_for(*setups[low], F.RESUME_FACTOR).solve(problem, th),
+                             history, "joint", self.max_iter)
+        return evaluator, F.best_outcome(final)[1]
 
     def fit_data(self, data: FrequencyData):
         """Fit a ``FrequencyData`` or a ``physmodel.data.sweep.FrequencySweep``."""
@@ -275,8 +320,8 @@ class ScheduledFit:
         if self.method == "two-stage":
             res = two_res
         else:
-            solver, best = self._joint(problem, scaling, t_range, per_t, theta2, history)
-            res = F.finish(st, problem, solver, best, scaling, data, weighting_name=wname,
+            evaluator, best = self._joint(problem, scaling, t_range, per_t, theta2, history)
+            res = F.finish(st, problem, evaluator, best, scaling, data, weighting_name=wname,
                            method="joint", settings=settings,
                            scale_covariance=self.scale_covariance, history=history,
                            time_s=time.perf_counter() - t_start, temperature_range=t_range,

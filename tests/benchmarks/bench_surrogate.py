@@ -299,7 +299,7 @@ def per_temperature_section(quick: bool):
     for sample, band, nf in PER_T_CASES:
         temps = TEMPS.get(sample, SEED001_TEMPS)
         data, truth = generate_sweep(sample, temps, np.geomspace(band[0], band[1], nf), seed=11)
-        methods = {"ours (RationalFit, IPOPT)": [], "scipy AAA": [], "Levy (invfreqs)": []}
+        methods = {"ours (RationalFit)": [], "scipy AAA": [], "Levy (invfreqs)": []}
         if have_vf:
             methods["scikit-rf VectorFitting"] = []
         RationalFit(m, n, raise_on_failure=False).fit_data(data.at_temperature(temps[0]))  # build solver once
@@ -309,7 +309,7 @@ def per_temperature_section(quick: bool):
             t0 = time.perf_counter()
             res = RationalFit(m, n, raise_on_failure=False).fit_data(d)
             dt = time.perf_counter() - t0
-            methods["ours (RationalFit, IPOPT)"].append((res.model.frequency_response(fk), res.model.poles(), dt,
+            methods["ours (RationalFit)"].append((res.model.frequency_response(fk), res.model.poles(), dt,
                                                          res.converged))
             t0 = time.perf_counter()
             hm, poles = _aaa(w, hk, n)
@@ -336,11 +336,11 @@ def per_temperature_section(quick: bool):
 # --------------------------------------------------------------------------- 3. timing
 def timing_section(quick: bool):
     print("\n## 3. Fit times: 10 temperatures x 60 frequencies, order 4/4, cubic schedules\n")
-    print("seed-002 sample, 0.1–20 Hz, all ten seed-001 temperatures. 'first' builds the CasADi "
-          "solvers, 'second' reuses the cached ones. Per-temperature fit times are in section 2.\n")
+    print("seed-002 sample, 0.1–20 Hz, all ten seed-001 temperatures. 'first' is the first fit in "
+          "the process (it builds any CasADi solver it needs), 'second' repeats it. Per-temperature fit times are in section 2.\n")
     data, _ = generate_sweep("seed-002 sample", SEED001_TEMPS, np.geomspace(0.1, 20.0, 60), seed=21)
     print("| method | form | run | total [s] | of which per-T stage [s] | of which joint NLP [s] | "
-          "joint IPOPT iterations | converged |")
+          "joint iterations | converged |")
     print("|:--|:--|:--|--:|--:|--:|--:|:--:|")
     for form in ("coefficients", "zpk"):
         for run in ("first", "second"):

@@ -5,8 +5,9 @@
   (29.4–30.3 °C); constraints now hold every pole left of −stability_margin·ω_ref.
 * calibrated actuator (``seed001_actuator``), seed 001's protocol, zpk 4/4: noise seed 7 ran out
   of iterations from both starts (far-out zeros drifting with the gain).
-* per-temperature sensor fits that need >1000 IPOPT iterations (a zero near 0 and a pole far
-  above the band) are resumed instead of reported as failures.
+* per-temperature sensor fits that need more than max_iter iterations (a zero near 0 and a pole
+  far above the band: >1000 IPOPT or ~800 Levenberg–Marquardt iterations) are resumed instead of
+  reported as failures.
 Oracles: numpy's roots on a 2001-point temperature grid (stability), the noise-free physics
 response (held-out error), IPOPT's own status (convergence).
 """
@@ -60,8 +61,10 @@ def test_slow_per_temperature_fit_is_resumed_not_failed():
     res = RationalFit(2, 2, max_iter=300).fit(sweep)
     first = [e for e in res.history if "resumed" not in e["stage"]]
     resumed = [e for e in res.history if "resumed" in e["stage"]]
-    assert not any(e["converged"] for e in first)          # every start ran out of 300 iterations …
-    assert len(resumed) == 1 and resumed[0]["converged"]    # … the cheapest was resumed and converged
+    cheapest = min(first, key=lambda e: e["cost"])
+    assert cheapest["status"] == "Maximum_Iterations_Exceeded"   # the best start ran out of 300 iterations …
+    assert len(resumed) == 1 and resumed[0]["converged"]    # … it was resumed and converged
+    assert resumed[0]["start"] == cheapest["start"]
     assert res.converged and resumed[0]["cost"] <= min(e["cost"] for e in first)
 
 

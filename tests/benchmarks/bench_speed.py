@@ -1,0 +1,476 @@
+"""Speed benchmark of the machinery around the surrogate fitters and the inversion (issue 17).
+
+Run (from the repository root; a script, not collected by pytest):
+
+    python tests/benchmarks/bench_speed.py [--sections fit,build,joint,stream] [--quick]
+    python tests/benchmarks/bench_speed.py --root /path/to/other/checkout ...
+
+``--root`` imports ``surrogate``, ``inversion`` and ``physmodel`` from another checkout (e.g.
+an export of the commit before this work) so that before/after numbers come from the same
+script; every ratio below is measured side by side within one run.
+
+Sections
+--------
+fit     Per-temperature fit (``RationalFit``, whole call) against a reference: one plain
+        output-error Levenberg–Marquardt solve (MINPACK through ``scipy.optimize.least_squares``,
+        residual and Jacobian compiled by CasADi with the data as parameters — built once per
+        case, not timed) from a Sanathanan–Koerner start computed here (timed), in the same
+        stable section parametrisation.  Cases: seed 000 sensor 4/4 (10–100 Hz), seed 001
+        actuator 3/3 and 4/4 (0.1–9 Hz), seed 002 sample 5 poles / 2 zeros (0.1–100 Hz), 60
+        log-spaced lines, noisy.  "Same accuracy": the reference's time to first reach our
+        final cost (+1e-6 relative); if it never does, its full time (its cost is then worse).
+        Also reported: our solve alone (starting points + Levenberg–Marquardt, without the
+        result assembly: covariance, stability check, per-temperature errors).
+build   Cost of building the CasADi/IPOPT problem against the number of lines, and the first
+        vs the cached joint fit (fresh interpreter each) at 10 temperatures × 240 lines.
+joint   Joint zpk schedules on the seed 001 physics (``seed001_actuator``, 0.1–9 Hz, 60 lines,
+        noise 0.2 dB / 1°, 3/5/10/20 temperatures on 19–55 °C, zpk 3/3 and 4/4, quadratic in T):
+        time, convergence, iterations, and the held-out error against the noise-free physics at
+        temperatures between the fitted ones.
+stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilter`` with
+        carried state and against the batch inverse; finite-preview batch throughput as a
+        ratio to ``scipy.signal.lfilter`` at 1, 5 and 20 kHz.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import os
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve()
+
+
+def _setup_path(root: str | None) -> None:
+    sys.path.insert(0, str(Path(root).resolve() if root else HERE.parents[2]))
+
+
+# ============================================================================ data
+NOISE = (0.2, 1.0)          # dB, degrees
+T000 = [23.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 60.0, 65.0]
+T001 = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
+
+
+def physics(kind: str, name: str, **overrides):
+    import physmodel
+
+    p = physmodel.get_parameter_set(name, **overrides)
+    return physmodel.ActuatorModel(p) if kind == "actuator" else physmodel.SensorModel(p)
+
+
+def sweep(model, quantity, f_hz, temps, seed, noise=NOISE):
+    from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+
+    nz = None if noise is None else MagnitudePhaseNoise(*noise)
+    return synthesize_sweep(model, quantity, f_hz, temps, nz, seed=seed)
+
+
+# ============================================================================ fit
+FIT_CASES = [  # label, model, quantity, band [Hz], temperatures, zeros, poles, noise, seeds
+    ("seed 000 sensor 4/4", ("sensor", "seed000_sensor"), "S", (10.0, 100.0), T000, 4, 4, NOISE, [11]),
+    ("seed 001 actuator 3/3", ("actuator", "seed001_actuator"), "M", (0.1, 9.0), T001, 3, 3, NOISE, [11]),
+    ("seed 001 actuator 4/4", ("actuator", "seed001_actuator"), "M", (0.1, 9.0), T001, 4, 4, NOISE, [11]),
+    ("seed 002 sample 5p/2z", ("actuator", "seed002_table3"), "M", (0.1, 100.0), [26.85], 2, 5, (0.3, 2.0),
+     [41, 42, 43, 44, 45]),
+]
+
+
+class ReferenceLM:
+    """One output-error LM solve in the stable section parametrisation, independent of the
+    package: residuals (ln|R|, arg R)/σ with R = H_model/H_data, H_model = g·N(s̃)/D(s̃),
+    N = Σ b_i s̃^i, D = Π (s̃² + e^u s̃ + e^v)·(s̃ + e^c); CasADi builds r(x; data) and its
+    Jacobian once per (orders, lines); MINPACK (scipy least_squares, method 'lm') solves."""
+
+    def __init__(self, m: int, n: int, n_lines: int):
+        import casadi as ca
+
+        self.m, self.n = m, n
+        x = ca.SX.sym("x", m + 1 + n)
+        p = ca.SX.sym("p", 5 * n_lines)
+        w, hr, hi, ia, ib = (p[i * n_lines:(i + 1) * n_lines] for i in range(5))
+        nr, ni = 0 * w, 0 * w
+        wp = 1 + 0 * w
+        for i in range(m + 1):   # (jw)^i = w^i j^i
+            re, im = [(1, 0), (0, 1), (-1, 0), (0, -1)][i % 4]
+            nr, ni = nr + re * x[i] * wp, ni + im * x[i] * wp
+            wp = wp * w
+        dr, di = 1 + 0 * w, 0 * w
+        k = m + 1
+        for _ in range(n // 2):
+            sr, si = ca.exp(x[k + 1]) - w * w, ca.exp(x[k]) * w
+            dr, di = dr * sr - di * si, dr * si + di * sr
+            k += 2
+        if n % 2:
+            sr, si = ca.exp(x[k]) + 0 * w, w
+            dr, di = dr * sr - di * si, dr * si + di * sr
+        # R = N / (D h)
+        pr, pi = dr * hr - di * hi, dr * hi + di * hr
+        r1 = 0.5 * (ca.log(nr * nr + ni * ni) - ca.log(pr * pr + pi * pi))
+        r2 = ca.atan2(ni * pr - nr * pi, nr * pr + ni * pi)
+        r = ca.vertcat(r1 * ia, r2 * ib)
+        self._f = ca.Function("r", [x, p], [r])
+        self._j = ca.Function("J", [x, p], [ca.jacobian(r, x)])
+
+    @staticmethod
+    def start(w, h, m, n, n_iter=8):
+        """Sanathanan–Koerner (relative weighting) start, unstable poles reflected, grouped
+        into sections, numerator by linear least squares."""
+        jw = 1j * w
+        wt = 1.0 / np.abs(h)
+        den = None
+        for _ in range(n_iter + 1):
+            d = np.ones_like(w) if den is None else np.abs(np.polyval(den[::-1], jw))
+            a = np.hstack([jw[:, None] ** np.arange(m + 1), -h[:, None] * jw[:, None] ** np.arange(n)])
+            rhs = h * jw ** n
+            ww = wt / d
+            A = np.vstack([(a * ww[:, None]).real, (a * ww[:, None]).imag])
+            b = np.concatenate([(rhs * ww).real, (rhs * ww).imag])
+            sc = np.linalg.norm(A, axis=0)
+            sol = np.linalg.lstsq(A / sc, b, rcond=None)[0] / sc
+            den = np.append(sol[m + 1:], 1.0)
+        poles = np.roots(den[::-1])
+        poles = -np.abs(poles.real) + 1j * poles.imag
+        cplx = sorted([p for p in poles if p.imag > 1e-9 * abs(p)], key=abs)
+        real = sorted([p.real for p in poles if abs(p.imag) <= 1e-9 * abs(p)])
+        secs = [(-2 * p.real, abs(p) ** 2) for p in cplx]
+        single = real.pop(int(np.argmax(np.abs(real)))) if n % 2 else None
+        secs += [(-(real[2 * i] + real[2 * i + 1]), real[2 * i] * real[2 * i + 1]) for i in range(len(real) // 2)]
+        theta_p = []
+        for c1, c0 in secs:
+            theta_p += [np.log(c1), np.log(c0)]
+        if single is not None:
+            theta_p.append(np.log(-single))
+        dpoly = np.real(np.poly(np.concatenate([poles])))[::-1]
+        dv = np.polyval(dpoly[::-1], jw)
+        a = jw[:, None] ** np.arange(m + 1)
+        ww = 1.0 / (np.abs(dv) * np.abs(h))
+        A = np.vstack([(a * ww[:, None]).real, (a * ww[:, None]).imag])
+        b = np.concatenate([(h * dv * ww).real, (h * dv * ww).imag])
+        sc = np.linalg.norm(A, axis=0)
+        num = np.linalg.lstsq(A / sc, b, rcond=None)[0] / sc
+        return np.concatenate([num, theta_p])
+
+    def solve(self, w, h, ia, ib, tol=1e-10):
+        """Returns (cost, trace of (time from start [s], cost) per residual evaluation)."""
+        from scipy.optimize import least_squares
+
+        t0 = time.perf_counter()
+        x0 = self.start(w, h, self.m, self.n)
+        p = np.concatenate([w, h.real, h.imag, ia, ib])
+        trace = []
+
+        def fun(x):
+            r = np.asarray(self._f(x, p), float).ravel()
+            trace.append((time.perf_counter() - t0, 0.5 * float(r @ r) / r.size))
+            return r
+
+        def jac(x):
+            return np.asarray(self._j(x, p), float)
+
+        res = least_squares(fun, x0, jac=jac, method="lm", xtol=tol, ftol=tol, gtol=np.sqrt(tol))
+        r = res.fun
+        return 0.5 * float(r @ r) / r.size, time.perf_counter() - t0, trace
+
+
+def fit_section(args):
+    from surrogate import RationalFit, from_sweep
+
+    print("\n## Per-temperature fit vs one output-error LM solve (reference)\n")
+    print("Whole `RationalFit(m, n).fit_data(d)` call vs the reference (SK start + MINPACK LM on a "
+          "CasADi residual, build not timed). Medians over interleaved repeats, summed over the "
+          "temperatures / noise seeds of each case. Cost = ½·mean(r²) of the σ-weighted log residual.\n")
+    print("| case | fits | ours [ms/fit] | of which solve [ms] | reference [ms/fit] (to our cost) | "
+          "ours / reference | solve / reference | mean cost ours / ref | worst cost ours / ref | converged | "
+          "starts stopped early |")
+    print("|:--|--:|--:|--:|--:|--:|--:|--:|--:|:--:|--:|")
+    reps = 3 if args.quick else 7
+    totals = []
+    for label, (kind, pset), q, band, temps, m, n, noise, seeds in FIT_CASES:
+        model = physics(kind, pset)
+        f_hz = np.geomspace(band[0], band[1], 60)
+        ref = ReferenceLM(m, n, f_hz.size)
+        sets = []
+        for seed in seeds:
+            data = from_sweep(sweep(model, q, f_hz, temps, seed, noise))
+            sets += [data.at_temperature(t) for t in temps]
+        t_ours, t_ref, t_ref_same, c_ours, c_ref, t_solve = [], [], [], [], [], []
+        n_conv, n_stop, n_runs = 0, 0, 0
+        RationalFit(m, n, raise_on_failure=False).fit_data(sets[0])   # warm caches (both sides)
+        for d in sets:
+            wref = float(np.sqrt(d.omega.min() * d.omega.max()))
+            g = float(np.exp(np.mean(np.log(np.abs(d.response)))))
+            w, h = d.omega / wref, d.response / g
+            ia = 1.0 / (d.magnitude_std_db * np.log(10) / 20)
+            ib = 1.0 / np.deg2rad(d.phase_std_deg)
+            to, tr, res, rc, trace = [], [], None, None, None
+            for _ in range(reps):
+                gc.collect()
+                t0 = time.perf_counter()
+                res = RationalFit(m, n, raise_on_failure=False).fit_data(d)
+                to.append(time.perf_counter() - t0)
+                gc.collect()
+                rc, el, trace = ref.solve(w, h, ia, ib)
+                tr.append(el)
+            t_ours.append(np.median(to))
+            t_solve.append(sum(e["time_s"] for e in res.history) + _init_time(d, m, n, reps))
+            t_ref.append(np.median(tr))
+            target = res.cost * (1 + 1e-6)
+            reach = [t for t, c in trace if c <= target]
+            t_ref_same.append(np.median(tr) * (reach[0] / trace[-1][0]) if reach else np.median(tr))
+            c_ours.append(res.cost)
+            c_ref.append(rc)
+            n_conv += res.converged
+            n_stop += sum(e["status"] == "Stopped_Early" for e in res.history)
+            n_runs += len(res.history)
+        ratio = np.sum(t_ours) / np.sum(t_ref_same)
+        ratio_solve = np.sum(t_solve) / np.sum(t_ref_same)
+        cr = np.array(c_ours) / np.array(c_ref)
+        totals.append((label, ratio, ratio_solve))
+        print(f"| {label} | {len(sets)} | {1e3 * np.mean(t_ours):.2f} | {1e3 * np.mean(t_solve):.2f} | "
+              f"{1e3 * np.mean(t_ref):.2f} ({1e3 * np.mean(t_ref_same):.2f}) | {ratio:.2f} | {ratio_solve:.2f} | "
+              f"{cr.mean():.4f} | {cr.max():.4f} | {n_conv}/{len(sets)} | {n_stop}/{n_runs} |")
+    print("\nGoal: ours / reference ≤ 1.0 at the same accuracy (whole call; solve alone in brackets): "
+          + "; ".join(f"{lab}: {r:.2f} ({rs:.2f}) {'met' if r <= 1.0 else ('met by the solve' if rs <= 1.0 else 'NOT met')}"
+                      for lab, r, rs in totals))
+
+
+def _init_time(d, m, n, reps):
+    """Median time of forming the starting points (scaling, problem, SK candidates), the part
+    of the solve the history entries do not time."""
+    from dataclasses import replace
+
+    from surrogate import _fit as F
+    from surrogate._structure import Structure
+
+    try:
+        from surrogate._init import initial_candidates
+        from surrogate._lsq import Evaluator
+    except ImportError:          # an older checkout: no separate solve phase to report
+        return float("nan")
+    st = Structure("sections", m, n, 0)
+    ts = []
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        sc = F.make_scaling(d, None, None, float(d.temperatures()[0]), 1.0)
+        pr, _ = F.make_problem(st, d, sc, "auto")
+        ev = Evaluator(pr)
+        initial_candidates(st, pr.w, pr.h,
+                           lambda s2, th, ev=ev, pr=pr: (ev if s2 == st else Evaluator(replace(pr, structure=s2))).costs(th))
+        ts.append(time.perf_counter() - t0)
+    return float(np.median(ts))
+
+
+# ============================================================================ joint
+JOINT_HELD = [26.3, 39.7, 48.1]   # °C, between the fitted temperatures for every count below
+
+
+def joint_section(args):
+    from surrogate import ScheduledFit, from_sweep, relative_rms_error
+
+    seeds = [1, 2] if args.quick else [1, 2, 3, 4, 5]
+    print("\n## Joint zpk schedules on the seed 001 physics\n")
+    print("seed001_actuator, M [mm/V], 60 log-spaced lines on 0.1–9 Hz, noise 0.2 dB / 1° (noise seeds "
+          f"{seeds}), fitted at n temperatures evenly spaced on 19–55 °C, quadratic schedules; held-out "
+          "error = relative RMS error against the noise-free physics at "
+          f"{JOINT_HELD} °C (mean over those temperatures and the seeds; worst in brackets). Time: the "
+          "whole ScheduledFit call (per-temperature stage included), median over the seeds; 'first' is "
+          "seed 1, the first fit with this number of lines in the process.\n")
+    print("| order | temperatures | first [s] | median [s] | max [s] | converged | joint iterations (median) | "
+          "held-out error joint | held-out error two-stage (NLP first stage) |")
+    print("|:--|--:|--:|--:|--:|:--:|--:|--:|--:|")
+    model = physics("actuator", "seed001_actuator")
+    f_hz = np.geomspace(0.1, 9.0, 60)
+    truth = sweep(model, "M", f_hz, JOINT_HELD, 0, None)
+    orders = [(3, 3), (4, 4)]
+    counts = [3, 5, 10] if args.quick else [3, 5, 10, 20]
+    for m, n in orders:
+        for n_t in counts:
+            temps = list(np.round(np.linspace(19.0, 55.0, n_t), 4))
+            times, conv, its, errs, errs2 = [], 0, [], [], []
+            for seed in seeds:
+                data = from_sweep(sweep(model, "M", f_hz, temps, seed))
+                t0 = time.perf_counter()
+                res = ScheduledFit("zpk", m, n, 2, raise_on_failure=False).fit_data(data)
+                times.append(time.perf_counter() - t0)
+                conv += bool(res.converged)
+                its.append(sum(e["iterations"] for e in res.history if e["stage"].startswith("joint")))
+                for t in JOINT_HELD:
+                    k = truth.temperature_c == t
+                    errs.append(relative_rms_error(res.model.frequency_response(f_hz, t), truth.response[k]))
+                    errs2.append(relative_rms_error(res.two_stage.frequency_response(f_hz, t), truth.response[k]))
+            print(f"| zpk {m}/{n} | {n_t} | {times[0]:.2f} | {np.median(times):.2f} | {np.max(times):.2f} | "
+                  f"{conv}/{len(seeds)} | {np.median(its):.0f} | {np.mean(errs):.4f} ({np.max(errs):.4f}) | "
+                  f"{np.mean(errs2):.4f} ({np.max(errs2):.4f}) |")
+
+
+# ============================================================================ build
+_BUILD_SNIPPET = """
+import sys, time, warnings
+sys.path.insert(0, {root!r}); sys.path.insert(0, {bench!r})
+warnings.simplefilter("ignore")
+import numpy as np
+from bench_speed import physics, sweep
+from surrogate import ScheduledFit, from_sweep
+if {case!r} == "zpk":
+    temps = list(np.linspace(19.0, 55.0, 10))
+    data = from_sweep(sweep(physics("actuator", "seed001_actuator"), "M", np.geomspace(0.1, 9.0, {lines}), temps, 1))
+    fit = lambda: ScheduledFit("zpk", 3, 3, 2, raise_on_failure=False)
+else:   # Hurwitz-constrained coefficient schedule (the IPOPT path)
+    temps = [23.0, 25.0, 30.0, 40.0, 50.0, 60.0, 65.0]
+    data = from_sweep(sweep(physics("sensor", "seed000_sensor"), "S", np.geomspace(10.0, 100.0, {lines}), temps, 2))
+    fit = lambda: ScheduledFit("coefficients", 4, 4, 3, max_iter=200, raise_on_failure=False)
+out = []
+for _ in range(2):
+    t0 = time.perf_counter()
+    res = fit().fit_data(data)
+    out.append(time.perf_counter() - t0)
+ipopt = any("constraints" in e["stage"] or "bounds" in e["stage"] for e in res.history)
+print(out[0], out[1], res.converged, ipopt)
+"""
+
+
+def build_section(args):
+    import surrogate
+    from surrogate import _nlp
+    from surrogate._structure import Structure
+
+    root = str(Path(surrogate.__file__).parents[1])
+    print("\n## Problem building against the number of lines\n")
+    print("Construction of the IPOPT solver (`surrogate._nlp.Solver`) for a joint zpk 3/3 quadratic "
+          "schedule with grid constraints, by number of lines (fresh structure each, median of 3):\n")
+    print("| lines | build [s] |")
+    print("|--:|--:|")
+    st = Structure("zpk", 3, 3, 2)
+    taus = np.linspace(-1, 1, 41)
+    for n_lines in (60, 600, 2400):
+        ts = []
+        for _ in range(3):
+            _nlp._CACHE.clear()
+            t0 = time.perf_counter()
+            try:
+                _nlp.Solver(st, n_lines, "log", grid_taus=taus)
+            except TypeError:
+                _nlp.Solver(st, "log", grid_taus=taus)
+            ts.append(time.perf_counter() - t0)
+        print(f"| {n_lines} | {np.median(ts):.3f} |")
+    print("\nFirst vs repeated joint fit in a fresh interpreter: zpk 3/3 quadratic on the seed 001 actuator "
+          "(10 temperatures), and the seed 000 sensor's coefficient 4/4 cubic schedule (7 temperatures) "
+          "whose unconstrained optimum is unstable, so it is re-solved by IPOPT with Hurwitz constraints:\n")
+    print("| fit | lines per temperature | first [s] | again [s] | first / again | converged | IPOPT used |")
+    print("|:--|--:|--:|--:|--:|:--:|:--:|")
+    for case, label in (("zpk", "seed 001 zpk 3/3"), ("hurwitz", "seed 000 coefficients 4/4 (Hurwitz)")):
+        for lines in (60, 240):
+            code = _BUILD_SNIPPET.format(root=root, bench=str(HERE.parent), lines=lines, case=case)
+            out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+            first, again, conv, ipopt = out.stdout.split()
+            first, again = float(first), float(again)
+            print(f"| {label} | {lines} | {first:.2f} | {again:.2f} | {first / again:.2f} | {conv} | {ipopt} |")
+
+
+# ============================================================================ stream
+def _median_interleaved(fns: dict, reps: int) -> dict:
+    times = {k: [] for k in fns}
+    for _ in range(reps):
+        for k, f in fns.items():
+            gc.collect()
+            t0 = time.perf_counter()
+            f()
+            times[k].append(time.perf_counter() - t0)
+    return {k: float(np.median(v)) for k, v in times.items()}
+
+
+def stream_section(args):
+    import scipy.signal as ss
+
+    from inversion import StreamingInverter, invert
+    from inversion.examples import seed000_sensor_35c
+
+    G = seed000_sensor_35c("coefficients")
+    reps = 3 if args.quick else 7
+    print("\n## Streaming and finite-preview batch inversion (seed 000 35 °C sensor model, 4th order)\n")
+    dt = 1e-3
+    rng = np.random.default_rng(0)
+    b4, a4 = ss.butter(4, 0.1)
+    n1 = 5_000 if args.quick else 20_000
+    u1 = np.sin(2 * np.pi * 20 * dt * np.arange(n1)) + 0.1 * rng.standard_normal(n1)
+    zi0 = ss.lfilter_zi(b4, a4) * 0.0
+
+    def stream(u, chunk):
+        inv = StreamingInverter(G, dt, "auto")
+        for i in range(0, u.size, chunk):
+            inv.push(u[i:i + chunk])
+
+    def lfilter_carried(u):
+        zi = zi0
+        for i in range(u.size):
+            _, zi = ss.lfilter(b4, a4, u[i:i + 1], zi=zi)
+
+    t = _median_interleaved({"stream": lambda: stream(u1, 1), "lfilter": lambda: lfilter_carried(u1)}, reps)
+    print(f"dt = 1 ms, preview auto ({StreamingInverter(G, dt, 'auto').preview_samples} samples).\n")
+    print("| chunk | streaming [ns/sample] | reference | reference [ns/sample] | streaming / reference | goal |")
+    print("|--:|--:|:--|--:|--:|:--|")
+    r1 = t["stream"] / t["lfilter"]
+    print(f"| 1 | {1e9 * t['stream'] / n1:.0f} | lfilter (4th order) with carried state, one sample per call | "
+          f"{1e9 * t['lfilter'] / n1:.0f} | {r1:.2f} | ≤ 5 µs/sample: "
+          f"{'met' if t['stream'] / n1 <= 5e-6 else 'NOT met'} |")
+    n2 = 1 << (18 if args.quick else 20)
+    u2 = np.sin(2 * np.pi * 20 * dt * np.arange(n2)) + 0.1 * rng.standard_normal(n2)
+    t = _median_interleaved({"stream": lambda: stream(u2, 4096),
+                             "batch": lambda: invert(G, dt, u2, preview="auto")}, reps)
+    r2 = t["stream"] / t["batch"]
+    print(f"| 4096 | {1e9 * t['stream'] / n2:.1f} | batch `invert(..., preview='auto')` of the whole record | "
+          f"{1e9 * t['batch'] / n2:.1f} | {r2:.2f} | ≤ 1.5× batch: {'met' if r2 <= 1.5 else 'NOT met'} |")
+    print("\nFinite-preview batch throughput as a ratio to `scipy.signal.lfilter` (4th-order Butterworth) "
+          "over the same samples, 2^21 samples:\n")
+    print("| sampling rate | preview [samples] | anticausal filter | invert [ns/sample] | lfilter [ns/sample] | "
+          "ratio (lfilter time / invert time) | goal ≥ 0.3 |")
+    print("|--:|--:|:--|--:|--:|--:|:--|")
+    n3 = 1 << (19 if args.quick else 21)
+    from inversion import split_inverse
+    from inversion._discrete import Plan
+
+    sp = split_inverse(G)
+    for fs in (1e3, 5e3, 20e3):
+        d = 1.0 / fs
+        u3 = np.sin(2 * np.pi * 20 * d * np.arange(n3)) + 0.1 * rng.standard_normal(n3)
+        t = _median_interleaved({"invert": lambda d=d, u3=u3: invert(sp, d, u3, preview="auto"),
+                                 "lfilter": lambda u3=u3: ss.lfilter(b4, a4, u3)}, reps)
+        plan = Plan(sp, d, round(sp.auto_preview_s / d))
+        kind = "fused" if getattr(plan, "fused", None) is not None else (
+            plan.anti.kind if plan.anti is not None else "none")
+        ratio = t["lfilter"] / t["invert"]
+        print(f"| {fs / 1e3:g} kHz | {plan.n_preview} | {kind} | {1e9 * t['invert'] / n3:.1f} | "
+              f"{1e9 * t['lfilter'] / n3:.1f} | {ratio:.2f} | {'met' if ratio >= 0.3 else 'NOT met'} |")
+
+
+# ============================================================================ main
+SECTIONS = {"fit": fit_section, "build": build_section, "joint": joint_section, "stream": stream_section}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--root", help="import the packages from this checkout instead of this one")
+    ap.add_argument("--sections", default=",".join(SECTIONS), help="comma-separated: " + ",".join(SECTIONS))
+    ap.add_argument("--quick", action="store_true", help="fewer repeats")
+    args = ap.parse_args(argv)
+    _setup_path(args.root)
+    import surrogate
+
+    warnings.simplefilter("ignore")
+    print(f"# speed benchmark — packages from {Path(surrogate.__file__).parents[1]}; "
+          f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.2f}")
+    t0 = time.perf_counter()
+    for name in args.sections.split(","):
+        SECTIONS[name.strip()](args)
+    print(f"\n(total {time.perf_counter() - t0:.1f} s)")
+
+
+if __name__ == "__main__":
+    main()

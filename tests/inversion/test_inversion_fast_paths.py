@@ -1,0 +1,126 @@
+"""The fast paths of issue 17: the factored fused finite-preview pass at fast sampling, and the
+one-sample and large-chunk paths of the streaming inverter.
+
+Oracles: the finite-preview window sum of seed 000 eq. (6) evaluated as an explicit backward
+state recursion with ``scipy.linalg.expm`` (independent of the filters and of ``expm_small``),
+and the batch inverse for the streaming paths.
+"""
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+from inversion import StreamingInverter, invert, split_inverse
+from inversion._discrete import Plan
+from inversion.examples import seed000_sensor_35c
+
+G35 = seed000_sensor_35c("coefficients")
+# stable part of order 3 with poles clustered near z = 1 at 1 MHz (second-order sections),
+# one right-half-plane zero (an anticausal part)
+CLUSTERED = (np.poly([20.0, -10.0, -12.0, -15.0]), np.poly([-100.0, -120.0, -150.0, -180.0]))
+
+
+def _window_sum_oracle(split, dt, n_prev, u):
+    """y_u[k] = C_r sum_{i=k}^{k+N-1} Phi^(i-k) (alpha u_i + beta u_{i+1}), u = 0 past the end,
+    as x[k] - Phi^N x[k+N] of the explicit backward recursion x[k] = Phi x[k+1] + g_k."""
+    M, B, Cr = -split.A_u, split.B_u, -split.C_u
+    m = M.shape[0]
+    big = np.zeros((m + 2, m + 2))
+    big[:m, :m], big[:m, m], big[m, m + 1] = M * dt, B * dt, 1.0
+    E = sla.expm(big)
+    Phi, alpha = E[:m, :m], E[:m, m + 1]
+    beta = E[:m, m] - alpha
+    n = u.size
+    up = np.append(u, 0.0)
+    x = np.zeros((n + n_prev + 1, m))
+    for k in range(n - 1, -1, -1):
+        x[k] = Phi @ x[k + 1] + alpha * up[k] + beta * up[k + 1]
+    xbar = x[:n] - x[n_prev:n_prev + n] @ np.linalg.matrix_power(Phi, n_prev).T
+    return xbar @ Cr
+
+
+@pytest.mark.parametrize("fs", [20e3, 100e3])
+def test_factored_fused_pass_equals_the_window_sum(fs):
+    split = split_inverse(G35)
+    dt = 1.0 / fs
+    n_prev = round(split.auto_preview_s / dt)
+    plan = Plan(split, dt, n_prev)
+    # the single transfer function is not accurate enough here: the factored form is used
+    assert plan.anti.kind == "sos" and plan.fused is not None and plan.fused.sos is not None
+    rng = np.random.default_rng(3)
+    n = n_prev + 4000
+    u = np.cumsum(rng.standard_normal(n)) * 1e-2 + np.sin(2 * np.pi * 50 * dt * np.arange(n))
+    ref = _window_sum_oracle(split, dt, n_prev, u)
+    got = invert(split, dt, u, preview=n_prev * dt).unstable_part
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.max(np.abs(ref)))
+
+
+def test_fused_pass_transfer_function_form_at_1khz_equals_the_window_sum():
+    split = split_inverse(G35)
+    dt, n_prev = 1e-3, 113
+    plan = Plan(split, dt, n_prev)
+    assert plan.fused is not None and plan.fused.sos is None
+    u = np.random.default_rng(4).standard_normal(3000)
+    ref = _window_sum_oracle(split, dt, n_prev, u)
+    got = invert(split, dt, u, preview=n_prev * dt).unstable_part
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-11 * np.max(np.abs(ref)))
+
+
+def _stream(inv, u, size):
+    outs = [inv.push(u[i:i + size]) for i in range(0, u.size, size)]
+    outs.append(inv.flush())
+    return np.concatenate(outs)
+
+
+@pytest.mark.parametrize("model, dt, preview, improper", [
+    (G35, 1e-3, "auto", "error"),                                  # transfer-function filters
+    (CLUSTERED, 1e-6, 0.002, "error"),                             # second-order sections
+    ((np.poly([-50.0, -500.0]), np.poly([-10.0, -100.0])), 1e-3, 0.02, "error"),   # minimum phase
+    (([100.0], [1.0, 14.0, 100.0]), 1e-3, 0.0, "differentiate"),   # stencil only
+])
+def test_one_sample_pushes_equal_the_batch_inverse(model, dt, preview, improper):
+    u = np.sin(2 * np.pi * 20 * 1e-3 * np.arange(2500)) + 0.3 * np.random.default_rng(7).standard_normal(2500)
+    ref = invert(model, dt, u, preview=preview, improper=improper).output
+    inv = StreamingInverter(model, dt, preview, improper=improper)
+    if model is CLUSTERED:
+        assert inv._plan.stable.kind == "sos"
+    y = _stream(inv, u, 1)
+    assert y.size == u.size
+    np.testing.assert_allclose(y, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+def test_switching_between_one_sample_and_chunk_paths_keeps_the_state():
+    u = np.random.default_rng(8).standard_normal(6000)
+    ref = invert(CLUSTERED, 1e-6, u, preview=0.002).output
+    inv = StreamingInverter(CLUSTERED, 1e-6, 0.002)
+    outs, i = [], 0
+    for size in [1] * 50 + [4096] + [1] * 30 + [700, 1, 1, 1000]:
+        outs.append(inv.push(u[i:i + size]))
+        i += size
+    outs.append(inv.push(u[i:]))
+    outs.append(inv.flush())
+    np.testing.assert_allclose(np.concatenate(outs), ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+def test_large_chunks_use_the_batch_pass_and_equal_it():
+    u = np.random.default_rng(9).standard_normal(40_000)
+    ref = invert(G35, 1e-3, u, preview="auto").output
+    y = _stream(StreamingInverter(G35, 1e-3, "auto"), u, 4096)
+    np.testing.assert_allclose(y, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+def test_long_preview_switches_between_kernel_block_sums_and_batch_pass():
+    """N = 1000: one-sample and 5-sample pushes use the kernel, 257–300-sample pushes the
+    two-stack block sums (N > 2 L), 2000-sample pushes the batch pass; any order of them
+    must give the batch inverse."""
+    u = np.random.default_rng(10).standard_normal(12_000)
+    ref = invert(G35, 1e-3, u, preview=1.0).output
+    inv = StreamingInverter(G35, 1e-3, 1.0)
+    outs, i = [], 0
+    for size in [1] * 40 + [300, 5, 2000] + [257] * 3 + [1] * 10 + [300] * 4 + [2000, 7, 300]:
+        outs.append(inv.push(u[i:i + size]))
+        i += size
+        assert inv._hist.size <= 2 * inv.preview_samples + 2000
+    outs.append(inv.push(u[i:]))
+    outs.append(inv.flush())
+    np.testing.assert_allclose(np.concatenate(outs), ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
