@@ -18,5 +18,9 @@ class TemperatureRangeError(IPMCError):
     """A temperature lies outside the validity range of a temperature law."""
 
 
+class NotConvergedError(IPMCError, RuntimeError):
+    """An optimiser did not converge (also a ``RuntimeError``); the command line exits 3, not 2."""
+
+
 class DataFormatError(IPMCError):
     """A data file (CSV/NPZ/MAT) is malformed; the message names the line and the problem."""

@@ -28,7 +28,7 @@ import sys
 
 from .commands import (calibrate, demo, diagnose, excite, feedforward, fit, frf, invert, run, sets, simulate, study,
                        sweep, validate)
-from .commands._common import EXIT_BAD_INPUT, EXIT_INTERRUPTED
+from .commands._common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED
 
 #: The subcommands, in the order ``ipmc --help`` lists them.
 COMMANDS = (sets, sweep, simulate, excite, frf, demo, run, study, fit, invert, feedforward, calibrate, diagnose,
@@ -77,7 +77,7 @@ def main(argv=None) -> int:
 
 
 def _main(argv) -> int:
-    from physmodel.errors import IPMCError
+    from physmodel.errors import IPMCError, NotConvergedError
 
     ap = build_parser()
     args = ap.parse_args(argv)
@@ -86,6 +86,9 @@ def _main(argv) -> int:
         return EXIT_BAD_INPUT
     try:
         return int(args.func(args))
+    except NotConvergedError as exc:
+        print(f"ipmc {args.command}: not converged: {exc}", file=sys.stderr)
+        return EXIT_FAILED
     except IPMCError as exc:
         print(f"ipmc {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

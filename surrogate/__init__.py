@@ -1,7 +1,9 @@
 """Low-order, temperature-scheduled rational surrogates of IPMC frequency responses.
 
-Fits are solved with CasADi/IPOPT in scaled variables (s̃ = s/ω_ref, response/g_ref,
-τ = (T − T_c)/T_s); frequencies are in Hz at the edges and the fitted transfer functions
+Fits are solved in scaled variables (s̃ = s/ω_ref, response/g_ref, τ = (T − T_c)/T_s) by a
+Levenberg–Marquardt solver with a closed-form Jacobian (all starts in lockstep, losing starts
+stopped early), and by CasADi/IPOPT only where a constraint is needed (section bounds, the
+Hurwitz stability constraints of the coefficient form); frequencies are in Hz at the edges and the fitted transfer functions
 use s in rad/s, like the seed papers' models.
 
 Public API
@@ -44,7 +46,8 @@ Order selection
 Metrics
     relative_rms_error, fit_percent (100·(1 − NRMSE)), log_rms_error
 Errors
-    ConvergenceError (raised when IPOPT does not converge; ``.result`` holds the flagged result)
+    ConvergenceError (a ``physmodel.errors.NotConvergedError``: raised when a fit does not converge;
+    ``.result`` holds the flagged result)
 Command line: ``ipmc fit`` (:mod:`scenarios.commands.fit`); figures: :mod:`scenarios.plots`.
 """
 

@@ -20,8 +20,8 @@ WEIGHTINGS = ("auto", "uncertainty", "log", "relative")
 def as_data(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg) -> FrequencyData:
     """Arrays → ``FrequencyData``; a ``FrequencyData`` or ``FrequencySweep`` passed as the first
     argument (the others ``None``) is taken as the data."""
-    if temperature_c is None and response is None:
-        return to_data(frequency_hz)
+    if response is None:          # data (a sweep, FrequencyData, FRD or {T: FRD}) and an optional temperature
+        return to_data(frequency_hz, temperature_c)
     return FrequencyData(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg)
 
 

@@ -23,12 +23,15 @@ import numpy as np
 
 from ._structure import CasadiBackend, NumpyBackend, Structure, evaluate, hurwitz_matrix
 
+from physmodel import interrupts
+from physmodel.errors import NotConvergedError
+
 __all__ = ["ConvergenceError", "Problem", "Solver", "SolveOutcome", "get_solver"]
 
 _OK_STATUSES = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
-class ConvergenceError(RuntimeError):
+class ConvergenceError(NotConvergedError):
     """A fit did not converge; ``.result`` holds the flagged result."""
 
     def __init__(self, message: str, result=None):
@@ -275,6 +278,7 @@ class Solver:
         sol = self._solver(**args)
         elapsed = time.perf_counter() - t0
         stats = self._solver.stats()
+        interrupts.check()     # CasADi catches Ctrl-C inside IPOPT and reports it as a failed solve
         theta = np.asarray(sol["x"], float).ravel()
         status = str(stats.get("return_status", "unknown"))
         cost = float(sol["f"])

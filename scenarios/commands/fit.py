@@ -83,7 +83,7 @@ def _report(args, data, fit_data, res, held_out, figures, verdict=None) -> str:
         f"- model: form `{st.form}`, {st.n_zeros} zeros, {st.n_poles} poles, degree {st.degree} in T, "
         f"method `{res.method}`, weighting `{res.weighting}`",
         f"- status: {'converged' if res.converged else 'NOT CONVERGED'} (`{res.status}`, "
-        f"{res.iterations} IPOPT iterations, {res.time_s:.2f} s)",
+        f"{res.iterations} iterations, {res.time_s:.2f} s)",
         f"- weighted RMS residual: {res.weighted_rms:.4g}",
         f"- goodness of fit: {'adequate' if verdict is None or verdict.adequate else '**INADEQUATE**'}"
         + (f" — {verdict.reason}" if verdict is not None else ""),

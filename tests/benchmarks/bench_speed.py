@@ -66,7 +66,7 @@ def physics(kind: str, name: str, **overrides):
 
 
 def sweep(model, quantity, f_hz, temps, seed, noise=NOISE):
-    from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+    from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 
     nz = None if noise is None else MagnitudePhaseNoise(*noise)
     return synthesize_sweep(model, quantity, f_hz, temps, nz, seed=seed)

@@ -155,7 +155,7 @@ def test_joint_zpk_fourth_order_converges_at_five_temperatures():
     iterations here (issue 17); the joint fit must converge and predict temperatures between
     the fitted ones within the one-line noise floor (~0.029)."""
     import physmodel
-    from physmodel.sweep import MagnitudePhaseNoise, synthesize_sweep
+    from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
     from surrogate import ScheduledFit, relative_rms_error
 
     model = physmodel.ActuatorModel(physmodel.get_parameter_set("seed001_actuator"))
