@@ -97,7 +97,8 @@ from .scheduled import (
     invert_scheduled_to,
     temperature_grid,
 )
-from .split import DEFAULT_PREVIEW_TOL, InverseSplit, frequency_preview, model_coefficients, split_inverse
+from .preview import DEFAULT_PREVIEW_TOL, frequency_preview
+from .split import InverseSplit, model_coefficients, split_inverse
 from .streaming import StreamingInverter
 
 __all__ = [

@@ -17,7 +17,8 @@ import numpy as np
 from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
 from .preview import PreviewChoice, TruncationModes, choose_preview, preview_rule, resolve_preview
-from .split import DEFAULT_PREVIEW_TOL, InverseSplit, split_inverse
+from .preview import DEFAULT_PREVIEW_TOL
+from .split import InverseSplit, split_inverse
 
 __all__ = [
     "InversionResult",

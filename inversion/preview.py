@@ -29,13 +29,78 @@ import numpy as np
 import scipy.signal as sig
 
 from ._discrete import FOHFilter, Plan, foh_matrices
-from ._errors import PreviewError
-from .split import DEFAULT_PREVIEW_TOL, InverseSplit, frequency_preview
+from ._errors import InversionError, PreviewError
+from .split import InverseSplit
 
 __all__ = ["PreviewChoice", "TruncationModes", "choose_preview", "preview_rule", "resolve_preview", "RULE_4_OVER_R0"]
 
 #: Largest condition number of the eigenvector matrix for the modal evaluation.
 _MAX_COND = 1e8
+
+
+#: Default tolerance of the automatic preview: truncation error relative to the full inverse.
+DEFAULT_PREVIEW_TOL = 1e-3
+
+
+def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
+                      omega_max: float, omega_min: float | None = None,
+                      n_omega: int = 256) -> tuple[float, float]:
+    """Smallest preview whose truncation error is below ``tol`` for every sinusoid in a band.
+
+    Signal-independent rule (used where the signal is not known in advance: streaming,
+    bounded-memory and scheduled inversion): the smallest ``T`` on a grid of step
+    ``0.05/r0`` such that, for it and every longer grid preview,
+
+        max_w |E_T(j w)| / |H(j w)|  <=  tol      for w in {0} U [omega_min, omega_max],
+
+    with ``E_T`` the discarded part of the anticausal kernel
+    (:meth:`InverseSplit.truncation_response`) and ``H`` the full inverse.  By Parseval the
+    same ratio bounds the L2 truncation error of any signal in the band relative to the L2
+    norm of its full inverse (edge transients of the record aside).
+
+    Parameters
+    ----------
+    split : InverseSplit
+    tol : float
+        Relative tolerance (> 0).
+    omega_max : float
+        Top of the band [rad/s] (e.g. the Nyquist frequency ``pi/dt``).
+    omega_min : float, optional
+        Bottom of the logarithmic part of the band [rad/s]; default ``1e-3 min(|zeros|)``.
+    n_omega : int
+        Frequencies on the logarithmic grid.
+
+    Returns
+    -------
+    (preview_s, bound) : (float, float)
+        The preview [s] and the relative error bound it achieves (0 for minimum phase).
+    """
+    if not (isinstance(tol, float | int) and math.isfinite(tol) and tol > 0):
+        raise InversionError(f"preview tolerance must be a positive number; got {tol!r}")
+    if split.n_unstable == 0:
+        return 0.0, 0.0
+    zmag = np.abs(split.zeros[np.abs(split.zeros) > 0])
+    lo = float(omega_min) if omega_min is not None else 1e-3 * float(np.min(zmag))
+    hi = float(omega_max)
+    if not (0 < lo < hi and math.isfinite(hi)):
+        raise InversionError(f"frequency band must satisfy 0 < omega_min < omega_max; got {lo!r}, {hi!r}")
+    w = np.concatenate(([0.0], np.logspace(math.log10(lo), math.log10(hi), n_omega)))
+    H = np.abs(split.frequency_response(w))
+    keep = H > 1e-12 * float(np.max(H))           # a zero of H (pole of G) carries no signal
+    w, H = w[keep], H[keep]
+    step = 0.05 / split.r0
+    T = step * np.arange(2001)                    # up to 100/r0 (exp(-100) of the kernel)
+    ratio = np.max(np.abs(split._truncation_terms(T, w)) / H, axis=1)
+    bad = np.flatnonzero(ratio > tol)
+    if bad.size == 0:
+        return 0.0, float(ratio[0])
+    i = int(bad[-1]) + 1
+    if i >= T.size:
+        raise InversionError(
+            f"no finite preview up to 100/r0 = {T[-1]:.4g} s brings the truncation error below "
+            f"{tol:g} of the inverse (best {ratio[-1]:.3g}); use preview='inf'")
+    return float(T[i]), float(np.max(ratio[i:]))
+
 
 
 #: Names of the 4/r0 rule (seed paper 000's Zou-Devasia choice), kept for its experiments.
@@ -71,7 +136,7 @@ def resolve_preview(preview: Any, split_or_auto: InverseSplit | float, dt: float
     Parameters
     ----------
     preview : "auto", "4/r0", "inf", None, float
-        ``"auto"``: the signal-independent tolerance rule :func:`inversion.split.frequency_preview`
+        ``"auto"``: the signal-independent tolerance rule :func:`inversion.preview.frequency_preview`
         over ``[0, pi/dt]`` (the smallest preview whose truncation error is below ``tol`` of
         the inverse for every sinusoid up to the Nyquist frequency; :func:`invert` instead
         chooses it for the signal at hand); ``"4/r0"``: the Zou–Devasia rule of seed paper 000

@@ -24,7 +24,7 @@ Properties:
   :func:`invert_scheduled_to` works in bounded memory like :func:`inversion.invert_to`.
 
 The automatic preview is the largest signal-independent tolerance preview over the grid
-(:func:`inversion.split.frequency_preview`: truncation error below 1e-3 of the inverse for every
+(:func:`inversion.preview.frequency_preview`: truncation error below 1e-3 of the inverse for every
 sinusoid up to the Nyquist frequency); ``preview="4/r0"`` is the largest ``4/r0(T_i)``.
 """
 
@@ -40,7 +40,8 @@ from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
 from .batch import (DEFAULT_CHUNK, SampledRecord, _signal, preview_rule, resolve_preview, sampling_interval,
                     time_base)
-from .split import DEFAULT_PREVIEW_TOL, InverseSplit, frequency_preview, split_inverse
+from .preview import DEFAULT_PREVIEW_TOL, frequency_preview
+from .split import InverseSplit, split_inverse
 from .streaming import StreamingInverter
 
 __all__ = [
@@ -114,7 +115,7 @@ def _splits(model_at: Callable[[float], Any], grid: np.ndarray, improper: str,
 def _auto(splits: list[InverseSplit], preview: Any, dt: float, tol: float = DEFAULT_PREVIEW_TOL) -> float:
     """The preview the named rule gives over the grid [s]: the largest over the grid models
     (``"4/r0"``: the largest 4/r0; ``"auto"``: the largest signal-independent tolerance
-    preview, :func:`inversion.split.frequency_preview` up to the Nyquist frequency)."""
+    preview, :func:`inversion.preview.frequency_preview` up to the Nyquist frequency)."""
     if preview_rule(preview) == "4/r0":
         return max(s.auto_preview_s for s in splits)
     if preview_rule(preview) != "auto":

@@ -49,10 +49,11 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
+from ._coefficients import model_coefficients
 from ._errors import ImproperInverseError, InversionError, NonHyperbolicModelError
+from ._norms import _abs_impulse, _l1_norm, _propagate, _to_tf
 
-__all__ = ["InverseSplit", "split_inverse", "model_coefficients", "IMPROPER_MODES", "frequency_preview",
-           "DEFAULT_PREVIEW_TOL"]
+__all__ = ["InverseSplit", "split_inverse", "model_coefficients", "IMPROPER_MODES"]
 
 IMPROPER_MODES = ("error", "filter", "differentiate")
 
@@ -61,87 +62,6 @@ _AXIS_RTOL = 1e-9
 #: Largest acceptable norm of the Sylvester coupling ``X`` (in scaled units) before the
 #: stable/anti-stable separation is declared numerically meaningless.
 _MAX_SYLVESTER_NORM = 1e8
-
-
-def _strip(c: np.ndarray) -> np.ndarray:
-    nz = np.flatnonzero(c)
-    if nz.size == 0:
-        return c[:0]
-    return c[nz[0]:]
-
-
-def model_coefficients(model: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Return ``(num, den)`` (descending powers of s, leading zeros stripped) of a SISO model.
-
-    Parameters
-    ----------
-    model : control.TransferFunction, control.StateSpace, or (num, den)
-        Continuous-time SISO model ``G(s)``.  A pair of coefficient sequences is read as
-        descending powers of ``s`` [s in rad/s].
-
-    Raises
-    ------
-    InversionError
-        for MIMO, discrete-time, improper (``deg num > deg den``), zero or non-finite models.
-    """
-    num: Any
-    den: Any
-    if isinstance(model, tuple | list) and len(model) == 2:
-        num, den = model
-    else:
-        try:
-            import control  # local: keep import cost out of the module import
-        except ImportError:  # pragma: no cover - control is a hard dependency
-            control = None
-        if control is not None and isinstance(model, control.StateSpace):
-            if model.ninputs != 1 or model.noutputs != 1:
-                raise InversionError(
-                    f"model must be SISO; got a state-space model with {model.ninputs} inputs "
-                    f"and {model.noutputs} outputs")
-            if not model.isctime():
-                raise InversionError(
-                    f"model must be continuous-time; got sampling time dt={model.dt}")
-            model = control.ss2tf(model)
-        if hasattr(model, "num") and hasattr(model, "den"):
-            if getattr(model, "ninputs", 1) != 1 or getattr(model, "noutputs", 1) != 1:
-                raise InversionError(
-                    f"model must be SISO; got {model.ninputs} inputs and {model.noutputs} outputs")
-            dt = getattr(model, "dt", 0)
-            if dt not in (0, None):
-                raise InversionError(
-                    f"model must be continuous-time (dt=0); got sampling time dt={dt}")
-            num, den = model.num, model.den
-            # python-control stores num[0][0]
-            while isinstance(num, list | tuple) and len(num) == 1 and not np.isscalar(num[0]):
-                num = num[0]
-            while isinstance(den, list | tuple) and len(den) == 1 and not np.isscalar(den[0]):
-                den = den[0]
-        elif hasattr(model, "at"):
-            raise InversionError(
-                "model looks like a temperature-scheduled surrogate (it has .at(T)); pass "
-                "model.at(temperature_c) or use inversion.invert_scheduled(model.at, ...)")
-        else:
-            raise InversionError(
-                f"cannot read a transfer function from a {type(model).__name__}; expected a "
-                "control.TransferFunction, control.StateSpace or a (num, den) pair")
-    try:
-        num_a = np.atleast_1d(np.asarray(num, dtype=float)).ravel()
-        den_a = np.atleast_1d(np.asarray(den, dtype=float)).ravel()
-    except (TypeError, ValueError) as exc:
-        raise InversionError(f"model coefficients must be real numbers: {exc}") from exc
-    if not (np.all(np.isfinite(num_a)) and np.all(np.isfinite(den_a))):
-        raise InversionError(
-            f"model coefficients must be finite; got num={num_a.tolist()}, den={den_a.tolist()}")
-    num_a, den_a = _strip(num_a), _strip(den_a)
-    if num_a.size == 0:
-        raise InversionError("model numerator is identically zero; G = 0 has no inverse")
-    if den_a.size == 0:
-        raise InversionError("model denominator is identically zero")
-    if num_a.size > den_a.size:
-        raise InversionError(
-            f"model must be proper (deg num <= deg den); got deg num = {num_a.size - 1} > "
-            f"deg den = {den_a.size - 1}")
-    return num_a, den_a
 
 
 @dataclass(frozen=True, eq=False)
@@ -359,72 +279,6 @@ class InverseSplit:
         return V @ R.T
 
 
-def _to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
-    if A.shape[0] == 0:
-        return None
-    import control
-    import scipy.signal as sig
-
-    b, a = sig.ss2tf(A, B.reshape(-1, 1), C.reshape(1, -1), np.zeros((1, 1)))
-    return control.tf(np.atleast_1d(b[0]), a)
-
-
-def _abs_impulse(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[float, np.ndarray]:
-    """``(step, |C exp(M t_i) B|)`` on a uniform grid ``t_i = i*step`` covering the response
-    of a stable ``M`` down to ``exp(-40)`` of its slowest mode."""
-    n = M.shape[0]
-    lam = np.linalg.eigvals(M)
-    slow = float(np.min(-lam.real))
-    fast = float(np.max(np.abs(lam)))
-    horizon = 40.0 / slow  # exp(-40) ~ 4e-18 of the slowest mode (times polynomial growth)
-    step = min(0.02 / fast, horizon / 2000.0)
-    n_steps = int(min(max(np.ceil(horizon / step), 2000), 400_000))
-    step = horizon / n_steps
-    Phi = sla.expm(M * step)
-    # propagate x(t) = exp(M t) B on the grid in blocks of powers (vectorised doubling)
-    xs = np.empty((n_steps + 1, n))
-    xs[0] = B
-    filled = 1
-    P = Phi
-    while filled < n_steps + 1:
-        m = min(filled, n_steps + 1 - filled)
-        xs[filled:filled + m] = xs[:m] @ P.T
-        filled += m
-        P = P @ P
-    return step, np.abs(xs @ C)
-
-
-def _propagate(M: np.ndarray, B: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """Rows ``exp(M T_i) B`` (0 for infinite ``T_i``).  A uniform grid starting at 0 is filled by
-    repeated multiplication with one ``exp(M step)`` (vectorised doubling); otherwise one matrix
-    exponential per entry."""
-    n = M.shape[0]
-    out = np.zeros((T.size, n))
-    fin = np.isfinite(T)
-    Tf = T[fin]
-    if Tf.size > 2 and Tf[0] == 0.0 and np.allclose(np.diff(Tf), Tf[1], rtol=1e-12, atol=0.0):
-        xs = np.empty((Tf.size, n))
-        xs[0] = B
-        filled, P = 1, sla.expm(M * Tf[1])
-        while filled < Tf.size:
-            m = min(filled, Tf.size - filled)
-            xs[filled:filled + m] = xs[:m] @ P.T
-            filled += m
-            P = P @ P
-        out[fin] = xs
-    else:
-        out[fin] = np.stack([sla.expm(M * Ti) @ B for Ti in Tf]) if Tf.size else np.zeros((0, n))
-    return out
-
-
-def _l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
-    """``int_0^inf |C exp(M t) B| dt`` for a stable ``M`` (trapezoid on a fine grid)."""
-    if M.shape[0] == 0:
-        return 0.0
-    step, h = _abs_impulse(M, B, C)
-    return float(step * (h.sum() - 0.5 * (h[0] + h[-1])))
-
-
 def _scale_poly(c: np.ndarray, w0: float) -> np.ndarray:
     """Coefficients of p(w0*sigma) given those of p(s) (descending powers)."""
     deg = c.size - 1
@@ -589,67 +443,3 @@ def _equalise(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, 
         f = math.sqrt(nc / nb)
         return A, B * f, C / f
     return A, B, C
-
-
-#: Default tolerance of the automatic preview: truncation error relative to the full inverse.
-DEFAULT_PREVIEW_TOL = 1e-3
-
-
-def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
-                      omega_max: float, omega_min: float | None = None,
-                      n_omega: int = 256) -> tuple[float, float]:
-    """Smallest preview whose truncation error is below ``tol`` for every sinusoid in a band.
-
-    Signal-independent rule (used where the signal is not known in advance: streaming,
-    bounded-memory and scheduled inversion): the smallest ``T`` on a grid of step
-    ``0.05/r0`` such that, for it and every longer grid preview,
-
-        max_w |E_T(j w)| / |H(j w)|  <=  tol      for w in {0} U [omega_min, omega_max],
-
-    with ``E_T`` the discarded part of the anticausal kernel
-    (:meth:`InverseSplit.truncation_response`) and ``H`` the full inverse.  By Parseval the
-    same ratio bounds the L2 truncation error of any signal in the band relative to the L2
-    norm of its full inverse (edge transients of the record aside).
-
-    Parameters
-    ----------
-    split : InverseSplit
-    tol : float
-        Relative tolerance (> 0).
-    omega_max : float
-        Top of the band [rad/s] (e.g. the Nyquist frequency ``pi/dt``).
-    omega_min : float, optional
-        Bottom of the logarithmic part of the band [rad/s]; default ``1e-3 min(|zeros|)``.
-    n_omega : int
-        Frequencies on the logarithmic grid.
-
-    Returns
-    -------
-    (preview_s, bound) : (float, float)
-        The preview [s] and the relative error bound it achieves (0 for minimum phase).
-    """
-    if not (isinstance(tol, float | int) and math.isfinite(tol) and tol > 0):
-        raise InversionError(f"preview tolerance must be a positive number; got {tol!r}")
-    if split.n_unstable == 0:
-        return 0.0, 0.0
-    zmag = np.abs(split.zeros[np.abs(split.zeros) > 0])
-    lo = float(omega_min) if omega_min is not None else 1e-3 * float(np.min(zmag))
-    hi = float(omega_max)
-    if not (0 < lo < hi and math.isfinite(hi)):
-        raise InversionError(f"frequency band must satisfy 0 < omega_min < omega_max; got {lo!r}, {hi!r}")
-    w = np.concatenate(([0.0], np.logspace(math.log10(lo), math.log10(hi), n_omega)))
-    H = np.abs(split.frequency_response(w))
-    keep = H > 1e-12 * float(np.max(H))           # a zero of H (pole of G) carries no signal
-    w, H = w[keep], H[keep]
-    step = 0.05 / split.r0
-    T = step * np.arange(2001)                    # up to 100/r0 (exp(-100) of the kernel)
-    ratio = np.max(np.abs(split._truncation_terms(T, w)) / H, axis=1)
-    bad = np.flatnonzero(ratio > tol)
-    if bad.size == 0:
-        return 0.0, float(ratio[0])
-    i = int(bad[-1]) + 1
-    if i >= T.size:
-        raise InversionError(
-            f"no finite preview up to 100/r0 = {T[-1]:.4g} s brings the truncation error below "
-            f"{tol:g} of the inverse (best {ratio[-1]:.3g}); use preview='inf'")
-    return float(T[i]), float(np.max(ratio[i:]))

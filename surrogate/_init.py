@@ -10,12 +10,8 @@ import numpy as np
 
 from physmodel.numerics import weighted_complex_lstsq
 
-from ._structure import (
-    Structure,
-    group_roots,
-    pole_slots_from_groups,
-    stabilise_roots,
-)
+from ._convert import group_roots, pole_slots_from_groups, stabilise_roots
+from ._structure import Structure
 
 __all__ = ["levy", "numerator_ls", "initial_candidates"]
 

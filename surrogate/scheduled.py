@@ -19,7 +19,8 @@ from ._data import FrequencyData, to_data
 from ._init import levy
 from ._lsq import STATUS_STOPPED, Evaluator
 from ._nlp import SolveOutcome, get_solver
-from ._structure import Structure, convert
+from ._convert import convert
+from ._structure import Structure
 from .models import RationalModel, Scaling
 from .rational import RationalFit
 

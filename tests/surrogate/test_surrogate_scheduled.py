@@ -104,7 +104,8 @@ def test_scheduled_fit_rejects_too_few_temperatures(synthetic_sweep):
 
 def test_structure_conversion_preserves_the_response():
     rng = np.random.default_rng(0)
-    from surrogate._structure import convert, response
+    from surrogate._convert import convert
+    from surrogate._structure import response
 
     w = np.geomspace(0.05, 20, 30)
     for _ in range(20):
