@@ -52,6 +52,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from physmodel.errors import IPMCError
+from surrogate import FORMS
 
 #: The order in which the runner executes the step tables.
 STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy", "fixtures")
@@ -114,7 +115,7 @@ class _List:
 _SWEEP_GRID = {"fmin_hz": NUM, "fmax_hz": NUM, "points": INT}
 #: [control_route]: the physics-calibrated route vs a direct schedule (scenarios/steps_control.py).
 CONTROL_ROUTE_SCHEMA = {"free": STRS, "prior": _Map(NUM), "starts": INT, "seed": INT, "dense_temperatures_c": NUMS,
-                        "form": _choice("zpk", "coefficients", "sections"), "n_zeros": INT, "n_poles": INT,
+                        "form": _choice(*FORMS), "n_zeros": INT, "n_poles": INT,
                         "degree": INT, "temperature_c": NUM, "frequency_hz": NUM, "amplitude_mm": NUM,
                         "fs_hz": NUM, "duration_s": NUM, "max_voltage_v": NUM, "note": STR}
 SECTIONS = {
@@ -134,7 +135,7 @@ SECTIONS = {
               # kind = "time" (virtual lab): noise and quantisation of the recorded signals [SI]
               "output_noise_rms": NUM, "input_noise_rms": NUM, "output_adc_step": NUM, "input_adc_step": NUM,
               "chain": NUMS, "chain_bandwidth_hz": NUM},
-    "surrogate": {"form": _choice("zpk", "coefficients", "sections"), "n_zeros": INT, "n_poles": INT,
+    "surrogate": {"form": _choice(*FORMS), "n_zeros": INT, "n_poles": INT,
                   "degree": INT, "method": _choice("joint", "two-stage"), "weighting": STR},
     "inversion": {"preview": NUM_OR_STR, "fs_hz": NUM, "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM,
                   "lead_s": NUM, "ramp_s": NUM,

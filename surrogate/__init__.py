@@ -55,7 +55,7 @@ from ._data import FrequencyData, from_sweep
 from ._fit import FitResult, TemperatureError
 from ._init import levy
 from ._nlp import ConvergenceError
-from ._structure import Structure
+from ._structure import FORMS, Structure
 from .metrics import fit_percent, log_rms_error, relative_rms_error
 from .models import RationalModel, Scaling, StabilityCheck, load
 from .rational import RationalFit
@@ -66,7 +66,7 @@ from .crossval import (CrossValidation, ScheduleCheck, ScheduleWarning, check_sc
 
 __all__ = [
     "FrequencyData", "from_sweep", "RationalFit", "ScheduledFit", "fit_sweep", "levy",
-    "FitResult", "TemperatureError", "RationalModel", "Scaling", "StabilityCheck", "Structure",
+    "FitResult", "TemperatureError", "RationalModel", "Scaling", "StabilityCheck", "Structure", "FORMS",
     "load", "order_selection", "OrderRow", "OrderSelectionReport", "relative_rms_error",
     "fit_percent", "log_rms_error", "ConvergenceError",
     "cross_validate", "select_degree", "check_schedule", "fit_checked", "dense_check", "physics_reference",

@@ -33,7 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import polynomial as P
 
-FORMS = ("coefficients", "sections", "zpk")
+#: The fitter forms, declared once (scheduled fits, the CLI and the scenario schema read this).
+FORMS = ("zpk", "coefficients", "sections")
 _LOG_BOUND = 30.0  # |log a| ≤ 30 keeps scaled section coefficients within e^±30
 
 

@@ -20,13 +20,12 @@ from ._init import levy
 from ._lsq import STATUS_STOPPED, Evaluator
 from ._nlp import SolveOutcome, get_solver
 from ._convert import convert
-from ._structure import Structure
+from ._structure import FORMS, Structure
 from .models import RationalModel, Scaling
 from .rational import RationalFit
 
 __all__ = ["ScheduledFit"]
 
-_FORMS = ("coefficients", "zpk", "sections")
 _METHODS = ("joint", "two-stage")
 _DENSE_CHECK = 501   # temperatures of the final stability check (FitResult.stability)
 _MAX_REFINE = 4      # rounds of adding unstable temperatures to the Hurwitz constraint grid
@@ -83,8 +82,8 @@ class ScheduledFit:
                  temperature_center_c: float | None = None, temperature_scale_c: float | None = None,
                  per_temperature: str = "nlp", raise_on_failure: bool = True,
                  scale_covariance: bool = True):
-        if form not in _FORMS:
-            raise ValueError(f"form must be one of {_FORMS}, got {form!r}")
+        if form not in FORMS:
+            raise ValueError(f"form must be one of {FORMS}, got {form!r}")
         if method not in _METHODS:
             raise ValueError(f"method must be one of {_METHODS}, got {method!r}")
         self.structure = Structure(form, n_zeros, n_poles, degree)

@@ -21,6 +21,7 @@ import numpy as np
 from physmodel.data.files import atomic_write
 from surrogate._data import FrequencyData
 from surrogate._fit import WEIGHTINGS
+from surrogate import FORMS
 from surrogate._nlp import ConvergenceError
 
 from .. import plots
@@ -52,7 +53,7 @@ def add_parser(subparsers):
     p.add_argument("--zeros", type=int, default=3, help="number of zeros (default 3)")
     p.add_argument("--poles", type=int, default=3, help="number of poles (default 3)")
     p.add_argument("--degree", type=int, default=2, help="polynomial degree in T (default 2)")
-    p.add_argument("--form", choices=("coefficients", "zpk", "sections"), default="zpk",
+    p.add_argument("--form", choices=FORMS, default="zpk",
                    help="schedule form (default zpk)")
     p.add_argument("--method", choices=("joint", "two-stage"), default="joint")
     p.add_argument("--weighting", choices=WEIGHTINGS, default="auto")
