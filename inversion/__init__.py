@@ -68,6 +68,7 @@ References (:mod:`inversion.references`)
 Units: SI inside (s, rad/s, 1/s); signals keep the units of the model (seed 000: mm and uA).
 """
 
+from . import references
 from ._errors import (
     ImproperInverseError,
     InversionError,
@@ -88,8 +89,8 @@ from .batch import (
     resolve_preview,
     sampling_interval,
 )
-from . import references
 from .limits import LimitError, Limits, LimitWarning, check_limits
+from .preview import DEFAULT_PREVIEW_TOL, frequency_preview
 from .scheduled import (
     ScheduledInversionResult,
     ScheduledStreamingInverter,
@@ -97,7 +98,6 @@ from .scheduled import (
     invert_scheduled_to,
     temperature_grid,
 )
-from .preview import DEFAULT_PREVIEW_TOL, frequency_preview
 from .split import InverseSplit, model_coefficients, split_inverse
 from .streaming import StreamingInverter
 

@@ -41,34 +41,76 @@ Units: SI inside (rad/s, K, m, V, A); Hz and °C at the edges, as the argument n
 
 __version__ = "0.1.0"
 
-from .errors import DataFormatError, IPMCError, ParameterError, TemperatureRangeError
-from .params import IPMCParameters, describe, state_at
-from .parameter_sets import (available_parameter_sets, get_parameter_set, load_parameter_set,
-                             register_parameter_set, save_parameter_set)
-from .temperature import (ISOTHERMAL, Arrhenius, Constant, IonicResistance, Linear, LogLinear,
-                          TemperatureLaws, WaterPermittivity)
-from .protocol import FrequencyModel, physics_model
-from .model import FrequencyResponse
 from .actuator import ActuatorModel
-from .sensor import SensorModel, TransimpedanceChain
-from .data import (ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, read_sweep, synthesize_sweep,
-                   write_sweep)
+from .data import ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, read_sweep, synthesize_sweep, write_sweep
+from .effects import LIBRARY, EffectModel
+from .errors import DataFormatError, IPMCError, ParameterError, TemperatureRangeError
 from .estimation.calibration import calibrate
+from .estimation.discrepancy import Diagnosis, diagnose
 from .estimation.lsq import fit_parameters
 from .estimation.records import CalibrationResult, FreeParameter
-from .effects import LIBRARY, EffectModel
-from .estimation.discrepancy import Diagnosis, diagnose
+from .model import FrequencyResponse
+from .parameter_sets import (
+    available_parameter_sets,
+    get_parameter_set,
+    load_parameter_set,
+    register_parameter_set,
+    save_parameter_set,
+)
+from .params import IPMCParameters, describe, state_at
+from .protocol import FrequencyModel, physics_model
+from .sensor import SensorModel, TransimpedanceChain
+from .temperature import (
+    ISOTHERMAL,
+    Arrhenius,
+    Constant,
+    IonicResistance,
+    Linear,
+    LogLinear,
+    TemperatureLaws,
+    WaterPermittivity,
+)
 
 __all__ = [
     "__version__",
-    "IPMCParameters", "describe", "state_at", "available_parameter_sets", "get_parameter_set",
-    "register_parameter_set", "load_parameter_set", "save_parameter_set",
-    "TemperatureLaws", "Arrhenius", "Constant", "IonicResistance", "Linear", "LogLinear", "WaterPermittivity",
+    "IPMCParameters",
+    "describe",
+    "state_at",
+    "available_parameter_sets",
+    "get_parameter_set",
+    "register_parameter_set",
+    "load_parameter_set",
+    "save_parameter_set",
+    "TemperatureLaws",
+    "Arrhenius",
+    "Constant",
+    "IonicResistance",
+    "Linear",
+    "LogLinear",
+    "WaterPermittivity",
     "ISOTHERMAL",
-    "FrequencyModel", "physics_model", "FrequencyResponse", "ActuatorModel", "SensorModel", "TransimpedanceChain",
-    "FrequencySweep", "synthesize_sweep", "MagnitudePhaseNoise", "ComplexGaussianNoise", "read_sweep",
+    "FrequencyModel",
+    "physics_model",
+    "FrequencyResponse",
+    "ActuatorModel",
+    "SensorModel",
+    "TransimpedanceChain",
+    "FrequencySweep",
+    "synthesize_sweep",
+    "MagnitudePhaseNoise",
+    "ComplexGaussianNoise",
+    "read_sweep",
     "write_sweep",
-    "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult",
-    "EffectModel", "LIBRARY", "diagnose", "Diagnosis",
-    "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
+    "calibrate",
+    "fit_parameters",
+    "FreeParameter",
+    "CalibrationResult",
+    "EffectModel",
+    "LIBRARY",
+    "diagnose",
+    "Diagnosis",
+    "IPMCError",
+    "ParameterError",
+    "TemperatureRangeError",
+    "DataFormatError",
 ]

@@ -9,14 +9,14 @@ the command line address parameters through these functions only.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import fields, replace
-from typing import Any, Mapping
+from typing import Any
 
 from .errors import ParameterError
 from .params import IPMCParameters
 
 Values = Mapping[str, float]
-
 
 
 # =============================================================================== physics wrapper
@@ -29,13 +29,16 @@ def _law_target(base: IPMCParameters, name: str):
     laws = base.laws
     qnames = [f.name for f in fields(laws)]
     if len(parts) != 3 or parts[1] not in qnames:
-        raise ParameterError(f"unknown temperature-law parameter {name!r}; expected 'laws.<quantity>.<attribute>' "
-                             f"with quantity in {qnames}")
+        raise ParameterError(
+            f"unknown temperature-law parameter {name!r}; expected 'laws.<quantity>.<attribute>' "
+            f"with quantity in {qnames}"
+        )
     law = getattr(laws, parts[1])
     attrs = [f.name for f in fields(law) if f.name != "valid_c"]
     if parts[2] not in attrs:
-        raise ParameterError(f"{name!r}: the law for {parts[1]} is {type(law).__name__}, whose parameters are "
-                             f"{attrs or 'none'}")
+        raise ParameterError(
+            f"{name!r}: the law for {parts[1]} is {type(law).__name__}, whose parameters are {attrs or 'none'}"
+        )
     return parts[1], parts[2], law
 
 
@@ -44,8 +47,10 @@ def check_parameter_name(base: IPMCParameters, name: str) -> None:
     if name.startswith("laws."):
         _law_target(base, name)
     elif name != "omega_n" and name not in _NUMERIC_FIELDS:
-        raise ParameterError(f"unknown parameter {name!r}; expected one of {list(_NUMERIC_FIELDS) + ['omega_n']} "
-                             "or 'laws.<quantity>.<attribute>'")
+        raise ParameterError(
+            f"unknown parameter {name!r}; expected one of {list(_NUMERIC_FIELDS) + ['omega_n']} "
+            "or 'laws.<quantity>.<attribute>'"
+        )
 
 
 def base_value(base: IPMCParameters, name: str) -> float:

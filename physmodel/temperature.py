@@ -21,10 +21,9 @@ IonicResistance     (T/T_ref) / (d(T)/d(T_ref)): Nernst-Einstein, resistance ∝
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, replace
-from typing import Mapping
-
 import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 from scipy import constants
@@ -185,7 +184,7 @@ class TemperatureLaws:
             out[name] = getattr(self, name).factor(T_K, T_ref_K, diffusivity_factor=out["d"])
         return out
 
-    def with_(self, **laws: _Law) -> "TemperatureLaws":
+    def with_(self, **laws: _Law) -> TemperatureLaws:
         """A copy with some laws replaced, e.g. ``laws.with_(E=Constant())``."""
         unknown = set(laws) - {f.name for f in fields(self)}
         if unknown:
@@ -202,7 +201,7 @@ class TemperatureLaws:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping) -> "TemperatureLaws":
+    def from_dict(cls, data: Mapping) -> TemperatureLaws:
         """The laws from ``{quantity: {"law": NAME, parameter: value, "valid_c": [lo, hi]}}`` (what
         :meth:`to_dict` writes); a wrong shape, name or value is a ParameterError naming the key."""
         kinds = {c.__name__: c for c in (Constant, Arrhenius, LogLinear, Linear, WaterPermittivity, IonicResistance)}
@@ -255,6 +254,12 @@ def real_number(v, where: str) -> float:
 
 #: Every parameter constant (for isothermal studies and for the width/Taylor checks).
 ISOTHERMAL = TemperatureLaws(
-    d=Constant(), E=Constant(), kappa_e=Constant(), Rp_specific=Constant(),
-    r1_sheet=Constant(), r2_specific=Constant(), C_minus=Constant(), h=Constant(),
+    d=Constant(),
+    E=Constant(),
+    kappa_e=Constant(),
+    Rp_specific=Constant(),
+    r1_sheet=Constant(),
+    r2_specific=Constant(),
+    C_minus=Constant(),
+    h=Constant(),
 )

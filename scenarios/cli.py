@@ -26,13 +26,41 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .commands import (calibrate, demo, diagnose, excite, feedforward, fit, frf, invert, run, sets, simulate, study,
-                       sweep, validate)
+from .commands import (
+    calibrate,
+    demo,
+    diagnose,
+    excite,
+    feedforward,
+    fit,
+    frf,
+    invert,
+    run,
+    sets,
+    simulate,
+    study,
+    sweep,
+    validate,
+)
 from .commands._common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED
 
 #: The subcommands, in the order ``ipmc --help`` lists them.
-COMMANDS = (sets, sweep, simulate, excite, frf, demo, run, study, fit, invert, feedforward, calibrate, diagnose,
-            validate)
+COMMANDS = (
+    sets,
+    sweep,
+    simulate,
+    excite,
+    frf,
+    demo,
+    run,
+    study,
+    fit,
+    invert,
+    feedforward,
+    calibrate,
+    diagnose,
+    validate,
+)
 
 
 def _version() -> str:

@@ -56,21 +56,54 @@ from ._fit import FitResult, TemperatureError
 from ._init import levy
 from ._nlp import ConvergenceError
 from ._structure import FORMS, Structure
+from .crossval import (
+    CrossValidation,
+    ScheduleCheck,
+    ScheduleWarning,
+    check_schedule,
+    cross_validate,
+    dense_check,
+    fit_checked,
+    physics_reference,
+    select_degree,
+)
 from .metrics import fit_percent, log_rms_error, relative_rms_error
 from .models import RationalModel, Scaling, StabilityCheck, load
 from .rational import RationalFit
 from .scheduled import ScheduledFit
 from .selection import OrderRow, OrderSelectionReport, order_selection
-from .crossval import (CrossValidation, ScheduleCheck, ScheduleWarning, check_schedule, cross_validate, dense_check,
-                       fit_checked, physics_reference, select_degree)
 
 __all__ = [
-    "FrequencyData", "from_sweep", "RationalFit", "ScheduledFit", "fit_sweep", "levy",
-    "FitResult", "TemperatureError", "RationalModel", "Scaling", "StabilityCheck", "Structure", "FORMS",
-    "load", "order_selection", "OrderRow", "OrderSelectionReport", "relative_rms_error",
-    "fit_percent", "log_rms_error", "ConvergenceError",
-    "cross_validate", "select_degree", "check_schedule", "fit_checked", "dense_check", "physics_reference",
-    "CrossValidation", "ScheduleCheck", "ScheduleWarning",
+    "FrequencyData",
+    "from_sweep",
+    "RationalFit",
+    "ScheduledFit",
+    "fit_sweep",
+    "levy",
+    "FitResult",
+    "TemperatureError",
+    "RationalModel",
+    "Scaling",
+    "StabilityCheck",
+    "Structure",
+    "FORMS",
+    "load",
+    "order_selection",
+    "OrderRow",
+    "OrderSelectionReport",
+    "relative_rms_error",
+    "fit_percent",
+    "log_rms_error",
+    "ConvergenceError",
+    "cross_validate",
+    "select_degree",
+    "check_schedule",
+    "fit_checked",
+    "dense_check",
+    "physics_reference",
+    "CrossValidation",
+    "ScheduleCheck",
+    "ScheduleWarning",
 ]
 
 

@@ -11,8 +11,6 @@ import numpy as np
 from ._structure import Structure, _factor_roots, _section_polys, polynomials, roots, slot_values
 
 
-
-
 # --------------------------------------------------- grouping roots into factors
 def _is_real(r, tol=1e-9):
     return abs(r.imag) <= tol * max(1.0, abs(r))
@@ -32,7 +30,7 @@ def _pairings(reals, n_pairs, single):
             a = items[0]
             for j in range(1, len(items)):
                 b = items[j]
-                for tail in matchings(items[1:j] + items[j + 1:]):
+                for tail in matchings(items[1:j] + items[j + 1 :]):
                     yield [(a, b)] + tail
 
         for mt in matchings(rest):

@@ -12,14 +12,50 @@ files     read_sweep / write_sweep (.csv, .npz, .mat by extension) and the per-f
 timesim   realize, simulate, sine, step, free_release, TimeSeries — time-domain virtual experiments
 """
 
-from .files import (atomic_write, by_extension, read_csv, read_mat, read_npz, read_sweep, write_csv, write_mat,
-                    write_npz, write_sweep)
-from .sweep import (ComplexGaussianNoise, FrequencySweep, MagnitudePhaseNoise, SweepLayout, merge_sweeps,
-                    sweep_layout, synthesize_sweep)
+from .files import (
+    atomic_write,
+    by_extension,
+    read_csv,
+    read_mat,
+    read_npz,
+    read_sweep,
+    write_csv,
+    write_mat,
+    write_npz,
+    write_sweep,
+)
 from .interop import as_sweep
+from .sweep import (
+    ComplexGaussianNoise,
+    FrequencySweep,
+    MagnitudePhaseNoise,
+    SweepLayout,
+    merge_sweeps,
+    sweep_layout,
+    synthesize_sweep,
+)
 from .units import QUANTITY_UNITS, UNITS, unit_scale
 
-__all__ = ["as_sweep", "FrequencySweep", "MagnitudePhaseNoise", "ComplexGaussianNoise", "synthesize_sweep", "SweepLayout",
-           "sweep_layout", "merge_sweeps", "read_sweep", "write_sweep", "read_csv", "write_csv", "read_npz",
-           "write_npz", "read_mat", "write_mat", "atomic_write", "by_extension", "UNITS", "unit_scale",
-           "QUANTITY_UNITS"]
+__all__ = [
+    "as_sweep",
+    "FrequencySweep",
+    "MagnitudePhaseNoise",
+    "ComplexGaussianNoise",
+    "synthesize_sweep",
+    "SweepLayout",
+    "sweep_layout",
+    "merge_sweeps",
+    "read_sweep",
+    "write_sweep",
+    "read_csv",
+    "write_csv",
+    "read_npz",
+    "write_npz",
+    "read_mat",
+    "write_mat",
+    "atomic_write",
+    "by_extension",
+    "UNITS",
+    "unit_scale",
+    "QUANTITY_UNITS",
+]

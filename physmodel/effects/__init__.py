@@ -5,10 +5,40 @@
 """
 
 from .base import Effect, EffectParameter
-from .library import (ALIASES, ALL_EFFECTS, DEFAULT_QUANTITY, KINDS, LIBRARY, OUT_OF_LIBRARY, EffectActuatorModel,
-                      EffectModel, EffectSensorModel, candidate_free_parameters, candidates_for, get_effect,
-                      make_effect_model, normalize_effects, split_values)
+from .library import (
+    ALIASES,
+    ALL_EFFECTS,
+    DEFAULT_QUANTITY,
+    KINDS,
+    LIBRARY,
+    OUT_OF_LIBRARY,
+    EffectActuatorModel,
+    EffectModel,
+    EffectSensorModel,
+    candidate_free_parameters,
+    candidates_for,
+    get_effect,
+    make_effect_model,
+    normalize_effects,
+    split_values,
+)
 
-__all__ = ["Effect", "EffectParameter", "LIBRARY", "OUT_OF_LIBRARY", "ALL_EFFECTS", "ALIASES", "KINDS",
-           "DEFAULT_QUANTITY", "EffectModel", "EffectActuatorModel", "EffectSensorModel", "make_effect_model",
-           "get_effect", "candidates_for", "normalize_effects", "split_values", "candidate_free_parameters"]
+__all__ = [
+    "Effect",
+    "EffectParameter",
+    "LIBRARY",
+    "OUT_OF_LIBRARY",
+    "ALL_EFFECTS",
+    "ALIASES",
+    "KINDS",
+    "DEFAULT_QUANTITY",
+    "EffectModel",
+    "EffectActuatorModel",
+    "EffectSensorModel",
+    "make_effect_model",
+    "get_effect",
+    "candidates_for",
+    "normalize_effects",
+    "split_values",
+    "candidate_free_parameters",
+]

@@ -40,8 +40,8 @@ def main(argv=None):
     T = np.linspace(0, 90, n_T)
     model = ActuatorModel(get_parameter_set("seed002_table3"))
     st = model.state(T)
-    from physmodel.model import evaluate_grid
     from physmodel.actuator import actuator_kernel
+    from physmodel.model import evaluate_grid
 
     s = 2j * np.pi * f
     z = (np.broadcast_to(s, (n_T, n_f)) * 1e-3 + 1.0).ravel().copy()
@@ -66,8 +66,10 @@ def main(argv=None):
     dt = time.perf_counter() - t0
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
-    print(f"{n_T * n_f_big:,} points into a preallocated output: {dt:.2f} s, "
-          f"peak extra memory {peak / 2**20:.1f} MiB (output itself {out['M'].nbytes / 2**20:.0f} MiB)")
+    print(
+        f"{n_T * n_f_big:,} points into a preallocated output: {dt:.2f} s, "
+        f"peak extra memory {peak / 2**20:.1f} MiB (output itself {out['M'].nbytes / 2**20:.0f} MiB)"
+    )
 
 
 if __name__ == "__main__":
