@@ -65,7 +65,8 @@ import scipy.signal as sig
 from ._sections import FusedPass, _sos
 from .split import InverseSplit
 
-__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan", "central_difference_kernel", "FUSED_BLOCK"]
+__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan",
+           "central_difference_kernel", "FUSED_BLOCK"]
 
 #: Samples per block of the fused finite-preview backward pass (intermediates stay in cache).
 FUSED_BLOCK = 1 << 16
@@ -91,7 +92,7 @@ def expm_small(A: np.ndarray) -> np.ndarray:
         return eye
     norm = float(np.max(np.sum(np.abs(A), axis=0)))
     s = int(np.ceil(np.log2(norm))) if norm > 1.0 else 0
-    X = A / 2.0**s
+    X = A / 2.0 ** s
     E = eye.copy()
     for k in range(20, 0, -1):
         E = eye + (X @ E) / k
@@ -119,9 +120,9 @@ def foh_matrices(M: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, n
     big[n, n + 1] = 1.0
     E = expm_small(big)
     Phi = E[:n, :n]
-    J0 = E[:n, n]  # int_0^dt exp(M tau) d tau B
-    alpha = E[:n, n + 1]  # int_0^dt exp(M tau) (1 - tau/dt) d tau B
-    beta = J0 - alpha  # int_0^dt exp(M tau) tau/dt d tau B
+    J0 = E[:n, n]          # int_0^dt exp(M tau) d tau B
+    alpha = E[:n, n + 1]   # int_0^dt exp(M tau) (1 - tau/dt) d tau B
+    beta = J0 - alpha      # int_0^dt exp(M tau) tau/dt d tau B
     return Phi, alpha, beta
 
 
@@ -152,9 +153,8 @@ class FOHFilter:
     sos: np.ndarray | None
 
     @classmethod
-    def build(
-        cls, Phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, C: np.ndarray, D_extra: float = 0.0
-    ) -> FOHFilter:
+    def build(cls, Phi: np.ndarray, alpha: np.ndarray, beta: np.ndarray, C: np.ndarray,
+              D_extra: float = 0.0) -> FOHFilter:
         n = Phi.shape[0]
         Bd = Phi @ alpha + beta
         Dd = float(C @ alpha) + float(D_extra)
@@ -184,7 +184,8 @@ class FOHFilter:
     def response(self, zs: np.ndarray) -> np.ndarray:
         """Exact frequency response ``C (zI - Phi)^-1 Bd + Dd`` at the points ``zs``."""
         n = self.order
-        rhs = np.broadcast_to((self.Phi @ self.alpha + self.beta).astype(complex)[:, None], (zs.size, n, 1))
+        rhs = np.broadcast_to((self.Phi @ self.alpha + self.beta).astype(complex)[:, None],
+                              (zs.size, n, 1))
         return np.linalg.solve(zs[:, None, None] * np.eye(n) - self.Phi, rhs)[..., 0] @ self.C + self.D
 
     @property
@@ -239,7 +240,7 @@ def central_difference_kernel(coeffs: np.ndarray, dt: float) -> tuple[np.ndarray
         rhs = np.zeros(2 * hk + 1)
         rhs[k] = float(np.prod(np.arange(1, k + 1)))
         w = np.linalg.solve(V, rhs)
-        kernel[h - hk : h + hk + 1] += c * w / dt**k
+        kernel[h - hk:h + hk + 1] += c * w / dt**k
     return kernel, h
 
 
@@ -283,12 +284,13 @@ class Plan:
         self.fused: FusedPass | None = None
         t1, t2 = self.anti, self.anti_tail
         if t1 is not None and t2 is not None:
-            if t1.sos is None and t2.sos is None and t1.a.size == t2.a.size and np.array_equal(t1.a, t2.a):
+            if (t1.sos is None and t2.sos is None and t1.a.size == t2.a.size
+                    and np.array_equal(t1.a, t2.a)):
                 p = max(t1.b.size, t2.b.size)
                 b1 = np.zeros(p)
-                b1[: t1.b.size] = t1.b
+                b1[:t1.b.size] = t1.b
                 b2 = np.zeros(p)
-                b2[: t2.b.size] = t2.b
+                b2[:t2.b.size] = t2.b
                 self.fused = FusedPass([b1], [b2], np.array(t1.a, dtype=float), None)
             else:
                 self.fused = FusedPass.factored(t1, t2)
@@ -305,13 +307,13 @@ class Plan:
             c1 = min(n, c0 + chunk)
             x = _read(src, c0, c1, check)
             if zi is not None:
-                y, zi = self.stable.run(x, zi)  # includes D * x
+                y, zi = self.stable.run(x, zi)   # includes D * x
             else:
                 y = self.D * x
             if h:
                 lo, hi = max(0, c0 - h), min(n, c1 + h)
                 ext = np.zeros(c1 - c0 + 2 * h)
-                ext[lo - (c0 - h) : hi - (c0 - h)] = _read(src, lo, hi, False)
+                ext[lo - (c0 - h):hi - (c0 - h)] = _read(src, lo, hi, False)
                 y += np.correlate(ext, self.kernel, mode="valid")
             sink(c0, c1, y, x)
 
@@ -342,12 +344,12 @@ class Plan:
                 o2r, zi2 = tail_f.run(xr, zi2)
                 o2 = o2r[::-1]
                 if N < L:
-                    yu[: L - N] -= o2[N:]
-                    yu[L - N :] -= tail
+                    yu[:L - N] -= o2[N:]
+                    yu[L - N:] -= tail
                     tail = o2[:N].copy()
                 else:
-                    yu -= tail[N - L :]
-                    tail = np.concatenate((o2, tail[: N - L]))
+                    yu -= tail[N - L:]
+                    tail = np.concatenate((o2, tail[:N - L]))
             sink(c0, c1, yu, x)
 
     def anticausal(self, u: np.ndarray) -> np.ndarray:
@@ -369,7 +371,7 @@ class Plan:
         """Finite-preview anticausal pass as one all-pole recursion (see module doc)."""
         fp = self.fused
         N = self.n_preview
-        h1, h2 = fp.reach(fp.fir1), fp.reach(fp.fir2)  # correlation reach beyond the block
+        h1, h2 = fp.reach(fp.fir1), fp.reach(fp.fir2)   # correlation reach beyond the block
         zi = fp.zi0()
         for c1 in range(n, 0, -block):
             c0 = max(0, c1 - block)
@@ -379,7 +381,7 @@ class Plan:
             if c0 + N < n:
                 q -= fp.correlate(_read_padded(src, n, c0 + N, c1 + N + h2), fp.fir2)
             w, zi = fp.all_pole(q[::-1], zi)
-            sink(c0, c1, w[::-1], seg[: c1 - c0])
+            sink(c0, c1, w[::-1], seg[:c1 - c0])
 
 
 def _read_padded(src: Any, n: int, lo: int, hi: int) -> np.ndarray:
@@ -388,7 +390,7 @@ def _read_padded(src: Any, n: int, lo: int, hi: int) -> np.ndarray:
         return _read(src, lo, hi, False)
     out = np.zeros(hi - lo)
     if lo < n:
-        out[: n - lo] = _read(src, lo, n, False)
+        out[:n - lo] = _read(src, lo, n, False)
     return out
 
 
@@ -400,6 +402,5 @@ def _read(src: Any, c0: int, c1: int, check: bool) -> np.ndarray:
         bad = int(np.flatnonzero(~np.isfinite(x))[0]) + c0
         raise NonFiniteSignalError(
             f"the signal must be finite; sample {bad} is {x[bad - c0]!r} (NaN/inf are not "
-            "allowed: fill or interpolate gaps before inverting)"
-        )
+            "allowed: fill or interpolate gaps before inverting)")
     return x

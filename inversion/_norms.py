@@ -37,7 +37,7 @@ def _abs_impulse(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[float, np
     P = Phi
     while filled < n_steps + 1:
         m = min(filled, n_steps + 1 - filled)
-        xs[filled : filled + m] = xs[:m] @ P.T
+        xs[filled:filled + m] = xs[:m] @ P.T
         filled += m
         P = P @ P
     return step, np.abs(xs @ C)
@@ -57,7 +57,7 @@ def _propagate(M: np.ndarray, B: np.ndarray, T: np.ndarray) -> np.ndarray:
         filled, P = 1, sla.expm(M * Tf[1])
         while filled < Tf.size:
             m = min(filled, Tf.size - filled)
-            xs[filled : filled + m] = xs[:m] @ P.T
+            xs[filled:filled + m] = xs[:m] @ P.T
             filled += m
             P = P @ P
         out[fin] = xs

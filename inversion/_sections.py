@@ -12,7 +12,8 @@ import scipy.signal as sig
 __all__ = ["FusedPass"]
 
 
-def _sos(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray, exact: np.ndarray) -> np.ndarray:
+def _sos(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray,
+         exact: np.ndarray) -> np.ndarray:
     n = Phi.shape[0]
     poles = np.linalg.eigvals(Phi)
     pencil_a = np.block([[Phi, Bd.reshape(n, 1)], [C.reshape(1, n), np.array([[Dd]])]])

@@ -124,6 +124,7 @@ class InversionResult(SampledRecord):
             return 0.0
         return float(self.split.tail_l1_norm(self.preview_s)) * float(np.max(np.abs(self.input)))
 
+
     @cached_property
     def discretisation_error_estimate(self) -> float:
         """Estimate of the largest error due to sampling [output units].
@@ -160,19 +161,20 @@ def sampling_interval(t: Any) -> float:
         dt = float(t)
         if not (math.isfinite(dt) and dt > 0):
             raise NonUniformSamplingError(
-                f"the sampling interval must be a positive finite number of seconds; got {t!r}"
-            )
+                f"the sampling interval must be a positive finite number of seconds; got {t!r}")
         return dt
     ta = np.asarray(t, dtype=float)
     if ta.ndim != 1 or ta.size < 2:
-        raise NonUniformSamplingError(f"time stamps must be a 1-D array with at least 2 samples; got shape {ta.shape}")
+        raise NonUniformSamplingError(
+            f"time stamps must be a 1-D array with at least 2 samples; got shape {ta.shape}")
     if not np.all(np.isfinite(ta)):
         i = int(np.flatnonzero(~np.isfinite(ta))[0])
         raise NonUniformSamplingError(f"time stamp {i} is {ta[i]!r}; time stamps must be finite")
     steps = np.diff(ta)
     dt = (ta[-1] - ta[0]) / (ta.size - 1)
     if not dt > 0:
-        raise NonUniformSamplingError(f"time stamps must increase; got t[0] = {ta[0]!r} and t[-1] = {ta[-1]!r}")
+        raise NonUniformSamplingError(
+            f"time stamps must increase; got t[0] = {ta[0]!r} and t[-1] = {ta[-1]!r}")
     tol = UNIFORM_RTOL * dt + 8 * np.finfo(float).eps * float(np.max(np.abs(ta)))
     dev = np.abs(steps - dt)
     i = int(np.argmax(dev))
@@ -180,8 +182,7 @@ def sampling_interval(t: Any) -> float:
         raise NonUniformSamplingError(
             f"time stamps are not uniformly spaced: step t[{i + 1}] - t[{i}] = {steps[i]!r} s "
             f"differs from the mean step {dt!r} s by {dev[i]:.3g} s (> {UNIFORM_RTOL:g} relative);"
-            " resample the signal onto a uniform grid first"
-        )
+            " resample the signal onto a uniform grid first")
     return float(dt)
 
 
@@ -208,8 +209,7 @@ def _signal(u: Any) -> np.ndarray:
         i = int(np.flatnonzero(~finite)[0])
         raise NonFiniteSignalError(
             f"the signal must be finite; sample {i} is {ua[i]!r} (NaN/inf are not allowed: "
-            "fill or interpolate gaps before inverting)"
-        )
+            "fill or interpolate gaps before inverting)")
     return ua
 
 
@@ -225,19 +225,10 @@ def _disc_estimate(split: InverseSplit, u: np.ndarray, n_preview: int | None) ->
     return (l1s + l1u) * d2 / 8.0
 
 
-def invert(
-    model: Any,
-    t: Any,
-    u: Any,
-    *,
-    preview: Any = "auto",
-    improper: str = "error",
-    filter_bandwidth: float | None = None,
-    t0: float = 0.0,
-    chunk_size: int | None = None,
-    preview_tol: float = DEFAULT_PREVIEW_TOL,
-    preview_norm: str = "linf",
-) -> InversionResult:
+def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str = "error",
+           filter_bandwidth: float | None = None, t0: float = 0.0,
+           chunk_size: int | None = None, preview_tol: float = DEFAULT_PREVIEW_TOL,
+           preview_norm: str = "linf") -> InversionResult:
     """Stable inversion ``y = G^{-1}[u]`` of a uniformly sampled signal.
 
     Parameters
@@ -341,24 +332,12 @@ def invert(
         i = int(np.flatnonzero(bad)[0])
         raise NonFiniteSignalError(
             f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
-            "scale the signal to the model's units"
-        )
+            "scale the signal to the model's units")
     return InversionResult(
-        input=ua,
-        output=output,
-        stable_part=stable,
-        unstable_part=unstable,
-        preview_s=prev_s,
-        preview_samples=n_prev,
-        r0=split.r0,
-        auto_preview_s=split.auto_preview_s,
-        dt=dt,
-        split=split,
-        t0=float(t0),
-        time_stamps=ta,
-        preview_rule=rule,
-        preview_choice=choice,
-    )
+        input=ua, output=output, stable_part=stable, unstable_part=unstable,
+        preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
+        auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
+        time_stamps=ta, preview_rule=rule, preview_choice=choice)
 
 
 @dataclass(frozen=True)
@@ -386,17 +365,9 @@ class ChunkedInversionSummary:
     chunk_size: int
 
 
-def invert_to(
-    model: Any,
-    dt: float,
-    u: Any,
-    out: Any,
-    *,
-    preview: Any = "auto",
-    improper: str = "error",
-    filter_bandwidth: float | None = None,
-    chunk_size: int = DEFAULT_CHUNK,
-) -> ChunkedInversionSummary:
+def invert_to(model: Any, dt: float, u: Any, out: Any, *, preview: Any = "auto",
+              improper: str = "error", filter_bandwidth: float | None = None,
+              chunk_size: int = DEFAULT_CHUNK) -> ChunkedInversionSummary:
     """Bounded-memory inversion of a long record, reading ``u`` and writing ``out`` by chunks.
 
     ``u`` and ``out`` may be anything supporting 1-D slicing and slice assignment, e.g.
@@ -437,9 +408,8 @@ def invert_to(
 
     plan.forward(u, n, int(chunk_size), put_s, check=True)
     plan.backward(u, n, int(chunk_size), add_u)
-    return ChunkedInversionSummary(
-        n_samples=n, dt=dt, preview_s=prev_s, preview_samples=n_prev, r0=split.r0, chunk_size=int(chunk_size)
-    )
+    return ChunkedInversionSummary(n_samples=n, dt=dt, preview_s=prev_s, preview_samples=n_prev,
+                                   r0=split.r0, chunk_size=int(chunk_size))
 
 
 def _with_limits(res: InversionResult, limits: Any, what: str, unit: str) -> InversionResult:
@@ -451,7 +421,8 @@ def _with_limits(res: InversionResult, limits: Any, what: str, unit: str) -> Inv
     return replace(res, limit_report=report)
 
 
-def decode_sensor(model: Any, t: Any, current: Any, *, limits: Any = None, **kwargs: Any) -> InversionResult:
+def decode_sensor(model: Any, t: Any, current: Any, *, limits: Any = None,
+                  **kwargs: Any) -> InversionResult:
     """Sensor decoding: recover the stimulus (e.g. tip displacement) from the sensor output.
 
     ``model`` maps stimulus -> sensor output (seed 000: displacement [mm] -> short-circuit
@@ -463,7 +434,8 @@ def decode_sensor(model: Any, t: Any, current: Any, *, limits: Any = None, **kwa
     return _with_limits(invert(model, t, current, **kwargs), limits, "decoded signal", "")
 
 
-def feedforward(model: Any, t: Any, desired: Any, *, limits: Any = None, **kwargs: Any) -> InversionResult:
+def feedforward(model: Any, t: Any, desired: Any, *, limits: Any = None,
+                **kwargs: Any) -> InversionResult:
     """Actuator feedforward: the input (e.g. voltage) that makes the output follow ``desired``.
 
     ``model`` maps actuator input -> output (seed 001: voltage [V] -> tip displacement [mm]).

@@ -55,7 +55,8 @@ def seed000_sensor_35c(form: str = "coefficients") -> Any:
     raise ValueError(f"form must be 'coefficients' or 'zeros'; got {form!r}")
 
 
-def toy_scheduled_sensor(temperature_c: float, *, kappa_per_c: float = 0.01, gain_per_c: float = 0.004) -> Any:
+def toy_scheduled_sensor(temperature_c: float, *, kappa_per_c: float = 0.01,
+                         gain_per_c: float = 0.004) -> Any:
     """TOY temperature-scheduled sensor: the printed 35 degC model time-scaled and rescaled.
 
     ``G_T(s) = g(T) G_35(s / kappa(T))`` with ``kappa(T) = 1 - kappa_per_c (T - 35)`` and
@@ -101,9 +102,8 @@ def toy_actuator() -> Any:
     return control.tf(num, den)
 
 
-def released_cantilever(
-    t: Any, *, w0: float = 1.0, t_release: float = 0.5, f_n: float = 30.0, zeta: float = 0.1
-) -> np.ndarray:
+def released_cantilever(t: Any, *, w0: float = 1.0, t_release: float = 0.5,
+                        f_n: float = 30.0, zeta: float = 0.1) -> np.ndarray:
     """Tip displacement of a cantilever held at ``w0`` until ``t_release``, then released.
 
     After release it oscillates freely as a damped second-order system,

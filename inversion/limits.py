@@ -68,8 +68,7 @@ class Limits:
                 lo, hi = (float(x) for x in self.output_range)
             except (TypeError, ValueError):
                 raise InversionError(
-                    f"Limits.output_range must be a pair (lo, hi); got {self.output_range!r}"
-                ) from None
+                    f"Limits.output_range must be a pair (lo, hi); got {self.output_range!r}") from None
             if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
                 raise InversionError(f"Limits.output_range needs finite lo < hi; got {self.output_range!r}")
             object.__setattr__(self, "output_range", (lo, hi))
@@ -110,21 +109,15 @@ class LimitViolation:
 
     def describe(self, what: str, unit: str) -> str:
         if self.kind == "max_rate":
-            return (
-                f"{what} changes at {self.value:.4g} {unit}/s at sample {self.index} "
-                f"(t = {self.time_s:.6g} s), above max_rate = {self.limit:.4g} {unit}/s "
-                f"({self.count} samples violate it)"
-            )
+            return (f"{what} changes at {self.value:.4g} {unit}/s at sample {self.index} "
+                    f"(t = {self.time_s:.6g} s), above max_rate = {self.limit:.4g} {unit}/s "
+                    f"({self.count} samples violate it)")
         if self.kind == "output_range":
-            return (
-                f"{what} is {self.value:.4g} {unit} at sample {self.index} (t = {self.time_s:.6g} s), "
-                f"outside the allowed range ending at {self.limit:.4g} {unit} "
-                f"({self.count} samples violate it)"
-            )
-        return (
-            f"{what} is {self.value:.4g} {unit} at sample {self.index} (t = {self.time_s:.6g} s), "
-            f"beyond max_voltage = ±{self.limit:.4g} {unit} ({self.count} samples violate it)"
-        )
+            return (f"{what} is {self.value:.4g} {unit} at sample {self.index} (t = {self.time_s:.6g} s), "
+                    f"outside the allowed range ending at {self.limit:.4g} {unit} "
+                    f"({self.count} samples violate it)")
+        return (f"{what} is {self.value:.4g} {unit} at sample {self.index} (t = {self.time_s:.6g} s), "
+                f"beyond max_voltage = ±{self.limit:.4g} {unit} ({self.count} samples violate it)")
 
 
 @dataclass(frozen=True)
@@ -152,9 +145,8 @@ class LimitReport:
     message: str = ""
 
 
-def check_limits(
-    y: Any, dt: float, limits: Limits | None, *, t0: float = 0.0, what: str = "output", unit: str = ""
-) -> LimitReport:
+def check_limits(y: Any, dt: float, limits: Limits | None, *, t0: float = 0.0,
+                 what: str = "output", unit: str = "") -> LimitReport:
     """Check a computed signal against ``limits``; refuse or warn on the first violation.
 
     Parameters
@@ -193,9 +185,8 @@ def check_limits(
         if idx.size:
             i = int(idx[0])
             b = bound(i) if callable(bound) else bound
-            found.append(
-                LimitViolation(kind, i + offset, t0 + (i + offset) * dt, float(values[i]), float(b), int(idx.size))
-            )
+            found.append(LimitViolation(kind, i + offset, t0 + (i + offset) * dt, float(values[i]),
+                                        float(b), int(idx.size)))
 
     if limits.max_voltage is not None:
         first(np.abs(ya) > limits.max_voltage, ya, "max_voltage", limits.max_voltage)
@@ -210,9 +201,7 @@ def check_limits(
     msg = "; ".join(v.describe(what, unit) for v in found)
     msg += f" (peak {peak:.4g} {unit}, peak rate {peak_rate:.4g} {unit}/s)"
     if limits.action == "error":
-        raise LimitError(
-            msg + ": refused. Check the model, use a longer preview or preview='inf', "
-            "lower the reference, or relax the limits (action='warn' to proceed)."
-        )
+        raise LimitError(msg + ": refused. Check the model, use a longer preview or preview='inf', "
+                         "lower the reference, or relax the limits (action='warn' to proceed).")
     warnings.warn(LimitWarning(msg), stacklevel=3)
     return LimitReport(False, found, peak, peak_rate, msg)

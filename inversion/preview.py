@@ -42,14 +42,9 @@ _MAX_COND = 1e8
 DEFAULT_PREVIEW_TOL = 1e-3
 
 
-def frequency_preview(
-    split: InverseSplit,
-    tol: float = DEFAULT_PREVIEW_TOL,
-    *,
-    omega_max: float,
-    omega_min: float | None = None,
-    n_omega: int = 256,
-) -> tuple[float, float]:
+def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
+                      omega_max: float, omega_min: float | None = None,
+                      n_omega: int = 256) -> tuple[float, float]:
     """Smallest preview whose truncation error is below ``tol`` for every sinusoid in a band.
 
     Signal-independent rule (used where the signal is not known in advance: streaming,
@@ -91,10 +86,10 @@ def frequency_preview(
         raise InversionError(f"frequency band must satisfy 0 < omega_min < omega_max; got {lo!r}, {hi!r}")
     w = np.concatenate(([0.0], np.logspace(math.log10(lo), math.log10(hi), n_omega)))
     H = np.abs(split.frequency_response(w))
-    keep = H > 1e-12 * float(np.max(H))  # a zero of H (pole of G) carries no signal
+    keep = H > 1e-12 * float(np.max(H))           # a zero of H (pole of G) carries no signal
     w, H = w[keep], H[keep]
     step = 0.05 / split.r0
-    T = step * np.arange(2001)  # up to 100/r0 (exp(-100) of the kernel)
+    T = step * np.arange(2001)                    # up to 100/r0 (exp(-100) of the kernel)
     ratio = np.max(np.abs(split._truncation_terms(T, w)) / H, axis=1)
     bad = np.flatnonzero(ratio > tol)
     if bad.size == 0:
@@ -103,9 +98,9 @@ def frequency_preview(
     if i >= T.size:
         raise InversionError(
             f"no finite preview up to 100/r0 = {T[-1]:.4g} s brings the truncation error below "
-            f"{tol:g} of the inverse (best {ratio[-1]:.3g}); use preview='inf'"
-        )
+            f"{tol:g} of the inverse (best {ratio[-1]:.3g}); use preview='inf'")
     return float(T[i]), float(np.max(ratio[i:]))
+
 
 
 #: Names of the 4/r0 rule (seed paper 000's Zou-Devasia choice), kept for its experiments.
@@ -133,14 +128,9 @@ def preview_rule(preview: Any) -> str:
     return "fixed"
 
 
-def resolve_preview(
-    preview: Any,
-    split_or_auto: InverseSplit | float,
-    dt: float,
-    n_samples: int | None = None,
-    *,
-    tol: float = DEFAULT_PREVIEW_TOL,
-) -> tuple[int | None, float]:
+def resolve_preview(preview: Any, split_or_auto: InverseSplit | float, dt: float,
+                    n_samples: int | None = None, *,
+                    tol: float = DEFAULT_PREVIEW_TOL) -> tuple[int | None, float]:
     """Turn a ``preview`` argument into ``(samples or None, seconds)`` without looking at a signal.
 
     Parameters
@@ -179,20 +169,18 @@ def resolve_preview(
             seconds = float(preview.strip() if isinstance(preview, str) else preview)
         except (TypeError, ValueError):
             raise PreviewError(
-                f"preview must be 'auto', '4/r0', 'inf' or a number of seconds; got {preview!r}"
-            ) from None
+                f"preview must be 'auto', '4/r0', 'inf' or a number of seconds; got {preview!r}") from None
     if math.isnan(seconds) or seconds < 0:
         raise PreviewError(f"preview must be >= 0 seconds (or 'auto'/'4/r0'/'inf'); got {preview!r}")
     n = int(round(seconds / dt))
     if n_samples is not None and n > n_samples - 1:
-        if rule == "auto":  # the whole record ahead: identical to the infinite preview
+        if rule == "auto":   # the whole record ahead: identical to the infinite preview
             return n_samples - 1, (n_samples - 1) * dt
         raise PreviewError(
             f"preview {seconds:.6g} s ({n} samples at dt = {dt:.6g} s"
             f"{', the 4/r0 rule' if rule == '4/r0' else ''})"
             f" is longer than the record ({n_samples} samples = {(n_samples - 1) * dt:.6g} s); "
-            "use a longer record, a shorter preview, or preview='auto' or 'inf'"
-        )
+            "use a longer record, a shorter preview, or preview='auto' or 'inf'")
     return n, n * dt
 
 
@@ -226,7 +214,8 @@ class TruncationModes:
             for i in range(lam.size):
                 self.zr[i] = sig.lfilter([a[i], b[i]], [1.0, -lam[i]], ur)
             self.lam, self.w = lam, self.Cr @ V
-            self._zmax = {"linf": np.max(np.abs(self.zr), axis=1), "l2": np.sqrt(np.sum(np.abs(self.zr) ** 2, axis=1))}
+            self._zmax = {"linf": np.max(np.abs(self.zr), axis=1),
+                          "l2": np.sqrt(np.sum(np.abs(self.zr) ** 2, axis=1))}
 
     def error(self, N: int) -> np.ndarray:
         """``y_N - y_inf`` [output units] for a preview of ``N`` samples."""
@@ -235,13 +224,13 @@ class TruncationModes:
         if N >= self.n:
             return out
         if self.modal:
-            c = self.w * self.lam**N
-            out[: self.n - N] = -np.real(c @ self.zr[:, : self.n - N])[::-1]
+            c = self.w * self.lam ** N
+            out[:self.n - N] = -np.real(c @ self.zr[:, :self.n - N])[::-1]
             return out
         C2 = self.Cr @ np.linalg.matrix_power(self.Phi, N)
         if np.any(C2):
             f = FOHFilter.build(self.Phi, self.al, self.be, C2)
-            out[: self.n - N] = -f.run(self.u[::-1], f.zi0())[0][::-1][N:]
+            out[:self.n - N] = -f.run(self.u[::-1], f.zi0())[0][::-1][N:]
         return out
 
     def bound(self, N: int, norm: str) -> float | None:
@@ -253,7 +242,6 @@ class TruncationModes:
     def first_bounded(self, target: float, norm: str) -> int:
         """Smallest ``N`` whose bound is <= ``target`` (``n - 1`` if none); bisection on the
         monotone bound (the L1 tail of the kernel times max|u| without the modal form)."""
-
         def b(N: int) -> float:
             v = self.bound(N, norm)
             if v is None:
@@ -310,15 +298,8 @@ class PreviewChoice:
     rule_4_over_r0_s: float
 
 
-def choose_preview(
-    split: InverseSplit,
-    dt: float,
-    u: Any,
-    *,
-    tol: float = DEFAULT_PREVIEW_TOL,
-    norm: str = "linf",
-    checked: bool = False,
-) -> PreviewChoice:
+def choose_preview(split: InverseSplit, dt: float, u: Any, *, tol: float = DEFAULT_PREVIEW_TOL,
+                   norm: str = "linf", checked: bool = False) -> PreviewChoice:
     """Smallest preview whose exact truncation error on the signal ``u`` is below ``tol``.
 
     The error of a preview of ``N`` samples (``e_N = y_N - y_inf``) is measured relative to the
@@ -375,7 +356,7 @@ def choose_preview(
             memo[N] = modes.error(N)
         return memo[N]
 
-    if size(err(hi)) > target:  # the bound is exact-or-larger; only rounding gets here
+    if size(err(hi)) > target:               # the bound is exact-or-larger; only rounding gets here
         hi = n - 1
     # scan down from the bound in steps shorter than the decay time and the oscillation
     # half-period of the anticausal modes (so no pocket where a longer preview fails again is
@@ -394,7 +375,7 @@ def choose_preview(
             hi = cand
         else:
             lo = cand
-    while hi - lo > 1:  # lo fails (or is -1), hi meets the tolerance
+    while hi - lo > 1:                       # lo fails (or is -1), hi meets the tolerance
         mid = (lo + hi) // 2
         if size(err(mid)) <= target:
             hi = mid
@@ -403,12 +384,6 @@ def choose_preview(
     N = hi
     e = err(N)
     return PreviewChoice(
-        samples=N,
-        seconds=N * dt,
-        tolerance=float(tol),
-        norm=norm,
-        relative_error=size(e) / ref,
-        max_error=float(np.max(np.abs(e))),
-        tail_bound=float(split.tail_l1_norm(N * dt)) * umax,
-        rule_4_over_r0_s=split.auto_preview_s,
-    )
+        samples=N, seconds=N * dt, tolerance=float(tol), norm=norm, relative_error=size(e) / ref,
+        max_error=float(np.max(np.abs(e))), tail_bound=float(split.tail_l1_norm(N * dt)) * umax,
+        rule_4_over_r0_s=split.auto_preview_s)

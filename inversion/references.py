@@ -31,17 +31,8 @@ import numpy as np
 
 from ._errors import InversionError
 
-__all__ = [
-    "Reference",
-    "sine",
-    "multitone",
-    "smoothed_steps",
-    "from_file",
-    "fade",
-    "smootherstep",
-    "edge_jump",
-    "read_columns",
-]
+__all__ = ["Reference", "sine", "multitone", "smoothed_steps", "from_file", "fade", "smootherstep",
+           "edge_jump", "read_columns"]
 
 
 def smootherstep(x: Any) -> np.ndarray:
@@ -91,24 +82,15 @@ class Reference:
 
         path = Path(path)
         col = f"reference_{self.unit}" if self.unit else "reference"
-        meta = {
-            "description": self.description,
-            "fade_in_s": f"{self.fade_in_s:g}",
-            "fade_out_s": f"{self.fade_out_s:g}",
-            "lead_s": f"{self.lead_s:g}",
-            "tail_s": f"{self.tail_s:g}",
-            **self.metadata,
-        }
+        meta = {"description": self.description, "fade_in_s": f"{self.fade_in_s:g}",
+                "fade_out_s": f"{self.fade_out_s:g}", "lead_s": f"{self.lead_s:g}",
+                "tail_s": f"{self.tail_s:g}", **self.metadata}
         if path.suffix.lower() == ".npz":
             import json
 
             def write_npz(fh: Any) -> None:
-                np.savez(
-                    fh,
-                    header=np.array(json.dumps({"format": "ipmc-reference", "metadata": meta})),
-                    time_s=self.t,
-                    **{col: self.y},
-                )
+                np.savez(fh, header=np.array(json.dumps({"format": "ipmc-reference", "metadata": meta})),
+                         time_s=self.t, **{col: self.y})
 
             return atomic_write(path, write_npz, "wb")
         if path.suffix.lower() != ".csv":
@@ -135,17 +117,8 @@ def _positive(name: str, v: Any, allow_zero: bool = False) -> float:
     return x
 
 
-def _assemble(
-    body_fn: Any,
-    duration_s: float,
-    fs_hz: float,
-    fade_in_s: float,
-    fade_out_s: float,
-    lead_s: float,
-    tail_s: float,
-    description: str,
-    unit: str,
-) -> Reference:
+def _assemble(body_fn: Any, duration_s: float, fs_hz: float, fade_in_s: float, fade_out_s: float,
+              lead_s: float, tail_s: float, description: str, unit: str) -> Reference:
     fs = _positive("fs_hz", fs_hz)
     dur = _positive("duration_s", duration_s)
     fi = _positive("fade_in_s", fade_in_s, True)
@@ -155,12 +128,11 @@ def _assemble(
     if fi + fo > dur:
         raise InversionError(
             f"fade_in_s + fade_out_s = {fi + fo:g} s exceeds duration_s = {dur:g} s (the signal "
-            "would never reach full amplitude)"
-        )
+            "would never reach full amplitude)")
     total = lead + dur + tail
     n = int(round(total * fs)) + 1
     t = np.arange(n) / fs
-    tau = t - lead  # time since the signal starts
+    tau = t - lead                                   # time since the signal starts
     y = np.zeros(n)
     on = (tau >= 0) & (tau <= dur)
     y[on] = body_fn(tau[on])
@@ -174,20 +146,10 @@ def _assemble(
     return Reference(t, y, body, fi, fo, lead, tail, description, unit)
 
 
-def sine(
-    amplitude: float,
-    frequency_hz: float,
-    duration_s: float,
-    fs_hz: float,
-    *,
-    phase_deg: float = 0.0,
-    offset: float = 0.0,
-    fade_in_s: float | None = None,
-    fade_out_s: float | None = None,
-    lead_s: float = 1.0,
-    tail_s: float = 1.0,
-    unit: str = "",
-) -> Reference:
+def sine(amplitude: float, frequency_hz: float, duration_s: float, fs_hz: float, *,
+         phase_deg: float = 0.0, offset: float = 0.0, fade_in_s: float | None = None,
+         fade_out_s: float | None = None, lead_s: float = 1.0, tail_s: float = 1.0,
+         unit: str = "") -> Reference:
     """``offset + amplitude sin(2 pi f tau + phase)`` for ``duration_s``, faded and padded with rest.
 
     Parameters
@@ -213,32 +175,14 @@ def sine(
     fi = 2.0 / f if fade_in_s is None else fade_in_s
     fo = 2.0 / f if fade_out_s is None else fade_out_s
     ph = math.radians(float(phase_deg))
-    return _assemble(
-        lambda tau: offset + amplitude * np.sin(2 * np.pi * f * tau + ph),
-        duration_s,
-        fs_hz,
-        fi,
-        fo,
-        lead_s,
-        tail_s,
-        f"sine {amplitude:g} {unit} at {f:g} Hz".replace("  ", " "),
-        unit,
-    )
+    return _assemble(lambda tau: offset + amplitude * np.sin(2 * np.pi * f * tau + ph), duration_s,
+                     fs_hz, fi, fo, lead_s, tail_s,
+                     f"sine {amplitude:g} {unit} at {f:g} Hz".replace("  ", " "), unit)
 
 
-def multitone(
-    amplitudes: Any,
-    frequencies_hz: Any,
-    duration_s: float,
-    fs_hz: float,
-    *,
-    phases_deg: Any = None,
-    fade_in_s: float | None = None,
-    fade_out_s: float | None = None,
-    lead_s: float = 1.0,
-    tail_s: float = 1.0,
-    unit: str = "",
-) -> Reference:
+def multitone(amplitudes: Any, frequencies_hz: Any, duration_s: float, fs_hz: float, *,
+              phases_deg: Any = None, fade_in_s: float | None = None, fade_out_s: float | None = None,
+              lead_s: float = 1.0, tail_s: float = 1.0, unit: str = "") -> Reference:
     """Sum of sines ``sum_i a_i sin(2 pi f_i tau + phi_i)``, faded and padded (fades default to two
     periods of the lowest frequency).  Amplitudes [output units], frequencies [Hz], phases [deg]."""
     a = np.atleast_1d(np.asarray(amplitudes, dtype=float))
@@ -246,8 +190,7 @@ def multitone(
     ph = np.zeros_like(f) if phases_deg is None else np.atleast_1d(np.asarray(phases_deg, dtype=float))
     if not (a.size == f.size == ph.size and a.size > 0):
         raise InversionError(
-            f"multitone needs as many amplitudes, frequencies and phases; got {a.size}, {f.size}, {ph.size}"
-        )
+            f"multitone needs as many amplitudes, frequencies and phases; got {a.size}, {f.size}, {ph.size}")
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(f)) and np.all(np.isfinite(ph))):
         raise InversionError("multitone amplitudes, frequencies and phases must be finite")
     fs = _positive("fs_hz", fs_hz)
@@ -266,16 +209,8 @@ def multitone(
     return _assemble(body, duration_s, fs, fi, fo, lead_s, tail_s, desc, unit)
 
 
-def smoothed_steps(
-    levels: Any,
-    hold_s: float,
-    fs_hz: float,
-    *,
-    transition_s: float = 0.5,
-    lead_s: float = 1.0,
-    tail_s: float = 1.0,
-    unit: str = "",
-) -> Reference:
+def smoothed_steps(levels: Any, hold_s: float, fs_hz: float, *, transition_s: float = 0.5,
+                   lead_s: float = 1.0, tail_s: float = 1.0, unit: str = "") -> Reference:
     """A staircase from rest through ``levels`` and back to rest, each transition a C2 ramp.
 
     Parameters
@@ -296,42 +231,24 @@ def smoothed_steps(
     hold = _positive("hold_s", hold_s)
     tr = _positive("transition_s", transition_s)
     seq = np.concatenate(([0.0], lv, [0.0]))
-    starts = np.arange(seq.size - 1) * (tr + hold)  # ramp k from seq[k] to seq[k+1]
+    starts = np.arange(seq.size - 1) * (tr + hold)       # ramp k from seq[k] to seq[k+1]
     duration = float(starts[-1] + tr)
 
     def body(tau: np.ndarray) -> np.ndarray:
         y = np.full(tau.shape, seq[0])
-        for k in range(seq.size - 1):  # a handful of ramps; each one vectorised
+        for k in range(seq.size - 1):        # a handful of ramps; each one vectorised
             y = y + (seq[k + 1] - seq[k]) * smootherstep((tau - starts[k]) / tr)
         return y
 
-    ref = _assemble(
-        body,
-        duration,
-        fs_hz,
-        0.0,
-        0.0,
-        lead_s,
-        tail_s,
-        f"smoothed steps {lv.tolist()} (hold {hold:g} s, ramps {tr:g} s)",
-        unit,
-    )
+    ref = _assemble(body, duration, fs_hz, 0.0, 0.0, lead_s, tail_s,
+                    f"smoothed steps {lv.tolist()} (hold {hold:g} s, ramps {tr:g} s)", unit)
     tau = ref.t - lead_s
     body_mask = (tau >= tr) & (tau <= duration - tr)
     return Reference(ref.t, ref.y, body_mask, tr, tr, lead_s, tail_s, ref.description, unit)
 
 
-def fade(
-    t: Any,
-    y: Any,
-    fade_in_s: float,
-    fade_out_s: float,
-    *,
-    lead_s: float = 0.0,
-    tail_s: float = 0.0,
-    unit: str = "",
-    description: str = "faded record",
-) -> Reference:
+def fade(t: Any, y: Any, fade_in_s: float, fade_out_s: float, *, lead_s: float = 0.0,
+         tail_s: float = 0.0, unit: str = "", description: str = "faded record") -> Reference:
     """Window an existing uniformly sampled record with C2 fades and pad it with rest.
 
     ``t`` [s] uniform; ``y`` [output units].  The first ``fade_in_s`` and the last ``fade_out_s``
@@ -352,19 +269,12 @@ def fade(
     def body(x: np.ndarray) -> np.ndarray:
         return np.interp(x, tau, y0)
 
-    return _assemble(body, float(tau[-1]), 1.0 / dt, fade_in_s, fade_out_s, lead_s, tail_s, description, unit)
+    return _assemble(body, float(tau[-1]), 1.0 / dt, fade_in_s, fade_out_s, lead_s, tail_s,
+                     description, unit)
 
 
-def from_file(
-    path: Any,
-    *,
-    column: str | None = None,
-    fade_in_s: float = 0.0,
-    fade_out_s: float = 0.0,
-    lead_s: float = 0.0,
-    tail_s: float = 0.0,
-    unit: str = "",
-) -> Reference:
+def from_file(path: Any, *, column: str | None = None, fade_in_s: float = 0.0, fade_out_s: float = 0.0,
+              lead_s: float = 0.0, tail_s: float = 0.0, unit: str = "") -> Reference:
     """A reference from a CSV (``#`` header lines, a header row with ``time_s`` and one value
     column) or an NPZ (arrays ``time_s`` and the value column), optionally faded and padded.
 
@@ -382,16 +292,8 @@ def from_file(
         raise InversionError(f"{path}: no column {column!r}; found {list(cols)}")
     if not unit and "_" in column:
         unit = column.rsplit("_", 1)[1]
-    return fade(
-        cols["time_s"],
-        cols[column],
-        fade_in_s,
-        fade_out_s,
-        lead_s=lead_s,
-        tail_s=tail_s,
-        unit=unit,
-        description=f"{Path(path).name}:{column}",
-    )
+    return fade(cols["time_s"], cols[column], fade_in_s, fade_out_s, lead_s=lead_s, tail_s=tail_s,
+                unit=unit, description=f"{Path(path).name}:{column}")
 
 
 def edge_jump(y: Any) -> float:
@@ -407,7 +309,7 @@ def edge_jump(y: Any) -> float:
     if nz.size == 0:
         return 0.0
     peak = float(np.max(np.abs(ya)))
-    ext = np.concatenate(([0.0], ya, [0.0]))  # rest beyond both ends
+    ext = np.concatenate(([0.0], ya, [0.0]))            # rest beyond both ends
     d = np.abs(np.diff(ext))
     i0, i1 = int(nz[0]), int(nz[-1])
     value = max(abs(float(ya[i0])), abs(float(ya[i1]))) / peak
@@ -439,7 +341,8 @@ def read_columns(path: Any) -> dict[str, np.ndarray]:
         import csv
 
         with open(path, encoding="utf-8", newline="") as fh:
-            rows = [(i, r) for i, r in enumerate(csv.reader(fh), start=1) if r and not r[0].lstrip().startswith("#")]
+            rows = [(i, r) for i, r in enumerate(csv.reader(fh), start=1)
+                    if r and not r[0].lstrip().startswith("#")]
         if len(rows) < 3:
             raise InversionError(f"{path}: needs a header row and at least 2 data rows")
         names = [c.strip() for c in rows[0][1]]

@@ -91,20 +91,22 @@ def _check_temperature(temperature: Any, n: int) -> np.ndarray:
     if Ta.ndim == 0:
         Ta = np.full(n, float(Ta))
     if Ta.shape != (n,):
-        raise InversionError(f"temperature trace must have one value per sample ({n}); got shape {Ta.shape}")
+        raise InversionError(
+            f"temperature trace must have one value per sample ({n}); got shape {Ta.shape}")
     if not np.all(np.isfinite(Ta)):
         i = int(np.flatnonzero(~np.isfinite(Ta))[0])
-        raise NonFiniteSignalError(f"the temperature trace must be finite; sample {i} is {Ta[i]!r} degC")
+        raise NonFiniteSignalError(
+            f"the temperature trace must be finite; sample {i} is {Ta[i]!r} degC")
     return Ta
 
 
-def _splits(
-    model_at: Callable[[float], Any], grid: np.ndarray, improper: str, filter_bandwidth: float | None
-) -> list[InverseSplit]:
+def _splits(model_at: Callable[[float], Any], grid: np.ndarray, improper: str,
+            filter_bandwidth: float | None) -> list[InverseSplit]:
     out = []
     for T in grid:
         try:
-            out.append(split_inverse(model_at(float(T)), improper=improper, filter_bandwidth=filter_bandwidth))
+            out.append(split_inverse(model_at(float(T)), improper=improper,
+                                     filter_bandwidth=filter_bandwidth))
         except InversionError as exc:
             raise type(exc)(f"model_at({float(T):.6g} degC): {exc}") from exc
     return out
@@ -117,7 +119,7 @@ def _auto(splits: list[InverseSplit], preview: Any, dt: float, tol: float = DEFA
     if preview_rule(preview) == "4/r0":
         return max(s.auto_preview_s for s in splits)
     if preview_rule(preview) != "auto":
-        return 0.0  # unused
+        return 0.0   # unused
     return max(frequency_preview(s, tol, omega_max=math.pi / dt)[0] for s in splits)
 
 
@@ -162,19 +164,10 @@ class ScheduledInversionResult(SampledRecord):
     time_stamps: np.ndarray | None = None
 
 
-def _run_scheduled(
-    splits: list[InverseSplit],
-    grid: np.ndarray,
-    dt: float,
-    n_prev: int | None,
-    u: Any,
-    Ta: Any,
-    n: int,
-    chunk: int,
-    sink_s: Any,
-    sink_u: Any,
-    check: bool,
-) -> None:
+
+def _run_scheduled(splits: list[InverseSplit], grid: np.ndarray, dt: float, n_prev: int | None,
+                   u: Any, Ta: Any, n: int, chunk: int, sink_s: Any, sink_u: Any,
+                   check: bool) -> None:
     for node, sp in enumerate(splits):
         plan = Plan(sp, dt, n_prev)
 
@@ -190,20 +183,11 @@ def _run_scheduled(
         plan.backward(u, n, chunk, wu)
 
 
-def invert_scheduled(
-    model_at: Callable[[float], Any],
-    t: Any,
-    u: Any,
-    temperature: Any,
-    *,
-    preview: Any = "auto",
-    grid_step: float = 1.0,
-    grid: Any = None,
-    improper: str = "error",
-    filter_bandwidth: float | None = None,
-    t0: float = 0.0,
-    chunk_size: int | None = None,
-) -> ScheduledInversionResult:
+def invert_scheduled(model_at: Callable[[float], Any], t: Any, u: Any, temperature: Any, *,
+                     preview: Any = "auto", grid_step: float = 1.0,
+                     grid: Any = None, improper: str = "error",
+                     filter_bandwidth: float | None = None, t0: float = 0.0,
+                     chunk_size: int | None = None) -> ScheduledInversionResult:
     """Stable inversion with a time-varying temperature.
 
     Parameters
@@ -256,20 +240,10 @@ def invert_scheduled(
 
     _run_scheduled(splits, g, dt, n_prev, ua, Ta, n, chunk, add_s, add_u, check=False)
     return ScheduledInversionResult(
-        input=ua,
-        temperature=Ta,
-        output=stable + unstable,
-        stable_part=stable,
-        unstable_part=unstable,
-        grid_c=g,
-        preview_s=prev_s,
-        preview_samples=n_prev,
-        r0=np.array([s.r0 for s in splits]),
-        dt=dt,
-        splits=splits,
-        t0=float(t0),
-        time_stamps=ta,
-    )
+        input=ua, temperature=Ta, output=stable + unstable, stable_part=stable,
+        unstable_part=unstable, grid_c=g, preview_s=prev_s, preview_samples=n_prev,
+        r0=np.array([s.r0 for s in splits]), dt=dt, splits=splits, t0=float(t0),
+        time_stamps=ta)
 
 
 def _grid(grid: Any, Ta: np.ndarray, step: float) -> np.ndarray:
@@ -282,36 +256,25 @@ def _grid(grid: Any, Ta: np.ndarray, step: float) -> np.ndarray:
     if lo < g[0] - 1e-9 or hi > g[-1] + 1e-9:
         raise InversionError(
             f"the temperature trace spans [{lo:.6g}, {hi:.6g}] degC but the grid covers only "
-            f"[{g[0]:.6g}, {g[-1]:.6g}] degC"
-        )
+            f"[{g[0]:.6g}, {g[-1]:.6g}] degC")
     return g
 
 
-def invert_scheduled_to(
-    model_at: Callable[[float], Any],
-    dt: float,
-    u: Any,
-    temperature: Any,
-    out: Any,
-    *,
-    preview: Any = "auto",
-    grid_step: float = 1.0,
-    grid: Any = None,
-    improper: str = "error",
-    filter_bandwidth: float | None = None,
-    chunk_size: int = DEFAULT_CHUNK,
-) -> np.ndarray:
+def invert_scheduled_to(model_at: Callable[[float], Any], dt: float, u: Any, temperature: Any,
+                        out: Any, *, preview: Any = "auto", grid_step: float = 1.0,
+                        grid: Any = None, improper: str = "error",
+                        filter_bandwidth: float | None = None,
+                        chunk_size: int = DEFAULT_CHUNK) -> np.ndarray:
     """Bounded-memory version of :func:`invert_scheduled` (``u``, ``temperature``, ``out``
     may be memory-mapped).  Returns the temperature grid [degC]."""
     dt = sampling_interval(dt)
     n = len(u)
     if len(out) != n or len(temperature) != n:
         raise InversionError(
-            f"u, temperature and out must have the same length; got {n}, {len(temperature)}, {len(out)}"
-        )
+            f"u, temperature and out must have the same length; got {n}, {len(temperature)}, {len(out)}")
     lo, hi = math.inf, -math.inf
     for c0 in range(0, n, chunk_size):
-        Tc = _check_temperature(temperature[c0 : c0 + chunk_size], min(chunk_size, n - c0))
+        Tc = _check_temperature(temperature[c0:c0 + chunk_size], min(chunk_size, n - c0))
         lo, hi = min(lo, float(Tc.min())), max(hi, float(Tc.max()))
     if grid is None:
         g = temperature_grid(lo, hi, grid_step)
@@ -320,7 +283,7 @@ def invert_scheduled_to(
     splits = _splits(model_at, g, improper, filter_bandwidth)
     n_prev, _ = resolve_preview(preview, _auto(splits, preview, dt), dt, n)
     for c0 in range(0, n, chunk_size):
-        out[c0 : c0 + chunk_size] = 0.0
+        out[c0:c0 + chunk_size] = 0.0
 
     def add(c0: int, c1: int, y: np.ndarray, _node: int) -> None:
         out[c0:c1] = np.asarray(out[c0:c1], dtype=float) + y
@@ -346,23 +309,18 @@ class ScheduledStreamingInverter:
         [degC]
     """
 
-    def __init__(
-        self,
-        model_at: Callable[[float], Any],
-        dt: float,
-        temperature_range: tuple[float, float],
-        preview: Any = "auto",
-        *,
-        grid_step: float = 1.0,
-        improper: str = "error",
-        filter_bandwidth: float | None = None,
-    ):
-        self.grid_c = temperature_grid(float(temperature_range[0]), float(temperature_range[1]), grid_step)
+    def __init__(self, model_at: Callable[[float], Any], dt: float,
+                 temperature_range: tuple[float, float], preview: Any = "auto", *,
+                 grid_step: float = 1.0, improper: str = "error",
+                 filter_bandwidth: float | None = None):
+        self.grid_c = temperature_grid(float(temperature_range[0]), float(temperature_range[1]),
+                                       grid_step)
         splits = _splits(model_at, self.grid_c, improper, filter_bandwidth)
         dt = sampling_interval(dt)
         n_prev, prev_s = resolve_preview(preview, _auto(splits, preview, dt), dt)
         if n_prev is None:
-            raise PreviewError(f"a streaming inverter needs a finite preview (seconds or 'auto'); got {preview!r}")
+            raise PreviewError(
+                f"a streaming inverter needs a finite preview (seconds or 'auto'); got {preview!r}")
         self.dt = dt
         self.preview_s = prev_s
         self._nodes = [StreamingInverter(sp, dt, prev_s) for sp in splits]
@@ -379,8 +337,7 @@ class ScheduledStreamingInverter:
         if x.size and (Tc.min() < lo - 1e-9 or Tc.max() > hi + 1e-9):
             raise InversionError(
                 f"temperature {float(Tc.min() if Tc.min() < lo else Tc.max()):.6g} degC is outside "
-                f"the declared range [{lo:.6g}, {hi:.6g}] degC"
-            )
+                f"the declared range [{lo:.6g}, {hi:.6g}] degC")
         self._T = np.concatenate((self._T, Tc))
         return self._blend([nd.push(x) for nd in self._nodes])
 

@@ -185,7 +185,8 @@ class InverseSplit:
         if part == "unstable":
             return hu
         if part != "total":
-            raise InversionError(f"part must be 'total', 'stable', 'unstable' or 'polynomial'; got {part!r}")
+            raise InversionError(
+                f"part must be 'total', 'stable', 'unstable' or 'polynomial'; got {part!r}")
         return poly + hs + hu
 
     def stable_tf(self) -> Any:
@@ -272,10 +273,9 @@ class InverseSplit:
         n = self.n_unstable
         # rows R(w) = C_u (j w I - A_u)^{-1}, one batched solve (transpose system)
         lhs = (1j * w)[:, None, None] * np.eye(n) - self.A_u
-        R = np.linalg.solve(
-            np.transpose(lhs, (0, 2, 1)), np.broadcast_to(self.C_u.astype(complex), (w.size, n))[..., None]
-        )[..., 0]
-        V = _propagate(-self.A_u, self.B_u, T)  # (m, n)
+        R = np.linalg.solve(np.transpose(lhs, (0, 2, 1)),
+                            np.broadcast_to(self.C_u.astype(complex), (w.size, n))[..., None])[..., 0]
+        V = _propagate(-self.A_u, self.B_u, T)                           # (m, n)
         return V @ R.T
 
 
@@ -285,7 +285,8 @@ def _scale_poly(c: np.ndarray, w0: float) -> np.ndarray:
     return c * w0 ** np.arange(deg, -1, -1, dtype=float)
 
 
-def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: float | None = None) -> InverseSplit:
+def split_inverse(model: Any, *, improper: str = "error",
+                  filter_bandwidth: float | None = None) -> InverseSplit:
     """Split ``1/G`` into polynomial + feedthrough + stable + anti-stable parts.
 
     Parameters
@@ -311,7 +312,8 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
         for invalid models or options.
     """
     if improper not in IMPROPER_MODES:
-        raise InversionError(f"improper must be one of {IMPROPER_MODES}; got {improper!r}")
+        raise InversionError(
+            f"improper must be one of {IMPROPER_MODES}; got {improper!r}")
     num, den = model_coefficients(model)
     rel_deg = den.size - num.size
     wf: float | None = None
@@ -319,8 +321,7 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
         if filter_bandwidth is None or not (np.isfinite(filter_bandwidth) and filter_bandwidth > 0):
             raise InversionError(
                 "improper='filter' needs filter_bandwidth, a positive finite bandwidth in "
-                f"rad/s; got {filter_bandwidth!r}"
-            )
+                f"rad/s; got {filter_bandwidth!r}")
         wf = float(filter_bandwidth)
         if rel_deg > 0:
             # G_f = G * ((s + wf)/wf)^r  (so that H_f = H * (wf/(s+wf))^r)
@@ -328,16 +329,15 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
             num = np.polymul(num, lp)
     elif filter_bandwidth is not None:
         raise InversionError(
-            f"filter_bandwidth={filter_bandwidth!r} is only used with improper='filter'; got improper={improper!r}"
-        )
+            f"filter_bandwidth={filter_bandwidth!r} is only used with improper='filter'; got "
+            f"improper={improper!r}")
     r_eff = den.size - num.size
     if r_eff > 0 and improper == "error":
         raise ImproperInverseError(
             f"the model is strictly proper (relative degree {r_eff}), so its inverse is "
             "improper (it contains s^k terms); choose improper='filter' with "
             "filter_bandwidth=<rad/s> to low-pass the inverse, or improper='differentiate' "
-            "to apply the s^k terms as central finite differences"
-        )
+            "to apply the s^k terms as central finite differences")
 
     m = num.size - 1  # number of zeros of G = order of the dynamic part of H
     zeros = np.roots(num) if m > 0 else np.zeros(0, complex)
@@ -352,8 +352,7 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
                 f"(|Re| = {abs(z.real):.3g} rad/s <= {_AXIS_RTOL:g} * max(|z|, {w0:.3g})); "
                 "the inverse would have a pole there and has no bounded stable realization. "
                 "Stable inversion needs a hyperbolic model (no zeros with Re s = 0): remove or "
-                "shift that zero (e.g. a zero at s = 0 of a high-pass sensor)"
-            )
+                "shift that zero (e.g. a zero at s = 0 of a high-pass sensor)")
 
     num_sc = _scale_poly(num, w0)
     den_sc = _scale_poly(den, w0)
@@ -370,29 +369,15 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
 
     empty2, empty1 = np.zeros((0, 0)), np.zeros(0)
     if m == 0:
-        return InverseSplit(
-            num=num,
-            den=den,
-            zeros=zeros,
-            relative_degree=rel_deg,
-            improper=improper,
-            filter_bandwidth=wf,
-            feedthrough=feedthrough,
-            derivative_coefficients=deriv,
-            A_s=empty2,
-            B_s=empty1,
-            C_s=empty1,
-            A_u=empty2,
-            B_u=empty1,
-            C_u=empty1,
-            r0=math.inf,
-            auto_preview_s=0.0,
-            frequency_scale=w0,
-        )
+        return InverseSplit(num=num, den=den, zeros=zeros, relative_degree=rel_deg,
+                            improper=improper, filter_bandwidth=wf, feedthrough=feedthrough,
+                            derivative_coefficients=deriv, A_s=empty2, B_s=empty1, C_s=empty1,
+                            A_u=empty2, B_u=empty1, C_u=empty1, r0=math.inf,
+                            auto_preview_s=0.0, frequency_scale=w0)
 
     rem = np.atleast_1d(rem)
     rem_full = np.zeros(m)
-    rem_full[m - rem.size :] = rem[-m:] if rem.size > m else rem
+    rem_full[m - rem.size:] = rem[-m:] if rem.size > m else rem
     # controllable canonical form of rem(sigma)/num(sigma), num monic of degree m
     A = np.zeros((m, m))
     A[0, :] = -num_sc[1:]
@@ -409,8 +394,7 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
     if sdim != n_lhp:  # pragma: no cover - only for pathological near-axis cases
         raise NonHyperbolicModelError(
             f"cannot separate stable and unstable zeros reliably: the Schur form has {sdim} "
-            f"left half-plane eigenvalues but the zeros {zeros} have {n_lhp}"
-        )
+            f"left half-plane eigenvalues but the zeros {zeros} have {n_lhp}")
     k = sdim
     T11, T12, T22 = T[:k, :k], T[:k, k:], T[k:, k:]
     if 0 < k < m:
@@ -420,8 +404,7 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
             raise NonHyperbolicModelError(
                 f"the stable and unstable zeros {zeros} are too close to separate the "
                 f"inverse numerically (Sylvester coupling norm {xn:.3g} > "
-                f"{_MAX_SYLVESTER_NORM:g})"
-            )
+                f"{_MAX_SYLVESTER_NORM:g})")
     else:
         X = np.zeros((k, m - k))
     W = np.eye(m)
@@ -445,25 +428,11 @@ def split_inverse(model: Any, *, improper: str = "error", filter_bandwidth: floa
         auto = 4.0 / r0
     else:
         r0, auto = math.inf, 0.0
-    return InverseSplit(
-        num=num,
-        den=den,
-        zeros=zeros,
-        relative_degree=rel_deg,
-        improper=improper,
-        filter_bandwidth=wf,
-        feedthrough=feedthrough,
-        derivative_coefficients=deriv,
-        A_s=A_s,
-        B_s=B_s,
-        C_s=C_s,
-        A_u=A_u,
-        B_u=B_u,
-        C_u=C_u,
-        r0=r0,
-        auto_preview_s=auto,
-        frequency_scale=w0,
-    )
+    return InverseSplit(num=num, den=den, zeros=zeros, relative_degree=rel_deg,
+                        improper=improper, filter_bandwidth=wf, feedthrough=feedthrough,
+                        derivative_coefficients=deriv, A_s=A_s, B_s=B_s, C_s=C_s,
+                        A_u=A_u, B_u=B_u, C_u=C_u, r0=r0, auto_preview_s=auto,
+                        frequency_scale=w0)
 
 
 def _equalise(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, ...]:

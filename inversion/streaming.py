@@ -70,7 +70,7 @@ def _left_powers(row: np.ndarray, Phi: np.ndarray, count: int) -> np.ndarray:
     filled, P = 1, Phi
     while filled < count:
         m = min(filled, count - filled)
-        out[filled : filled + m] = out[:m] @ P
+        out[filled:filled + m] = out[:m] @ P
         filled += m
         P = P @ P
     return out
@@ -106,20 +106,14 @@ class StreamingInverter:
     end of the signal (zeros afterwards, as in the batch inverse) and returns the rest.
     """
 
-    def __init__(
-        self,
-        model: Any,
-        dt: float,
-        preview: Any = "auto",
-        *,
-        improper: str = "error",
-        filter_bandwidth: float | None = None,
-    ):
+    def __init__(self, model: Any, dt: float, preview: Any = "auto", *, improper: str = "error",
+                 filter_bandwidth: float | None = None):
         self.split = _as_split(model, improper, filter_bandwidth)
         self.dt = sampling_interval(dt)
         n_prev, prev_s = resolve_preview(preview, self.split, self.dt)
         if n_prev is None:
-            raise PreviewError(f"a streaming inverter needs a finite preview (seconds or 'auto'); got {preview!r}")
+            raise PreviewError(
+                f"a streaming inverter needs a finite preview (seconds or 'auto'); got {preview!r}")
         self.preview_samples: int = n_prev
         self.preview_s: float = prev_s
         self._plan = p = Plan(self.split, self.dt, n_prev)
@@ -131,24 +125,24 @@ class StreamingInverter:
         self._blocks_ok = False
         if p.anti is not None:
             N = n_prev
-            rows = _left_powers(p.anti_C, p.anti_phi, N + 1)  # C_r Phi^q
+            rows = _left_powers(p.anti_C, p.anti_phi, N + 1)        # C_r Phi^q
             taps = np.zeros(N + 1)
             taps[:N] += rows[:N] @ p.anti_alpha
             taps[1:] += rows[:N] @ p.anti_beta
             self._anti_taps = taps
             if N >= MIN_BLOCK:
                 self._blocks_ok = True
-                self._Wr = rows  # C_r Phi^q
-                self._Wa = rows @ p.anti_alpha  # C_r Phi^q alpha
-                self._Pa = _left_powers(p.anti_alpha, p.anti_phi.T, N)  # Phi^i alpha
-                self._Pb = _left_powers(p.anti_beta, p.anti_phi.T, N)  # Phi^i beta
+                self._Wr = rows                                      # C_r Phi^q
+                self._Wa = rows @ p.anti_alpha                       # C_r Phi^q alpha
+                self._Pa = _left_powers(p.anti_alpha, p.anti_phi.T, N)   # Phi^i alpha
+                self._Pb = _left_powers(p.anti_beta, p.anti_phi.T, N)    # Phi^i beta
         # one kernel for a single output: anticausal taps and the difference stencil over
         # the window u[k-h .. k+delay]
         kern = np.zeros(h + d + 1)
         if self._anti_taps is not None:
-            kern[h : h + n_prev + 1] += self._anti_taps
+            kern[h:h + n_prev + 1] += self._anti_taps
         if h:
-            kern[: 2 * h + 1] += p.kernel
+            kern[:2 * h + 1] += p.kernel
         self._kernel = kern if np.any(kern) else None
         # the stable filter for one-sample steps (transposed direct form II, as lfilter)
         self._step_ba = self._step_sos = None
@@ -194,12 +188,12 @@ class StreamingInverter:
     @property
     def _hist(self) -> np.ndarray:
         """Retained inputs (those later outputs still need), a view."""
-        return self._u[self._keep() - self._base : self._n_in - self._base]
+        return self._u[self._keep() - self._base:self._n_in - self._base]
 
     @property
     def _ys(self) -> np.ndarray:
         """Causal part of the outputs not yet emitted, a view."""
-        return self._y[self._n_out - self._base : self._n_in - self._base]
+        return self._y[self._n_out - self._base:self._n_in - self._base]
 
     def reset(self) -> None:
         """Forget all history (start a new signal)."""
@@ -213,8 +207,8 @@ class StreamingInverter:
         self._u = np.zeros(max(BUFFER, 4 * (self.delay_samples + h + 1)))
         self._y = np.zeros_like(self._u)
         st = self._plan.stable
-        self._zi = st.zi0() if st is not None else None  # lfilter/sosfilt state (array)
-        self._zl = None  # the same state as a list
+        self._zi = st.zi0() if st is not None else None    # lfilter/sosfilt state (array)
+        self._zl = None                                      # the same state as a list
         self._reset_blocks()
 
     def _reset_blocks(self) -> None:
@@ -244,14 +238,14 @@ class StreamingInverter:
         if x.size == 1:
             v = x.item()
             if not math.isfinite(v):
-                raise NonFiniteSignalError(f"the signal must be finite; sample {self._n_in} (chunk index 0) is {v!r}")
+                raise NonFiniteSignalError(
+                    f"the signal must be finite; sample {self._n_in} (chunk index 0) is {v!r}")
             return self._consume_one(v)
         x = x.ravel()
         if x.size and not np.all(np.isfinite(x)):
             i = int(np.flatnonzero(~np.isfinite(x))[0])
             raise NonFiniteSignalError(
-                f"the signal must be finite; sample {self._n_in + i} (chunk index {i}) is {x[i]!r}"
-            )
+                f"the signal must be finite; sample {self._n_in + i} (chunk index {i}) is {x[i]!r}")
         return self._consume(x)
 
     def flush(self) -> np.ndarray:
@@ -261,7 +255,7 @@ class StreamingInverter:
         end = self._n_in
         out = self._consume(np.zeros(self.delay_samples))
         self._closed = True
-        return out[: max(0, end - (self._n_out - out.size))]
+        return out[:max(0, end - (self._n_out - out.size))]
 
     # ------------------------------------------------------------------------------------
     def _room(self, count: int) -> int:
@@ -269,7 +263,7 @@ class StreamingInverter:
         pos = self._n_in - self._base
         if pos + count <= self._u.size:
             return pos
-        keep = self._keep()  # the oldest sample still needed
+        keep = self._keep()                          # the oldest sample still needed
         live = self._n_in - keep
         size = max(BUFFER, 4 * (self.delay_samples + self._plan.h + 1), 2 * (live + count))
         if size > self._u.size or size < self._u.size // 4:
@@ -277,8 +271,8 @@ class StreamingInverter:
         else:
             u, y = self._u, self._y
         s = keep - self._base
-        u[:live] = self._u[s : s + live]
-        y[:live] = self._y[s : s + live]
+        u[:live] = self._u[s:s + live]
+        y[:live] = self._y[s:s + live]
         self._u, self._y, self._base = u, y, keep
         return live
 
@@ -318,7 +312,7 @@ class StreamingInverter:
             self._reset_blocks()
         if self._kernel is not None:
             w0 = k - p.h - self._base
-            out += float(self._kernel @ self._u[w0 : w0 + self._kernel.size])
+            out += float(self._kernel @ self._u[w0:w0 + self._kernel.size])
         self._n_out = k + 1
         return np.array([out])
 
@@ -326,27 +320,27 @@ class StreamingInverter:
         p = self._plan
         if x.size:
             pos = self._room(x.size)
-            self._u[pos : pos + x.size] = x
+            self._u[pos:pos + x.size] = x
             if p.stable is not None:
                 if self._zl is not None:
                     zi = np.asarray(self._zl, float)
                     self._zi, self._zl = zi.reshape(p.stable.zi0().shape), None
-                ys, self._zi = p.stable.run(x, self._zi)  # includes D * x
+                ys, self._zi = p.stable.run(x, self._zi)   # includes D * x
             else:
                 ys = p.D * x
-            self._y[pos : pos + x.size] = ys
+            self._y[pos:pos + x.size] = ys
             self._n_in += x.size
         k_lo, k_hi = self._n_out, self._n_in - self.delay_samples
         if k_hi <= k_lo:
             return np.zeros(0)
         b = self._base
-        out = self._y[k_lo - b : k_hi - b].copy()
+        out = self._y[k_lo - b:k_hi - b].copy()
         n_out = k_hi - k_lo
         if p.h:
-            out += np.correlate(self._u[k_lo - p.h - b : k_hi + p.h - b], p.kernel, mode="valid")
+            out += np.correlate(self._u[k_lo - p.h - b:k_hi + p.h - b], p.kernel, mode="valid")
         taps = self._anti_taps
         if taps is not None:
-            seg = self._u[k_lo - b : k_hi + taps.size - 1 - b]
+            seg = self._u[k_lo - b:k_hi + taps.size - 1 - b]
             if n_out * taps.size <= KERNEL_WORK:
                 out += np.correlate(seg, taps, mode="valid")
                 self._reset_blocks()
@@ -361,7 +355,7 @@ class StreamingInverter:
     # -- the two-stack block sums ---------------------------------------------------------
     def _ur(self, lo: int, hi: int) -> np.ndarray:
         """Retained inputs [lo, hi) (lo >= 0)."""
-        return self._u[lo - self._base : hi - self._base]
+        return self._u[lo - self._base:hi - self._base]
 
     def _blocks(self, k_lo: int, k_hi: int) -> np.ndarray:
         """Anticausal outputs k_lo .. k_hi-1 from the block sums (module doc of the old
@@ -388,12 +382,13 @@ class StreamingInverter:
         """Outputs of ``nb`` complete blocks starting at the block boundary ``k``."""
         p = self._plan
         N = self.preview_samples
-        u = self._ur(k, k + (nb + 1) * N)  # blocks + the following block
-        win = np.lib.stride_tricks.sliding_window_view(u, N + 1)[: nb * N : N]  # (nb, N+1)
+        u = self._ur(k, k + (nb + 1) * N)            # blocks + the following block
+        win = np.lib.stride_tricks.sliding_window_view(u, N + 1)[: nb * N: N]  # (nb, N+1)
         o = p.anti.run_rows(np.ascontiguousarray(win[:, ::-1]))[:, ::-1]
-        S = o[:, :N] - self._Wa[N:0:-1][None, :] * win[:, N : N + 1]
-        nxt = u[N:].reshape(nb, N)  # u_{a+i}, i = 0..N-1, per block
-        terms = self._Pa[None, : N - 1, :] * nxt[:, : N - 1, None] + self._Pb[None, : N - 1, :] * nxt[:, 1:, None]
+        S = o[:, :N] - self._Wa[N:0:-1][None, :] * win[:, N:N + 1]
+        nxt = u[N:].reshape(nb, N)                  # u_{a+i}, i = 0..N-1, per block
+        terms = (self._Pa[None, :N - 1, :] * nxt[:, :N - 1, None]
+                 + self._Pb[None, :N - 1, :] * nxt[:, 1:, None])
         R = np.zeros((nb, N, terms.shape[2]))
         np.cumsum(terms, axis=1, out=R[:, 1:, :])
         tail = np.einsum("pj,bpj->bp", self._Wr[N - np.arange(N)], R)
@@ -407,10 +402,10 @@ class StreamingInverter:
         base = (k // N) * N
         a = base + N
         if self._S is None:
-            seg = self._ur(base, a + 1)  # N + 1 samples, u_a last
+            seg = self._ur(base, a + 1)                # N + 1 samples, u_a last
             o, _ = p.anti.run(seg[::-1], p.anti.zi0())
             o = o[::-1]
-            self._S = o[:N] - Wa[N:0:-1] * seg[N]  # C_r S_k = o'_k - C_r Phi^(a-k) alpha u_a
+            self._S = o[:N] - Wa[N:0:-1] * seg[N]      # C_r S_k = o'_k - C_r Phi^(a-k) alpha u_a
         P_lo, P_hi = k - base, k_end - base
         # R_p for p in [p_last, P_hi - 1]
         i0, i1 = self._p_last, P_hi - 1
@@ -420,7 +415,7 @@ class StreamingInverter:
             Rs = np.vstack((self._R, self._R + np.cumsum(terms, axis=0)))
         else:
             Rs = self._R[None, :]
-        sel = Rs[P_lo - i0 :]
+        sel = Rs[P_lo - i0:]
         ps = np.arange(P_lo, P_hi)
         tail = np.einsum("ij,ij->i", Wr[N - ps], sel)
         out = self._S[P_lo:P_hi] + tail

@@ -83,11 +83,11 @@ def mode_tip_values(lam):
     (sin λ − cos λ − e^{−λ})/(sinh λ + sin λ) without cancellation."""
     lam = np.asarray(lam, dtype=float)
     e = np.exp(-lam)
-    den = 0.5 * (1.0 - e * e) + e * np.sin(lam)  # (sinh λ + sin λ) e^{−λ}
-    one_m = e * (np.sin(lam) - np.cos(lam) - e) / den  # 1 − σ
+    den = 0.5 * (1.0 - e * e) + e * np.sin(lam)                 # (sinh λ + sin λ) e^{−λ}
+    one_m = e * (np.sin(lam) - np.cos(lam) - e) / den           # 1 − σ
     sig = 1.0 - one_m
-    hc = 0.5 * (one_m / e + (1.0 + sig) * e)  # cosh λ − σ sinh λ
-    hs = 0.5 * (one_m / e - (1.0 + sig) * e)  # sinh λ − σ cosh λ
+    hc = 0.5 * (one_m / e + (1.0 + sig) * e)                    # cosh λ − σ sinh λ
+    hs = 0.5 * (one_m / e - (1.0 + sig) * e)                    # sinh λ − σ cosh λ
     phi1 = hc - np.cos(lam) + sig * np.sin(lam)
     dphi1 = lam * (hs + np.sin(lam) + sig * np.cos(lam))
     return phi1, dphi1, sig

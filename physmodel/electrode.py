@@ -54,10 +54,10 @@ class StripTerms(NamedTuple):
     """Everything the actuator and sensor share at points s: charge terms, slice and line."""
 
     c: transport.ChargeTerms
-    frac: np.ndarray  # 1/(1 + r2 θ)
-    A: np.ndarray  # slice admittance term [S/m]
-    X: np.ndarray  # bending / collection kernel X(x)
-    xcoth: np.ndarray  # x coth x (None unless asked for)
+    frac: np.ndarray       # 1/(1 + r2 θ)
+    A: np.ndarray          # slice admittance term [S/m]
+    X: np.ndarray          # bending / collection kernel X(x)
+    xcoth: np.ndarray      # x coth x (None unless asked for)
 
 
 def strip_terms(p, s, want_xcoth: bool) -> StripTerms:

@@ -40,11 +40,9 @@ def check_finite_output(values: Mapping[str, np.ndarray], f_hz: np.ndarray, T_c:
         bad = ~np.isfinite(v)
         if bad.any():
             _, it, jf = np.nonzero(bad)
-            raise IPMCError(
-                f"{q} is not finite in double precision at frequency_hz {np.unique(f_hz[jf])[:3].tolist()} "
-                f"and temperature_c {np.unique(T_c[it])[:3].tolist()}; the model is evaluated "
-                "reliably over 1e-9–1e12 Hz"
-            )
+            raise IPMCError(f"{q} is not finite in double precision at frequency_hz {np.unique(f_hz[jf])[:3].tolist()} "
+                            f"and temperature_c {np.unique(T_c[it])[:3].tolist()}; the model is evaluated "
+                            "reliably over 1e-9–1e12 Hz")
 
 
 def check_frequencies(frequency_hz) -> np.ndarray:
@@ -56,7 +54,9 @@ def check_frequencies(frequency_hz) -> np.ndarray:
         raise IPMCError("frequency_hz is empty; expected at least one frequency [Hz]")
     bad = ~np.isfinite(f) | (f <= 0)
     if np.any(bad):
-        raise IPMCError(f"frequencies must be finite and > 0 Hz (use dc_gain() for 0 Hz); got {f[bad][:5].tolist()}")
+        raise IPMCError(
+            f"frequencies must be finite and > 0 Hz (use dc_gain() for 0 Hz); got {f[bad][:5].tolist()}"
+        )
     return f
 
 
@@ -71,15 +71,9 @@ def check_s(s) -> np.ndarray:
     return s
 
 
-def evaluate_grid(
-    state: State,
-    s: np.ndarray,
-    kernel: Kernel,
-    quantities: Sequence[str],
-    chunk_size: int = DEFAULT_CHUNK,
-    out: Mapping[str, np.ndarray] | None = None,
-    progress: Callable[[int], None] | None = None,
-) -> dict[str, np.ndarray]:
+def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Sequence[str],
+                  chunk_size: int = DEFAULT_CHUNK, out: Mapping[str, np.ndarray] | None = None,
+                  progress: Callable[[int], None] | None = None) -> dict[str, np.ndarray]:
     """Evaluate ``kernel`` on every (set, temperature, s) point; returns arrays (n_sets, n_T, n_s)."""
     if chunk_size < 1:
         raise IPMCError(f"chunk_size must be >= 1, got {chunk_size}")
@@ -92,9 +86,8 @@ def evaluate_grid(
         if out is not None and q in out:
             arr = out[q]
             if arr.shape != (n_sets, n_T, n_s) or arr.dtype != np.complex128:
-                raise IPMCError(
-                    f"out[{q!r}] must be complex128 with shape {(n_sets, n_T, n_s)}, got {arr.dtype} {arr.shape}"
-                )
+                raise IPMCError(f"out[{q!r}] must be complex128 with shape {(n_sets, n_T, n_s)}, "
+                                f"got {arr.dtype} {arr.shape}")
             results[q] = arr
         else:
             results[q] = np.empty((n_sets, n_T, n_s), dtype=complex)
@@ -210,21 +203,17 @@ class PhysicsModel:
         q = self.primary_quantity
         return self.frequency_response(frequency_hz, np.atleast_1d(temperature_c), quantities=(q,))[q][0]
 
-    def frequency_response(
-        self, frequency_hz, temperature_c, quantities=None, out=None, progress=None
-    ) -> FrequencyResponse:
+    def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
+                           progress=None) -> FrequencyResponse:
         """Frequency responses at ``frequency_hz`` [Hz] and ``temperature_c`` [°C]."""
         qs = self._check_quantities(quantities or self.quantities)
         f = check_frequencies(frequency_hz)
         T = np.atleast_1d(real_array(temperature_c, "temperature_c", "°C"))
-        with np.errstate(all="ignore"):  # overflow far outside the valid band: checked below
+        with np.errstate(all="ignore"):       # overflow far outside the valid band: checked below
             vals = evaluate_grid(self.state(T), 2j * np.pi * f, self._kernel, qs, self.chunk_size, out, progress)
         check_finite_output(vals, f, T)
         return FrequencyResponse(
-            frequency_hz=f,
-            temperature_c=T,
-            parameter_sets=tuple(p.name for p in self.params),
-            values=vals,
-            units={q: self.units[q] for q in qs},
+            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
+            values=vals, units={q: self.units[q] for q in qs},
             descriptions={q: self.descriptions[q] for q in qs},
         )

@@ -115,7 +115,7 @@ def line_kernels(x, want_xcoth: bool = True):
         xs = np.where(small, 1.0, x)
         em1 = _em1(xs)
     two_p = em1 + 2.0
-    one_p_e2 = two_p * em1  # e² + 1 = (em1 + 1)² + 1 = em1 (em1 + 2) + 2
+    one_p_e2 = two_p * em1          # e² + 1 = (em1 + 1)² + 1 = em1 (em1 + 2) + 2
     one_p_e2 += 2.0
     num = xs * two_p
     num += em1

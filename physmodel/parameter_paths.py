@@ -19,6 +19,7 @@ from .params import IPMCParameters
 Values = Mapping[str, float]
 
 
+
 # =============================================================================== physics wrapper
 _NUMERIC_FIELDS = tuple(f.name for f in fields(IPMCParameters) if f.name not in ("laws", "name", "source"))
 
@@ -29,16 +30,13 @@ def _law_target(base: IPMCParameters, name: str):
     laws = base.laws
     qnames = [f.name for f in fields(laws)]
     if len(parts) != 3 or parts[1] not in qnames:
-        raise ParameterError(
-            f"unknown temperature-law parameter {name!r}; expected 'laws.<quantity>.<attribute>' "
-            f"with quantity in {qnames}"
-        )
+        raise ParameterError(f"unknown temperature-law parameter {name!r}; expected 'laws.<quantity>.<attribute>' "
+                             f"with quantity in {qnames}")
     law = getattr(laws, parts[1])
     attrs = [f.name for f in fields(law) if f.name != "valid_c"]
     if parts[2] not in attrs:
-        raise ParameterError(
-            f"{name!r}: the law for {parts[1]} is {type(law).__name__}, whose parameters are {attrs or 'none'}"
-        )
+        raise ParameterError(f"{name!r}: the law for {parts[1]} is {type(law).__name__}, whose parameters are "
+                             f"{attrs or 'none'}")
     return parts[1], parts[2], law
 
 
@@ -47,10 +45,8 @@ def check_parameter_name(base: IPMCParameters, name: str) -> None:
     if name.startswith("laws."):
         _law_target(base, name)
     elif name != "omega_n" and name not in _NUMERIC_FIELDS:
-        raise ParameterError(
-            f"unknown parameter {name!r}; expected one of {list(_NUMERIC_FIELDS) + ['omega_n']} "
-            "or 'laws.<quantity>.<attribute>'"
-        )
+        raise ParameterError(f"unknown parameter {name!r}; expected one of {list(_NUMERIC_FIELDS) + ['omega_n']} "
+                             "or 'laws.<quantity>.<attribute>'")
 
 
 def base_value(base: IPMCParameters, name: str) -> float:

@@ -30,14 +30,8 @@ BETA1L_SQ = 1.8751040687119611**2
 
 
 def _meta(unit: str, doc: str, group: str, *, positive=True, allow_inf=False, allow_zero=False):
-    return {
-        "unit": unit,
-        "doc": doc,
-        "group": group,
-        "positive": positive,
-        "allow_inf": allow_inf,
-        "allow_zero": allow_zero,
-    }
+    return {"unit": unit, "doc": doc, "group": group, "positive": positive,
+            "allow_inf": allow_inf, "allow_zero": allow_zero}
 
 
 @dataclass(frozen=True)
@@ -56,48 +50,19 @@ class IPMCParameters:
     C_minus: float = field(metadata=_meta("mol/m^3", "fixed anion concentration C-", "material"))
     kappa_e: float = field(metadata=_meta("F/m", "effective dielectric permittivity", "material"))
     # coupling
-    alpha0: float = field(
-        metadata=_meta("J/C", "actuation coupling: stress = alpha0 * charge density", "material", positive=False)
-    )
-    a0: float = field(
-        metadata=_meta("C/J", "sensing coupling: boundary charge density = a0 * stress", "material", positive=False)
-    )
+    alpha0: float = field(metadata=_meta("J/C", "actuation coupling: stress = alpha0 * charge density", "material", positive=False))
+    a0: float = field(metadata=_meta("C/J", "sensing coupling: boundary charge density = a0 * stress", "material", positive=False))
     # electrodes
-    r1_sheet: float = field(
-        metadata=_meta(
-            "Ohm",
-            "electrode sheet resistance along the length (r1' of seed 002; r1 = r1'/W)",
-            "electrode",
-            allow_zero=True,
-        )
-    )
-    r2_specific: float = field(
-        metadata=_meta(
-            "Ohm m^2",
-            "through-thickness electrode resistance times width (r2' of seed 002; r2 = r2'/W)",
-            "electrode",
-            allow_zero=True,
-        )
-    )
-    Rp_specific: float = field(
-        metadata=_meta(
-            "Ohm m^2",
-            "polymer leakage resistance times width (Rp' of seed 002; inf = no leakage)",
-            "electrode",
-            allow_inf=True,
-        )
-    )
+    r1_sheet: float = field(metadata=_meta("Ohm", "electrode sheet resistance along the length (r1' of seed 002; r1 = r1'/W)", "electrode", allow_zero=True))
+    r2_specific: float = field(metadata=_meta("Ohm m^2", "through-thickness electrode resistance times width (r2' of seed 002; r2 = r2'/W)", "electrode", allow_zero=True))
+    Rp_specific: float = field(metadata=_meta("Ohm m^2", "polymer leakage resistance times width (Rp' of seed 002; inf = no leakage)", "electrode", allow_inf=True))
     # mechanics
     E: float = field(metadata=_meta("Pa", "Young's modulus of the composite beam", "mechanics"))
-    rho: float = field(
-        metadata=_meta("kg/m^3", "effective density setting the first mode (includes any added mass)", "mechanics")
-    )
+    rho: float = field(metadata=_meta("kg/m^3", "effective density setting the first mode (includes any added mass)", "mechanics"))
     xi: float = field(metadata=_meta("-", "damping ratio of the first bending mode", "mechanics"))
     # bookkeeping
     T_ref: float = field(default=300.0, metadata=_meta("K", "reference temperature of the values above", "state"))
-    laws: TemperatureLaws = field(
-        default_factory=TemperatureLaws, metadata={"unit": "", "doc": "temperature laws", "group": "state"}
-    )
+    laws: TemperatureLaws = field(default_factory=TemperatureLaws, metadata={"unit": "", "doc": "temperature laws", "group": "state"})
     name: str = field(default="custom", metadata={"unit": "", "doc": "name", "group": "source"})
     source: str = field(default="user", metadata={"unit": "", "doc": "where the values come from", "group": "source"})
 
@@ -210,25 +175,8 @@ def density_for_mode(omega_n, E, L, h):
 
 # ---------------------------------------------------------------------- state at temperature
 #: Names of the arrays in a :class:`State`.
-STATE_FIELDS = (
-    "L",
-    "W",
-    "h",
-    "d",
-    "C_minus",
-    "kappa_e",
-    "alpha0",
-    "a0",
-    "r1",
-    "r2",
-    "Rp",
-    "E",
-    "rho",
-    "xi",
-    "T",
-    "K",
-    "omega_n",
-)
+STATE_FIELDS = ("L", "W", "h", "d", "C_minus", "kappa_e", "alpha0", "a0", "r1", "r2", "Rp",
+                "E", "rho", "xi", "T", "K", "omega_n")
 
 
 @dataclass(frozen=True)
@@ -266,7 +214,7 @@ class State:
 
     def take(self, i_set: int, i_T: int) -> State:
         """The state of one parameter set at one temperature (arrays of shape (1, 1, 1))."""
-        return State(**{k: getattr(self, k)[i_set : i_set + 1, i_T : i_T + 1] for k in STATE_FIELDS})
+        return State(**{k: getattr(self, k)[i_set:i_set + 1, i_T:i_T + 1] for k in STATE_FIELDS})
 
 
 def as_parameter_list(params) -> list[IPMCParameters]:
@@ -308,7 +256,7 @@ def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -
         for name in LAW_PARAMETERS:
             fac[name][idx] = f[name]
     names = ("L", "W", "alpha0", "a0", "rho", "xi") + tuple(LAW_PARAMETERS)
-    table = np.array([_FIELD_GETTER(p) for p in plist], dtype=float)  # (n, len(_NUMERIC_STATE))
+    table = np.array([_FIELD_GETTER(p) for p in plist], dtype=float)          # (n, len(_NUMERIC_STATE))
     col = {name: table[:, _NUMERIC_STATE.index(name)][:, None] for name in names}
     W = col["W"]
     vals = {name: np.broadcast_to(col[name], (n, T.size)) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
@@ -336,12 +284,5 @@ def describe(p: IPMCParameters) -> str:
     return "\n".join(lines)
 
 
-__all__ = [
-    "IPMCParameters",
-    "State",
-    "state_at",
-    "first_mode_omega",
-    "density_for_mode",
-    "describe",
-    "as_parameter_list",
-]
+__all__ = ["IPMCParameters", "State", "state_at", "first_mode_omega", "density_for_mode", "describe",
+           "as_parameter_list"]

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 from .errors import ParameterError
 from .params import IPMCParameters
 
-_SEEDS = "fitted values of the seed papers as shipped in physmodel.parameter_sets (seed000_sensor, seed002_table2/3)"
+_SEEDS = ("fitted values of the seed papers as shipped in physmodel.parameter_sets (seed000_sensor, "
+          "seed002_table2/3)")
 
 
 @dataclass(frozen=True)
@@ -39,9 +40,8 @@ class PlausibleRange:
 
     def __post_init__(self):
         if not (math.isfinite(self.lower) and math.isfinite(self.upper) and 0 < self.lower < self.upper):
-            raise ParameterError(
-                f"plausible range of {self.name}: need 0 < lower < upper (finite), got [{self.lower!r}, {self.upper!r}]"
-            )
+            raise ParameterError(f"plausible range of {self.name}: need 0 < lower < upper (finite), got "
+                                 f"[{self.lower!r}, {self.upper!r}]")
 
     def contains(self, value: float) -> bool:
         return self.lower <= abs(value) <= self.upper
@@ -58,75 +58,33 @@ class PlausibleRange:
 
 
 #: Default plausible ranges per IPMCParameters field (values at T_ref).
-DEFAULT_RANGES: dict[str, PlausibleRange] = {
-    r.name: r
-    for r in (
-        PlausibleRange(
-            "d",
-            1e-13,
-            1e-9,
-            "m^2/s",
-            "cation diffusivity in hydrated Nafion is 1e-11-1e-9 m²/s (water self-diffusion ~1e-9); "
-            "Chen-Tan fits range 2e-13 (seed 000) to 3.5e-11 (seed 002); " + _SEEDS,
-        ),
-        PlausibleRange(
-            "C_minus",
-            500.0,
-            2500.0,
-            "mol/m^3",
-            "fixed-anion concentration of Nafion: EW 1100 g/mol at 1.6-2 g/cm³ hydrated/dry gives "
-            "~1000-1800 mol/m³; seeds 942-1091",
-        ),
-        PlausibleRange(
-            "kappa_e",
-            1e-7,
-            1e-4,
-            "F/m",
-            "effective dielectric permittivity of the Chen-Tan model (includes the electrode "
-            "interface area): seeds fit 4.5e-7-1.3e-6; about one decade below, two above",
-        ),
-        PlausibleRange(
-            "E",
-            3e7,
-            2e9,
-            "Pa",
-            "Young's modulus of hydrated Nafion-based IPMC strips, 50 MPa-1 GPa (seeds 154-421 MPa)",
-        ),
-        PlausibleRange(
-            "rho",
-            1000.0,
-            60000.0,
-            "kg/m^3",
-            "effective (modal) density: Nafion ~2000 kg/m³ with Pt layers, plus the hydrodynamic added "
-            "mass π ρ_f W²/4 per length in water (Sader 1998), ≈ 6× the strip's own mass for seed 002 "
-            "(W = 4 mm, 2h = 0.25 mm), whose fitted ωn implies ≈ 3.4e4 kg/m³",
-        ),
-        PlausibleRange("xi", 0.01, 1.0, "1", "first-mode damping ratio of strips in air or water (seeds 0.1-0.18)"),
-        PlausibleRange(
-            "r1_sheet",
-            0.1,
-            5e3,
-            "Ohm",
-            "electrode sheet resistance: fresh Pt a few Ω/sq, cracked/dried up to 10³ Ω "
-            "(Shahinpoor & Kim 2000, Smart Mater. Struct. 9:543); seeds 10-64 Ω",
-        ),
-        PlausibleRange(
-            "r2_specific",
-            1e-7,
-            1e-2,
-            "Ohm m^2",
-            "through-thickness/contact area resistance: Nafion 117 1.6e-5 Ω·m² (Slade et al. 2002, "
-            "J. Electrochem. Soc. 149:A1556); seeds ~1e-5",
-        ),
-        PlausibleRange(
-            "Rp_specific",
-            1e-3,
-            1e4,
-            "Ohm m^2",
-            "leakage area resistance of the polymer (seeds 0.37-0.5 Ω·m²), a few decades either way",
-        ),
-    )
-}
+DEFAULT_RANGES: dict[str, PlausibleRange] = {r.name: r for r in (
+    PlausibleRange("d", 1e-13, 1e-9, "m^2/s",
+                   "cation diffusivity in hydrated Nafion is 1e-11-1e-9 m²/s (water self-diffusion ~1e-9); "
+                   "Chen-Tan fits range 2e-13 (seed 000) to 3.5e-11 (seed 002); " + _SEEDS),
+    PlausibleRange("C_minus", 500.0, 2500.0, "mol/m^3",
+                   "fixed-anion concentration of Nafion: EW 1100 g/mol at 1.6-2 g/cm³ hydrated/dry gives "
+                   "~1000-1800 mol/m³; seeds 942-1091"),
+    PlausibleRange("kappa_e", 1e-7, 1e-4, "F/m",
+                   "effective dielectric permittivity of the Chen-Tan model (includes the electrode "
+                   "interface area): seeds fit 4.5e-7-1.3e-6; about one decade below, two above"),
+    PlausibleRange("E", 3e7, 2e9, "Pa",
+                   "Young's modulus of hydrated Nafion-based IPMC strips, 50 MPa-1 GPa (seeds 154-421 MPa)"),
+    PlausibleRange("rho", 1000.0, 60000.0, "kg/m^3",
+                   "effective (modal) density: Nafion ~2000 kg/m³ with Pt layers, plus the hydrodynamic added "
+                   "mass π ρ_f W²/4 per length in water (Sader 1998), ≈ 6× the strip's own mass for seed 002 "
+                   "(W = 4 mm, 2h = 0.25 mm), whose fitted ωn implies ≈ 3.4e4 kg/m³"),
+    PlausibleRange("xi", 0.01, 1.0, "1",
+                   "first-mode damping ratio of strips in air or water (seeds 0.1-0.18)"),
+    PlausibleRange("r1_sheet", 0.1, 5e3, "Ohm",
+                   "electrode sheet resistance: fresh Pt a few Ω/sq, cracked/dried up to 10³ Ω "
+                   "(Shahinpoor & Kim 2000, Smart Mater. Struct. 9:543); seeds 10-64 Ω"),
+    PlausibleRange("r2_specific", 1e-7, 1e-2, "Ohm m^2",
+                   "through-thickness/contact area resistance: Nafion 117 1.6e-5 Ω·m² (Slade et al. 2002, "
+                   "J. Electrochem. Soc. 149:A1556); seeds ~1e-5"),
+    PlausibleRange("Rp_specific", 1e-3, 1e4, "Ohm m^2",
+                   "leakage area resistance of the polymer (seeds 0.37-0.5 Ω·m²), a few decades either way"),
+)}
 
 
 def _omega_range(p: IPMCParameters) -> PlausibleRange:
@@ -134,18 +92,13 @@ def _omega_range(p: IPMCParameters) -> PlausibleRange:
     lam1 = 1.8751040687119611
     f = lambda E, rho: (lam1 / p.L) ** 2 * math.sqrt(E * p.h**2 / (3.0 * rho))  # noqa: E731
     E, rho = DEFAULT_RANGES["E"], DEFAULT_RANGES["rho"]
-    return PlausibleRange(
-        "omega_n",
-        f(E.lower, rho.upper),
-        f(E.upper, rho.lower),
-        "rad/s",
-        f"first clamped-free mode of this strip (L = {p.L:.3g} m, 2h = {2 * p.h:.3g} m) over the E and rho ranges",
-    )
+    return PlausibleRange("omega_n", f(E.lower, rho.upper), f(E.upper, rho.lower), "rad/s",
+                          f"first clamped-free mode of this strip (L = {p.L:.3g} m, 2h = {2 * p.h:.3g} m) over the "
+                          f"E and rho ranges")
 
 
-def plausible_ranges(
-    params: IPMCParameters, overrides: Mapping[str, PlausibleRange | tuple] | None = None
-) -> dict[str, PlausibleRange]:
+def plausible_ranges(params: IPMCParameters, overrides: Mapping[str, PlausibleRange | tuple] | None = None
+                     ) -> dict[str, PlausibleRange]:
     """Plausible ranges for the fields of ``params`` (and ``omega_n``): the defaults, replaced by
     ``overrides`` (``{name: PlausibleRange}`` or ``{name: (lower, upper)}``, user-stated)."""
     out = dict(DEFAULT_RANGES)

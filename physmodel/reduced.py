@@ -54,9 +54,9 @@ def reduced_polynomials(st, taylor_order: int = 3, include_mode: bool = True):
     g0 = h * np.sqrt(K / d)
     EI = E * 2.0 / 3.0 * W * h**3
     P = np.polynomial.polynomial  # ascending-power arithmetic
-    num_theta = W * kap * g0 * np.array([0.0, K, 1.0])  # s W κe γ0 (s + K)
-    den_theta = h * np.array([K, g0])  # h (γ0 s + K)
-    D_A = P.polyadd(den_theta, r2 * num_theta)  # h(γ0 s + K) + r2 s W κe γ0 (s + K)
+    num_theta = W * kap * g0 * np.array([0.0, K, 1.0])        # s W κe γ0 (s + K)
+    den_theta = h * np.array([K, g0])                         # h (γ0 s + K)
+    D_A = P.polyadd(den_theta, r2 * num_theta)                # h(γ0 s + K) + r2 s W κe γ0 (s + K)
     N_A = num_theta.copy()
     if np.isfinite(Rp):
         N_A = P.polyadd(N_A, (2.0 / Rp) * D_A)

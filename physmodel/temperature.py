@@ -254,12 +254,6 @@ def real_number(v, where: str) -> float:
 
 #: Every parameter constant (for isothermal studies and for the width/Taylor checks).
 ISOTHERMAL = TemperatureLaws(
-    d=Constant(),
-    E=Constant(),
-    kappa_e=Constant(),
-    Rp_specific=Constant(),
-    r1_sheet=Constant(),
-    r2_specific=Constant(),
-    C_minus=Constant(),
-    h=Constant(),
+    d=Constant(), E=Constant(), kappa_e=Constant(), Rp_specific=Constant(),
+    r1_sheet=Constant(), r2_specific=Constant(), C_minus=Constant(), h=Constant(),
 )

@@ -30,12 +30,12 @@ def gamma(s, h, d, K):
 class ChargeTerms(NamedTuple):
     """Intermediate terms of the charge dynamics, computed once per point and shared."""
 
-    u: np.ndarray  # s + K            [1/s]
-    g: np.ndarray  # γ(s)             [-]
-    sg: np.ndarray  # s γ              [1/s]
-    t: np.ndarray  # tanh γ (scalar 1.0 when Re γ > 20 everywhere)
-    gmt: np.ndarray  # γ − tanh γ       [-]
-    den: np.ndarray  # s γ + K tanh γ   [1/s]
+    u: np.ndarray      # s + K            [1/s]
+    g: np.ndarray      # γ(s)             [-]
+    sg: np.ndarray     # s γ              [1/s]
+    t: np.ndarray      # tanh γ (scalar 1.0 when Re γ > 20 everywhere)
+    gmt: np.ndarray    # γ − tanh γ       [-]
+    den: np.ndarray    # s γ + K tanh γ   [1/s]
 
 
 def _gamma_on_axis(w, K, c):
@@ -59,8 +59,8 @@ def charge_terms(s, h, d, K) -> ChargeTerms:
     u = s + K
     c = h * h / d
     if np.iscomplexobj(s) and not np.any(s.real):
-        g = _gamma_on_axis(s.imag, K, c)  # frequency responses: s = jω
-        t, gmt = tanh_and_gmt(g, min_real=np.min(np.sqrt(c * K)))  # Re γ ≥ γ0 on the axis
+        g = _gamma_on_axis(s.imag, K, c)        # frequency responses: s = jω
+        t, gmt = tanh_and_gmt(g, min_real=np.min(np.sqrt(c * K)))   # Re γ ≥ γ0 on the axis
     else:
         g = principal_sqrt(u * c)
         t, gmt = tanh_and_gmt(g)

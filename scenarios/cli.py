@@ -45,22 +45,8 @@ from .commands import (
 from .commands._common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED
 
 #: The subcommands, in the order ``ipmc --help`` lists them.
-COMMANDS = (
-    sets,
-    sweep,
-    simulate,
-    excite,
-    frf,
-    demo,
-    run,
-    study,
-    fit,
-    invert,
-    feedforward,
-    calibrate,
-    diagnose,
-    validate,
-)
+COMMANDS = (sets, sweep, simulate, excite, frf, demo, run, study, fit, invert, feedforward, calibrate, diagnose,
+            validate)
 
 
 def _version() -> str:

@@ -19,15 +19,12 @@ from .spec import load_scenario
 
 DEMO_SCENARIO = Path(__file__).with_name("demo.toml")
 #: Demo outputs copied into scenarios/figures/ for the README: {report file: figure file}.
-README_FIGURES = {
-    "surrogate_bode.png": "demo_surrogate_bode.png",
-    "inversion_2_hz_sine_at_45_c.png": "demo_tracking_45c.png",
-}
+README_FIGURES = {"surrogate_bode.png": "demo_surrogate_bode.png",
+                  "inversion_2_hz_sine_at_45_c.png": "demo_tracking_45c.png"}
 
 
-def run_demo(
-    out: Path, quiet: bool = False, quick: bool = False, update_figures: bool = False, force: bool = False
-) -> RunResult:
+def run_demo(out: Path, quiet: bool = False, quick: bool = False, update_figures: bool = False,
+             force: bool = False) -> RunResult:
     """Run the flagship scenario into ``out`` (``force``: even when it holds another run's results);
     returns the :class:`~scenarios.runner.RunResult`."""
     res = run_scenario(load_scenario(DEMO_SCENARIO, quick=quick), Path(out), quiet=quiet, force=force)

@@ -142,9 +142,8 @@ def pole_zero_locus(model, temperatures_c, path, title: str = "") -> Path:
     return _save(fig, path)
 
 
-def tracking(
-    t, reference, achieved, path, title: str = "", unit: str = "mm", labels=("reference", "achieved"), window=None
-) -> Path:
+def tracking(t, reference, achieved, path, title: str = "", unit: str = "mm",
+             labels=("reference", "achieved"), window=None) -> Path:
     """Reference and achieved signals (top) and their error (bottom); ``window`` shades the
     interval over which the error bound is taken."""
     fig, (a1, a2) = _subplots(2, 1, sharex=True, figsize=(7, 5))
@@ -197,7 +196,8 @@ def save_bode(model, data, temperature_c, path, title=None) -> None:
     _save(fig, path, dpi=110)
 
 
-def save_poles_zeros_vs_temperature(model, path, per_temperature_models=None, n_temperatures: int = 121) -> None:
+def save_poles_zeros_vs_temperature(model, path, per_temperature_models=None,
+                                    n_temperatures: int = 121) -> None:
     """Real and imaginary parts of poles and zeros [rad/s] against temperature [°C]."""
     if not model.is_scheduled:
         raise IPMCError("pole/zero-vs-temperature plots need a scheduled model")
@@ -306,22 +306,19 @@ def residual_bode(path, data, G, title: str) -> Path:
     return _save(fig, path, dpi=90)
 
 
+
+
 def diagnosis_figures(diagnosis, folder) -> list[Path]:
     """bode_before.png and bode_after.png of a :class:`~physmodel.estimation.discrepancy.Diagnosis`."""
     folder = Path(folder)
-    return [
-        residual_bode(folder / "bode_before.png", diagnosis.data, diagnosis.predicted_before, "baseline (before)"),
-        residual_bode(
-            folder / "bode_after.png",
-            diagnosis.data,
-            diagnosis.predicted_after,
-            "after: + " + (", ".join(diagnosis.final_effects) or "nothing"),
-        ),
-    ]
+    return [residual_bode(folder / "bode_before.png", diagnosis.data, diagnosis.predicted_before, "baseline (before)"),
+            residual_bode(folder / "bode_after.png", diagnosis.data, diagnosis.predicted_after,
+                          "after: + " + (", ".join(diagnosis.final_effects) or "nothing"))]
 
 
 # ---------------------------------------------------------------------------- inversion
-def inversion_traces(path: str, t, u, y, ucol: str, ref, refcol, title: str) -> Path:
+def inversion_traces(path: str, t, u, y, ucol: str,
+          ref, refcol, title: str) -> Path:
     """Input, reconstruction and (with a reference) its error against time."""
     rows = 3 if ref is not None else 2
     fig, axes = _subplots(rows, 1, sharex=True, figsize=(8, 2.4 * rows))

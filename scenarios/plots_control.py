@@ -12,18 +12,8 @@ from .plots import _save, _subplots
 __all__ = ["feedforward_check"]
 
 
-def feedforward_check(
-    t,
-    reference,
-    predicted,
-    voltage,
-    path,
-    *,
-    unit: str = "mm",
-    title: str = "",
-    max_voltage: float | None = None,
-    body=None,
-) -> Path:
+def feedforward_check(t, reference, predicted, voltage, path, *, unit: str = "mm", title: str = "",
+                      max_voltage: float | None = None, body=None) -> Path:
     """Three stacked panels over time [s]: reference and predicted tip [unit], the tracking error
     ``predicted - reference`` [unit], and the feedforward voltage [V] with ``±max_voltage``
     dashed.  ``body`` (bool mask) shades the unfaded part of the reference."""

@@ -69,9 +69,9 @@ class _Ctx:
     report: list = field(default_factory=list)
     model: object = None
     base_params: object = None
-    data: object = None  # noisy sweep (what a lab would measure)
-    exact: object = None  # noise-free physics on the same grid
-    fit: object = None  # surrogate FitResult
+    data: object = None      # noisy sweep (what a lab would measure)
+    exact: object = None     # noise-free physics on the same grid
+    fit: object = None       # surrogate FitResult
 
     def file(self, path: Path) -> Path:
         self.files.append(Path(path).relative_to(self.out).as_posix())
@@ -96,7 +96,7 @@ def _metric_value(expr: str, metrics: dict, where: str) -> float:
             raise ScenarioError(f"{where}: metric {t!r} was not produced; available: {sorted(metrics)}")
     if len(terms) == 1:
         return metrics[terms[0]]
-    with np.errstate(divide="ignore", invalid="ignore"):  # a zero denominator is a failed check (inf/NaN)
+    with np.errstate(divide="ignore", invalid="ignore"):   # a zero denominator is a failed check (inf/NaN)
         return float(np.float64(metrics[terms[0]]) / np.float64(metrics[terms[1]]))
 
 
@@ -107,17 +107,8 @@ def evaluate_checks(spec: Scenario, metrics: dict) -> list[CheckResult]:
     named = {c["metric"].strip() for c in spec.section("checks").values()}
     if "surrogate.converged" in metrics and "surrogate.converged" not in named:
         v = metrics["surrogate.converged"]
-        out.append(
-            CheckResult(
-                "surrogate_converged",
-                "surrogate.converged",
-                v,
-                1.0,
-                None,
-                "(implicit) the surrogate fit converged",
-                v >= 1,
-            )
-        )
+        out.append(CheckResult("surrogate_converged", "surrogate.converged", v, 1.0, None,
+                               "(implicit) the surrogate fit converged", v >= 1))
     for name, c in spec.section("checks").items():
         v = float(_metric_value(c["metric"], metrics, f"{spec.path}: [checks.{name}]"))
         lo, hi = c.get("min"), c.get("max")
@@ -144,7 +135,7 @@ def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:
     from physmodel.data.files import atomic_write
 
     t0 = time.perf_counter()
-    (out / "report.md").unlink(missing_ok=True)  # a stale report must not vouch for new files
+    (out / "report.md").unlink(missing_ok=True)         # a stale report must not vouch for new files
     say = (lambda *a: None) if quiet else (lambda *a: print(*a, file=sys.stderr))
     ctx = _Ctx(spec, out, say)
     _build_model(ctx)
@@ -168,51 +159,23 @@ def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:
     checks = evaluate_checks(spec, ctx.metrics)
     elapsed = time.perf_counter() - t0
     finite = lambda v: v if isinstance(v, float) and np.isfinite(v) else (None if isinstance(v, float) else v)  # noqa: E731
-    payload = {
-        "scenario": spec.name,
-        "quick": spec.quick,
-        "metrics": {k: finite(v) for k, v in ctx.metrics.items()},
-        "checks": [{k: finite(v) for k, v in c.__dict__.items()} for c in checks],
-    }
+    payload = {"scenario": spec.name, "quick": spec.quick, "metrics": {k: finite(v) for k, v in ctx.metrics.items()},
+               "checks": [{k: finite(v) for k, v in c.__dict__.items()} for c in checks]}
     ctx.file(atomic_write(out / "metrics.json", lambda fh: fh.write(json.dumps(payload, indent=2, allow_nan=False))))
     sc = spec.section("scenario")
     m = spec.section("model")
-    lines = [
-        f"# {sc.get('title', spec.name)}",
-        "",
-        sc.get("description", ""),
-        "",
-        f"Scenario `{spec.name}` ({spec.path}{', quick mode' if spec.quick else ''}); source: {sc.get('source', '-')}.",
-        "",
-        f"Model: {m['kind']} `{ctx.base_params.name}` ({ctx.base_params.source})"
-        + (f", overrides {m['params']}" if m.get("params") else "")
-        + ".",
-        "",
-        *ctx.report,
-        "## Checks",
-        "",
-        _md_table(
-            ["check", "result", "measured", "expected", "what"],
-            [
-                (
-                    c.name,
-                    "PASS" if c.passed else "FAIL",
-                    f"{c.value:.4g}",
-                    f"`{c.metric}` {c.bound_text()}",
-                    c.description,
-                )
-                for c in checks
-            ],
-        ),
-        "",
-        f"{sum(c.passed for c in checks)}/{len(checks)} checks passed; ran in {elapsed:.1f} s.",
-        "",
-        "## Files",
-        "",
-        *[f"- `{f}`" for f in ctx.files],
-        "- `report.md` (this file, written last)",
-        "",
-    ]
+    lines = [f"# {sc.get('title', spec.name)}", "",
+             sc.get("description", ""), "",
+             f"Scenario `{spec.name}` ({spec.path}{', quick mode' if spec.quick else ''}); source: "
+             f"{sc.get('source', '-')}.", "",
+             f"Model: {m['kind']} `{ctx.base_params.name}` ({ctx.base_params.source})"
+             + (f", overrides {m['params']}" if m.get("params") else "") + ".", "", *ctx.report,
+             "## Checks", "",
+             _md_table(["check", "result", "measured", "expected", "what"],
+                       [(c.name, "PASS" if c.passed else "FAIL", f"{c.value:.4g}", f"`{c.metric}` {c.bound_text()}",
+                         c.description) for c in checks]), "",
+             f"{sum(c.passed for c in checks)}/{len(checks)} checks passed; ran in {elapsed:.1f} s.", "",
+             "## Files", "", *[f"- `{f}`" for f in ctx.files], "- `report.md` (this file, written last)", ""]
     interrupts.check()
     atomic_write(out / "report.md", lambda fh: fh.write("\n".join(lines)))
     return RunResult(spec.name, out, dict(ctx.metrics), checks, list(ctx.files), elapsed)
@@ -221,10 +184,8 @@ def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:
 def summary_line(res: RunResult) -> str:
     n_ok = sum(c.passed for c in res.checks)
     failed = [c.name for c in res.checks if not c.passed]
-    return (
-        f"{res.scenario}: {n_ok}/{len(res.checks)} checks passed in {res.elapsed_s:.1f} s; report "
-        f"{res.out / 'report.md'}" + (f"; FAILED: {', '.join(failed)}" if failed else "")
-    )
+    return (f"{res.scenario}: {n_ok}/{len(res.checks)} checks passed in {res.elapsed_s:.1f} s; report "
+            f"{res.out / 'report.md'}" + (f"; FAILED: {', '.join(failed)}" if failed else ""))
 
 
 __all__ = ["CheckResult", "RunResult", "run_scenario", "evaluate_checks", "summary_line", "STEPS"]

@@ -55,17 +55,7 @@ from physmodel.errors import IPMCError
 from surrogate import FORMS
 
 #: The order in which the runner executes the step tables.
-STEP_ORDER = (
-    "sweep",
-    "surrogate",
-    "control_route",
-    "inversion",
-    "widths",
-    "taylor",
-    "blackbox",
-    "discrepancy",
-    "fixtures",
-)
+STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy", "fixtures")
 
 
 class ScenarioError(IPMCError):
@@ -94,25 +84,14 @@ NUM = _T("a finite number", _is_num, float)
 INT = _T("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool))
 STR = _T("a string", lambda v: isinstance(v, str))
 BOOL = _T("true or false", lambda v: isinstance(v, bool))
-NUMS = _T(
-    "a non-empty list of finite numbers",
-    lambda v: isinstance(v, list) and v and all(map(_is_num, v)),
-    lambda v: [float(x) for x in v],
-)
-INTS = _T(
-    "a non-empty list of integers",
-    lambda v: isinstance(v, list) and v and all(isinstance(x, int) and not isinstance(x, bool) for x in v),
-)
+NUMS = _T("a non-empty list of finite numbers", lambda v: isinstance(v, list) and v and all(map(_is_num, v)),
+          lambda v: [float(x) for x in v])
+INTS = _T("a non-empty list of integers", lambda v: isinstance(v, list) and v and all(
+    isinstance(x, int) and not isinstance(x, bool) for x in v))
 STRS = _T("a list of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v))
 NUM_OR_STR = _T("a number or a string", lambda v: _is_num(v) or isinstance(v, str))
-PAIRS = _T(
-    "a list of [n_zeros, n_poles] pairs",
-    lambda v: (
-        isinstance(v, list)
-        and v
-        and all(isinstance(p, list) and len(p) == 2 and all(isinstance(x, int) for x in p) for p in v)
-    ),
-)
+PAIRS = _T("a list of [n_zeros, n_poles] pairs", lambda v: isinstance(v, list) and v and all(
+    isinstance(p, list) and len(p) == 2 and all(isinstance(x, int) for x in p) for p in v))
 
 
 def _choice(*opts):
@@ -135,139 +114,47 @@ class _List:
 
 _SWEEP_GRID = {"fmin_hz": NUM, "fmax_hz": NUM, "points": INT}
 #: [control_route]: the physics-calibrated route vs a direct schedule (scenarios/steps_control.py).
-CONTROL_ROUTE_SCHEMA = {
-    "free": STRS,
-    "prior": _Map(NUM),
-    "starts": INT,
-    "seed": INT,
-    "dense_temperatures_c": NUMS,
-    "form": _choice(*FORMS),
-    "n_zeros": INT,
-    "n_poles": INT,
-    "degree": INT,
-    "temperature_c": NUM,
-    "frequency_hz": NUM,
-    "amplitude_mm": NUM,
-    "fs_hz": NUM,
-    "duration_s": NUM,
-    "max_voltage_v": NUM,
-    "note": STR,
-}
+CONTROL_ROUTE_SCHEMA = {"free": STRS, "prior": _Map(NUM), "starts": INT, "seed": INT, "dense_temperatures_c": NUMS,
+                        "form": _choice(*FORMS), "n_zeros": INT, "n_poles": INT,
+                        "degree": INT, "temperature_c": NUM, "frequency_hz": NUM, "amplitude_mm": NUM,
+                        "fs_hz": NUM, "duration_s": NUM, "max_voltage_v": NUM, "note": STR}
 SECTIONS = {
     "control_route": CONTROL_ROUTE_SCHEMA,
     "scenario": {"name": STR, "title": STR, "description": STR, "source": STR},
-    "model": {
-        "kind": _choice("actuator", "sensor"),
-        "set": STR,
-        "quantity": STR,
-        "kernel": _choice("boundary_charge", "reciprocal"),
-        "params": _Map(NUM),
-    },
-    "sweep": {
-        "temperatures_c": NUMS,
-        **_SWEEP_GRID,
-        "held_out_c": NUMS,
-        "plot_temperatures_c": NUMS,
-        # source = "virtual_lab": the sweep is estimated from simulated time records
-        # (scenarios/virtual_lab.py, which validates the values of these keys)
-        "source": _choice("synthetic", "virtual_lab"),
-        "excitation": _choice("multisine", "stepped"),
-        "fs_hz": NUM,
-        "period_s": NUM,
-        "periods": INT,
-        "transient_periods": INT,
-        "rms": NUM,
-        "amplitude": NUM,
-        "phases": STR,
-        "settle_s": NUM,
-        "settle_periods": NUM,
-        "min_measure_s": NUM,
-        "oversample": INT,
-        "estimator": _choice("h1", "h2"),
-        "max_std_db": NUM,
-    },
-    "noise": {
-        "kind": _choice("none", "magphase", "complex", "time"),
-        "sigma_db": NUM,
-        "sigma_deg": NUM,
-        "sigma": NUM,
-        "seed": INT,
-        # kind = "time" (virtual lab): noise and quantisation of the recorded signals [SI]
-        "output_noise_rms": NUM,
-        "input_noise_rms": NUM,
-        "output_adc_step": NUM,
-        "input_adc_step": NUM,
-        "chain": NUMS,
-        "chain_bandwidth_hz": NUM,
-    },
-    "surrogate": {
-        "form": _choice(*FORMS),
-        "n_zeros": INT,
-        "n_poles": INT,
-        "degree": INT,
-        "method": _choice("joint", "two-stage"),
-        "weighting": STR,
-    },
-    "inversion": {
-        "preview": NUM_OR_STR,
-        "fs_hz": NUM,
-        "duration_s": NUM,
-        "settle_s": NUM,
-        "end_margin_s": NUM,
-        "lead_s": NUM,
-        "ramp_s": NUM,
-        "experiments": _List(
-            {
-                "name": STR,
-                "temperature_c": NUM,
-                "stimulus": _choice("sine", "release"),
-                "amplitude_mm": NUM,
-                "frequencies_hz": NUMS,
-                "model_temperature_c": NUM,
-                "t_release_s": NUM,
-                "noise_rms": NUM,
-                "seed": INT,
-                "highpass_hz": NUM,
-                "window_s": NUMS,
-            }
-        ),
-    },
+    "model": {"kind": _choice("actuator", "sensor"), "set": STR, "quantity": STR,
+              "kernel": _choice("boundary_charge", "reciprocal"), "params": _Map(NUM)},
+    "sweep": {"temperatures_c": NUMS, **_SWEEP_GRID, "held_out_c": NUMS, "plot_temperatures_c": NUMS,
+              # source = "virtual_lab": the sweep is estimated from simulated time records
+              # (scenarios/virtual_lab.py, which validates the values of these keys)
+              "source": _choice("synthetic", "virtual_lab"), "excitation": _choice("multisine", "stepped"),
+              "fs_hz": NUM, "period_s": NUM, "periods": INT, "transient_periods": INT, "rms": NUM, "amplitude": NUM,
+              "phases": STR, "settle_s": NUM, "settle_periods": NUM, "min_measure_s": NUM, "oversample": INT,
+              "estimator": _choice("h1", "h2"), "max_std_db": NUM},
+    "noise": {"kind": _choice("none", "magphase", "complex", "time"), "sigma_db": NUM, "sigma_deg": NUM,
+              "sigma": NUM, "seed": INT,
+              # kind = "time" (virtual lab): noise and quantisation of the recorded signals [SI]
+              "output_noise_rms": NUM, "input_noise_rms": NUM, "output_adc_step": NUM, "input_adc_step": NUM,
+              "chain": NUMS, "chain_bandwidth_hz": NUM},
+    "surrogate": {"form": _choice(*FORMS), "n_zeros": INT, "n_poles": INT,
+                  "degree": INT, "method": _choice("joint", "two-stage"), "weighting": STR},
+    "inversion": {"preview": NUM_OR_STR, "fs_hz": NUM, "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM,
+                  "lead_s": NUM, "ramp_s": NUM,
+                  "experiments": _List({"name": STR, "temperature_c": NUM, "stimulus": _choice("sine", "release"),
+                                        "amplitude_mm": NUM, "frequencies_hz": NUMS, "model_temperature_c": NUM,
+                                        "t_release_s": NUM, "noise_rms": NUM, "seed": INT,
+                                        "highpass_hz": NUM, "window_s": NUMS})},
     "widths": {"widths_m": NUMS, "temperature_c": NUM, **_SWEEP_GRID},
     "taylor": {"orders": INTS, "temperature_c": NUM, **_SWEEP_GRID, "band_hz": NUMS},
     "blackbox": {"orders": PAIRS, "temperature_c": NUM},
-    "discrepancy": {
-        "effects": _Map(_Map(NUM)),
-        "free": STRS,
-        "null_draws": INT,
-        "null_refits": INT,
-        "alpha": NUM,
-        "seed": INT,
-        "laws": STR,
-        "candidate_bounds": _Map(NUMS),
-        "candidate_starts": _Map(NUM),
-        "plausible": _Map(NUMS),
-        "prior": BOOL,
-        "baseline_starts": INT,
-    },
-    "fixtures": {
-        "count": INT,
-        "seed": INT,
-        "formats": STRS,
-        "temperatures_c": NUMS,
-        **_SWEEP_GRID,
-        "step_duration_s": NUM,
-        "fs_hz": NUM,
-        "noise_rms_mm": NUM,
-    },
+    "discrepancy": {"effects": _Map(_Map(NUM)), "free": STRS, "null_draws": INT, "null_refits": INT, "alpha": NUM,
+                    "seed": INT, "laws": STR, "candidate_bounds": _Map(NUMS), "candidate_starts": _Map(NUM),
+                    "plausible": _Map(NUMS), "prior": BOOL, "baseline_starts": INT},
+    "fixtures": {"count": INT, "seed": INT, "formats": STRS, "temperatures_c": NUMS, **_SWEEP_GRID,
+                 "step_duration_s": NUM, "fs_hz": NUM, "noise_rms_mm": NUM},
     "checks": _Map({"metric": STR, "min": NUM, "max": NUM, "description": STR}),
 }
-REQUIRED = {
-    "scenario": ("name",),
-    "model": ("kind", "set"),
-    "sweep": ("temperatures_c",),
-    "checks.*": ("metric",),
-    "inversion.experiments": ("name", "temperature_c", "amplitude_mm"),
-}
+REQUIRED = {"scenario": ("name",), "model": ("kind", "set"), "sweep": ("temperatures_c",),
+            "checks.*": ("metric",), "inversion.experiments": ("name", "temperature_c", "amplitude_mm")}
 
 
 def _validate(value, schema, where: str, req_key: str):
@@ -348,10 +235,8 @@ def parse_scenario(raw: dict, where: str = "<scenario>", *, quick: bool = False)
         raise ScenarioError(f"{where}: [quick] must be a table")
     for k, v in quick_tab.items():
         if k in ("scenario", "checks", "quick") or k not in SECTIONS:
-            raise ScenarioError(
-                f"{where}: [quick.{k}] is not allowed; quick may shrink "
-                f"{sorted(set(SECTIONS) - {'scenario', 'checks'})}"
-            )
+            raise ScenarioError(f"{where}: [quick.{k}] is not allowed; quick may shrink "
+                                f"{sorted(set(SECTIONS) - {'scenario', 'checks'})}")
         if k not in data:
             raise ScenarioError(f"{where}: [quick.{k}] shrinks a table the scenario does not have")
         checked = _validate(v, SECTIONS[k], f"{where}: [quick.{k}]", k)
@@ -365,13 +250,8 @@ def parse_scenario(raw: dict, where: str = "<scenario>", *, quick: bool = False)
     for sec in ("sweep",):
         if sec in data:
             _require(data[sec], REQUIRED[sec], f"{where}: [{sec}]")
-    for dep, need in (
-        ("surrogate", "sweep"),
-        ("control_route", "sweep"),
-        ("inversion", "surrogate"),
-        ("blackbox", "sweep"),
-        ("discrepancy", "sweep"),
-    ):
+    for dep, need in (("surrogate", "sweep"), ("control_route", "sweep"), ("inversion", "surrogate"), ("blackbox", "sweep"),
+                      ("discrepancy", "sweep")):
         if dep in data and need not in data:
             raise ScenarioError(f"{where}: [{dep}] needs a [{need}] table")
     if "inversion" in data and not data["inversion"].get("experiments"):
@@ -382,10 +262,8 @@ def parse_scenario(raw: dict, where: str = "<scenario>", *, quick: bool = False)
         for term in chk["metric"].split("/"):
             sec = term.strip().split(".")[0]
             if sec not in data or sec not in STEP_ORDER:
-                raise ScenarioError(
-                    f"{where}: [checks.{name}] metric {term.strip()!r} refers to [{sec}], "
-                    f"which this scenario does not run (steps: {[s for s in STEP_ORDER if s in data]})"
-                )
+                raise ScenarioError(f"{where}: [checks.{name}] metric {term.strip()!r} refers to [{sec}], "
+                                    f"which this scenario does not run (steps: {[s for s in STEP_ORDER if s in data]})")
     _check_values(data, where)
     return Scenario(data["scenario"]["name"], where, data, quick)
 
@@ -409,13 +287,8 @@ def _check_values(data: dict, where: str) -> None:
         lo, hi, n = cfg.get("fmin_hz", 1.0), cfg.get("fmax_hz", math.inf), cfg.get("points", 2)
         need(lo > 0, sec, "fmin_hz", lo, "> 0 Hz")
         need(hi > lo, sec, "fmax_hz", cfg.get("fmax_hz"), f"> fmin_hz ({lo:g} Hz)")
-        need(
-            2 <= n <= MAX_SWEEP_LINES // max(n_temps, 1),
-            sec,
-            "points",
-            n,
-            f"2 to {MAX_SWEEP_LINES // max(n_temps, 1)} (at most {MAX_SWEEP_LINES} lines over {n_temps} temperature(s))",
-        )
+        need(2 <= n <= MAX_SWEEP_LINES // max(n_temps, 1), sec, "points", n,
+             f"2 to {MAX_SWEEP_LINES // max(n_temps, 1)} (at most {MAX_SWEEP_LINES} lines over {n_temps} temperature(s))")
 
     def temps(sec, key, values):
         for t in values if isinstance(values, list) else [values]:
@@ -428,20 +301,9 @@ def _check_values(data: dict, where: str) -> None:
                 temps("sweep", key, sw[key])
         grid("sweep", sw, len(sw["temperatures_c"]))
         missing = [t for t in sw.get("held_out_c", []) if t not in sw["temperatures_c"]]
-        need(
-            not missing,
-            "sweep",
-            "held_out_c",
-            sw.get("held_out_c"),
-            f"temperatures from temperatures_c {sw['temperatures_c']}",
-        )
-        need(
-            len(set(sw["temperatures_c"]) - set(sw.get("held_out_c", []))) >= 1,
-            "sweep",
-            "held_out_c",
-            sw.get("held_out_c"),
-            "at least one temperature left to fit",
-        )
+        need(not missing, "sweep", "held_out_c", sw.get("held_out_c"), f"temperatures from temperatures_c {sw['temperatures_c']}")
+        need(len(set(sw["temperatures_c"]) - set(sw.get("held_out_c", []))) >= 1, "sweep", "held_out_c",
+             sw.get("held_out_c"), "at least one temperature left to fit")
     nz = data.get("noise", {})
     for key in ("sigma_db", "sigma_deg", "sigma"):
         if key in nz:
@@ -455,25 +317,14 @@ def _check_values(data: dict, where: str) -> None:
         need(sg.get("n_zeros", 3) >= 0, "surrogate", "n_zeros", sg.get("n_zeros"), ">= 0")
         need(sg.get("n_poles", 3) >= 1, "surrogate", "n_poles", sg.get("n_poles"), ">= 1")
         need(sg.get("degree", 2) >= 0, "surrogate", "degree", sg.get("degree"), ">= 0 (polynomial degree in T)")
-        need(
-            sg.get("weighting", "auto") in WEIGHTINGS,
-            "surrogate",
-            "weighting",
-            sg.get("weighting"),
-            f"one of {list(WEIGHTINGS)}",
-        )
+        need(sg.get("weighting", "auto") in WEIGHTINGS, "surrogate", "weighting", sg.get("weighting"), f"one of {list(WEIGHTINGS)}")
     if "inversion" in data:
         inv = data["inversion"]
         fs, dur = inv.get("fs_hz", 1000.0), inv.get("duration_s", 8.0)
         need(fs > 0, "inversion", "fs_hz", fs, "> 0 Hz")
         need(dur > 0, "inversion", "duration_s", dur, "> 0 s")
-        need(
-            dur * fs <= MAX_TIME_SAMPLES,
-            "inversion",
-            "duration_s",
-            dur,
-            f"at most {MAX_TIME_SAMPLES} samples at fs_hz = {fs:g} (duration_s × fs_hz = {dur * fs:.3g})",
-        )
+        need(dur * fs <= MAX_TIME_SAMPLES, "inversion", "duration_s", dur,
+             f"at most {MAX_TIME_SAMPLES} samples at fs_hz = {fs:g} (duration_s × fs_hz = {dur * fs:.3g})")
         for key in ("settle_s", "end_margin_s", "lead_s", "ramp_s"):
             if key in inv:
                 need(0 <= inv[key] < dur, "inversion", key, inv[key], f"in [0, duration_s = {dur:g}) s")
@@ -489,34 +340,17 @@ def _check_values(data: dict, where: str) -> None:
             if "model_temperature_c" in exp:
                 temps(sec, "model_temperature_c", exp["model_temperature_c"])
             for fr in exp.get("frequencies_hz", []):
-                need(
-                    0 < fr < fs / 2,
-                    sec,
-                    "frequencies_hz",
-                    exp["frequencies_hz"],
-                    f"in (0, {fs / 2:g}) Hz, below the Nyquist frequency of fs_hz = {fs:g}",
-                )
+                need(0 < fr < fs / 2, sec, "frequencies_hz", exp["frequencies_hz"],
+                     f"in (0, {fs / 2:g}) Hz, below the Nyquist frequency of fs_hz = {fs:g}")
             if "t_release_s" in exp:
-                need(
-                    0 < exp["t_release_s"] < dur,
-                    sec,
-                    "t_release_s",
-                    exp["t_release_s"],
-                    f"in (0, duration_s = {dur:g}) s",
-                )
+                need(0 < exp["t_release_s"] < dur, sec, "t_release_s", exp["t_release_s"], f"in (0, duration_s = {dur:g}) s")
             if "noise_rms" in exp:
                 need(exp["noise_rms"] >= 0, sec, "noise_rms", exp["noise_rms"], ">= 0")
             if "highpass_hz" in exp:
                 need(0 < exp["highpass_hz"] < fs / 2, sec, "highpass_hz", exp["highpass_hz"], f"in (0, {fs / 2:g}) Hz")
             if "window_s" in exp:
                 w = exp["window_s"]
-                need(
-                    len(w) == 2 and 0 <= w[0] < w[1] <= dur,
-                    sec,
-                    "window_s",
-                    w,
-                    f"[t0, t1] with 0 <= t0 < t1 <= {dur:g} s",
-                )
+                need(len(w) == 2 and 0 <= w[0] < w[1] <= dur, sec, "window_s", w, f"[t0, t1] with 0 <= t0 < t1 <= {dur:g} s")
             if "seed" in exp:
                 need(exp["seed"] >= 0, sec, "seed", exp["seed"], "a non-negative integer")
     if "widths" in data:
@@ -529,13 +363,7 @@ def _check_values(data: dict, where: str) -> None:
         grid("taylor", t)
     if "blackbox" in data:
         for nzb, npb in data["blackbox"]["orders"]:
-            need(
-                nzb >= 0 and npb >= 1,
-                "blackbox",
-                "orders",
-                data["blackbox"]["orders"],
-                "[n_zeros >= 0, n_poles >= 1] pairs",
-            )
+            need(nzb >= 0 and npb >= 1, "blackbox", "orders", data["blackbox"]["orders"], "[n_zeros >= 0, n_poles >= 1] pairs")
     if "fixtures" in data:
         fx = data["fixtures"]
         need(1 <= fx.get("count", 3) <= MAX_FIXTURES, "fixtures", "count", fx.get("count"), f"1 to {MAX_FIXTURES}")
@@ -543,13 +371,8 @@ def _check_values(data: dict, where: str) -> None:
         grid("fixtures", fx, len(fx.get("temperatures_c", [25.0])))
         fs, dur = fx.get("fs_hz", 500.0), fx.get("step_duration_s", 1.0)
         need(fs > 0, "fixtures", "fs_hz", fs, "> 0 Hz")
-        need(
-            0 < dur and dur * fs <= MAX_TIME_SAMPLES,
-            "fixtures",
-            "step_duration_s",
-            dur,
-            f"> 0 s and at most {MAX_TIME_SAMPLES} samples at fs_hz = {fs:g}",
-        )
+        need(0 < dur and dur * fs <= MAX_TIME_SAMPLES, "fixtures", "step_duration_s", dur,
+             f"> 0 s and at most {MAX_TIME_SAMPLES} samples at fs_hz = {fs:g}")
         if "seed" in fx:
             need(fx["seed"] >= 0, "fixtures", "seed", fx["seed"], "a non-negative integer")
         if "noise_rms_mm" in fx:

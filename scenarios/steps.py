@@ -101,7 +101,7 @@ def step_sweep(ctx: _Ctx):
         ctx.metric("sweep.median_std_db", float(np.median(ctx.data.magnitude_std_db)))
     else:
         if ctx.spec.section("noise").get("kind") == "time":
-            raise ScenarioError(f'{ctx.spec.path}: [noise] kind = "time" needs [sweep] source = "virtual_lab"')
+            raise ScenarioError(f"{ctx.spec.path}: [noise] kind = \"time\" needs [sweep] source = \"virtual_lab\"")
         f = _grid(cfg, 0.1, 100.0, 40)
         noise, seed = _noise(ctx)
         ctx.exact = synthesize_sweep(ctx.model, q, f, temps)
@@ -110,20 +110,14 @@ def step_sweep(ctx: _Ctx):
     ctx.file(ctx.data.to_npz(ctx.out / "data" / "sweep.npz"))
     ctx.file(ctx.exact.to_csv(ctx.out / "data" / "sweep_exact.csv"))
     shown = cfg.get("plot_temperatures_c", temps)
-    ctx.file(
-        plots.bode(
-            [_subset(ctx.data, shown), _subset(ctx.exact, shown)],
-            ctx.out / "bode.png",
-            labels=["data", "physics"],
-            styles=["o", "-"],
-            title=f"{ctx.base_params.name}: {ctx.exact.metadata['description']}",
-        )
-    )
+    ctx.file(plots.bode([_subset(ctx.data, shown), _subset(ctx.exact, shown)], ctx.out / "bode.png",
+                        labels=["data", "physics"], styles=["o", "-"],
+                        title=f"{ctx.base_params.name}: {ctx.exact.metadata['description']}"))
     f0, T, H = ctx.exact.grid()
     cold, hot = np.abs(H[0]), np.abs(H[-1])
     ddb = 20 * np.log10(cold / hot)
     k = int(np.argmax(np.abs(ddb)))
-    fd = np.geomspace(f0[0], f0[-1], 4000)  # resonance from the physics on a dense grid
+    fd = np.geomspace(f0[0], f0[-1], 4000)             # resonance from the physics on a dense grid
     Hd = ctx.model.frequency_response(fd, [T[0], T[-1]], quantities=(q,))[q][0]
     pk = [_resonance_hz(fd, h) for h in Hd]
     ctx.metric("sweep.lines", ctx.data.frequency_hz.size)
@@ -133,19 +127,13 @@ def step_sweep(ctx: _Ctx):
     ctx.metric("sweep.gain_ratio_hot_cold_at_fmax", hot[-1] / cold[-1])
     ctx.metric("sweep.peak_frequency_shift_hz", pk[1] - pk[0])
     ctx.metric("sweep.peak_frequency_hz", pk[0])
-    ctx.section(
-        "Frequency sweeps",
-        f"{len(temps)} temperatures × {f.size} log-spaced lines, {f[0]:g}–{f[-1]:g} Hz, "
-        f"{ctx.data.output_unit}/{ctx.data.input_unit}; noise: {ctx.data.metadata.get('noise', 'none')}"
-        f" (seed {ctx.data.metadata.get('seed', '-')}).",
-        "",
-        "![Bode](bode.png)",
-        "",
-        f"Largest magnitude difference between {T[0]:g} °C and {T[-1]:g} °C: {ddb[k]:+.2f} dB at "
-        f"{f0[k]:.3g} Hz (cold minus hot); resonance peak moves from {pk[0]:.3g} Hz to {pk[1]:.3g} Hz."
-        if T.size > 1
-        else f"Resonance peak at {pk[0]:.3g} Hz.",
-    )
+    ctx.section("Frequency sweeps",
+                f"{len(temps)} temperatures × {f.size} log-spaced lines, {f[0]:g}–{f[-1]:g} Hz, "
+                f"{ctx.data.output_unit}/{ctx.data.input_unit}; noise: {ctx.data.metadata.get('noise', 'none')}"
+                f" (seed {ctx.data.metadata.get('seed', '-')}).", "", "![Bode](bode.png)", "",
+                f"Largest magnitude difference between {T[0]:g} °C and {T[-1]:g} °C: {ddb[k]:+.2f} dB at "
+                f"{f0[k]:.3g} Hz (cold minus hot); resonance peak moves from {pk[0]:.3g} Hz to {pk[1]:.3g} Hz."
+                if T.size > 1 else f"Resonance peak at {pk[0]:.3g} Hz.")
 
 
 def step_surrogate(ctx: _Ctx):
@@ -163,10 +151,9 @@ def step_surrogate(ctx: _Ctx):
     kw = {k: cfg[k] for k in ("method", "weighting") if k in cfg}
     try:
         fit = fit_sweep(train, nz, npo, cfg.get("degree", 2), form=cfg.get("form", "zpk"), raise_on_failure=False, **kw)
-    except ValueError as exc:  # the surrogate package refuses an order/degree the data cannot carry
-        raise ScenarioError(
-            f"{ctx.spec.path}: [surrogate] n_zeros={nz}, n_poles={npo}, degree={cfg.get('degree', 2)}: {exc}"
-        ) from None
+    except ValueError as exc:        # the surrogate package refuses an order/degree the data cannot carry
+        raise ScenarioError(f"{ctx.spec.path}: [surrogate] n_zeros={nz}, n_poles={npo}, degree={cfg.get('degree', 2)}: "
+                            f"{exc}") from None
     ctx.fit = fit
     model = fit.model
     model.to_json(ctx.out / "surrogate.json")
@@ -193,37 +180,20 @@ def step_surrogate(ctx: _Ctx):
     resp = model.frequency_response(ctx.data.frequency_hz, ctx.data.temperature_c, extrapolate=True)
     sur = replace(ctx.data, response=resp, magnitude_std_db=None, phase_std_deg=None)
     shown = ctx.spec.section("sweep").get("plot_temperatures_c", list(ctx.data.temperatures()))
-    ctx.file(
-        plots.bode(
-            [_subset(ctx.data, shown), _subset(sur, shown)],
-            ctx.out / "surrogate_bode.png",
-            labels=["data", "surrogate"],
-            styles=["o", "-"],
-            title=f"{cfg.get('form', 'zpk')} {nz}/{npo} surrogate, degree {cfg.get('degree', 2)} in T",
-        )
-    )
-    ctx.file(
-        plots.pole_zero_locus(
-            model, grid, ctx.out / "pole_zero_locus.png", title=f"surrogate poles (x) and zeros (o), {lo:g}–{hi:g} °C"
-        )
-    )
-    ctx.section(
-        "Temperature-scheduled surrogate",
-        f"{cfg.get('form', 'zpk')} form, {nz} zeros / {npo} poles, degree {cfg.get('degree', 2)} in T, "
-        f"{fit.method} fit on {train.temperatures().size} temperatures "
-        f"({'converged' if fit.converged else 'NOT CONVERGED: ' + str(fit.status)}); model in `surrogate.json`.",
-        "",
-        "![surrogate Bode](surrogate_bode.png)",
-        "",
-        "![pole/zero locus](pole_zero_locus.png)",
-        "",
-        "Relative RMS error sqrt(mean |G/P − 1|²) against the noise-free physics P:",
-        "",
-        _md_table(["T [°C]", "role", "rel. RMS error"], rows),
-        "",
-        f"Right-half-plane zeros over {lo:g}–{hi:g} °C: {min(n_rhp)}–{max(n_rhp)}; "
-        f"largest pole real part {stab.max_pole_real_part_rad_s:.3g} rad/s.",
-    )
+    ctx.file(plots.bode([_subset(ctx.data, shown), _subset(sur, shown)], ctx.out / "surrogate_bode.png",
+                        labels=["data", "surrogate"], styles=["o", "-"],
+                        title=f"{cfg.get('form', 'zpk')} {nz}/{npo} surrogate, degree {cfg.get('degree', 2)} in T"))
+    ctx.file(plots.pole_zero_locus(model, grid, ctx.out / "pole_zero_locus.png",
+                                   title=f"surrogate poles (x) and zeros (o), {lo:g}–{hi:g} °C"))
+    ctx.section("Temperature-scheduled surrogate",
+                f"{cfg.get('form', 'zpk')} form, {nz} zeros / {npo} poles, degree {cfg.get('degree', 2)} in T, "
+                f"{fit.method} fit on {train.temperatures().size} temperatures "
+                f"({'converged' if fit.converged else 'NOT CONVERGED: ' + str(fit.status)}); model in `surrogate.json`.",
+                "", "![surrogate Bode](surrogate_bode.png)", "", "![pole/zero locus](pole_zero_locus.png)", "",
+                "Relative RMS error sqrt(mean |G/P − 1|²) against the noise-free physics P:", "",
+                _md_table(["T [°C]", "role", "rel. RMS error"], rows), "",
+                f"Right-half-plane zeros over {lo:g}–{hi:g} °C: {min(n_rhp)}–{max(n_rhp)}; "
+                f"largest pole real part {stab.max_pole_real_part_rad_s:.3g} rad/s.")
 
 
 def _plant_response(ctx: _Ctx, f_hz: float, T: float) -> complex:
@@ -255,9 +225,8 @@ def step_inversion(ctx: _Ctx):
     lead, ramp = cfg.get("lead_s", 0.0), cfg.get("ramp_s", 0.0)
     preview = cfg.get("preview", "inf")
     if isinstance(preview, str) and preview not in ("inf", "auto", "4/r0"):
-        raise ScenarioError(
-            f"{ctx.spec.path}: [inversion] preview must be 'inf', 'auto', '4/r0' or seconds, got {preview!r}"
-        )
+        raise ScenarioError(f"{ctx.spec.path}: [inversion] preview must be 'inf', 'auto', '4/r0' or seconds, "
+                            f"got {preview!r}")
     if not settle < dur - margin:
         raise ScenarioError(f"{ctx.spec.path}: [inversion] settle_s={settle} leaves no error window in {dur} s")
     is_act = ctx.spec.section("model")["kind"] == "actuator"
@@ -273,14 +242,14 @@ def step_inversion(ctx: _Ctx):
         if is_act:
             if stim != "sine":
                 raise ScenarioError(f"{ctx.spec.path}: experiment {exp['name']!r}: actuators track sines only")
-            ref = _stimulus(exp, t, lead, ramp)  # mm
-            u = feedforward(G, t, ref, preview=preview).output  # V
-            got = simulate(ctx.model, T, t, u).output * 1e3  # m -> mm
+            ref = _stimulus(exp, t, lead, ramp)                               # mm
+            u = feedforward(G, t, ref, preview=preview).output                # V
+            got = simulate(ctx.model, T, t, u).output * 1e3                    # m -> mm
             labels = ("reference", "tip displacement (physics plant)")
         else:
             if stim == "release":
                 ts = free_release(ctx.model, T, exp["amplitude_mm"] * 1e-3, exp.get("t_release_s", dur / 2), dur, fs)
-                ref, cur = ts.input * 1e3, ts.output * 1e6  # mm, uA
+                ref, cur = ts.input * 1e3, ts.output * 1e6                    # mm, uA
             else:
                 ref = _stimulus(exp, t, lead, ramp)
                 cur = simulate(ctx.model, T, t, ref * 1e-3).output * 1e6
@@ -288,7 +257,7 @@ def step_inversion(ctx: _Ctx):
                 if "seed" not in exp:
                     raise ScenarioError(f"experiment {exp['name']!r}: noise_rms needs a seed")
                 cur = cur + exp["noise_rms"] * np.random.default_rng(exp["seed"]).standard_normal(t.size)
-            got = decode_sensor(G, t, cur, preview=preview).output  # mm
+            got = decode_sensor(G, t, cur, preview=preview).output          # mm
             labels = ("tip displacement", "decoded from current")
         w_lo, w_hi = exp.get("window_s", [settle, t[-1] - margin])
         win = (t >= w_lo) & (t <= w_hi)
@@ -313,32 +282,14 @@ def step_inversion(ctx: _Ctx):
         png = f"inversion_{_slug(exp['name'])}.png"
         if "highpass_hz" in exp:
             labels = tuple(f"{lab}, high-passed at {exp['highpass_hz']:g} Hz" for lab in labels)
-        ctx.file(
-            plots.tracking(
-                t,
-                ref,
-                got,
-                ctx.out / png,
-                labels=labels,
-                window=(w_lo, w_hi),
-                title=f"{exp['name']}: physics at {T:g} °C, surrogate at {Tm:g} °C",
-            )
-        )
-        rows.append(
-            (exp["name"], f"{T:g}", f"{Tm:g}", f"{emax:.4f}", f"{emax / exp['amplitude_mm']:.3f}", f"![]({png})")
-        )
-    what = (
-        "feedforward (desired tip displacement → voltage) applied to the physics plant"
-        if is_act
-        else "sensor decoding (short-circuit current → tip displacement) of the physics sensor's output"
-    )
-    ctx.section(
-        "Stable inversion",
-        f"{what}; preview {preview}; {fs:g} Hz, {dur:g} s records; error bound = "
-        f"max |error| over {settle:g}–{t[-1] - margin:g} s unless the experiment sets its own window (shaded).",
-        "",
-        _md_table(["experiment", "plant T [°C]", "model T [°C]", "max |error| [mm]", "relative", "traces"], rows),
-    )
+        ctx.file(plots.tracking(t, ref, got, ctx.out / png, labels=labels, window=(w_lo, w_hi),
+                                title=f"{exp['name']}: physics at {T:g} °C, surrogate at {Tm:g} °C"))
+        rows.append((exp["name"], f"{T:g}", f"{Tm:g}", f"{emax:.4f}", f"{emax / exp['amplitude_mm']:.3f}", f"![]({png})"))
+    what = "feedforward (desired tip displacement → voltage) applied to the physics plant" if is_act else \
+        "sensor decoding (short-circuit current → tip displacement) of the physics sensor's output"
+    ctx.section("Stable inversion", f"{what}; preview {preview}; {fs:g} Hz, {dur:g} s records; error bound = "
+                f"max |error| over {settle:g}–{t[-1] - margin:g} s unless the experiment sets its own window (shaded).", "",
+                _md_table(["experiment", "plant T [°C]", "model T [°C]", "max |error| [mm]", "relative", "traces"], rows))
 
 
 def step_widths(ctx: _Ctx):
@@ -353,23 +304,11 @@ def step_widths(ctx: _Ctx):
     M = ActuatorModel([ctx.base_params.replace(W=w) for w in widths]).frequency_response(f, [T])["M"][:, 0]
     dev = float(np.max(np.abs(M / M[0] - 1)))
     ctx.metric("widths.max_rel_change", dev)
-    ctx.file(
-        plots.curves(
-            f,
-            {f"W = {w * 1e3:g} mm": 20 * np.log10(np.abs(m) * 1e3) for w, m in zip(widths, M)},
-            ctx.out / "widths.png",
-            "frequency [Hz]",
-            "magnitude [dB mm/V]",
-            f"width study at {T:g} °C",
-        )
-    )
-    ctx.section(
-        "Width study",
-        f"Physics model at widths {[w * 1e3 for w in widths]} mm, {T:g} °C: largest relative "
-        f"change of M(jω) {dev:.1e} (the model is width-independent; measured strips are not).",
-        "",
-        "![widths](widths.png)",
-    )
+    ctx.file(plots.curves(f, {f"W = {w * 1e3:g} mm": 20 * np.log10(np.abs(m) * 1e3) for w, m in zip(widths, M)},
+                          ctx.out / "widths.png", "frequency [Hz]", "magnitude [dB mm/V]", f"width study at {T:g} °C"))
+    ctx.section("Width study", f"Physics model at widths {[w * 1e3 for w in widths]} mm, {T:g} °C: largest relative "
+                f"change of M(jω) {dev:.1e} (the model is width-independent; measured strips are not).", "",
+                "![widths](widths.png)")
 
 
 def step_taylor(ctx: _Ctx):
@@ -392,22 +331,10 @@ def step_taylor(ctx: _Ctx):
         curves[f"Taylor order {k}"] = 20 * np.log10(np.abs(red) * 1e3)
         e = ctx.metric(f"taylor.order_{k}_max_db_error", np.max(np.abs(20 * np.log10(np.abs(red / ex)))[band]))
         rows.append((k, f"{e:.3f}"))
-    ctx.file(
-        plots.curves(
-            f,
-            curves,
-            ctx.out / "taylor_orders.png",
-            "frequency [Hz]",
-            "magnitude [dB mm/V]",
-            f"reduced (Taylor) models around the first mode, {T:g} °C",
-        )
-    )
-    ctx.section(
-        "Reduced (Taylor) models",
-        "![Taylor orders](taylor_orders.png)",
-        "",
-        _md_table(["Taylor order", f"max |error| {lo:g}–{hi:g} Hz [dB]"], rows),
-    )
+    ctx.file(plots.curves(f, curves, ctx.out / "taylor_orders.png", "frequency [Hz]", "magnitude [dB mm/V]",
+                          f"reduced (Taylor) models around the first mode, {T:g} °C"))
+    ctx.section("Reduced (Taylor) models", "![Taylor orders](taylor_orders.png)", "",
+                _md_table(["Taylor order", f"max |error| {lo:g}–{hi:g} Hz [dB]"], rows))
 
 
 def step_blackbox(ctx: _Ctx):
@@ -429,24 +356,11 @@ def step_blackbox(ctx: _Ctx):
         ctx.metric(f"blackbox.z{nz}_p{npo}.converged", r.converged)
         curves[f"{nz} zeros / {npo} poles"] = 20 * np.log10(np.abs(g))
         rows.append((nz, npo, f"{fp:.2f}", "yes" if r.converged else "NO"))
-    ctx.file(
-        plots.curves(
-            sw.frequency_hz,
-            curves,
-            ctx.out / "blackbox.png",
-            "frequency [Hz]",
-            f"magnitude [dB {sw.output_unit}/{sw.input_unit}]",
-            f"black-box fits at {T:g} °C",
-        )
-    )
-    ctx.section(
-        "Black-box orders",
-        f"fit = 100 (1 − NRMSE) on the sweep at {T:g} °C.",
-        "",
-        _md_table(["zeros", "poles", "fit [%]", "converged"], rows),
-        "",
-        "![black-box fits](blackbox.png)",
-    )
+    ctx.file(plots.curves(sw.frequency_hz, curves, ctx.out / "blackbox.png", "frequency [Hz]",
+                          f"magnitude [dB {sw.output_unit}/{sw.input_unit}]", f"black-box fits at {T:g} °C"))
+    ctx.section("Black-box orders", "fit = 100 (1 − NRMSE) on the sweep at "
+                f"{T:g} °C.", "", _md_table(["zeros", "poles", "fit [%]", "converged"], rows), "",
+                "![black-box fits](blackbox.png)")
 
 
 def step_discrepancy(ctx: _Ctx):
@@ -467,12 +381,9 @@ def step_discrepancy(ctx: _Ctx):
     f = ctx.data.frequency_hz[ctx.data.temperature_c == ctx.data.temperatures()[0]]
     data = synthesize_sweep(truth, q, f, list(ctx.data.temperatures()), noise, seed)
     ctx.file(data.to_csv(ctx.out / "data" / "discrepancy_sweep.csv"))
-    kw = {
-        k: cfg[k]
-        for k in ("null_draws", "null_refits", "alpha", "seed", "laws", "candidate_starts", "prior", "baseline_starts")
-        if k in cfg
-    }
-    for key in ("candidate_bounds", "plausible"):  # NAME = [LOWER, UPPER]
+    kw = {k: cfg[k] for k in ("null_draws", "null_refits", "alpha", "seed", "laws", "candidate_starts", "prior",
+                              "baseline_starts") if k in cfg}
+    for key in ("candidate_bounds", "plausible"):          # NAME = [LOWER, UPPER]
         if key in cfg:
             bad = [n for n, v in cfg[key].items() if len(v) != 2]
             if bad:
@@ -496,27 +407,19 @@ def step_discrepancy(ctx: _Ctx):
 
     ctx.metric("discrepancy.gap_shrink", gap_shrink(diag))
     fitted = diag.named_effect() or {}
-    for eff, params in effects.items():  # the known synthetic truth as oracle
+    for eff, params in effects.items():                  # the known synthetic truth as oracle
         for par, true in params.items():
             got = fitted.get(eff, {}).get(par)
             if got is not None and true != 0:
                 ctx.metric(f"discrepancy.{eff}.{par}.rel_error", abs(got["value"] / true - 1))
                 lo, hi = got["ci95"]
                 ctx.metric(f"discrepancy.{eff}.{par}.truth_in_ci95", lo <= true <= hi)
-    ctx.section(
-        "Discrepancy demo",
-        f"Hidden effect(s) in the synthetic data: {hidden} "
-        f"({effects}); diagnosis against the plain `{ctx.base_params.name}` model: **{diag.verdict}**, "
-        f"named {named}. {diag.message}",
-        "",
-        "Before (baseline model) and after (with the named effect fitted):",
-        "",
-        "![before](discrepancy/bode_before.png)",
-        "",
-        "![after](discrepancy/bode_after.png)",
-        "",
-        "Full diagnosis: `discrepancy/summary.md`, `discrepancy/report.json`.",
-    )
+    ctx.section("Discrepancy demo", f"Hidden effect(s) in the synthetic data: {hidden} "
+                f"({effects}); diagnosis against the plain `{ctx.base_params.name}` model: **{diag.verdict}**, "
+                f"named {named}. {diag.message}", "",
+                "Before (baseline model) and after (with the named effect fitted):", "",
+                "![before](discrepancy/bode_before.png)", "", "![after](discrepancy/bode_after.png)", "",
+                "Full diagnosis: `discrepancy/summary.md`, `discrepancy/report.json`.")
 
 
 def step_fixtures(ctx: _Ctx):
@@ -539,11 +442,8 @@ def step_fixtures(ctx: _Ctx):
     manifest, worst = [], 0.0
 
     def make(i):
-        return (
-            synthesize_sweep(ctx.model, q, f, temps, noise, seeds[i])
-            if noise
-            else synthesize_sweep(ctx.model, q, f, temps)
-        )
+        return synthesize_sweep(ctx.model, q, f, temps, noise, seeds[i]) if noise else \
+            synthesize_sweep(ctx.model, q, f, temps)
 
     for i in range(n):
         sw = make(i)
@@ -555,15 +455,8 @@ def step_fixtures(ctx: _Ctx):
             worst = max(worst, float(np.max(np.abs(back.response / sw.response - 1))))
             manifest.append({"file": p.name, "seed": seeds[i], "fingerprint": sw.fingerprint()})
         amp = 1.0 if is_act else 1e-3
-        ts = step(
-            ctx.model,
-            temps[0],
-            amp,
-            cfg.get("step_duration_s", 1.0),
-            cfg.get("fs_hz", 500.0),
-            output_noise_rms=cfg.get("noise_rms_mm", 0.005) * 1e-3 if is_act else 1e-9,
-            seed=seeds[i],
-        )
+        ts = step(ctx.model, temps[0], amp, cfg.get("step_duration_s", 1.0), cfg.get("fs_hz", 500.0),
+                  output_noise_rms=cfg.get("noise_rms_mm", 0.005) * 1e-3 if is_act else 1e-9, seed=seeds[i])
         for fmt in [x for x in formats if x in ("csv", "npz")]:
             ctx.file(ts.save(ctx.out / "fixtures" / f"step_{i:02d}.{fmt}"))
     ctx.metric("fixtures.datasets", n)
@@ -572,28 +465,13 @@ def step_fixtures(ctx: _Ctx):
     ctx.metric("fixtures.distinct", len({m["fingerprint"] for m in manifest}) == n if noise else 1.0)
     from physmodel.data.files import atomic_write
 
-    ctx.file(
-        atomic_write(
-            ctx.out / "fixtures" / "manifest.json",
-            lambda fh: fh.write(json.dumps({"scenario": ctx.spec.name, "files": manifest}, indent=2)),
-        )
-    )
-    ctx.section(
-        "Fixture batch",
-        f"{n} seeded datasets (seeds from SeedSequence({cfg.get('seed', 0)}).spawn) in "
-        f"{formats}: sweeps at {temps} °C, {f.size} lines, and a {'1 V' if is_act else '1 mm'} step record "
-        f"each; read-back relative error {worst:.1e}; `fixtures/manifest.json` lists seeds and fingerprints.",
-    )
+    ctx.file(atomic_write(ctx.out / "fixtures" / "manifest.json",
+                          lambda fh: fh.write(json.dumps({"scenario": ctx.spec.name, "files": manifest}, indent=2))))
+    ctx.section("Fixture batch", f"{n} seeded datasets (seeds from SeedSequence({cfg.get('seed', 0)}).spawn) in "
+                f"{formats}: sweeps at {temps} °C, {f.size} lines, and a {'1 V' if is_act else '1 mm'} step record "
+                f"each; read-back relative error {worst:.1e}; `fixtures/manifest.json` lists seeds and fingerprints.")
 
 
-STEPS = {
-    "sweep": step_sweep,
-    "surrogate": step_surrogate,
-    "control_route": step_control_route,
-    "inversion": step_inversion,
-    "widths": step_widths,
-    "taylor": step_taylor,
-    "blackbox": step_blackbox,
-    "discrepancy": step_discrepancy,
-    "fixtures": step_fixtures,
-}
+STEPS = {"sweep": step_sweep, "surrogate": step_surrogate, "control_route": step_control_route,
+         "inversion": step_inversion, "widths": step_widths, "taylor": step_taylor, "blackbox": step_blackbox,
+         "discrepancy": step_discrepancy, "fixtures": step_fixtures}

@@ -30,7 +30,6 @@ from .spec import ScenarioError
 
 __all__ = ["step_control_route"]
 
-
 def _dense_vs(model, physics_model, f, temps):
     from surrogate.crossval import dense_check, physics_reference
 
@@ -62,16 +61,14 @@ def step_control_route(ctx) -> None:
     form = cfg.get("form", "zpk")
     T_ff = cfg.get("temperature_c", float(np.mean(measured)))
     if not measured[0] < T_ff < measured[-1]:
-        raise ScenarioError(
-            f"{ctx.spec.path}: [control_route] temperature_c must lie between the measured "
-            f"temperatures {measured.tolist()}"
-        )
+        raise ScenarioError(f"{ctx.spec.path}: [control_route] temperature_c must lie between the measured "
+                            f"temperatures {measured.tolist()}")
     # 1. the direct fit on the measured temperatures
     direct_fitter = surrogate.ScheduledFit(form, nz, npo, deg, raise_on_failure=False)
     direct = direct_fitter.fit(data)
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always", ScheduleWarning)
-        chk_direct = check_schedule(direct_fitter, data, direct.model)  # no physics: what a user sees
+        chk_direct = check_schedule(direct_fitter, data, direct.model)        # no physics: what a user sees
     warned = any(issubclass(w.category, ScheduleWarning) for w in rec)
     dense_direct = _dense_vs(direct.model, truth, f, measured)
     # 2. the physics-calibrated route
@@ -92,7 +89,7 @@ def step_control_route(ctx) -> None:
     A, fr, fs = cfg.get("amplitude_mm", 0.3), cfg.get("frequency_hz", 1.0), cfg.get("fs_hz", 10_000.0)
     ref = sine(A, fr, cfg.get("duration_s", max(8.0 / fr, 4.0)), fs, unit="mm")
     real = model_realization(truth, T_ff, fs, ref.t[-1])
-    P = truth.frequency_response(np.array([fr]), [T_ff])["M"][0, 0, 0] * 1e3  # mm/V
+    P = truth.frequency_response(np.array([fr]), [T_ff])["M"][0, 0, 0] * 1e3      # mm/V
     lim = Limits(max_voltage=cfg.get("max_voltage_v", 3.0), action="warn")
     rows = []
     for name, res in (("direct", direct), ("route", route)):
@@ -110,23 +107,12 @@ def step_control_route(ctx) -> None:
         # truncation error and the sampling (discretisation) bound, both through |P|, plus 5 %
         allow = abs(P) * (ff.truncation_error + ff.discretisation_error_estimate) + 0.05 * pred
         ctx.metric(f"control_route.{name}_prediction_gap_over_allowance", abs(err - pred) / allow)
-        rows.append(
-            (name, f"{ff.preview_s:.3g}", f"{ff.limit_report.peak:.3g}", f"{err * 1e3:.3g}", f"{pred * 1e3:.3g}")
-        )
+        rows.append((name, f"{ff.preview_s:.3g}", f"{ff.limit_report.peak:.3g}", f"{err * 1e3:.3g}",
+                     f"{pred * 1e3:.3g}"))
         if name == "route":
-            ctx.file(
-                feedforward_check(
-                    ref.t,
-                    ref.y,
-                    y,
-                    ff.output,
-                    ctx.out / "control_route_feedforward.png",
-                    unit="mm",
-                    max_voltage=lim.max_voltage,
-                    body=ref.body,
-                    title=f"physics-calibrated route, {T_ff:g} °C, {fr:g} Hz",
-                )
-            )
+            ctx.file(feedforward_check(ref.t, ref.y, y, ff.output, ctx.out / "control_route_feedforward.png",
+                                       unit="mm", max_voltage=lim.max_voltage, body=ref.body,
+                                       title=f"physics-calibrated route, {T_ff:g} °C, {fr:g} Hz"))
     ctx.metric("control_route.direct_between_error", dense_direct.between_error)
     ctx.metric("control_route.direct_at_fit_error", dense_direct.at_fit_error)
     ctx.metric("control_route.direct_warned", warned)
@@ -136,43 +122,28 @@ def step_control_route(ctx) -> None:
     ctx.metric("control_route.route_check_ok", chk_route.ok and not route_warned)
     for k, v in cal.values.items():
         ctx.metric(f"control_route.calibrated.{k}", v)
-    ctx.file(
-        plots.curves(
-            dense_direct.temperatures_c,
-            {
-                f"direct fit on {measured.tolist()} °C": dense_direct.errors,
-                f"calibrated physics, fit on {len(dense_t)} temperatures": np.interp(
-                    dense_direct.temperatures_c, dense_route.temperatures_c, dense_route.errors
-                ),
-            },
-            ctx.out / "control_route_schedule_error.png",
-            "temperature [°C]",
-            "relative RMS error vs the true physics",
-            logx=False,
-            title=f"{form} {nz}/{npo} schedule, degree {deg}",
-        )
-    )
+    ctx.file(plots.curves(dense_direct.temperatures_c,
+                          {f"direct fit on {measured.tolist()} °C": dense_direct.errors,
+                           f"calibrated physics, fit on {len(dense_t)} temperatures": np.interp(
+                               dense_direct.temperatures_c, dense_route.temperatures_c, dense_route.errors)},
+                          ctx.out / "control_route_schedule_error.png", "temperature [°C]",
+                          "relative RMS error vs the true physics", logx=False,
+                          title=f"{form} {nz}/{npo} schedule, degree {deg}"))
     ctx.section(
         "Physics-calibrated route",
         f"Direct {form} {nz}/{npo} degree-{deg} fit on the measured {measured.tolist()} °C: error at them "
         f"{dense_direct.at_fit_error:.3g}, between them up to {dense_direct.between_error:.3g} (worst at "
         f"{dense_direct.worst_temperature_c:g} °C) against the true physics; "
-        f"`check_schedule` {'warned' if warned else 'did not warn'}: {chk_direct.message[:300]}.",
-        "",
+        f"`check_schedule` {'warned' if warned else 'did not warn'}: {chk_direct.message[:300]}.", "",
         f"Route: calibrated {', '.join(f'{k} = {v:.4g}' for k, v in cal.values.items())} "
         f"({'converged' if cal.converged else 'NOT converged'}); calibrated physics swept at {dense_t} °C; "
         f"schedule error against the true physics at most {float(np.max(dense_route.errors)):.3g} "
-        f"(leave-one-out {chk_route.cv.cv_error:.3g}; check {'ok' if chk_route.ok else 'FAILED'}).",
-        "",
-        "![schedule error](control_route_schedule_error.png)",
-        "",
+        f"(leave-one-out {chk_route.cv.cv_error:.3g}; check {'ok' if chk_route.ok else 'FAILED'}).", "",
+        "![schedule error](control_route_schedule_error.png)", "",
         f"Feedforward of a faded {A:g} mm, {fr:g} Hz sine at {T_ff:g} °C through the true physics "
-        f"({fs:g} Hz; error between the fades):",
-        "",
-        plots_table(["schedule", "preview [s]", "peak [V]", "tracking error [um]", "A|P/G-1| [um]"], rows),
-        "",
-        "![feedforward](control_route_feedforward.png)",
-    )
+        f"({fs:g} Hz; error between the fades):", "",
+        plots_table(["schedule", "preview [s]", "peak [V]", "tracking error [um]", "A|P/G-1| [um]"], rows), "",
+        "![feedforward](control_route_feedforward.png)")
 
 
 def plots_table(header, rows) -> str:

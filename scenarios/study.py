@@ -49,24 +49,8 @@ from physmodel.errors import IPMCError
 
 from .spec import ScenarioError, read_toml
 
-_STUDY_KEYS = {
-    "name",
-    "kind",
-    "set",
-    "quantity",
-    "kernel",
-    "method",
-    "samples",
-    "seed",
-    "temperatures_c",
-    "frequencies_hz",
-    "fmin_hz",
-    "fmax_hz",
-    "points",
-    "chunk_size",
-    "noise",
-    "parameters",
-}
+_STUDY_KEYS = {"name", "kind", "set", "quantity", "kernel", "method", "samples", "seed", "temperatures_c",
+               "frequencies_hz", "fmin_hz", "fmax_hz", "points", "chunk_size", "noise", "parameters"}
 _DISTS = {"lognormal": ("median", "sigma"), "normal": ("mean", "std"), "uniform": ("low", "high")}
 _NOISE_KEYS = {"kind", "sigma_db", "sigma_deg", "sigma"}
 
@@ -124,10 +108,8 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
         lo, hi = _num(s.get("fmin_hz", 0.1), "fmin_hz"), _num(s.get("fmax_hz", 100.0), "fmax_hz")
         n = s.get("points", 50)
         if not (0 < lo < hi) or not isinstance(n, int) or isinstance(n, bool) or not 2 <= n <= MAX_STUDY_ROWS:
-            raise StudyError(
-                f"{where}: [study] need 0 < fmin_hz < fmax_hz and integer points in [2, {MAX_STUDY_ROWS}]; "
-                f"got fmin_hz = {lo!r}, fmax_hz = {hi!r}, points = {n!r}"
-            )
+            raise StudyError(f"{where}: [study] need 0 < fmin_hz < fmax_hz and integer points in [2, {MAX_STUDY_ROWS}]; "
+                             f"got fmin_hz = {lo!r}, fmax_hz = {hi!r}, points = {n!r}")
         f = np.geomspace(lo, hi, n).tolist()
     if min(f) <= 0:
         raise StudyError(f"{where}: [study] frequencies must be > 0 Hz")
@@ -172,17 +154,13 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
             raise StudyError(f"{where}: [study] samples must be a positive integer, got {n!r}")
     rows = s["samples"] * len(s["temperatures_c"]) * len(s["frequencies_hz"])
     if rows > MAX_STUDY_ROWS:
-        raise StudyError(
-            f"{where}: [study] samples × temperatures_c × frequencies = {rows} rows; at most "
-            f"{MAX_STUDY_ROWS} (split the study)"
-        )
+        raise StudyError(f"{where}: [study] samples × temperatures_c × frequencies = {rows} rows; at most "
+                         f"{MAX_STUDY_ROWS} (split the study)")
     if "noise" in s:
         nz = s["noise"]
         if not isinstance(nz, dict) or not set(nz) <= _NOISE_KEYS or nz.get("kind") not in ("magphase", "complex"):
-            raise StudyError(
-                f"{where}: [study.noise] takes kind = 'magphase' | 'complex' and "
-                f"{sorted(_NOISE_KEYS - {'kind'})}, got {nz!r}"
-            )
+            raise StudyError(f"{where}: [study.noise] takes kind = 'magphase' | 'complex' and "
+                             f"{sorted(_NOISE_KEYS - {'kind'})}, got {nz!r}")
         for k in _NOISE_KEYS - {"kind"}:
             if k in nz and _num(nz[k], f"{where}: [study.noise] {k}") < 0:
                 raise StudyError(f"{where}: [study.noise] {k} = {nz[k]!r}: expected >= 0")
@@ -244,14 +222,11 @@ def evaluate_chunk(spec: dict, indices) -> dict:
     q = spec["quantity"]
     f, T = np.asarray(spec["frequencies_hz"]), np.asarray(spec["temperatures_c"])
     _, in_u, _, out_u = QUANTITY_UNITS[(spec["kind"], q)]
-    H = model.frequency_response(f, T, quantities=(q,))[q] * (unit_scale(in_u) / unit_scale(out_u))  # (n, nT, nf)
+    H = model.frequency_response(f, T, quantities=(q,))[q] * (unit_scale(in_u) / unit_scale(out_u))   # (n, nT, nf)
     nz = spec.get("noise")
     if nz:
-        noise = (
-            MagnitudePhaseNoise(nz.get("sigma_db", 0.1), nz.get("sigma_deg", 1.0))
-            if nz["kind"] == "magphase"
-            else ComplexGaussianNoise(nz.get("sigma", 0.01))
-        )
+        noise = (MagnitudePhaseNoise(nz.get("sigma_db", 0.1), nz.get("sigma_deg", 1.0)) if nz["kind"] == "magphase"
+                 else ComplexGaussianNoise(nz.get("sigma", 0.01)))
         H = np.stack([noise.apply(H[k].ravel(), rng).reshape(H[k].shape) for k, (_, rng) in enumerate(draws)])
     n, nT, nf = H.shape
     cols = {"sample": np.repeat(np.asarray(indices, dtype=np.int64), nT * nf)}
@@ -283,8 +258,7 @@ class StudyTable:
     def equals(self, other: StudyTable) -> bool:
         """Bit-identical columns (the reproducibility contract)."""
         return list(self.columns) == list(other.columns) and all(
-            np.array_equal(self.columns[k], other.columns[k]) for k in self.columns
-        )
+            np.array_equal(self.columns[k], other.columns[k]) for k in self.columns)
 
     def to_csv(self, path) -> Path:
         from physmodel.data.files import atomic_write
@@ -294,9 +268,7 @@ class StudyTable:
 
         def write(fh):
             fh.write("# ipmc-study 1\n")
-            fh.write(
-                f"# study: {self.spec['name']}\n# response: {out_name} [{out_u}/{in_u}] ({self.spec['quantity']})\n"
-            )
+            fh.write(f"# study: {self.spec['name']}\n# response: {out_name} [{out_u}/{in_u}] ({self.spec['quantity']})\n")
             fh.write(f"# spec: {json.dumps(self.spec, sort_keys=True)}\n")
             fh.write(",".join(self.columns) + "\n")
             cols = [c.tolist() for c in self.columns.values()]
@@ -309,11 +281,8 @@ class StudyTable:
         from physmodel.data.files import atomic_write
 
         def write(fh):
-            np.savez(
-                fh,
-                header=np.array(json.dumps({"format": "ipmc-study", "version": 1, "spec": self.spec})),
-                **self.columns,
-            )
+            np.savez(fh, header=np.array(json.dumps({"format": "ipmc-study", "version": 1, "spec": self.spec})),
+                     **self.columns)
 
         return atomic_write(path, write, "wb")
 
@@ -326,9 +295,8 @@ def _chunks(spec) -> list[list[int]]:
     return [list(range(a, min(a + c, n))) for a in range(0, n, c)]
 
 
-def run_study(
-    spec: dict, *, scheduler=None, workers: int | None = None, backend: str | None = None, progress=None
-) -> StudyTable:
+def run_study(spec: dict, *, scheduler=None, workers: int | None = None, backend: str | None = None,
+              progress=None) -> StudyTable:
     """Evaluate a validated study (:func:`parse_study`).
 
     ``backend``: "serial" (this process), "processes" (concurrent.futures, ``workers`` processes;
@@ -374,23 +342,13 @@ def _run_dask(spec, chunks, scheduler, tick):
         raise StudyError("the Dask backend needs dask[distributed]: pip install 'ipmc[dask]'") from None
     own = isinstance(scheduler, str)
     try:
-        client = (
-            Client(scheduler, timeout="20s")
-            if own
-            else (scheduler if isinstance(scheduler, Client) else Client(scheduler))
-        )
-    except (ValueError, TypeError, OSError, TimeoutError) as exc:  # malformed or unreachable address
-        raise StudyError(
-            f"--scheduler {scheduler!r}: cannot connect to a Dask scheduler "
-            f"({type(exc).__name__}: {exc}); expected an address such as tcp://HOST:8786"
-        ) from None
+        client = Client(scheduler, timeout="20s") if own else (scheduler if isinstance(scheduler, Client) else Client(scheduler))
+    except (ValueError, TypeError, OSError, TimeoutError) as exc:   # malformed or unreachable address
+        raise StudyError(f"--scheduler {scheduler!r}: cannot connect to a Dask scheduler "
+                         f"({type(exc).__name__}: {exc}); expected an address such as tcp://HOST:8786") from None
     try:
-        futs = [
-            client.submit(
-                evaluate_chunk, spec, c, key=f"ipmc-study-{spec['name']}-{spec['seed']}-{k}-{os.getpid()}", pure=False
-            )
-            for k, c in enumerate(chunks)
-        ]
+        futs = [client.submit(evaluate_chunk, spec, c, key=f"ipmc-study-{spec['name']}-{spec['seed']}-{k}-{os.getpid()}",
+                              pure=False) for k, c in enumerate(chunks)]
         index = {f.key: k for k, f in enumerate(futs)}
         parts = [None] * len(chunks)
         for fut in as_completed(futs):

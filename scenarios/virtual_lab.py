@@ -97,10 +97,8 @@ class Measurement:
             raise IPMCError(f"Measurement.chain={self.chain!r} must be a physmodel.TransimpedanceChain or None")
 
     def describe(self) -> dict:
-        d = {
-            k: f"{getattr(self, k):g}"
-            for k in ("output_noise_rms", "input_noise_rms", "output_adc_step", "input_adc_step")
-        }
+        d = {k: f"{getattr(self, k):g}" for k in ("output_noise_rms", "input_noise_rms", "output_adc_step",
+                                                   "input_adc_step")}
         d["seed"] = str(self.seed)
         if self.chain is not None:
             c = self.chain
@@ -147,9 +145,8 @@ def _drive(excitation, periods: int | None, transient_periods: int | None, overs
 
     if oversample != 1:
         if isinstance(excitation, Multisine):
-            excitation = replace(
-                excitation, fs_hz=excitation.fs_hz * oversample, n_samples=excitation.n_samples * oversample
-            )
+            excitation = replace(excitation, fs_hz=excitation.fs_hz * oversample,
+                                 n_samples=excitation.n_samples * oversample)
         elif isinstance(excitation, SteppedSinePlan):
             excitation = replace(excitation, fs_hz=excitation.fs_hz * oversample)
     if isinstance(excitation, Multisine):
@@ -162,10 +159,8 @@ def _drive(excitation, periods: int | None, transient_periods: int | None, overs
         if periods is not None or transient_periods is not None:
             raise IPMCError("periods/transient_periods: a stepped-sine plan carries its own periods and settle time")
         return excitation.record()
-    raise IPMCError(
-        f"excitation must be a Multisine or a SteppedSinePlan (physmodel.data.excitation), "
-        f"got {type(excitation).__name__}"
-    )
+    raise IPMCError(f"excitation must be a Multisine or a SteppedSinePlan (physmodel.data.excitation), "
+                    f"got {type(excitation).__name__}")
 
 
 def _temperatures(temperatures_c) -> np.ndarray:
@@ -199,19 +194,9 @@ def chain_as_simulated(chain, frequency_hz, fsim_hz: float) -> np.ndarray:
     return chain.gain * -a * ((i0 - i1) * zi + i1) / (1 - e * zi)
 
 
-def simulate_records(
-    model,
-    excitation,
-    temperatures_c,
-    measurement: Measurement = Measurement(),
-    *,
-    periods: int | None = None,
-    transient_periods: int | None = None,
-    oversample: int = 16,
-    set_index: int = 0,
-    tol: float = 1e-4,
-    timings: dict | None = None,
-) -> list[TimeRecord]:
+def simulate_records(model, excitation, temperatures_c, measurement: Measurement = Measurement(), *,
+                     periods: int | None = None, transient_periods: int | None = None, oversample: int = 16,
+                     set_index: int = 0, tol: float = 1e-4, timings: dict | None = None) -> list[TimeRecord]:
     """Time records of the physics driven by ``excitation`` at each temperature (see module doc).
 
     Parameters
@@ -251,18 +236,16 @@ def simulate_records(
     fine = _drive(excitation, periods, transient_periods, int(oversample)) if oversample > 1 else sig
     if measurement.chain is not None and kind != "sensor":
         raise IPMCError("Measurement.chain: a transimpedance chain reads a sensor's current; the model is an actuator")
-    ((in_name, in_unit),) = sig.units.items()
+    (in_name, in_unit), = sig.units.items()
     want = "voltage" if kind == "actuator" else "length"
     if UNITS.get(in_unit, ("?",))[0] != want:
-        raise IPMCError(
-            f"excitation unit {in_unit!r}: a{'n' if kind == 'actuator' else ''} {kind} is driven by a "
-            f"{want} (e.g. {'V' if kind == 'actuator' else 'mm'})"
-        )
+        raise IPMCError(f"excitation unit {in_unit!r}: a{'n' if kind == 'actuator' else ''} {kind} is driven by a "
+                        f"{want} (e.g. {'V' if kind == 'actuator' else 'mm'})")
     R = int(oversample)
     u_fine = fine.channels[in_name] * unit_scale(in_unit)
     u_si = u_fine[::R]
     t = sig.t
-    if u_si.size != t.size:  # the fine grid holds the coarse one exactly
+    if u_si.size != t.size:                 # the fine grid holds the coarse one exactly
         raise IPMCError(f"oversample={R}: the design's {t.size} samples do not divide its fine grid")
     fs = float(excitation.fs_hz)
     if kind == "actuator":
@@ -284,32 +267,20 @@ def simulate_records(
         # images of the fine grid's hold for oversample <= 20 at a vector fit's cost at fs
         real = model_realization(model, float(Tk), fs, float(t[-1] - t[0]), set_index=set_index, tol=tol)
         t1 = time.perf_counter()
-        ts = simulate(model, float(Tk), fine.t, u_fine, chain=measurement.chain, set_index=set_index, realization=real)
+        ts = simulate(model, float(Tk), fine.t, u_fine, chain=measurement.chain, set_index=set_index,
+                      realization=real)
         t2 = time.perf_counter()
         y = ts.output[::R] if e_out is None else ts.output[::R] + e_out[k]
         u = u_si if e_in is None else u_si + e_in[k]
         y = _quantise(y, measurement.output_adc_step)
         u = _quantise(u, measurement.input_adc_step)
-        meta = {
-            "temperature_c": f"{Tk:g}",
-            **{k2: v for k2, v in sig.metadata.items()},
-            "virtual_lab": "scenarios.virtual_lab",
-            "model": ts.metadata["model"],
-            "parameter_set": ts.metadata["parameter_set"],
-            "realization": ts.metadata["realization"],
-            "hold": ts.metadata["hold"],
-            "simulation_fs_hz": f"{fs * R:.17g}",
-            "oversample": str(R),
-            **measurement.describe(),
-        }
-        recs.append(
-            TimeRecord(
-                t,
-                {i_name: u / unit_scale(i_unit), o_name: y / unit_scale(o_unit)},
-                {i_name: i_unit, o_name: o_unit},
-                meta,
-            )
-        )
+        meta = {"temperature_c": f"{Tk:g}", **{k2: v for k2, v in sig.metadata.items()},
+                "virtual_lab": "scenarios.virtual_lab", "model": ts.metadata["model"],
+                "parameter_set": ts.metadata["parameter_set"], "realization": ts.metadata["realization"],
+                "hold": ts.metadata["hold"], "simulation_fs_hz": f"{fs * R:.17g}", "oversample": str(R),
+                **measurement.describe()}
+        recs.append(TimeRecord(t, {i_name: u / unit_scale(i_unit), o_name: y / unit_scale(o_unit)},
+                               {i_name: i_unit, o_name: o_unit}, meta))
         tm["realization"] = tm.get("realization", 0.0) + t1 - t0
         tm["simulation"] = tm.get("simulation", 0.0) + t2 - t1 + time.perf_counter() - t2
     return recs
@@ -326,38 +297,18 @@ def estimate(record: TimeRecord, excitation, *, transient_periods: int | None = 
         raise IPMCError(f"record: expected an input and an output channel, got {names}")
     if isinstance(excitation, Multisine):
         tp = 1 if transient_periods is None else transient_periods
-        return estimate_record(
-            record,
-            names[0],
-            [names[1]],
-            method=estimator,
-            nperseg=excitation.n_samples,
-            noverlap=0,
-            window="boxcar",
-            discard_s=tp * excitation.period_s,
-            frequencies_hz=excitation.frequency_hz,
-        )
+        return estimate_record(record, names[0], [names[1]], method=estimator, nperseg=excitation.n_samples,
+                               noverlap=0, window="boxcar", discard_s=tp * excitation.period_s,
+                               frequencies_hz=excitation.frequency_hz)
     if isinstance(excitation, SteppedSinePlan):
         return estimate_record(record, names[0], [names[1]], method="stepped_sine", plan=excitation)
     raise IPMCError(f"excitation must be a Multisine or a SteppedSinePlan, got {type(excitation).__name__}")
 
 
-def virtual_lab(
-    model,
-    excitation,
-    temperatures_c: Sequence[float],
-    measurement: Measurement = Measurement(),
-    *,
-    periods: int | None = None,
-    transient_periods: int | None = None,
-    estimator: str = "h1",
-    hold_correction: bool = True,
-    max_std_db: float | None = None,
-    oversample: int = 16,
-    set_index: int = 0,
-    tol: float = 1e-4,
-    keep_records: bool = False,
-) -> VirtualLabResult:
+def virtual_lab(model, excitation, temperatures_c: Sequence[float], measurement: Measurement = Measurement(), *,
+                periods: int | None = None, transient_periods: int | None = None, estimator: str = "h1",
+                hold_correction: bool = True, max_std_db: float | None = None, oversample: int = 16,
+                set_index: int = 0, tol: float = 1e-4, keep_records: bool = False) -> VirtualLabResult:
     """Simulate, measure and estimate: a :class:`FrequencySweep` of the model's main quantity
     (actuator M in mm/V, sensor S in µA/mm) with per-line σ, over all ``temperatures_c`` [°C].
 
@@ -371,18 +322,9 @@ def virtual_lab(
         raise IPMCError(f"estimator={estimator!r}; expected 'h1' or 'h2'")
     kind = _kind(model)
     timings: dict = {}
-    recs = simulate_records(
-        model,
-        excitation,
-        temperatures_c,
-        measurement,
-        periods=periods,
-        transient_periods=transient_periods,
-        oversample=oversample,
-        set_index=set_index,
-        tol=tol,
-        timings=timings,
-    )
+    recs = simulate_records(model, excitation, temperatures_c, measurement, periods=periods,
+                            transient_periods=transient_periods, oversample=oversample, set_index=set_index, tol=tol,
+                            timings=timings)
     q = "M" if kind == "actuator" else "S"
     _, unit_in, _, unit_out = QUANTITY_UNITS[(kind, q)]
     fs = float(excitation.fs_hz)
@@ -400,9 +342,7 @@ def virtual_lab(
             c = measurement.chain
             if foh and c.bandwidth_hz is not None:
                 factor *= chain_as_simulated(c, e.frequency_hz, fsim)
-                notes["chain_divided_out"] = (
-                    f"as simulated: its pole discretised with a first-order hold at {fsim:g} Hz"
-                )
+                notes["chain_divided_out"] = f"as simulated: its pole discretised with a first-order hold at {fsim:g} Hz"
             else:
                 factor *= c.response(2j * np.pi * e.frequency_hz)
                 notes["chain_divided_out"] = "yes"
@@ -410,77 +350,34 @@ def virtual_lab(
             factor *= np.sinc(e.frequency_hz / fsim) ** 2
             notes["hold_correction"] = f"divided by sinc^2(f/{fsim:g} Hz) of the simulation's first-order hold"
         out_unit = e.output_units[0]
-        if measurement.chain is not None:  # V → A through the chain's V/A
+        if measurement.chain is not None:      # V → A through the chain's V/A
             out_unit = "A"
         from dataclasses import replace
 
-        e2 = replace(
-            e,
-            response=e.response / factor,
-            output_names=("current",) if measurement.chain is not None else e.output_names,
-            output_units=(out_unit,),
-        )
-        sw = e2.to_sweep(
-            Tk,
-            max_std_db=max_std_db,
-            quantity=q,
-            metadata={
-                "source": "scenarios.virtual_lab",
-                "parameter_set": rec.metadata["parameter_set"],
-                "model": rec.metadata["model"],
-                "excitation": rec.metadata.get("excitation", ""),
-                **measurement.describe(),
-                **notes,
-            },
-        )
+        e2 = replace(e, response=e.response / factor, output_names=("current",) if measurement.chain is not None
+                     else e.output_names, output_units=(out_unit,))
+        sw = e2.to_sweep(Tk, max_std_db=max_std_db, quantity=q,
+                         metadata={"source": "scenarios.virtual_lab", "parameter_set": rec.metadata["parameter_set"],
+                                   "model": rec.metadata["model"], "excitation": rec.metadata.get("excitation", ""),
+                                   **measurement.describe(), **notes})
         sweeps.append(sw.in_units(unit_in, unit_out))
     timings["estimation"] = time.perf_counter() - t0
-    return VirtualLabResult(
-        merge_sweeps(sweeps),
-        tuple(ests),
-        tuple(r.metadata for r in recs),
-        tuple(recs) if keep_records else (),
-        timings,
-        float(recs[0].t[-1] - recs[0].t[0] + 1 / fs),
-    )
+    return VirtualLabResult(merge_sweeps(sweeps), tuple(ests), tuple(r.metadata for r in recs),
+                            tuple(recs) if keep_records else (), timings, float(recs[0].t[-1] - recs[0].t[0] + 1 / fs))
+
+
 
 
 # ---------------------------------------------------------------------------- scenario tables
 #: Keys of a scenario's ``[sweep]`` table read when ``source = "virtual_lab"`` (with defaults).
-SWEEP_KEYS = {
-    "source": "virtual_lab",
-    "temperatures_c": None,
-    "fmin_hz": 0.1,
-    "fmax_hz": 100.0,
-    "points": 40,
-    "excitation": "multisine",
-    "fs_hz": None,
-    "period_s": None,
-    "periods": 8,
-    "transient_periods": 2,
-    "rms": 1.0,
-    "amplitude": 1.0,
-    "phases": "schroeder",
-    "settle_s": 0.0,
-    "settle_periods": 0.0,
-    "min_measure_s": 0.0,
-    "oversample": 16,
-    "estimator": "h1",
-    "max_std_db": None,
-    "held_out_c": None,
-    "plot_temperatures_c": None,
-}
+SWEEP_KEYS = {"source": "virtual_lab", "temperatures_c": None, "fmin_hz": 0.1, "fmax_hz": 100.0, "points": 40,
+              "excitation": "multisine", "fs_hz": None, "period_s": None, "periods": 8, "transient_periods": 2,
+              "rms": 1.0, "amplitude": 1.0, "phases": "schroeder", "settle_s": 0.0, "settle_periods": 0.0,
+              "min_measure_s": 0.0, "oversample": 16, "estimator": "h1", "max_std_db": None,
+              "held_out_c": None, "plot_temperatures_c": None}
 #: Keys of the ``[noise]`` table for a virtual lab (SI units; ``kind = "time"``).
-NOISE_KEYS = {
-    "kind": "time",
-    "output_noise_rms": 0.0,
-    "input_noise_rms": 0.0,
-    "output_adc_step": 0.0,
-    "input_adc_step": 0.0,
-    "chain": None,
-    "chain_bandwidth_hz": None,
-    "seed": None,
-}
+NOISE_KEYS = {"kind": "time", "output_noise_rms": 0.0, "input_noise_rms": 0.0, "output_adc_step": 0.0,
+              "input_adc_step": 0.0, "chain": None, "chain_bandwidth_hz": None, "seed": None}
 
 
 def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") -> VirtualLabResult:
@@ -501,10 +398,8 @@ def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") 
     if sweep.get("source", "virtual_lab") != "virtual_lab":
         raise IPMCError(f"{where}[sweep] source = {sweep['source']!r}; this reader handles 'virtual_lab'")
     if noise.get("kind", "time") != "time":
-        raise IPMCError(
-            f"{where}[noise] kind = {noise['kind']!r}: a virtual lab adds noise to the time records; "
-            f'use kind = "time" with output_noise_rms, input_noise_rms, output_adc_step, ...'
-        )
+        raise IPMCError(f"{where}[noise] kind = {noise['kind']!r}: a virtual lab adds noise to the time records; "
+                        f"use kind = \"time\" with output_noise_rms, input_noise_rms, output_adc_step, ...")
     for table, got, known in (("sweep", sweep, SWEEP_KEYS), ("noise", noise, NOISE_KEYS)):
         bad = sorted(set(got) - set(known))
         if bad:
@@ -518,10 +413,8 @@ def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") 
         raise IPMCError(f"{where}[sweep] fs_hz: required (the DAQ's sample rate [Hz])")
     lo, hi, n = cfg["fmin_hz"], cfg["fmax_hz"], cfg["points"]
     if not (isinstance(n, int) and n >= 1 and 0 < lo <= hi):
-        raise IPMCError(
-            f"{where}[sweep] fmin_hz/fmax_hz/points: need 0 < fmin_hz <= fmax_hz and points >= 1, "
-            f"got {lo!r}, {hi!r}, {n!r}"
-        )
+        raise IPMCError(f"{where}[sweep] fmin_hz/fmax_hz/points: need 0 < fmin_hz <= fmax_hz and points >= 1, "
+                        f"got {lo!r}, {hi!r}, {n!r}")
     ch, unit = ("voltage", "V") if kind == "actuator" else ("tip_displacement", "mm")
     chain = None
     if nz["chain"] is not None:
@@ -530,14 +423,8 @@ def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") 
             raise IPMCError(f"{where}[noise] chain: expected [R1, R2, R3] in ohm, got {r!r}")
         chain = TransimpedanceChain(float(r[0]), float(r[1]), float(r[2]), bandwidth_hz=nz["chain_bandwidth_hz"])
     try:
-        meas = Measurement(
-            float(nz["output_noise_rms"]),
-            float(nz["input_noise_rms"]),
-            float(nz["output_adc_step"]),
-            float(nz["input_adc_step"]),
-            chain,
-            nz["seed"],
-        )
+        meas = Measurement(float(nz["output_noise_rms"]), float(nz["input_noise_rms"]), float(nz["output_adc_step"]),
+                           float(nz["input_adc_step"]), chain, nz["seed"])
         exc: Multisine | SteppedSinePlan
         if cfg["excitation"] == "multisine":
             period = cfg["period_s"] if cfg["period_s"] is not None else max(10.0, 1.0 / lo)
@@ -545,30 +432,15 @@ def from_config(model, sweep: dict, noise: dict | None = None, where: str = "") 
             exc = multisine(f, cfg["fs_hz"], period, rms=cfg["rms"], phases=cfg["phases"], channel=ch, unit=unit)
             kw = {"periods": cfg["periods"], "transient_periods": cfg["transient_periods"]}
         elif cfg["excitation"] == "stepped":
-            exc = stepped_sine_plan(
-                np.geomspace(lo, hi, n),
-                cfg["fs_hz"],
-                amplitude=cfg["amplitude"],
-                periods=cfg["periods"],
-                min_measure_s=cfg["min_measure_s"],
-                settle_s=cfg["settle_s"],
-                settle_periods=cfg["settle_periods"],
-                channel=ch,
-                unit=unit,
-            )
+            exc = stepped_sine_plan(np.geomspace(lo, hi, n), cfg["fs_hz"], amplitude=cfg["amplitude"],
+                                    periods=cfg["periods"], min_measure_s=cfg["min_measure_s"],
+                                    settle_s=cfg["settle_s"], settle_periods=cfg["settle_periods"], channel=ch,
+                                    unit=unit)
             kw = {}
         else:
             raise IPMCError(f"[sweep] excitation = {cfg['excitation']!r}; expected 'multisine' or 'stepped'")
-        return virtual_lab(
-            model,
-            exc,
-            cfg["temperatures_c"],
-            meas,
-            estimator=cfg["estimator"],
-            max_std_db=cfg["max_std_db"],
-            oversample=cfg["oversample"],
-            **kw,
-        )
+        return virtual_lab(model, exc, cfg["temperatures_c"], meas, estimator=cfg["estimator"],
+                           max_std_db=cfg["max_std_db"], oversample=cfg["oversample"], **kw)
     except IPMCError as exc_:
         raise IPMCError(f"{where}[sweep]/[noise] virtual lab: {exc_}") from None
     except (TypeError, ValueError) as exc_:

@@ -30,7 +30,7 @@ def _pairings(reals, n_pairs, single):
             a = items[0]
             for j in range(1, len(items)):
                 b = items[j]
-                for tail in matchings(items[1:j] + items[j + 1 :]):
+                for tail in matchings(items[1:j] + items[j + 1:]):
                     yield [(a, b)] + tail
 
         for mt in matchings(rest):

@@ -80,21 +80,16 @@ class FrequencyData:
         n = int(np.size(self.frequency_hz))
         t = _temperature_column(self.temperature_c, n)
         # the sweep's checks, once; a missing temperature is one (arbitrary) temperature
-        sweep = FrequencySweep(
-            np.zeros(n) if t is None else t, self.frequency_hz, self.response, self.magnitude_std_db, self.phase_std_deg
-        )
+        sweep = FrequencySweep(np.zeros(n) if t is None else t, self.frequency_hz, self.response,
+                               self.magnitude_std_db, self.phase_std_deg)
         for name in ("magnitude_std_db", "phase_std_deg"):
             v = getattr(sweep, name)
             if v is not None and np.any(v <= 0):
                 i = int(np.argmax(v <= 0))
                 raise IPMCError(f"{name} must be > 0 (it becomes a weight 1/σ), got {float(v[i])!r} at index {i}")
-        values = {
-            "frequency_hz": sweep.frequency_hz,
-            "response": sweep.response,
-            "temperature_c": None if t is None else sweep.temperature_c,
-            "magnitude_std_db": sweep.magnitude_std_db,
-            "phase_std_deg": sweep.phase_std_deg,
-        }
+        values = {"frequency_hz": sweep.frequency_hz, "response": sweep.response,
+                  "temperature_c": None if t is None else sweep.temperature_c,
+                  "magnitude_std_db": sweep.magnitude_std_db, "phase_std_deg": sweep.phase_std_deg}
         for name, v in values.items():
             if v is not None:
                 v = v.copy()
@@ -131,15 +126,9 @@ class FrequencyData:
             return None if a is None else a[idx]
 
         return FrequencyData(
-            self.frequency_hz[idx],
-            take(self.temperature_c),
-            self.response[idx],
-            take(self.magnitude_std_db),
-            take(self.phase_std_deg),
-            self.input_name,
-            self.input_unit,
-            self.output_name,
-            self.output_unit,
+            self.frequency_hz[idx], take(self.temperature_c), self.response[idx],
+            take(self.magnitude_std_db), take(self.phase_std_deg),
+            self.input_name, self.input_unit, self.output_name, self.output_unit,
             dict(self.metadata),
         )
 
@@ -149,7 +138,10 @@ class FrequencyData:
             raise IPMCError("these data carry no temperature")
         mask = np.isclose(self.temperature_c, temperature_c, rtol=0, atol=1e-9)
         if not mask.any():
-            raise IPMCError(f"no data at temperature_c={temperature_c!r}; available: {self.temperatures().tolist()}")
+            raise IPMCError(
+                f"no data at temperature_c={temperature_c!r}; available: "
+                f"{self.temperatures().tolist()}"
+            )
         return self.select(mask)
 
     def fingerprint(self) -> str:
@@ -175,15 +167,15 @@ class FrequencyData:
     def log_std(self) -> tuple[np.ndarray, np.ndarray]:
         """Standard deviations of ln|H| [Np] and arg H [rad] per line."""
         if not self.has_uncertainty:
-            raise IPMCError("weighting='uncertainty' needs both magnitude_std_db and phase_std_deg")
+            raise IPMCError(
+                "weighting='uncertainty' needs both magnitude_std_db and phase_std_deg"
+            )
         return self.magnitude_std_db * _LN10_OVER_20, np.deg2rad(self.phase_std_deg)
 
     def labels(self) -> dict:
         return {
-            "input_name": self.input_name,
-            "input_unit": self.input_unit,
-            "output_name": self.output_name,
-            "output_unit": self.output_unit,
+            "input_name": self.input_name, "input_unit": self.input_unit,
+            "output_name": self.output_name, "output_unit": self.output_unit,
         }
 
 
@@ -222,15 +214,12 @@ def to_data(data, temperature_c=None) -> FrequencyData:
         return from_sweep(data)
     from physmodel.data.interop import as_sweep, is_frd
 
-    if temperature_c is None and (
-        is_frd(data) or (isinstance(data, tuple | list) and len(data) == 2 and not is_frd(data[0]))
-    ):
-        sw = as_sweep(data, 0.0)  # one unspecified temperature
+    if temperature_c is None and (is_frd(data) or (isinstance(data, tuple | list) and len(data) == 2
+                                                   and not is_frd(data[0]))):
+        sw = as_sweep(data, 0.0)        # one unspecified temperature
         return FrequencyData(sw.frequency_hz, None, sw.response)
     if isinstance(data, dict | list | tuple) or is_frd(data):
         return from_sweep(as_sweep(data, temperature_c))
-    raise IPMCError(
-        f"expected FrequencyData or a physmodel FrequencySweep, got {type(data).__name__} "
-        "(also accepted: a control.FrequencyResponseData, a mapping {temperature_c: FRD} or "
-        "(frequency_hz, response) arrays)"
-    )
+    raise IPMCError(f"expected FrequencyData or a physmodel FrequencySweep, got {type(data).__name__} "
+                    "(also accepted: a control.FrequencyResponseData, a mapping {temperature_c: FRD} or "
+                    "(frequency_hz, response) arrays)")

@@ -20,7 +20,7 @@ WEIGHTINGS = ("auto", "uncertainty", "log", "relative")
 def as_data(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg) -> FrequencyData:
     """Arrays → ``FrequencyData``; a ``FrequencyData`` or ``FrequencySweep`` passed as the first
     argument (the others ``None``) is taken as the data."""
-    if response is None:  # data (a sweep, FrequencyData, FRD or {T: FRD}) and an optional temperature
+    if response is None:          # data (a sweep, FrequencyData, FRD or {T: FRD}) and an optional temperature
         return to_data(frequency_hz, temperature_c)
     return FrequencyData(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg)
 
@@ -89,11 +89,8 @@ def make_problem(structure: Structure, data: FrequencyData, scaling: Scaling, we
 def check_order_per_temperature(structure: Structure, data: FrequencyData):
     """Each temperature must carry at least as many real equations as a per-T fit has unknowns."""
     n_unknown = structure.n_zeros + 1 + structure.n_poles
-    groups = (
-        [(None, data.n)]
-        if data.temperature_c is None
-        else [(t, int(np.sum(data.temperature_c == t))) for t in data.temperatures()]
-    )
+    groups = [(None, data.n)] if data.temperature_c is None else [
+        (t, int(np.sum(data.temperature_c == t))) for t in data.temperatures()]
     for t, count in groups:
         if 2 * count < n_unknown:
             where = "" if t is None else f" at temperature_c={t:g}"
@@ -119,7 +116,8 @@ class TemperatureError:
     fit_percent: float
 
 
-def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolate=False, response=None):
+def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolate=False,
+                           response=None):
     """Fit quality at each temperature of ``data`` (one evaluation of the model over all
     lines, split by temperature).  ``response``: the model's response on the lines of
     ``data`` if already at hand."""
@@ -136,7 +134,8 @@ def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolat
             fp = fit_percent(hm, hd)
         except ValueError:  # a single line per temperature: NRMSE undefined
             fp = float("nan")
-        out.append(TemperatureError(None if t is None else float(t), int(hd.size), relative_rms_error(hm, hd), fp))
+        out.append(TemperatureError(None if t is None else float(t), int(hd.size),
+                                    relative_rms_error(hm, hd), fp))
     return out
 
 
@@ -198,16 +197,9 @@ class FitResult:
 
 
 def history_entry(stage: str, start: str, out: SolveOutcome) -> dict:
-    return {
-        "stage": stage,
-        "start": start,
-        "status": out.status,
-        "converged": out.converged,
-        "iterations": out.iterations,
-        "cost": out.cost,
-        "time_s": out.time_s,
-        "objective_trace": out.objective_trace,
-    }
+    return {"stage": stage, "start": start, "status": out.status, "converged": out.converged,
+            "iterations": out.iterations, "cost": out.cost, "time_s": out.time_s,
+            "objective_trace": out.objective_trace}
 
 
 def best_outcome(outcomes, prefer: str | None = None, rel_tol: float = 0.02):
@@ -217,7 +209,6 @@ def best_outcome(outcomes, prefer: str | None = None, rel_tol: float = 0.02):
 
     If ``prefer`` names a converged start whose cost is within ``rel_tol`` of the best, it
     wins (continuation across temperatures keeps section identities that way)."""
-
     def cost(o):
         return o[1].cost if np.isfinite(o[1].cost) else np.inf
 
@@ -251,16 +242,8 @@ def _outcome(lm: LevenbergMarquardt, i: int, time_s: float) -> SolveOutcome:
         lm.run(n, only=[i])
         return _outcome(lm, i, time.perf_counter() - t0)
 
-    return SolveOutcome(
-        lm.theta[i].copy(),
-        float(lm.cost[i]),
-        lm.status[i],
-        bool(lm.converged[i]),
-        int(lm.iterations[i]),
-        time_s,
-        list(lm.traces[i]),
-        resume,
-    )
+    return SolveOutcome(lm.theta[i].copy(), float(lm.cost[i]), lm.status[i], bool(lm.converged[i]),
+                        int(lm.iterations[i]), time_s, list(lm.traces[i]), resume)
 
 
 def race_starts(evaluator, starts, max_iter: int, tol: float, lb, ub, prefer: str | None = "warm") -> list:
@@ -296,27 +279,11 @@ def resume_slowest(outcomes: list, solve_long, history: list, stage: str, max_it
     outcomes.append((name, out))
 
 
-def finish(
-    structure,
-    problem: Problem,
-    evaluator,
-    outcome: SolveOutcome,
-    scaling: Scaling,
-    data: FrequencyData,
-    *,
-    weighting_name: str,
-    method: str,
-    settings: dict,
-    scale_covariance: bool,
-    history: list,
-    time_s: float,
-    temperature_range,
-    compute_covariance: bool = True,
-    two_stage=None,
-    per_temperature_models=None,
-    raise_on_failure: bool = True,
-    stability_grid: int = 501,
-) -> FitResult:
+def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scaling: Scaling,
+           data: FrequencyData, *, weighting_name: str, method: str, settings: dict,
+           scale_covariance: bool, history: list, time_s: float, temperature_range,
+           compute_covariance: bool = True, two_stage=None, per_temperature_models=None,
+           raise_on_failure: bool = True, stability_grid: int = 501) -> FitResult:
     theta = outcome.theta
     cov, rank_def = None, False
     at_bounds = []
@@ -342,33 +309,18 @@ def finish(
     model = RationalModel(structure, theta, scaling, temperature_range, cov, data.labels(), info)
     stability = model.stability_check(stability_grid)
     # the model's response on the data lines: H_model = R · H_data, R from the residual model
-    errs = per_temperature_errors(
-        model, data, response=None if evaluator is None else evaluator.ratio(theta) * data.response
-    )
+    errs = per_temperature_errors(model, data, response=None if evaluator is None
+                                  else evaluator.ratio(theta) * data.response)
     ci = model.confidence_intervals()
     res = FitResult(
-        model=model,
-        converged=outcome.converged,
-        status=outcome.status,
-        iterations=outcome.iterations,
-        cost=outcome.cost,
-        weighted_rms=float(np.sqrt(np.mean(r**2))),
-        weighting=weighting_name,
-        method=method,
-        param_names=structure.param_names(),
-        params=theta.copy(),
-        stderr=model.stderr,
-        ci95_low=None if ci is None else ci[0],
-        ci95_high=None if ci is None else ci[1],
-        covariance_rank_deficient=rank_def,
-        at_bounds=at_bounds,
-        per_temperature=errs,
-        stability=stability,
-        time_s=time_s,
-        data_fingerprint=info["data_fingerprint"],
-        history=history,
-        two_stage=two_stage,
-        per_temperature_models=per_temperature_models,
+        model=model, converged=outcome.converged, status=outcome.status,
+        iterations=outcome.iterations, cost=outcome.cost,
+        weighted_rms=float(np.sqrt(np.mean(r ** 2))), weighting=weighting_name, method=method,
+        param_names=structure.param_names(), params=theta.copy(), stderr=model.stderr,
+        ci95_low=None if ci is None else ci[0], ci95_high=None if ci is None else ci[1],
+        covariance_rank_deficient=rank_def, at_bounds=at_bounds, per_temperature=errs,
+        stability=stability, time_s=time_s, data_fingerprint=info["data_fingerprint"],
+        history=history, two_stage=two_stage, per_temperature_models=per_temperature_models,
     )
     if not outcome.converged and raise_on_failure:
         raise ConvergenceError(

@@ -32,10 +32,10 @@ def levy(w, h, n_zeros: int, n_poles: int, row_weight=None):
     vz = jw[:, None] ** np.arange(n_zeros + 1)
     vp = jw[:, None] ** np.arange(n_poles)
     a = np.hstack([vz, -h[:, None] * vp])
-    rhs = h * jw**n_poles
+    rhs = h * jw ** n_poles
     wt = np.ones_like(w) if row_weight is None else np.asarray(row_weight, float)
     sol = _solve_weighted(a, rhs, wt)
-    return sol[: n_zeros + 1], np.append(sol[n_zeros + 1 :], 1.0)
+    return sol[: n_zeros + 1], np.append(sol[n_zeros + 1:], 1.0)
 
 
 def numerator_ls(w, h, n_zeros: int, den, relative: bool = True):
@@ -56,19 +56,15 @@ def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8):
     h = np.asarray(h, complex)
     jw = 1j * w
     vd = jw[:, None] ** np.arange(n_poles + 1)
-    a = np.hstack(
-        [
-            vd[:, : n_zeros + 1] if n_zeros <= n_poles else jw[:, None] ** np.arange(n_zeros + 1),
-            -h[:, None] * vd[:, :n_poles],
-        ]
-    )
+    a = np.hstack([vd[:, :n_zeros + 1] if n_zeros <= n_poles else jw[:, None] ** np.arange(n_zeros + 1),
+                   -h[:, None] * vd[:, :n_poles]])
     rhs = h * vd[:, n_poles]
     rel = 1.0 / np.abs(h)
     wt, out = rel, []
     for _ in range(n_iter + 1):
         sol = _solve_weighted(a, rhs, wt)
-        den = np.append(sol[n_zeros + 1 :], 1.0)
-        out.append((sol[: n_zeros + 1], den))
+        den = np.append(sol[n_zeros + 1:], 1.0)
+        out.append((sol[:n_zeros + 1], den))
         d = np.abs(vd @ den)
         if not np.all(np.isfinite(d)) or np.any(d == 0):
             break
@@ -97,7 +93,8 @@ def spread_poles(w, n_poles: int, damping: float = 0.5) -> np.ndarray:
     mags = np.exp(np.linspace(lo, hi, n_pairs + 2)[1:-1]) if n_pairs else np.array([])
     rts = []
     for m in mags:
-        rts += [m * (-damping + 1j * np.sqrt(1 - damping**2)), m * (-damping - 1j * np.sqrt(1 - damping**2))]
+        rts += [m * (-damping + 1j * np.sqrt(1 - damping ** 2)),
+                m * (-damping - 1j * np.sqrt(1 - damping ** 2))]
     if n_poles % 2:
         rts.append(-np.exp(0.5 * (lo + hi)))
     return np.array(rts, complex)
@@ -108,7 +105,7 @@ def _sk_costs(sk, structure, costs):
     +inf where a pole is unstable (those would be reflected before use), and the poles of
     every iterate (one batched eigenvalue call; NaN where the denominator is not finite)."""
     n = structure.n_poles
-    dens = np.array([den for _, den in sk])  # (k, n+1), monic
+    dens = np.array([den for _, den in sk])                   # (k, n+1), monic
     comp = np.zeros((len(sk), n, n))
     comp[:, 0, :] = -dens[:, -2::-1]
     comp[:, np.arange(1, n), np.arange(n - 1)] = 1.0
@@ -143,7 +140,7 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
             picks = list(range(len(sk)))
             if len(sk) > 1:
                 j = 1 + int(np.argmin(raw[1:]))
-                if np.isfinite(raw[j]):  # else: no stable SK iterate, convert them all
+                if np.isfinite(raw[j]):   # else: no stable SK iterate, convert them all
                     picks = [0, j]
             for i in picks:
                 num, den = sk[i]

@@ -28,21 +28,14 @@ import numpy as np
 
 from ._structure import Structure
 
-__all__ = [
-    "Evaluator",
-    "LevenbergMarquardt",
-    "STATUS_OK",
-    "STATUS_ACCEPTABLE",
-    "STATUS_MAXITER",
-    "STATUS_STOPPED",
-    "STATUS_FAILED",
-]
+__all__ = ["Evaluator", "LevenbergMarquardt", "STATUS_OK", "STATUS_ACCEPTABLE", "STATUS_MAXITER",
+           "STATUS_STOPPED", "STATUS_FAILED"]
 
 # statuses follow IPOPT's names, so results read the same whichever solver produced them
 STATUS_OK = "Solve_Succeeded"
 STATUS_ACCEPTABLE = "Solved_To_Acceptable_Level"
 STATUS_MAXITER = "Maximum_Iterations_Exceeded"
-STATUS_STOPPED = "Stopped_Early"  # a start that lost the race (see LevenbergMarquardt)
+STATUS_STOPPED = "Stopped_Early"   # a start that lost the race (see LevenbergMarquardt)
 STATUS_FAILED = "Evaluation_Failed"
 
 
@@ -89,15 +82,16 @@ class Evaluator:
         self.lay = _layout(st)
         w = np.asarray(problem.w, float)
         self.n_lines = w.size
-        self.s = (1j * w)[:, None]  # (N, 1)
+        self.s = (1j * w)[:, None]                   # (N, 1)
         self.s2 = self.s * self.s
         m, n = st.n_zeros, st.n_poles
         self.spow = (1j * w)[:, None] ** np.arange(max(m, n) + 1)
-        self._sp_num_t = np.ascontiguousarray(self.spow[:, : m + 1].T)
+        self._sp_num_t = np.ascontiguousarray(self.spow[:, :m + 1].T)
         self._sp_den_t = np.ascontiguousarray(self.spow[:, :n].T)
         self.tpow = np.asarray(problem.tau, float)[:, None] ** np.arange(st.n_coef)
         self.inv_h = 1.0 / np.asarray(problem.h, complex)
-        self.weights = np.concatenate([np.asarray(problem.inv_sig_a, float), np.asarray(problem.inv_sig_b, float)])
+        self.weights = np.concatenate([np.asarray(problem.inv_sig_a, float),
+                                       np.asarray(problem.inv_sig_b, float)])
         self.n_params = st.n_params
 
     def _slots(self, theta: np.ndarray) -> np.ndarray:
@@ -132,14 +126,14 @@ class Evaluator:
                 num = num * e
                 if grad:
                     g[..., lay["ze"]] = 1.0 / e
-        elif v.shape[1] == 1:  # one temperature: a matrix product
+        elif v.shape[1] == 1:                     # one temperature: a matrix product
             num = v[:, 0, lay["b"]] @ self._sp_num_t
             if grad:
-                g[..., lay["b"]] = sp[:, : m + 1] / num[..., None]
+                g[..., lay["b"]] = sp[:, :m + 1] / num[..., None]
         else:
-            num = (v[..., lay["b"]] * sp[:, : m + 1]).sum(axis=-1)
+            num = (v[..., lay["b"]] * sp[:, :m + 1]).sum(axis=-1)
             if grad:
-                g[..., lay["b"]] = sp[:, : m + 1] / num[..., None]
+                g[..., lay["b"]] = sp[:, :m + 1] / num[..., None]
         if lay["form"] == "coefficients":
             if v.shape[1] == 1:
                 den = sp[:, n] + v[:, 0, lay["a"]] @ self._sp_den_t
@@ -226,9 +220,9 @@ def _normal_equations(J: np.ndarray, r: np.ndarray):
     a = g = None
     rows = block_rows(J.shape[2])
     for i in range(0, J.shape[1], rows):
-        jb = J[:, i : i + rows]
+        jb = J[:, i:i + rows]
         jt = jb.transpose(0, 2, 1)
-        ab, gb = jt @ jb, (jt @ r[:, i : i + rows, None])[..., 0]
+        ab, gb = jt @ jb, (jt @ r[:, i:i + rows, None])[..., 0]
         a, g = (ab, gb) if a is None else (a + ab, g + gb)
     return a, g
 
@@ -238,7 +232,8 @@ def _matvec(J: np.ndarray, x: np.ndarray) -> np.ndarray:
     rows = block_rows(J.shape[2])
     if J.shape[1] <= rows:
         return (J @ x[..., None])[..., 0]
-    return np.concatenate([(J[:, i : i + rows] @ x[..., None])[..., 0] for i in range(0, J.shape[1], rows)], axis=1)
+    return np.concatenate([(J[:, i:i + rows] @ x[..., None])[..., 0]
+                           for i in range(0, J.shape[1], rows)], axis=1)
 
 
 class LevenbergMarquardt:
@@ -353,7 +348,7 @@ class LevenbergMarquardt:
         while done < budget and not ended:
             done += 1
             a, g = _normal_equations(J, r)
-            diag = np.einsum("sii->si", a)  # a view
+            diag = np.einsum("sii->si", a)                    # a view
             cn = np.sqrt(diag)
             np.maximum(scale, cn, out=scale)
             d = np.where(scale > 0, scale, 1.0)
@@ -384,9 +379,9 @@ class LevenbergMarquardt:
             dx = xt - x
             lin = r + _matvec(J, dx)
             pred = rr - np.einsum("si,si->s", lin, lin)
-            rt, jt_new = ev.residual(xt, jacobian=True)  # the Jacobian serves if accepted
+            rt, jt_new = ev.residual(xt, jacobian=True)   # the Jacobian serves if accepted
             rrt = np.einsum("si,si->s", rt, rt)
-            actual = rr - rrt  # NaN where rt is not finite
+            actual = rr - rrt                               # NaN where rt is not finite
             rho = actual / np.where(pred > 0, pred, np.nan)
             acc = (rho > 1e-4) & ~stationary
             mu = np.where(acc, mu * np.maximum(1 / 3, 1 - (2 * rho - 1) ** 3), mu * nu)

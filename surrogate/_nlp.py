@@ -87,7 +87,8 @@ class Problem:
     def line_data(self, n_lines: int | None = None) -> np.ndarray:
         """(w̃, τ, Re h, Im h, 1/σ_a, 1/σ_b) of every line, line after line (6N,); padded to
         ``n_lines`` with copies of the first line at zero weight (zero residuals)."""
-        d = np.column_stack([self.w, self.tau, self.h.real, self.h.imag, self.inv_sig_a, self.inv_sig_b])
+        d = np.column_stack([self.w, self.tau, self.h.real, self.h.imag,
+                             self.inv_sig_a, self.inv_sig_b])
         if n_lines is not None and n_lines > d.shape[0]:
             pad = np.repeat(d[:1], n_lines - d.shape[0], axis=0)
             pad[:, 4:] = 0.0
@@ -95,17 +96,8 @@ class Problem:
         return d.ravel()
 
     def residual(self, theta) -> np.ndarray:
-        return residual(
-            self.structure,
-            np.asarray(theta, float),
-            self.w,
-            self.tau,
-            self.h.real,
-            self.h.imag,
-            self.inv_sig_a,
-            self.inv_sig_b,
-            self.kind,
-        )
+        return residual(self.structure, np.asarray(theta, float), self.w, self.tau, self.h.real,
+                        self.h.imag, self.inv_sig_a, self.inv_sig_b, self.kind)
 
     def cost(self, theta) -> float:
         """½·mean(r²); +inf where the model cannot be evaluated."""
@@ -156,8 +148,10 @@ def _block_functions(structure: Structure, kind: str):
     line_h = ca.Function("line_hessian", [x, d], [ca.hessian(0.5 * ca.sumsqr(r), x)[0]])
     xm = ca.MX.sym("x", structure.n_params)
     dm = ca.MX.sym("d", 6, BLOCK_LINES)
-    block_r = ca.Function("block_residual", [xm, dm], [line_r.map("lines", "serial", BLOCK_LINES, [0], [])(xm, dm)])
-    block_h = ca.Function("block_hessian", [xm, dm], [line_h.map("lines_h", "serial", BLOCK_LINES, [0], [0])(xm, dm)])
+    block_r = ca.Function("block_residual", [xm, dm],
+                          [line_r.map("lines", "serial", BLOCK_LINES, [0], [])(xm, dm)])
+    block_h = ca.Function("block_hessian", [xm, dm],
+                          [line_h.map("lines_h", "serial", BLOCK_LINES, [0], [0])(xm, dm)])
     return block_r, block_h
 
 
@@ -181,19 +175,9 @@ class Solver:
     at the grid temperatures (a margin, so that poles cannot cross the axis between them).
     """
 
-    def __init__(
-        self,
-        structure: Structure,
-        n_points: int,
-        kind: str,
-        *,
-        max_iter: int = 300,
-        tol: float = 1e-10,
-        grid_taus=None,
-        hurwitz: bool = False,
-        hurwitz_margin: float = 1e-4,
-        pole_margin: float = 0.0,
-    ):
+    def __init__(self, structure: Structure, n_points: int, kind: str, *, max_iter: int = 300,
+                 tol: float = 1e-10, grid_taus=None, hurwitz: bool = False,
+                 hurwitz_margin: float = 1e-4, pole_margin: float = 0.0):
         import casadi as ca
 
         st = self.structure = structure
@@ -201,7 +185,7 @@ class Solver:
         n = self.n_points
         self.n_blocks = nb = -(-n // BLOCK_LINES)
         x = ca.MX.sym("x", st.n_params)
-        p = ca.MX.sym("p", 6 * nb * BLOCK_LINES)  # line after line, see line_data
+        p = ca.MX.sym("p", 6 * nb * BLOCK_LINES)      # line after line, see line_data
         data = ca.reshape(p, 6, nb * BLOCK_LINES)
         block_r, block_h = _block_functions(st, kind)
         r = block_r.map("blocks", "serial", nb, [0], [])(x, data)
@@ -214,7 +198,7 @@ class Solver:
             for s_name in [s for s in st.slots if s.startswith("log_")] + st.zero_slots:
                 j = st.slots.index(s_name) * nc
                 for tau in taus:
-                    g.append(ca.dot(xs[j : j + nc], ca.DM(tau ** np.arange(nc))))
+                    g.append(ca.dot(xs[j:j + nc], ca.DM(tau ** np.arange(nc))))
                     self._g_kinds.append(s_name)
         if hurwitz and taus.size:
             if st.form != "coefficients":
@@ -225,22 +209,17 @@ class Solver:
         self.hurwitz_margin = hurwitz_margin
         gs = ca.vertcat(*g) if g else ca.SX(0, 1)
         lam_gs = ca.SX.sym("lam_g", gs.shape[0])
-        g_hess = ca.Function(
-            "g_hess", [xs, lam_gs], [ca.hessian(ca.dot(lam_gs, gs), xs)[0] if g else ca.SX(st.n_params, st.n_params)]
-        )
+        g_hess = ca.Function("g_hess", [xs, lam_gs], [ca.hessian(ca.dot(lam_gs, gs), xs)[0]
+                                                     if g else ca.SX(st.n_params, st.n_params)])
         gx = ca.Function("constraints", [xs], [gs])(x)
         # exact Hessian of the Lagrangian, assembled from per-line Hessians (mapped and summed:
         # differentiating the mapped objective instead costs time proportional to the lines)
         lam_f = ca.MX.sym("lam_f")
         lam_g = ca.MX.sym("lam_g", gs.shape[0])
         h_f = block_h.map("blocks_h", "serial", nb, [0], [0])(x, data) / (2 * n)
-        hess = ca.Function(
-            "lagrangian_hessian",
-            [x, p, lam_f, lam_g],
-            [ca.triu(lam_f * h_f + g_hess(x, lam_g))],
-            ["x", "p", "lam_f", "lam_g"],
-            ["triu_hess_gamma_x_x"],
-        )
+        hess = ca.Function("lagrangian_hessian", [x, p, lam_f, lam_g],
+                           [ca.triu(lam_f * h_f + g_hess(x, lam_g))],
+                           ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
         nlp = {"x": x, "p": p, "f": f, "g": gx}
         opts = {
             "print_time": False,
@@ -262,16 +241,18 @@ class Solver:
 
         n, nc = st.n_poles, st.n_coef
         # Taylor shift D(s) → D(s − shift): q_i = Σ_{k≥i} a_k C(k, i) (−shift)^(k−i), a_n = 1
-        tmat = np.array([[comb(k, i) * (-shift) ** (k - i) if k >= i else 0.0 for k in range(n + 1)] for i in range(n)])
+        tmat = np.array([[comb(k, i) * (-shift) ** (k - i) if k >= i else 0.0 for k in range(n + 1)]
+                         for i in range(n)])
         g = []
         for tau in taus:
             tp = ca.DM(tau ** np.arange(nc))
             a = []
             for j in range(n):
                 k = st.slots.index(f"a{j}")
-                a.append(ca.dot(x[k * nc : (k + 1) * nc], tp))
+                a.append(ca.dot(x[k * nc:(k + 1) * nc], tp))
             a_all = a + [1.0]
-            a = [sum(float(tmat[i, k]) * a_all[k] for k in range(n + 1) if tmat[i, k] != 0.0) for i in range(n)]
+            a = [sum(float(tmat[i, k]) * a_all[k] for k in range(n + 1) if tmat[i, k] != 0.0)
+                 for i in range(n)]
             g += a  # Liénard–Chipart: all coefficients positive …
             hm = hurwitz_matrix([1.0] + a[::-1])
             for order in range(n - 1, 1, -2):  # … and Δ_{n-1}, Δ_{n-3}, … positive
@@ -297,43 +278,28 @@ class Solver:
         sol = self._solver(**args)
         elapsed = time.perf_counter() - t0
         stats = self._solver.stats()
-        interrupts.check()  # CasADi catches Ctrl-C inside IPOPT and reports it as a failed solve
+        interrupts.check()     # CasADi catches Ctrl-C inside IPOPT and reports it as a failed solve
         theta = np.asarray(sol["x"], float).ravel()
         status = str(stats.get("return_status", "unknown"))
         cost = float(sol["f"])
         ok = status in _OK_STATUSES and np.isfinite(cost) and np.all(np.isfinite(theta))
         trace = [float(v) for v in stats.get("iterations", {}).get("obj", [])]
-        return SolveOutcome(theta, cost, status, bool(ok), int(stats.get("iter_count", -1)), elapsed, trace)
+        return SolveOutcome(theta, cost, status, bool(ok), int(stats.get("iter_count", -1)),
+                            elapsed, trace)
 
 
-def get_solver(
-    structure: Structure,
-    n_points: int,
-    kind: str,
-    *,
-    max_iter: int,
-    tol: float,
-    grid_taus=None,
-    hurwitz: bool = False,
-    pole_margin: float = 0.0,
-) -> Solver:
+def get_solver(structure: Structure, n_points: int, kind: str, *, max_iter: int, tol: float,
+               grid_taus=None, hurwitz: bool = False, pole_margin: float = 0.0) -> Solver:
     """Cached :class:`Solver` (building one costs far more than solving a small fit)."""
     taus = None if grid_taus is None else tuple(np.round(np.asarray(grid_taus, float), 12))
-    key = (structure, int(n_points), kind, int(max_iter), float(tol), taus, bool(hurwitz), float(pole_margin))
+    key = (structure, int(n_points), kind, int(max_iter), float(tol), taus, bool(hurwitz),
+           float(pole_margin))
     solver = _CACHE.get(key)
     if solver is None:
         if len(_CACHE) >= _CACHE_MAX:
             _CACHE.pop(next(iter(_CACHE)))
-        solver = Solver(
-            structure,
-            n_points,
-            kind,
-            max_iter=max_iter,
-            tol=tol,
-            grid_taus=taus,
-            hurwitz=hurwitz,
-            pole_margin=pole_margin,
-        )
+        solver = Solver(structure, n_points, kind, max_iter=max_iter, tol=tol,
+                        grid_taus=taus, hurwitz=hurwitz, pole_margin=pole_margin)
         _CACHE[key] = solver
     return solver
 
@@ -341,7 +307,7 @@ def get_solver(
 def _r_factor(a: np.ndarray) -> np.ndarray:
     """Triangular factor of a = QR by modified Gram–Schmidt (backward stable for R), with
     element-wise numpy operations only (no BLAS/LAPACK call on the tall matrix)."""
-    q = np.array(a.T, dtype=float, order="C")  # columns of a as rows
+    q = np.array(a.T, dtype=float, order="C")          # columns of a as rows
     p = q.shape[0]
     r = np.zeros((p, p))
     for j in range(p):
@@ -351,9 +317,9 @@ def _r_factor(a: np.ndarray) -> np.ndarray:
             continue
         q[j] /= nrm
         if j + 1 < p:
-            proj = np.einsum("ij,j->i", q[j + 1 :], q[j])
-            r[j, j + 1 :] = proj
-            q[j + 1 :] -= proj[:, None] * q[j]
+            proj = np.einsum("ij,j->i", q[j + 1:], q[j])
+            r[j, j + 1:] = proj
+            q[j + 1:] -= proj[:, None] * q[j]
     return r
 
 
@@ -367,7 +333,7 @@ def covariance(jac: np.ndarray, resid: np.ndarray, scale: bool):
     # but the only LAPACK call is on the small R.  LAPACK on the tall jac runs matrix-vector
     # products on several OpenBLAS threads, which on a busy machine wait for each other (up to
     # 0.7 s for 4800 x 21, against 2 ms here).
-    small = jac.size <= 20_000  # below OpenBLAS's threading thresholds
+    small = jac.size <= 20_000                  # below OpenBLAS's threading thresholds
     s, vt = np.linalg.svd(jac if small else _r_factor(jac), full_matrices=False)[1:]
     keep = s > s[0] * 1e-12 if s.size else s.astype(bool)
     inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 0.0)

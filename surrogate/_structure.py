@@ -58,7 +58,9 @@ class Structure:
         if self.n_poles < 1:
             raise ValueError(f"n_poles must be >= 1, got {self.n_poles}")
         if self.n_zeros > self.n_poles:
-            raise ValueError(f"n_zeros={self.n_zeros} > n_poles={self.n_poles}: only proper models are supported")
+            raise ValueError(
+                f"n_zeros={self.n_zeros} > n_poles={self.n_poles}: only proper models are supported"
+            )
 
     # ------------------------------------------------------------ layout
     @property
@@ -153,8 +155,8 @@ class Structure:
         sb = self.slot_bounds(w_min, w_max) if self.degree == 0 else self.slot_bounds()
         for j, s in enumerate(self.slots):
             if s in sb:
-                lo[j * self.n_coef : (j + 1) * self.n_coef] = sb[s][0] if self.degree == 0 else -_LOG_BOUND
-                hi[j * self.n_coef : (j + 1) * self.n_coef] = sb[s][1] if self.degree == 0 else _LOG_BOUND
+                lo[j * self.n_coef:(j + 1) * self.n_coef] = sb[s][0] if self.degree == 0 else -_LOG_BOUND
+                hi[j * self.n_coef:(j + 1) * self.n_coef] = sb[s][1] if self.degree == 0 else _LOG_BOUND
         return lo, hi
 
     def with_degree(self, degree: int) -> Structure:
@@ -164,7 +166,8 @@ class Structure:
         return Structure(form, self.n_zeros, self.n_poles, self.degree)
 
     def to_dict(self) -> dict:
-        return {"form": self.form, "n_zeros": self.n_zeros, "n_poles": self.n_poles, "degree": self.degree}
+        return {"form": self.form, "n_zeros": self.n_zeros, "n_poles": self.n_poles,
+                "degree": self.degree}
 
     # ----------------------------------------------------- slot matrices
     def slot_matrix(self, theta) -> np.ndarray:
@@ -332,7 +335,7 @@ def denominators(structure: Structure, theta, taus) -> np.ndarray:
     shape (len(taus), n_poles + 1); the same numbers as ``polynomials(...)[1]`` per τ."""
     taus = np.atleast_1d(np.asarray(taus, float))
     vals = structure.slot_matrix(theta) @ (taus[None, :] ** np.arange(structure.n_coef)[:, None])
-    v = dict(zip(structure.slots, vals))  # slot -> (K,)
+    v = dict(zip(structure.slots, vals))                       # slot -> (K,)
     n, k = structure.n_poles, taus.size
     if structure.form == "coefficients":
         return np.column_stack([v[f"a{j}"] for j in range(n)] + [np.ones(k)])
@@ -343,7 +346,7 @@ def denominators(structure: Structure, theta, taus) -> np.ndarray:
     for sec in sections:
         out = np.zeros((k, den.shape[1] + len(sec) - 1))
         for j, c in enumerate(sec):
-            out[:, j : j + den.shape[1]] += den * c[:, None]
+            out[:, j:j + den.shape[1]] += den * c[:, None]
         den = out
     return den
 

@@ -49,41 +49,21 @@ def assess(result, *, alpha: float = ALPHA, max_relative_rms: float = MAX_RELATI
     if result.weighting == "uncertainty" and n_res > n_par and math.isfinite(result.cost):
         from scipy.stats import chi2
 
-        x = 2.0 * n_res * float(result.cost)  # cost = ½·mean r²
+        x = 2.0 * n_res * float(result.cost)          # cost = ½·mean r²
         dof = n_res - n_par
         p = float(chi2.sf(x, dof))
         ok = p >= alpha
-        return Adequacy(
-            ok,
-            "chi2",
-            x,
-            dof,
-            p,
-            alpha,
-            f"chi2 = {x:.4g} on {dof} degrees of freedom (expected {dof} ± {math.sqrt(2 * dof):.3g}), "
-            f"p = {p:.2g}: "
-            + (
-                "consistent with the declared noise"
-                if ok
-                else f"the model does not fit the data within the declared noise (p < {alpha:g})"
-            ),
-        )
+        return Adequacy(ok, "chi2", x, dof, p, alpha,
+                        f"chi2 = {x:.4g} on {dof} degrees of freedom (expected {dof} ± {math.sqrt(2 * dof):.3g}), "
+                        f"p = {p:.2g}: " + ("consistent with the declared noise" if ok else
+                                            f"the model does not fit the data within the declared noise (p < {alpha:g})"))
     worst = max((e for e in result.per_temperature), key=lambda e: e.relative_rms_error)
     ok = bool(np.isfinite(worst.relative_rms_error) and worst.relative_rms_error <= max_relative_rms)
     at = "" if worst.temperature_c is None else f" at {worst.temperature_c:g} °C"
-    return Adequacy(
-        ok,
-        "relative_rms",
-        float(worst.relative_rms_error),
-        None,
-        None,
-        max_relative_rms,
-        f"no declared noise: worst relative RMS error {worst.relative_rms_error:.3g}{at} (fit "
-        f"{worst.fit_percent:.1f} %); "
-        + ("within" if ok else "above")
-        + f" {max_relative_rms:g}"
-        + ("" if ok else ": the model does not fit the data"),
-    )
+    return Adequacy(ok, "relative_rms", float(worst.relative_rms_error), None, None, max_relative_rms,
+                    f"no declared noise: worst relative RMS error {worst.relative_rms_error:.3g}{at} (fit "
+                    f"{worst.fit_percent:.1f} %); " + ("within" if ok else "above") +
+                    f" {max_relative_rms:g}" + ("" if ok else ": the model does not fit the data"))
 
 
 __all__ = ["Adequacy", "assess", "ALPHA", "MAX_RELATIVE_RMS"]

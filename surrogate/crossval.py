@@ -37,23 +37,9 @@ from ._data import FrequencyData, to_data
 from ._fit import per_temperature_errors
 from ._nlp import ConvergenceError
 
-__all__ = [
-    "ScheduleWarning",
-    "HeldOutError",
-    "CrossValidation",
-    "DegreeSelection",
-    "DenseCheck",
-    "ScheduleCheck",
-    "cross_validate",
-    "select_degree",
-    "dense_check",
-    "physics_reference",
-    "check_schedule",
-    "PHYSICS_ROUTE",
-    "FEW_TEMPERATURES",
-    "CheckedFit",
-    "fit_checked",
-]
+__all__ = ["ScheduleWarning", "HeldOutError", "CrossValidation", "DegreeSelection", "DenseCheck",
+           "ScheduleCheck", "cross_validate", "select_degree", "dense_check", "physics_reference",
+           "check_schedule", "PHYSICS_ROUTE", "FEW_TEMPERATURES", "CheckedFit", "fit_checked"]
 
 #: At most this many fit temperatures counts as "few": the physics-calibrated route is proposed.
 FEW_TEMPERATURES = 5
@@ -63,8 +49,7 @@ PHYSICS_ROUTE = (
     "(physmodel.estimation.calibration.calibrate, `ipmc calibrate`), sweep the calibrated physics densely "
     "(>= 7 temperatures over the range: `ipmc sweep --params-json calibrated.json`), fit the schedule "
     "to that sweep holding temperatures out (`ipmc fit --exclude ...`) and check it with "
-    "surrogate.crossval.check_schedule(..., physics=...); the scenario control_route.toml shows it"
-)
+    "surrogate.crossval.check_schedule(..., physics=...); the scenario control_route.toml shows it")
 
 
 class ScheduleWarning(UserWarning):
@@ -143,17 +128,14 @@ class CrossValidation:
         return max(e for _, e in self.fit_errors) if self.fit_errors else float("nan")
 
     def to_markdown(self) -> str:
-        head = f"Leave-one-temperature-out, {self.form} {self.n_zeros}/{self.n_poles}, degree {self.degree}: " + (
-            "" if self.feasible else f"not possible ({self.reason})"
-        )
+        head = (f"Leave-one-temperature-out, {self.form} {self.n_zeros}/{self.n_poles}, degree {self.degree}: "
+                + ("" if self.feasible else f"not possible ({self.reason})"))
         rows = ["| T [°C] | role | relative RMS error | refit converged |", "|---:|:---|---:|:---|"]
         for t, e in self.fit_errors:
             rows.append(f"| {t:g} | in fit | {e:.4f} | |")
         for h in self.held_out:
             role = "held out (extrapolated)" if h.extrapolated else "held out"
-            rows.append(
-                f"| {h.temperature_c:g} | {role} | {h.relative_rms_error:.4f} | {'yes' if h.converged else 'NO'} |"
-            )
+            rows.append(f"| {h.temperature_c:g} | {role} | {h.relative_rms_error:.4f} | {'yes' if h.converged else 'NO'} |")
         return head + "\n\n" + "\n".join(rows) + "\n"
 
 
@@ -171,7 +153,7 @@ def _clone(template: Any, degree: int | None = None) -> Any:
 def _fit(template: Any, data: FrequencyData, degree: int | None = None):
     try:
         return _clone(template, degree).fit_data(data)
-    except ConvergenceError as exc:  # pragma: no cover - raise_on_failure=False returns flagged results
+    except ConvergenceError as exc:   # pragma: no cover - raise_on_failure=False returns flagged results
         return exc.result
 
 
@@ -180,9 +162,8 @@ def _errors_at(model: Any, data: FrequencyData, temps) -> list[tuple[float, floa
     return [(float(e.temperature_c), float(e.relative_rms_error)) for e in errs]
 
 
-def cross_validate(
-    template: Any, data: Any, *, degree: int | None = None, ends: bool = False, full_result: Any = None
-) -> CrossValidation:
+def cross_validate(template: Any, data: Any, *, degree: int | None = None, ends: bool = False,
+                   full_result: Any = None) -> CrossValidation:
     """Leave-one-temperature-out cross-validation of a scheduled fit.
 
     Parameters
@@ -211,27 +192,18 @@ def cross_validate(
     need = max(deg + 1, 2)
     candidates = temps if ends else temps[1:-1]
     if temps.size - 1 < need or candidates.size == 0:
-        reason = (
-            f"{temps.size} temperatures: holding one out leaves {temps.size - 1}, a degree-{deg} schedule needs {need}"
-            if temps.size - 1 < need
-            else f"no temperature lies between {temps[0]:g} and {temps[-1]:g} °C"
-        )
+        reason = (f"{temps.size} temperatures: holding one out leaves {temps.size - 1}, a degree-{deg} "
+                  f"schedule needs {need}" if temps.size - 1 < need else
+                  f"no temperature lies between {temps[0]:g} and {temps[-1]:g} °C")
         return CrossValidation(**base, held_out=(), fit_errors=fit_errors, feasible=False, reason=reason)
     held = []
-    for t in candidates:  # one refit per held-out temperature (each an NLP)
+    for t in candidates:      # one refit per held-out temperature (each an NLP)
         train = data.select(data.temperature_c != t)
         res = _fit(template, train, deg)
-        ((_, err),) = _errors_at(res.model, data, [t])
+        (_, err), = _errors_at(res.model, data, [t])
         tt = train.temperatures()
-        held.append(
-            HeldOutError(
-                float(t),
-                int(np.sum(data.temperature_c == t)),
-                err,
-                bool(res.converged),
-                bool(t < tt.min() or t > tt.max()),
-            )
-        )
+        held.append(HeldOutError(float(t), int(np.sum(data.temperature_c == t)), err, bool(res.converged),
+                                 bool(t < tt.min() or t > tt.max())))
     return CrossValidation(**base, held_out=tuple(held), fit_errors=fit_errors)
 
 
@@ -257,9 +229,7 @@ class DegreeSelection:
         lines = ["| degree | error at fit T (max) | held-out error between (mean / max) |", "|---:|---:|:---|"]
         for r in self.rows:
             cv = f"{r.mean_cv_error:.4f} / {r.cv_error:.4f}" if r.feasible else f"n/a ({r.reason})"
-            lines.append(
-                f"| {r.degree}{' (chosen)' if r.degree == self.best_degree else ''} | {r.fit_error:.4f} | {cv} |"
-            )
+            lines.append(f"| {r.degree}{' (chosen)' if r.degree == self.best_degree else ''} | {r.fit_error:.4f} | {cv} |")
         return "\n".join(lines) + "\n"
 
 
@@ -281,10 +251,8 @@ def select_degree(template: Any, data: Any, degrees=(0, 1, 2, 3)) -> DegreeSelec
         rows.append(cross_validate(template, data, degree=d))
     ok = [r for r in rows if r.feasible]
     if not ok:
-        raise IPMCError(
-            f"no degree in {list(degrees)} can be cross-validated on {n_t} temperatures "
-            f"(need at least 3, one of them between the others); use " + PHYSICS_ROUTE
-        )
+        raise IPMCError(f"no degree in {list(degrees)} can be cross-validated on {n_t} temperatures "
+                        f"(need at least 3, one of them between the others); use " + PHYSICS_ROUTE)
     best = min(ok, key=lambda r: (round(r.mean_cv_error, 12), r.degree))
     return DegreeSelection(tuple(rows), best.degree, _fit(template, data, best.degree))
 
@@ -332,9 +300,8 @@ def physics_reference(model: Any, quantity: str = "M") -> Callable:
     return ref
 
 
-def dense_check(
-    model: Any, reference: Callable, frequency_hz: Any, fit_temperatures_c: Any, *, step_c: float = 1.0
-) -> DenseCheck:
+def dense_check(model: Any, reference: Callable, frequency_hz: Any, fit_temperatures_c: Any, *,
+                step_c: float = 1.0) -> DenseCheck:
     """Compare a scheduled ``model`` with ``reference`` on a grid of ``step_c`` [°C] spanning the fit
     temperatures (which are included).  ``reference(frequency_hz, temperatures) -> (n_T, n_f)``."""
     ft = np.unique(np.asarray(fit_temperatures_c, float))
@@ -382,17 +349,9 @@ class ScheduleCheck:
     notes: list = field(default_factory=list)
 
 
-def check_schedule(
-    template: Any,
-    data: Any,
-    model: Any = None,
-    *,
-    physics: Any = None,
-    frequency_hz: Any = None,
-    factor: float = 2.0,
-    step_c: float = 1.0,
-    warn: bool = True,
-) -> ScheduleCheck:
+def check_schedule(template: Any, data: Any, model: Any = None, *, physics: Any = None,
+                   frequency_hz: Any = None, factor: float = 2.0, step_c: float = 1.0,
+                   warn: bool = True) -> ScheduleCheck:
     """Trust check of a scheduled fit between its temperatures.
 
     Parameters
@@ -422,11 +381,8 @@ def check_schedule(
     cv = cross_validate(template, data, full_result=full)
     dense = None
     if physics is not None:
-        ref = (
-            physics
-            if callable(physics) and not hasattr(physics, "frequency_response")
-            else physics_reference(physics, "M" if type(physics).__name__ == "ActuatorModel" else "S")
-        )
+        ref = physics if callable(physics) and not hasattr(physics, "frequency_response") else \
+            physics_reference(physics, "M" if type(physics).__name__ == "ActuatorModel" else "S")
         f = data.frequency_hz[data.temperature_c == temps[0]] if frequency_hz is None else frequency_hz
         dense = dense_check(model, ref, f, temps, step_c=step_c)
     at_fit = cv.fit_error
@@ -436,29 +392,23 @@ def check_schedule(
     if not cv.feasible:
         notes.append(f"leave-one-temperature-out not possible: {cv.reason}")
     else:
-        notes.append(
-            "held-out errors: " + ", ".join(f"{h.temperature_c:g} °C {h.relative_rms_error:.3g}" for h in cv.held_out)
-        )
+        notes.append("held-out errors: " + ", ".join(f"{h.temperature_c:g} °C {h.relative_rms_error:.3g}"
+                                                   for h in cv.held_out))
     if dense is not None:
-        notes.append(
-            f"against the physics on {dense.temperatures_c.size} temperatures: at fit temperatures "
-            f"{dense.at_fit_error:.3g}, between {dense.between_error:.3g} (worst at "
-            f"{dense.worst_temperature_c:g} °C)"
-        )
+        notes.append(f"against the physics on {dense.temperatures_c.size} temperatures: at fit temperatures "
+                     f"{dense.at_fit_error:.3g}, between {dense.between_error:.3g} (worst at "
+                     f"{dense.worst_temperature_c:g} °C)")
     proposal = PHYSICS_ROUTE if temps.size <= FEW_TEMPERATURES else ""
     if not measured:
         ok = False
-        msg = (
-            f"the schedule ({cv.form} {cv.n_zeros}/{cv.n_poles}, degree {cv.degree}, {temps.size} "
-            f"temperatures {temps.tolist()} °C) is unverified between its temperatures: "
-            f"{'; '.join(notes)}; its error at them is {at_fit:.3g}"
-        )
+        msg = (f"the schedule ({cv.form} {cv.n_zeros}/{cv.n_poles}, degree {cv.degree}, {temps.size} "
+               f"temperatures {temps.tolist()} °C) is unverified between its temperatures: "
+               f"{'; '.join(notes)}; its error at them is {at_fit:.3g}")
     else:
         ok = bool(between <= factor * at_fit)
-        msg = (
-            f"schedule error between fit temperatures {between:.3g} "
-            f"{'<=' if ok else 'exceeds'} {factor:g} x its error at them ({at_fit:.3g}); " + "; ".join(notes)
-        )
+        msg = (f"schedule error between fit temperatures {between:.3g} "
+               f"{'<=' if ok else 'exceeds'} {factor:g} x its error at them ({at_fit:.3g}); "
+               + "; ".join(notes))
     if not ok and proposal:
         msg += f". With {temps.size} temperatures, use {proposal}"
     if not ok and warn:
@@ -496,19 +446,13 @@ class CheckedFit:
         parts = []
         if self.selection is not None:
             parts += ["### Degree chosen by leave-one-temperature-out", "", self.selection.to_markdown()]
-        parts += [
-            "### Error between fit temperatures",
-            "",
-            self.check.cv.to_markdown(),
-            ("OK: " if self.check.ok else "**WARNING**: ") + self.check.message,
-            "",
-        ]
+        parts += ["### Error between fit temperatures", "", self.check.cv.to_markdown(),
+                  ("OK: " if self.check.ok else "**WARNING**: ") + self.check.message, ""]
         return "\n".join(parts)
 
 
-def fit_checked(
-    template: Any, data: Any, *, degrees=None, physics: Any = None, factor: float = 2.0, warn: bool = True
-) -> CheckedFit:
+def fit_checked(template: Any, data: Any, *, degrees=None, physics: Any = None, factor: float = 2.0,
+                warn: bool = True) -> CheckedFit:
     """Fit a schedule and check it between its temperatures in one call.
 
     ``degrees``: candidate degrees to choose from by cross-validation (:func:`select_degree`);

@@ -60,4 +60,4 @@ def log_rms_error(model, data) -> float:
     """
     m, d = _pair(model, data)
     r = np.log(m / d)
-    return float(np.sqrt(np.mean(r.real**2 + r.imag**2)))
+    return float(np.sqrt(np.mean(r.real ** 2 + r.imag ** 2)))

@@ -94,20 +94,14 @@ class RationalModel:
         Fit settings, status and data fingerprint, saved with the model.
     """
 
-    def __init__(
-        self,
-        structure: S.Structure,
-        params,
-        scaling: Scaling,
-        temperature_range_c=None,
-        covariance=None,
-        labels=None,
-        info=None,
-    ):
+    def __init__(self, structure: S.Structure, params, scaling: Scaling,
+                 temperature_range_c=None, covariance=None, labels=None, info=None):
         self.structure = structure
         p = np.array(params, dtype=float).ravel()
         if p.shape[0] != structure.n_params:
-            raise ValueError(f"params has {p.shape[0]} entries, structure {structure} needs {structure.n_params}")
+            raise ValueError(
+                f"params has {p.shape[0]} entries, structure {structure} needs {structure.n_params}"
+            )
         if not np.all(np.isfinite(p)):
             raise ValueError("params contain non-finite values")
         p.setflags(write=False)
@@ -178,7 +172,8 @@ class RationalModel:
         for i, name in enumerate(self.param_names):
             row = {"name": name, "value": float(self._params[i])}
             if ci is not None:
-                row.update(stderr=float(self.stderr[i]), ci95_low=float(ci[0][i]), ci95_high=float(ci[1][i]))
+                row.update(stderr=float(self.stderr[i]), ci95_low=float(ci[0][i]),
+                           ci95_high=float(ci[1][i]))
             rows.append(row)
         return rows
 
@@ -383,12 +378,12 @@ class RationalModel:
             grid, re = [None], np.atleast_1d(self.max_pole_real_part())
         i = int(np.argmax(re))
         worst = float(re[i])
-        return StabilityCheck(bool(worst < 0), worst, None if grid[i] is None else float(grid[i]), len(grid))
+        return StabilityCheck(bool(worst < 0), worst, None if grid[i] is None else float(grid[i]),
+                              len(grid))
 
     # ------------------------------------------------------------ persistence
     def to_dict(self) -> dict:
         """The model as JSON-ready data (schema ``ipmc.surrogate.rational_model``, versioned)."""
-
         def clean(x):
             return None if x is None else np.asarray(x, float).tolist()
 
@@ -398,16 +393,13 @@ class RationalModel:
             "structure": self.structure.to_dict(),
             "scaling": asdict(self.scaling),
             "temperature_range_c": None if self.temperature_range_c is None else list(self.temperature_range_c),
-            "params": {"names": self.param_names, "values": clean(self._params), "covariance": clean(self.covariance)},
+            "params": {"names": self.param_names, "values": clean(self._params),
+                       "covariance": clean(self.covariance)},
             "labels": self.labels,
             "info": self.info,
-            "conventions": {
-                "s": "rad/s",
-                "frequency_edges": "Hz",
-                "temperature": "degC",
-                "model": "H = gain_ref*N(s/omega_ref, tau)/D(s/omega_ref, tau), "
-                "tau = (T - temperature_center_c)/temperature_scale_c",
-            },
+            "conventions": {"s": "rad/s", "frequency_edges": "Hz", "temperature": "degC",
+                            "model": "H = gain_ref*N(s/omega_ref, tau)/D(s/omega_ref, tau), "
+                                     "tau = (T - temperature_center_c)/temperature_scale_c"},
         }
 
     def to_json(self, path) -> None:
@@ -434,7 +426,9 @@ class RationalModel:
         if not isinstance(d, dict) or d.get("schema") != SCHEMA:
             raise IPMCError(f"not a {SCHEMA} document (schema={d.get('schema') if isinstance(d, dict) else None!r})")
         if d.get("schema_version") != SCHEMA_VERSION:
-            raise IPMCError(f"unsupported schema_version {d.get('schema_version')!r}; this code reads {SCHEMA_VERSION}")
+            raise IPMCError(
+                f"unsupported schema_version {d.get('schema_version')!r}; this code reads {SCHEMA_VERSION}"
+            )
         for key, kind in (("structure", dict), ("params", dict), ("scaling", dict)):
             if not isinstance(d.get(key), kind):
                 raise IPMCError(f"key {key!r}: expected an object, got {type(d.get(key)).__name__}")
@@ -448,28 +442,20 @@ class RationalModel:
         except TypeError as exc:
             raise IPMCError(f"key 'structure' or 'scaling': {exc}") from None
         if params["names"] != st.param_names():
-            raise IPMCError(
-                f"key 'params.names': the parameter names do not match the structure (expected {st.param_names()})"
-            )
+            raise IPMCError("key 'params.names': the parameter names do not match the structure "
+                            f"(expected {st.param_names()})")
         values = np.asarray(params["values"], dtype=object)
         if values.shape != (len(params["names"]),) or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) for v in values
-        ):
+                isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) for v in values):
             raise IPMCError(f"key 'params.values': expected {len(params['names'])} finite numbers")
-        return cls(
-            st,
-            params["values"],
-            scaling,
-            d.get("temperature_range_c"),
-            params.get("covariance"),
-            d.get("labels"),
-            d.get("info"),
-        )
+        return cls(st, params["values"], scaling, d.get("temperature_range_c"), params.get("covariance"),
+                   d.get("labels"), d.get("info"))
 
     def __repr__(self):
         st = self.structure
         rng = "" if self.temperature_range_c is None else f", T in {list(self.temperature_range_c)} °C"
-        return f"RationalModel(form={st.form!r}, n_zeros={st.n_zeros}, n_poles={st.n_poles}, degree={st.degree}{rng})"
+        return (f"RationalModel(form={st.form!r}, n_zeros={st.n_zeros}, n_poles={st.n_poles}, "
+                f"degree={st.degree}{rng})")
 
 
 def load(path) -> RationalModel:

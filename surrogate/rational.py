@@ -59,21 +59,10 @@ class RationalFit:
     history_ : list of dict, one per start (and resumed solve).
     """
 
-    def __init__(
-        self,
-        n_zeros: int,
-        n_poles: int,
-        *,
-        stable: bool = True,
-        weighting: str = "auto",
-        init: str = "auto",
-        max_iter: int = 300,
-        tol: float = 1e-10,
-        omega_ref_rad_s: float | None = None,
-        gain_ref: float | None = None,
-        raise_on_failure: bool = True,
-        scale_covariance: bool = True,
-    ):
+    def __init__(self, n_zeros: int, n_poles: int, *, stable: bool = True, weighting: str = "auto",
+                 init: str = "auto", max_iter: int = 300, tol: float = 1e-10,
+                 omega_ref_rad_s: float | None = None, gain_ref: float | None = None,
+                 raise_on_failure: bool = True, scale_covariance: bool = True):
         self.structure = Structure("sections" if stable else "coefficients", n_zeros, n_poles, 0)
         self.n_zeros, self.n_poles = self.structure.n_zeros, self.structure.n_poles
         self.stable = bool(stable)
@@ -89,21 +78,14 @@ class RationalFit:
         self.scale_covariance = bool(scale_covariance)
 
     def settings(self) -> dict:
-        return {
-            "estimator": "RationalFit",
-            "n_zeros": self.n_zeros,
-            "n_poles": self.n_poles,
-            "stable": self.stable,
-            "weighting": self.weighting,
-            "init": self.init,
-            "max_iter": self.max_iter,
-            "tol": self.tol,
-            "omega_ref_rad_s": self.omega_ref_rad_s,
-            "gain_ref": self.gain_ref,
-            "scale_covariance": self.scale_covariance,
-        }
+        return {"estimator": "RationalFit", "n_zeros": self.n_zeros, "n_poles": self.n_poles,
+                "stable": self.stable, "weighting": self.weighting, "init": self.init,
+                "max_iter": self.max_iter, "tol": self.tol,
+                "omega_ref_rad_s": self.omega_ref_rad_s, "gain_ref": self.gain_ref,
+                "scale_covariance": self.scale_covariance}
 
-    def fit(self, frequency_hz, temperature_c=None, response=None, magnitude_std_db=None, phase_std_deg=None):
+    def fit(self, frequency_hz, temperature_c=None, response=None, magnitude_std_db=None,
+            phase_std_deg=None):
         """Fit one temperature's data (``temperature_c`` scalar, constant array or None), or a
         ``FrequencySweep`` / ``FrequencyData`` passed alone.
 
@@ -130,7 +112,8 @@ class RationalFit:
             )
         st = self.structure
         F.check_order_per_temperature(st, data)
-        scaling = F.make_scaling(data, self.omega_ref_rad_s, self.gain_ref, float(temps[0]) if temps.size else 0.0, 1.0)
+        scaling = F.make_scaling(data, self.omega_ref_rad_s, self.gain_ref,
+                                 float(temps[0]) if temps.size else 0.0, 1.0)
         problem, wname = F.make_problem(st, data, scaling, self.weighting)
         starts = []
         if theta0 is not None:
@@ -158,21 +141,11 @@ class RationalFit:
         F.resume_slowest(outcomes, None, history, stage, self.max_iter)
         _, best = F.best_outcome(outcomes, prefer="warm")
         temp_range = None if not temps.size else (float(temps[0]), float(temps[0]))
-        res = F.finish(
-            st,
-            problem,
-            evaluator,
-            best,
-            scaling,
-            data,
-            weighting_name=wname,
-            method="rational",
-            settings=self.settings(),
-            scale_covariance=self.scale_covariance,
-            history=history,
-            time_s=time.perf_counter() - t_start,
-            temperature_range=temp_range,
-            raise_on_failure=self.raise_on_failure,
-        )
+        res = F.finish(st, problem, evaluator, best, scaling, data, weighting_name=wname,
+                       method="rational", settings=self.settings(),
+                       scale_covariance=self.scale_covariance, history=history,
+                       time_s=time.perf_counter() - t_start, temperature_range=temp_range,
+                       raise_on_failure=self.raise_on_failure)
         self.model_, self.result_, self.history_ = res.model, res, history
         return res
+

@@ -27,8 +27,8 @@ from .rational import RationalFit
 __all__ = ["ScheduledFit"]
 
 _METHODS = ("joint", "two-stage")
-_DENSE_CHECK = 501  # temperatures of the final stability check (FitResult.stability)
-_MAX_REFINE = 4  # rounds of adding unstable temperatures to the Hurwitz constraint grid
+_DENSE_CHECK = 501   # temperatures of the final stability check (FitResult.stability)
+_MAX_REFINE = 4      # rounds of adding unstable temperatures to the Hurwitz constraint grid
 
 
 class ScheduledFit:
@@ -75,28 +75,13 @@ class ScheduledFit:
     model_, result_, history_, two_stage_model_, per_temperature_models_
     """
 
-    def __init__(
-        self,
-        form: str = "zpk",
-        n_zeros: int = 3,
-        n_poles: int = 3,
-        degree: int = 2,
-        *,
-        method: str = "joint",
-        weighting: str = "auto",
-        enforce_stability: bool = True,
-        stability_grid: int = 41,
-        stability_margin: float = 1e-3,
-        max_iter: int = 500,
-        tol: float = 1e-10,
-        omega_ref_rad_s: float | None = None,
-        gain_ref: float | None = None,
-        temperature_center_c: float | None = None,
-        temperature_scale_c: float | None = None,
-        per_temperature: str = "nlp",
-        raise_on_failure: bool = True,
-        scale_covariance: bool = True,
-    ):
+    def __init__(self, form: str = "zpk", n_zeros: int = 3, n_poles: int = 3, degree: int = 2, *,
+                 method: str = "joint", weighting: str = "auto", enforce_stability: bool = True,
+                 stability_grid: int = 41, stability_margin: float = 1e-3, max_iter: int = 500, tol: float = 1e-10,
+                 omega_ref_rad_s: float | None = None, gain_ref: float | None = None,
+                 temperature_center_c: float | None = None, temperature_scale_c: float | None = None,
+                 per_temperature: str = "nlp", raise_on_failure: bool = True,
+                 scale_covariance: bool = True):
         if form not in FORMS:
             raise ValueError(f"form must be one of {FORMS}, got {form!r}")
         if method not in _METHODS:
@@ -107,7 +92,8 @@ class ScheduledFit:
         self.weighting = F.check_weighting(weighting)
         self.enforce_stability = bool(enforce_stability)
         self.stability_grid = F.check_positive_int("stability_grid", stability_grid, 2)
-        self.stability_margin = F.check_positive_float("stability_margin", stability_margin, allow_none=False)
+        self.stability_margin = F.check_positive_float("stability_margin", stability_margin,
+                                                       allow_none=False)
         self.max_iter = F.check_positive_int("max_iter", max_iter)
         self.tol = F.check_positive_float("tol", tol, allow_none=False)
         self.omega_ref_rad_s = F.check_positive_float("omega_ref_rad_s", omega_ref_rad_s)
@@ -123,28 +109,19 @@ class ScheduledFit:
         self.scale_covariance = bool(scale_covariance)
 
     def settings(self) -> dict:
-        return {
-            "estimator": "ScheduledFit",
-            "form": self.form,
-            "n_zeros": self.n_zeros,
-            "n_poles": self.n_poles,
-            "degree": self.degree,
-            "method": self.method,
-            "weighting": self.weighting,
-            "enforce_stability": self.enforce_stability,
-            "stability_grid": self.stability_grid,
-            "stability_margin": self.stability_margin,
-            "max_iter": self.max_iter,
-            "tol": self.tol,
-            "omega_ref_rad_s": self.omega_ref_rad_s,
-            "gain_ref": self.gain_ref,
-            "temperature_center_c": self.temperature_center_c,
-            "temperature_scale_c": self.temperature_scale_c,
-            "per_temperature": self.per_temperature,
-            "scale_covariance": self.scale_covariance,
-        }
+        return {"estimator": "ScheduledFit", "form": self.form, "n_zeros": self.n_zeros,
+                "n_poles": self.n_poles, "degree": self.degree, "method": self.method,
+                "weighting": self.weighting, "enforce_stability": self.enforce_stability,
+                "stability_grid": self.stability_grid,
+                "stability_margin": self.stability_margin, "max_iter": self.max_iter, "tol": self.tol,
+                "omega_ref_rad_s": self.omega_ref_rad_s, "gain_ref": self.gain_ref,
+                "temperature_center_c": self.temperature_center_c,
+                "temperature_scale_c": self.temperature_scale_c,
+                "per_temperature": self.per_temperature,
+                "scale_covariance": self.scale_covariance}
 
-    def fit(self, frequency_hz, temperature_c=None, response=None, magnitude_std_db=None, phase_std_deg=None):
+    def fit(self, frequency_hz, temperature_c=None, response=None, magnitude_std_db=None,
+            phase_std_deg=None):
         """Fit tidy data (one line per frequency and temperature), or a ``FrequencySweep`` /
         ``FrequencyData`` passed alone.
 
@@ -170,37 +147,19 @@ class ScheduledFit:
             st0 = Structure("coefficients", self.n_zeros, self.n_poles, 0)
             for t in data.temperatures():
                 d = data.at_temperature(t)
-                num, den = levy(
-                    d.omega / scaling.omega_ref_rad_s, d.response / scaling.gain_ref, self.n_zeros, self.n_poles
-                )
+                num, den = levy(d.omega / scaling.omega_ref_rad_s, d.response / scaling.gain_ref,
+                                self.n_zeros, self.n_poles)
                 theta = np.concatenate([num, den[:-1]])
                 ok = bool(np.all(np.isfinite(theta)))
-                history.append(
-                    {
-                        "stage": f"per-T {t:g} °C",
-                        "start": "levy",
-                        "status": "linear least squares",
-                        "converged": ok,
-                        "iterations": 0,
-                        "cost": float("nan"),
-                        "time_s": 0.0,
-                        "objective_trace": [],
-                    }
-                )
+                history.append({"stage": f"per-T {t:g} °C", "start": "levy", "status": "linear least squares",
+                                "converged": ok, "iterations": 0, "cost": float("nan"), "time_s": 0.0,
+                                "objective_trace": []})
                 out[float(t)] = (st0, theta, ok)
             return out
-        fitter = RationalFit(
-            self.n_zeros,
-            self.n_poles,
-            stable=True,
-            weighting=self.weighting,
-            max_iter=self.max_iter,
-            tol=self.tol,
-            omega_ref_rad_s=scaling.omega_ref_rad_s,
-            gain_ref=scaling.gain_ref,
-            raise_on_failure=False,
-            scale_covariance=self.scale_covariance,
-        )
+        fitter = RationalFit(self.n_zeros, self.n_poles, stable=True, weighting=self.weighting,
+                             max_iter=self.max_iter, tol=self.tol,
+                             omega_ref_rad_s=scaling.omega_ref_rad_s, gain_ref=scaling.gain_ref,
+                             raise_on_failure=False, scale_covariance=self.scale_covariance)
         prev = None
         for t in data.temperatures():
             res = fitter.fit_data(data.at_temperature(t), theta0=prev, stage=f"per-T {t:g} °C")
@@ -252,16 +211,9 @@ class ScheduledFit:
         w_min, w_max = float(problem.w.min()), float(problem.w.max())
 
         def solver_for(grid, constrained, budget=1):
-            return get_solver(
-                st,
-                problem.n_points,
-                problem.kind,
-                max_iter=budget * self.max_iter,
-                tol=self.tol,
-                grid_taus=grid,
-                hurwitz=constrained,
-                pole_margin=self.stability_margin if constrained else 0.0,
-            )
+            return get_solver(st, problem.n_points, problem.kind, max_iter=budget * self.max_iter,
+                              tol=self.tol, grid_taus=grid, hurwitz=constrained,
+                              pole_margin=self.stability_margin if constrained else 0.0)
 
         def unstable(theta):
             return RationalModel(st, theta, scaling, t_range).max_pole_real_part(dense_t) >= 0
@@ -283,7 +235,8 @@ class ScheduledFit:
         evaluator = Evaluator(problem)
         lb, ub = st.bounds()
         starts = {"two-stage": theta2, "constant": const.ravel()}
-        outcomes = F.race_starts(evaluator, list(starts.items()), self.max_iter, self.tol, lb, ub, prefer=None)
+        outcomes = F.race_starts(evaluator, list(starts.items()), self.max_iter, self.tol, lb, ub,
+                                 prefer=None)
         history += [F.history_entry("joint", name, out) for name, out in outcomes]
         F.resume_slowest(outcomes, None, history, "joint", self.max_iter)
         final, setups = [], {}
@@ -305,16 +258,16 @@ class ScheduledFit:
             if outside_slot_bounds(out.theta):
                 setups[name] = (taus, False)
                 out = solver_for(taus, False).solve(problem, out.theta)
-                history.append(F.history_entry(f"joint (section bounds at {taus.size} temperatures)", name, out))
+                history.append(F.history_entry(
+                    f"joint (section bounds at {taus.size} temperatures)", name, out))
             if out.converged and hurwitz and unstable(out.theta).any():
-                start = starts[name]  # a stable start is the better way in
+                start = starts[name]          # a stable start is the better way in
                 grid, th = taus, (start if not unstable(start).any() else out.theta)
                 for _ in range(_MAX_REFINE + 1):
                     setups[name] = (grid, True)
                     out = solver_for(grid, True).solve(problem, th)
-                    history.append(
-                        F.history_entry(f"joint (Hurwitz constraints at {grid.size} temperatures)", name, out)
-                    )
+                    history.append(F.history_entry(
+                        f"joint (Hurwitz constraints at {grid.size} temperatures)", name, out))
                     bad = unstable(out.theta)
                     if not out.converged or not bad.any():
                         break
@@ -325,13 +278,8 @@ class ScheduledFit:
         # a constrained (IPOPT) solve that ran out of iterations is resumed like the others
         low = min(final, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)[0]
         if low in setups:
-            F.resume_slowest(
-                final,
-                lambda th: solver_for(*setups[low], F.RESUME_FACTOR).solve(problem, th),
-                history,
-                "joint",
-                self.max_iter,
-            )
+            F.resume_slowest(final, lambda th: solver_for(*setups[low], F.RESUME_FACTOR).solve(problem, th),
+                             history, "joint", self.max_iter)
         return evaluator, F.best_outcome(final)[1]
 
     def fit_data(self, data: FrequencyData):
@@ -348,70 +296,37 @@ class ScheduledFit:
                 f"got {temps.size}: {temps.tolist()}"
             )
         F.check_order_per_temperature(st, data)
-        scaling = F.make_scaling(
-            data, self.omega_ref_rad_s, self.gain_ref, self.temperature_center_c, self.temperature_scale_c
-        )
+        scaling = F.make_scaling(data, self.omega_ref_rad_s, self.gain_ref,
+                                 self.temperature_center_c, self.temperature_scale_c)
         t_range = (float(temps.min()), float(temps.max()))
         history = []
         per_t = self._per_temperature(data, scaling, history)
-        per_t_models = {
-            t: RationalModel(
-                s0, th, Scaling(scaling.omega_ref_rad_s, scaling.gain_ref, t, 1.0), (t, t), labels=data.labels()
-            )
-            for t, (s0, th, _) in per_t.items()
-        }
+        per_t_models = {t: RationalModel(s0, th, Scaling(scaling.omega_ref_rad_s, scaling.gain_ref, t, 1.0),
+                                         (t, t), labels=data.labels())
+                        for t, (s0, th, _) in per_t.items()}
         theta2 = self._two_stage_params(per_t, scaling)
         problem, wname = F.make_problem(st, data, scaling, self.weighting)
         settings = self.settings()
         ok2 = all(c for _, _, c in per_t.values())
-        two_out = SolveOutcome(
-            theta2,
-            problem.cost(theta2),
-            "two-stage" if ok2 else "two-stage: a per-temperature fit did not converge",
-            ok2,
-            0,
-            0.0,
-        )
-        two_res = F.finish(
-            st,
-            problem,
-            None,
-            two_out,
-            scaling,
-            data,
-            weighting_name=wname,
-            method="two-stage",
-            settings={**settings, "method": "two-stage"},
-            scale_covariance=self.scale_covariance,
-            history=list(history),
-            time_s=time.perf_counter() - t_start,
-            temperature_range=t_range,
-            compute_covariance=False,
-            per_temperature_models=per_t_models,
-            raise_on_failure=self.raise_on_failure and self.method == "two-stage",
-        )
+        two_out = SolveOutcome(theta2, problem.cost(theta2),
+                               "two-stage" if ok2 else "two-stage: a per-temperature fit did not converge",
+                               ok2, 0, 0.0)
+        two_res = F.finish(st, problem, None, two_out, scaling, data, weighting_name=wname,
+                           method="two-stage", settings={**settings, "method": "two-stage"},
+                           scale_covariance=self.scale_covariance, history=list(history),
+                           time_s=time.perf_counter() - t_start, temperature_range=t_range,
+                           compute_covariance=False, per_temperature_models=per_t_models,
+                           raise_on_failure=self.raise_on_failure and self.method == "two-stage")
         if self.method == "two-stage":
             res = two_res
         else:
             evaluator, best = self._joint(problem, scaling, t_range, per_t, theta2, history)
-            res = F.finish(
-                st,
-                problem,
-                evaluator,
-                best,
-                scaling,
-                data,
-                weighting_name=wname,
-                method="joint",
-                settings=settings,
-                scale_covariance=self.scale_covariance,
-                history=history,
-                time_s=time.perf_counter() - t_start,
-                temperature_range=t_range,
-                two_stage=two_res.model,
-                per_temperature_models=per_t_models,
-                raise_on_failure=self.raise_on_failure,
-            )
+            res = F.finish(st, problem, evaluator, best, scaling, data, weighting_name=wname,
+                           method="joint", settings=settings,
+                           scale_covariance=self.scale_covariance, history=history,
+                           time_s=time.perf_counter() - t_start, temperature_range=t_range,
+                           two_stage=two_res.model, per_temperature_models=per_t_models,
+                           raise_on_failure=self.raise_on_failure)
         self.model_, self.result_, self.history_ = res.model, res, res.history
         self.two_stage_model_ = two_res.model
         self.per_temperature_models_ = per_t_models

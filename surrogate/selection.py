@@ -109,18 +109,9 @@ class OrderSelectionReport:
         return "\n".join(lines)
 
 
-def order_selection(
-    frequency_hz,
-    temperature_c=None,
-    response=None,
-    orders=None,
-    magnitude_std_db=None,
-    phase_std_deg=None,
-    *,
-    weighting: str = "auto",
-    stable: bool = True,
-    max_iter: int = 300,
-) -> OrderSelectionReport:
+def order_selection(frequency_hz, temperature_c=None, response=None, orders=None,
+                    magnitude_std_db=None, phase_std_deg=None, *, weighting: str = "auto", stable: bool = True,
+                    max_iter: int = 300) -> OrderSelectionReport:
     """Fit every (n_zeros, n_poles) in ``orders`` at every temperature and tabulate the errors.
 
     Units as in ``RationalFit.fit``; a ``FrequencySweep`` / ``FrequencyData`` may be passed as
@@ -159,7 +150,8 @@ def order_selection(
     temps = [None] if data.temperature_c is None else list(data.temperatures())
     rows = []
     for m, n in orders:
-        fitter = RationalFit(m, n, stable=stable, weighting=weighting, max_iter=max_iter, raise_on_failure=False)
+        fitter = RationalFit(m, n, stable=stable, weighting=weighting, max_iter=max_iter,
+                             raise_on_failure=False)
         rel, fp, wr, conv, stab = [], [], [], [], []
         for t in temps:
             d: FrequencyData = data if t is None else data.at_temperature(t)
@@ -170,17 +162,6 @@ def order_selection(
             wr.append(res.weighted_rms)
             conv.append(res.converged)
             stab.append(res.stability.stable)
-        rows.append(
-            OrderRow(
-                m,
-                n,
-                m + n + 1,
-                tuple(None if t is None else float(t) for t in temps),
-                tuple(rel),
-                tuple(fp),
-                tuple(wr),
-                tuple(conv),
-                tuple(stab),
-            )
-        )
+        rows.append(OrderRow(m, n, m + n + 1, tuple(None if t is None else float(t) for t in temps),
+                             tuple(rel), tuple(fp), tuple(wr), tuple(conv), tuple(stab)))
     return OrderSelectionReport(tuple(rows))

@@ -28,19 +28,10 @@ def test_the_gallery_is_not_empty():
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_example_runs(script, tmp_path):
-    env = dict(
-        os.environ,
-        MPLBACKEND="Agg",
-        PYTHONPATH=os.pathsep.join([str(ROOT)] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])),
-    )
-    proc = subprocess.run(
-        [sys.executable, "-W", "error", str(script)],
-        cwd=tmp_path,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=TIMEOUT_S,
-    )
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=os.pathsep.join(
+        [str(ROOT)] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])))
+    proc = subprocess.run([sys.executable, "-W", "error", str(script)], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=TIMEOUT_S)
     assert proc.returncode == 0, f"{script.name} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-5000:]}"
 
 
@@ -53,3 +44,4 @@ def test_citation_names_the_package_version():
     text = (ROOT / "CITATION.cff").read_text(encoding="utf-8")
     found = re.findall(r"^version:\s*\"?([^\s\"]+)\"?\s*$", text, flags=re.M)
     assert found == [physmodel.__version__], (found, physmodel.__version__)
+

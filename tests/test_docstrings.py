@@ -72,10 +72,10 @@ def test_the_checker_on_known_cases():
     assert _lookup(_documented(_own_doc(_partly_documented_fn), "function"), "a") is None
     assert _own_doc(_Undocumented) is None and _own_doc(_Undocumented.method) is None
     typ, desc = documented["gain"]
-    assert NUMERIC.search(typ) and not UNIT.search(typ + " " + desc)  # would be reported
+    assert NUMERIC.search(typ) and not UNIT.search(typ + " " + desc)       # would be reported
     typ, desc = documented["frequency_hz"]
-    assert NUMERIC.search(typ) and UNIT.search(typ + " " + desc)  # passes
-    assert not NUMERIC.search(documented["n_points"][0])  # counts need no unit
+    assert NUMERIC.search(typ) and UNIT.search(typ + " " + desc)           # passes
+    assert not NUMERIC.search(documented["n_points"][0])                   # counts need no unit
 
 
 def test_the_rest_check_on_known_cases():
@@ -104,25 +104,14 @@ def test_the_rest_check_on_known_cases():
 def test_the_walk_finds_the_public_api():
     names = {q for q, _, _ in OBJECTS}
     # one name of each kind per package, so that an empty or broken walk cannot pass
-    for expected in (
-        "physmodel.ActuatorModel",
-        "physmodel.ActuatorModel.frequency_response",
-        "physmodel.calibrate",
-        "surrogate.ScheduledFit.fit",
-        "surrogate.RationalModel.at",
-        "inversion.invert",
-        "inversion.StreamingInverter.push",
-    ):
+    for expected in ("physmodel.ActuatorModel", "physmodel.ActuatorModel.frequency_response",
+                     "physmodel.calibrate", "surrogate.ScheduledFit.fit", "surrogate.RationalModel.at",
+                     "inversion.invert", "inversion.StreamingInverter.push"):
         assert expected in names
     assert len(names) > 150
     rendered = {e.name for e in audit.rendered_objects()}
-    for expected in (
-        "physmodel.FrequencySweep.to_frd",
-        "physmodel.data.timesim.simulate",
-        "physmodel.estimation.frf.h1",
-        "scenarios.cli.main",
-        "inversion.StreamingInverter.push",
-    ):
+    for expected in ("physmodel.FrequencySweep.to_frd", "physmodel.data.timesim.simulate",
+                     "physmodel.estimation.frf.h1", "scenarios.cli.main", "inversion.StreamingInverter.push"):
         assert expected in rendered
     assert len(rendered) > len(names)
 
@@ -135,13 +124,10 @@ def test_public_names_have_docstrings():
 
 def test_documented_functions_list_their_parameters():
     missing = audit.missing_parameters()
-    new = {
-        q: v for q, v in missing.items() if not set(v) <= set(docstring_policy.KNOWN_PARAMETERS_UNDOCUMENTED.get(q, ()))
-    }
-    assert not new, (
-        "numpydoc 'Parameters' sections lack these signature parameters "
-        f"(name: parameters): {new}; document them, or {UPDATE}"
-    )
+    new = {q: v for q, v in missing.items()
+           if not set(v) <= set(docstring_policy.KNOWN_PARAMETERS_UNDOCUMENTED.get(q, ()))}
+    assert not new, ("numpydoc 'Parameters' sections lack these signature parameters "
+                     f"(name: parameters): {new}; document them, or {UPDATE}")
 
 
 def test_numerical_parameters_carry_units():
@@ -153,11 +139,8 @@ def test_numerical_parameters_carry_units():
 def test_docstrings_are_valid_rest_and_references_resolve():
     bad = {n: why for n, why in audit.invalid_rest().items() if n not in docstring_policy.VERBATIM}
     assert not bad, f"docstrings that are not valid reST (name: first problem): {bad}; fix them, or {UPDATE}"
-    unresolved = {
-        t: who
-        for t, who in audit.unresolved_references(docstring_policy.VERBATIM).items()
-        if t not in docstring_policy.UNRESOLVED_REFERENCES
-    }
+    unresolved = {t: who for t, who in audit.unresolved_references(docstring_policy.VERBATIM).items()
+                  if t not in docstring_policy.UNRESOLVED_REFERENCES}
     assert not unresolved, f"cross-references to nothing documented (target: cited by): {unresolved}; or {UPDATE}"
 
 

@@ -106,42 +106,23 @@ class Multisine:
         """The signal to play: the period repeated ``transient_periods + periods`` times."""
         total = _whole(periods, "periods", 1) + _whole(transient_periods, "transient_periods")
         u = np.tile(self.period(), total)
-        meta = {
-            "excitation": "multisine",
-            "multisine": json.dumps(self.to_dict()),
-            "periods": periods,
-            "transient_periods": transient_periods,
-            "crest_factor": f"{self.crest_factor:.4f}",
-            "expected_duration_s": f"{self.duration_s(periods, transient_periods):.6g}",
-            "estimate_with": f"h1(nperseg={self.n_samples}, noverlap=0, window='boxcar', "
-            f"discard_s={transient_periods * self.period_s:.6g}, frequencies_hz=lines)",
-        }
+        meta = {"excitation": "multisine", "multisine": json.dumps(self.to_dict()), "periods": periods,
+                "transient_periods": transient_periods, "crest_factor": f"{self.crest_factor:.4f}",
+                "expected_duration_s": f"{self.duration_s(periods, transient_periods):.6g}",
+                "estimate_with": f"h1(nperseg={self.n_samples}, noverlap=0, window='boxcar', "
+                                 f"discard_s={transient_periods * self.period_s:.6g}, frequencies_hz=lines)"}
         return TimeRecord(np.arange(u.size) / self.fs_hz, {self.channel: u}, {self.channel: self.unit}, meta)
 
     def to_dict(self) -> dict:
-        return {
-            "fs_hz": self.fs_hz,
-            "n_samples": self.n_samples,
-            "lines": self.lines.tolist(),
-            "amplitudes": self.amplitudes.tolist(),
-            "phases_rad": self.phases_rad.tolist(),
-            "phase_method": self.phase_method,
-            "channel": self.channel,
-            "unit": self.unit,
-        }
+        return {"fs_hz": self.fs_hz, "n_samples": self.n_samples, "lines": self.lines.tolist(),
+                "amplitudes": self.amplitudes.tolist(), "phases_rad": self.phases_rad.tolist(),
+                "phase_method": self.phase_method, "channel": self.channel, "unit": self.unit}
 
     @classmethod
     def from_dict(cls, d: dict) -> Multisine:
-        return cls(
-            float(d["fs_hz"]),
-            int(d["n_samples"]),
-            np.asarray(d["lines"], dtype=int),
-            np.asarray(d["amplitudes"], dtype=float),
-            np.asarray(d["phases_rad"], dtype=float),
-            d["phase_method"],
-            d["channel"],
-            d["unit"],
-        )
+        return cls(float(d["fs_hz"]), int(d["n_samples"]), np.asarray(d["lines"], dtype=int),
+                   np.asarray(d["amplitudes"], dtype=float), np.asarray(d["phases_rad"], dtype=float),
+                   d["phase_method"], d["channel"], d["unit"])
 
 
 def schroeder_phases(amplitudes) -> np.ndarray:
@@ -173,20 +154,9 @@ def _clip_phases(ms: Multisine, iterations: int, clip: float) -> tuple[np.ndarra
     return np.mod(phases, 2 * np.pi), best_cf
 
 
-def multisine(
-    frequencies_hz,
-    fs_hz: float,
-    period_s: float,
-    *,
-    amplitude=1.0,
-    rms: float | None = None,
-    phases: str = "schroeder",
-    iterations: int = 200,
-    clip: float = 0.9,
-    seed: int | None = None,
-    channel: str = "voltage",
-    unit: str = "V",
-) -> Multisine:
+def multisine(frequencies_hz, fs_hz: float, period_s: float, *, amplitude=1.0, rms: float | None = None,
+              phases: str = "schroeder", iterations: int = 200, clip: float = 0.9, seed: int | None = None,
+              channel: str = "voltage", unit: str = "V") -> Multisine:
     """Design a multisine.
 
     Parameters
@@ -205,20 +175,16 @@ def multisine(
         raise IPMCError(f"period_s={period_s!r} must be a finite number > 0 [s]")
     N = int(round(period_s * fs))
     if abs(N - period_s * fs) > 1e-6 * max(N, 1) or N < 4:
-        raise IPMCError(
-            f"period_s={period_s!r} s at fs_hz={fs:g} is {period_s * fs:g} samples; "
-            "a period must be a whole number (>= 4) of samples"
-        )
+        raise IPMCError(f"period_s={period_s!r} s at fs_hz={fs:g} is {period_s * fs:g} samples; "
+                        "a period must be a whole number (>= 4) of samples")
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)):
         raise IPMCError(f"frequencies_hz must be a non-empty 1-D array of finite values, got {frequencies_hz!r}")
     k = np.rint(f * period_s).astype(int)
     off = (np.abs(f * period_s - k) > 1e-6) | (k < 1) | (2 * k >= N)
     if off.any():
-        raise IPMCError(
-            f"frequencies_hz: {f[off][:5].tolist()} Hz are not lines of a {period_s:g} s period "
-            f"(multiples of {1 / period_s:g} Hz, above 0 and below fs/2 = {fs / 2:g} Hz)"
-        )
+        raise IPMCError(f"frequencies_hz: {f[off][:5].tolist()} Hz are not lines of a {period_s:g} s period "
+                        f"(multiples of {1 / period_s:g} Hz, above 0 and below fs/2 = {fs / 2:g} Hz)")
     if np.any(np.diff(k) <= 0):
         raise IPMCError("frequencies_hz must strictly increase (one component per line)")
     a = np.broadcast_to(np.asarray(amplitude, dtype=float), k.shape).copy() if np.ndim(amplitude) <= 1 else None
@@ -279,31 +245,19 @@ class SteppedSinePlan:
 
     def record(self) -> TimeRecord:
         u = self.signal()
-        meta = {
-            "excitation": "stepped_sine",
-            "stepped_sine_plan": json.dumps(self.to_dict()),
-            "steps": self.frequency_hz.size,
-            "expected_duration_s": f"{self.duration_s:.6g}",
-        }
+        meta = {"excitation": "stepped_sine", "stepped_sine_plan": json.dumps(self.to_dict()),
+                "steps": self.frequency_hz.size, "expected_duration_s": f"{self.duration_s:.6g}"}
         return TimeRecord(np.arange(u.size) / self.fs_hz, {self.channel: u}, {self.channel: self.unit}, meta)
 
     def to_dict(self) -> dict:
-        return {
-            "fs_hz": self.fs_hz,
-            **{
-                k: getattr(self, k).tolist()
-                for k in ("frequency_hz", "amplitude", "settle_s", "periods", "step_start_s", "step_stop_s")
-            },
-            "channel": self.channel,
-            "unit": self.unit,
-        }
+        return {"fs_hz": self.fs_hz, **{k: getattr(self, k).tolist() for k in
+                ("frequency_hz", "amplitude", "settle_s", "periods", "step_start_s", "step_stop_s")},
+                "channel": self.channel, "unit": self.unit}
 
     @classmethod
     def from_dict(cls, d: dict) -> SteppedSinePlan:
-        arr = {
-            k: np.asarray(d[k], dtype=float)
-            for k in ("frequency_hz", "amplitude", "settle_s", "periods", "step_start_s", "step_stop_s")
-        }
+        arr = {k: np.asarray(d[k], dtype=float) for k in
+               ("frequency_hz", "amplitude", "settle_s", "periods", "step_start_s", "step_stop_s")}
         arr["periods"] = arr["periods"].astype(int)
         return cls(float(d["fs_hz"]), channel=d["channel"], unit=d["unit"], **arr)
 
@@ -318,18 +272,9 @@ class SteppedSinePlan:
             raise IPMCError(f"record: malformed 'stepped_sine_plan' header ({exc})") from None
 
 
-def stepped_sine_plan(
-    frequencies_hz,
-    fs_hz: float,
-    *,
-    amplitude=1.0,
-    periods=10,
-    min_measure_s: float = 0.0,
-    settle_s: float = 0.0,
-    settle_periods: float = 0.0,
-    channel: str = "voltage",
-    unit: str = "V",
-) -> SteppedSinePlan:
+def stepped_sine_plan(frequencies_hz, fs_hz: float, *, amplitude=1.0, periods=10, min_measure_s: float = 0.0,
+                      settle_s: float = 0.0, settle_periods: float = 0.0, channel: str = "voltage",
+                      unit: str = "V") -> SteppedSinePlan:
     """Plan a stepped sine.
 
     Parameters
@@ -359,7 +304,7 @@ def stepped_sine_plan(
     if not np.all(np.isfinite(a)) or np.any(a <= 0):
         raise IPMCError(f"amplitude must be finite and > 0, got {amplitude!r}")
     settle = np.maximum(settle_s, settle_periods / f)
-    n_step = np.ceil((settle + P / f) * fs - 1e-9).astype(np.int64)  # whole samples, covering the periods
+    n_step = np.ceil((settle + P / f) * fs - 1e-9).astype(np.int64)      # whole samples, covering the periods
     edges = np.concatenate([[0], np.cumsum(n_step)]) / fs
     return SteppedSinePlan(fs, f, a, settle, P, edges[:-1], edges[1:], channel, unit)
 
@@ -376,18 +321,8 @@ def settle_time_s(poles, tolerance: float = 1e-3) -> float:
 
 
 # ----------------------------------------------------------------------------------- chirp
-def chirp(
-    f0_hz: float,
-    f1_hz: float,
-    sweep_s: float,
-    fs_hz: float,
-    *,
-    amplitude: float = 1.0,
-    method: str = "logarithmic",
-    repeats: int = 1,
-    channel: str = "voltage",
-    unit: str = "V",
-) -> TimeRecord:
+def chirp(f0_hz: float, f1_hz: float, sweep_s: float, fs_hz: float, *, amplitude: float = 1.0,
+          method: str = "logarithmic", repeats: int = 1, channel: str = "voltage", unit: str = "V") -> TimeRecord:
     """A swept sine from ``f0_hz`` to ``f1_hz`` over ``sweep_s`` [s], played ``repeats`` times.
 
     With repeats > 1 the sweep is periodic: estimate with ``h1(nperseg = sweep samples,
@@ -405,12 +340,6 @@ def chirp(
     tt = np.arange(n) / fs
     one = amplitude * signal.chirp(tt, f0_hz, n / fs, f1_hz, method=method, phi=-90)
     u = np.tile(one, reps)
-    meta = {
-        "excitation": f"{method} chirp",
-        "f0_hz": f0_hz,
-        "f1_hz": f1_hz,
-        "sweep_s": n / fs,
-        "repeats": reps,
-        "expected_duration_s": f"{u.size / fs:.6g}",
-    }
+    meta = {"excitation": f"{method} chirp", "f0_hz": f0_hz, "f1_hz": f1_hz, "sweep_s": n / fs, "repeats": reps,
+            "expected_duration_s": f"{u.size / fs:.6g}"}
     return TimeRecord(np.arange(u.size) / fs, {channel: u}, {channel: unit}, meta)

@@ -40,8 +40,8 @@ def atomic_write(path, write_fn, mode: str = "w") -> Path:
             os.fsync(fh.fileno())
         mask = os.umask(0)
         os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)  # created 0600
-        interrupts.check()  # an interrupt a solver swallowed must not commit a file
+        os.chmod(tmp, 0o666 & ~mask)   # created 0600
+        interrupts.check()             # an interrupt a solver swallowed must not commit a file
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
@@ -66,21 +66,15 @@ def read_text(path, what: str = "file") -> str:
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise DataFormatError(
-            f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
-            "save the file as UTF-8"
-        ) from None
+        line = data[:exc.start].count(b"\n") + 1
+        raise DataFormatError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
+                              "save the file as UTF-8") from None
 
 
 #: What each ipmc command leaves in its output folder, to recognise whose results a folder holds:
 #: (file, identity, or a function of the file's JSON giving the identity).
-OWNER_FILES = (
-    ("metrics.json", lambda d: f"ipmc run {d['scenario']}"),
-    ("calibration.json", lambda d: "ipmc calibrate"),
-    ("model.json", lambda d: "ipmc fit"),
-    ("report.json", lambda d: "ipmc diagnose"),
-)
+OWNER_FILES = (("metrics.json", lambda d: f"ipmc run {d['scenario']}"), ("calibration.json", lambda d: "ipmc calibrate"),
+               ("model.json", lambda d: "ipmc fit"), ("report.json", lambda d: "ipmc diagnose"))
 
 
 def folder_owner(folder) -> str | None:
@@ -108,10 +102,8 @@ def check_output_folder(path, identity: str, *, force: bool = False, option: str
     owner = folder_owner(path) if path.is_dir() else None
     if owner is not None and owner != identity and not force:
         held = owner if owner.startswith("files") else f"the results of {owner!r}"
-        raise IPMCError(
-            f"{option} {path}: the folder holds {held}, not of {identity!r}; choose another "
-            "folder or pass --force to write into it"
-        )
+        raise IPMCError(f"{option} {path}: the folder holds {held}, not of {identity!r}; choose another "
+                        "folder or pass --force to write into it")
     return path
 
 
@@ -140,14 +132,12 @@ def output_folder(path, identity: str, *, force: bool = False, option: str = "--
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
-                raise IPMCError(
-                    f"{option} {path}: another ipmc run is writing into this folder; wait for it "
-                    "or choose another folder"
-                ) from None
+                raise IPMCError(f"{option} {path}: another ipmc run is writing into this folder; wait for it "
+                                "or choose another folder") from None
         check_output_folder(path, identity, force=force, option=option)
         yield path
     finally:
-        os.close(fd)  # closing the descriptor releases the lock
+        os.close(fd)                   # closing the descriptor releases the lock
 
 
 def _columns(sw: FrequencySweep) -> dict[str, np.ndarray]:
@@ -181,26 +171,15 @@ def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], whe
     H = 10 ** (cols["magnitude_db"] / 20) * np.exp(1j * np.radians(cols["phase_deg"]))
     meta = {k: v for k, v in header.items() if k not in ("input", "output", "ipmc-sweep")}
     has_std = "magnitude_std_db" in cols
-    return FrequencySweep(
-        cols["temperature_c"],
-        cols["frequency_hz"],
-        H,
-        cols["magnitude_std_db"] if has_std else None,
-        cols["phase_std_deg"] if has_std else None,
-        in_name,
-        in_unit,
-        out_name,
-        out_unit,
-        meta,
-    )
+    return FrequencySweep(cols["temperature_c"], cols["frequency_hz"], H,
+                          cols["magnitude_std_db"] if has_std else None,
+                          cols["phase_std_deg"] if has_std else None,
+                          in_name, in_unit, out_name, out_unit, meta)
 
 
 def _header_lines(sw: FrequencySweep) -> list[str]:
-    lines = [
-        f"ipmc-sweep {FORMAT_VERSION}",
-        f"input: {sw.input_name} [{sw.input_unit}]",
-        f"output: {sw.output_name} [{sw.output_unit}]",
-    ]
+    lines = [f"ipmc-sweep {FORMAT_VERSION}", f"input: {sw.input_name} [{sw.input_unit}]",
+             f"output: {sw.output_name} [{sw.output_unit}]"]
     for k, v in sw.metadata.items():
         v = str(v).replace("\n", " ")
         lines.append(f"{k}: {v}")
@@ -246,9 +225,7 @@ def read_csv(path) -> FrequencySweep:
         raise DataFormatError(f"{path}:{i + 1}: missing column(s) {missing}; found {colnames}")
     unknown = [c for c in colnames if c not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS]
     if unknown:
-        raise DataFormatError(
-            f"{path}:{i + 1}: unknown column(s) {unknown}; expected {list(REQUIRED_COLUMNS + OPTIONAL_COLUMNS)}"
-        )
+        raise DataFormatError(f"{path}:{i + 1}: unknown column(s) {unknown}; expected {list(REQUIRED_COLUMNS + OPTIONAL_COLUMNS)}")
     has_std = [c in colnames for c in OPTIONAL_COLUMNS]
     if any(has_std) and not all(has_std):
         raise DataFormatError(f"{path}:{i + 1}: give both {OPTIONAL_COLUMNS} or neither")
@@ -288,10 +265,8 @@ def read_csv(path) -> FrequencySweep:
             if f[k] == f[k - 1]:
                 raise DataFormatError(f"{path}:{line_no[k]}: duplicate frequency {f[k]:g} Hz at {T[k]:g} °C")
             if f[k] < f[k - 1]:
-                raise DataFormatError(
-                    f"{path}:{line_no[k]}: frequencies at {T[k]:g} °C are not sorted "
-                    f"({f[k]:g} Hz after {f[k - 1]:g} Hz)"
-                )
+                raise DataFormatError(f"{path}:{line_no[k]}: frequencies at {T[k]:g} °C are not sorted "
+                                      f"({f[k]:g} Hz after {f[k - 1]:g} Hz)")
         else:
             if T[k] in seen_T:
                 raise DataFormatError(f"{path}:{line_no[k]}: rows at {T[k]:g} °C are not contiguous")
@@ -307,15 +282,9 @@ def read_csv(path) -> FrequencySweep:
 # ----------------------------------------------------------------------------------- NPZ / MAT
 def write_npz(sw: FrequencySweep, path) -> Path:
     cols = _columns(sw)
-    header = json.dumps(
-        {
-            "format": "ipmc-sweep",
-            "version": FORMAT_VERSION,
-            "input": f"{sw.input_name} [{sw.input_unit}]",
-            "output": f"{sw.output_name} [{sw.output_unit}]",
-            "metadata": sw.metadata,
-        }
-    )
+    header = json.dumps({"format": "ipmc-sweep", "version": FORMAT_VERSION,
+                         "input": f"{sw.input_name} [{sw.input_unit}]",
+                         "output": f"{sw.output_name} [{sw.output_unit}]", "metadata": sw.metadata})
 
     def write(fh):
         np.savez(fh, header=np.array(header), response_real=sw.response.real, response_imag=sw.response.imag, **cols)
@@ -380,10 +349,8 @@ def read_npz(path) -> FrequencySweep:
                 continue
             size = zf.getinfo(members[key]).file_size
             if size > MAX_ARRAY_BYTES:
-                raise DataFormatError(
-                    f"{where}: array {key!r} holds {size} bytes; a sweep array holds at most "
-                    f"{MAX_ARRAY_BYTES} ({MAX_SWEEP_LINES} lines)"
-                )
+                raise DataFormatError(f"{where}: array {key!r} holds {size} bytes; a sweep array holds at most "
+                                      f"{MAX_ARRAY_BYTES} ({MAX_SWEEP_LINES} lines)")
             try:
                 with zf.open(members[key]) as fh:
                     data[key] = np.lib.format.read_array(fh, allow_pickle=False)
@@ -410,15 +377,14 @@ def read_npz(path) -> FrequencySweep:
     cols = {k: _column(data[k], k, where) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
     parts = [k for k in ("response_real", "response_imag") if k in data]
     if len(parts) == 1:
-        raise DataFormatError(
-            f"{where}: has {parts[0]!r} but not its partner; give response_real and response_imag together, or neither"
-        )
+        raise DataFormatError(f"{where}: has {parts[0]!r} but not its partner; give response_real and "
+                              "response_imag together, or neither")
     response = None
     if parts:
         re_, im_ = (_column(data[k], k, where) for k in ("response_real", "response_imag"))
         if re_.size != im_.size:
             raise DataFormatError(f"{where}: response_real has {re_.size} values, response_imag {im_.size}")
-        response = re_ + 1j * im_  # exact complex values, not rounded through dB/deg
+        response = re_ + 1j * im_      # exact complex values, not rounded through dB/deg
     header = {"input": hdr["input"], "output": hdr["output"], **{str(k): str(v) for k, v in meta.items()}}
     return _sweep_from_arrays(cols, header, response, where)
 
@@ -463,13 +429,12 @@ def read_mat(path) -> FrequencySweep:
     if not Path(path).is_file():
         raise DataFormatError(f"{where}: no such file")
     wanted = REQUIRED_COLUMNS + OPTIONAL_COLUMNS + ("response", "input", "output", "metadata_json")
-    try:  # scipy's parser raises many exception types on a malformed file; all mean "not readable"
+    try:   # scipy's parser raises many exception types on a malformed file; all mean "not readable"
         shapes = {name: shape for name, shape, _ in whosmat(path)}
         for key in wanted:
             if key in shapes and 16 * int(np.prod(shapes[key], dtype=np.int64)) > MAX_ARRAY_BYTES:
-                raise DataFormatError(
-                    f"{where}: variable {key!r} has shape {shapes[key]}; a sweep holds at most {MAX_SWEEP_LINES} lines"
-                )
+                raise DataFormatError(f"{where}: variable {key!r} has shape {shapes[key]}; a sweep holds at most "
+                                      f"{MAX_SWEEP_LINES} lines")
         data = loadmat(path, variable_names=[k for k in wanted if k in shapes])
     except DataFormatError:
         raise
@@ -487,14 +452,10 @@ def read_mat(path) -> FrequencySweep:
             raise DataFormatError(f"{where}: variable 'metadata_json' is not JSON: {exc}") from None
         if not isinstance(meta, dict):
             raise DataFormatError(f"{where}: variable 'metadata_json' must hold a JSON object")
-    header = {
-        "input": _mat_text(data, "input", where),
-        "output": _mat_text(data, "output", where),
-        **{str(k): str(v) for k, v in meta.items()},
-    }
-    response = (
-        _column(data["response"], "response", where, allow_complex=True).astype(complex) if "response" in data else None
-    )
+    header = {"input": _mat_text(data, "input", where), "output": _mat_text(data, "output", where),
+              **{str(k): str(v) for k, v in meta.items()}}
+    response = _column(data["response"], "response", where, allow_complex=True).astype(complex) \
+        if "response" in data else None
     return _sweep_from_arrays(cols, header, response, where)
 
 

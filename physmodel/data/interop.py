@@ -37,7 +37,7 @@ def _frd_arrays(frd: Any, where: str) -> tuple[np.ndarray, np.ndarray]:
     if dt not in (0, None):
         raise IPMCError(f"{where}: the FRD must be continuous-time (dt = 0); got dt = {dt!r}")
     data = getattr(frd, "frdata", None)
-    if data is None:  # python-control < 0.10
+    if data is None:            # python-control < 0.10
         data = frd.fresp
     H = np.asarray(data, dtype=complex).reshape(-1)
     w = np.asarray(frd.omega, dtype=float).reshape(-1)
@@ -62,25 +62,17 @@ def _pair(obj: Any, where: str) -> tuple[np.ndarray, np.ndarray]:
         if f.size != H.size:
             raise IPMCError(f"{where}: {f.size} frequencies but {H.size} responses")
         return f, H
-    raise IPMCError(
-        f"{where}: expected a control.FrequencyResponseData or (frequency_hz, response); got {type(obj).__name__}"
-    )
+    raise IPMCError(f"{where}: expected a control.FrequencyResponseData or (frequency_hz, response); "
+                    f"got {type(obj).__name__}")
 
 
 def _build(T: np.ndarray, f: np.ndarray, H: np.ndarray, labels: dict, meta: dict) -> FrequencySweep:
-    order = np.lexsort((f, T))  # by temperature, then frequency
+    order = np.lexsort((f, T))            # by temperature, then frequency
     return FrequencySweep(T[order], f[order], H[order], metadata=meta, **labels)
 
 
-def as_sweep(
-    obj: Any,
-    temperature_c: Any = None,
-    *,
-    input_name: str = "input",
-    input_unit: str = "1",
-    output_name: str = "output",
-    output_unit: str = "1",
-) -> FrequencySweep:
+def as_sweep(obj: Any, temperature_c: Any = None, *, input_name: str = "input", input_unit: str = "1",
+             output_name: str = "output", output_unit: str = "1") -> FrequencySweep:
     """A :class:`FrequencySweep` from a sweep, FRD object(s), a mapping or arrays (see the module doc).
 
     Parameters
@@ -101,12 +93,8 @@ def as_sweep(
     labels = dict(input_name=input_name, input_unit=input_unit, output_name=output_name, output_unit=output_unit)
     if isinstance(obj, FrequencySweep):
         return obj
-    if (
-        isinstance(obj, Sequence)
-        and not isinstance(obj, str | bytes)
-        and obj
-        and all(isinstance(s, FrequencySweep) for s in obj)
-    ):
+    if isinstance(obj, Sequence) and not isinstance(obj, str | bytes) and obj \
+            and all(isinstance(s, FrequencySweep) for s in obj):
         return merge_sweeps(list(obj))
     meta = {"source": "physmodel.data.interop.as_sweep"}
     if isinstance(obj, Mapping):
@@ -125,32 +113,26 @@ def as_sweep(
         return _build(np.concatenate(Ts), np.concatenate(fs), np.concatenate(Hs), labels, meta)
     if is_frd(obj):
         if temperature_c is None or np.ndim(temperature_c) != 0:
-            raise IPMCError(
-                "as_sweep: an FRD carries no temperature; pass temperature_c=<°C> (a scalar) "
-                "or a mapping {temperature_c: frd}"
-            )
+            raise IPMCError("as_sweep: an FRD carries no temperature; pass temperature_c=<°C> (a scalar) "
+                            "or a mapping {temperature_c: frd}")
         f, H = _frd_arrays(obj, "as_sweep")
         return _build(np.full(f.size, float(temperature_c)), f, H, labels, meta)
     if isinstance(obj, Sequence) and obj and all(is_frd(x) for x in obj):
         temps = np.atleast_1d(np.asarray(temperature_c if temperature_c is not None else [], dtype=float))
         if temps.size != len(obj):
-            raise IPMCError(
-                f"as_sweep: {len(obj)} FRDs need {len(obj)} temperatures in temperature_c; got {temps.size}"
-            )
+            raise IPMCError(f"as_sweep: {len(obj)} FRDs need {len(obj)} temperatures in temperature_c; "
+                            f"got {temps.size}")
         return as_sweep(dict(zip(temps.tolist(), obj)), **labels)
     if isinstance(obj, tuple | list) and len(obj) == 2:
         f, H = _pair(obj, "as_sweep")
         if temperature_c is None:
-            raise IPMCError(
-                "as_sweep: arrays (frequency_hz, response) need temperature_c (a scalar or one value per line) [°C]"
-            )
+            raise IPMCError("as_sweep: arrays (frequency_hz, response) need temperature_c (a scalar or one "
+                            "value per line) [°C]")
         T = np.asarray(temperature_c, dtype=float)
         T = np.full(f.size, float(T)) if T.ndim == 0 else T.reshape(-1)
         if T.size != f.size:
             raise IPMCError(f"as_sweep: temperature_c has {T.size} values for {f.size} lines")
         return _build(T, f, H, labels, meta)
-    raise IPMCError(
-        f"as_sweep: cannot read frequency-response data from a {type(obj).__name__}; expected a "
-        "FrequencySweep, a control.FrequencyResponseData, a mapping {temperature_c: FRD}, or "
-        "(frequency_hz, response) arrays"
-    )
+    raise IPMCError(f"as_sweep: cannot read frequency-response data from a {type(obj).__name__}; expected a "
+                    "FrequencySweep, a control.FrequencyResponseData, a mapping {temperature_c: FRD}, or "
+                    "(frequency_hz, response) arrays")

@@ -46,7 +46,6 @@ OPTIONAL_COLUMNS = ("magnitude_std_db", "phase_std_deg")
 #: a typo such as ``points = 100000000`` is a clear error, not a process killed for memory.
 MAX_SWEEP_LINES = 5_000_000
 
-
 # ----------------------------------------------------------------------------------- noise
 @dataclass(frozen=True)
 class MagnitudePhaseNoise:
@@ -134,10 +133,8 @@ class FrequencySweep:
         f = np.asarray(self.frequency_hz, dtype=float).reshape(-1)
         H = np.asarray(self.response, dtype=complex).reshape(-1)
         if not (T.size == f.size == H.size):
-            raise IPMCError(
-                f"temperature_c, frequency_hz and response must have one value per line; "
-                f"got {T.size}, {f.size}, {H.size}"
-            )
+            raise IPMCError(f"temperature_c, frequency_hz and response must have one value per line; "
+                            f"got {T.size}, {f.size}, {H.size}")
         if T.size == 0:
             raise IPMCError("a sweep needs at least one line")
         for name, arr in (("temperature_c", T), ("frequency_hz", f)):
@@ -148,13 +145,9 @@ class FrequencySweep:
         if np.any(f <= 0):
             raise IPMCError(f"frequencies must be > 0 Hz; got {f[f <= 0][:5].tolist()}")
         if np.any(T <= -273.15):
-            raise IPMCError(
-                f"temperature_c must be above absolute zero (-273.15 °C); got {T[T <= -273.15][:5].tolist()}"
-            )
+            raise IPMCError(f"temperature_c must be above absolute zero (-273.15 °C); got {T[T <= -273.15][:5].tolist()}")
         if np.any(H == 0):
-            raise IPMCError(
-                f"response is exactly 0 at rows {np.flatnonzero(H == 0)[:5].tolist()}; magnitude in dB undefined"
-            )
+            raise IPMCError(f"response is exactly 0 at rows {np.flatnonzero(H == 0)[:5].tolist()}; magnitude in dB undefined")
         object.__setattr__(self, "temperature_c", T)
         object.__setattr__(self, "frequency_hz", f)
         object.__setattr__(self, "response", H)
@@ -175,10 +168,8 @@ class FrequencySweep:
             ff = f[T == t]
             bad = np.flatnonzero(np.diff(ff) <= 0)
             if bad.size:
-                raise IPMCError(
-                    f"frequencies at {t:g} °C must strictly increase; "
-                    f"{ff[bad[0]]:g} Hz is followed by {ff[bad[0] + 1]:g} Hz"
-                )
+                raise IPMCError(f"frequencies at {t:g} °C must strictly increase; "
+                                f"{ff[bad[0]]:g} Hz is followed by {ff[bad[0] + 1]:g} Hz")
 
     # -------------------------------------------------------------- views
     def temperatures(self) -> np.ndarray:
@@ -194,9 +185,7 @@ class FrequencySweep:
 
     def _subset(self, mask) -> FrequencySweep:
         return replace(
-            self,
-            temperature_c=self.temperature_c[mask],
-            frequency_hz=self.frequency_hz[mask],
+            self, temperature_c=self.temperature_c[mask], frequency_hz=self.frequency_hz[mask],
             response=self.response[mask],
             magnitude_std_db=None if self.magnitude_std_db is None else self.magnitude_std_db[mask],
             phase_std_deg=None if self.phase_std_deg is None else self.phase_std_deg[mask],
@@ -252,9 +241,7 @@ class FrequencySweep:
 
     def in_units(self, input_unit: str, output_unit: str) -> FrequencySweep:
         """The same sweep with the response expressed in other units."""
-        k = (unit_scale(self.output_unit) / unit_scale(output_unit)) / (
-            unit_scale(self.input_unit) / unit_scale(input_unit)
-        )
+        k = (unit_scale(self.output_unit) / unit_scale(output_unit)) / (unit_scale(self.input_unit) / unit_scale(input_unit))
         if UNITS[input_unit][0] != UNITS[self.input_unit][0] or UNITS[output_unit][0] != UNITS[self.output_unit][0]:
             raise IPMCError(f"cannot convert {self.output_unit}/{self.input_unit} to {output_unit}/{input_unit}")
         return replace(self, response=self.response * k, input_unit=input_unit, output_unit=output_unit)
@@ -277,16 +264,8 @@ class FrequencySweep:
 
 
 # ----------------------------------------------------------------------------------- synthesis
-def synthesize_sweep(
-    model,
-    quantity: str,
-    frequency_hz,
-    temperature_c,
-    noise=None,
-    seed: int | None = None,
-    set_index: int = 0,
-    progress=None,
-) -> FrequencySweep:
+def synthesize_sweep(model, quantity: str, frequency_hz, temperature_c, noise=None, seed: int | None = None,
+                     set_index: int = 0, progress=None) -> FrequencySweep:
     """A synthetic sweep of ``model`` (ActuatorModel / SensorModel) with seeded noise.
 
     ``noise``: None (exact), :class:`MagnitudePhaseNoise` or :class:`ComplexGaussianNoise`.
@@ -298,23 +277,19 @@ def synthesize_sweep(
         raise IPMCError(f"model kind {kind!r}: synthesize_sweep needs a physics model (kind 'actuator' or 'sensor')")
     key = (kind, quantity)
     if key not in QUANTITY_UNITS:
-        raise IPMCError(
-            f"{kind} quantity {quantity!r} cannot be swept; expected one of "
-            f"{[q for k, q in QUANTITY_UNITS if k == kind]}"
-        )
+        raise IPMCError(f"{kind} quantity {quantity!r} cannot be swept; expected one of "
+                        f"{[q for k, q in QUANTITY_UNITS if k == kind]}")
     if noise is not None and seed is None:
         raise IPMCError("a noisy sweep needs an explicit integer seed (reproducibility)")
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
         raise IPMCError(f"seed must be a non-negative integer, got {seed!r}")
     n_lines = int(np.size(frequency_hz)) * int(np.size(temperature_c))
     if n_lines > MAX_SWEEP_LINES:
-        raise IPMCError(
-            f"{np.size(frequency_hz)} frequencies × {np.size(temperature_c)} temperatures = {n_lines} "
-            f"lines; a sweep holds at most {MAX_SWEEP_LINES} (split it)"
-        )
+        raise IPMCError(f"{np.size(frequency_hz)} frequencies × {np.size(temperature_c)} temperatures = {n_lines} "
+                        f"lines; a sweep holds at most {MAX_SWEEP_LINES} (split it)")
     in_name, in_unit, out_name, out_unit = QUANTITY_UNITS[key]
     resp = model.frequency_response(frequency_hz, temperature_c, quantities=(quantity,), progress=progress)
-    H = resp[quantity][set_index] * (unit_scale(in_unit) / unit_scale(out_unit))  # (n_T, n_f)
+    H = resp[quantity][set_index] * (unit_scale(in_unit) / unit_scale(out_unit))     # (n_T, n_f)
     f = np.broadcast_to(resp.frequency_hz, H.shape).ravel()
     T = np.broadcast_to(resp.temperature_c[:, None], H.shape).ravel()
     H = H.ravel()
@@ -357,20 +332,16 @@ def sweep_layout(data: FrequencySweep, kind: str, quantity: str | None = None) -
         raise IPMCError(f"kind={kind!r}; expected 'actuator' or 'sensor'")
     q = quantity or ("M" if kind == "actuator" else "S")
     if (kind, q) not in QUANTITY_UNITS:
-        raise IPMCError(
-            f"{kind} quantity {q!r} cannot be compared with data; expected one of "
-            f"{[k[1] for k in QUANTITY_UNITS if k[0] == kind]}"
-        )
+        raise IPMCError(f"{kind} quantity {q!r} cannot be compared with data; expected one of "
+                        f"{[k[1] for k in QUANTITY_UNITS if k[0] == kind]}")
     _, unit_in, _, unit_out = QUANTITY_UNITS[(kind, q)]
     want_in, want_out = UNITS[unit_in][0], UNITS[unit_out][0]
     got_in, got_out = UNITS[data.input_unit][0], UNITS[data.output_unit][0]
     if (got_in, got_out) != (want_in, want_out):
-        raise DataFormatError(
-            f"the sweep is {data.output_name} [{data.output_unit}] per {data.input_name} "
-            f"[{data.input_unit}] ({got_out}/{got_in}); {kind} quantity {q} needs "
-            f"{want_out}/{want_in} (see physmodel.sweep.QUANTITY_UNITS {QUANTITY_UNITS[(kind, q)]})"
-        )
-    factor = unit_scale(data.input_unit) / unit_scale(data.output_unit)  # SI response -> sweep units
+        raise DataFormatError(f"the sweep is {data.output_name} [{data.output_unit}] per {data.input_name} "
+                              f"[{data.input_unit}] ({got_out}/{got_in}); {kind} quantity {q} needs "
+                              f"{want_out}/{want_in} (see physmodel.sweep.QUANTITY_UNITS {QUANTITY_UNITS[(kind, q)]})")
+    factor = unit_scale(data.input_unit) / unit_scale(data.output_unit)   # SI response -> sweep units
     fu, inv_f = np.unique(data.frequency_hz, return_inverse=True)
     Tu, inv_T = np.unique(data.temperature_c, return_inverse=True)
     return SweepLayout(q, factor, fu, inv_f, Tu, inv_T)
@@ -395,15 +366,7 @@ def merge_sweeps(data: FrequencySweep | Sequence[FrequencySweep]) -> FrequencySw
     if not std and any(s.magnitude_std_db is not None for s in conv):
         raise IPMCError("some sweeps carry per-line standard deviations and others do not; give all or none")
     cat = lambda k: np.concatenate([getattr(s, k) for s in conv])  # noqa: E731
-    return FrequencySweep(
-        cat("temperature_c"),
-        cat("frequency_hz"),
-        cat("response"),
-        cat("magnitude_std_db") if std else None,
-        cat("phase_std_deg") if std else None,
-        first.input_name,
-        first.input_unit,
-        first.output_name,
-        first.output_unit,
-        dict(first.metadata),
-    )
+    return FrequencySweep(cat("temperature_c"), cat("frequency_hz"), cat("response"),
+                          cat("magnitude_std_db") if std else None, cat("phase_std_deg") if std else None,
+                          first.input_name, first.input_unit, first.output_name, first.output_unit,
+                          dict(first.metadata))

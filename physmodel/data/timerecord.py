@@ -50,11 +50,10 @@ def split_column(column: str, where: str = "") -> tuple[str, str]:
         raise DataFormatError(f"{where}column {column!r} must be named '<name>_<unit>', e.g. 'voltage_V'")
     name, unit = column.rsplit("_", 1)
     if not (_NAME.match(name) and _UNIT.match(unit)):
-        raise DataFormatError(
-            f"{where}column {column!r} must be named '<name>_<unit>' with a name of "
-            f"letters, digits and '_' and a unit of letters/digits, e.g. 'current_uA'"
-        )
+        raise DataFormatError(f"{where}column {column!r} must be named '<name>_<unit>' with a name of "
+                              f"letters, digits and '_' and a unit of letters/digits, e.g. 'current_uA'")
     return name, unit
+
 
 
 def sample_rate(t_or_fs, n: int, block_samples: int = TIME_BLOCK_SAMPLES) -> float:
@@ -80,10 +79,8 @@ def sample_rate(t_or_fs, n: int, block_samples: int = TIME_BLOCK_SAMPLES) -> flo
         dev = np.abs(np.asarray(t[a:b], dtype=float) - (t0 + np.arange(a, b) * h))
         if not np.all(dev <= 1e-3 * h):
             k = a + int(np.argmax(np.where(np.isfinite(dev), dev, np.inf)))
-            raise IPMCError(
-                f"t_or_fs: sample {k} is at {float(t[k])!r} s, off the uniform grid "
-                f"t0 + k·{h:.6g} s; resample the record to a uniform time base"
-            )
+            raise IPMCError(f"t_or_fs: sample {k} is at {float(t[k])!r} s, off the uniform grid "
+                            f"t0 + k·{h:.6g} s; resample the record to a uniform time base")
     return 1.0 / h
 
 
@@ -111,9 +108,7 @@ class TimeRecord:
         if not self.channels:
             raise IPMCError("a time record needs at least one channel")
         if set(self.channels) != set(self.units):
-            raise IPMCError(
-                f"channels {sorted(self.channels)} and units {sorted(self.units)} must name the same channels"
-            )
+            raise IPMCError(f"channels {sorted(self.channels)} and units {sorted(self.units)} must name the same channels")
         chans = {}
         for name, v in self.channels.items():
             split_column(f"{name}_{self.units[name]}", "")
@@ -326,9 +321,8 @@ def read_mat(path) -> TimeRecord:
         raise DataFormatError(f"{path}: no such file") from None
     meta = json.loads(str(data["metadata_json"][0])) if "metadata_json" in data else {}
     skip = {"format", "metadata_json"}
-    cols = {
-        k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items() if not k.startswith("__") and k not in skip
-    }
+    cols = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items()
+            if not k.startswith("__") and k not in skip}
     _check_finite(cols, where)
     return _build(cols, {k: str(v) for k, v in meta.items()}, where)
 

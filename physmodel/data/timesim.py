@@ -63,7 +63,7 @@ def _block_state(poles, ctilde):
             b[i] = 1.0
             i += 1
         else:
-            A[i : i + 2, i : i + 2] = [[a.real, a.imag], [-a.imag, a.real]]
+            A[i:i + 2, i:i + 2] = [[a.real, a.imag], [-a.imag, a.real]]
             b[i] = 2.0
             i += 2
     return A, b, ctilde
@@ -97,7 +97,7 @@ def vector_fit(s, H, n_poles: int, weight=None, iterations: int = 15, direct: bo
     beta = np.logspace(lo, hi, n_pairs)
     poles = np.array([complex(-b / 100.0, b) for b in beta])
     if n_poles % 2:
-        poles = np.concatenate([[complex(-(10**lo), 0.0)], poles])
+        poles = np.concatenate([[complex(-10**lo, 0.0)], poles])
     for _ in range(iterations):
         Phi = _basis(s, poles)
         cols = [Phi]
@@ -105,7 +105,7 @@ def vector_fit(s, H, n_poles: int, weight=None, iterations: int = 15, direct: bo
             cols.append(np.ones((s.size, 1)))
         cols.append(-H[:, None] * Phi)
         x = weighted_complex_lstsq(np.hstack(cols), H, weight)
-        ct = x[-Phi.shape[1] :]
+        ct = x[-Phi.shape[1]:]
         A, b, c = _block_state(poles, ct)
         poles = _pairs(np.linalg.eigvals(A - np.outer(b, c)))
     Phi = _basis(s, poles)
@@ -170,7 +170,7 @@ class Realization:
                 A[i, i], B[i, 0], C[0, i] = a.real, 1.0, r.real
                 i += 1
             else:
-                A[i : i + 2, i : i + 2] = [[a.real, a.imag], [-a.imag, a.real]]
+                A[i:i + 2, i:i + 2] = [[a.real, a.imag], [-a.imag, a.real]]
                 B[i, 0] = 2.0
                 C[0, i], C[0, i + 1] = r.real, r.imag
                 i += 2
@@ -239,16 +239,9 @@ def check_uniform_time(t) -> float:
     return float(h)
 
 
-def realize(
-    fn: Callable[[np.ndarray], np.ndarray],
-    band_hz: tuple[float, float],
-    dc_value: float | None = None,
-    derivative: bool = False,
-    tol: float = 1e-4,
-    max_order: int = 60,
-    points_per_decade: int = 24,
-    description: str = "",
-) -> Realization:
+def realize(fn: Callable[[np.ndarray], np.ndarray], band_hz: tuple[float, float], dc_value: float | None = None,
+            derivative: bool = False, tol: float = 1e-4, max_order: int = 60, points_per_decade: int = 24,
+            description: str = "") -> Realization:
     """Fit a stable modal realisation to ``fn(s)`` (vectorised over complex ``s`` [1/s]).
 
     ``band_hz``: (f_lo, f_hi) of the fit.  ``dc_value``: the closed-form value at s = 0 (added as a
@@ -289,8 +282,7 @@ def realize(
     if err > tol:
         raise RealizationError(
             f"vector fitting reached a max relative error of {err:.2e} (> tol={tol:g}) with up to "
-            f"{max_order} poles over {f_lo:g}-{f_hi:g} Hz; widen tol or raise max_order"
-        )
+            f"{max_order} poles over {f_lo:g}-{f_hi:g} Hz; widen tol or raise max_order")
     return Realization(poles, res, d, (f_lo, f_hi), float(err), description)
 
 
@@ -311,11 +303,8 @@ class TimeSeries:
     metadata: dict = field(default_factory=dict)
 
     def columns(self) -> dict:
-        cols = {
-            "time_s": self.t,
-            f"{self.input_name}_{self.input_unit}": self.input,
-            f"{self.output_name}_{self.output_unit}": self.output,
-        }
+        cols = {"time_s": self.t, f"{self.input_name}_{self.input_unit}": self.input,
+                f"{self.output_name}_{self.output_unit}": self.output}
         if self.clean_output is not None:
             cols[f"{self.output_name}_clean_{self.output_unit}"] = self.clean_output
         if self.clean_input is not None:
@@ -338,11 +327,8 @@ class TimeSeries:
 
     def to_npz(self, path) -> Path:
         def write(fh):
-            np.savez(
-                fh,
-                header=np.array(json.dumps({"format": "ipmc-timeseries", "version": 1, "metadata": self.metadata})),
-                **self.columns(),
-            )
+            np.savez(fh, header=np.array(json.dumps({"format": "ipmc-timeseries", "version": 1, "metadata": self.metadata})),
+                     **self.columns())
 
         return atomic_write(path, write, "wb")
 
@@ -350,9 +336,8 @@ class TimeSeries:
         return by_extension(path, {".csv": self.to_csv, ".npz": self.to_npz}, "time-series")(path)
 
 
-def model_realization(
-    model, temperature_c: float, fs: float, duration: float, output: str = "auto", set_index: int = 0, tol: float = 1e-4
-) -> Realization:
+def model_realization(model, temperature_c: float, fs: float, duration: float, output: str = "auto",
+                      set_index: int = 0, tol: float = 1e-4) -> Realization:
     """Realise the model's main transfer function at one temperature for a simulation at ``fs`` [Hz]
     lasting ``duration`` [s].  ``output``: actuator "displacement" (M) or "current" (1/Z);
     sensor "current" (S)."""
@@ -360,47 +345,26 @@ def model_realization(
     if output == "auto":
         output = "displacement" if is_act else "current"
     f_lo = min(1e-3, 0.01 / duration)
-    f_hi = min(20.0 * fs, max(5.0 * fs, 1e5))  # beyond 100 kHz, 5 fs suffices for FOH input spectra
+    f_hi = min(20.0 * fs, max(5.0 * fs, 1e5))   # beyond 100 kHz, 5 fs suffices for FOH input spectra
     if is_act and output == "displacement":
         q, deriv, dc = "M", False, float(model.dc_gain([temperature_c])["M0"][set_index, 0])
     elif output == "current":
         q, deriv, dc = ("I" if is_act else "S"), True, None
     else:
-        raise IPMCError(
-            f"output {output!r} is not available for {type(model).__name__}; "
-            f"expected {'displacement or current' if is_act else 'current'}"
-        )
+        raise IPMCError(f"output {output!r} is not available for {type(model).__name__}; "
+                        f"expected {'displacement or current' if is_act else 'current'}")
     T = [float(temperature_c)]
 
     def fn(s):
         return model.evaluate(s, T, quantities=(q,))[q][set_index, 0]
 
-    return realize(
-        fn,
-        (f_lo, f_hi),
-        dc_value=dc,
-        derivative=deriv,
-        tol=tol,
-        description=f"{type(model).__name__} {q} at {temperature_c:g} °C, set {model.params[set_index].name}",
-    )
+    return realize(fn, (f_lo, f_hi), dc_value=dc, derivative=deriv, tol=tol,
+                   description=f"{type(model).__name__} {q} at {temperature_c:g} °C, set {model.params[set_index].name}")
 
 
-def simulate(
-    model,
-    temperature_c: float,
-    t,
-    u,
-    output: str = "auto",
-    chain=None,
-    output_noise_rms: float = 0.0,
-    input_noise_rms: float = 0.0,
-    seed: int | None = None,
-    hold: str = "foh",
-    initial: str = "rest",
-    set_index: int = 0,
-    tol: float = 1e-4,
-    realization: Realization | None = None,
-) -> TimeSeries:
+def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None, output_noise_rms: float = 0.0,
+             input_noise_rms: float = 0.0, seed: int | None = None, hold: str = "foh", initial: str = "rest",
+             set_index: int = 0, tol: float = 1e-4, realization: Realization | None = None) -> TimeSeries:
     """Run a virtual experiment: input samples ``u`` (SI: V for actuators, m for sensors) at ``t`` [s].
 
     ``chain``: optional :class:`~physmodel.sensor.TransimpedanceChain` applied to a current output
@@ -428,14 +392,8 @@ def simulate(
             y = y * chain.gain
         else:
             wc = 2 * np.pi * chain.bandwidth_hz
-            amp = Realization(
-                np.array([complex(-wc, 0.0)]),
-                np.array([complex(chain.gain * wc, 0.0)]),
-                0.0,
-                (0.0, np.inf),
-                0.0,
-                "amplifier pole",
-            )
+            amp = Realization(np.array([complex(-wc, 0.0)]), np.array([complex(chain.gain * wc, 0.0)]), 0.0,
+                              (0.0, np.inf), 0.0, "amplifier pole")
             y = amp.simulate(t, y, hold=hold, initial=initial)
         out_name, out_unit = "amplifier_output", "V"
     in_name, in_unit = ("voltage", "V") if is_act else ("tip_displacement", "m")
@@ -443,18 +401,12 @@ def simulate(
     y_meas = y + output_noise_rms * rng.standard_normal(y.size) if output_noise_rms else y.copy()
     u = np.asarray(u, dtype=float)
     u_meas = u + input_noise_rms * rng.standard_normal(u.size) if input_noise_rms else u.copy()
-    meta = {
-        "model": type(model).__name__ + (f" (kernel={model.kernel})" if hasattr(model, "kernel") else ""),
-        "parameter_set": model.params[set_index].name,
-        "temperature_c": f"{temperature_c:g}",
-        "realization": f"order {real.order}, max rel error {real.max_rel_error:.1e} over "
-        f"{real.band_hz[0]:g}-{real.band_hz[1]:g} Hz",
-        "hold": hold,
-        "initial": initial,
-        "output_noise_rms": f"{output_noise_rms:g}",
-        "input_noise_rms": f"{input_noise_rms:g}",
-        "seed": str(seed),
-    }
+    meta = {"model": type(model).__name__ + (f" (kernel={model.kernel})" if hasattr(model, "kernel") else ""),
+            "parameter_set": model.params[set_index].name, "temperature_c": f"{temperature_c:g}",
+            "realization": f"order {real.order}, max rel error {real.max_rel_error:.1e} over "
+                           f"{real.band_hz[0]:g}-{real.band_hz[1]:g} Hz",
+            "hold": hold, "initial": initial, "output_noise_rms": f"{output_noise_rms:g}",
+            "input_noise_rms": f"{input_noise_rms:g}", "seed": str(seed)}
     if chain is not None:
         meta["chain"] = f"R1={chain.R1:g} R2={chain.R2:g} R3={chain.R3:g} bandwidth_hz={chain.bandwidth_hz}"
     return TimeSeries(t, u_meas, y_meas, in_name, in_unit, out_name, out_unit, y, u, meta)
@@ -476,19 +428,16 @@ def time_grid(duration: float, fs: float) -> np.ndarray:
     if not (np.isfinite(fs) and fs > 0):
         raise IPMCError(f"fs={fs!r} Hz must be > 0")
     if duration * fs > MAX_TIME_SAMPLES:
-        raise IPMCError(
-            f"duration {duration:g} s at fs {fs:g} Hz is {duration * fs:.3g} samples; at most "
-            f"{MAX_TIME_SAMPLES} per record"
-        )
+        raise IPMCError(f"duration {duration:g} s at fs {fs:g} Hz is {duration * fs:.3g} samples; at most "
+                        f"{MAX_TIME_SAMPLES} per record")
     n = int(round(duration * fs)) + 1
     if n < 2:
         raise IPMCError(f"duration {duration} s at fs {fs} Hz gives fewer than 2 samples")
     return np.arange(n) / fs
 
 
-def sine(
-    model, temperature_c: float, amplitude: float, frequency_hz: float, duration: float, fs: float, **kw
-) -> TimeSeries:
+def sine(model, temperature_c: float, amplitude: float, frequency_hz: float, duration: float, fs: float,
+         **kw) -> TimeSeries:
     """Sinusoidal excitation from rest: u = amplitude·sin(2π f t) (V for actuators, m for sensors)."""
     if not (np.isfinite(frequency_hz) and 0 < frequency_hz < fs / 2):
         raise IPMCError(f"frequency_hz={frequency_hz!r} must be in (0, fs/2 = {fs / 2:g}) Hz")
@@ -496,9 +445,8 @@ def sine(
     return simulate(model, temperature_c, t, amplitude * np.sin(2 * np.pi * frequency_hz * t), **kw)
 
 
-def step(
-    model, temperature_c: float, amplitude: float, duration: float, fs: float, t_step: float = 0.0, **kw
-) -> TimeSeries:
+def step(model, temperature_c: float, amplitude: float, duration: float, fs: float, t_step: float = 0.0,
+         **kw) -> TimeSeries:
     """A step of ``amplitude`` at ``t_step`` [s] from rest (exact under zero-order hold)."""
     t = time_grid(duration, fs)
     u = np.where(t >= t_step, amplitude, 0.0)
@@ -517,9 +465,8 @@ def released_tip_displacement(t, w0: float, t_release: float, omega_n: float, xi
     return np.where(tau < 0, w0, free)
 
 
-def free_release(
-    model, temperature_c: float, w0: float, t_release: float, duration: float, fs: float, set_index: int = 0, **kw
-) -> TimeSeries:
+def free_release(model, temperature_c: float, w0: float, t_release: float, duration: float, fs: float,
+                 set_index: int = 0, **kw) -> TimeSeries:
     """Seed 000 Figs. 14-15: displace the tip by ``w0`` [m], hold, release at ``t_release`` [s].
 
     Sensor: the displacement (first mode at this temperature) drives the current, starting from the
@@ -527,10 +474,8 @@ def free_release(
     the displacement itself.
     """
     if not (np.isfinite(t_release) and 0 <= t_release < duration):
-        raise IPMCError(
-            f"t_release = {t_release!r} s must lie in [0, duration = {duration!r} s): a release "
-            "after the record ends leaves nothing to record"
-        )
+        raise IPMCError(f"t_release = {t_release!r} s must lie in [0, duration = {duration!r} s): a release "
+                        "after the record ends leaves nothing to record")
     if not (np.isfinite(w0) and w0 != 0):
         raise IPMCError(f"w0 = {w0!r} m: the initial tip displacement must be finite and non-zero")
     st = model.state([temperature_c])
@@ -539,12 +484,8 @@ def free_release(
     t = time_grid(duration, fs)
     w = released_tip_displacement(t, w0, t_release, wn, xi)
     if getattr(model, "kind", None) == "actuator":
-        meta = {
-            "model": "ActuatorModel (electrodes shorted)",
-            "parameter_set": model.params[set_index].name,
-            "temperature_c": f"{temperature_c:g}",
-            "experiment": "free release",
-        }
+        meta = {"model": "ActuatorModel (electrodes shorted)", "parameter_set": model.params[set_index].name,
+                "temperature_c": f"{temperature_c:g}", "experiment": "free release"}
         return TimeSeries(t, np.zeros_like(t), w, "voltage", "V", "tip_displacement", "m", w, np.zeros_like(t), meta)
     kw.setdefault("initial", "steady")
     ts = simulate(model, temperature_c, t, w, set_index=set_index, **kw)

@@ -6,25 +6,12 @@ from ..errors import DataFormatError
 
 #: Units the files may use, as multiples of the SI unit of their kind.
 UNITS: dict[str, tuple[str, float]] = {
-    "V": ("voltage", 1.0),
-    "mV": ("voltage", 1e-3),
-    "uV": ("voltage", 1e-6),
-    "µV": ("voltage", 1e-6),
-    "m": ("length", 1.0),
-    "mm": ("length", 1e-3),
-    "um": ("length", 1e-6),
-    "µm": ("length", 1e-6),
-    "A": ("current", 1.0),
-    "mA": ("current", 1e-3),
-    "uA": ("current", 1e-6),
-    "µA": ("current", 1e-6),
+    "V": ("voltage", 1.0), "mV": ("voltage", 1e-3), "uV": ("voltage", 1e-6), "µV": ("voltage", 1e-6),
+    "m": ("length", 1.0), "mm": ("length", 1e-3), "um": ("length", 1e-6), "µm": ("length", 1e-6),
+    "A": ("current", 1.0), "mA": ("current", 1e-3), "uA": ("current", 1e-6), "µA": ("current", 1e-6),
     "nA": ("current", 1e-9),
-    "Ohm": ("impedance", 1.0),
-    "ohm": ("impedance", 1.0),
-    "Ω": ("impedance", 1.0),
-    "kOhm": ("impedance", 1e3),
-    "N": ("force", 1.0),
-    "mN": ("force", 1e-3),
+    "Ohm": ("impedance", 1.0), "ohm": ("impedance", 1.0), "Ω": ("impedance", 1.0), "kOhm": ("impedance", 1e3),
+    "N": ("force", 1.0), "mN": ("force", 1e-3),
     "1": ("dimensionless", 1.0),
 }
 

@@ -50,10 +50,8 @@ class EffectParameter:
         if not self.lower < self.upper:
             raise ParameterError(f"effect parameter {self.name}: bounds [{self.lower}, {self.upper}] are empty")
         if not (self.lower <= self.off <= self.upper) or not (self.lower <= self.typical <= self.upper):
-            raise ParameterError(
-                f"effect parameter {self.name}: off={self.off} and typical={self.typical} "
-                f"must lie in [{self.lower}, {self.upper}]"
-            )
+            raise ParameterError(f"effect parameter {self.name}: off={self.off} and typical={self.typical} "
+                                 f"must lie in [{self.lower}, {self.upper}]")
         if self.typical == self.off:
             raise ParameterError(f"effect parameter {self.name}: typical must differ from off ({self.off})")
 
@@ -104,9 +102,8 @@ class Effect:
         for p in self.parameters:
             if p.name == name:
                 return p
-        raise ParameterError(
-            f"effect {self.name!r} has no parameter {name!r}; expected one of {[p.name for p in self.parameters]}"
-        )
+        raise ParameterError(f"effect {self.name!r} has no parameter {name!r}; "
+                             f"expected one of {[p.name for p in self.parameters]}")
 
     def is_off(self, values: Mapping[str, float]) -> bool:
         if self.switch is not None:
@@ -127,21 +124,16 @@ class Effect:
             ov = dict((overrides or {}).get(p.name, {}))
             bad = set(ov) - {"lower", "upper", "typical"}
             if bad:
-                raise ParameterError(
-                    f"{self.name}.{p.name}: unknown bound key(s) {sorted(bad)}; expected lower, upper, typical"
-                )
+                raise ParameterError(f"{self.name}.{p.name}: unknown bound key(s) {sorted(bad)}; "
+                                     "expected lower, upper, typical")
             lo, hi, ty = (float(ov.get("lower", lo)), float(ov.get("upper", hi)), float(ov.get("typical", ty)))
             for k, v in (("lower", lo), ("upper", hi)):
                 if not math.isfinite(v) or not (p.lower <= v <= p.upper):
-                    raise ParameterError(
-                        f"{self.name}.{p.name}: candidate {k} {v!r} [{p.unit}] must lie in the "
-                        f"absolute bounds [{p.lower:g}, {p.upper:g}]"
-                    )
+                    raise ParameterError(f"{self.name}.{p.name}: candidate {k} {v!r} [{p.unit}] must lie in the "
+                                         f"absolute bounds [{p.lower:g}, {p.upper:g}]")
             if not lo < hi or not lo <= p.off <= hi:
-                raise ParameterError(
-                    f"{self.name}.{p.name}: candidate bounds [{lo:g}, {hi:g}] must be increasing "
-                    f"and contain the off value {p.off:g}"
-                )
+                raise ParameterError(f"{self.name}.{p.name}: candidate bounds [{lo:g}, {hi:g}] must be increasing "
+                                     f"and contain the off value {p.off:g}")
             ty = min(max(ty, lo), hi)
             if ty == p.off:
                 ty = p.off + 0.1 * ((hi - p.off) if hi > p.off else (lo - p.off))

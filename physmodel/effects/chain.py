@@ -78,92 +78,52 @@ def _cpe_bounds(p):
 
 
 EFFECTS = [
-    Effect(
-        "amplifier_bandwidth",
-        "measurement-amplifier bandwidth",
-        "The poles of the measuring amplifier (transimpedance or displacement sensor), "
-        "1/((1 + s τa)(1 + s τb)): a dominant pole and a non-dominant one (0 = single pole); "
-        "independent of temperature.",
-        "seed 000 Fig. 4 (op-amp chain); Franco, Design with Operational Amplifiers (two-pole open-loop response)",
-        "response",
-        (
-            P("time_constant", "s", 0.0, 0.0, 0.05, 1.5e-3, "τa = 1/ωa"),
-            P("second_time_constant", "s", 0.0, 0.0, 0.05, 3e-4, "τb of a second pole"),
-        ),
-        quantities=_MEAS,
-        apply=_r_amplifier,
-    ),
-    Effect(
-        "time_delay",
-        "acquisition time delay",
-        "A pure delay e^{-sτ} between excitation and acquisition channels: phase −ωτ, magnitude unchanged.",
-        "Pintelon & Schoukens, System Identification (2012), ch. 2",
-        "response",
-        (P("delay", "s", 0.0, 0.0, 0.05, 1e-3, "delay τ"),),
-        quantities=_MEAS,
-        apply=_r_delay,
-    ),
-    Effect(
-        "series_resistance",
-        "lumped series resistance",
-        "A lumped resistance Rs in series with the strip (leads, clamp contacts, source/amplifier "
-        "input resistance): divider Z/(Z + Rs) on the driven or measured signal.",
-        "standard equivalent-circuit practice (Barsoukov & Macdonald, Impedance Spectroscopy)",
-        "series",
-        (P("resistance", "Ohm", 0.0, 0.0, 1e4, 20.0, "series resistance Rs"),),
-        quantities=_MEAS,
-        apply=_z_series_resistance,
-    ),
-    Effect(
-        "series_cpe",
-        "interface constant-phase element in series",
-        "An electrode double-layer CPE in series with the strip, Z_cpe = S'/(W L)·(jω)^(−n): "
-        "divider Z/(Z + Z_cpe) on the driven or measured signal, a low-frequency roll-off with "
-        "constant phase −nπ/2 of the added impedance.",
-        "Macdonald & Barsoukov, Impedance Spectroscopy (2005) §2.2.2.2; CPE exponent 0.9-1 for metal electrodes",
-        "series",
-        (
-            P("S_area", "Ohm m^2 s^-n", 0.0, 0.0, 1e3, 0.05, "area-specific CPE coefficient S' = W L/Q"),
-            P("n", "1", 0.9, 0.5, 1.0, 0.8, "CPE exponent n", limits=("upper",)),
-        ),
-        quantities=_MEAS,
-        apply=_z_series_cpe,
-        switch="S_area",
-        fit_bounds=_cpe_bounds,
-        bounds_doc="S' in [0, 50·2λ/κe]: up to fifty times the inverse area capacitance of the strip's "
-        "own double layers at T_ref (≈ 2.5 Ω·m²·s^(−n) for seed 002); typical 1× it; n in [0.5, 1].",
-    ),
-    Effect(
-        "coupling_compliance",
-        "excitation-coupling compliance",
-        "The imposed tip displacement is applied through a spring: w_tip/w_drive = "
-        "1/(1 + ε/G1(s)), ε = tip stiffness / coupling stiffness.",
-        "seed 000 §III (imposed tip displacement)",
-        "response",
-        (P("compliance_ratio", "1", 0.0, 0.0, 5.0, 0.2, "ε = k_tip/k_coupling"),),
-        kinds=("sensor",),
-        quantities=("S",),
-        apply=_r_coupling,
-    ),
+    Effect("amplifier_bandwidth", "measurement-amplifier bandwidth",
+           "The poles of the measuring amplifier (transimpedance or displacement sensor), "
+           "1/((1 + s τa)(1 + s τb)): a dominant pole and a non-dominant one (0 = single pole); "
+           "independent of temperature.", "seed 000 Fig. 4 (op-amp chain); Franco, Design with "
+           "Operational Amplifiers (two-pole open-loop response)",
+           "response", (P("time_constant", "s", 0.0, 0.0, 0.05, 1.5e-3, "τa = 1/ωa"),
+                        P("second_time_constant", "s", 0.0, 0.0, 0.05, 3e-4, "τb of a second pole")),
+           quantities=_MEAS, apply=_r_amplifier),
+    Effect("time_delay", "acquisition time delay",
+           "A pure delay e^{-sτ} between excitation and acquisition channels: phase −ωτ, magnitude "
+           "unchanged.", "Pintelon & Schoukens, System Identification (2012), ch. 2", "response",
+           (P("delay", "s", 0.0, 0.0, 0.05, 1e-3, "delay τ"),), quantities=_MEAS, apply=_r_delay),
+    Effect("series_resistance", "lumped series resistance",
+           "A lumped resistance Rs in series with the strip (leads, clamp contacts, source/amplifier "
+           "input resistance): divider Z/(Z + Rs) on the driven or measured signal.",
+           "standard equivalent-circuit practice (Barsoukov & Macdonald, Impedance Spectroscopy)",
+           "series", (P("resistance", "Ohm", 0.0, 0.0, 1e4, 20.0, "series resistance Rs"),),
+           quantities=_MEAS, apply=_z_series_resistance),
+    Effect("series_cpe", "interface constant-phase element in series",
+           "An electrode double-layer CPE in series with the strip, Z_cpe = S'/(W L)·(jω)^(−n): "
+           "divider Z/(Z + Z_cpe) on the driven or measured signal, a low-frequency roll-off with "
+           "constant phase −nπ/2 of the added impedance.",
+           "Macdonald & Barsoukov, Impedance Spectroscopy (2005) §2.2.2.2; CPE exponent 0.9-1 for "
+           "metal electrodes", "series",
+           (P("S_area", "Ohm m^2 s^-n", 0.0, 0.0, 1e3, 0.05, "area-specific CPE coefficient S' = W L/Q"),
+            P("n", "1", 0.9, 0.5, 1.0, 0.8, "CPE exponent n", limits=("upper",))),
+           quantities=_MEAS, apply=_z_series_cpe, switch="S_area", fit_bounds=_cpe_bounds,
+           bounds_doc="S' in [0, 50·2λ/κe]: up to fifty times the inverse area capacitance of the strip's "
+                      "own double layers at T_ref (≈ 2.5 Ω·m²·s^(−n) for seed 002); typical 1× it; n in [0.5, 1]."),
+    Effect("coupling_compliance", "excitation-coupling compliance",
+           "The imposed tip displacement is applied through a spring: w_tip/w_drive = "
+           "1/(1 + ε/G1(s)), ε = tip stiffness / coupling stiffness.", "seed 000 §III (imposed tip "
+           "displacement)", "response",
+           (P("compliance_ratio", "1", 0.0, 0.0, 5.0, 0.2, "ε = k_tip/k_coupling"),),
+           kinds=("sensor",), quantities=("S",), apply=_r_coupling),
 ]
 
 #: Effects kept OUT of the candidate list: used by blind generators only.
 OUT_OF_LIBRARY = [
-    Effect(
-        "fixture_resonance",
-        "fixture resonance (out of library)",
-        "A notch/resonance of the test fixture: (s² + 2ζz ωf s + ωf²)/(s² + 2ζ ωf s + ωf²), ζz = ζ (1 − depth).",
-        "generator only",
-        "response",
-        (
-            P("frequency_hz", "Hz", 1.0, 0.01, 1e4, 5.0, "fixture resonance"),
+    Effect("fixture_resonance", "fixture resonance (out of library)",
+           "A notch/resonance of the test fixture: (s² + 2ζz ωf s + ωf²)/(s² + 2ζ ωf s + ωf²), "
+           "ζz = ζ (1 − depth).", "generator only", "response",
+           (P("frequency_hz", "Hz", 1.0, 0.01, 1e4, 5.0, "fixture resonance"),
             P("depth", "1", 0.0, 0.0, 1.0, 0.6, "notch depth (0 off)"),
-            P("damping", "1", 0.05, 0.001, 1.0, 0.1, "damping ratio of the fixture"),
-        ),
-        quantities=_MEAS,
-        apply=_r_fixture,
-        switch="depth",
-    ),
+            P("damping", "1", 0.05, 0.001, 1.0, 0.1, "damping ratio of the fixture")),
+           quantities=_MEAS, apply=_r_fixture, switch="depth"),
 ]
 
 __all__ = ["EFFECTS", "OUT_OF_LIBRARY", "cpe_impedance", "double_layer_area_impedance"]

@@ -67,9 +67,8 @@ class _Context:
         return self._x
 
 
-def candidate_free_parameters(
-    effect: str, params: IPMCParameters | None = None, overrides: Mapping[str, Mapping[str, float]] | None = None
-) -> tuple:
+def candidate_free_parameters(effect: str, params: IPMCParameters | None = None,
+                              overrides: Mapping[str, Mapping[str, float]] | None = None) -> tuple:
     """The parameters of library ``effect`` with candidate bounds for the strip ``params`` (see
     :meth:`Effect.candidate_parameters`); ``overrides = {param: {"lower"|"upper"|"typical": value}}``."""
     return get_effect(effect).candidate_parameters(params, overrides)
@@ -79,19 +78,15 @@ def get_effect(name: str) -> Effect:
     """The effect called ``name`` (library or out-of-library)."""
     name = ALIASES.get(name, name)
     if name not in ALL_EFFECTS:
-        raise ParameterError(
-            f"unknown effect {name!r}; expected one of {sorted(LIBRARY)} (or out-of-library {sorted(OUT_OF_LIBRARY)})"
-        )
+        raise ParameterError(f"unknown effect {name!r}; expected one of {sorted(LIBRARY)} "
+                             f"(or out-of-library {sorted(OUT_OF_LIBRARY)})")
     return ALL_EFFECTS[name]
 
 
 def candidates_for(kind: str, quantity: str, n_temperatures: int = 2) -> list[str]:
     """Library effects that can change ``quantity`` of a ``kind`` model with this many temperatures."""
-    return [
-        e.name
-        for e in LIBRARY.values()
-        if e.applies_to(kind, quantity) and (n_temperatures > 1 or not e.needs_temperatures)
-    ]
+    return [e.name for e in LIBRARY.values()
+            if e.applies_to(kind, quantity) and (n_temperatures > 1 or not e.needs_temperatures)]
 
 
 def normalize_effects(effects: Mapping[str, Mapping[str, float]] | None) -> dict[str, dict[str, float]]:
@@ -146,7 +141,8 @@ class _EffectMixin:
         for name in self.effects:
             e = get_effect(name)
             if self.kind not in e.kinds:
-                raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model (it applies to {e.kinds})")
+                raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model "
+                                f"(it applies to {e.kinds})")
         self._active = [(get_effect(n), v) for n, v in self.effects.items() if not get_effect(n).is_off(v)]
 
     def state(self, temperature_c) -> State:
@@ -162,9 +158,8 @@ class _EffectMixin:
         d["omega_n"] = first_mode_omega(d["E"], d["rho"], d["L"], d["h"])
         return State(**d)
 
-    def frequency_response(
-        self, frequency_hz, temperature_c, quantities=None, out=None, progress=None
-    ) -> FrequencyResponse:
+    def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
+                           progress=None) -> FrequencyResponse:
         """Like the base model's, with every effect applied.  ``out`` is filled if given."""
         qs = self._check_quantities(quantities or self.quantities)
         f = check_frequencies(frequency_hz)
@@ -207,7 +202,7 @@ class _EffectMixin:
             for q in qs:
                 if q == "Z":
                     vals[q] = vals[q] + zs
-                elif q != "G":  # voltage divider (actuator) / current divider (sensor)
+                elif q != "G":                 # voltage divider (actuator) / current divider (sensor)
                     vals[q] = vals[q] * (Z0 / (Z0 + zs))
         res = {}
         for q in qs:
@@ -217,11 +212,8 @@ class _EffectMixin:
             else:
                 res[q] = np.asarray(vals[q], dtype=complex)
         return FrequencyResponse(
-            frequency_hz=f,
-            temperature_c=T,
-            parameter_sets=tuple(p.name for p in self.params),
-            values=res,
-            units={q: self.units[q] for q in qs},
+            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
+            values=res, units={q: self.units[q] for q in qs},
             descriptions={q: self.descriptions[q] for q in qs},
         )
 
@@ -249,14 +241,8 @@ class _EffectMixin:
         from ..data.sweep import sweep_layout
 
         lay = sweep_layout(data, self.kind, quantity or DEFAULT_QUANTITY[self.kind])
-        q, scale, freqs, fi, temps, ti = (
-            lay.quantity,
-            lay.factor,
-            lay.frequencies_hz,
-            lay.f_index,
-            lay.temperatures_c,
-            lay.t_index,
-        )
+        q, scale, freqs, fi, temps, ti = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,
+                                          lay.temperatures_c, lay.t_index)
 
         def predict(values: Mapping[str, float]) -> np.ndarray:
             m = self.with_values(values) if values else self
@@ -319,9 +305,8 @@ class EffectSensorModel(_EffectMixin, SensorModel):
         return {"kernel": self.kernel}
 
 
-def make_effect_model(
-    params, kind: str, effects=None, *, kernel: str = "boundary_charge", chunk_size: int = DEFAULT_CHUNK
-):
+def make_effect_model(params, kind: str, effects=None, *, kernel: str = "boundary_charge",
+                      chunk_size: int = DEFAULT_CHUNK):
     if kind == "actuator":
         return EffectActuatorModel(params, effects, chunk_size)
     if kind == "sensor":
@@ -329,14 +314,9 @@ def make_effect_model(
     raise IPMCError(f"kind must be one of {KINDS}, got {kind!r}")
 
 
-def EffectModel(
-    base_params: IPMCParameters | Sequence[IPMCParameters],
-    kind: str = "actuator",
-    effects: Mapping[str, Mapping[str, float]] | None = None,
-    *,
-    kernel: str = "boundary_charge",
-    chunk_size: int = DEFAULT_CHUNK,
-):
+def EffectModel(base_params: IPMCParameters | Sequence[IPMCParameters], kind: str = "actuator",
+                effects: Mapping[str, Mapping[str, float]] | None = None, *,
+                kernel: str = "boundary_charge", chunk_size: int = DEFAULT_CHUNK):
     """A base model (``kind`` "actuator" | "sensor") with named effects switched on.
 
     ``effects`` maps effect names (see :data:`LIBRARY`, :data:`OUT_OF_LIBRARY`) to
@@ -349,23 +329,7 @@ def EffectModel(
     return make_effect_model(base_params, kind, effects, kernel=kernel, chunk_size=chunk_size)
 
 
-__all__ = [
-    "Effect",
-    "EffectParameter",
-    "EffectModel",
-    "EffectActuatorModel",
-    "EffectSensorModel",
-    "LIBRARY",
-    "OUT_OF_LIBRARY",
-    "ALL_EFFECTS",
-    "ALIASES",
-    "get_effect",
-    "candidates_for",
-    "normalize_effects",
-    "split_values",
-    "candidate_free_parameters",
-    "CPE_REFERENCE_HZ",
-    "SECOND_MODE_RATIO",
-    "DEFAULT_QUANTITY",
-    "KINDS",
-]
+__all__ = ["Effect", "EffectParameter", "EffectModel", "EffectActuatorModel", "EffectSensorModel",
+           "LIBRARY", "OUT_OF_LIBRARY", "ALL_EFFECTS", "ALIASES", "get_effect", "candidates_for", "normalize_effects",
+           "split_values", "candidate_free_parameters", "CPE_REFERENCE_HZ", "SECOND_MODE_RATIO", "DEFAULT_QUANTITY",
+           "KINDS"]

@@ -38,9 +38,8 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
         lo, hi = defaults[attr]
         return FreeParameter(name, lo, hi, "linear", min(max(v, lo), hi))
     if not math.isfinite(v) or v == 0:
-        raise ParameterError(
-            f"{name} = {v!r} in the base set: no default bounds; give them explicitly (e.g. '{name}:LOWER:UPPER')"
-        )
+        raise ParameterError(f"{name} = {v!r} in the base set: no default bounds; give them explicitly "
+                             f"(e.g. '{name}:LOWER:UPPER')")
     span = 3.0 if name == "omega_n" else 10.0
     lo, hi = sorted((v / span, v * span))
     if name == "xi":
@@ -49,27 +48,16 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
     return FreeParameter(name, lo, hi, "log", v)
 
 
-def physics_predictor(
-    data: FrequencySweep,
-    base: IPMCParameters,
-    kind: str = "actuator",
-    quantity: str | None = None,
-    kernel: str = "boundary_charge",
-):
+def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "actuator",
+                      quantity: str | None = None, kernel: str = "boundary_charge"):
     """``predict_many(list of values) -> (n_sets, N)`` in the sweep's units, plus a wide-band
     :class:`SensitivityProbe` at the median data temperature.  One model call per batch
     (sets × temperatures × union of frequencies)."""
     from ..protocol import physics_model
 
     lay = sweep_layout(data, kind, quantity)
-    q, factor, fu, inv_f, Tu, inv_T = (
-        lay.quantity,
-        lay.factor,
-        lay.frequencies_hz,
-        lay.f_index,
-        lay.temperatures_c,
-        lay.t_index,
-    )
+    q, factor, fu, inv_f, Tu, inv_T = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,
+                                       lay.temperatures_c, lay.t_index)
 
     def model_of(values_list):
         plist = [apply_values(base, v) for v in values_list]
@@ -88,24 +76,12 @@ def physics_predictor(
     return predict_many, SensitivityProbe(f_probe, probe_many), q
 
 
-def calibrate(
-    data: FrequencySweep | Sequence[FrequencySweep],
-    base: IPMCParameters,
-    free: Sequence[FreeParameter | str],
-    *,
-    kind: str = "actuator",
-    quantity: str | None = None,
-    starts: int = 4,
-    seed: int = 0,
-    kernel: str = "boundary_charge",
-    max_nfev: int | None = None,
-    identify: bool = True,
-    hold_undetermined: bool = True,
-    name: str | None = None,
-    progress: Callable[[int], None] | None = None,
-    misfit: str = "widen",
-    **kwargs,
-) -> CalibrationResult:
+def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParameters,
+              free: Sequence[FreeParameter | str], *, kind: str = "actuator", quantity: str | None = None,
+              starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
+              identify: bool = True, hold_undetermined: bool = True, name: str | None = None,
+              progress: Callable[[int], None] | None = None, misfit: str = "widen",
+              **kwargs) -> CalibrationResult:
     """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
 
     ``free``: :class:`FreeParameter` records or bare names (default bounds: see
@@ -139,47 +115,24 @@ def calibrate(
             if item.initial is None:
                 v = base_value(base, item.name)
                 if not item.lower <= v <= item.upper:
-                    raise ParameterError(
-                        f"free parameter {item.name}: the base value {v!r} lies outside the "
-                        f"bounds [{item.lower!r}, {item.upper!r}]; give an initial value"
-                    )
+                    raise ParameterError(f"free parameter {item.name}: the base value {v!r} lies outside the "
+                                         f"bounds [{item.lower!r}, {item.upper!r}]; give an initial value")
                 item = item.with_initial(v)
             fps.append(item)
         else:
             raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
     predict_many, probe, q = physics_predictor(data, base, kind, quantity, kernel)
-    res = fit_parameters(
-        data,
-        None,
-        fps,
-        starts=starts,
-        seed=seed,
-        predict_many=predict_many,
-        max_nfev=max_nfev,
-        identify=identify,
-        hold_undetermined=hold_undetermined,
-        probe=probe,
-        progress=progress,
-        **kwargs,
-    )
+    res = fit_parameters(data, None, fps, starts=starts, seed=seed, predict_many=predict_many,
+                         max_nfev=max_nfev, identify=identify, hold_undetermined=hold_undetermined,
+                         probe=probe, progress=progress, **kwargs)
     label = name or f"{base.name}_calibrated"
-    src = (
-        f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
-        f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"
-        + (f"; undetermined (held at base): {', '.join(res.held)}" if res.held else "")
-        + f"; base: {base.name}"
-    )
+    src = (f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
+           f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"
+           + (f"; undetermined (held at base): {', '.join(res.held)}" if res.held else "")
+           + f"; base: {base.name}")
     res.parameters = replace(apply_values(base, res.values), name=label, source=src)
-    res.metadata.update(
-        {
-            "kind": kind,
-            "quantity": q,
-            "kernel": kernel,
-            "base": base.name,
-            "data_fingerprint": data.fingerprint(),
-            "seed": seed,
-        }
-    )
+    res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
+                         "data_fingerprint": data.fingerprint(), "seed": seed})
     if not res.adequate:
         apply_misfit_policy(res, widen=misfit == "widen")
     return res
@@ -204,43 +157,24 @@ def apply_misfit_policy(res: CalibrationResult, widen: bool) -> CalibrationResul
             res.stderr[n] = res.stderr[n] * R
         else:
             res.ci_lower[n] = res.ci_upper[n] = res.stderr[n] = float("nan")
-        res.identifiability[n] = Identifiability(
-            False, "not assessed: the model does not fit the data (" + gof.reason + ")"
-        )
-    res.message += (
-        "; MODEL INADEQUATE: "
-        + gof.reason
-        + ("; intervals widened by the Birge ratio %.3g" % R if widen else "; intervals withheld")
-    )
+        res.identifiability[n] = Identifiability(False, "not assessed: the model does not fit the data (" + gof.reason + ")")
+    res.message += ("; MODEL INADEQUATE: " + gof.reason
+                    + ("; intervals widened by the Birge ratio %.3g" % R if widen else "; intervals withheld"))
     return res
 
 
-def model_sweep(
-    result: CalibrationResult,
-    data: FrequencySweep,
-    kind: str | None = None,
-    quantity: str | None = None,
-    kernel: str | None = None,
-) -> FrequencySweep:
+def model_sweep(result: CalibrationResult, data: FrequencySweep, kind: str | None = None,
+                quantity: str | None = None, kernel: str | None = None) -> FrequencySweep:
     """The calibrated model's response on the data's lines, as a sweep (for overlays)."""
     if result.parameters is None:
         raise IPMCError("the result has no physical parameter set (use calibrate(), not fit_parameters())")
     kind = kind or result.metadata.get("kind", "actuator")
-    predict_many, _, _ = physics_predictor(
-        data,
-        result.parameters,
-        kind,
-        quantity or result.metadata.get("quantity"),
-        kernel or result.metadata.get("kernel", "boundary_charge"),
-    )
+    predict_many, _, _ = physics_predictor(data, result.parameters, kind,
+                                           quantity or result.metadata.get("quantity"),
+                                           kernel or result.metadata.get("kernel", "boundary_charge"))
     G = predict_many([{}])[0]
-    return replace(
-        data,
-        response=G,
-        magnitude_std_db=None,
-        phase_std_deg=None,
-        metadata={"source": "calibrated model", "parameter_set": result.parameters.name},
-    )
+    return replace(data, response=G, magnitude_std_db=None, phase_std_deg=None,
+                   metadata={"source": "calibrated model", "parameter_set": result.parameters.name})
 
 
 __all__ = ["default_free_parameter", "physics_predictor", "calibrate", "model_sweep"]

@@ -60,27 +60,13 @@ class CandidateResult:
     penalty: float = 0.0
 
     def to_dict(self) -> dict:
-        return {
-            "name": self.name,
-            "values": self.values,
-            "ci95_lower": self.ci_lower,
-            "ci95_upper": self.ci_upper,
-            "cost": self.cost,
-            "lr": self.lr,
-            "aic": self.aic,
-            "bic": self.bic,
-            "n_parameters": self.n_parameters,
-            "significant": self.significant,
-            "closes_gap": self.closes_gap,
-            "converged": self.converged,
-            "signature_norm": self.signature_norm,
-            "lr_linearised": self.lr_linearised,
-            "note": self.note,
-            "candidate_bounds": self.bounds,
-            "at_or_near_bound": self.at_bound,
-            "outside_plausible_range": self.implausible,
-            "penalty": self.penalty,
-        }
+        return {"name": self.name, "values": self.values, "ci95_lower": self.ci_lower,
+                "ci95_upper": self.ci_upper, "cost": self.cost, "lr": self.lr, "aic": self.aic,
+                "bic": self.bic, "n_parameters": self.n_parameters, "significant": self.significant,
+                "closes_gap": self.closes_gap, "converged": self.converged,
+                "signature_norm": self.signature_norm, "lr_linearised": self.lr_linearised, "note": self.note,
+                "candidate_bounds": self.bounds, "at_or_near_bound": self.at_bound,
+                "outside_plausible_range": self.implausible, "penalty": self.penalty}
 
 
 @dataclass
@@ -131,15 +117,9 @@ class Diagnosis:
             return None
         out = {}
         for n in self.named:
-            out[n] = {
-                k.split(".", 1)[1]: {
-                    "value": self.final.values[k],
-                    "ci95": [self.final.ci_lower[k], self.final.ci_upper[k]],
-                    "unit": get_effect(n).parameter(k.split(".", 1)[1]).unit,
-                }
-                for k in self.final.names
-                if k.startswith(n + ".")
-            }
+            out[n] = {k.split(".", 1)[1]: {"value": self.final.values[k], "ci95": [self.final.ci_lower[k], self.final.ci_upper[k]],
+                                            "unit": get_effect(n).parameter(k.split(".", 1)[1]).unit}
+                      for k in self.final.names if k.startswith(n + ".")}
         return out
 
     def to_dict(self) -> dict:
@@ -156,44 +136,28 @@ class Diagnosis:
                 return bool(o)
             return o
 
-        return clean(
-            {
-                "format": "ipmc-diagnosis",
-                "version": 1,
-                "verdict": self.verdict,
-                "named": list(self.named),
-                "message": self.message,
-                "named_effect": self.named_effect(),
-                "kind": self.kind,
-                "quantity": self.quantity,
-                "alpha": self.alpha,
-                "lr_threshold": self.threshold,
-                "gap_threshold_2cost": self.gap_threshold,
-                "noise_estimated": self.noise_estimated,
-                "baseline": self.baseline.to_dict(),
-                "final": self.final.to_dict() if self.final is not None else None,
-                "final_effects": self.final_effects,
-                "candidates": {k: v.to_dict() for k, v in self.candidates.items()},
-                "skipped_candidates": self.skipped,
-                "confusable_pairs": [
-                    {"a": a, "b": b, "cosine": c, "what_separates": self.separation.get(f"{a}~{b}", "")}
-                    for a, b, c in self.confusable
-                ],
-                "localisation_before": self.localisation_before,
-                "localisation_after": self.localisation_after,
-                "gap_before": self.gap_before,
-                "gap_after": self.gap_after,
-                "null": self.null,
-                "elapsed_s": self.elapsed_s,
-                "metadata": self.metadata,
-                "temperature_laws": self.laws,
-                "baseline_audit": self.baseline_audit,
-                "baseline_parameters": self._baseline_rows(),
-                "final_at_bound": self.final_at_bound,
-                "final_outside_plausible_range": self.final_implausible,
-                "cost_warning": self.cost_warning,
-            }
-        )
+        return clean({
+            "format": "ipmc-diagnosis", "version": 1,
+            "verdict": self.verdict, "named": list(self.named), "message": self.message,
+            "named_effect": self.named_effect(),
+            "kind": self.kind, "quantity": self.quantity, "alpha": self.alpha,
+            "lr_threshold": self.threshold, "gap_threshold_2cost": self.gap_threshold,
+            "noise_estimated": self.noise_estimated,
+            "baseline": self.baseline.to_dict(),
+            "final": self.final.to_dict() if self.final is not None else None,
+            "final_effects": self.final_effects,
+            "candidates": {k: v.to_dict() for k, v in self.candidates.items()},
+            "skipped_candidates": self.skipped,
+            "confusable_pairs": [{"a": a, "b": b, "cosine": c, "what_separates": self.separation.get(f"{a}~{b}", "")}
+                                 for a, b, c in self.confusable],
+            "localisation_before": self.localisation_before,
+            "localisation_after": self.localisation_after,
+            "gap_before": self.gap_before, "gap_after": self.gap_after,
+            "null": self.null, "elapsed_s": self.elapsed_s, "metadata": self.metadata,
+            "temperature_laws": self.laws, "baseline_audit": self.baseline_audit,
+            "baseline_parameters": self._baseline_rows(), "final_at_bound": self.final_at_bound,
+            "final_outside_plausible_range": self.final_implausible, "cost_warning": self.cost_warning,
+        })
 
     def _baseline_rows(self) -> list:
         b = self.baseline
@@ -204,137 +168,72 @@ class Diagnosis:
         rows = []
         for fp in b.free:
             n = fp.name
-            rows.append(
-                {
-                    "name": n,
-                    "value": b.values[n],
-                    "ci95": [b.ci_lower.get(n), b.ci_upper.get(n)],
-                    "bounds": [fp.lower, fp.upper],
-                    "plausible": rng.get(n, "none"),
-                    "flag": "; ".join(
-                        x for x in (flags.get(n, ""), "outside plausible range" if n in out_r else "") if x
-                    ),
-                    "multistart_range": spread.get(n),
-                }
-            )
+            rows.append({"name": n, "value": b.values[n], "ci95": [b.ci_lower.get(n), b.ci_upper.get(n)],
+                         "bounds": [fp.lower, fp.upper], "plausible": rng.get(n, "none"),
+                         "flag": "; ".join(x for x in (flags.get(n, ""), "outside plausible range" if n in out_r else "")
+                                           if x), "multistart_range": spread.get(n)})
         return rows
 
     def summary(self) -> str:
         """A readable Markdown summary."""
         L = [f"# Discrepancy diagnosis: {self.verdict.upper()}", "", self.message, ""]
         if self.noise_estimated:
-            L += [
-                "*The data carry no per-line uncertainty: 1 % per line was assumed; absolute gap "
-                "tests are relative to that assumption.*",
-                "",
-            ]
+            L += ["*The data carry no per-line uncertainty: 1 % per line was assumed; absolute gap "
+                  "tests are relative to that assumption.*", ""]
         if self.cost_warning:
             L += [f"**Cost vs declared noise — {self.cost_warning}.**", ""]
         L += [f"Temperature laws: {self.laws}", ""]
-        L += [
-            "## Baseline parameters",
-            "",
-            "| parameter | value | 95 % CI | fit bounds | plausible range | flag | multi-start range |",
-            "|---|---|---|---|---|---|---|",
-        ]
+        L += ["## Baseline parameters", "", "| parameter | value | 95 % CI | fit bounds | plausible range | flag | "
+              "multi-start range |", "|---|---|---|---|---|---|---|"]
         for r in self._baseline_rows():
             ci = r["ci95"]
             ms = r["multistart_range"]
-            L.append(
-                f"| {r['name']} | {r['value']:.4g} | [{_g(ci[0])}, {_g(ci[1])}] | [{r['bounds'][0]:.3g}, "
-                f"{r['bounds'][1]:.3g}] | {r['plausible']} | {r['flag'] or '–'} | "
-                + (f"[{ms[0]:.4g}, {ms[1]:.4g}]" if ms else "–")
-                + " |"
-            )
+            L.append(f"| {r['name']} | {r['value']:.4g} | [{_g(ci[0])}, {_g(ci[1])}] | [{r['bounds'][0]:.3g}, "
+                     f"{r['bounds'][1]:.3g}] | {r['plausible']} | {r['flag'] or '–'} | "
+                     + (f"[{ms[0]:.4g}, {ms[1]:.4g}]" if ms else "–") + " |")
         ms = self.baseline_audit.get("multistart", {})
         if ms.get("n_starts"):
-            L += [
-                "",
-                f"Multi-start: {ms['n_at_best']} of {ms['n_starts']} starts reach the best cost (within "
-                f"{ms['tolerance']:g}); start costs " + ", ".join(f"{c:.4g}" for c in ms["costs"]) + ".",
-            ]
+            L += ["", f"Multi-start: {ms['n_at_best']} of {ms['n_starts']} starts reach the best cost (within "
+                      f"{ms['tolerance']:g}); start costs " + ", ".join(f"{c:.4g}" for c in ms["costs"]) + "."]
         if self.baseline_audit.get("penalty", 0) > 0:
             L += ["", f"Plausible-range penalty of the baseline: {self.baseline_audit['penalty']:.4g} (cost units)."]
         L += [""]
         gb, ga = self.gap_before, self.gap_after
-        L += [
-            "## Gap before / after",
-            "",
-            "| | weighted cost | expected | z | "
-            + " | ".join(f"{t:g} °C dB / deg" for t in gb["temperatures_c"])
-            + " |",
-            "|---|---|---|---|" + "---|" * len(gb["temperatures_c"]),
-        ]
+        L += ["## Gap before / after", "",
+              "| | weighted cost | expected | z | " + " | ".join(f"{t:g} °C dB / deg" for t in gb["temperatures_c"]) + " |",
+              "|---|---|---|---|" + "---|" * len(gb["temperatures_c"])]
         for lab, g in (("before", gb), ("after", ga)):
-            L.append(
-                f"| {lab} | {g['cost']:.4g} | {g['expected_cost']:.4g} ± {g['cost_std']:.3g} | {g['z']:.3g} | "
-                + " | ".join(f"{a:.3g} / {b:.3g}" for a, b in zip(g["rms_db"], g["rms_deg"]))
-                + " |"
-            )
-        L += [
-            "",
-            f"Gap shrink (cost − expected, before / after): {gap_shrink(self):.3g}×",
-            "",
-            f"LR threshold (family-wise α = {self.alpha:g}, Monte Carlo under the null): {self.threshold:.3g}; "
-            f"gap threshold on 2·cost: {self.gap_threshold:.4g}",
-            "",
-            "## Candidates",
-            "",
-            "| effect | LR | significant | closes gap | AIC | BIC | fitted values "
-            "[candidate bounds] | at/near a bound, outside plausible range |",
-            "|---|---|---|---|---|---|---|---|",
-        ]
+            L.append(f"| {lab} | {g['cost']:.4g} | {g['expected_cost']:.4g} ± {g['cost_std']:.3g} | {g['z']:.3g} | "
+                     + " | ".join(f"{a:.3g} / {b:.3g}" for a, b in zip(g["rms_db"], g["rms_deg"])) + " |")
+        L += ["", f"Gap shrink (cost − expected, before / after): {gap_shrink(self):.3g}×", "",
+              f"LR threshold (family-wise α = {self.alpha:g}, Monte Carlo under the null): {self.threshold:.3g}; "
+              f"gap threshold on 2·cost: {self.gap_threshold:.4g}", "",
+              "## Candidates", "", "| effect | LR | significant | closes gap | AIC | BIC | fitted values "
+              "[candidate bounds] | at/near a bound, outside plausible range |",
+              "|---|---|---|---|---|---|---|---|"]
         for c in sorted(self.candidates.values(), key=lambda c: -c.lr):
-            vals = ", ".join(
-                f"{k} = {v:.4g} (CI [{c.ci_lower[k]:.3g}, {c.ci_upper[k]:.3g}]; bounds "
-                f"[{c.bounds.get(k, [float('nan')] * 2)[0]:.3g}, {c.bounds.get(k, [float('nan')] * 2)[1]:.3g}])"
-                for k, v in c.values.items()
-            )
-            flags = (
-                "; ".join(
-                    [
-                        f"{a['name']} {a['status']} {a['side']} bound {a['bound']:.3g}"
-                        + (" (physical limit)" if a["hard"] else "")
-                        for a in c.at_bound
-                    ]
-                    + [
-                        f"{a['name']} = {a['value']:.3g} outside [{a['lower']:.3g}, {a['upper']:.3g}]"
-                        for a in c.implausible
-                    ]
-                )
-                or "–"
-            )
-            L.append(
-                f"| {c.name} | {c.lr:.4g} | {'yes' if c.significant else 'no'} | "
-                f"{'yes' if c.closes_gap else 'no'} | {c.aic:.4g} | {c.bic:.4g} | {vals} | {flags} |"
-            )
+            vals = ", ".join(f"{k} = {v:.4g} (CI [{c.ci_lower[k]:.3g}, {c.ci_upper[k]:.3g}]; bounds "
+                             f"[{c.bounds.get(k, [float('nan')] * 2)[0]:.3g}, {c.bounds.get(k, [float('nan')] * 2)[1]:.3g}])"
+                             for k, v in c.values.items())
+            flags = "; ".join([f"{a['name']} {a['status']} {a['side']} bound {a['bound']:.3g}"
+                               + (" (physical limit)" if a["hard"] else "") for a in c.at_bound]
+                              + [f"{a['name']} = {a['value']:.3g} outside [{a['lower']:.3g}, {a['upper']:.3g}]"
+                                 for a in c.implausible]) or "–"
+            L.append(f"| {c.name} | {c.lr:.4g} | {'yes' if c.significant else 'no'} | "
+                     f"{'yes' if c.closes_gap else 'no'} | {c.aic:.4g} | {c.bic:.4g} | {vals} | {flags} |")
         pt = self.metadata.get("pairs_tried", [])
         if pt:
-            L += [
-                "",
-                "Pairs refitted jointly: "
-                + "; ".join(
-                    f"{p['pair'][0]} + {p['pair'][1]}: cost {p['cost']:.4g}, LR on top {p['lr_first_on_top']:.3g} / "
-                    f"{p['lr_second_on_top']:.3g}{', closes the gap' if p['closes_gap'] else ''}"
-                    for p in pt
-                ),
-            ]
+            L += ["", "Pairs refitted jointly: " + "; ".join(
+                f"{p['pair'][0]} + {p['pair'][1]}: cost {p['cost']:.4g}, LR on top {p['lr_first_on_top']:.3g} / "
+                f"{p['lr_second_on_top']:.3g}{', closes the gap' if p['closes_gap'] else ''}" for p in pt)]
         if self.final_at_bound:
-            L += [
-                "",
-                "Final fit, parameters at a bound: "
-                + "; ".join(
-                    f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g}"
-                    + (", physical limit)" if a["hard"] else ")")
-                    for a in self.final_at_bound
-                ),
-            ]
+            L += ["", "Final fit, parameters at a bound: " + "; ".join(
+                f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g}"
+                + (", physical limit)" if a["hard"] else ")") for a in self.final_at_bound)]
         if self.skipped:
             L += ["", "Not testable on these data: " + "; ".join(f"{k} ({v})" for k, v in self.skipped.items())]
         L += ["", "## Confusable pairs (signature cosine ≥ %.2g)" % CONFUSABLE_COSINE, ""]
-        L += [f"- {a} ~ {b}: {c:.3f}. {self.separation.get(f'{a}~{b}', '')}" for a, b, c in self.confusable] or [
-            "- none"
-        ]
+        L += [f"- {a} ~ {b}: {c:.3f}. {self.separation.get(f'{a}~{b}', '')}" for a, b, c in self.confusable] or ["- none"]
         L += ["", "## Where the baseline misfits (flagged cells)", ""]
         L += _loc_lines(self.localisation_before)
         L += ["", "## After", ""]
@@ -364,21 +263,14 @@ def _loc_lines(rows) -> list:
     flagged = [r for r in rows if r["flagged"]]
     if not flagged:
         return ["- no cell exceeds its band"]
-    out = [
-        "| band [Hz] | T [°C] | part | lines | RMS std. residual | RMS dB or deg | mean |",
-        "|---|---|---|---|---|---|---|",
-    ]
+    out = ["| band [Hz] | T [°C] | part | lines | RMS std. residual | RMS dB or deg | mean |", "|---|---|---|---|---|---|---|"]
     for r in flagged:
         if r["temperature_c"] is None:
-            out.append(
-                f"| {r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} | all | {r['part']} | {r['n']} | – | – | "
-                f"slope {r['slope_per_K']:.3g}/K (z = {r['z']:.3g}) |"
-            )
+            out.append(f"| {r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} | all | {r['part']} | {r['n']} | – | – | "
+                       f"slope {r['slope_per_K']:.3g}/K (z = {r['z']:.3g}) |")
             continue
-        out.append(
-            f"| {r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} | {r['temperature_c']:g} | {r['part']} | {r['n']} | "
-            f"{r['rms_std']:.3g} | {r['rms_physical']:.3g} | {r['mean_std']:.3g} |"
-        )
+        out.append(f"| {r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} | {r['temperature_c']:g} | {r['part']} | {r['n']} | "
+                   f"{r['rms_std']:.3g} | {r['rms_physical']:.3g} | {r['mean_std']:.3g} |")
     return out
 
 
@@ -423,9 +315,7 @@ def resolve_laws(base, laws):
         return replace(base, laws=laws), f"given: {describe_laws(laws)}"
     if isinstance(laws, str):
         if laws not in named:
-            raise ParameterError(
-                f"laws = {laws!r}; expected one of {sorted(named)}, a table of laws, or TemperatureLaws"
-            )
+            raise ParameterError(f"laws = {laws!r}; expected one of {sorted(named)}, a table of laws, or TemperatureLaws")
         chosen = named[laws] or base.laws
         return replace(base, laws=chosen), f"{laws!r}: {describe_laws(chosen)}"
     if isinstance(laws, Mapping):
@@ -439,9 +329,8 @@ def resolve_laws(base, laws):
                 raise ParameterError(f"laws: no temperature law for {k!r}; expected one of {sorted(cur)}")
             cur[k] = {"law": v} if isinstance(v, str) else dict(v)
             if "law" not in cur[k]:
-                raise ParameterError(
-                    f'laws.{k} = {v!r}: give the law\'s name, e.g. {{law = "Arrhenius", activation_energy = 15e3}}'
-                )
+                raise ParameterError(f"laws.{k} = {v!r}: give the law's name, e.g. {{law = \"Arrhenius\", "
+                                     "activation_energy = 15e3}")
         try:
             chosen = TemperatureLaws.from_dict(cur)
         except TypeError as exc:
@@ -465,9 +354,8 @@ def _candidate_overrides(candidate_bounds, candidate_starts) -> tuple[dict, dict
             try:
                 lo, hi = (float(x) for x in v)
             except (TypeError, ValueError):
-                raise ParameterError(
-                    f"candidate bound {key!r}: expected (lower, upper) or a table of lower/upper/typical, got {v!r}"
-                ) from None
+                raise ParameterError(f"candidate bound {key!r}: expected (lower, upper) or a table of "
+                                     f"lower/upper/typical, got {v!r}") from None
             spec = {"lower": lo, "upper": hi}
         bounds.setdefault(get_effect(e).name, {})[p] = spec
     starts: dict = {}
@@ -499,10 +387,8 @@ def _hard_sides(cpars: dict) -> dict:
 
 def _named_msg(c: str, cr: CandidateResult) -> str:
     e = LIBRARY[c]
-    vals = "; ".join(
-        f"{p.name} = {cr.values[p.name]:.4g} {p.unit} (95 % CI [{cr.ci_lower[p.name]:.3g}, {cr.ci_upper[p.name]:.3g}])"
-        for p in e.parameters
-    )
+    vals = "; ".join(f"{p.name} = {cr.values[p.name]:.4g} {p.unit} (95 % CI [{cr.ci_lower[p.name]:.3g}, "
+                     f"{cr.ci_upper[p.name]:.3g}])" for p in e.parameters)
     return f"Named: {c} ({e.title}), LR {cr.lr:.4g}; {vals}."
 
 
@@ -510,8 +396,6 @@ def _worst_cells(rows) -> str:
     flagged = sorted((r for r in rows if r["flagged"] and r["temperature_c"] is not None), key=lambda r: r["p_value"])
     if not flagged:
         return "no single cell (a diffuse misfit)"
-    parts = [
-        f"{r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} Hz at {r['temperature_c']:g} °C ({r['part']})"
-        for r in flagged[:3]
-    ]
+    parts = [f"{r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} Hz at {r['temperature_c']:g} °C ({r['part']})"
+             for r in flagged[:3]]
     return ", ".join(parts)

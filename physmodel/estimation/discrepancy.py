@@ -22,15 +22,15 @@ user's free parameters, and:
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
    baseline Jacobian projected out) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`;
 5. decides: ``none``, ``named`` (one significant candidate that closes the gap, plus a second one
-   significant on top of it if any — a forward step; else the best
-   pair among the :data:`PAIR_POOL` most significant candidates whose members are each
-   significant on top of the other and that closes the gap; pairs are drawn from the most
-   significant candidates and from those that best explain what the best one leaves, never a
-   declared-confusable pair; each member must carry more than :data:`CLOSE_FRACTION` of the
-   baseline's excess), ``ambiguous`` (several closers within :data:`AMBIGUITY_AIC` or declared
-   confusable), ``at_bound`` (the named effect closes the gap only with a
-   parameter at its candidate bound: "widen the bound, or the effect is larger than allowed" —
-   never a confident name), ``unexplained`` (a significant gap nothing closes).  The gap test
+   significant on top of it if any — a forward step; else the best pair among the
+   :data:`PAIR_POOL` most significant candidates whose members are each significant on top of the
+   other and that closes the gap; pairs are drawn from the most significant candidates and from
+   those that best explain what the best one leaves, never a declared-confusable pair; each
+   member must carry more than :data:`CLOSE_FRACTION` of the baseline's excess), ``ambiguous``
+   (several closers within :data:`AMBIGUITY_AIC` or declared confusable), ``at_bound`` (the named
+   effect closes the gap only with a parameter at its candidate bound: "widen the bound, or the
+   effect is larger than allowed" — never a confident name), ``unexplained`` (a significant gap
+   nothing closes).  The gap test
    compares 2·cost (data lines only) with the (1 − α/5) quantile of its null distribution; an
    effect that leaves at most :data:`CLOSE_FRACTION` of the baseline's excess above it also
    closes the gap (the message then states the remaining share).
@@ -41,7 +41,6 @@ only by leaving its plausible range (evidence of a missing effect).  Residuals a
 :func:`physmodel.estimation.residuals.standardised_residuals`; data without per-line standard
 deviations use the 1 % fallback and the report says so.
 """
-
 from __future__ import annotations
 
 import math
@@ -84,42 +83,32 @@ from .priors import (
 )
 from .records import CalibrationResult, FreeParameter
 from .residuals import standardised_residuals
-from .signatures import _constrained_lr, _gap, _localise, _orth, _project_out, _separation, _signature, _z_jacobian
+from .signatures import (
+    _constrained_lr,
+    _gap,
+    _localise,
+    _orth,
+    _project_out,
+    _separation,
+    _signature,
+    _simulated,
+    _z_jacobian,
+)
 
 #: Pairs of two effects: every pair among this many most significant candidates, and each of the
 #: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
 PAIR_POOL = 4
 
 
-def _simulated(G, e, s_ln, s_ph):
-    N = G.size
-    return G * np.exp(e[:N] * s_ln + 1j * e[N:] * s_ph)
-
-
 # =============================================================================== main entry
-def diagnose(
-    data: FrequencySweep,
-    base: IPMCParameters,
-    *,
-    kind: str = "actuator",
-    quantity: str | None = None,
-    free: Sequence[str | FreeParameter] = ("alpha0",),
-    baseline_effects: Mapping[str, Mapping[str, float]] | Sequence[str] = (),
-    candidates: Sequence[str] | None = None,
-    alpha: float = 0.05,
-    null_draws: int = 4000,
-    null_refits: int = 4,
-    seed: int = 0,
-    kernel: str = "boundary_charge",
-    max_nfev: int = 200,
-    laws=None,
-    candidate_bounds: Mapping | None = None,
-    candidate_starts: Mapping | None = None,
-    plausible: Mapping | None = None,
-    prior: bool = True,
-    baseline_starts: int = 3,
-    progress: Callable[[str], None] | None = None,
-) -> Diagnosis:
+def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuator", quantity: str | None = None,
+             free: Sequence[str | FreeParameter] = ("alpha0",),
+             baseline_effects: Mapping[str, Mapping[str, float]] | Sequence[str] = (),
+             candidates: Sequence[str] | None = None, alpha: float = 0.05, null_draws: int = 4000,
+             null_refits: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int = 200,
+             laws=None, candidate_bounds: Mapping | None = None, candidate_starts: Mapping | None = None,
+             plausible: Mapping | None = None, prior: bool = True, baseline_starts: int = 3,
+             progress: Callable[[str], None] | None = None) -> Diagnosis:
     """Diagnose the discrepancy between ``data`` and the ``base`` model (see module docstring).
 
     ``free``: the user's calibration parameters (names with default bounds, ``"effect.param"`` of a
@@ -172,9 +161,8 @@ def diagnose(
 
     def fit(free_list, sim=None, starts=1, identify=True):
         pr = prob if sim is None else PenalisedProblem(sim, pm, prob.penalties)
-        return pr.fit(
-            free_list, starts=starts, seed=seed, max_nfev=max_nfev, identify=identify, hold_undetermined=False
-        )
+        return pr.fit(free_list, starts=starts, seed=seed, max_nfev=max_nfev, identify=identify,
+                      hold_undetermined=False)
 
     # ---- 1. baseline
     res0 = fit(free0, starts=int(baseline_starts))
@@ -182,21 +170,14 @@ def diagnose(
     G0 = pm([v0])[0]
     r0 = standardised_residuals(G0, data, s_ln, s_ph)
     cost0 = res0.metadata["data_cost"]
-    audit0 = {
-        "at_bound": bound_audit(res0, free0),
-        "implausible": plausible_audit(v0, ranges),
-        "multistart": multistart_spread(res0),
-        "penalty": res0.metadata["penalty"],
-        "plausible_ranges": {k: ranges[k].describe() for k in names0 if k in ranges},
-    }
+    audit0 = {"at_bound": bound_audit(res0, free0), "implausible": plausible_audit(v0, ranges),
+              "multistart": multistart_spread(res0), "penalty": res0.metadata["penalty"],
+              "plausible_ranges": {k: ranges[k].describe() for k in names0 if k in ranges}}
     say(f"baseline fitted: cost {cost0:.4g} (expected {res0.expected_cost:.4g})")
 
     # ---- 2. signatures, confusability
-    cand = (
-        [get_effect(c).name for c in candidates]
-        if candidates is not None
-        else [c for c in candidates_for(kind, q, n_temps) if c not in beff]
-    )
+    cand = [get_effect(c).name for c in candidates] if candidates is not None else [
+        c for c in candidates_for(kind, q, n_temps) if c not in beff]
     for c in cand:
         if c not in LIBRARY:
             raise ParameterError(f"unknown candidate effect {c!r}; expected library names {sorted(LIBRARY)}")
@@ -220,9 +201,7 @@ def diagnose(
             continue
         sigs[c], sided[c], raw_sigs[c] = Sp, one, S
         if max_lr < MIN_SIGNATURE_LR:
-            first_order[c] = (
-                "confounded with the free parameters to first order (refitted; only nonlinear terms can show it)"
-            )
+            first_order[c] = "confounded with the free parameters to first order (refitted; only nonlinear terms can show it)"
     confusable = []
     orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order}
     for a, b in combinations(orth, 2):
@@ -297,43 +276,22 @@ def diagnose(
         dc = res.metadata["data_cost"]
         ab, imp = audit(res, eff_free(c))
         cres[c] = CandidateResult(
-            c,
-            ev,
-            {p: res.ci_lower[f"{c}.{p}"] for p in ev},
-            {p: res.ci_upper[f"{c}.{p}"] for p in ev},
-            dc,
-            lr,
-            2 * res.cost + 2 * (k0 + k),
-            2 * res.cost + (k0 + k) * math.log(n_res),
-            k,
-            False,
-            False,
-            res.converged,
-            float(np.linalg.norm(sigs[c])),
-            float(_constrained_lr(sigs[c], sided[c], -_project_out(Q0, r0[:, None]))[0]),
-            first_order.get(c, ""),
-            bounds={p.name: [p.lower, p.upper] for p in cpars[c]},
-            at_bound=ab,
-            implausible=imp,
-            penalty=res.metadata["penalty"],
-        )
+            c, ev, {p: res.ci_lower[f"{c}.{p}"] for p in ev}, {p: res.ci_upper[f"{c}.{p}"] for p in ev},
+            dc, lr, 2 * res.cost + 2 * (k0 + k), 2 * res.cost + (k0 + k) * math.log(n_res), k,
+            False, False, res.converged, float(np.linalg.norm(sigs[c])),
+            float(_constrained_lr(sigs[c], sided[c], -_project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""),
+            bounds={p.name: [p.lower, p.upper] for p in cpars[c]}, at_bound=ab, implausible=imp,
+            penalty=res.metadata["penalty"])
     say(f"{len(cres)} candidates refitted")
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
     full_max, lin_used = [], []
     for b in range(int(null_refits)):
         e = E[:, b]
-        sim = FrequencySweep(
-            data.temperature_c,
-            data.frequency_hz,
-            _simulated(G0, e, s_ln, s_ph),
-            np.asarray(s_ln) * 20 / math.log(10),
-            np.degrees(s_ph),
-            data.input_name,
-            data.input_unit,
-            data.output_name,
-            data.output_unit,
-        )
-        rb = fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim, identify=False)
+        sim = FrequencySweep(data.temperature_c, data.frequency_hz, _simulated(G0, e, s_ln, s_ph),
+                             np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
+                             data.input_unit, data.output_name, data.output_unit)
+        rb = fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
+                 identify=False)
         m = 0.0
         for c in sigs:
             rc = refit([c], rb.values, [None], sim=sim, identify=False)
@@ -372,29 +330,21 @@ def diagnose(
     if not sig:
         if gap0_sig:
             verdict = "unexplained"
-            message = (
-                f"The baseline leaves a significant gap (2·cost {2 * cost0:.4g} > {gap_thr0:.4g}) "
-                f"that no library candidate reduces significantly; the gap remains in {where}."
-            )
+            message = (f"The baseline leaves a significant gap (2·cost {2 * cost0:.4g} > {gap_thr0:.4g}) "
+                       f"that no library candidate reduces significantly; the gap remains in {where}.")
         else:
             verdict = "none"
-            message = (
-                f"No significant discrepancy: best candidate LR "
-                f"{max([c.lr for c in cres.values()], default=0.0):.3g} ≤ threshold {T:.3g}, and the "
-                f"baseline cost {cost0:.4g} is within its null band."
-            )
+            message = (f"No significant discrepancy: best candidate LR "
+                       f"{max([c.lr for c in cres.values()], default=0.0):.3g} ≤ threshold {T:.3g}, and the "
+                       f"baseline cost {cost0:.4g} is within its null band.")
     else:
-
         def explainers(a, pool):
             """Candidates of ``pool`` that best explain what a leaves (linearised LR on its residual)."""
             r_a = standardised_residuals(pm([fits[a].values])[0], data, s_ln, s_ph)
             Qa = _orth(np.hstack([J0, sigs[a]]))
-            sc = {
-                b: float(_constrained_lr(_project_out(Qa, sigs[b]), sided[b], -_project_out(Qa, r_a[:, None]))[0])
-                for b in pool
-                if b != a
-            }
-            return [b for b in sorted(sc, key=lambda k: -sc[k])[: PAIR_POOL - 1]], r_a, Qa
+            sc = {b: float(_constrained_lr(_project_out(Qa, sigs[b]), sided[b], -_project_out(Qa, r_a[:, None]))[0])
+                  for b in pool if b != a}
+            return [b for b in sorted(sc, key=lambda k: -sc[k])[:PAIR_POOL - 1]], r_a, Qa
 
         def pair_fits(pairs):
             out = []
@@ -402,17 +352,10 @@ def diagnose(
                 va = {**fits[a].values, **{k: v for k, v in fits[b].values.items() if k.startswith(b + ".")}}
                 _, r_a, Qa = explainers(a, [])
                 res2 = refit([a, b], va, [{b: {p.name: p.off for p in cpars[b]}}, {b: lin_start(b, r_a, Qa)}])
-                lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)  # each on top
+                lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)   # each on top
                 closes = closes_gap(res2.metadata["data_cost"], [a, b])
-                pair_tried.append(
-                    {
-                        "pair": [a, b],
-                        "cost": res2.metadata["data_cost"],
-                        "lr_first_on_top": lr_a,
-                        "lr_second_on_top": lr_b,
-                        "closes_gap": closes,
-                    }
-                )
+                pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
+                                   "lr_second_on_top": lr_b, "closes_gap": closes})
                 if min(lr_a, lr_b) > T2:
                     out.append(((a, b), res2, lr_a, lr_b, closes))
             return sorted(out, key=lambda x: x[1].cost)
@@ -421,21 +364,13 @@ def diagnose(
             best2 = ok[0]
             a, b = best2[0]
             alt = [x[0] for x in ok[1:] if x[4] and 2 * (x[1].cost - best2[1].cost) < AMBIGUITY_AIC]
-            msg = (
-                f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
-                f"{best2[2]:.4g}, {best2[3]:.4g} > {T2:.3g}); the gap closes."
-            )
+            msg = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
+                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T2:.3g}); the gap closes.")
             if alt:
-                return (
-                    "ambiguous",
-                    sorted({a, b} | {c for x in alt for c in x}),
-                    list(best2[0]),
-                    best2[1],
-                    msg.replace("Named two effects", "Ambiguous: best pair")
-                    + " Other pairs fit as well (AIC within %g): " % AMBIGUITY_AIC
-                    + "; ".join(f"{x[0]} + {x[1]}" for x in alt)
-                    + ".",
-                )
+                return ("ambiguous", sorted({a, b} | {c for x in alt for c in x}), list(best2[0]), best2[1],
+                        msg.replace("Named two effects", "Ambiguous: best pair")
+                        + " Other pairs fit as well (AIC within %g): " % AMBIGUITY_AIC
+                        + "; ".join(f"{x[0]} + {x[1]}" for x in alt) + ".")
             return "named", [a, b], list(best2[0]), best2[1], msg
 
         # a second effect must be significant and carry more than the share of the excess that a
@@ -444,21 +379,16 @@ def diagnose(
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            amb = [
-                c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC or frozenset((top, c)) in conf_set
-            ]  # declared confusable and also closing
+            amb = [c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC
+                   or frozenset((top, c)) in conf_set]          # declared confusable and also closing
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
                 verdict = "ambiguous"
-                pairs = [
-                    f"{a}~{b}" + ("" if frozenset((a, b)) in conf_set else " (not declared confusable)")
-                    for a, b in combinations(amb, 2)
-                ]
-                message = (
-                    f"Ambiguous between {', '.join(amb)} (each closes the gap; AIC within {AMBIGUITY_AIC:g} or "
-                    f"declared confusable; {'; '.join(pairs)}; lowest AIC: {top}). "
-                    "Separate them with a wider band, more temperatures, or magnitude vs phase."
-                )
+                pairs = [f"{a}~{b}" + ("" if frozenset((a, b)) in conf_set else " (not declared confusable)")
+                         for a, b in combinations(amb, 2)]
+                message = (f"Ambiguous between {', '.join(amb)} (each closes the gap; AIC within {AMBIGUITY_AIC:g} or "
+                           f"declared confusable; {'; '.join(pairs)}; lowest AIC: {top}). "
+                           "Separate them with a wider band, more temperatures, or magnitude vs phase.")
             else:
                 verdict, message = "named", _named_msg(top, cres[top])
             # forward step: a second significant candidate (not one of the closers, not confusable
@@ -467,7 +397,7 @@ def diagnose(
             ok = pair_fits([(top, b) for b in explainers(top, pool)[0]]) if pool else []
             if ok:
                 v2, n2, final_effects, final_fit, m2 = name_pair(ok)
-                if verdict == "ambiguous":  # the first effect stays ambiguous
+                if verdict == "ambiguous":       # the first effect stays ambiguous
                     v2, n2 = "ambiguous", sorted(set(n2) | set(amb))
                     m2 += f" The first effect is ambiguous between {', '.join(amb)}."
                 verdict, named2, message = v2, n2, m2
@@ -485,102 +415,60 @@ def diagnose(
                 verdict = "unexplained"
                 final_effects = list(ok[0][0]) if ok else [best]
                 final_fit = ok[0][1] if ok else fits[best]
-                message = (
-                    f"Unexplained: the best candidate {best} (LR {cres[best].lr:.4g}) reduces the cost but a "
-                    f"significant gap remains (2·cost {2 * final_fit.metadata['data_cost']:.4g} > "
-                    f"{gap_thr(final_effects):.4g}) in {where}; no candidate or pair of candidates in the "
-                    "library explains it."
-                )
+                message = (f"Unexplained: the best candidate {best} (LR {cres[best].lr:.4g}) reduces the cost but a "
+                           f"significant gap remains (2·cost {2 * final_fit.metadata['data_cost']:.4g} > "
+                           f"{gap_thr(final_effects):.4g}) in {where}; no candidate or pair of candidates in the "
+                           "library explains it.")
     if verdict in ("named", "ambiguous") and final_fit is not None:
         thr_f = gap_thr(final_effects)
         if 2 * final_fit.metadata["data_cost"] > thr_f:
-            message += (
-                f" A small residual misfit remains ({100 * (2 * final_fit.metadata['data_cost'] - thr_f) / max(2 * cost0 - gap_thr0, 1e-300):.2g} % "
-                "of the baseline's excess over the gap threshold): the data's own law for this effect "
-                "differs slightly from the library's parametrisation."
-            )
+            message += (f" A small residual misfit remains ({100 * (2 * final_fit.metadata['data_cost'] - thr_f) / max(2 * cost0 - gap_thr0, 1e-300):.2g} % "
+                        "of the baseline's excess over the gap threshold): the data's own law for this effect "
+                        "differs slightly from the library's parametrisation.")
     # ---- 7. audits of the final model
     final_bounds, final_implausible = ([], [])
     if final_fit is not None:
         final_bounds, final_implausible = audit(final_fit, [fp for c in final_effects for fp in eff_free(c)])
     at_bound = [a for a in final_bounds if a["status"] == "at"]
-    widen = [
-        a
-        for a in at_bound
-        if not a["hard"]
-        and "." in a["name"]
-        and not a["name"].startswith("laws.")
-        and a["name"].split(".", 1)[0] in final_effects
-    ]
+    widen = [a for a in at_bound if not a["hard"] and "." in a["name"] and not a["name"].startswith("laws.")
+             and a["name"].split(".", 1)[0] in final_effects]
     # a significant candidate confusable with a named effect that stopped at a widenable bound: its
     # LR there is only a lower bound, so it might beat the named effect once the bound is widened
-    widen += [
-        a
-        for c in sig
-        if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
-        for a in cres[c].at_bound
-        if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
-    ]
+    widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
+              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")]
     if verdict in ("named", "ambiguous") and widen:
         verdict = "at_bound"
-        message = (
-            "At bound — widen or the effect is larger than allowed: "
-            + "; ".join(f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in widen)
+        message = ("At bound — widen or the effect is larger than allowed: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in widen)
             + ". The gap closes only there, or a confusable candidate stopped there, so this is not a confident "
             "name (raise the bound with "
-            "candidate_bounds / --candidate-bound, or the effect is outside the physical range assumed). " + message
-        )
+            "candidate_bounds / --candidate-bound, or the effect is outside the physical range assumed). "
+            + message)
     if verdict == "unexplained" and final_effects:
-        stuck = (
-            [
-                a
-                for c in final_effects
-                for a in cres[c].at_bound
-                if c in cres and a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
-            ]
-            if len(final_effects) == 1
-            else [a for a in at_bound if not a["hard"] and a["name"].split(".", 1)[0] in final_effects]
-        )
+        stuck = [a for c in final_effects for a in cres[c].at_bound if c in cres and a["status"] == "at"
+                 and not a["hard"] and a["name"].startswith(c + ".")] if len(final_effects) == 1 else [
+            a for a in at_bound if not a["hard"] and a["name"].split(".", 1)[0] in final_effects]
         if stuck:
-            message += (
-                " The best candidate ended at its bound ("
-                + "; ".join(f"{a['name']} = {a['value']:.4g}, {a['side']} bound {a['bound']:.4g}" for a in stuck)
-                + "): widen it — the effect may be larger than allowed."
-            )
+            message += (" The best candidate ended at its bound (" + "; ".join(
+                f"{a['name']} = {a['value']:.4g}, {a['side']} bound {a['bound']:.4g}" for a in stuck)
+                + "): widen it — the effect may be larger than allowed.")
     other_bounds = [a for a in at_bound if a not in widen and not a["hard"]]
     if other_bounds:
-        message += (
-            " Parameters at a bound in the final fit: "
-            + "; ".join(f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in other_bounds)
-            + "."
-        )
+        message += (" Parameters at a bound in the final fit: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in other_bounds) + ".")
     b0 = [a for a in audit0["at_bound"] if a["status"] == "at"]
     if b0 and verdict in ("none", "unexplained"):
-        message += (
-            " Baseline parameters at a fit bound: "
-            + "; ".join(f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in b0)
-            + "."
-        )
+        message += " Baseline parameters at a fit bound: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in b0) + "."
     if audit0["implausible"]:
-        bad0 = ", ".join(
-            f"{x['name']} = {x['value']:.3g} {x['unit']} (plausible [{x['lower']:.3g}, {x['upper']:.3g}])"
-            for x in audit0["implausible"]
-        )
-        message += (
-            f" The baseline fits only by leaving the plausible range of {bad0}: that is itself evidence of a "
-            "missing effect"
-            + (
-                "."
-                if verdict != "none"
-                else "; consider the candidates above or revise the plausible range if it does not apply to this strip."
-            )
-        )
+        bad0 = ", ".join(f"{x['name']} = {x['value']:.3g} {x['unit']} (plausible [{x['lower']:.3g}, {x['upper']:.3g}])"
+                         for x in audit0["implausible"])
+        message += (f" The baseline fits only by leaving the plausible range of {bad0}: that is itself evidence of a "
+                    "missing effect" + ("." if verdict != "none" else "; consider the candidates above or "
+                                        "revise the plausible range if it does not apply to this strip."))
     if final_implausible:
-        message += (
-            " In the final fit outside the plausible range: "
-            + ", ".join(f"{x['name']} = {x['value']:.3g} {x['unit']}" for x in final_implausible)
-            + "."
-        )
+        message += " In the final fit outside the plausible range: " + ", ".join(
+            f"{x['name']} = {x['value']:.3g} {x['unit']}" for x in final_implausible) + "."
     if not res0.converged:
         message += f" WARNING: the baseline calibration did not converge ({res0.message})."
     bad = [c for c, cr in cres.items() if not cr.converged]
@@ -599,76 +487,29 @@ def diagnose(
     warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
     if warn:
         message += f" Cost vs declared noise: {warn}."
-    fe = (
-        {
-            c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
-            for c in final_effects
-        }
-        if final_fit is not None
-        else {}
-    )
+    fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
+          for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
-        verdict=verdict,
-        named=named,
-        message=message,
-        kind=kind,
-        quantity=q,
-        alpha=alpha,
-        threshold=T,
-        gap_threshold=gap_thr0,
-        baseline=res0,
-        final=final_fit,
-        final_effects=fe,
-        candidates=cres,
-        skipped=skipped,
-        confusable=confusable,
-        separation=separation,
-        localisation_before=_localise(data, r0, alpha),
-        localisation_after=_localise(data, rf, alpha),
-        gap_before=_gap(data, r0, k0),
+        verdict=verdict, named=named, message=message, kind=kind, quantity=q, alpha=alpha, threshold=T,
+        gap_threshold=gap_thr0, baseline=res0, final=final_fit, final_effects=fe, candidates=cres,
+        skipped=skipped, confusable=confusable, separation=separation, localisation_before=_localise(data, r0, alpha),
+        localisation_after=_localise(data, rf, alpha), gap_before=_gap(data, r0, k0),
         gap_after=_gap(data, rf, n_free_after),
-        null={
-            "method": "linearised Gaussian null at the fitted baseline (constrained LR per candidate, "
-            "max over candidates) scaled by full-refit parametric bootstrap",
-            "draws": int(null_draws),
-            "refits": int(null_refits),
-            "lr_threshold_linearised": T_lin,
-            "nonlinearity_ratio": ratio,
-            "bootstrap_full_max_lr": full_max,
-            "bootstrap_lin_max_lr": lin_used,
-            "alpha_gap": alpha_gap,
-            "seed": seed,
-        },
-        noise_estimated=estimated,
-        elapsed_s=time.perf_counter() - t0,
-        data=data,
-        predicted_before=G0,
-        predicted_after=Gf,
-        metadata={
-            "base": base.name,
-            "free": names0,
-            "baseline_effects": beff,
-            "candidates": cand,
-            "data_fingerprint": data.fingerprint(),
-            "pairs_tried": pair_tried,
-            "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
-            "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none",
-        },
-        laws=laws_note,
-        baseline_audit=audit0,
-        final_at_bound=at_bound,
-        final_implausible=final_implausible,
+        null={"method": "linearised Gaussian null at the fitted baseline (constrained LR per candidate, "
+                        "max over candidates) scaled by full-refit parametric bootstrap",
+              "draws": int(null_draws), "refits": int(null_refits), "lr_threshold_linearised": T_lin,
+              "nonlinearity_ratio": ratio, "bootstrap_full_max_lr": full_max, "bootstrap_lin_max_lr": lin_used,
+              "alpha_gap": alpha_gap, "seed": seed},
+        noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
+        predicted_before=G0, predicted_after=Gf,
+        metadata={"base": base.name, "free": names0, "baseline_effects": beff, "candidates": cand,
+                  "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried,
+                  "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
+                  "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
+        laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
         cost_warning=warn,
     )
 
 
-__all__ = [
-    "diagnose",
-    "Diagnosis",
-    "CandidateResult",
-    "VERDICTS",
-    "gap_shrink",
-    "CONFUSABLE_COSINE",
-    "AMBIGUITY_AIC",
-    "PAIR_POOL",
-]
+__all__ = ["diagnose", "Diagnosis", "CandidateResult", "VERDICTS", "gap_shrink", "CONFUSABLE_COSINE",
+           "AMBIGUITY_AIC", "PAIR_POOL"]

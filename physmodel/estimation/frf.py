@@ -142,48 +142,27 @@ class FRFEstimate:
             return int(output)
         if output in self.output_names:
             return self.output_names.index(output)
-        raise IPMCError(
-            f"output {output!r} is not a channel of the estimate; expected one of {list(self.output_names)}"
-        )
+        raise IPMCError(f"output {output!r} is not a channel of the estimate; expected one of {list(self.output_names)}")
 
     def channel(self, output: str | int | None) -> FRFEstimate:
         """The estimate for one output channel."""
         i = self.index(output)
-        return replace(
-            self,
-            response=self.response[i : i + 1],
-            magnitude_std_db=self.magnitude_std_db[i : i + 1],
-            phase_std_deg=self.phase_std_deg[i : i + 1],
-            coherence=None if self.coherence is None else self.coherence[i : i + 1],
-            output_names=(self.output_names[i],),
-            output_units=(self.output_units[i],),
-        )
+        return replace(self, response=self.response[i:i + 1], magnitude_std_db=self.magnitude_std_db[i:i + 1],
+                       phase_std_deg=self.phase_std_deg[i:i + 1],
+                       coherence=None if self.coherence is None else self.coherence[i:i + 1],
+                       output_names=(self.output_names[i],), output_units=(self.output_units[i],))
 
     def reciprocal(self, output: str | int | None = None) -> FRFEstimate:
         """input/output of one channel (e.g. impedance V/I from the admittance I/V estimated with the
         voltage as reference).  σ of ln|H| and of the phase are unchanged by inversion."""
         c = self.channel(output)
-        return replace(
-            c,
-            response=1.0 / c.response,
-            input_name=c.output_names[0],
-            input_unit=c.output_units[0],
-            output_names=(c.input_name,),
-            output_units=(c.input_unit,),
-            settings={**c.settings, "reciprocal": True},
-        )
+        return replace(c, response=1.0 / c.response, input_name=c.output_names[0], input_unit=c.output_units[0],
+                       output_names=(c.input_name,), output_units=(c.input_unit,),
+                       settings={**c.settings, "reciprocal": True})
 
-    def to_sweep(
-        self,
-        temperature_c: float,
-        output: str | int | None = None,
-        *,
-        min_coherence: float | None = None,
-        band_hz: tuple | None = None,
-        max_std_db: float | None = None,
-        quantity: str | None = None,
-        metadata: dict | None = None,
-    ) -> FrequencySweep:
+    def to_sweep(self, temperature_c: float, output: str | int | None = None, *, min_coherence: float | None = None,
+                 band_hz: tuple | None = None, max_std_db: float | None = None, quantity: str | None = None,
+                 metadata: dict | None = None) -> FrequencySweep:
         """A :class:`~physmodel.sweep.FrequencySweep` of one channel at ``temperature_c`` [°C].
 
         ``min_coherence``, ``band_hz`` [Hz] and ``max_std_db`` [dB] drop lines (e.g. the unexcited
@@ -212,38 +191,21 @@ class FRFEstimate:
             with np.errstate(invalid="ignore"):
                 keep &= self.magnitude_std_db[i] <= float(max_std_db)
         if not keep.any():
-            raise IPMCError(
-                f"no lines left after band_hz={band_hz!r}, min_coherence={min_coherence!r} "
-                f"and max_std_db={max_std_db!r}"
-            )
+            raise IPMCError(f"no lines left after band_hz={band_hz!r}, min_coherence={min_coherence!r} "
+                            f"and max_std_db={max_std_db!r}")
         H, sm, sp = self.response[i, keep], self.magnitude_std_db[i, keep], self.phase_std_deg[i, keep]
         bad = ~(np.isfinite(H) & (H != 0) & np.isfinite(sm) & np.isfinite(sp))
         if bad.any():
-            raise IPMCError(
-                f"lines at {f[keep][bad][:5].tolist()} Hz have no finite response or σ "
-                f"(no excitation there?); drop them with min_coherence=, band_hz= or the "
-                f"estimator's frequencies_hz="
-            )
-        meta = {
-            "source": f"physmodel.estimation.frf.{self.method}",
-            "method": self.method,
-            **{k: str(v) for k, v in self.settings.items()},
-        }
+            raise IPMCError(f"lines at {f[keep][bad][:5].tolist()} Hz have no finite response or σ "
+                            f"(no excitation there?); drop them with min_coherence=, band_hz= or the "
+                            f"estimator's frequencies_hz=")
+        meta = {"source": f"physmodel.estimation.frf.{self.method}", "method": self.method,
+                **{k: str(v) for k, v in self.settings.items()}}
         if quantity is not None:
             meta["quantity"] = quantity
         meta.update({k: str(v) for k, v in (metadata or {}).items()})
-        return FrequencySweep(
-            np.full(H.size, float(temperature_c)),
-            f[keep],
-            H,
-            sm,
-            sp,
-            self.input_name,
-            self.input_unit,
-            self.output_names[i],
-            self.output_units[i],
-            meta,
-        )
+        return FrequencySweep(np.full(H.size, float(temperature_c)), f[keep], H, sm, sp, self.input_name,
+                              self.input_unit, self.output_names[i], self.output_units[i], meta)
 
 
 def _sigma_from_coherence(coh: np.ndarray, dof: float) -> tuple[np.ndarray, np.ndarray]:
@@ -263,7 +225,7 @@ def effective_averages(window: np.ndarray, step: int, n_segments: int) -> float:
     js = np.arange(1, min(n_segments, -(-n // step)))
     if js.size == 0:
         return float(n_segments)
-    rho = np.array([np.dot(w[: n - j * step], w[j * step :]) for j in js]) / np.dot(w, w)
+    rho = np.array([np.dot(w[:n - j * step], w[j * step:]) for j in js]) / np.dot(w, w)
     return float(n_segments / (1.0 + 2.0 * np.sum((1.0 - js / n_segments) * rho**2)))
 
 
@@ -284,24 +246,10 @@ def _power(X: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->j", X.real, X.real) + np.einsum("ij,ij->j", X.imag, X.imag)
 
 
-def welch_frf(
-    t_or_fs,
-    u,
-    y,
-    *,
-    estimator: str = "h1",
-    nperseg: int | None = None,
-    noverlap: int | None = None,
-    window="hann",
-    detrend: str | bool = "constant",
-    discard_s: float = 0.0,
-    frequencies_hz=None,
-    block_samples: int = BLOCK_SAMPLES,
-    input_name: str = "input",
-    input_unit: str = "1",
-    output_names: Sequence[str] | None = None,
-    output_units: Sequence[str] | None = None,
-) -> FRFEstimate:
+def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = None, noverlap: int | None = None,
+              window="hann", detrend: str | bool = "constant", discard_s: float = 0.0, frequencies_hz=None,
+              block_samples: int = BLOCK_SAMPLES, input_name: str = "input", input_unit: str = "1",
+              output_names: Sequence[str] | None = None, output_units: Sequence[str] | None = None) -> FRFEstimate:
     """H1 or H2 estimate with coherence and per-line σ (see module doc).
 
     Parameters
@@ -343,14 +291,11 @@ def welch_frf(
     step = nperseg - int(noverlap)
     K = (n - nperseg) // step + 1
     if K < 2:
-        raise IPMCError(
-            f"nperseg={nperseg}, noverlap={noverlap} give {K} segment from {n} samples; "
-            f"σ needs at least 2 averages (shorten nperseg or record longer)"
-        )
+        raise IPMCError(f"nperseg={nperseg}, noverlap={noverlap} give {K} segment from {n} samples; "
+                        f"σ needs at least 2 averages (shorten nperseg or record longer)")
     try:
-        win = (
-            signal.get_window(window, nperseg) if isinstance(window, (str, tuple)) else np.asarray(window, dtype=float)
-        )
+        win = (signal.get_window(window, nperseg) if isinstance(window, (str, tuple))
+               else np.asarray(window, dtype=float))
     except ValueError as exc:
         raise IPMCError(f"window={window!r}: {exc}") from None
     if win.shape != (nperseg,):
@@ -374,38 +319,29 @@ def welch_frf(
             Suy[c] += np.einsum("ij,ij->j", U, Y)
             Syy[c] += _power(Y)
             del Y
-    f = sp_fft.rfftfreq(nperseg, 1.0 / fs)[1:]  # DC carries no response after detrending
+    f = sp_fft.rfftfreq(nperseg, 1.0 / fs)[1:]            # DC carries no response after detrending
     Suu, Syy, Suy = Suu[1:], Syy[:, 1:], Suy[:, 1:]
     if frequencies_hz is not None:
         want = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
         k = np.rint(want * nperseg / fs).astype(int)
         off = (k < 1) | (k > nf - 1) | (np.abs(want * nperseg / fs - k) > 1e-6)
         if off.any() or want.size == 0:
-            raise IPMCError(
-                f"frequencies_hz: {want[off][:5].tolist()} Hz are not bins of a {nperseg}-sample "
-                f"segment at fs={fs:g} Hz (multiples of {fs / nperseg:g} Hz up to {fs / 2:g} Hz)"
-            )
+            raise IPMCError(f"frequencies_hz: {want[off][:5].tolist()} Hz are not bins of a {nperseg}-sample "
+                            f"segment at fs={fs:g} Hz (multiples of {fs / nperseg:g} Hz up to {fs / 2:g} Hz)")
         if np.any(np.diff(k) <= 0):
             raise IPMCError("frequencies_hz must strictly increase")
         f, Suu, Syy, Suy = f[k - 1], Suu[k - 1], Syy[:, k - 1], Suy[:, k - 1]
     with np.errstate(divide="ignore", invalid="ignore"):
         H = Suy / Suu if estimator == "h1" else Syy / Suy.conj()
-        coh = np.abs(Suy) ** 2 / (Suu * Syy)
+        coh = np.abs(Suy)**2 / (Suu * Syy)
     coh = np.where(np.isfinite(coh), coh, 0.0)
     n_eff = effective_averages(win, step, K)
     sm, sp = _sigma_from_coherence(coh, n_eff - 1.0)
     names, units = _names(output_names, output_units, len(ys), "output")
-    settings = {
-        "fs_hz": fs,
-        "nperseg": nperseg,
-        "noverlap": int(noverlap),
-        "window": window if isinstance(window, (str, tuple)) else "custom",
-        "detrend": detrend,
-        "discard_s": discard_s,
-        "segments": K,
-        "effective_averages": round(n_eff, 3),
-        "resolution_hz": fs / nperseg,
-    }
+    settings = {"fs_hz": fs, "nperseg": nperseg, "noverlap": int(noverlap),
+                "window": window if isinstance(window, (str, tuple)) else "custom", "detrend": detrend,
+                "discard_s": discard_s, "segments": K, "effective_averages": round(n_eff, 3),
+                "resolution_hz": fs / nperseg}
     return FRFEstimate(f, H, sm, sp, coh, np.full(f.size, K), estimator, input_name, input_unit, names, units, settings)
 
 
@@ -420,7 +356,8 @@ def h2(t_or_fs, u, y, **kw) -> FRFEstimate:
 
 
 # ----------------------------------------------------------------------------------- records
-def estimate_record(record, input: str, outputs: Sequence[str] | None = None, method: str = "h1", **kw) -> FRFEstimate:
+def estimate_record(record, input: str, outputs: Sequence[str] | None = None, method: str = "h1",
+                    **kw) -> FRFEstimate:
     """FRF from channel ``input`` to ``outputs`` (default: every other channel) of a
     :class:`~physmodel.estimation.records.TimeRecord`, in the record's units.
 
@@ -438,21 +375,13 @@ def estimate_record(record, input: str, outputs: Sequence[str] | None = None, me
         raise IPMCError(f"outputs: the record has no channel besides the input {inp!r}")
     if inp in outs:
         raise IPMCError(f"outputs: {inp!r} is the input channel")
-    return fns[method](
-        record.t,
-        record.channels[inp],
-        [record.channels[o] for o in outs],
-        input_name=inp,
-        input_unit=record.units[inp],
-        output_names=outs,
-        output_units=[record.units[o] for o in outs],
-        **kw,
-    )
+    return fns[method](record.t, record.channels[inp], [record.channels[o] for o in outs], input_name=inp,
+                       input_unit=record.units[inp], output_names=outs, output_units=[record.units[o] for o in outs],
+                       **kw)
 
 
-def frf_sweep(
-    estimates: Sequence[tuple[float, FRFEstimate]], output: str | int | None = None, **to_sweep_kw
-) -> FrequencySweep:
+def frf_sweep(estimates: Sequence[tuple[float, FRFEstimate]], output: str | int | None = None,
+              **to_sweep_kw) -> FrequencySweep:
     """One :class:`FrequencySweep` from ``[(temperature_c, estimate), ...]`` (one estimate per
     temperature [°C]), each converted by :meth:`FRFEstimate.to_sweep`."""
     from ..data.sweep import merge_sweeps

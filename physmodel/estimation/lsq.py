@@ -64,6 +64,7 @@ BOUND_TOL = 1e-3
 FD_STEP = 1e-6
 
 
+
 # =============================================================================== the engine
 class _Counter:
     def __init__(self):
@@ -82,10 +83,8 @@ def _as_batch(predict, predict_many, counter: _Counter, n_lines: int):
         else:
             out = np.stack([np.asarray(predict(v), dtype=complex).reshape(-1) for v in values_list])
         if out.shape != (len(values_list), n_lines):
-            raise IPMCError(
-                f"the predictor returned shape {out.shape}; expected {(len(values_list), n_lines)} "
-                "(one complex value per data line and parameter set)"
-            )
+            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(len(values_list), n_lines)} "
+                            "(one complex value per data line and parameter set)")
         return out
 
     return many
@@ -150,30 +149,14 @@ def _solve(free, fixed: dict, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_ste
         return ((R - f0[None, :]) / steps[:, None]).T
 
     z0 = np.clip(np.asarray(z0, dtype=float), lo, hi)
-    sol = least_squares(
-        fun,
-        z0,
-        jac=jac,
-        bounds=(lo, hi),
-        method="trf",
-        x_scale=1.0,
-        ftol=ftol,
-        xtol=1e-10,
-        gtol=1e-10,
-        max_nfev=max_nfev,
-    )
+    sol = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0,
+                        ftol=ftol, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
     z = sol.x
     r = fun(z)
     J = jac(z)
-    msg = (
-        sol.message.rstrip(".")
-        if sol.status > 0
-        else (
-            f"stopped after {sol.nfev} function evaluations (max_nfev={max_nfev}) before converging"
-            if sol.status == 0
-            else sol.message
-        )
-    )
+    msg = sol.message.rstrip(".") if sol.status > 0 else (
+        f"stopped after {sol.nfev} function evaluations (max_nfev={max_nfev}) before converging"
+        if sol.status == 0 else sol.message)
     return _Fit(z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=int(sol.nfev), status=int(sol.status), message=msg)
 
 
@@ -185,21 +168,14 @@ def _covariance(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (Vt.T * inv) @ Vt, s
 
 
-def _sensitivity_peaks(
-    free,
-    values: dict,
-    J: np.ndarray,
-    data: FrequencySweep,
-    probe: SensitivityProbe | None,
-    many_counter: _Counter,
-    fd_step: float,
-):
+def _sensitivity_peaks(free, values: dict, J: np.ndarray, data: FrequencySweep, probe: SensitivityProbe | None,
+                       many_counter: _Counter, fd_step: float):
     """Per free parameter: (frequency of peak |∂lnG/∂z| [Hz], in-band max / overall max)."""
     n = data.frequency_hz.size
     out = {}
     # in-band sensitivity from the weighted Jacobian converted back to |∂ ln G/∂z| per line
     s_ln, s_ph, _ = noise_std(data)
-    in_band = np.sqrt((J[:n] * s_ln[:, None]) ** 2 + (J[n:] * s_ph[:, None]) ** 2)  # (N, n_free)
+    in_band = np.sqrt((J[:n] * s_ln[:, None]) ** 2 + (J[n:] * s_ph[:, None]) ** 2)   # (N, n_free)
     band_max = in_band.max(axis=0)
     if probe is None:
         for j, fp in enumerate(free):
@@ -254,10 +230,8 @@ def _identifiability(free, z, J, cov, values, data, probe, counter, fd_step):
         where = ""
         if frac < 0.5:
             side = "above" if peak_hz > fmax else "below" if peak_hz < fmin else "inside"
-            where = (
-                f"sensitivity peaks at {_fmt_hz(peak_hz)}, {side} the measured band "
-                f"{_fmt_hz(fmin)}–{_fmt_hz(fmax)} (in-band sensitivity {100 * frac:.2g} % of the peak)"
-            )
+            where = (f"sensitivity peaks at {_fmt_hz(peak_hz)}, {side} the measured band "
+                     f"{_fmt_hz(fmin)}–{_fmt_hz(fmax)} (in-band sensitivity {100 * frac:.2g} % of the peak)")
         others = [(abs(corr[j, k]), free[k].name) for k in range(len(free)) if k != j and np.isfinite(corr[j, k])]
         conf = max(others) if others else (0.0, "")
         if pinned is not None:
@@ -277,9 +251,8 @@ def _identifiability(free, z, J, cov, values, data, probe, counter, fd_step):
             report[fp.name] = Identifiability(False, "; ".join(parts), peak_hz, frac)
             badness[fp.name] = ratio if np.isfinite(ratio) else 1e300
         else:
-            report[fp.name] = Identifiability(
-                True, "determined by the data" + (f" ({where})" if where else ""), peak_hz, frac
-            )
+            report[fp.name] = Identifiability(True, "determined by the data" + (f" ({where})" if where else ""),
+                                              peak_hz, frac)
     return report, badness, se, corr
 
 
@@ -289,23 +262,13 @@ def _fmt_hz(f: float) -> str:
     return f"{f:.3g} Hz"
 
 
-def fit_parameters(
-    data: FrequencySweep,
-    predict: Callable[[Values], np.ndarray] | None,
-    free: Sequence[FreeParameter],
-    *,
-    starts: int = 1,
-    seed: int = 0,
-    predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
-    fixed: Values | None = None,
-    max_nfev: int | None = None,
-    ftol: float = 1e-10,
-    identify: bool = True,
-    hold_undetermined: bool = True,
-    probe: SensitivityProbe | None = None,
-    fd_step: float = FD_STEP,
-    progress: Callable[[int], None] | None = None,
-) -> CalibrationResult:
+def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray] | None,
+                   free: Sequence[FreeParameter], *, starts: int = 1, seed: int = 0,
+                   predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
+                   fixed: Values | None = None, max_nfev: int | None = None, ftol: float = 1e-10,
+                   identify: bool = True, hold_undetermined: bool = True,
+                   probe: SensitivityProbe | None = None, fd_step: float = FD_STEP,
+                   progress: Callable[[int], None] | None = None) -> CalibrationResult:
     """Fit ``free`` parameters of a generic predictor to ``data`` by weighted least squares.
 
     ``predict(values) -> (N,) complex`` at every line of ``data`` (same order and units);
@@ -350,17 +313,9 @@ def fit_parameters(
         fit = _solve(free, fixed, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_step)
         fits.append(fit)
         initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
-        records.append(
-            StartRecord(
-                i,
-                initial,
-                {fp.name: float(fp.from_z(v)) for fp, v in zip(free, fit.z)},
-                fit.cost,
-                fit.nfev,
-                fit.status,
-                fit.message,
-            )
-        )
+        records.append(StartRecord(i, initial,
+                                   {fp.name: float(fp.from_z(v)) for fp, v in zip(free, fit.z)},
+                                   fit.cost, fit.nfev, fit.status, fit.message))
         if progress:
             progress(1)
     best = min(range(len(fits)), key=lambda k: fits[k].cost)
@@ -376,9 +331,8 @@ def fit_parameters(
     while True:
         act = [free[k] for k in active]
         values = dict(fixed)
-        values.update(
-            {fp.name: (x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))) for k, fp in enumerate(free)}
-        )
+        values.update({fp.name: (x_init[k] if fp.name in held else float(fp.from_z(z_full[k])))
+                       for k, fp in enumerate(free)})
         cov, _ = _covariance(fit.J)
         noise_scale = 1.0
         dof = 2 * n_lines - len(act)
@@ -386,12 +340,8 @@ def fit_parameters(
             noise_scale = math.sqrt(2.0 * fit.cost / dof) if dof > 0 else float("nan")
             cov = cov * noise_scale**2
         if not (identify and converged and act):
-            report = {
-                fp.name: Identifiability(
-                    True, "not assessed" if not identify else "not assessed (the fit did not converge)"
-                )
-                for fp in act
-            }
+            report = {fp.name: Identifiability(True, "not assessed" if not identify else
+                                               "not assessed (the fit did not converge)") for fp in act}
             se = np.sqrt(np.maximum(np.diag(cov), 0.0))
             d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
             corr = cov / np.outer(d, d)
@@ -411,9 +361,8 @@ def fit_parameters(
             break
         fixed_now = dict(fixed)
         fixed_now.update({free[k].name: x_init[k] for k in range(len(free)) if free[k].name in held})
-        fit = _solve(
-            [free[k] for k in active], fixed_now, z_full[active], many, data, s_ln, s_ph, max_nfev, ftol, fd_step
-        )
+        fit = _solve([free[k] for k in active], fixed_now, z_full[active], many, data, s_ln, s_ph,
+                     max_nfev, ftol, fd_step)
         z_full[active] = fit.z
         converged = fit.status > 0
         message += f"; refit without {', '.join(to_hold)}: {fit.message}"
@@ -433,9 +382,8 @@ def fit_parameters(
         zk, sk = z_full[k], se[i]
         a, b = fp.from_z(zk - Z95 * sk), fp.from_z(zk + Z95 * sk)
         lo_ci[fp.name], hi_ci[fp.name] = float(min(a, b)), float(max(a, b))
-        stderr[fp.name] = float(
-            abs(values[fp.name]) * math.log(10) * sk if fp.scale == "log" else sk * (fp.upper - fp.lower)
-        )
+        stderr[fp.name] = float(abs(values[fp.name]) * math.log(10) * sk if fp.scale == "log"
+                                else sk * (fp.upper - fp.lower))
         ident[fp.name] = report[fp.name]
         for k2 in active:
             C[k, k2] = corr[i, pos[k2]]
@@ -448,29 +396,11 @@ def fit_parameters(
         message += f"; undetermined and held at their start value: {', '.join(held)}"
     gof = goodness_of_fit(cost, 2 * n_lines, n_act, estimated)
     return CalibrationResult(
-        names=names,
-        values=values,
-        parameters=None,
-        stderr=stderr,
-        ci_lower=lo_ci,
-        ci_upper=hi_ci,
-        correlation=C,
-        cost=cost,
-        expected_cost=expected,
-        cost_std=math.sqrt(max(expected, 0.0)),
-        n_lines=n_lines,
-        n_evaluations=counter.evaluations,
-        n_model_calls=counter.calls,
-        converged=bool(converged),
-        message=message,
-        starts=records,
-        identifiability=ident,
-        noise_estimated=estimated,
-        noise_scale=float(noise_scale),
-        held=list(held),
-        free=list(free),
+        names=names, values=values, parameters=None, stderr=stderr, ci_lower=lo_ci, ci_upper=hi_ci,
+        correlation=C, cost=cost, expected_cost=expected, cost_std=math.sqrt(max(expected, 0.0)),
+        n_lines=n_lines, n_evaluations=counter.evaluations, n_model_calls=counter.calls,
+        converged=bool(converged), message=message, starts=records, identifiability=ident,
+        noise_estimated=estimated, noise_scale=float(noise_scale), held=list(held), free=list(free),
         band_hz=(float(data.frequency_hz.min()), float(data.frequency_hz.max())),
-        temperatures_c=data.temperatures().tolist(),
-        elapsed_s=time.perf_counter() - t0,
-        goodness_of_fit=gof,
+        temperatures_c=data.temperatures().tolist(), elapsed_s=time.perf_counter() - t0, goodness_of_fit=gof,
     )

@@ -36,7 +36,7 @@ from .residuals import noise_std, standardised_residuals
 
 #: Width of the soft wall outside a plausible range [decades].
 WALL_DECADES = 0.02
-_SIGMA_LN_DB = 20.0 / math.log(10.0)  # σ_ln = 1 Np in dB
+_SIGMA_LN_DB = 20.0 / math.log(10.0)            # σ_ln = 1 Np in dB
 
 
 @dataclass(frozen=True)
@@ -77,15 +77,8 @@ class PenalisedProblem:
         self.data_aug = FrequencySweep(
             np.concatenate([data.temperature_c, np.full(k, t_last)]),
             np.concatenate([data.frequency_hz, f_last * (2.0 + np.arange(k))]),
-            np.concatenate([data.response, np.ones(k, dtype=complex)]),
-            db,
-            deg,
-            data.input_name,
-            data.input_unit,
-            data.output_name,
-            data.output_unit,
-            dict(data.metadata or {}),
-        )
+            np.concatenate([data.response, np.ones(k, dtype=complex)]), db, deg,
+            data.input_name, data.input_unit, data.output_name, data.output_unit, dict(data.metadata or {}))
 
         def pm_aug(values_list):
             G = np.asarray(predict_many(values_list), dtype=complex)
@@ -102,9 +95,8 @@ class PenalisedProblem:
         return {pe.name: self._rho(pe, values) for pe in self.penalties}
 
     def data_cost(self, values: Mapping[str, float]) -> float:
-        r = standardised_residuals(
-            np.asarray(self.predict_many([values]), dtype=complex)[0], self.data, self.s_ln, self.s_ph
-        )
+        r = standardised_residuals(np.asarray(self.predict_many([values]), dtype=complex)[0], self.data,
+                                   self.s_ln, self.s_ph)
         return float(0.5 * r @ r)
 
     def fit(self, free: Sequence[FreeParameter], **kw) -> CalibrationResult:
@@ -119,9 +111,8 @@ class PenalisedProblem:
         return res
 
 
-def penalties_for(
-    free: Sequence[FreeParameter], ranges: Mapping[str, PlausibleRange], wall: float = WALL_DECADES
-) -> list[RangePenalty]:
+def penalties_for(free: Sequence[FreeParameter], ranges: Mapping[str, PlausibleRange],
+                  wall: float = WALL_DECADES) -> list[RangePenalty]:
     """One :class:`RangePenalty` per free parameter that has a plausible range."""
     return [RangePenalty(fp.name, ranges[fp.name], wall) for fp in free if fp.name in ranges]
 
@@ -136,10 +127,8 @@ def _free_list(base: IPMCParameters, free, effects: dict) -> list:
             if "." in item and not item.startswith("laws."):
                 e, p = item.split(".", 1)
                 if e not in effects:
-                    raise ParameterError(
-                        f"free parameter {item!r} belongs to effect {e!r}, which is not among "
-                        f"the baseline effects {sorted(effects)}"
-                    )
+                    raise ParameterError(f"free parameter {item!r} belongs to effect {e!r}, which is not among "
+                                         f"the baseline effects {sorted(effects)}")
                 par = get_effect(e).parameter(p)
                 fp = FreeParameter(item, par.lower, par.upper, "linear", effects[e][p])
             else:
@@ -178,16 +167,9 @@ def bound_audit(res: CalibrationResult, free: Sequence[FreeParameter], hard: Map
         for side, frac in (("lower", frac_lo), ("upper", frac_hi)):
             if frac <= NEAR_BOUND:
                 bound = fp.lower if (side == "lower") == (fp.scale == "linear" or fp.sign > 0) else fp.upper
-                out.append(
-                    {
-                        "name": fp.name,
-                        "value": float(v),
-                        "bound": float(bound),
-                        "side": side,
-                        "status": "at" if frac <= AT_BOUND else "near",
-                        "hard": side in (hard or {}).get(fp.name, ()),
-                    }
-                )
+                out.append({"name": fp.name, "value": float(v), "bound": float(bound), "side": side,
+                            "status": "at" if frac <= AT_BOUND else "near",
+                            "hard": side in (hard or {}).get(fp.name, ())})
     return out
 
 
@@ -197,17 +179,8 @@ def plausible_audit(values: Mapping[str, float], ranges: Mapping[str, PlausibleR
     for k, v in values.items():
         if k in ranges and not ranges[k].contains(v):
             r = ranges[k]
-            out.append(
-                {
-                    "name": k,
-                    "value": float(v),
-                    "lower": r.lower,
-                    "upper": r.upper,
-                    "unit": r.unit,
-                    "decades": r.decades_outside(v),
-                    "source": r.source,
-                }
-            )
+            out.append({"name": k, "value": float(v), "lower": r.lower, "upper": r.upper, "unit": r.unit,
+                        "decades": r.decades_outside(v), "source": r.source})
     return out
 
 
@@ -233,29 +206,15 @@ def cost_warning(cost: float, n_lines: int, n_free: int, level: float = 1e-3) ->
     dof = max(2 * n_lines - n_free, 1)
     ratio = 2 * cost / dof
     if 2 * cost < chi2.ppf(level, dof):
-        return (
-            f"too low: the weighted cost is {ratio:.3g}× its expectation ({2 * cost:.4g} vs χ² with {dof} "
-            f"degrees of freedom); the declared noise σ is likely about {1 / math.sqrt(max(ratio, 1e-12)):.3g}× "
-            "too large, which makes every test here too lenient"
-        )
+        return (f"too low: the weighted cost is {ratio:.3g}× its expectation ({2 * cost:.4g} vs χ² with {dof} "
+                f"degrees of freedom); the declared noise σ is likely about {1 / math.sqrt(max(ratio, 1e-12)):.3g}× "
+                "too large, which makes every test here too lenient")
     if 2 * cost > chi2.ppf(1 - level, dof):
-        return (
-            f"too high: the weighted cost is {ratio:.3g}× its expectation ({2 * cost:.4g} vs χ² with {dof} "
-            f"degrees of freedom); either a misfit remains or the declared σ is about "
-            f"{math.sqrt(ratio):.3g}× too small"
-        )
+        return (f"too high: the weighted cost is {ratio:.3g}× its expectation ({2 * cost:.4g} vs χ² with {dof} "
+                f"degrees of freedom); either a misfit remains or the declared σ is about "
+                f"{math.sqrt(ratio):.3g}× too small")
     return ""
 
 
-__all__ = [
-    "RangePenalty",
-    "PenalisedProblem",
-    "penalties_for",
-    "WALL_DECADES",
-    "bound_audit",
-    "plausible_audit",
-    "multistart_spread",
-    "cost_warning",
-    "AT_BOUND",
-    "NEAR_BOUND",
-]
+__all__ = ["RangePenalty", "PenalisedProblem", "penalties_for", "WALL_DECADES", "bound_audit", "plausible_audit",
+           "multistart_spread", "cost_warning", "AT_BOUND", "NEAR_BOUND"]

@@ -19,7 +19,6 @@ from ..params import IPMCParameters
 
 Values = Mapping[str, float]
 
-
 # =============================================================================== free parameters
 @dataclass(frozen=True)
 class FreeParameter:
@@ -55,28 +54,22 @@ class FreeParameter:
                 raise ParameterError(f"free parameter {self.name}: {k}={v!r} must be a finite number")
             object.__setattr__(self, k, float(v))
         if not self.lower < self.upper:
-            raise ParameterError(
-                f"free parameter {self.name}: bounds reversed or empty, lower={self.lower!r} "
-                f"must be < upper={self.upper!r}"
-            )
+            raise ParameterError(f"free parameter {self.name}: bounds reversed or empty, lower={self.lower!r} "
+                                 f"must be < upper={self.upper!r}")
         scale = self.scale or ("log" if self.lower > 0 else "linear")
         if scale not in ("log", "linear"):
             raise ParameterError(f"free parameter {self.name}: scale={self.scale!r}; expected 'log' or 'linear'")
         if scale == "log" and not (self.lower > 0 or self.upper < 0):
-            raise ParameterError(
-                f"free parameter {self.name}: a log scale needs bounds of one sign, not "
-                f"crossing zero; got [{self.lower!r}, {self.upper!r}]"
-            )
+            raise ParameterError(f"free parameter {self.name}: a log scale needs bounds of one sign, not "
+                                 f"crossing zero; got [{self.lower!r}, {self.upper!r}]")
         object.__setattr__(self, "scale", scale)
         if self.initial is not None:
             v = self.initial
             if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) or not math.isfinite(v):
                 raise ParameterError(f"free parameter {self.name}: initial={v!r} must be a finite number")
             if not self.lower <= v <= self.upper:
-                raise ParameterError(
-                    f"free parameter {self.name}: initial={v!r} lies outside its bounds "
-                    f"[{self.lower!r}, {self.upper!r}]"
-                )
+                raise ParameterError(f"free parameter {self.name}: initial={v!r} lies outside its bounds "
+                                     f"[{self.lower!r}, {self.upper!r}]")
             object.__setattr__(self, "initial", float(v))
 
     # scaled coordinate ---------------------------------------------------------------------
@@ -144,7 +137,6 @@ class FreeParameter:
             Start value within the bounds. [the parameter's SI unit]
         """
         return replace(self, initial=float(value))
-
 
 # =============================================================================== results
 @dataclass(frozen=True)
@@ -267,7 +259,7 @@ class CalibrationResult:
     temperatures_c: list
     elapsed_s: float
     metadata: dict = field(default_factory=dict)
-    goodness_of_fit: object = None  # physmodel.estimation.residuals.GoodnessOfFit
+    goodness_of_fit: object = None    # physmodel.estimation.residuals.GoodnessOfFit
 
     @property
     def adequate(self) -> bool:
@@ -286,19 +278,13 @@ class CalibrationResult:
             f"calibration: {'converged' if self.converged else 'NOT CONVERGED'} ({self.message})",
             f"  data: {self.n_lines} lines, {len(self.temperatures_c)} temperature(s), band "
             f"{self.band_hz[0]:.4g}-{self.band_hz[1]:.4g} Hz; noise "
-            + (
-                f"estimated from the residuals (no per-line std in the data), scale {self.noise_scale:.3g}"
-                if self.noise_estimated
-                else "from the sweep's per-line std"
-            ),
+            + ("estimated from the residuals (no per-line std in the data), scale "
+               f"{self.noise_scale:.3g}" if self.noise_estimated else "from the sweep's per-line std"),
             f"  cost {self.cost:.4g} (expected {self.expected_cost:.4g} ± {self.cost_std:.3g}); "
             f"{len(self.starts)} start(s); {self.n_evaluations} model evaluations in {self.n_model_calls} calls; "
             f"{self.elapsed_s:.2f} s",
-            *(
-                [f"  goodness of fit: {'adequate' if self.adequate else 'INADEQUATE'} — {self.goodness_of_fit.reason}"]
-                if self.goodness_of_fit is not None
-                else []
-            ),
+            *([f"  goodness of fit: {'adequate' if self.adequate else 'INADEQUATE'} — {self.goodness_of_fit.reason}"]
+              if self.goodness_of_fit is not None else []),
             f"  {'parameter':34s} {'value':>12s} {'95 % interval':>27s}  status",
         ]
         for n in self.names:
@@ -308,68 +294,40 @@ class CalibrationResult:
             else:
                 ci = f"[{self.ci_lower[n]:.5g}, {self.ci_upper[n]:.5g}]"
                 ok = n not in self.identifiability or self.identifiability[n].identifiable
-                lines.append(
-                    f"  {n:34s} {self.values[n]:12.5g} {ci:>27s}  {'ok' if ok else 'NOT ASSESSED (model inadequate)'}"
-                )
+                lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci:>27s}  {'ok' if ok else 'NOT ASSESSED (model inadequate)'}")
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
         """The record as JSON-ready data (format ``ipmc-calibration`` 1; non-finite numbers as
         None)."""
-
         def num(v):
             v = float(v)
             return v if math.isfinite(v) else None
 
         corr = [[num(c) for c in row] for row in np.asarray(self.correlation, dtype=float)]
         return {
-            "format": "ipmc-calibration",
-            "version": 1,
-            "converged": bool(self.converged),
-            "message": self.message,
+            "format": "ipmc-calibration", "version": 1,
+            "converged": bool(self.converged), "message": self.message,
             "parameters": [
-                {
-                    "name": n,
-                    "value": num(self.values[n]),
-                    "stderr": num(self.stderr[n]),
-                    "ci95_lower": num(self.ci_lower[n]),
-                    "ci95_upper": num(self.ci_upper[n]),
-                    "held": n in self.held,
-                    "identifiable": bool(self.identifiability[n].identifiable) if n in self.identifiability else None,
-                    "reason": self.identifiability[n].reason if n in self.identifiability else "",
-                    "sensitivity_peak_hz": (
-                        num(self.identifiability[n].sensitivity_peak_hz)
-                        if n in self.identifiability and self.identifiability[n].sensitivity_peak_hz is not None
-                        else None
-                    ),
-                    "bounds": [fp.lower, fp.upper],
-                    "scale": fp.scale,
-                }
+                {"name": n, "value": num(self.values[n]), "stderr": num(self.stderr[n]),
+                 "ci95_lower": num(self.ci_lower[n]), "ci95_upper": num(self.ci_upper[n]),
+                 "held": n in self.held,
+                 "identifiable": bool(self.identifiability[n].identifiable) if n in self.identifiability else None,
+                 "reason": self.identifiability[n].reason if n in self.identifiability else "",
+                 "sensitivity_peak_hz": (num(self.identifiability[n].sensitivity_peak_hz)
+                                         if n in self.identifiability and self.identifiability[n].sensitivity_peak_hz is not None else None),
+                 "bounds": [fp.lower, fp.upper], "scale": fp.scale}
                 for n, fp in zip(self.names, self.free)
             ],
             "correlation": {"names": list(self.names), "matrix": corr},
-            "cost": num(self.cost),
-            "expected_cost": num(self.expected_cost),
-            "cost_std": num(self.cost_std),
-            "n_lines": int(self.n_lines),
-            "n_evaluations": int(self.n_evaluations),
+            "cost": num(self.cost), "expected_cost": num(self.expected_cost), "cost_std": num(self.cost_std),
+            "n_lines": int(self.n_lines), "n_evaluations": int(self.n_evaluations),
             "n_model_calls": int(self.n_model_calls),
-            "noise_estimated": bool(self.noise_estimated),
-            "noise_scale": num(self.noise_scale),
+            "noise_estimated": bool(self.noise_estimated), "noise_scale": num(self.noise_scale),
             "band_hz": [float(self.band_hz[0]), float(self.band_hz[1])],
             "temperatures_c": [float(t) for t in self.temperatures_c],
-            "starts": [
-                {
-                    "index": s.index,
-                    "initial": s.initial,
-                    "final": s.final,
-                    "cost": num(s.cost),
-                    "nfev": s.nfev,
-                    "status": s.status,
-                    "message": s.message,
-                }
-                for s in self.starts
-            ],
+            "starts": [{"index": s.index, "initial": s.initial, "final": s.final, "cost": num(s.cost),
+                        "nfev": s.nfev, "status": s.status, "message": s.message} for s in self.starts],
             "elapsed_s": float(self.elapsed_s),
             "goodness_of_fit": self.goodness_of_fit.to_dict() if self.goodness_of_fit is not None else None,
             "metadata": {k: str(v) for k, v in self.metadata.items()},

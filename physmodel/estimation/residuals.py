@@ -20,7 +20,6 @@ from ..errors import DataFormatError, IPMCError
 #: carries no per-line uncertainty; the covariance is then rescaled by the fitted residual variance.
 FALLBACK_RELATIVE_STD = 0.01
 
-
 def noise_std(data: FrequencySweep) -> tuple[np.ndarray, np.ndarray, bool]:
     """Per-line σ_ln [Np] and σ_φ [rad] of a sweep, and whether they are the fallback (estimated)."""
     n = data.frequency_hz.size
@@ -30,11 +29,9 @@ def noise_std(data: FrequencySweep) -> tuple[np.ndarray, np.ndarray, bool]:
     s_ph = np.radians(data.phase_std_deg)
     bad = np.flatnonzero((s_ln <= 0) | (s_ph <= 0))
     if bad.size:
-        raise DataFormatError(
-            f"per-line standard deviations must be > 0 to weight a fit; line(s) "
-            f"{bad[:5].tolist()} have magnitude_std_db={data.magnitude_std_db[bad[:5]].tolist()}, "
-            f"phase_std_deg={data.phase_std_deg[bad[:5]].tolist()}"
-        )
+        raise DataFormatError(f"per-line standard deviations must be > 0 to weight a fit; line(s) "
+                              f"{bad[:5].tolist()} have magnitude_std_db={data.magnitude_std_db[bad[:5]].tolist()}, "
+                              f"phase_std_deg={data.phase_std_deg[bad[:5]].tolist()}")
     return s_ln, s_ph, False
 
 
@@ -47,10 +44,8 @@ def standardised_residuals(model_response, data: FrequencySweep, s_ln, s_ph) -> 
         raise IPMCError(f"model response has {G.shape[-1]} values per set for {n} data lines")
     bad = ~np.isfinite(G) | (G == 0)
     if np.any(bad):
-        raise IPMCError(
-            f"model response is zero or not finite at {int(bad.sum())} line(s) "
-            f"(first at frequency {data.frequency_hz[np.flatnonzero(bad.reshape(-1, n).any(0))[0]]:g} Hz)"
-        )
+        raise IPMCError(f"model response is zero or not finite at {int(bad.sum())} line(s) "
+                        f"(first at frequency {data.frequency_hz[np.flatnonzero(bad.reshape(-1, n).any(0))[0]]:g} Hz)")
     lr = np.log(data.response / G)
     return np.concatenate([lr.real / s_ln, lr.imag / s_ph], axis=-1)
 
@@ -100,68 +95,32 @@ class GoodnessOfFit:
 
     def to_dict(self) -> dict:
         num = lambda v: None if v is None or not math.isfinite(v) else float(v)  # noqa: E731
-        return {
-            "adequate": bool(self.adequate),
-            "chi2": num(self.chi2),
-            "dof": int(self.dof),
-            "reduced_chi2": num(self.reduced_chi2),
-            "p_value": num(self.p_value),
-            "relative_noise": num(self.relative_noise),
-            "reason": self.reason,
-        }
+        return {"adequate": bool(self.adequate), "chi2": num(self.chi2), "dof": int(self.dof),
+                "reduced_chi2": num(self.reduced_chi2), "p_value": num(self.p_value),
+                "relative_noise": num(self.relative_noise), "reason": self.reason}
 
 
-def goodness_of_fit(
-    cost: float, n_residuals: int, n_parameters: int, noise_estimated: bool, alpha: float = GOF_ALPHA
-) -> GoodnessOfFit:
+def goodness_of_fit(cost: float, n_residuals: int, n_parameters: int, noise_estimated: bool,
+                    alpha: float = GOF_ALPHA) -> GoodnessOfFit:
     """Test a weighted least-squares cost ½Σr² against its χ² expectation (see :class:`GoodnessOfFit`)."""
     from scipy.stats import chi2 as chi2_dist
 
     dof = int(n_residuals - n_parameters)
     x = 2.0 * float(cost)
     if dof <= 0 or not math.isfinite(x):
-        return GoodnessOfFit(
-            dof > 0 and math.isfinite(x),
-            x,
-            dof,
-            float("nan"),
-            None,
-            None,
-            "not testable: " + ("no residual degrees of freedom" if dof <= 0 else "the cost is not finite"),
-        )
+        return GoodnessOfFit(dof > 0 and math.isfinite(x), x, dof, float("nan"), None, None,
+                             "not testable: " + ("no residual degrees of freedom" if dof <= 0 else "the cost is not finite"))
     red = x / dof
     if not noise_estimated:
         p = float(chi2_dist.sf(x, dof))
         ok = p >= alpha
-        return GoodnessOfFit(
-            ok,
-            x,
-            dof,
-            red,
-            p,
-            None,
-            f"chi2 = {x:.4g} on {dof} degrees of freedom (expected {dof} ± {math.sqrt(2 * dof):.3g}), "
-            f"p = {p:.2g}: "
-            + (
-                "consistent with the declared noise"
-                if ok
-                else f"the model does not fit the data within the declared noise (p < {alpha:g})"
-            ),
-        )
+        return GoodnessOfFit(ok, x, dof, red, p, None,
+                             f"chi2 = {x:.4g} on {dof} degrees of freedom (expected {dof} ± {math.sqrt(2 * dof):.3g}), "
+                             f"p = {p:.2g}: " + ("consistent with the declared noise" if ok else
+                                                 f"the model does not fit the data within the declared noise (p < {alpha:g})"))
     rel = FALLBACK_RELATIVE_STD * math.sqrt(red)
     ok = rel <= MAX_ESTIMATED_RELATIVE_NOISE
-    return GoodnessOfFit(
-        ok,
-        x,
-        dof,
-        red,
-        None,
-        rel,
-        f"no per-line standard deviations: the residuals imply {rel:.3g} relative noise per line "
-        f"(ln-magnitude, phase in rad); "
-        + (
-            "plausible as measurement noise"
-            if ok
-            else f"above {MAX_ESTIMATED_RELATIVE_NOISE:g} this is a misfit, not noise: the model does not fit the data"
-        ),
-    )
+    return GoodnessOfFit(ok, x, dof, red, None, rel,
+                         f"no per-line standard deviations: the residuals imply {rel:.3g} relative noise per line "
+                         f"(ln-magnitude, phase in rad); " + ("plausible as measurement noise" if ok else
+                         f"above {MAX_ESTIMATED_RELATIVE_NOISE:g} this is a misfit, not noise: the model does not fit the data"))

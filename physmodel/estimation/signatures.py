@@ -37,7 +37,7 @@ def _signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph, pa
     and which are one-sided (off at a bound).  ``params``: the effect's parameters with their
     candidate bounds (default: the library's)."""
     pts, steps, one_sided = [], [], []
-    for p in params if params is not None else LIBRARY[effect].parameters:
+    for p in (params if params is not None else LIBRARY[effect].parameters):
         span = p.typical - p.off
         h = 1e-3
         v = dict(values)
@@ -76,7 +76,7 @@ def _constrained_lr(S, one_sided, E):
                 Ginv = np.linalg.pinv(G)
             except np.linalg.LinAlgError:  # pragma: no cover
                 continue
-            b = Ss.T @ E  # (m, n)
+            b = Ss.T @ E                        # (m, n)
             d = Ginv @ b
             lr = np.sum(b * d, axis=0)
             ok = np.ones(E.shape[1], bool)
@@ -111,43 +111,25 @@ def _localise(data: FrequencySweep, r: np.ndarray, alpha: float, n_bands: int = 
                 x = rr[m]
                 ss = float(np.sum(x * x))
                 p = float(chi2.sf(ss, n))
-                rows.append(
-                    {
-                        "band_hz": [float(10 ** edges[bi]), float(10 ** edges[bi + 1])],
-                        "temperature_c": float(t),
-                        "part": pname,
-                        "n": n,
-                        "rms_std": float(math.sqrt(ss / n)),
-                        "mean_std": float(x.mean()),
-                        "rms_physical": float(np.sqrt(np.mean((x * scale[m]) ** 2))),
-                        "p_value": p,
-                        "flagged": bool(p < alpha / cells),
-                    }
-                )
+                rows.append({"band_hz": [float(10 ** edges[bi]), float(10 ** edges[bi + 1])],
+                             "temperature_c": float(t), "part": pname, "n": n,
+                             "rms_std": float(math.sqrt(ss / n)), "mean_std": float(x.mean()),
+                             "rms_physical": float(np.sqrt(np.mean((x * scale[m]) ** 2))),
+                             "p_value": p, "flagged": bool(p < alpha / cells)})
                 means.append((float(t), float(x.mean()), n))
             if len(means) >= 3:
                 T = np.array([m[0] for m in means])
                 y = np.array([m[1] for m in means])
-                w = np.array([m[2] for m in means], float)  # var(mean) = 1/n
+                w = np.array([m[2] for m in means], float)    # var(mean) = 1/n
                 Tm = np.sum(w * T) / w.sum()
                 sxx = np.sum(w * (T - Tm) ** 2)
                 slope = float(np.sum(w * (T - Tm) * y) / sxx)
                 z = slope * math.sqrt(sxx)
-                rows.append(
-                    {
-                        "band_hz": [float(10 ** edges[bi]), float(10 ** edges[bi + 1])],
-                        "temperature_c": None,
-                        "part": pname + " trend with T",
-                        "n": int(w.sum()),
-                        "rms_std": float("nan"),
-                        "mean_std": slope,
-                        "rms_physical": float("nan"),
-                        "p_value": float(2 * _norm_sf(abs(z))),
-                        "flagged": bool(2 * _norm_sf(abs(z)) < alpha / cells),
-                        "slope_per_K": slope,
-                        "z": float(z),
-                    }
-                )
+                rows.append({"band_hz": [float(10 ** edges[bi]), float(10 ** edges[bi + 1])], "temperature_c": None,
+                             "part": pname + " trend with T", "n": int(w.sum()), "rms_std": float("nan"),
+                             "mean_std": slope, "rms_physical": float("nan"),
+                             "p_value": float(2 * _norm_sf(abs(z))), "flagged": bool(2 * _norm_sf(abs(z)) < alpha / cells),
+                             "slope_per_K": slope, "z": float(z)})
     return rows
 
 
@@ -163,16 +145,11 @@ def _gap(data: FrequencySweep, r: np.ndarray, n_free: int) -> dict:
     temps = data.temperatures()
     db = r[:N] * s_ln * 20 / math.log(10)
     deg = np.degrees(r[N:] * s_ph)
-    return {
-        "cost": cost,
-        "expected_cost": exp,
-        "cost_std": math.sqrt(max(exp, 1e-12)),
-        "z": (cost - exp) / math.sqrt(max(exp, 1e-12)),
-        "n_free": n_free,
-        "temperatures_c": temps.tolist(),
-        "rms_db": [float(np.sqrt(np.mean(db[data.temperature_c == t] ** 2))) for t in temps],
-        "rms_deg": [float(np.sqrt(np.mean(deg[data.temperature_c == t] ** 2))) for t in temps],
-    }
+    return {"cost": cost, "expected_cost": exp, "cost_std": math.sqrt(max(exp, 1e-12)),
+            "z": (cost - exp) / math.sqrt(max(exp, 1e-12)), "n_free": n_free,
+            "temperatures_c": temps.tolist(),
+            "rms_db": [float(np.sqrt(np.mean(db[data.temperature_c == t] ** 2))) for t in temps],
+            "rms_deg": [float(np.sqrt(np.mean(deg[data.temperature_c == t] ** 2))) for t in temps]}
 
 
 def _separation(a: str, b: str, raw: dict, data: FrequencySweep) -> str:
@@ -201,8 +178,12 @@ def _separation(a: str, b: str, raw: dict, data: FrequencySweep) -> str:
     if abs(math.log10(fa / fb)) > 0.15:
         hints.append(f"frequency (centroids {fa:.3g} Hz vs {fb:.3g} Hz); widen the band")
     if not hints:
-        return (
-            "Their first-order signatures coincide on these data; only higher-order terms separate "
-            "them: extend the band to where the effects are large."
-        )
+        return ("Their first-order signatures coincide on these data; only higher-order terms separate "
+                "them: extend the band to where the effects are large.")
     return "Separate by " + "; ".join(hints) + "."
+
+
+def _simulated(G, e, s_ln, s_ph):
+    """``G`` with standardised log-magnitude/phase noise ``e`` (2N,) applied at σ ``s_ln`` [Np], ``s_ph`` [rad]."""
+    N = G.size
+    return G * np.exp(e[:N] * s_ln + 1j * e[N:] * s_ph)

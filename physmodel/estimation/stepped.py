@@ -54,29 +54,15 @@ def _period_phasors(chans: list, fs: float, t0: float, m0: float, f: float, P: i
                 sums[6 + 3 * x_i + k] += np.bincount(g, weights=xb if q is None else xb * q, minlength=P)
     cc, cs, c1, ss, s1, n1 = sums[:6]
     A = np.stack([np.stack([cc, cs, c1], -1), np.stack([cs, ss, s1], -1), np.stack([c1, s1, n1], -1)], -2)
-    R = sums[6:].reshape(len(chans), 3, P).transpose(2, 1, 0)  # (P, 3, n_channels)
+    R = sums[6:].reshape(len(chans), 3, P).transpose(2, 1, 0)           # (P, 3, n_channels)
     coef = np.linalg.solve(A, R)
     return coef[:, 0, :] - 1j * coef[:, 1, :]
 
 
-def stepped_sine(
-    t_or_fs,
-    u,
-    y,
-    frequencies_hz=None,
-    step_start_s=None,
-    step_stop_s=None,
-    *,
-    plan=None,
-    settle_s=0.0,
-    settle_periods=0.0,
-    periods=None,
-    block_samples: int = BLOCK_SAMPLES,
-    input_name: str = "input",
-    input_unit: str = "1",
-    output_names: Sequence[str] | None = None,
-    output_units: Sequence[str] | None = None,
-) -> FRFEstimate:
+def stepped_sine(t_or_fs, u, y, frequencies_hz=None, step_start_s=None, step_stop_s=None, *, plan=None,
+                 settle_s=0.0, settle_periods=0.0, periods=None, block_samples: int = BLOCK_SAMPLES,
+                 input_name: str = "input", input_unit: str = "1", output_names: Sequence[str] | None = None,
+                 output_units: Sequence[str] | None = None) -> FRFEstimate:
     """Stepped-sine estimate: per-period sine fits after each step's transient (see module doc).
 
     Parameters
@@ -112,25 +98,20 @@ def stepped_sine(
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)):
         raise IPMCError(f"frequencies_hz must be a non-empty 1-D array of finite values, got {frequencies_hz!r}")
     if np.any(f <= 0) or np.any(f > fs / 4):
-        raise IPMCError(
-            f"frequencies_hz: {f[(f <= 0) | (f > fs / 4)][:5].tolist()} Hz are outside (0, fs/4 = "
-            f"{fs / 4:g}] Hz; a sine fit needs at least 4 samples per period"
-        )
+        raise IPMCError(f"frequencies_hz: {f[(f <= 0) | (f > fs / 4)][:5].tolist()} Hz are outside (0, fs/4 = "
+                        f"{fs / 4:g}] Hz; a sine fit needs at least 4 samples per period")
     vals, counts = np.unique(f, return_counts=True)
     if np.any(counts > 1):
         raise IPMCError(f"frequencies_hz repeats {vals[counts > 1][:5].tolist()} Hz; give each frequency once")
     starts = _per_step(step_start_s, "step_start_s", f.shape, "[s]")
     t_end = t0 + n / fs
-    stops = (
-        np.append(starts[1:], t_end) if step_stop_s is None else _per_step(step_stop_s, "step_stop_s", f.shape, "[s]")
-    )
+    stops = (np.append(starts[1:], t_end) if step_stop_s is None
+             else _per_step(step_stop_s, "step_stop_s", f.shape, "[s]"))
     bad = np.flatnonzero((stops <= starts) | (starts < t0 - 0.5 / fs) | (stops > t_end + 1e-9 * max(1.0, abs(t_end))))
     if bad.size:
         i = bad[0]
-        raise IPMCError(
-            f"step {i} ({f[i]:g} Hz) runs from {starts[i]:g} to {stops[i]:g} s; steps must lie in the "
-            f"record ({t0:g} to {t_end:g} s) and end after they start"
-        )
+        raise IPMCError(f"step {i} ({f[i]:g} Hz) runs from {starts[i]:g} to {stops[i]:g} s; steps must lie in the "
+                        f"record ({t0:g} to {t_end:g} s) and end after they start")
     s_s = _per_step(settle_s, "settle_s", f.shape, ">= 0 [s]")
     s_p = _per_step(settle_periods, "settle_periods", f.shape, ">= 0")
     if np.any(s_s < 0) or np.any(s_p < 0):
@@ -143,25 +124,19 @@ def stepped_sine(
     else:
         P = _per_step(periods, "periods", f.shape, "whole numbers")
         if np.any(P != np.round(P)):
-            raise IPMCError(
-                f"periods={periods!r}: a stepped sine is measured over whole periods; a fractional "
-                f"period leaks the sine into the estimate.  Give whole numbers (or None for all "
-                f"whole periods in each step)"
-            )
+            raise IPMCError(f"periods={periods!r}: a stepped sine is measured over whole periods; a fractional "
+                            f"period leaks the sine into the estimate.  Give whole numbers (or None for all "
+                            f"whole periods in each step)")
         short = np.flatnonzero(P > avail)
         if short.size:
             i = short[0]
-            raise IPMCError(
-                f"step {i} ({f[i]:g} Hz): periods={int(P[i])} need {P[i] / f[i]:g} s after the "
-                f"{settle[i]:g} s settle, but the step leaves {max(stops[i] - m0[i], 0):g} s"
-            )
+            raise IPMCError(f"step {i} ({f[i]:g} Hz): periods={int(P[i])} need {P[i] / f[i]:g} s after the "
+                            f"{settle[i]:g} s settle, but the step leaves {max(stops[i] - m0[i], 0):g} s")
     few = np.flatnonzero(P < 2)
     if few.size:
         i = few[0]
-        raise IPMCError(
-            f"step {i} ({f[i]:g} Hz): {int(max(P[i], 0))} whole period(s) after the {settle[i]:g} s "
-            f"settle; σ from the scatter between periods needs at least 2"
-        )
+        raise IPMCError(f"step {i} ({f[i]:g} Hz): {int(max(P[i], 0))} whole period(s) after the {settle[i]:g} s "
+                        f"settle; σ from the scatter between periods needs at least 2")
     chans = [u, *ys]
     H = np.empty((len(ys), f.size), dtype=complex)
     sl = np.empty((len(ys), f.size))
@@ -180,26 +155,8 @@ def stepped_sine(
         sp[:, i] = np.sqrt(np.sum(z.imag**2, axis=0) / ((Pi - 1) * Pi))
     order = np.argsort(f)
     names, units = _names(output_names, output_units, len(ys), "output")
-    settings = {
-        "fs_hz": fs,
-        "steps": f.size,
-        "settle_s_min": float(settle.min()),
-        "settle_s_max": float(settle.max()),
-        "periods_min": int(P.min()),
-        "periods_max": int(P.max()),
-        "unused_tail_s_max": float(np.max(stops - m0 - P / f)),
-    }
-    return FRFEstimate(
-        f[order],
-        H[:, order],
-        NEPER_TO_DB * sl[:, order],
-        np.degrees(sp[:, order]),
-        None,
-        P[order].astype(int),
-        "stepped_sine",
-        input_name,
-        input_unit,
-        names,
-        units,
-        settings,
-    )
+    settings = {"fs_hz": fs, "steps": f.size, "settle_s_min": float(settle.min()), "settle_s_max": float(settle.max()),
+                "periods_min": int(P.min()), "periods_max": int(P.max()),
+                "unused_tail_s_max": float(np.max(stops - m0 - P / f))}
+    return FRFEstimate(f[order], H[:, order], NEPER_TO_DB * sl[:, order], np.degrees(sp[:, order]), None,
+                       P[order].astype(int), "stepped_sine", input_name, input_unit, names, units, settings)

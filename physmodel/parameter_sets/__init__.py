@@ -28,6 +28,7 @@ _FORMAT = "ipmc-parameter-set"
 _VERSION = 1
 
 
+
 #: Modules of this package that are not parameter-set sources.
 _NOT_SOURCES = ("derivation", "published")
 
@@ -50,8 +51,6 @@ def _discover() -> dict[str, Callable[[], IPMCParameters]]:
 
 
 _REGISTRY: dict[str, Callable[[], IPMCParameters]] = _discover()
-
-
 def available_parameter_sets() -> list[str]:
     """Names accepted by :func:`get_parameter_set`."""
     return sorted(_REGISTRY)
@@ -71,10 +70,8 @@ def get_parameter_set(name: str | os.PathLike, **overrides: Any) -> IPMCParamete
     elif text.lower().endswith(".json") or Path(text).is_file():
         p = load_parameter_set(text)
     else:
-        raise ParameterError(
-            f"unknown parameter set {text!r}; expected one of {available_parameter_sets()} "
-            "or the path of a JSON parameter file"
-        )
+        raise ParameterError(f"unknown parameter set {text!r}; expected one of {available_parameter_sets()} "
+                             "or the path of a JSON parameter file")
     return p.replace(**overrides) if overrides else p
 
 
@@ -105,18 +102,15 @@ def load_parameter_set(path: str | os.PathLike) -> IPMCParameters:
         raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from None
     if isinstance(data, dict) and "parameters" in data:
         if data.get("format") != _FORMAT:
-            raise ParameterError(
-                f"parameter file {str(path)!r} has format {data.get('format')!r}, expected {_FORMAT!r}"
-            )
+            raise ParameterError(f"parameter file {str(path)!r} has format {data.get('format')!r}, "
+                                 f"expected {_FORMAT!r}")
         version = data.get("version", 0)
         if isinstance(version, bool) or not isinstance(version, int) or version < 0:
-            raise ParameterError(
-                f"parameter file {str(path)!r}: version must be a non-negative integer, got {version!r}"
-            )
+            raise ParameterError(f"parameter file {str(path)!r}: version must be a non-negative integer, "
+                                 f"got {version!r}")
         if version > _VERSION:
-            raise ParameterError(
-                f"parameter file {str(path)!r} has version {version}, this library reads up to {_VERSION}"
-            )
+            raise ParameterError(f"parameter file {str(path)!r} has version {version}, "
+                                 f"this library reads up to {_VERSION}")
         data = data["parameters"]
     if not isinstance(data, dict):
         raise ParameterError(f"parameter file {str(path)!r} holds {type(data).__name__}, expected an object")

@@ -64,13 +64,8 @@ SENSOR_FIT_TEMPERATURES_C = (23.0, 25.0, 30.0, 40.0, 50.0, 60.0, 65.0)
 #: Per-line uncertainty given to the printed model's response when used as data [dB], [deg].
 PRINTED_STD_DB, PRINTED_STD_DEG = 0.5, 5.0
 #: (name, lower, upper) of the sensor's free parameters (log scale; a0 keeps its negative sign).
-SENSOR_FREE = (
-    ("a0", -1e3, -1e-4),
-    ("d", 1e-15, 1e-9),
-    ("kappa_e", 1e-8, 1e-3),
-    ("r1_sheet", 1e-2, 1e5),
-    ("r2_specific", 1e-8, 1e2),
-)
+SENSOR_FREE = (("a0", -1e3, -1e-4), ("d", 1e-15, 1e-9), ("kappa_e", 1e-8, 1e-3),
+               ("r1_sheet", 1e-2, 1e5), ("r2_specific", 1e-8, 1e2))
 
 ACTUATOR_TEMPERATURES_C = (19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0)
 ACTUATOR_TARGET_DB, ACTUATOR_TARGET_HZ = 7.0, 3.0
@@ -92,18 +87,10 @@ def printed_sensor_sweep(n_points: int = 31) -> FrequencySweep:
     """The printed 35 °C model as a measured sweep over 10–100 Hz (µA per mm, 0.5 dB / 5° per line)."""
     f = np.logspace(math.log10(SENSOR_BAND_HZ[0]), math.log10(SENSOR_BAND_HZ[1]), int(n_points))
     n = f.size
-    return FrequencySweep(
-        np.full(n, SENSOR_T_CAL_C),
-        f,
-        printed_sensor_response(f),
-        np.full(n, PRINTED_STD_DB),
-        np.full(n, PRINTED_STD_DEG),
-        "tip_displacement",
-        "mm",
-        "current",
-        "uA",
-        {"source": "seed 000 Sec. IV-A printed 35 C model, evaluated as data"},
-    )
+    return FrequencySweep(np.full(n, SENSOR_T_CAL_C), f, printed_sensor_response(f),
+                          np.full(n, PRINTED_STD_DB), np.full(n, PRINTED_STD_DEG),
+                          "tip_displacement", "mm", "current", "uA",
+                          {"source": "seed 000 Sec. IV-A printed 35 C model, evaluated as data"})
 
 
 def sensor_base():
@@ -119,16 +106,8 @@ def calibrate_seed000_sensor(*, starts: int = 4, seed: int = 0, progress=None):
     base = sensor_base()
     # start at the development values, a0 with the sign the phase calls for (module doc)
     free = [FreeParameter(n, lo, hi, "log", -abs(base.a0) if n == "a0" else None) for n, lo, hi in SENSOR_FREE]
-    return calibrate(
-        printed_sensor_sweep(),
-        base,
-        free,
-        kind="sensor",
-        starts=starts,
-        seed=seed,
-        name="seed000_sensor",
-        progress=progress,
-    )
+    return calibrate(printed_sensor_sweep(), base, free, kind="sensor", starts=starts, seed=seed,
+                     name="seed000_sensor", progress=progress)
 
 
 @dataclass(frozen=True)
@@ -148,19 +127,14 @@ def misfit(model_response, data_response, frequency_hz) -> Misfit:
     db = 20 * np.log10(np.abs(ratio))
     deg = np.degrees(np.angle(ratio))
     f = np.asarray(frequency_hz, float)
-    return Misfit(
-        float(np.sqrt(np.mean(db**2))),
-        float(np.max(np.abs(db))),
-        float(np.sqrt(np.mean(deg**2))),
-        float(np.max(np.abs(deg))),
-        (float(f.min()), float(f.max())),
-    )
+    return Misfit(float(np.sqrt(np.mean(db**2))), float(np.max(np.abs(db))),
+                  float(np.sqrt(np.mean(deg**2))), float(np.max(np.abs(deg))), (float(f.min()), float(f.max())))
 
 
 def sensor_misfit_35c(params, n_points: int = 91) -> Misfit:
     """Misfit of a sensor parameter set against the printed 35 °C model over 10–100 Hz."""
     f = np.logspace(1, 2, n_points)
-    S = SensorModel(params).frequency_response(f, [SENSOR_T_CAL_C])["S"][0, 0] * 1e3  # A/m → µA/mm
+    S = SensorModel(params).frequency_response(f, [SENSOR_T_CAL_C])["S"][0, 0] * 1e3   # A/m → µA/mm
     return misfit(S, printed_sensor_response(f), f)
 
 
@@ -182,11 +156,9 @@ class SensorTrends:
     def monotone(self) -> dict:
         """Which published directions hold strictly at every step of rising temperature."""
         d = lambda v: np.diff(np.asarray(v))
-        return {
-            "cutoff_decreases": bool(np.all(d(self.cutoff_hz) < 0)),
-            "hf_gain_decreases": bool(np.all(d(self.hf_gain_db) < 0)),
-            "phase_lag_increases": bool(np.all(d(self.phase_lag_deg) > 0)),
-        }
+        return {"cutoff_decreases": bool(np.all(d(self.cutoff_hz) < 0)),
+                "hf_gain_decreases": bool(np.all(d(self.hf_gain_db) < 0)),
+                "phase_lag_increases": bool(np.all(d(self.phase_lag_deg) > 0))}
 
 
 def sensor_trends(params, temperatures_c=SENSOR_FIT_TEMPERATURES_C, n_points: int = 401) -> SensorTrends:
@@ -196,7 +168,7 @@ def sensor_trends(params, temperatures_c=SENSOR_FIT_TEMPERATURES_C, n_points: in
     m = r.magnitude_db("S", 1e3)[0]
     ph = r.phase_deg("S")[0]
     top = m.max(axis=1, keepdims=True)
-    first = np.argmax(m >= top - 3.0, axis=1)  # first index within 3 dB of the maximum
+    first = np.argmax(m >= top - 3.0, axis=1)          # first index within 3 dB of the maximum
     # interpolate the crossing in log f between the neighbouring grid points
     cut = []
     for j, k in enumerate(first):
@@ -206,12 +178,8 @@ def sensor_trends(params, temperatures_c=SENSOR_FIT_TEMPERATURES_C, n_points: in
         y0, y1 = m[j, k - 1] - (top[j, 0] - 3.0), m[j, k] - (top[j, 0] - 3.0)
         lf = np.log10(f[k - 1]) + (np.log10(f[k]) - np.log10(f[k - 1])) * (-y0) / (y1 - y0)
         cut.append(float(10**lf))
-    return SensorTrends(
-        tuple(float(t) for t in temperatures_c),
-        tuple(m[:, -1].tolist()),
-        tuple(cut),
-        tuple((-ph.mean(axis=1)).tolist()),
-    )
+    return SensorTrends(tuple(float(t) for t in temperatures_c), tuple(m[:, -1].tolist()), tuple(cut),
+                        tuple((-ph.mean(axis=1)).tolist()))
 
 
 #: The published directions the sensor laws are chosen on (the third, ``phase_lag_increases``, is held out).
@@ -234,10 +202,8 @@ def choose_sensor_laws(params, trends=SENSOR_CALIBRATION_TRENDS) -> tuple[float,
     """
     unknown = set(trends) - {"cutoff_decreases", "hf_gain_decreases", "phase_lag_increases"}
     if unknown or not trends:
-        raise IPMCError(
-            f"choose_sensor_laws: trends must name some of cutoff_decreases, hf_gain_decreases, "
-            f"phase_lag_increases; got {sorted(trends)}"
-        )
+        raise IPMCError(f"choose_sensor_laws: trends must name some of cutoff_decreases, hf_gain_decreases, "
+                        f"phase_lag_increases; got {sorted(trends)}")
     cands = sorted(((c, e) for c in C_SLOPES for e in E_SLOPES), key=lambda ce: (abs(ce[0]) + abs(ce[1] + 0.0075), ce))
     for c, e in cands:
         tr = sensor_trends(with_slopes(params, c, e))
@@ -269,9 +235,8 @@ def actuator_trends(params, temperatures_c=ACTUATOR_TEMPERATURES_C) -> ActuatorT
     D = m[0] - m[1]
     i = int(np.argmax(np.abs(D)))
     mf = np.abs(model.frequency_response(ff, list(temperatures_c), quantities=("M",))["M"][0])
-    return ActuatorTrends(
-        float(D[i]), float(f[i]), tuple(ff[np.argmax(mf, axis=1)].tolist()), tuple(float(t) for t in temperatures_c)
-    )
+    return ActuatorTrends(float(D[i]), float(f[i]), tuple(ff[np.argmax(mf, axis=1)].tolist()),
+                          tuple(float(t) for t in temperatures_c))
 
 
 def actuator_base():
@@ -309,26 +274,17 @@ def derive(progress=None) -> dict:
     sensor = cal.parameters
     c, e, tr = choose_sensor_laws(sensor)
     act, sol = solve_actuator_trend()
-    return {
-        "sensor_calibration": cal,
-        "sensor_values": {k: getattr(sensor, k) for k, *_ in SENSOR_FREE},
-        "sensor_c_slope": c,
-        "sensor_e_slope": e,
-        "sensor_trends": tr,
-        "sensor_misfit": sensor_misfit_35c(sensor),
-        "actuator_E": act.E,
-        "actuator_c_slope": act.laws.C_minus.slope,
-        "actuator_trends": actuator_trends(act),
-        "actuator_solution": sol,
-    }
+    return {"sensor_calibration": cal, "sensor_values": {k: getattr(sensor, k) for k, *_ in SENSOR_FREE},
+            "sensor_c_slope": c, "sensor_e_slope": e, "sensor_trends": tr,
+            "sensor_misfit": sensor_misfit_35c(sensor),
+            "actuator_E": act.E, "actuator_c_slope": act.laws.C_minus.slope,
+            "actuator_trends": actuator_trends(act), "actuator_solution": sol}
 
 
 def main() -> int:  # pragma: no cover - a derivation script
     out = derive()
     print(out["sensor_calibration"].summary())
-    print(
-        "sensor values (store in parameter_sets.py):", {k: float(f"{v:.6g}") for k, v in out["sensor_values"].items()}
-    )
+    print("sensor values (store in parameter_sets.py):", {k: float(f"{v:.6g}") for k, v in out["sensor_values"].items()})
     print("sensor laws: C_minus slope", out["sensor_c_slope"], "E slope", out["sensor_e_slope"])
     print("sensor trends (chosen on", SENSOR_CALIBRATION_TRENDS, "):", out["sensor_trends"])
     print("held-out phase lag rises:", out["sensor_trends"].monotone()["phase_lag_increases"])

@@ -50,8 +50,5 @@ def seed000_printed_model_35c() -> tuple[tuple[float, ...], tuple[float, ...], t
     """Seed 000, Sec. IV-A, the 35 °C sensor model: (numerator, denominator) in descending powers of
     s [rad/s], tip displacement [mm] → current [µA], and its zeros as printed [rad/s]."""
     t = load_published()["sensor_seed000"]
-    return (
-        tuple(float(v) for v in t["model_35c_num"]),
-        tuple(float(v) for v in t["model_35c_den"]),
-        tuple(complex(z.replace(" ", "")) for z in t["model_35c_zeros_printed"]),
-    )
+    return (tuple(float(v) for v in t["model_35c_num"]), tuple(float(v) for v in t["model_35c_den"]),
+            tuple(complex(z.replace(" ", "")) for z in t["model_35c_zeros_printed"]))

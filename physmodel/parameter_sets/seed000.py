@@ -46,39 +46,29 @@ from ..temperature import LogLinear
 from .dev import dev_set
 
 #: Calibrated seed values (derived by physmodel/parameter_sets/derivation.py; see the module doc).
-SEED000_SENSOR_CAL = {"a0": -0.217398, "d": 1.97062e-13, "T_ref": 308.15, "C_minus_slope": -0.025, "E_slope": -0.0125}
+SEED000_SENSOR_CAL = {"a0": -0.217398, "d": 1.97062e-13, "T_ref": 308.15,
+                      "C_minus_slope": -0.025, "E_slope": -0.0125}
 
 
 def _seed000_sensor() -> IPMCParameters:
     c = SEED000_SENSOR_CAL
-    p = dev_set(
-        "seed000_sensor",
-        18e-3,
-        6.5e-3,
-        105e-6,
-        "seed 000 sensor geometry; a0, d calibrated to the printed 35 C model over 10-100 Hz "
-        "(kappa_e, r1', r2' undetermined, held at development values); C- and E log-linear laws "
-        "(-2.5 %/K, -1.25 %/K) chosen on the published cut-off and high-frequency-gain directions "
-        "(physmodel/parameter_sets/derivation.py)",
-    )
-    return p.replace(
-        a0=c["a0"],
-        d=c["d"],
-        T_ref=c["T_ref"],
-        laws=p.laws.with_(C_minus=LogLinear(slope=c["C_minus_slope"]), E=LogLinear(slope=c["E_slope"])),
-    )
+    p = dev_set("seed000_sensor", 18e-3, 6.5e-3, 105e-6,
+             "seed 000 sensor geometry; a0, d calibrated to the printed 35 C model over 10-100 Hz "
+             "(kappa_e, r1', r2' undetermined, held at development values); C- and E log-linear laws "
+             "(-2.5 %/K, -1.25 %/K) chosen on the published cut-off and high-frequency-gain directions "
+             "(physmodel/parameter_sets/derivation.py)")
+    return p.replace(a0=c["a0"], d=c["d"], T_ref=c["T_ref"],
+                     laws=p.laws.with_(C_minus=LogLinear(slope=c["C_minus_slope"]), E=LogLinear(slope=c["E_slope"])))
 
 
 SETS = {"seed000_sensor": _seed000_sensor}
 
 #: The published claims (``published.toml`` ids) each calibrated set was fitted or solved to, and what
 #: was fitted to each; every other claim checked with the set is a prediction.
-CALIBRATION = {
-    "seed000_sensor": {
-        "sensor_seed000.model_35c_num": "a0, d fitted to the printed 35 C model (its response over 10-100 Hz as data)",
-        "sensor_seed000.model_35c_den": "a0, d fitted to the printed 35 C model (its response over 10-100 Hz as data)",
-        "sensor_seed000.model_order": "the only response the set was fitted to is a printed 4/4 model",
-        "sensor_seed000.trends_with_rising_temperature[0]": "C- and E law slopes chosen on a grid to make it hold",
-        "sensor_seed000.trends_with_rising_temperature[1]": "C- and E law slopes chosen on a grid to make it hold",
-    }
-}
+CALIBRATION = {"seed000_sensor": {
+    "sensor_seed000.model_35c_num": "a0, d fitted to the printed 35 C model (its response over 10-100 Hz as data)",
+    "sensor_seed000.model_35c_den": "a0, d fitted to the printed 35 C model (its response over 10-100 Hz as data)",
+    "sensor_seed000.model_order": "the only response the set was fitted to is a printed 4/4 model",
+    "sensor_seed000.trends_with_rising_temperature[0]": "C- and E law slopes chosen on a grid to make it hold",
+    "sensor_seed000.trends_with_rising_temperature[1]": "C- and E law slopes chosen on a grid to make it hold",
+}}

@@ -33,23 +33,16 @@ SEED001_ACTUATOR_CAL = {"E": 4.21417e8, "C_minus_slope": -0.026088}
 
 def _seed001_actuator() -> IPMCParameters:
     c = SEED001_ACTUATOR_CAL
-    p = dev_set(
-        "seed001_actuator",
-        45e-3,
-        11e-3,
-        150e-6,
-        "seed 001 actuator geometry with development values; E (first mode) and a C- log-linear law "
-        "(-2.61 %/K) solved from the printed trend: largest 19-vs-55 C difference 7 dB at 3 Hz "
-        "(physmodel/parameter_sets/derivation.py)",
-    )
+    p = dev_set("seed001_actuator", 45e-3, 11e-3, 150e-6,
+             "seed 001 actuator geometry with development values; E (first mode) and a C- log-linear law "
+             "(-2.61 %/K) solved from the printed trend: largest 19-vs-55 C difference 7 dB at 3 Hz "
+             "(physmodel/parameter_sets/derivation.py)")
     return p.replace(E=c["E"], laws=p.laws.with_(C_minus=LogLinear(slope=c["C_minus_slope"])))
 
 
 SETS = {"seed001_actuator": _seed001_actuator}
 
 #: The published claims (``published.toml`` ids) the set was solved to; every other claim is a prediction.
-CALIBRATION = {
-    "seed001_actuator": {
-        "actuator_seed001.trends[1]": "E at T_ref and the C- slope solved from D(3 Hz) = 7 dB, dD/dlnf(3 Hz) = 0",
-    }
-}
+CALIBRATION = {"seed001_actuator": {
+    "actuator_seed001.trends[1]": "E at T_ref and the C- slope solved from D(3 Hz) = 7 dB, dD/dlnf(3 Hz) = 0",
+}}

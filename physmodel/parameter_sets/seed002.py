@@ -38,19 +38,11 @@ def _seed002(table: int) -> IPMCParameters:
         vals = dict(d=3.07e-11, C_minus=941.94, alpha0=-155.0, kappa_e=4.47e-7, r2_specific=8.81e-6, r1_sheet=56.44)
     vals["alpha0"] = vals["alpha0"] / _OMEGA_N_002  # seed's mode has ωn, not ωn², in its numerator
     return IPMCParameters(
-        L=L,
-        W=W,
-        h=h,
-        E=_E_002,
-        rho=density_for_mode(_OMEGA_N_002, _E_002, L, h),
-        xi=0.18,
-        Rp_specific=0.37,
-        a0=DEV_A0,
-        T_ref=300.0,
-        laws=TemperatureLaws(),
+        L=L, W=W, h=h, E=_E_002, rho=density_for_mode(_OMEGA_N_002, _E_002, L, h), xi=0.18,
+        Rp_specific=0.37, a0=DEV_A0, T_ref=300.0, laws=TemperatureLaws(),
         name=f"seed002_table{table}",
         source=f"{_SEED002_SOURCE}; Table {table}{' (initial)' if table == 2 else ' (fitted)'}; "
-        "alpha0 = printed/omega_n (see module doc)",
+               "alpha0 = printed/omega_n (see module doc)",
         **vals,
     )
 

@@ -55,9 +55,7 @@ def check_plot_path(path, option: str = "--plot") -> Path:
     before any computation, so a typo does not cost a whole run)."""
     p = Path(path)
     if p.suffix.lower() not in PLOT_FORMATS:
-        raise CLIError(
-            f"{option} {p}: unknown figure type {p.suffix or '(none)'!r}; use one of {', '.join(PLOT_FORMATS)}"
-        )
+        raise CLIError(f"{option} {p}: unknown figure type {p.suffix or '(none)'!r}; use one of {', '.join(PLOT_FORMATS)}")
     if p.is_dir():
         raise CLIError(f"{option} {p} is a folder; expected a file name")
     return p
@@ -75,7 +73,6 @@ def check_out_file(path, suffixes, option: str = "--out") -> Path:
 
 def _load_params(args):
     from physmodel import get_parameter_set
-
     if getattr(args, "params_json", None):
         from physmodel.parameter_sets import load_parameter_set
 
@@ -96,28 +93,14 @@ def _model(args, params):
 
 
 def _add_model_args(p):
-    p.add_argument(
-        "--kind",
-        choices=("actuator", "sensor"),
-        default="actuator",
-        help="actuator (voltage in) or sensor (tip displacement in, short-circuit current out)",
-    )
-    p.add_argument(
-        "--set", default="seed002_table3", help="named parameter set (see 'ipmc sets'); default seed002_table3"
-    )
+    p.add_argument("--kind", choices=("actuator", "sensor"), default="actuator",
+                   help="actuator (voltage in) or sensor (tip displacement in, short-circuit current out)")
+    p.add_argument("--set", default="seed002_table3", help="named parameter set (see 'ipmc sets'); default seed002_table3")
     p.add_argument("--params-json", help="a parameter-set JSON file (IPMCParameters.to_dict) instead of --set")
-    p.add_argument(
-        "--param",
-        action="append",
-        metavar="NAME=VALUE",
-        help="override a parameter in SI units, e.g. --param W=2e-3 (repeatable)",
-    )
-    p.add_argument(
-        "--kernel",
-        choices=("boundary_charge", "reciprocal"),
-        default="boundary_charge",
-        help="sensing kernel (sensor only)",
-    )
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="override a parameter in SI units, e.g. --param W=2e-3 (repeatable)")
+    p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), default="boundary_charge",
+                   help="sensing kernel (sensor only)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
 
 

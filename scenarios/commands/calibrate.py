@@ -42,10 +42,8 @@ def parse_free(spec: str, base):
     if len(parts) == 1:
         return default_free_parameter(base, name)
     if len(parts) not in (3, 4, 5):
-        raise ParameterError(
-            f"--free {spec!r}: expected NAME, NAME:LOWER:UPPER, NAME:LOWER:UPPER:SCALE "
-            "or NAME:LOWER:UPPER:SCALE:INITIAL"
-        )
+        raise ParameterError(f"--free {spec!r}: expected NAME, NAME:LOWER:UPPER, NAME:LOWER:UPPER:SCALE "
+                             "or NAME:LOWER:UPPER:SCALE:INITIAL")
     try:
         lo, hi = float(parts[1]), float(parts[2])
         initial = float(parts[4]) if len(parts) == 5 else None
@@ -61,56 +59,29 @@ def parse_free(spec: str, base):
 def add_parser(subparsers):
     """Add the ``calibrate`` subcommand."""
     p = subparsers.add_parser(
-        "calibrate",
-        help="calibrate physical parameters to a measured sweep (estimates, intervals, identifiability)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+        "calibrate", help="calibrate physical parameters to a measured sweep (estimates, intervals, identifiability)",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("sweep", metavar="SWEEP_FILE", help="frequency sweep (.csv, .npz or .mat; physmodel format)")
-    p.add_argument(
-        "--set",
-        required=True,
-        dest="base_set",
-        help="base parameter set: a name (see 'ipmc sets') or a JSON parameter file",
-    )
-    p.add_argument(
-        "--param",
-        action="append",
-        metavar="NAME=VALUE",
-        help="override a base parameter in SI units before fitting (repeatable)",
-    )
+    p.add_argument("--set", required=True, dest="base_set",
+                   help="base parameter set: a name (see 'ipmc sets') or a JSON parameter file")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="override a base parameter in SI units before fitting (repeatable)")
     p.add_argument("--kind", choices=("actuator", "sensor"), default="actuator", help="model kind (default actuator)")
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
-    p.add_argument(
-        "--kernel",
-        choices=("boundary_charge", "reciprocal"),
-        default="boundary_charge",
-        help="sensing kernel (sensor only)",
-    )
-    p.add_argument(
-        "--free",
-        action="append",
-        required=True,
-        metavar="SPEC",
-        help="a parameter to fit: NAME[:LOWER:UPPER[:log|linear[:INITIAL]]] (repeatable)",
-    )
-    p.add_argument(
-        "--starts", type=int, default=4, help="number of starts (base value + seeded Latin hypercube; default 4)"
-    )
+    p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), default="boundary_charge",
+                   help="sensing kernel (sensor only)")
+    p.add_argument("--free", action="append", required=True, metavar="SPEC",
+                   help="a parameter to fit: NAME[:LOWER:UPPER[:log|linear[:INITIAL]]] (repeatable)")
+    p.add_argument("--starts", type=int, default=4, help="number of starts (base value + seeded Latin hypercube; default 4)")
     p.add_argument("--seed", type=int, default=0, help="seed of the extra starts (default 0)")
     p.add_argument("--max-nfev", type=int, help="residual evaluations allowed per start (default: scipy's)")
-    p.add_argument(
-        "--no-hold", action="store_true", help="report undetermined parameters but do not hold them at their base value"
-    )
-    p.add_argument(
-        "--accept-misfit",
-        action="store_true",
-        help="exit 0 even when the model does not fit the data (goodness-of-fit test failed); "
-        "intervals are then widened by the Birge ratio instead of withheld",
-    )
-    p.add_argument(
-        "--force", "--overwrite", action="store_true", help="write into a folder that holds another run's results"
-    )
+    p.add_argument("--no-hold", action="store_true",
+                   help="report undetermined parameters but do not hold them at their base value")
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="exit 0 even when the model does not fit the data (goodness-of-fit test failed); "
+                        "intervals are then widened by the Birge ratio instead of withheld")
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--name", help="name of the calibrated parameter set (default <base>_calibrated)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
@@ -139,21 +110,11 @@ def run(args) -> int:
 
         bar = tqdm(total=args.starts, desc="calibrate (starts)", unit="start", file=sys.stderr)
     try:
-        res = calibrate(
-            data,
-            base,
-            free,
-            kind=args.kind,
-            quantity=args.quantity,
-            kernel=args.kernel,
-            starts=args.starts,
-            seed=args.seed,
-            max_nfev=args.max_nfev,
-            hold_undetermined=not args.no_hold,
-            name=args.name,
-            misfit="widen" if args.accept_misfit else "withhold",
-            progress=bar.update if bar is not None else None,
-        )
+        res = calibrate(data, base, free, kind=args.kind, quantity=args.quantity, kernel=args.kernel,
+                        starts=args.starts, seed=args.seed, max_nfev=args.max_nfev,
+                        hold_undetermined=not args.no_hold, name=args.name,
+                        misfit="widen" if args.accept_misfit else "withhold",
+                        progress=bar.update if bar is not None else None)
     finally:
         if bar is not None:
             bar.close()
@@ -164,11 +125,9 @@ def run(args) -> int:
         print(f"ipmc calibrate: the fit did not converge: {res.message}", file=sys.stderr)
         return EXIT_FAILED
     if not res.adequate:
-        print(
-            f"ipmc calibrate: the model does not fit the data: {res.goodness_of_fit.reason}"
-            + ("" if args.accept_misfit else " (intervals withheld; --accept-misfit to exit 0 with widened intervals)"),
-            file=sys.stderr,
-        )
+        print(f"ipmc calibrate: the model does not fit the data: {res.goodness_of_fit.reason}"
+              + ("" if args.accept_misfit else " (intervals withheld; --accept-misfit to exit 0 with widened intervals)"),
+              file=sys.stderr)
         return EXIT_OK if args.accept_misfit else EXIT_FAILED
     return EXIT_OK
 
@@ -207,19 +166,11 @@ def render_report(res, data, args) -> str:
         f"- model: {res.metadata.get('kind')} quantity {res.metadata.get('quantity')}, base set `{args.base_set}`",
         f"- status: {'converged' if res.converged else '**NOT CONVERGED**'} — {res.message}",
         f"- weighted cost {res.cost:.5g}; expected for a correct model {res.expected_cost:.5g} ± {res.cost_std:.3g}",
-        "- goodness of fit: "
-        + (
-            "n/a"
-            if res.goodness_of_fit is None
-            else ("adequate" if res.adequate else "**INADEQUATE**") + f" — {res.goodness_of_fit.reason}"
-        ),
-        "- noise: "
-        + (
-            "**estimated** from the residuals (the sweep has no per-line standard deviations); "
-            f"intervals scaled by {res.noise_scale:.3g}"
-            if res.noise_estimated
-            else "per-line standard deviations from the sweep"
-        ),
+        "- goodness of fit: " + ("n/a" if res.goodness_of_fit is None else
+                                 ("adequate" if res.adequate else "**INADEQUATE**") + f" — {res.goodness_of_fit.reason}"),
+        "- noise: " + ("**estimated** from the residuals (the sweep has no per-line standard deviations); "
+                        f"intervals scaled by {res.noise_scale:.3g}" if res.noise_estimated
+                        else "per-line standard deviations from the sweep"),
         f"- effort: {len(res.starts)} start(s), {res.n_evaluations} model evaluations in {res.n_model_calls} "
         f"batched calls, {res.elapsed_s:.2f} s",
         "",
@@ -230,55 +181,31 @@ def render_report(res, data, args) -> str:
     ]
     for n, fp in zip(res.names, res.free):
         st = res.identifiability[n]
-        status = (
-            ("determined" if st.identifiable else f"**not assessed**: {st.reason}")
-            if n not in res.held
+        status = ("determined" if st.identifiable else f"**not assessed**: {st.reason}") if n not in res.held \
             else f"**undetermined** (held at base): {st.reason}"
-        )
         ci = "–" if n in res.held else f"[{_g(res.ci_lower[n])}, {_g(res.ci_upper[n])}]"
-        lines.append(
-            f"| `{n}` | {_g(res.values[n])} | {_g(res.stderr[n])} | {ci} | "
-            f"[{fp.lower:.4g}, {fp.upper:.4g}] | {fp.scale} | {status} |"
-        )
+        lines.append(f"| `{n}` | {_g(res.values[n])} | {_g(res.stderr[n])} | {ci} | "
+                     f"[{fp.lower:.4g}, {fp.upper:.4g}] | {fp.scale} | {status} |")
     det = res.determined
     if len(det) > 1:
         idx = [res.names.index(n) for n in det]
-        lines += [
-            "",
-            "## Correlation of the determined parameters",
-            "",
-            "| | " + " | ".join(f"`{n}`" for n in det) + " |",
-            "|:---|" + "---:|" * len(det),
-        ]
+        lines += ["", "## Correlation of the determined parameters", "",
+                  "| | " + " | ".join(f"`{n}`" for n in det) + " |",
+                  "|:---|" + "---:|" * len(det)]
         for i, n in zip(idx, det):
             lines.append(f"| `{n}` | " + " | ".join(f"{res.correlation[i, j]:.3f}" for j in idx) + " |")
     lines += ["", "## Identifiability", ""]
     for n in res.names:
         st = res.identifiability[n]
-        peak = (
-            ""
-            if st.sensitivity_peak_hz is None or st.identifiable
-            else f" (sensitivity peak {st.sensitivity_peak_hz:.4g} Hz)"
-        )
+        peak = ("" if st.sensitivity_peak_hz is None or st.identifiable
+                else f" (sensitivity peak {st.sensitivity_peak_hz:.4g} Hz)")
         lines.append(f"- `{n}`: {'identifiable' if st.identifiable else 'NOT identifiable'} — {st.reason}{peak}")
-    lines += [
-        "",
-        "## Starts",
-        "",
-        "| start | initial | final | cost | evaluations | status |",
-        "|---:|:---|:---|---:|---:|:---|",
-    ]
+    lines += ["", "## Starts", "", "| start | initial | final | cost | evaluations | status |",
+              "|---:|:---|:---|---:|---:|:---|"]
     for s in res.starts:
         ini = ", ".join(f"{k}={v:.4g}" for k, v in s.initial.items())
         fin = ", ".join(f"{k}={v:.4g}" for k, v in s.final.items())
         lines.append(f"| {s.index} | {ini} | {fin} | {s.cost:.5g} | {s.nfev} | {s.message} |")
-    lines += [
-        "",
-        "## Figure",
-        "",
-        "![Bode overlay and residuals](bode.png)",
-        "",
-        'Load the calibrated set with `physmodel.get_parameter_set("<folder>/parameters.json")`.',
-        "",
-    ]
+    lines += ["", "## Figure", "", "![Bode overlay and residuals](bode.png)", "",
+              "Load the calibrated set with `physmodel.get_parameter_set(\"<folder>/parameters.json\")`.", ""]
     return "\n".join(lines)

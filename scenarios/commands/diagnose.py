@@ -64,73 +64,40 @@ _GEOMETRY = ("L", "W", "h")
 def add_parser(subparsers):
     """Add the ``diagnose`` subcommand."""
     p = subparsers.add_parser(
-        "diagnose",
-        help="locate a model/data discrepancy, name the missing effect, refit, show the gap shrink",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+        "diagnose", help="locate a model/data discrepancy, name the missing effect, refit, show the gap shrink",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("experiment", nargs="?", help="experiment description (TOML); flags override its entries")
     p.add_argument("--data", help="sweep file (.csv/.npz/.mat)")
     p.add_argument("--kind", choices=("actuator", "sensor"), help="model kind (default actuator)")
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
     p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), help="sensing kernel")
     p.add_argument("--set", dest="base_set", help="starting parameter set: a name or a JSON file")
-    p.add_argument(
-        "--param",
-        action="append",
-        metavar="NAME=VALUE",
-        help="override a base parameter (SI), e.g. W=2e-3 (repeatable)",
-    )
-    p.add_argument(
-        "--free",
-        action="append",
-        metavar="SPEC",
-        help="free parameter NAME[:LOWER:UPPER[:SCALE[:INITIAL]]] (repeatable; default alpha0)",
-    )
-    p.add_argument(
-        "--baseline-effect",
-        action="append",
-        metavar="NAME[:P=V,...]",
-        help="effect already in the model; without values its parameters are fitted (repeatable)",
-    )
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="override a base parameter (SI), e.g. W=2e-3 (repeatable)")
+    p.add_argument("--free", action="append", metavar="SPEC",
+                   help="free parameter NAME[:LOWER:UPPER[:SCALE[:INITIAL]]] (repeatable; default alpha0)")
+    p.add_argument("--baseline-effect", action="append", metavar="NAME[:P=V,...]",
+                   help="effect already in the model; without values its parameters are fitted (repeatable)")
     p.add_argument("--candidates", help="comma-separated library effects to test (default: all that apply)")
     p.add_argument("--alpha", type=float, help="family-wise false-positive rate (default 0.05)")
     p.add_argument("--null-draws", type=int, help="linearised null Monte Carlo draws (default 4000)")
     p.add_argument("--null-refits", type=int, help="full-refit bootstrap draws under the null (default 4)")
     p.add_argument("--seed", type=int, help="seed of the null Monte Carlo (default 0)")
     p.add_argument("--laws", help="temperature laws: set (the set's own), isothermal, default (physics.md §7)")
-    p.add_argument(
-        "--law",
-        action="append",
-        metavar="QUANTITY=LAW[:P=V,...]",
-        help="change one law, e.g. d=Arrhenius:activation_energy=20e3 or E=Constant (repeatable)",
-    )
-    p.add_argument(
-        "--candidate-bound",
-        action="append",
-        metavar="EFFECT.PARAM=LO:HI",
-        help="candidate bounds (SI) replacing the strip-scaled ones (repeatable)",
-    )
-    p.add_argument(
-        "--candidate-start",
-        action="append",
-        metavar="EFFECT.PARAM=V",
-        help="extra start value of a candidate parameter (repeatable)",
-    )
-    p.add_argument(
-        "--plausible",
-        action="append",
-        metavar="NAME=LO:HI",
-        help="plausible range of a base parameter replacing the default (repeatable)",
-    )
-    p.add_argument(
-        "--no-prior", action="store_true", help="do not hold the free base parameters to their plausible ranges"
-    )
+    p.add_argument("--law", action="append", metavar="QUANTITY=LAW[:P=V,...]",
+                   help="change one law, e.g. d=Arrhenius:activation_energy=20e3 or E=Constant (repeatable)")
+    p.add_argument("--candidate-bound", action="append", metavar="EFFECT.PARAM=LO:HI",
+                   help="candidate bounds (SI) replacing the strip-scaled ones (repeatable)")
+    p.add_argument("--candidate-start", action="append", metavar="EFFECT.PARAM=V",
+                   help="extra start value of a candidate parameter (repeatable)")
+    p.add_argument("--plausible", action="append", metavar="NAME=LO:HI",
+                   help="plausible range of a base parameter replacing the default (repeatable)")
+    p.add_argument("--no-prior", action="store_true",
+                   help="do not hold the free base parameters to their plausible ranges")
     p.add_argument("--baseline-starts", type=int, help="multi-start count of the baseline fit (default 3)")
     p.add_argument("--out", help="report folder (default diagnosis)")
-    p.add_argument(
-        "--force", "--overwrite", action="store_true", help="write into a folder that holds another run's results"
-    )
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
     return p
@@ -147,29 +114,9 @@ def _load_toml(path: Path) -> dict:
         spec = tomllib.loads(read_text(path, "experiment file"))
     except tomllib.TOMLDecodeError as exc:
         raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
-    known = {
-        "data",
-        "kind",
-        "quantity",
-        "kernel",
-        "set",
-        "free",
-        "candidates",
-        "alpha",
-        "seed",
-        "out",
-        "geometry",
-        "parameters",
-        "baseline_effects",
-        "null_draws",
-        "null_refits",
-        "laws",
-        "candidate_bounds",
-        "candidate_starts",
-        "plausible",
-        "prior",
-        "baseline_starts",
-    }
+    known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
+             "geometry", "parameters", "baseline_effects", "null_draws", "null_refits", "laws",
+             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts"}
     unknown = set(spec) - known
     if unknown:
         raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
@@ -197,43 +144,29 @@ def _is_strs(v):
 
 
 #: Experiment-file keys: (check, what is expected).
-_TYPES = {
-    "data": (lambda v: isinstance(v, str), "a file name"),
-    "kind": (lambda v: v in ("actuator", "sensor"), "'actuator' or 'sensor'"),
-    "quantity": (lambda v: isinstance(v, str), "a quantity name (M, H, Z, I, S)"),
-    "kernel": (lambda v: v in ("boundary_charge", "reciprocal"), "'boundary_charge' or 'reciprocal'"),
-    "set": (lambda v: isinstance(v, str), "a parameter-set name or JSON file"),
-    "free": (lambda v: _is_strs(v) and len(v) > 0, "a non-empty list of strings NAME[:LOWER:UPPER...]"),
-    "candidates": (lambda v: _is_strs(v) or isinstance(v, str), "a list of effect names"),
-    "alpha": (lambda v: _is_num(v) and 0 < v < 1, "a number in (0, 1)"),
-    "seed": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
-    "out": (lambda v: isinstance(v, str), "a folder name"),
-    "null_draws": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
-    "null_refits": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
-    "geometry": (
-        lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()),
-        "a table of L, W, h [m] numbers",
-    ),
-    "parameters": (
-        lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()),
-        "a table of NAME = number (SI)",
-    ),
-    "baseline_effects": (
-        lambda v: (
-            isinstance(v, dict) and all(isinstance(e, dict) and all(_is_num(x) for x in e.values()) for e in v.values())
-        ),
-        "a table of [baseline_effects.NAME] tables of numbers",
-    ),
-    "laws": (lambda v: isinstance(v, (str, dict)), "a name (set, isothermal, default) or a [laws] table"),
-    "candidate_bounds": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
-    "candidate_starts": (
-        lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()),
-        "a table of NAME = number",
-    ),
-    "plausible": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
-    "prior": (lambda v: isinstance(v, bool), "true or false"),
-    "baseline_starts": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
-}
+_TYPES = {"data": (lambda v: isinstance(v, str), "a file name"), "kind": (lambda v: v in ("actuator", "sensor"), "'actuator' or 'sensor'"),
+          "quantity": (lambda v: isinstance(v, str), "a quantity name (M, H, Z, I, S)"),
+          "kernel": (lambda v: v in ("boundary_charge", "reciprocal"), "'boundary_charge' or 'reciprocal'"),
+          "set": (lambda v: isinstance(v, str), "a parameter-set name or JSON file"),
+          "free": (lambda v: _is_strs(v) and len(v) > 0, "a non-empty list of strings NAME[:LOWER:UPPER...]"),
+          "candidates": (lambda v: _is_strs(v) or isinstance(v, str), "a list of effect names"),
+          "alpha": (lambda v: _is_num(v) and 0 < v < 1, "a number in (0, 1)"),
+          "seed": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
+          "out": (lambda v: isinstance(v, str), "a folder name"),
+          "null_draws": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
+          "null_refits": (lambda v: _is_int(v) and v >= 0, "a non-negative integer"),
+          "geometry": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()), "a table of L, W, h [m] numbers"),
+          "parameters": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()), "a table of NAME = number (SI)"),
+          "baseline_effects": (lambda v: isinstance(v, dict) and all(isinstance(e, dict) and all(_is_num(x) for x in e.values())
+                                                                     for e in v.values()),
+                               "a table of [baseline_effects.NAME] tables of numbers"),
+          "laws": (lambda v: isinstance(v, (str, dict)), "a name (set, isothermal, default) or a [laws] table"),
+          "candidate_bounds": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
+          "candidate_starts": (lambda v: isinstance(v, dict) and all(_is_num(x) for x in v.values()),
+                               "a table of NAME = number"),
+          "plausible": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
+          "prior": (lambda v: isinstance(v, bool), "true or false"),
+          "baseline_starts": (lambda v: _is_int(v) and v >= 1, "a positive integer")}
 
 
 def _check_types(spec: dict, path: Path) -> None:
@@ -241,8 +174,6 @@ def _check_types(spec: dict, path: Path) -> None:
         ok, what = _TYPES[key]
         if not ok(value):
             raise IPMCError(f"experiment file {str(path)!r}: {key} = {value!r}; expected {what}")
-
-
 def _range(item: str, option: str) -> tuple[str, tuple[float, float]]:
     name, sep, rest = item.partition("=")
     parts = rest.split(":")
@@ -265,13 +196,9 @@ def _laws(spec: dict, args, set_name) -> object:
             q, sep, rest = item.partition("=")
             law, _, params = rest.partition(":")
             if not sep or not law.strip():
-                raise IPMCError(
-                    f"--law {item!r}: expected QUANTITY=LAW[:P=V,...], e.g. d=Arrhenius:activation_energy=2e4"
-                )
-            table[q.strip()] = {
-                "law": law.strip(),
-                **parse_assignments([x for x in params.split(",") if x.strip()], option=f"--law {item!r}:"),
-            }
+                raise IPMCError(f"--law {item!r}: expected QUANTITY=LAW[:P=V,...], e.g. d=Arrhenius:activation_energy=2e4")
+            table[q.strip()] = {"law": law.strip(),
+                                **parse_assignments([x for x in params.split(",") if x.strip()], option=f"--law {item!r}:")}
         laws = table
     if laws is not None and not isinstance(laws, (str, dict)):
         raise IPMCError(f"laws = {laws!r}: expected a name (set, isothermal, default) or a table")
@@ -282,11 +209,9 @@ def _laws(spec: dict, args, set_name) -> object:
             raise IPMCError(f"parameter file {set_name!r} cannot be read: {exc}") from None
         base_choice = laws.get("base", "set") if isinstance(laws, dict) else laws
         if not has_laws and base_choice in (None, "set"):
-            raise IPMCError(
-                f"parameter file {set_name!r} has no 'laws': choose the temperature laws explicitly "
-                'with laws = "isothermal" | "default" (physics.md §7) or a [laws] table '
-                "(--laws / --law); they are stated in the report"
-            )
+            raise IPMCError(f"parameter file {set_name!r} has no 'laws': choose the temperature laws explicitly "
+                            "with laws = \"isothermal\" | \"default\" (physics.md §7) or a [laws] table "
+                            "(--laws / --law); they are stated in the report")
     return laws
 
 
@@ -375,24 +300,13 @@ def build(args):
     prior = False if args.no_prior else spec.get("prior", True)
     if not isinstance(prior, bool):
         raise IPMCError(f"prior = {prior!r}: expected true or false")
-    kw = dict(
-        kind=pick(args.kind, "kind", "actuator"),
-        quantity=pick(args.quantity, "quantity"),
-        laws=_laws(spec, args, set_name),
-        candidate_bounds=cb or None,
-        candidate_starts=cs or None,
-        plausible=pl or None,
-        prior=prior,
-        baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
-        free=free,
-        baseline_effects=effects,
-        candidates=cands,
-        alpha=float(pick(args.alpha, "alpha", 0.05)),
-        null_draws=int(pick(args.null_draws, "null_draws", 4000)),
-        null_refits=int(pick(args.null_refits, "null_refits", 4)),
-        seed=int(pick(args.seed, "seed", 0)),
-        kernel=pick(args.kernel, "kernel", "boundary_charge"),
-    )
+    kw = dict(kind=pick(args.kind, "kind", "actuator"), quantity=pick(args.quantity, "quantity"),
+              laws=_laws(spec, args, set_name), candidate_bounds=cb or None, candidate_starts=cs or None,
+              plausible=pl or None, prior=prior, baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
+              free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
+              null_draws=int(pick(args.null_draws, "null_draws", 4000)),
+              null_refits=int(pick(args.null_refits, "null_refits", 4)), seed=int(pick(args.seed, "seed", 0)),
+              kernel=pick(args.kernel, "kernel", "boundary_charge"))
     if kw["kind"] not in ("actuator", "sensor"):
         raise IPMCError(f"kind = {kw['kind']!r}; expected 'actuator' or 'sensor'")
     return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
@@ -427,11 +341,9 @@ def run(args) -> int:
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)
-        print(
-            f"weighted cost {d.gap_before['cost']:.4g} -> {d.gap_after['cost']:.4g} "
-            f"(expected {d.gap_after['expected_cost']:.4g}); gap shrink {gap_shrink(d):.3g}x; "
-            f"{d.elapsed_s:.1f} s"
-        )
+        print(f"weighted cost {d.gap_before['cost']:.4g} -> {d.gap_after['cost']:.4g} "
+              f"(expected {d.gap_after['expected_cost']:.4g}); gap shrink {gap_shrink(d):.3g}x; "
+              f"{d.elapsed_s:.1f} s")
         print(f"report: {out}/report.json, summary.md, bode_before.png, bode_after.png")
     return EXIT_OK
 

@@ -41,12 +41,8 @@ def _frequency_options(p, count_help: str):
 
 
 def add_parser(sub):
-    p = sub.add_parser(
-        "excite",
-        help="design an excitation (multisine, stepped sine, chirp) -> signal file",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = sub.add_parser("excite", help="design an excitation (multisine, stepped sine, chirp) -> signal file",
+                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     kinds = p.add_subparsers(dest="design", metavar="DESIGN", required=True)
     m = kinds.add_parser("multisine", help="periodic multisine with low-crest-factor phases")
     _common(m)
@@ -97,24 +93,11 @@ def _frequencies(args, grid: float | None) -> np.ndarray:
 
 
 #: Library argument names → the options that set them (error messages name the option).
-OPTIONS = {
-    "frequencies_hz": "--frequencies",
-    "fs_hz": "--fs",
-    "period_s": "--period",
-    "f0_hz": "--f0",
-    "f1_hz": "--f1",
-    "sweep_s": "--sweep-s",
-    "transient_periods": "--transient-periods",
-    "min_measure_s": "--min-measure-s",
-    "settle_s": "--settle-s",
-    "settle_periods": "--settle-periods",
-    "repeats": "--repeats",
-    "amplitude": "--amplitude",
-    "rms": "--rms",
-    "seed": "--seed",
-    "iterations": "--iterations",
-    "periods": "--periods",
-}
+OPTIONS = {"frequencies_hz": "--frequencies", "fs_hz": "--fs", "period_s": "--period", "f0_hz": "--f0",
+           "f1_hz": "--f1", "sweep_s": "--sweep-s", "transient_periods": "--transient-periods",
+           "min_measure_s": "--min-measure-s", "settle_s": "--settle-s", "settle_periods": "--settle-periods",
+           "repeats": "--repeats", "amplitude": "--amplitude", "rms": "--rms", "seed": "--seed",
+           "iterations": "--iterations", "periods": "--periods"}
 
 
 def as_options(exc: Exception, options: dict, prefix: str = "") -> CLIError:
@@ -144,7 +127,7 @@ def run(args) -> int:
     ch, unit = _channel(args)
     try:
         split_column(f"{ch}_{unit}")
-    except IPMCError as exc:  # DataFormatError: name the options
+    except IPMCError as exc:                  # DataFormatError: name the options
         raise CLIError(f"--channel {ch!r} / --unit {unit!r}: {exc}") from None
 
     try:
@@ -159,10 +142,8 @@ def run(args) -> int:
     rec.save(out)
     if not args.quiet:
         print(f"wrote {out}: {what}")
-        print(
-            f"  {u.size} samples at {args.fs:g} Hz; expected duration {float(rec.metadata['expected_duration_s']):g} s; "
-            f"crest factor {cf:.3f} (peak {np.max(np.abs(u)):.4g} {unit}, RMS {np.sqrt(np.mean(u**2)):.4g} {unit})"
-        )
+        print(f"  {u.size} samples at {args.fs:g} Hz; expected duration {float(rec.metadata['expected_duration_s']):g} s; "
+              f"crest factor {cf:.3f} (peak {np.max(np.abs(u)):.4g} {unit}, RMS {np.sqrt(np.mean(u**2)):.4g} {unit})")
     return EXIT_OK
 
 
@@ -178,51 +159,21 @@ def _design(args, ch: str, unit: str):
             note = f" ({args.count - f.size} requested lines coincided on the 1/period = {1 / args.period:g} Hz grid)"
         if args.amplitude is not None and args.rms is not None:
             raise CLIError("--amplitude and --rms: give one of them")
-        ms = multisine(
-            f,
-            args.fs,
-            args.period,
-            amplitude=1.0 if args.amplitude is None else args.amplitude,
-            rms=args.rms,
-            phases=args.phases,
-            seed=args.seed,
-            channel=ch,
-            unit=unit,
-        )
+        ms = multisine(f, args.fs, args.period, amplitude=1.0 if args.amplitude is None else args.amplitude,
+                       rms=args.rms, phases=args.phases, seed=args.seed, channel=ch, unit=unit)
         rec = ms.record(args.periods, args.transient_periods)
-        what = (
-            f"multisine: {f.size} lines {f[0]:g}-{f[-1]:g} Hz{note}, period {ms.period_s:g} s, "
-            f"{args.transient_periods} transient + {args.periods} measured periods, {args.phases} phases"
-        )
+        what = (f"multisine: {f.size} lines {f[0]:g}-{f[-1]:g} Hz{note}, period {ms.period_s:g} s, "
+                f"{args.transient_periods} transient + {args.periods} measured periods, {args.phases} phases")
     elif args.design == "stepped":
         f = _frequencies(args, None)
-        plan = stepped_sine_plan(
-            f,
-            args.fs,
-            amplitude=args.amplitude,
-            periods=args.periods,
-            min_measure_s=args.min_measure_s,
-            settle_s=args.settle_s,
-            settle_periods=args.settle_periods,
-            channel=ch,
-            unit=unit,
-        )
+        plan = stepped_sine_plan(f, args.fs, amplitude=args.amplitude, periods=args.periods,
+                                 min_measure_s=args.min_measure_s, settle_s=args.settle_s,
+                                 settle_periods=args.settle_periods, channel=ch, unit=unit)
         rec = plan.record()
-        what = (
-            f"stepped sine: {f.size} steps {f.min():g}-{f.max():g} Hz, {int(plan.periods.min())}-"
-            f"{int(plan.periods.max())} periods per step, settle {plan.settle_s.min():g}-{plan.settle_s.max():g} s"
-        )
+        what = (f"stepped sine: {f.size} steps {f.min():g}-{f.max():g} Hz, {int(plan.periods.min())}-"
+                f"{int(plan.periods.max())} periods per step, settle {plan.settle_s.min():g}-{plan.settle_s.max():g} s")
     else:
-        rec = chirp(
-            args.f0,
-            args.f1,
-            args.sweep_s,
-            args.fs,
-            amplitude=args.amplitude,
-            method=args.method,
-            repeats=args.repeats,
-            channel=ch,
-            unit=unit,
-        )
+        rec = chirp(args.f0, args.f1, args.sweep_s, args.fs, amplitude=args.amplitude, method=args.method,
+                    repeats=args.repeats, channel=ch, unit=unit)
         what = f"{args.method} chirp {args.f0:g}-{args.f1:g} Hz, {args.sweep_s:g} s x {args.repeats}"
     return rec, what

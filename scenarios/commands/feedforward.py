@@ -34,12 +34,8 @@ __all__ = ["add_parser", "run", "build_reference"]
 
 
 def add_parser(sub):
-    p = sub.add_parser(
-        "feedforward",
-        help="feedforward voltage of a surrogate, checked on the physics",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = sub.add_parser("feedforward", help="feedforward voltage of a surrogate, checked on the physics",
+                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("surrogate", help="surrogate model JSON (what 'ipmc fit' writes)")
     p.add_argument("--temperature", type=float, required=True, help="operating temperature [°C]")
     g = p.add_argument_group("reference (in the surrogate's output unit, e.g. mm)")
@@ -62,12 +58,8 @@ def add_parser(sub):
     c.add_argument("--preview-tol", type=float, default=1e-3, help="auto preview: relative truncation error")
     c.add_argument("--max-voltage", type=float, default=3.0, help="largest |V| allowed [V] (IPMCs take ~2-3 V)")
     c.add_argument("--max-rate", type=float, help="largest |dV/dt| allowed [V/s]")
-    c.add_argument(
-        "--on-limit",
-        choices=("error", "warn"),
-        default="error",
-        help="refuse (exit 3, nothing written) or warn and continue",
-    )
+    c.add_argument("--on-limit", choices=("error", "warn"), default="error",
+                   help="refuse (exit 3, nothing written) or warn and continue")
     c.add_argument("--max-error", type=float, help="fail (exit 3) if the predicted tracking error exceeds this [unit]")
     m = p.add_argument_group("physics check")
     m.add_argument("--set", default="seed001_actuator", help="parameter set of the physics (default seed001_actuator)")
@@ -87,25 +79,11 @@ def build_reference(args, unit: str):
     lead, tail = args.lead, args.tail
     if args.reference_file:
         fade = 0.0 if args.fade is None else args.fade
-        return R.from_file(
-            args.reference_file,
-            column=args.reference_column,
-            fade_in_s=fade,
-            fade_out_s=fade,
-            lead_s=lead,
-            tail_s=tail,
-            unit=unit,
-        )
+        return R.from_file(args.reference_file, column=args.reference_column, fade_in_s=fade,
+                           fade_out_s=fade, lead_s=lead, tail_s=tail, unit=unit)
     if args.reference == "steps":
-        return R.smoothed_steps(
-            _floats(args.levels, "--levels"),
-            args.hold,
-            args.fs,
-            transition_s=args.transition,
-            lead_s=lead,
-            tail_s=tail,
-            unit=unit,
-        )
+        return R.smoothed_steps(_floats(args.levels, "--levels"), args.hold, args.fs,
+                                transition_s=args.transition, lead_s=lead, tail_s=tail, unit=unit)
     amps = _floats(args.amplitude, "--amplitude")
     freqs = _floats(args.frequency, "--frequency")
     fmin = min(freqs)
@@ -113,20 +91,10 @@ def build_reference(args, unit: str):
     if args.reference == "sine":
         if len(amps) != 1 or len(freqs) != 1:
             raise CLIError("--reference sine takes one --amplitude and one --frequency (use multitone)")
-        return R.sine(
-            amps[0],
-            freqs[0],
-            dur,
-            args.fs,
-            fade_in_s=args.fade,
-            fade_out_s=args.fade,
-            lead_s=lead,
-            tail_s=tail,
-            unit=unit,
-        )
-    return R.multitone(
-        amps, freqs, dur, args.fs, fade_in_s=args.fade, fade_out_s=args.fade, lead_s=lead, tail_s=tail, unit=unit
-    )
+        return R.sine(amps[0], freqs[0], dur, args.fs, fade_in_s=args.fade, fade_out_s=args.fade,
+                      lead_s=lead, tail_s=tail, unit=unit)
+    return R.multitone(amps, freqs, dur, args.fs, fade_in_s=args.fade, fade_out_s=args.fade,
+                       lead_s=lead, tail_s=tail, unit=unit)
 
 
 def _surrogate(path, temperature_c):
@@ -141,9 +109,8 @@ def _surrogate(path, temperature_c):
         raise CLIError(f"{path}: not a surrogate model JSON ({exc})") from None
     lo_hi = model.temperature_range_c
     if model.is_scheduled and lo_hi is not None and not (lo_hi[0] <= temperature_c <= lo_hi[1]):
-        raise CLIError(
-            f"--temperature {temperature_c:g} °C is outside the surrogate's range [{lo_hi[0]:g}, {lo_hi[1]:g}] °C"
-        )
+        raise CLIError(f"--temperature {temperature_c:g} °C is outside the surrogate's range "
+                       f"[{lo_hi[0]:g}, {lo_hi[1]:g}] °C")
     return model
 
 
@@ -161,25 +128,19 @@ def run(args) -> int:
         if u not in UNITS:
             raise CLIError(f"{args.surrogate}: {what} unit {u!r} is not one of {sorted(UNITS)}")
     if UNITS[in_unit][0] != "voltage" or UNITS[out_unit][0] != "length":
-        raise CLIError(
-            f"{args.surrogate}: expected an actuator surrogate (length per voltage), got {out_unit}/{in_unit}"
-        )
+        raise CLIError(f"{args.surrogate}: expected an actuator surrogate (length per voltage), got "
+                       f"{out_unit}/{in_unit}")
     ref = build_reference(args, out_unit)
     from inversion.references import edge_jump
 
     jump = edge_jump(ref.y)
     if jump > 0.01:
-        print(
-            f"ipmc feedforward: warning: the reference is at {100 * jump:.0f} % of its peak at a record end; "
-            "the noncausal inverse sees a jump to zero there (a voltage spike): use --fade and --lead/--tail",
-            file=sys.stderr,
-        )
-    v_scale = unit_scale(in_unit)  # surrogate input unit -> V
-    limits = Limits(
-        max_voltage=args.max_voltage / v_scale if args.max_voltage else None,
-        max_rate=args.max_rate / v_scale if args.max_rate else None,
-        action=args.on_limit,
-    )
+        print(f"ipmc feedforward: warning: the reference is at {100 * jump:.0f} % of its peak at a record end; "
+              "the noncausal inverse sees a jump to zero there (a voltage spike): use --fade and --lead/--tail",
+              file=sys.stderr)
+    v_scale = unit_scale(in_unit)                       # surrogate input unit -> V
+    limits = Limits(max_voltage=args.max_voltage / v_scale if args.max_voltage else None,
+                    max_rate=args.max_rate / v_scale if args.max_rate else None, action=args.on_limit)
     try:
         ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits)
     except LimitError as exc:
@@ -188,47 +149,29 @@ def run(args) -> int:
     volts = ff.output * v_scale
     out = Path(args.out)
     cols = {"time_s": ref.t, "voltage_V": volts, f"reference_{out_unit}": ref.y}
-    lines = [
-        f"# Feedforward at {args.temperature:g} °C",
-        "",
-        f"- surrogate: `{args.surrogate}` ({model!r})",
-        f"- reference: {ref.description}; fades {ref.fade_in_s:g}/{ref.fade_out_s:g} s, rest "
-        f"{ref.lead_s:g}/{ref.tail_s:g} s, {ref.t.size} samples at {1 / ref.dt:g} Hz",
-        f"- preview: {ff.preview_rule} -> {ff.preview_s:.4g} s"
-        + (
-            f" (truncation error {ff.preview_choice.relative_error:.2g} of the inverse, tolerance "
-            f"{ff.preview_choice.tolerance:g}; the 4/r0 rule would give {ff.auto_preview_s:.4g} s)"
-            if ff.preview_choice is not None
-            else ""
-        )
-        + f"; truncation error {ff.truncation_error * v_scale:.3g} V (bound {ff.truncation_bound * v_scale:.3g} V)",
-        f"- peak voltage {ff.limit_report.peak * v_scale:.4g} V, peak rate {ff.limit_report.peak_rate * v_scale:.4g} V/s "
-        f"(limits: max_voltage {args.max_voltage}, max_rate {args.max_rate})",
-    ]
+    lines = [f"# Feedforward at {args.temperature:g} °C", "",
+             f"- surrogate: `{args.surrogate}` ({model!r})",
+             f"- reference: {ref.description}; fades {ref.fade_in_s:g}/{ref.fade_out_s:g} s, rest "
+             f"{ref.lead_s:g}/{ref.tail_s:g} s, {ref.t.size} samples at {1 / ref.dt:g} Hz",
+             f"- preview: {ff.preview_rule} -> {ff.preview_s:.4g} s"
+             + (f" (truncation error {ff.preview_choice.relative_error:.2g} of the inverse, tolerance "
+                f"{ff.preview_choice.tolerance:g}; the 4/r0 rule would give {ff.auto_preview_s:.4g} s)"
+                if ff.preview_choice is not None else "")
+             + f"; truncation error {ff.truncation_error * v_scale:.3g} V (bound {ff.truncation_bound * v_scale:.3g} V)",
+             f"- peak voltage {ff.limit_report.peak * v_scale:.4g} V, peak rate {ff.limit_report.peak_rate * v_scale:.4g} V/s "
+             f"(limits: max_voltage {args.max_voltage}, max_rate {args.max_rate})"]
     trunc_rel = ff.truncation_error / max(ff.limit_report.peak, 1e-300)
     if trunc_rel > 0.01:
-        lines.append(
-            f"- **preview too short: it changes the voltage by {100 * trunc_rel:.0f} % of its peak "
-            "(use --preview auto or inf)**"
-        )
-        print(
-            f"ipmc feedforward: warning: the {ff.preview_s:.3g} s preview changes the voltage by "
-            f"{100 * trunc_rel:.0f} % of its peak; use --preview auto or inf",
-            file=sys.stderr,
-        )
+        lines.append(f"- **preview too short: it changes the voltage by {100 * trunc_rel:.0f} % of its peak "
+                     "(use --preview auto or inf)**")
+        print(f"ipmc feedforward: warning: the {ff.preview_s:.3g} s preview changes the voltage by "
+              f"{100 * trunc_rel:.0f} % of its peak; use --preview auto or inf", file=sys.stderr)
     disc = ff.discretisation_error_estimate * v_scale
-    lines.append(
-        f"- sampling: discretisation error of the inverse <= {disc:.3g} V at {1 / ref.dt:g} Hz"
-        + (
-            " — **more than 1 % of the peak voltage: sample faster (--fs)**"
-            if disc > 0.01 * ff.limit_report.peak * v_scale
-            else ""
-        )
-    )
+    lines.append(f"- sampling: discretisation error of the inverse <= {disc:.3g} V at {1 / ref.dt:g} Hz"
+                 + (" — **more than 1 % of the peak voltage: sample faster (--fs)**"
+                    if disc > 0.01 * ff.limit_report.peak * v_scale else ""))
     if jump > 0.01:
-        lines.append(
-            f"- **the reference ends away from rest ({100 * jump:.0f} % of its peak): expect spikes at the ends**"
-        )
+        lines.append(f"- **the reference ends away from rest ({100 * jump:.0f} % of its peak): expect spikes at the ends**")
     if not ff.limit_report.ok:
         lines.append(f"- **LIMIT VIOLATED**: {ff.limit_report.message}")
     status = EXIT_OK
@@ -246,35 +189,19 @@ def run(args) -> int:
         e_max = float(np.max(np.abs(err)))
         e_body = float(np.max(np.abs(err[ref.body]))) if np.any(ref.body) else e_max
         cols[f"predicted_tip_{out_unit}"] = y
-        lines += [
-            f"- physics: `{params.name}`, {ts.metadata['realization']}",
-            f"- tracking error: max {e_max:.4g} {out_unit} over the record, {e_body:.4g} {out_unit} "
-            f"between the fades (reference peak {float(np.max(np.abs(ref.y))):.4g} {out_unit})",
-        ]
+        lines += [f"- physics: `{params.name}`, {ts.metadata['realization']}",
+                  f"- tracking error: max {e_max:.4g} {out_unit} over the record, {e_body:.4g} {out_unit} "
+                  f"between the fades (reference peak {float(np.max(np.abs(ref.y))):.4g} {out_unit})"]
         if not args.reference_file and args.reference == "sine":
             f = _floats(args.frequency, "--frequency")[0]
             A = _floats(args.amplitude, "--amplitude")[0]
-            P = (
-                plant.frequency_response(np.array([f]), [args.temperature])["M"][0, 0, 0]
-                / unit_scale(out_unit)
-                * v_scale
-            )
+            P = plant.frequency_response(np.array([f]), [args.temperature])["M"][0, 0, 0] / unit_scale(out_unit) * v_scale
             Gj = complex(G(2j * math.pi * f))
-            lines.append(
-                f"- steady-state prediction A |P/G - 1| = {A * abs(P / Gj - 1):.4g} {out_unit} "
-                f"(P: physics, G: surrogate at {f:g} Hz)"
-            )
-        fig = feedforward_check(
-            ref.t,
-            ref.y,
-            y,
-            volts,
-            out / "feedforward.png",
-            unit=out_unit,
-            max_voltage=args.max_voltage,
-            body=ref.body,
-            title=f"{ref.description}, {args.temperature:g} °C, preview {ff.preview_s:.3g} s",
-        )
+            lines.append(f"- steady-state prediction A |P/G - 1| = {A * abs(P / Gj - 1):.4g} {out_unit} "
+                         f"(P: physics, G: surrogate at {f:g} Hz)")
+        fig = feedforward_check(ref.t, ref.y, y, volts, out / "feedforward.png", unit=out_unit,
+                                max_voltage=args.max_voltage, body=ref.body,
+                                title=f"{ref.description}, {args.temperature:g} °C, preview {ff.preview_s:.3g} s")
         lines += ["", f"![feedforward]({fig.name})"]
         if args.max_error is not None and e_body > args.max_error:
             lines.append(f"- **tracking error {e_body:.4g} {out_unit} exceeds --max-error {args.max_error:g}**")

@@ -46,35 +46,23 @@ def read_csv(path) -> FrequencyData:
 def add_parser(subparsers):
     """Add the ``fit`` subcommand to an argparse subparsers object."""
     p = subparsers.add_parser(
-        "fit",
-        help="fit a temperature-scheduled rational transfer function to a sweep CSV",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+        "fit", help="fit a temperature-scheduled rational transfer function to a sweep CSV",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("csv", help="sweep CSV (physmodel format)")
     p.add_argument("--zeros", type=int, default=3, help="number of zeros (default 3)")
     p.add_argument("--poles", type=int, default=3, help="number of poles (default 3)")
     p.add_argument("--degree", type=int, default=2, help="polynomial degree in T (default 2)")
-    p.add_argument("--form", choices=FORMS, default="zpk", help="schedule form (default zpk)")
+    p.add_argument("--form", choices=FORMS, default="zpk",
+                   help="schedule form (default zpk)")
     p.add_argument("--method", choices=("joint", "two-stage"), default="joint")
     p.add_argument("--weighting", choices=WEIGHTINGS, default="auto")
-    p.add_argument(
-        "--exclude",
-        type=float,
-        nargs="*",
-        default=[],
-        metavar="T",
-        help="temperatures [°C] held out of the fit and reported as validation",
-    )
+    p.add_argument("--exclude", type=float, nargs="*", default=[], metavar="T",
+                   help="temperatures [°C] held out of the fit and reported as validation")
     p.add_argument("--max-iter", type=int, default=500)
-    p.add_argument(
-        "--accept-misfit",
-        action="store_true",
-        help="exit 0 even when the model does not fit the data (goodness-of-fit test failed)",
-    )
-    p.add_argument(
-        "--force", "--overwrite", action="store_true", help="write into a folder that holds another run's results"
-    )
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="exit 0 even when the model does not fit the data (goodness-of-fit test failed)")
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--out", default="fit-out", help="output directory (default fit-out)")
     p.add_argument("--quiet", action="store_true", help="no summary line")
     p.set_defaults(func=run)
@@ -109,22 +97,13 @@ def _report(args, data, fit_data, res, held_out, figures, verdict=None) -> str:
         "|---:|:---|---:|---:|---:|",
     ]
     for e in res.per_temperature:
-        lines.append(
-            f"| {_fmt(e.temperature_c, 'g')} | fit | {e.n_lines} | {e.relative_rms_error:.4f} | {e.fit_percent:.2f} |"
-        )
+        lines.append(f"| {_fmt(e.temperature_c, 'g')} | fit | {e.n_lines} | {e.relative_rms_error:.4f} | {e.fit_percent:.2f} |")
     lo, hi = m.temperature_range_c or (None, None)
     for e in held_out:
         role = "held out" if lo is None or lo <= e.temperature_c <= hi else "held out, extrapolated"
-        lines.append(
-            f"| {_fmt(e.temperature_c, 'g')} | {role} | {e.n_lines} | {e.relative_rms_error:.4f} | {e.fit_percent:.2f} |"
-        )
-    lines += [
-        "",
-        "## Parameters (scaled; see model.json for the scales)",
-        "",
-        "| name | value | std. error | 95 % CI |",
-        "|:---|---:|---:|:---|",
-    ]
+        lines.append(f"| {_fmt(e.temperature_c, 'g')} | {role} | {e.n_lines} | {e.relative_rms_error:.4f} | {e.fit_percent:.2f} |")
+    lines += ["", "## Parameters (scaled; see model.json for the scales)", "",
+              "| name | value | std. error | 95 % CI |", "|:---|---:|---:|:---|"]
     for row in m.parameter_table():
         ci = f"[{row['ci95_low']:.4g}, {row['ci95_high']:.4g}]" if "ci95_low" in row else "n/a"
         lines.append(f"| {row['name']} | {row['value']:.6g} | {_fmt(row.get('stderr'))} | {ci} |")
@@ -139,7 +118,7 @@ def run(args) -> int:
     from physmodel.data.files import check_output_folder
     from surrogate import RationalFit, ScheduledFit
 
-    check_output_folder(args.out, "ipmc fit", force=args.force)  # refuse before the fit, not after
+    check_output_folder(args.out, "ipmc fit", force=args.force)     # refuse before the fit, not after
     try:
         data = read_csv(args.csv)
         temps = data.temperatures()
@@ -147,40 +126,23 @@ def run(args) -> int:
         for t in excl:
             if not np.any(np.isclose(temps, t)):
                 raise ValueError(f"--exclude {t:g}: no data at that temperature (have {temps.tolist()})")
-        keep = (
-            ~np.any(np.isclose(data.temperature_c[:, None], excl[None, :]), axis=1)
-            if excl.size
-            else np.ones(data.n, bool)
-        )
+        keep = ~np.any(np.isclose(data.temperature_c[:, None], excl[None, :]), axis=1) if excl.size else np.ones(data.n, bool)
         if not keep.any():
-            raise ValueError(
-                f"--exclude {sorted(set(args.exclude))} leaves no temperature to fit (have {temps.tolist()})"
-            )
+            raise ValueError(f"--exclude {sorted(set(args.exclude))} leaves no temperature to fit (have {temps.tolist()})")
         fit_data = data.select(keep)
         fit_temps = fit_data.temperatures()
         if fit_temps.size == 1:
             fitter = RationalFit(args.zeros, args.poles, weighting=args.weighting, max_iter=args.max_iter)
         else:
-            fitter = ScheduledFit(
-                args.form,
-                args.zeros,
-                args.poles,
-                args.degree,
-                method=args.method,
-                weighting=args.weighting,
-                max_iter=args.max_iter,
-            )
+            fitter = ScheduledFit(args.form, args.zeros, args.poles, args.degree, method=args.method,
+                                  weighting=args.weighting, max_iter=args.max_iter)
         res = fitter.fit_data(fit_data)
     except ConvergenceError as exc:
         print(f"ipmc fit: {exc}", file=sys.stderr)
         return EXIT_NOT_CONVERGED
     except (ValueError, OSError) as exc:
-        print(
-            f"ipmc fit: bad input: {args.csv}: {exc}"
-            if str(args.csv) not in str(exc)
-            else f"ipmc fit: bad input: {exc}",
-            file=sys.stderr,
-        )
+        print(f"ipmc fit: bad input: {args.csv}: {exc}" if str(args.csv) not in str(exc) else f"ipmc fit: bad input: {exc}",
+              file=sys.stderr)
         return EXIT_BAD_INPUT
     from physmodel.data.files import output_folder
     from surrogate.adequacy import assess
@@ -190,7 +152,7 @@ def run(args) -> int:
     if res.model.is_scheduled:
         from surrogate import check_schedule
 
-        schedule = check_schedule(fitter, fit_data, res.model, warn=False)  # leave-one-temperature-out
+        schedule = check_schedule(fitter, fit_data, res.model, warn=False)     # leave-one-temperature-out
         if not schedule.ok:
             print(f"ipmc fit: WARNING: {schedule.message}", file=sys.stderr)
     with output_folder(args.out, "ipmc fit", force=args.force) as out:
@@ -199,11 +161,8 @@ def run(args) -> int:
         print(f"ipmc fit: the fit did not converge (IPOPT status {res.status!r})", file=sys.stderr)
         return EXIT_NOT_CONVERGED
     if not verdict.adequate:
-        print(
-            f"ipmc fit: the model does not fit the data: {verdict.reason}"
-            + ("" if args.accept_misfit else " (--accept-misfit to exit 0)"),
-            file=sys.stderr,
-        )
+        print(f"ipmc fit: the model does not fit the data: {verdict.reason}"
+              + ("" if args.accept_misfit else " (--accept-misfit to exit 0)"), file=sys.stderr)
         return EXIT_OK if args.accept_misfit else EXIT_NOT_CONVERGED
     return EXIT_OK
 
@@ -226,19 +185,15 @@ def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, sche
         plots.save_bode(model, data, t, out / name, title=f"T = {t:g} °C" + (" (held out)" if t in excl else ""))
         figures.append(name)
     if model.is_scheduled:
-        plots.save_poles_zeros_vs_temperature(model, out / "poles_zeros_vs_temperature.png", res.per_temperature_models)
+        plots.save_poles_zeros_vs_temperature(model, out / "poles_zeros_vs_temperature.png",
+                                        res.per_temperature_models)
         figures.append("poles_zeros_vs_temperature.png")
     model.to_json(out / "model.json")
     report = _report(args, data, fit_data, res, held, figures, verdict)
     if schedule is not None:
-        report += (
-            "\n## Between the fit temperatures (leave-one-temperature-out)\n\n"
-            + schedule.cv.to_markdown()
-            + "\n"
-            + ("OK: " if schedule.ok else "**WARNING**: ")
-            + schedule.message
-            + "\n"
-        )
+        report += ("\n## Between the fit temperatures (leave-one-temperature-out)\n\n" + schedule.cv.to_markdown()
+                   + "\n" + ("OK: " if schedule.ok else "**WARNING**: ") + schedule.message
+                   + "\n")
     atomic_write(out / "report.md", lambda fh: fh.write(report))
     if not args.quiet:
         print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")

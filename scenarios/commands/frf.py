@@ -43,39 +43,22 @@ from .excite import as_options
 
 SUFFIXES = (".csv", ".npz", ".mat")
 #: Estimator argument names → the options that set them (error messages name the option).
-OPTIONS = {
-    "frequencies_hz": "--frequencies",
-    "nperseg": "--nperseg",
-    "noverlap": "--noverlap",
-    "window": "--window",
-    "discard_s": "--discard-s",
-    "settle_s": "--settle-s",
-    "settle_periods": "--settle-periods",
-    "periods": "--periods",
-    "max_std_db": "--max-std-db",
-    "band_hz": "--band",
-    "min_coherence": "--min-coherence",
-}
+OPTIONS = {"frequencies_hz": "--frequencies", "nperseg": "--nperseg", "noverlap": "--noverlap", "window": "--window",
+           "discard_s": "--discard-s", "settle_s": "--settle-s", "settle_periods": "--settle-periods",
+           "periods": "--periods", "max_std_db": "--max-std-db", "band_hz": "--band", "min_coherence": "--min-coherence"}
 
 
 def add_parser(sub):
-    p = sub.add_parser(
-        "frf",
-        help="estimate frequency responses with per-line σ from time records -> sweep",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = sub.add_parser("frf", help="estimate frequency responses with per-line σ from time records -> sweep",
+                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("records", nargs="+", metavar="RECORD", help="time records (.csv, .npz, .mat; ipmc-timeseries)")
     p.add_argument("--out", required=True, help="sweep file (.csv, .npz or .mat)")
     p.add_argument("--input", required=True, help="input (reference) channel, e.g. voltage")
     p.add_argument("--output", action="append", required=True, help="output channel (repeatable)")
     p.add_argument("--method", choices=("h1", "h2", "stepped"), default="h1", help="estimator (default h1)")
-    p.add_argument(
-        "--temperature",
-        action="append",
-        help="bath temperature [°C], one per record (repeatable or comma-separated); "
-        "default each record's temperature_c header",
-    )
+    p.add_argument("--temperature", action="append",
+                   help="bath temperature [°C], one per record (repeatable or comma-separated); "
+                        "default each record's temperature_c header")
     g = p.add_argument_group("Welch (h1, h2)")
     g.add_argument("--nperseg", type=int, help="segment length [samples]")
     g.add_argument("--noverlap", type=int, help="segment overlap [samples] (default nperseg/2)")
@@ -151,10 +134,8 @@ def _plan(args, records):
     elif "stepped_sine_plan" in records[0].metadata:
         rec, where = records[0], args.records[0]
     else:
-        raise CLIError(
-            "--plan: a stepped-sine estimate needs the schedule; give the signal file written by "
-            "'ipmc excite stepped' (or records whose header holds 'stepped_sine_plan')"
-        )
+        raise CLIError("--plan: a stepped-sine estimate needs the schedule; give the signal file written by "
+                       "'ipmc excite stepped' (or records whose header holds 'stepped_sine_plan')")
     try:
         return SteppedSinePlan.from_record(rec)
     except IPMCError as exc:
@@ -164,21 +145,16 @@ def _plan(args, records):
 def _estimator_kwargs(args, records) -> tuple[dict, str]:
     """Keyword arguments of estimate_record and a description of where they came from."""
     if args.method == "stepped":
-        bad = [
-            o
-            for o in ("nperseg", "noverlap", "window", "discard_s", "lines", "frequencies", "min_coherence")
-            if getattr(args, o) is not None
-        ]
+        bad = [o for o in ("nperseg", "noverlap", "window", "discard_s", "lines", "frequencies", "min_coherence")
+               if getattr(args, o) is not None]
         if bad:
             raise CLIError(f"--{bad[0].replace('_', '-')} applies to h1/h2, not to --method stepped")
         plan = _plan(args, records)
         over = {k: getattr(args, k) for k in ("settle_s", "settle_periods", "periods") if getattr(args, k) is not None}
         if not over:
             return {"method": "stepped_sine", "plan": plan}, f"plan of {plan.frequency_hz.size} steps"
-        return (
-            {"method": "stepped_sine", "plan": None, "_plan": plan, **over},
-            f"plan of {plan.frequency_hz.size} steps, overrides {over}",
-        )
+        return ({"method": "stepped_sine", "plan": None, "_plan": plan, **over},
+                f"plan of {plan.frequency_hz.size} steps, overrides {over}")
     bad = [o for o in ("plan", "settle_s", "settle_periods", "periods") if getattr(args, o) is not None]
     if bad:
         raise CLIError(f"--{bad[0].replace('_', '-')} applies to --method stepped, not to {args.method}")
@@ -187,13 +163,8 @@ def _estimator_kwargs(args, records) -> tuple[dict, str]:
     how = "Welch"
     if found is not None:
         ms, tp = found
-        kw.update(
-            nperseg=ms.n_samples,
-            noverlap=0,
-            window="boxcar",
-            discard_s=tp * ms.period_s,
-            frequencies_hz=ms.frequency_hz,
-        )
+        kw.update(nperseg=ms.n_samples, noverlap=0, window="boxcar", discard_s=tp * ms.period_s,
+                  frequencies_hz=ms.frequency_hz)
         how = f"multisine lines ({ms.lines.size} lines, period {ms.period_s:g} s, {tp} transient period(s))"
         for rec, path in zip(records, args.records):
             if abs(rec.fs - ms.fs_hz) > 1e-9 * ms.fs_hz:
@@ -212,12 +183,11 @@ def _estimate(rec, path: str, args, kw: dict):
 
     kw = dict(kw)
     plan = kw.pop("_plan", None)
-    if plan is not None:  # a plan with overridden settle/periods: explicit schedule
+    if plan is not None:                    # a plan with overridden settle/periods: explicit schedule
         t0 = float(rec.t[0])
         kw.pop("plan")
-        kw.update(
-            frequencies_hz=plan.frequency_hz, step_start_s=plan.step_start_s + t0, step_stop_s=plan.step_stop_s + t0
-        )
+        kw.update(frequencies_hz=plan.frequency_hz, step_start_s=plan.step_start_s + t0,
+                  step_stop_s=plan.step_stop_s + t0)
     try:
         return estimate_record(rec, args.input, args.output, **kw)
     except IPMCError as exc:
@@ -261,11 +231,8 @@ def run(args) -> int:
                     raise CLIError(f"{path}: {opt} {nm}: {exc}") from None
     kw, how = _estimator_kwargs(args, records)
     ests = [_estimate(rec, p, args, kw) for rec, p in zip(records, args.records)]
-    keep = {
-        "min_coherence": args.min_coherence,
-        "band_hz": tuple(args.band) if args.band else None,
-        "max_std_db": args.max_std_db,
-    }
+    keep = {"min_coherence": args.min_coherence, "band_hz": tuple(args.band) if args.band else None,
+                "max_std_db": args.max_std_db}
     if args.method == "stepped" and args.min_coherence is not None:
         raise CLIError("--min-coherence: a stepped-sine estimate has no coherence; use --max-std-db or --band")
     written, lines = [], []
@@ -280,11 +247,9 @@ def run(args) -> int:
                 raise as_options(exc, OPTIONS, f"{src} ({o}): ") from None
             sweeps.append(sw)
             kept.append((c, T, np.isin(c.frequency_hz, sw.frequency_hz)))
-            lines.append(
-                f"  {Path(src).name} at {T:g} °C, {sw.output_name}/{sw.input_name}: {sw.frequency_hz.size} "
-                f"of {c.frequency_hz.size} lines kept, median σ {np.median(sw.magnitude_std_db):.3g} dB / "
-                f"{np.median(sw.phase_std_deg):.3g}°"
-            )
+            lines.append(f"  {Path(src).name} at {T:g} °C, {sw.output_name}/{sw.input_name}: {sw.frequency_hz.size} "
+                         f"of {c.frequency_hz.size} lines kept, median σ {np.median(sw.magnitude_std_db):.3g} dB / "
+                         f"{np.median(sw.phase_std_deg):.3g}°")
         sweep = merge_sweeps(sweeps)
         write_sweep(sweep, path)
         written.append(path)
@@ -294,19 +259,13 @@ def run(args) -> int:
             ppath = Path(args.plot)
             if len(args.output) > 1:
                 ppath = ppath.with_name(f"{ppath.stem}_{o}{ppath.suffix}")
-            plots.frf_estimate(
-                kept,
-                ppath,
-                title=f"{sweep.output_name} [{sweep.output_unit}] / "
-                f"{sweep.input_name} [{sweep.input_unit}], {args.method}",
-            )
+            plots.frf_estimate(kept, ppath, title=f"{sweep.output_name} [{sweep.output_unit}] / "
+                                                  f"{sweep.input_name} [{sweep.input_unit}], {args.method}")
             written.append(ppath)
     if not args.quiet:
         st = ests[0].settings
-        print(
-            f"{args.method} from {len(records)} record(s), {how}; settings: "
-            + ", ".join(f"{k}={v}" for k, v in st.items())
-        )
+        print(f"{args.method} from {len(records)} record(s), {how}; settings: "
+              + ", ".join(f"{k}={v}" for k, v in st.items()))
         print("\n".join(lines))
         print("wrote " + ", ".join(str(p) for p in written))
     return EXIT_OK

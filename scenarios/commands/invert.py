@@ -64,47 +64,28 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("input", help="input CSV with a header, a time_s column and signal columns")
     p.add_argument("-o", "--out", required=True, help="output CSV path")
     p.add_argument("--quiet", action="store_true", help="no summary line")
-    p.add_argument("--column", default=None, help="signal column to invert (default: first column other than time_s)")
+    p.add_argument("--column", default=None,
+                   help="signal column to invert (default: first column other than time_s)")
     p.add_argument("--time-column", default="time_s", help="time column name [s] (default time_s)")
-    p.add_argument(
-        "--reference", default=None, help="column with the true signal; adds reference and error columns/plot"
-    )
-    p.add_argument(
-        "--num",
-        nargs="+",
-        default=None,
-        metavar="C",
-        help="model numerator coefficients, descending powers of s (s in rad/s); "
-        "write --num=-17.3,2.2e4,... when a coefficient is negative",
-    )
-    p.add_argument(
-        "--den", nargs="+", default=None, metavar="C", help="model denominator coefficients, descending powers of s"
-    )
-    p.add_argument(
-        "--surrogate", default=None, help="surrogate model JSON (needs --temperature); hook for the surrogate package"
-    )
+    p.add_argument("--reference", default=None,
+                   help="column with the true signal; adds reference and error columns/plot")
+    p.add_argument("--num", nargs="+", default=None, metavar="C",
+                   help="model numerator coefficients, descending powers of s (s in rad/s); "
+                        "write --num=-17.3,2.2e4,... when a coefficient is negative")
+    p.add_argument("--den", nargs="+", default=None, metavar="C",
+                   help="model denominator coefficients, descending powers of s")
+    p.add_argument("--surrogate", default=None,
+                   help="surrogate model JSON (needs --temperature); hook for the surrogate package")
     p.add_argument("--temperature", type=float, default=None, help="temperature [degC] for --surrogate")
-    p.add_argument(
-        "--preview",
-        default="auto",
-        help="'auto' (smallest preview whose truncation error < --preview-tol of the inverse; default), "
-        "'4/r0' (the seed-000 rule), 'inf' (full noncausal inverse) or seconds",
-    )
-    p.add_argument(
-        "--preview-tol",
-        type=float,
-        default=1e-3,
-        help="relative truncation error allowed by --preview auto (default 1e-3)",
-    )
-    p.add_argument(
-        "--improper",
-        choices=("error", "filter", "differentiate"),
-        default="error",
-        help="handling of a strictly proper model (improper inverse)",
-    )
-    p.add_argument(
-        "--filter-bandwidth", type=float, default=None, help="low-pass bandwidth [rad/s] for --improper filter"
-    )
+    p.add_argument("--preview", default="auto",
+                   help="'auto' (smallest preview whose truncation error < --preview-tol of the inverse; default), "
+                        "'4/r0' (the seed-000 rule), 'inf' (full noncausal inverse) or seconds")
+    p.add_argument("--preview-tol", type=float, default=1e-3,
+                   help="relative truncation error allowed by --preview auto (default 1e-3)")
+    p.add_argument("--improper", choices=("error", "filter", "differentiate"), default="error",
+                   help="handling of a strictly proper model (improper inverse)")
+    p.add_argument("--filter-bandwidth", type=float, default=None,
+                   help="low-pass bandwidth [rad/s] for --improper filter")
     p.add_argument("--plot", default=None, help="write a PNG with input, reconstruction and error")
     p.set_defaults(func=run)
     return p
@@ -120,7 +101,7 @@ def model_from_surrogate(path: str, temperature_c: float) -> Any:
     import surrogate
     from physmodel.data.files import read_text
 
-    read_text(path, "--surrogate")  # missing file, folder, not UTF-8: a clear message
+    read_text(path, "--surrogate")           # missing file, folder, not UTF-8: a clear message
     try:
         return surrogate.load(path).at(float(temperature_c))
     except (ValueError, KeyError, TypeError, IndexError, AttributeError, json.JSONDecodeError) as exc:
@@ -136,11 +117,8 @@ def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
     finite number."""
     from physmodel.data.files import read_text
 
-    lines = [
-        (i, ln)
-        for i, ln in enumerate(read_text(path, "signal file").splitlines(), start=1)
-        if ln.strip() and not ln.lstrip().startswith("#")
-    ]
+    lines = [(i, ln) for i, ln in enumerate(read_text(path, "signal file").splitlines(), start=1)
+             if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise InversionError(f"{path}: empty file (expected a header row)")
     parsed = csv.reader([ln for _, ln in lines])
@@ -155,9 +133,7 @@ def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
             raise InversionError(f"{path}:{lineno}: non-numeric field in {row!r}") from None
         bad = [h for h, v in zip(header, vals) if not math.isfinite(v)]
         if bad:
-            raise InversionError(
-                f"{path}:{lineno}: {bad[0]} = {row[header.index(bad[0])].strip()!r}; expected a finite number"
-            )
+            raise InversionError(f"{path}:{lineno}: {bad[0]} = {row[header.index(bad[0])].strip()!r}; expected a finite number")
         rows.append(vals)
     if len(set(header)) != len(header):
         raise InversionError(f"{path}: duplicate column names in header {header}")
@@ -195,26 +171,17 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.preview_tol) and 0 < args.preview_tol < 1):
         raise InversionError(f"--preview-tol must be in (0, 1), got {args.preview_tol!r}")
     try:
-        res = invert(
-            model,
-            t,
-            u,
-            preview=preview,
-            preview_tol=args.preview_tol,
-            improper=args.improper,
-            filter_bandwidth=args.filter_bandwidth,
-        )
+        res = invert(model, t, u, preview=preview, preview_tol=args.preview_tol, improper=args.improper,
+                     filter_bandwidth=args.filter_bandwidth)
     except InversionError as exc:
         raise InversionError(f"{args.input}: {exc}") from None
     y = res.output
     if not np.all(np.isfinite(y)):
         # the CLI boundary guard: the library should refuse this itself (see the issue-13 report)
         k = int(np.flatnonzero(~np.isfinite(y))[0])
-        raise InversionError(
-            f"{args.input}: the inversion of column {ucol!r} overflows double precision "
-            f"({np.count_nonzero(~np.isfinite(y))} non-finite outputs from t = {t[k]:.6g} s; "
-            f"largest |input| {np.max(np.abs(u)):.3g}); scale the signal or check the model"
-        )
+        raise InversionError(f"{args.input}: the inversion of column {ucol!r} overflows double precision "
+                             f"({np.count_nonzero(~np.isfinite(y))} non-finite outputs from t = {t[k]:.6g} s; "
+                             f"largest |input| {np.max(np.abs(u)):.3g}); scale the signal or check the model")
     ref = data[:, header.index(args.reference)] if args.reference is not None else None
     cols = [args.time_column, ucol, "reconstruction"]
     table = [t, u, y]

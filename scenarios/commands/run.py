@@ -11,19 +11,16 @@ from ..spec import ScenarioError, bundled_scenarios, load_scenario, resolve_bund
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "run",
-        help="run a scenario file (scenarios/*.toml) into a report folder",
+        "run", help="run a scenario file (scenarios/*.toml) into a report folder",
         description="Run a scenario TOML (model, parameter set, temperatures, grid or stimulus, noise, steps, "
-        "checks; schema in the README and scenarios/spec.py) and write data, surrogate JSON, PNG "
-        "figures, metrics.json and report.md (last) to --out.  Exit 3 when a check fails.",
-    )
+                    "checks; schema in the README and scenarios/spec.py) and write data, surrogate JSON, PNG "
+                    "figures, metrics.json and report.md (last) to --out.  Exit 3 when a check fails.")
     p.add_argument("scenario", nargs="?", help="scenario file, or the name of a bundled one (e.g. seed001_actuator)")
     p.add_argument("--list", action="store_true", help="list the bundled scenarios and exit")
     p.add_argument("--out", help="output folder (default ./ipmc-run-<name>)")
     p.add_argument("--quick", action="store_true", help="apply the scenario's [quick] table (smaller grids)")
-    p.add_argument(
-        "--force", "--overwrite", action="store_true", help="write into a folder that holds another run's results"
-    )
+    p.add_argument("--force", "--overwrite", action="store_true",
+                   help="write into a folder that holds another run's results")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
 

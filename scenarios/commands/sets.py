@@ -11,7 +11,6 @@ def add_parser(sub):
     p.add_argument("--json", help="also write the set as JSON to this file")
     p.set_defaults(func=run)
 
-
 def run(args) -> int:
     from physmodel import available_parameter_sets, describe, get_parameter_set
 
@@ -22,10 +21,7 @@ def run(args) -> int:
 
             from physmodel.data.files import atomic_write
 
-            atomic_write(
-                args.json,
-                lambda fh: fh.write(json.dumps(get_parameter_set(args.name).to_dict(), indent=2, default=str)),
-            )
+            atomic_write(args.json, lambda fh: fh.write(json.dumps(get_parameter_set(args.name).to_dict(), indent=2, default=str)))
         return EXIT_OK
     for n in available_parameter_sets():
         print(f"{n:24s} {get_parameter_set(n).source}")

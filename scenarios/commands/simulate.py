@@ -16,31 +16,18 @@ from ._common import EXIT_OK, CLIError, _add_model_args, _floats, _load_params, 
 
 
 def add_parser(sub):
-    p = sub.add_parser(
-        "simulate",
-        help="time-domain virtual experiment",
-        description="Sine, step or free-release experiment with the exact model (via a verified "
-        "rational realisation); SI units in the output file.",
-    )
+    p = sub.add_parser("simulate", help="time-domain virtual experiment",
+                       description="Sine, step or free-release experiment with the exact model (via a verified "
+                                   "rational realisation); SI units in the output file.")
     _add_model_args(p)
-    p.add_argument(
-        "--experiment",
-        choices=("sine", "step", "release"),
-        default=None,
-        help="built-in excitation (default sine); not with --input",
-    )
-    p.add_argument(
-        "--input",
-        dest="input_file",
-        metavar="FILE",
-        help="drive the model with a recorded input (time-series CSV/NPZ with time_s and "
-        "e.g. voltage_V); see the module help",
-    )
+    p.add_argument("--experiment", choices=("sine", "step", "release"), default=None,
+                   help="built-in excitation (default sine); not with --input")
+    p.add_argument("--input", dest="input_file", metavar="FILE",
+                   help="drive the model with a recorded input (time-series CSV/NPZ with time_s and "
+                        "e.g. voltage_V); see the module help")
     p.add_argument("--input-column", help="column of --input to use (default: voltage_* / tip_displacement_*)")
     p.add_argument("--temperature", type=float, default=25.0, help="bath temperature [°C]")
-    p.add_argument(
-        "--amplitude", type=float, help="input amplitude: V (actuator, default 1) or m (sensor, default 1e-3)"
-    )
+    p.add_argument("--amplitude", type=float, help="input amplitude: V (actuator, default 1) or m (sensor, default 1e-3)")
     p.add_argument("--frequency", type=float, default=2.0, help="sine frequency [Hz]")
     p.add_argument("--duration", type=float, default=2.0, help="record length [s]")
     p.add_argument("--fs", type=float, default=1000.0, help="sampling rate [Hz]")
@@ -53,7 +40,6 @@ def add_parser(sub):
     p.add_argument("--out", required=True, help="output file (.csv or .npz)")
     p.add_argument("--plot", help="also write a plot of the traces (PNG)")
     p.set_defaults(func=run)
-
 
 def run(args) -> int:
     from physmodel import TransimpedanceChain
@@ -125,23 +111,18 @@ def read_input(path, kind: str, column: str | None = None):
     if column is None:
         pick = [c for c in names if c.rsplit("_", 1)[0] == want[0]]
         if not pick:
-            raise CLIError(
-                f"--input {path}: no {want[0]}_<unit> column for a {kind} (found {names}); name it with --input-column"
-            )
+            raise CLIError(f"--input {path}: no {want[0]}_<unit> column for a {kind} (found {names}); "
+                           "name it with --input-column")
         column = pick[0]
     if column not in cols:
         raise CLIError(f"--input-column {column!r}: not in {path} (found {names})")
     unit = column.rsplit("_", 1)[1] if "_" in column else ""
     if unit not in UNITS:
-        raise CLIError(
-            f"--input {path}: column {column!r} has no unit suffix from {sorted(UNITS)} "
-            f"(expected e.g. {want[0]}_{want[1]})"
-        )
+        raise CLIError(f"--input {path}: column {column!r} has no unit suffix from {sorted(UNITS)} "
+                       f"(expected e.g. {want[0]}_{want[1]})")
     if UNITS[unit][0] != want[2]:
-        raise CLIError(
-            f"--input {path}: column {column!r} is a {UNITS[unit][0]}, but a {kind} is driven "
-            f"by a {want[2]} ({want[0]}_{want[1]})"
-        )
+        raise CLIError(f"--input {path}: column {column!r} is a {UNITS[unit][0]}, but a {kind} is driven "
+                       f"by a {want[2]} ({want[0]}_{want[1]})")
     t = cols["time_s"]
     try:
         check_uniform_time(t)

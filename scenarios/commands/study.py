@@ -11,12 +11,10 @@ from ..study import StudyError, _chunks, load_study, run_study
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "study",
-        help="Monte Carlo / grid parameter study on local processes or a Dask cluster",
+        "study", help="Monte Carlo / grid parameter study on local processes or a Dask cluster",
         description="Evaluate a parameter study (parameters × temperatures × frequencies; schema in "
-        "scenarios/study.py and the README) and write a tidy table, one row per sample × "
-        "temperature × frequency.  Same seed → identical table on any backend.",
-    )
+                    "scenarios/study.py and the README) and write a tidy table, one row per sample × "
+                    "temperature × frequency.  Same seed → identical table on any backend.")
     p.add_argument("spec", help="study TOML file, or the name of a bundled study (e.g. actuator_mc)")
     p.add_argument("--out", required=True, help="output table (.csv or .npz)")
     p.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://10.0.0.5:8786); default: local processes")
@@ -39,20 +37,13 @@ def run(args) -> int:
 
         bar = tqdm(total=len(_chunks(spec)), desc=spec["name"], unit="chunk", file=sys.stderr)
     try:
-        table = run_study(
-            spec,
-            scheduler=args.scheduler,
-            workers=args.workers,
-            backend="serial" if args.serial else None,
-            progress=bar.update if bar else None,
-        )
+        table = run_study(spec, scheduler=args.scheduler, workers=args.workers,
+                          backend="serial" if args.serial else None, progress=bar.update if bar else None)
     finally:
         if bar is not None:
             bar.close()
     table.save(out)
     if not args.quiet:
-        print(
-            f"wrote {out}: {table.n_rows} rows ({spec['samples']} samples × {len(spec['temperatures_c'])} "
-            f"temperatures × {len(spec['frequencies_hz'])} frequencies) on {table.backend} in {table.elapsed_s:.1f} s"
-        )
+        print(f"wrote {out}: {table.n_rows} rows ({spec['samples']} samples × {len(spec['temperatures_c'])} "
+              f"temperatures × {len(spec['frequencies_hz'])} frequencies) on {table.backend} in {table.elapsed_s:.1f} s")
     return 0

@@ -18,12 +18,9 @@ from ._common import (
 
 
 def add_parser(sub):
-    p = sub.add_parser(
-        "sweep",
-        help="synthetic frequency sweep at several temperatures",
-        description="Evaluate the physics model on a log frequency grid at several temperatures, "
-        "optionally add seeded noise, and write CSV/NPZ/MAT (+ a Bode plot).",
-    )
+    p = sub.add_parser("sweep", help="synthetic frequency sweep at several temperatures",
+                       description="Evaluate the physics model on a log frequency grid at several temperatures, "
+                                   "optionally add seeded noise, and write CSV/NPZ/MAT (+ a Bode plot).")
     _add_model_args(p)
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
     p.add_argument("--temperatures", default="20,40,60", help="comma-separated temperatures [°C] (default 20,40,60)")
@@ -39,7 +36,6 @@ def add_parser(sub):
     p.add_argument("--plot", help="also write a Bode plot (PNG)")
     p.set_defaults(func=run)
 
-
 def run(args) -> int:
     from physmodel.data.files import write_sweep
     from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise, synthesize_sweep
@@ -50,10 +46,8 @@ def run(args) -> int:
     from physmodel.data.sweep import MAX_SWEEP_LINES
 
     if not 2 <= args.points <= MAX_SWEEP_LINES // len(temps):
-        raise CLIError(
-            f"--points must be 2 to {MAX_SWEEP_LINES // len(temps)} (at most {MAX_SWEEP_LINES} lines over "
-            f"{len(temps)} temperature(s)), got {args.points}"
-        )
+        raise CLIError(f"--points must be 2 to {MAX_SWEEP_LINES // len(temps)} (at most {MAX_SWEEP_LINES} lines over "
+                       f"{len(temps)} temperature(s)), got {args.points}")
     bad = [t for t in temps if t <= -273.15]
     if bad:
         raise CLIError(f"--temperatures {bad}: below absolute zero (-273.15 °C)")
@@ -84,8 +78,6 @@ def run(args) -> int:
 
         bode(sw, args.plot, title=f"{model.params[0].name}: {sw.metadata['description']}")
     if not args.quiet:
-        print(
-            f"wrote {out} ({sw.frequency_hz.size} lines, {len(temps)} temperatures, "
-            f"{sw.output_unit}/{sw.input_unit})" + (f" and {args.plot}" if args.plot else "")
-        )
+        print(f"wrote {out} ({sw.frequency_hz.size} lines, {len(temps)} temperatures, "
+              f"{sw.output_unit}/{sw.input_unit})" + (f" and {args.plot}" if args.plot else ""))
     return EXIT_OK

@@ -13,21 +13,17 @@ from ._common import EXIT_FAILED, EXIT_OK
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
-        "validate",
-        help="check every published claim of the seed papers against the project's numbers",
+        "validate", help="check every published claim of the seed papers against the project's numbers",
         description="Evaluate every claim printed by the seed papers (the published.toml shipped in "
-        "physmodel.parameter_sets: sensor study, actuator study, seed 002) with the seed parameter sets "
-        "and write validation.md and validation.json.  Each row has a status (reproduced, "
-        "not-reproduced, not-checkable, fail) and a basis (independent, calibrated, input, paper, "
-        "metadata); the headline counts only independent reproductions.  Exit 0 when every claim is "
-        "reproduced or explained (not-reproduced / not-checkable rows are findings), 3 when a claim "
-        "the project reproduces fails (regression).",
-    )
+                    "physmodel.parameter_sets: sensor study, actuator study, seed 002) with the seed parameter sets "
+                    "and write validation.md and validation.json.  Each row has a status (reproduced, "
+                    "not-reproduced, not-checkable, fail) and a basis (independent, calibrated, input, paper, "
+                    "metadata); the headline counts only independent reproductions.  Exit 0 when every claim is "
+                    "reproduced or explained (not-reproduced / not-checkable rows are findings), 3 when a claim "
+                    "the project reproduces fails (regression).")
     p.add_argument("--out", default="ipmc-validation", help="output folder (default ./ipmc-validation)")
     p.add_argument("--quick", action="store_true", help="fewer temperatures in the surrogate fits (faster)")
-    p.add_argument(
-        "--published", help="path of a TOML file of printed claims (default: the one shipped in the package)"
-    )
+    p.add_argument("--published", help="path of a TOML file of printed claims (default: the one shipped in the package)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
 
 
@@ -39,10 +35,8 @@ def run(args) -> int:
         raise IPMCError(f"--out {out} exists and is not a folder")
     n = len(published_claims(load_published(args.published)))
     if n == 0:
-        raise IPMCError(
-            f"--published {args.published}: no claims found (expected tables like [sensor_seed000] "
-            "with printed numbers)"
-        )
+        raise IPMCError(f"--published {args.published}: no claims found (expected tables like [sensor_seed000] "
+                        "with printed numbers)")
     bar = None
     if not args.quiet:
         from tqdm import tqdm

@@ -26,21 +26,5 @@ from .framework import (
     validate,
 )
 
-__all__ = [
-    "BASES",
-    "CHECKS",
-    "DEFAULT_PUBLISHED",
-    "EXTRA_ROWS",
-    "KINDS",
-    "META_KEYS",
-    "STATUSES",
-    "Claim",
-    "ClaimRow",
-    "Context",
-    "Outcome",
-    "ValidationReport",
-    "claim_location",
-    "load_published",
-    "published_claims",
-    "validate",
-]
+__all__ = ["BASES", "CHECKS", "DEFAULT_PUBLISHED", "EXTRA_ROWS", "KINDS", "META_KEYS", "STATUSES", "Claim", "ClaimRow",
+           "Context", "Outcome", "ValidationReport", "claim_location", "load_published", "published_claims", "validate"]

@@ -115,29 +115,17 @@ class ValidationReport:
 
     def headline(self) -> str:
         c = self.counts
-        return (
-            f"{self.independent_reproductions} claims independently reproduced "
-            f"(of {self.independent_rows} independent comparisons; {len(self.rows)} rows: "
-            + ", ".join(f"{c[s]} {s}" for s in STATUSES)
-            + ")"
-        )
+        return (f"{self.independent_reproductions} claims independently reproduced "
+                f"(of {self.independent_rows} independent comparisons; {len(self.rows)} rows: "
+                + ", ".join(f"{c[s]} {s}" for s in STATUSES) + ")")
 
     def to_dict(self) -> dict:
-        return {
-            "format": "ipmc-validation",
-            "version": 2,
-            "published": self.published,
-            "quick": self.quick,
-            "elapsed_s": round(self.elapsed_s, 3),
-            "headline": self.headline(),
-            "independent_reproductions": self.independent_reproductions,
-            "counts": self.counts,
-            "counts_by_basis": self.counts_by_basis,
-            "calibration": self.calibration,
-            "papers": self.papers,
-            "metadata": self.metadata,
-            "rows": [asdict(r) for r in self.rows],
-        }
+        return {"format": "ipmc-validation", "version": 2, "published": self.published, "quick": self.quick,
+                "elapsed_s": round(self.elapsed_s, 3), "headline": self.headline(),
+                "independent_reproductions": self.independent_reproductions,
+                "counts": self.counts, "counts_by_basis": self.counts_by_basis,
+                "calibration": self.calibration, "papers": self.papers, "metadata": self.metadata,
+                "rows": [asdict(r) for r in self.rows]}
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2, ensure_ascii=False, allow_nan=False)
@@ -145,46 +133,28 @@ class ValidationReport:
     def to_markdown(self) -> str:
         esc = lambda s: str(s).replace("|", "\\|").replace("\n", " ")
         cb = self.counts_by_basis
-        lines = [
-            "# Validation against the seed papers",
-            "",
-            f"**{self.headline()}**" + (" (quick mode: fewer temperatures)" if self.quick else "") + ".",
-            f"Claims from `{self.published}`, {self.elapsed_s:.1f} s.",
-            "",
-            (
-                "Only `reproduced` rows of basis `independent` are evidence that the physics reproduces a paper: "
-                "`calibrated` rows check that a fit hit its target, `input` rows re-read model inputs, `paper` rows "
-                "check the paper against itself, `metadata` rows are bookkeeping.  `not-reproduced` is a finding "
-                "about the physics (the reason says why); `fail` is a regression."
-            ),
-            "",
-            "| status \\ basis | " + " | ".join(BASES) + " | total |",
-            "|---|" + "---|" * (len(BASES) + 1),
-        ]
+        lines = ["# Validation against the seed papers", "",
+                 f"**{self.headline()}**" + (" (quick mode: fewer temperatures)" if self.quick else "") + ".",
+                 f"Claims from `{self.published}`, {self.elapsed_s:.1f} s.", "",
+                 ("Only `reproduced` rows of basis `independent` are evidence that the physics reproduces a paper: "
+                  "`calibrated` rows check that a fit hit its target, `input` rows re-read model inputs, `paper` rows "
+                  "check the paper against itself, `metadata` rows are bookkeeping.  `not-reproduced` is a finding "
+                  "about the physics (the reason says why); `fail` is a regression."), "",
+                 "| status \\ basis | " + " | ".join(BASES) + " | total |", "|---|" + "---|" * (len(BASES) + 1)]
         for s in STATUSES:
             lines.append(f"| {s} | " + " | ".join(str(cb[s][b]) for b in BASES) + f" | {sum(cb[s].values())} |")
         lines += ["", "## Papers", ""]
         lines += [f"- {esc(k)}: {esc(v)}" for k, v in self.papers.items()]
         lines += ["", "## Calibration and hold-out", ""]
         for name, table in self.calibration.items():
-            lines.append(
-                f"- `{name}` calibrated on: "
-                + "; ".join(f"`{cid}` ({esc(what)})" for cid, what in table.items())
-                + ".  Every other row that uses it is a prediction."
-            )
-        lines += [
-            "",
-            "## Claims",
-            "",
-            "| claim | source, location | printed | ours | criterion | status | basis | reason |",
-            "|---|---|---|---|---|---|---|---|",
-        ]
+            lines.append(f"- `{name}` calibrated on: " + "; ".join(f"`{cid}` ({esc(what)})" for cid, what in table.items())
+                         + ".  Every other row that uses it is a prediction.")
+        lines += ["", "## Claims", "", "| claim | source, location | printed | ours | criterion | status | basis | reason |",
+                  "|---|---|---|---|---|---|---|---|"]
         for r in self.rows:
             basis = f"**{r.basis}**" + (f": {esc(r.basis_note)}" if r.basis_note else "")
-            lines.append(
-                f"| `{r.claim_id}` | {esc(r.source)}, {esc(r.location)} | {esc(r.printed)} | {esc(r.ours)} "
-                f"| {esc(r.criterion)} | **{r.status}** | {basis} | {esc(r.reason)} |"
-            )
+            lines.append(f"| `{r.claim_id}` | {esc(r.source)}, {esc(r.location)} | {esc(r.printed)} | {esc(r.ours)} "
+                         f"| {esc(r.criterion)} | **{r.status}** | {basis} | {esc(r.reason)} |")
         return "\n".join(lines) + "\n"
 
 
@@ -306,9 +276,8 @@ def _basis(ctx, claim_id: str, claim: Claim) -> tuple[str, str]:
 
 def _judge(ctx, claim_id, source, location, printed, value, claim: Claim) -> ClaimRow:
     basis, note = _basis(ctx, claim_id, claim)
-    row = lambda ours, crit, status, reason: ClaimRow(
-        claim_id, source, location, printed, ours, crit, status, basis, reason, note
-    )
+    row = lambda ours, crit, status, reason: ClaimRow(claim_id, source, location, printed, ours, crit,
+                                                      status, basis, reason, note)
     if claim.expect.startswith("not-checkable"):
         ours = claim.check(ctx, value).ours if claim.check is not None else "-"
         return row(ours, "-", "not-checkable", claim.expect.split(":", 1)[1].strip())
@@ -322,12 +291,8 @@ def _judge(ctx, claim_id, source, location, printed, value, claim: Claim) -> Cla
         return row(out.ours, out.criterion, "reproduced", out.note)
     if claim.expect.startswith("finding"):
         return row(out.ours, out.criterion, "not-reproduced", claim.expect.split(":", 1)[1].strip())
-    return row(
-        out.ours,
-        out.criterion,
-        "fail",
-        "regression: the project reproduces this claim, but the criterion is no longer met",
-    )
+    return row(out.ours, out.criterion, "fail", "regression: the project reproduces this claim, but the criterion is no "
+               "longer met")
 
 
 def _rows(ctx, claim_id, section, key, value) -> list[ClaimRow]:
@@ -336,19 +301,8 @@ def _rows(ctx, claim_id, section, key, value) -> list[ClaimRow]:
     source = str(table.get("cite_as") or table.get("paper") or section)
     location = claim_location(ctx.pub, claim_id)
     if claim_id not in CHECKS:
-        return [
-            ClaimRow(
-                claim_id,
-                source,
-                location,
-                _printed(value),
-                "-",
-                "-",
-                "fail",
-                "metadata",
-                "no check is mapped to this claim (scenarios.validation CHECKS must cover every claim)",
-            )
-        ]
+        return [ClaimRow(claim_id, source, location, _printed(value), "-", "-", "fail", "metadata",
+                         "no check is mapped to this claim (scenarios.validation CHECKS must cover every claim)")]
     rows = [_judge(ctx, claim_id, source, location, _printed(value), value, CHECKS[claim_id])]
     for tag, printed, extra in EXTRA_ROWS.get(claim_id, []):
         rows.append(_judge(ctx, f"{claim_id}+{tag}", source, location, printed, value, extra))
@@ -372,17 +326,7 @@ def validate(*, quick: bool = False, progress=None, published=None) -> Validatio
         rows.extend(_rows(ctx, *claim))
         if progress:
             progress(1)
-    papers = {
-        str(t.get("cite_as", s)): str(t.get("citation", t.get("paper", s)))
-        for s, t in data.items()
-        if isinstance(t, dict)
-    }
-    return ValidationReport(
-        tuple(rows),
-        bool(quick),
-        str(path),
-        time.perf_counter() - t0,
-        dict(ctx._memo.get("metadata", {})),
-        ctx.calibration,
-        papers,
-    )
+    papers = {str(t.get("cite_as", s)): str(t.get("citation", t.get("paper", s)))
+              for s, t in data.items() if isinstance(t, dict)}
+    return ValidationReport(tuple(rows), bool(quick), str(path), time.perf_counter() - t0,
+                            dict(ctx._memo.get("metadata", {})), ctx.calibration, papers)

@@ -41,20 +41,11 @@ NOISE = MagnitudePhaseNoise(0.1, 1.0)
 
 def setup():
     base = get_parameter_set("seed002_table3")
-    truth = replace(
-        base.replace(d=4.2e-11, kappa_e=3.9e-7, alpha0=base.alpha0 * 1.15, E=1.7e8, xi=0.21, r1_sheet=80.0),
-        laws=base.laws.with_(d=Arrhenius(19e3), E=LogLinear(-0.009)),
-    )
-    true = {
-        "d": truth.d,
-        "kappa_e": truth.kappa_e,
-        "alpha0": truth.alpha0,
-        "E": truth.E,
-        "xi": truth.xi,
-        "r1_sheet": truth.r1_sheet,
-        "laws.d.activation_energy": 19e3,
-        "laws.E.slope": -0.009,
-    }
+    truth = replace(base.replace(d=4.2e-11, kappa_e=3.9e-7, alpha0=base.alpha0 * 1.15, E=1.7e8, xi=0.21,
+                                 r1_sheet=80.0),
+                    laws=base.laws.with_(d=Arrhenius(19e3), E=LogLinear(-0.009)))
+    true = {"d": truth.d, "kappa_e": truth.kappa_e, "alpha0": truth.alpha0, "E": truth.E, "xi": truth.xi,
+            "r1_sheet": truth.r1_sheet, "laws.d.activation_energy": 19e3, "laws.E.slope": -0.009}
     return base, truth, true
 
 
@@ -63,22 +54,16 @@ def single(base, truth, true, starts):
     t0 = time.perf_counter()
     res = calibrate(sw, base, FREE, starts=starts, seed=0)
     dt = time.perf_counter() - t0
-    print(
-        f"== 8-parameter calibration: {len(TEMPS)} temperatures x {len(FREQS)} frequencies "
-        f"({res.n_lines} lines), {starts} starts"
-    )
-    print(
-        f"time {dt:.2f} s; {res.n_evaluations} model evaluations (parameter sets x all lines) "
-        f"in {res.n_model_calls} batched calls; converged={res.converged}"
-    )
+    print(f"== 8-parameter calibration: {len(TEMPS)} temperatures x {len(FREQS)} frequencies "
+          f"({res.n_lines} lines), {starts} starts")
+    print(f"time {dt:.2f} s; {res.n_evaluations} model evaluations (parameter sets x all lines) "
+          f"in {res.n_model_calls} batched calls; converged={res.converged}")
     print(f"cost {res.cost:.1f}, expected {res.expected_cost:.1f} +- {res.cost_std:.1f}; held: {res.held or 'none'}")
     print(f"{'parameter':28s} {'true':>12s} {'estimate':>12s} {'95 % interval':>28s}  inside")
     for n in FREE:
         inside = res.ci_lower[n] <= true[n] <= res.ci_upper[n]
-        print(
-            f"{n:28s} {true[n]:12.5g} {res.values[n]:12.5g} [{res.ci_lower[n]:12.5g}, {res.ci_upper[n]:12.5g}]  "
-            f"{'yes' if inside else 'NO'}"
-        )
+        print(f"{n:28s} {true[n]:12.5g} {res.values[n]:12.5g} [{res.ci_lower[n]:12.5g}, {res.ci_upper[n]:12.5g}]  "
+              f"{'yes' if inside else 'NO'}")
     for s in res.starts:
         print(f"  start {s.index}: cost {s.cost:.1f} after {s.nfev} residual evaluations ({s.message})")
     return res
@@ -92,7 +77,6 @@ def monte_carlo(base, truth, true, draws):
     t0 = time.perf_counter()
     try:
         from tqdm import tqdm
-
         it = tqdm(range(draws), desc="monte carlo", file=sys.stderr)
     except ImportError:  # pragma: no cover
         it = range(draws)
@@ -110,19 +94,13 @@ def monte_carlo(base, truth, true, draws):
                 hits[n] += 1
     dt = time.perf_counter() - t0
     half = 1.96 * math.sqrt(0.95 * 0.05 / draws)
-    print(
-        f"\n== Monte Carlo coverage of the 95 % intervals over {draws} noise draws ({dt:.1f} s, "
-        f"{np.mean(evals):.0f} model evaluations per calibration)"
-    )
+    print(f"\n== Monte Carlo coverage of the 95 % intervals over {draws} noise draws ({dt:.1f} s, "
+          f"{np.mean(evals):.0f} model evaluations per calibration)")
     print(f"not converged: {failed}; draws with a parameter held as undetermined: {held}")
-    print(
-        f"mean cost {np.mean(costs):.1f} (expected {np.mean(expected):.1f}); "
-        f"sd {np.std(costs, ddof=1):.1f} (expected {math.sqrt(np.mean(expected)):.1f})"
-    )
-    print(
-        f"coverage (nominal 0.95; a correct interval lands in [{0.95 - half:.3f}, {0.95 + half:.3f}] "
-        f"95 % of the time at this N):"
-    )
+    print(f"mean cost {np.mean(costs):.1f} (expected {np.mean(expected):.1f}); "
+          f"sd {np.std(costs, ddof=1):.1f} (expected {math.sqrt(np.mean(expected)):.1f})")
+    print(f"coverage (nominal 0.95; a correct interval lands in [{0.95 - half:.3f}, {0.95 + half:.3f}] "
+          f"95 % of the time at this N):")
     for n in FREE:
         print(f"  {n:28s} {hits[n] / draws:.3f}")
     print(f"  {'all parameters (mean)':28s} {np.mean([hits[n] / draws for n in FREE]):.3f}")
@@ -143,14 +121,10 @@ def monte_carlo_estimated_noise(base, truth, true, draws):
             if n not in res.held and res.ci_lower[n] <= true[n] <= res.ci_upper[n]:
                 hits[n] += 1
     half = 1.96 * math.sqrt(0.95 * 0.05 / draws)
-    print(
-        f"\n== Same, data WITHOUT per-line std (complex noise 1 %, noise estimated), {draws} draws "
-        f"({time.perf_counter() - t0:.1f} s)"
-    )
-    print(
-        f"estimated noise scale {np.mean(scales):.4f} (true {0.01 / math.sqrt(2) / 0.01:.4f}); "
-        f"coverage band for N={draws}: [{0.95 - half:.3f}, {0.95 + half:.3f}]"
-    )
+    print(f"\n== Same, data WITHOUT per-line std (complex noise 1 %, noise estimated), {draws} draws "
+          f"({time.perf_counter() - t0:.1f} s)")
+    print(f"estimated noise scale {np.mean(scales):.4f} (true {0.01 / math.sqrt(2) / 0.01:.4f}); "
+          f"coverage band for N={draws}: [{0.95 - half:.3f}, {0.95 + half:.3f}]")
     print("  " + ", ".join(f"{n} {hits[n] / draws:.3f}" for n in FREE))
     print(f"  all parameters (mean) {np.mean([hits[n] / draws for n in FREE]):.3f}")
 
@@ -159,9 +133,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--draws", type=int, default=400)
     ap.add_argument("--starts", type=int, default=4)
-    ap.add_argument(
-        "--draws-estimated", type=int, default=200, help="draws of the estimated-noise coverage check (0 to skip)"
-    )
+    ap.add_argument("--draws-estimated", type=int, default=200,
+                    help="draws of the estimated-noise coverage check (0 to skip)")
     args = ap.parse_args(argv)
     base, truth, true = setup()
     single(base, truth, true, args.starts)

@@ -80,13 +80,8 @@ def library_case(label, level, rng):
     if label == "none":
         effects = {}
     elif label == "out_of_library":
-        effects = {
-            "fixture_resonance": {
-                "frequency_hz": float(rng.uniform(0.5, 30.0)),
-                "depth": float(rng.uniform(0.4, 0.8)),
-                "damping": 0.05,
-            }
-        }
+        effects = {"fixture_resonance": {"frequency_hz": float(rng.uniform(0.5, 30.0)),
+                                         "depth": float(rng.uniform(0.4, 0.8)), "damping": 0.05}}
     elif label == "two":
         a, b = rng.choice(CANDS, 2, replace=False)
         effects = {a: draw_effect(a, rng), b: draw_effect(b, rng)}
@@ -96,28 +91,10 @@ def library_case(label, level, rng):
     m = EffectModel(P, "actuator", effects)
     data = synthesize_sweep(m, "M", F, T, MagnitudePhaseNoise(sd, sp), seed=int(rng.integers(2**31)))
     exact = synthesize_sweep(m, "M", F, T)
-    exact = FrequencySweep(
-        exact.temperature_c,
-        exact.frequency_hz,
-        exact.response,
-        data.magnitude_std_db,
-        data.phase_std_deg,
-        data.input_name,
-        data.input_unit,
-        data.output_name,
-        data.output_unit,
-    )
-    data = FrequencySweep(
-        data.temperature_c,
-        data.frequency_hz,
-        data.response,
-        data.magnitude_std_db,
-        data.phase_std_deg,
-        data.input_name,
-        data.input_unit,
-        data.output_name,
-        data.output_unit,
-    )
+    exact = FrequencySweep(exact.temperature_c, exact.frequency_hz, exact.response, data.magnitude_std_db,
+                           data.phase_std_deg, data.input_name, data.input_unit, data.output_name, data.output_unit)
+    data = FrequencySweep(data.temperature_c, data.frequency_hz, data.response, data.magnitude_std_db,
+                          data.phase_std_deg, data.input_name, data.input_unit, data.output_name, data.output_unit)
     return data, exact, effects
 
 
@@ -142,10 +119,8 @@ def library_plan(reps: int):
 def independent_plan(n_per_label: int, n_null: int, first_seed: int = 0):
     import independent_generator as ig
 
-    plan = [
-        ("independent", lab, first_seed + s)
-        for s, lab in enumerate(lab for lab in ig.LABELS for _ in range(n_per_label))
-    ]
+    plan = [("independent", lab, first_seed + s)
+            for s, lab in enumerate(lab for lab in ig.LABELS for _ in range(n_per_label))]
     first = first_seed + len(plan)
     plan += [("independent", "none", first + k) for k in range(max(0, n_null - n_per_label))]
     return plan
@@ -181,24 +156,12 @@ def summarise(d, *, generator, label, expected, lam, detectable, out_of_library,
     fab = final_at_bound_names(d)
     final_at_bound = bool(fab)
     at_bound_said = all(n in d.message for n in fab) and "bound" in d.message
-    return dict(
-        generator=generator,
-        label=label,
-        level=level,
-        expected=sorted(expected),
-        lam=lam,
-        detectable=detectable,
-        oo=out_of_library,
-        verdict=d.verdict,
-        named=sorted(d.named),
-        declared=declared,
-        t=dt,
-        gap_shrink=gap_shrink(d),
-        cost_ratio=d.gap_before["cost"] / d.gap_after["cost"],
-        final_at_bound=final_at_bound,
-        at_bound_said=at_bound_said,
-        cost_warning=getattr(d, "cost_warning", "") or "",
-    )
+    return dict(generator=generator, label=label, level=level, expected=sorted(expected), lam=lam,
+                detectable=detectable, oo=out_of_library, verdict=d.verdict, named=sorted(d.named),
+                declared=declared, t=dt, gap_shrink=gap_shrink(d),
+                cost_ratio=d.gap_before["cost"] / d.gap_after["cost"],
+                final_at_bound=final_at_bound, at_bound_said=at_bound_said,
+                cost_warning=getattr(d, "cost_warning", "") or "")
 
 
 def run_case(item):
@@ -212,17 +175,9 @@ def run_case(item):
         d = diagnose(data, P, kind="actuator", free=FREE, alpha=ALPHA, seed=idx)
         dt = time.perf_counter() - t0
         expected = [e for e in effects if e in LIBRARY]
-        return summarise(
-            d,
-            generator=gen,
-            label=label,
-            expected=expected if label != "out_of_library" else [],
-            lam=lam,
-            detectable=lam >= DETECTABLE,
-            out_of_library=label == "out_of_library",
-            dt=dt,
-            level=level,
-        )
+        return summarise(d, generator=gen, label=label, expected=expected if label != "out_of_library" else [],
+                         lam=lam, detectable=lam >= DETECTABLE, out_of_library=label == "out_of_library",
+                         dt=dt, level=level)
     import independent_generator as ig
 
     sweep, truth = ig.make_case(key, label)
@@ -234,16 +189,8 @@ def run_case(item):
         det = min(truth["lam_each_baseline"].values()) >= DETECTABLE
     else:
         det = (truth["lam_baseline"] or 0.0) >= DETECTABLE
-    return summarise(
-        d,
-        generator=gen,
-        label=label,
-        expected=truth["expected"],
-        lam=truth["lam_baseline"] or 0.0,
-        detectable=det,
-        out_of_library=truth["out_of_library"],
-        dt=dt,
-    )
+    return summarise(d, generator=gen, label=label, expected=truth["expected"], lam=truth["lam_baseline"] or 0.0,
+                     detectable=det, out_of_library=truth["out_of_library"], dt=dt)
 
 
 def run_all(plan, workers: int):
@@ -266,11 +213,8 @@ def run_all(plan, workers: int):
 
 
 def _line(i, n, r):
-    print(
-        f"[{i + 1:3d}/{n}] {r['generator'][:3]} {r['level']:8s} {r['label']:45s} λ={r['lam']:9.1f} -> "
-        f"{outcome(r):45s} {r['t']:5.1f} s" + (" [at bound]" if r["final_at_bound"] else ""),
-        flush=True,
-    )
+    print(f"[{i + 1:3d}/{n}] {r['generator'][:3]} {r['level']:8s} {r['label']:45s} λ={r['lam']:9.1f} -> "
+          f"{outcome(r):45s} {r['t']:5.1f} s" + (" [at bound]" if r["final_at_bound"] else ""), flush=True)
 
 
 # =============================================================================== scoring
@@ -290,8 +234,7 @@ def correct(r, confident_only=True):
     if r["verdict"] == "ambiguous":
         # every true effect among the names, every other name declared confusable with a true one
         return all(t in r["named"] for t in truth) and all(
-            any(frozenset((t, o)) in r["declared"] for t in truth) for o in r["named"] if o not in truth
-        )
+            any(frozenset((t, o)) in r["declared"] for t in truth) for o in r["named"] if o not in truth)
     return False
 
 
@@ -324,24 +267,16 @@ def report(rows, title):
         print(f"  {lab:45s} " + ", ".join(f"{k} {v}" for k, v in sorted(cnt.items(), key=lambda kv: -kv[1])))
     k = sum(r["verdict"] in ("named", "ambiguous", "at_bound") for r in nulls)
     k2 = sum(r["verdict"] != "none" for r in nulls)
-    print(
-        f"\n=== False positives on null data (nominal α = {ALPHA}) ===\n  a name (named/ambiguous/at bound): "
-        f"{_rate(k, len(nulls))}\n  any verdict but 'none': {_rate(k2, len(nulls))}"
-    )
+    print(f"\n=== False positives on null data (nominal α = {ALPHA}) ===\n  a name (named/ambiguous/at bound): "
+          f"{_rate(k, len(nulls))}\n  any verdict but 'none': {_rate(k2, len(nulls))}")
     det = [r for r in singles if r["detectable"]]
-    print(
-        f"\n=== Naming accuracy, single library effects ===\n  detectable (λ ≥ {DETECTABLE:g}), confident name: "
-        f"{_rate(sum(correct(r) for r in det), len(det))}\n  detectable, incl. 'at bound' names: "
-        f"{_rate(sum(correct(r, False) for r in det), len(det))}\n  all single cases: "
-        f"{_rate(sum(correct(r) for r in singles), len(singles))}"
-    )
+    print(f"\n=== Naming accuracy, single library effects ===\n  detectable (λ ≥ {DETECTABLE:g}), confident name: "
+          f"{_rate(sum(correct(r) for r in det), len(det))}\n  detectable, incl. 'at bound' names: "
+          f"{_rate(sum(correct(r, False) for r in det), len(det))}\n  all single cases: "
+          f"{_rate(sum(correct(r) for r in singles), len(singles))}")
     wrong = [r for r in singles if r["verdict"] in ("named", "ambiguous") and not correct(r)]
-    undeclared = [
-        r
-        for r in wrong
-        if not all(frozenset((r["expected"][0], n)) in r["declared"] for n in r["named"] if n != r["expected"][0])
-        or r["expected"][0] not in r["named"]
-    ]
+    undeclared = [r for r in wrong if not all(frozenset((r["expected"][0], n)) in r["declared"]
+                                              for n in r["named"] if n != r["expected"][0]) or r["expected"][0] not in r["named"]]
     print(f"  wrong confident names: {len(wrong)}; not between pairs the report declares confusable: {len(undeclared)}")
     for r in wrong:
         print(f"    truth {r['label']:28s} -> {outcome(r)} (λ={r['lam']:.0f})")
@@ -350,10 +285,8 @@ def report(rows, title):
             print(f"    missed (detectable) {r['label']:28s} λ={r['lam']:.0f} -> {outcome(r)}")
     if pairs:
         dp = [r for r in pairs if r["detectable"]]
-        print(
-            f"\n=== Two hidden effects ===\n  both named (all): {_rate(sum(correct(r) for r in pairs), len(pairs))}"
-            f"\n  both named (each detectable on top of the other): {_rate(sum(correct(r) for r in dp), len(dp))}"
-        )
+        print(f"\n=== Two hidden effects ===\n  both named (all): {_rate(sum(correct(r) for r in pairs), len(pairs))}"
+              f"\n  both named (each detectable on top of the other): {_rate(sum(correct(r) for r in dp), len(dp))}")
         for r in pairs:
             if not correct(r):
                 print(f"    {r['label']:45s} -> {outcome(r)}" + ("" if r["detectable"] else " (not detectable)"))
@@ -361,32 +294,25 @@ def report(rows, title):
         c = Counter(r["verdict"] for r in oo)
         vis = [r for r in oo if r["verdict"] != "none"]
         conf = [r for r in oo if r["verdict"] == "named"]
-        print(
-            "\n=== Out of library ===\n  outcomes: "
-            + ", ".join(f"{k} {v}" for k, v in c.items())
-            + f"\n  unexplained among all: {_rate(sum(r['verdict'] == 'unexplained' for r in oo), len(oo))}"
-            f"\n  unexplained among those not 'none': {_rate(sum(r['verdict'] == 'unexplained' for r in vis), len(vis))}"
-            f"\n  confident wrong names: {len(conf)}" + "".join(f"\n    {r['label']} -> {outcome(r)}" for r in conf)
-        )
+        print("\n=== Out of library ===\n  outcomes: " + ", ".join(f"{k} {v}" for k, v in c.items())
+              + f"\n  unexplained among all: {_rate(sum(r['verdict'] == 'unexplained' for r in oo), len(oo))}"
+              f"\n  unexplained among those not 'none': {_rate(sum(r['verdict'] == 'unexplained' for r in vis), len(vis))}"
+              f"\n  confident wrong names: {len(conf)}" + "".join(f"\n    {r['label']} -> {outcome(r)}" for r in conf))
     hidden = [r for r in rows if r["verdict"] == "named" and r["final_at_bound"] and not r["at_bound_said"]]
     print(f"\n=== Verdicts resting on a parameter at its bound without saying so: {len(hidden)} ===")
     ok = [r for r in rows if correct(r)]
     if ok:
         cr = np.array([r["cost_ratio"] for r in ok])
         gs = np.array([r["gap_shrink"] for r in ok])
-        print(
-            f"\n=== Gap shrink (correctly named cases, n = {len(ok)}) ===\n  weighted cost before/after: "
-            f"median {np.median(cr):.3g}, min {cr.min():.3g}; excess-cost ratio median {np.median(gs):.3g}, "
-            f"share ≥ 5× {np.mean(gs >= 5):.2f}"
-        )
+        print(f"\n=== Gap shrink (correctly named cases, n = {len(ok)}) ===\n  weighted cost before/after: "
+              f"median {np.median(cr):.3g}, min {cr.min():.3g}; excess-cost ratio median {np.median(gs):.3g}, "
+              f"share ≥ 5× {np.mean(gs >= 5):.2f}")
     warn = Counter(r["cost_warning"].split(":")[0] for r in rows if r["cost_warning"])
     if warn:
         print("\n=== Cost-vs-noise warnings: " + ", ".join(f"{k} {v}" for k, v in warn.items()) + " ===")
     ts = np.array([r["t"] for r in rows])
-    print(
-        f"\n=== Time per diagnosis: mean {ts.mean():.1f} s, median {np.median(ts):.1f} s, max {ts.max():.1f} s "
-        f"(n = {ts.size}, wall per process on a shared 2-core machine) ==="
-    )
+    print(f"\n=== Time per diagnosis: mean {ts.mean():.1f} s, median {np.median(ts):.1f} s, max {ts.max():.1f} s "
+          f"(n = {ts.size}, wall per process on a shared 2-core machine) ===")
 
 
 def real_data():
@@ -397,18 +323,8 @@ def real_data():
     f = np.logspace(1, 2, 40)
     H = np.array([complex(tf(2j * np.pi * x)) for x in f])
     n = f.size
-    data = FrequencySweep(
-        np.full(n, 35.0),
-        f,
-        H,
-        np.full(n, 0.01 * 20 / math.log(10)),
-        np.full(n, math.degrees(0.01)),
-        "tip_displacement",
-        "mm",
-        "current",
-        "uA",
-        {"source": "seed 000 printed 35 C model"},
-    )
+    data = FrequencySweep(np.full(n, 35.0), f, H, np.full(n, 0.01 * 20 / math.log(10)), np.full(n, math.degrees(0.01)),
+                          "tip_displacement", "mm", "current", "uA", {"source": "seed 000 printed 35 C model"})
     for set_name in ("seed000_sensor", "seed000_sensor_dev"):
         try:
             ps = get_parameter_set(set_name)
@@ -418,11 +334,9 @@ def real_data():
         d = diagnose(data, ps, kind="sensor", free=("a0", "d", "kappa_e"), seed=0)
         print(f"  base {set_name}, free a0, d, kappa_e: verdict {d.verdict} {d.named}")
         print(f"    {d.message}")
-        print(
-            f"    cost {d.gap_before['cost']:.4g} -> {d.gap_after['cost']:.4g} (expected {d.gap_before['expected_cost']:.4g}); "
-            f"RMS {d.gap_before['rms_db'][0]:.2f} dB / {d.gap_before['rms_deg'][0]:.1f}° -> "
-            f"{d.gap_after['rms_db'][0]:.2f} dB / {d.gap_after['rms_deg'][0]:.1f}°"
-        )
+        print(f"    cost {d.gap_before['cost']:.4g} -> {d.gap_after['cost']:.4g} (expected {d.gap_before['expected_cost']:.4g}); "
+              f"RMS {d.gap_before['rms_db'][0]:.2f} dB / {d.gap_before['rms_deg'][0]:.1f}° -> "
+              f"{d.gap_after['rms_db'][0]:.2f} dB / {d.gap_after['rms_deg'][0]:.1f}°")
         top = sorted(d.candidates.values(), key=lambda c: -c.lr)[:3]
         print("    top candidates: " + "; ".join(f"{c.name} LR {c.lr:.3g} {c.values}" for c in top))
 
@@ -436,26 +350,19 @@ def real_data():
         data_a = synthesize_sweep(EffectModel(pw, "actuator"), "M", f2, [26.85], noise, seed=int(W * 1e5))
         da = diagnose(data_a, P, kind="actuator", free=("alpha0", "d", "xi"), seed=1)
         # (b) polymer 2000 kg/m³ + added water mass; the calibrated 4 mm set holds the 4 mm added mass
-        mass = lambda w: 2000.0 * 2 * P.h * w + 1000.0 * math.pi * w**2 / 4  # kg/m, beam + water
-        mu = mass(W) / mass(4e-3) * (4e-3 / W) - 1.0  # per-width modal mass change
-        data_b = synthesize_sweep(
-            EffectModel(pw, "actuator", {"added_fluid_mass": {"mass_ratio": mu}}),
-            "M",
-            f2,
-            [26.85],
-            noise,
-            seed=int(W * 1e5) + 1,
-        )
+        mass = lambda w: 2000.0 * 2 * P.h * w + 1000.0 * math.pi * w**2 / 4        # kg/m, beam + water
+        mu = mass(W) / mass(4e-3) * (4e-3 / W) - 1.0                                  # per-width modal mass change
+        data_b = synthesize_sweep(EffectModel(pw, "actuator", {"added_fluid_mass": {"mass_ratio": mu}}), "M", f2,
+                                  [26.85], noise, seed=int(W * 1e5) + 1)
         db = diagnose(data_b, pw, kind="actuator", free=("alpha0", "d", "xi"), seed=1)
         fitted = db.final.values.get("added_fluid_mass.mass_ratio") if db.final else None
-        print(
-            f"  W = {W * 1e3:3.1f} mm: (a) model at W vs 4 mm set: {da.verdict} (best LR "
-            f"{max(c.lr for c in da.candidates.values()):.2g}, threshold {da.threshold:.2g}); "
-            f"(b) water added mass μ = {mu:+.3f}: {db.verdict} {db.named}"
-            + (f" μ̂ = {fitted:+.3f}" if fitted is not None else "")
-            + f"; cost {db.gap_before['cost']:.4g} -> "
-            f"{db.gap_after['cost']:.4g}"
-        )
+        print(f"  W = {W * 1e3:3.1f} mm: (a) model at W vs 4 mm set: {da.verdict} (best LR "
+              f"{max(c.lr for c in da.candidates.values()):.2g}, threshold {da.threshold:.2g}); "
+              f"(b) water added mass μ = {mu:+.3f}: {db.verdict} {db.named}"
+              + (f" μ̂ = {fitted:+.3f}" if fitted is not None else "") + f"; cost {db.gap_before['cost']:.4g} -> "
+              f"{db.gap_after['cost']:.4g}")
+
+
 
 
 def main(argv=None):
@@ -463,20 +370,12 @@ def main(argv=None):
     ap.add_argument("--generator", choices=("library", "independent", "both"), default="both")
     ap.add_argument("--n-per-label", type=int, default=2, help="independent: cases per label (default 2)")
     ap.add_argument("--null", type=int, default=12, help="independent: null cases in all (default 12)")
-    ap.add_argument(
-        "--first-seed",
-        type=int,
-        default=0,
-        help="independent: first case seed (seeds 0-63 were looked at while developing; use e.g. "
-        "1000 for held-out cases)",
-    )
+    ap.add_argument("--first-seed", type=int, default=0,
+                    help="independent: first case seed (seeds 0-63 were looked at while developing; use e.g. "
+                         "1000 for held-out cases)")
     ap.add_argument("--library-reps", type=int, default=1, help="library: cases per effect and noise level")
-    ap.add_argument(
-        "--library-null",
-        type=int,
-        default=0,
-        help="library: extra null cases (noise levels in turn; seeds apart from the main plan)",
-    )
+    ap.add_argument("--library-null", type=int, default=0,
+                    help="library: extra null cases (noise levels in turn; seeds apart from the main plan)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--real-only", action="store_true", help="only the published-model runs")
     ap.add_argument("--no-real", action="store_true", help="skip the published-model runs")

@@ -58,23 +58,19 @@ def report(name, tm, tp, nu, draws):
     n = tm.size
     band = 1.96 * math.sqrt(0.95 * 0.05 / n)
     cm, cp = np.mean(np.abs(tm) <= 2), np.mean(np.abs(tp) <= 2)
-    print(
-        f"  {name:34s} lines {n:7d}  coverage mag {cm:.4f} phase {cp:.4f}  (t_{nu:.0f}: {t_coverage(nu):.4f}, "
-        f"±{band:.4f} binomial)  χ²/term mag {np.mean(tm**2):.3f} phase {np.mean(tp**2):.3f} "
-        f"(expected {nu / (nu - 2):.3f})  robust sd (1.4826·MAD) mag {1.4826 * np.median(np.abs(tm)):.3f} "
-        f"phase {1.4826 * np.median(np.abs(tp)):.3f}"
-    )
+    print(f"  {name:34s} lines {n:7d}  coverage mag {cm:.4f} phase {cp:.4f}  (t_{nu:.0f}: {t_coverage(nu):.4f}, "
+          f"±{band:.4f} binomial)  χ²/term mag {np.mean(tm**2):.3f} phase {np.mean(tp**2):.3f} "
+          f"(expected {nu / (nu - 2):.3f})  robust sd (1.4826·MAD) mag {1.4826 * np.median(np.abs(tm)):.3f} "
+          f"phase {1.4826 * np.median(np.abs(tp)):.3f}")
 
 
 def welch_coverage(draws: int):
     print(f"== 1. σ calibration over {draws} draws (python-control resonance 50 Hz, ζ = 0.2, fs = 1 kHz)")
     sysd = orc.resonant(FS)
     n = 102_400
-    cases = [
-        ("H1 hann 50% (output noise 0.3)", h1, dict(nperseg=1024), dict(output_noise=0.3), "out"),
-        ("H1 hann no overlap (output noise 0.3)", h1, dict(nperseg=1024, noverlap=0), dict(output_noise=0.3), "out"),
-        ("H2 hann 50% (input noise 0.3)", h2, dict(nperseg=1024), dict(input_noise=0.3), "in"),
-    ]
+    cases = [("H1 hann 50% (output noise 0.3)", h1, dict(nperseg=1024), dict(output_noise=0.3), "out"),
+             ("H1 hann no overlap (output noise 0.3)", h1, dict(nperseg=1024, noverlap=0), dict(output_noise=0.3), "out"),
+             ("H2 hann 50% (input noise 0.3)", h2, dict(nperseg=1024), dict(input_noise=0.3), "in")]
     naive = {"h1_db": [], "h1_deg": [], "naive_db": [], "naive_deg": [], "sig_db": [], "sig_deg": [], "gamma2": []}
     for name, fn, kw, noise, where in cases:
         tms, tps, gs, sds = [], [], [], []
@@ -87,8 +83,8 @@ def welch_coverage(draws: int):
             tms.append(tm)
             tps.append(tp)
             sds.append(e.magnitude_std_db[0])
-            s2 = noise.get("output_noise", 0.0) ** 2 if where == "out" else noise["input_noise"] ** 2
-            gs.append(np.abs(H) ** 2 / (np.abs(H) ** 2 + s2) if where == "out" else np.full(H.size, 1 / (1 + s2)))
+            s2 = noise.get("output_noise", 0.0)**2 if where == "out" else noise["input_noise"]**2
+            gs.append(np.abs(H)**2 / (np.abs(H)**2 + s2) if where == "out" else np.full(H.size, 1 / (1 + s2)))
             if fn is h1 and "noverlap" not in kw:
                 k = np.arange(1, e.frequency_hz.size + 1) * (n // 1024)
                 Hn = np.fft.rfft(y)[k] / np.fft.rfft(u)[k]
@@ -103,10 +99,8 @@ def welch_coverage(draws: int):
         dt = time.perf_counter() - t0
         tm, tp, g = np.concatenate(tms), np.concatenate(tps), np.concatenate(gs)
         nu = 2 * (e.settings["effective_averages"] - 1)
-        print(
-            f" {name}: {e.settings['segments']} segments, {e.settings['effective_averages']:.1f} effective; "
-            f"{dt / draws * 1e3:.1f} ms per draw (simulation included)"
-        )
+        print(f" {name}: {e.settings['segments']} segments, {e.settings['effective_averages']:.1f} effective; "
+              f"{dt / draws * 1e3:.1f} ms per draw (simulation included)")
         for lo, hi in ((0.9, 1.01), (0.5, 0.9), (0.2, 0.5), (0.02, 0.2), (0.0, 0.02)):
             m = (g >= lo) & (g < hi)
             if m.any():
@@ -132,16 +126,13 @@ def stepped_coverage(draws: int):
     t0 = time.perf_counter()
     for d in range(draws):
         rng = np.random.default_rng(20_000 + d)
-        e = stepped_sine(
-            t, u0 + 0.002 * rng.standard_normal(u0.size), y0 + 0.05 * rng.standard_normal(u0.size), plan=plan
-        )
+        e = stepped_sine(t, u0 + 0.002 * rng.standard_normal(u0.size), y0 + 0.05 * rng.standard_normal(u0.size),
+                         plan=plan)
         tm, tp = standardised(e, H)
         tms.append(tm)
         tps.append(tp)
     dt = time.perf_counter() - t0
-    print(
-        f" stepped sine: {f.size} steps × {P} periods, {plan.duration_s:.1f} s record; {dt / draws * 1e3:.1f} ms per draw"
-    )
+    print(f" stepped sine: {f.size} steps × {P} periods, {plan.duration_s:.1f} s record; {dt / draws * 1e3:.1f} ms per draw")
     report("stepped sine, all steps", np.concatenate(tms), np.concatenate(tps), P - 1, draws)
 
 
@@ -151,12 +142,10 @@ def naive_comparison(nv):
         print(f"  {label} ({sel.sum()} lines):")
         for key, unit in (("db", "dB"), ("deg", "deg")):
             a, b = np.abs(nv[f"naive_{key}"][sel]), np.abs(nv[f"h1_{key}"][sel])
-            print(
-                f"    |error| [{unit}]  naive: median {np.median(a):.3f}  95 % {np.percentile(a, 95):.3f}  "
-                f"rms {np.sqrt(np.mean(a**2)):.3f}  |  H1: median {np.median(b):.3f}  95 % {np.percentile(b, 95):.3f}  "
-                f"rms {np.sqrt(np.mean(b**2)):.3f}, stated σ rms {np.sqrt(np.mean(nv[f'sig_{key}'][sel] ** 2)):.3f} "
-                f"(the naive ratio states no σ)"
-            )
+            print(f"    |error| [{unit}]  naive: median {np.median(a):.3f}  95 % {np.percentile(a, 95):.3f}  "
+                  f"rms {np.sqrt(np.mean(a**2)):.3f}  |  H1: median {np.median(b):.3f}  95 % {np.percentile(b, 95):.3f}  "
+                  f"rms {np.sqrt(np.mean(b**2)):.3f}, stated σ rms {np.sqrt(np.mean(nv[f'sig_{key}'][sel]**2)):.3f} "
+                  f"(the naive ratio states no σ)")
 
 
 # ----------------------------------------------------------------------------------- big record
@@ -164,10 +153,9 @@ def write_record(path: Path, minutes: float, fs: float, kind: str, block: int = 
     """(4, n) float64 .npy memmap: time, voltage [V], current [A], displacement [mm]; block by block."""
     n = int(minutes * 60 * fs)
     plan = None
-    if kind == "stepped":  # 30 steps of about minutes/30 each, 0.5 s settle
-        plan = stepped_sine_plan(
-            np.geomspace(0.5, 500, 30), fs, periods=10, min_measure_s=minutes * 2 - 0.5, settle_s=0.5
-        )
+    if kind == "stepped":                 # 30 steps of about minutes/30 each, 0.5 s settle
+        plan = stepped_sine_plan(np.geomspace(0.5, 500, 30), fs, periods=10, min_measure_s=minutes * 2 - 0.5,
+                                 settle_s=0.5)
         n = plan.n_samples
     adm = orc.coefficients(orc.resonant(fs, f_n=300.0, zeta=0.7, gain=0.02))
     mob = orc.coefficients(orc.resonant(fs, f_n=40.0, zeta=0.3, gain=2.0))
@@ -219,11 +207,9 @@ def big_record(minutes: float, fs: float):
                     e, dt, peak = timed(lambda: h1(arr[0], arr[1], [arr[2], arr[3]], nperseg=1 << 14))
                 else:
                     e, dt, peak = timed(lambda: stepped_sine(arr[0], arr[1], [arr[2], arr[3]], plan=plan))
-                print(
-                    f"  {kind:8s} {mins:4g} min ({arr.shape[1] / 1e6:.1f} M samples × 4 rows = {size:.0f} MiB on disk, "
-                    f"written in {gen:.1f} s): {e.method} over {e.frequency_hz.size} lines in {dt:.2f} s, "
-                    f"peak traced memory {peak / 2**20:.1f} MiB"
-                )
+                print(f"  {kind:8s} {mins:4g} min ({arr.shape[1] / 1e6:.1f} M samples × 4 rows = {size:.0f} MiB on disk, "
+                      f"written in {gen:.1f} s): {e.method} over {e.frequency_hz.size} lines in {dt:.2f} s, "
+                      f"peak traced memory {peak / 2**20:.1f} MiB")
 
 
 def main(argv=None):

@@ -66,10 +66,8 @@ def main(argv=None):
     dt = time.perf_counter() - t0
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
-    print(
-        f"{n_T * n_f_big:,} points into a preallocated output: {dt:.2f} s, "
-        f"peak extra memory {peak / 2**20:.1f} MiB (output itself {out['M'].nbytes / 2**20:.0f} MiB)"
-    )
+    print(f"{n_T * n_f_big:,} points into a preallocated output: {dt:.2f} s, "
+          f"peak extra memory {peak / 2**20:.1f} MiB (output itself {out['M'].nbytes / 2**20:.0f} MiB)")
 
 
 if __name__ == "__main__":

@@ -44,7 +44,7 @@ FS = 1000.0
 
 
 def fit_surrogates(plant, t_track: float, quick: bool) -> dict:
-    sw = synthesize_sweep(plant, "M", F_FIT, TEMPS_C)  # mm/V
+    sw = synthesize_sweep(plant, "M", F_FIT, TEMPS_C)          # mm/V
     F, T, H = sw.frequency_hz, sw.temperature_c, sw.response
     out = {}
     forms = [("zpk", 3), ("zpk", 4), ("coefficients", 3), ("coefficients", 4)]
@@ -69,7 +69,7 @@ def run_case(plant, real, G, t_track, f_hz):
     for name, pv in (("auto", "auto"), ("inf", "inf"), ("4/r0", "4/r0")):
         try:
             ff = feedforward(sp, t, d, preview=pv)
-        except Exception as exc:  # 4/r0 can exceed short records
+        except Exception as exc:   # 4/r0 can exceed short records
             row[name] = (np.nan, np.nan, np.nan, str(exc)[:40])
             continue
         y = simulate(plant, t_track, t, ff.output, realization=real).output * 1e3
@@ -84,10 +84,8 @@ def main() -> int:
     plant = physmodel.ActuatorModel(physmodel.get_parameter_set("seed001_actuator"))
     temps = [35.0] if args.quick else [19.0, 35.0, 55.0]
     freqs = [0.1, 0.5, 1.0, 2.0, 5.0]
-    print(
-        "| T [°C] | surrogate | f [Hz] | T_p auto [s] | 4/r0 [s] | V peak auto / inf / 4/r0 [V] | "
-        "error auto / inf / 4/r0 [mm] | err ratio | peak ratio |"
-    )
+    print("| T [°C] | surrogate | f [Hz] | T_p auto [s] | 4/r0 [s] | V peak auto / inf / 4/r0 [V] | "
+          "error auto / inf / 4/r0 [mm] | err ratio | peak ratio |")
     print("|---:|:---|---:|---:|---:|:---|:---|---:|---:|")
     worst_e, worst_v, fails = 0.0, 0.0, 0
     for tt in temps:
@@ -103,16 +101,12 @@ def main() -> int:
                 worst_e, worst_v = max(worst_e, re_), max(worst_v, rv)
                 ok = re_ <= 2.0 and rv <= 1.2
                 fails += not ok
-                print(
-                    f"| {tt:g} | {name}{'' if conv else ' (NOT CONVERGED)'} | {f:g} | {pa:.3g} | {rule:.3g} | "
-                    f"{va:.3g} / {vi:.3g} / {vr:.3g} | {ea:.3g} / {ei:.3g} / {er:.3g} | {re_:.3f} | {rv:.4f} |"
-                    + ("" if ok else " FAIL")
-                )
+                print(f"| {tt:g} | {name}{'' if conv else ' (NOT CONVERGED)'} | {f:g} | {pa:.3g} | {rule:.3g} | "
+                      f"{va:.3g} / {vi:.3g} / {vr:.3g} | {ea:.3g} / {ei:.3g} / {er:.3g} | {re_:.3f} | {rv:.4f} |"
+                      + ("" if ok else " FAIL"))
                 sys.stdout.flush()
-    print(
-        f"\nworst error ratio auto/inf = {worst_e:.3f} (goal <= 2), worst peak ratio = {worst_v:.4f} "
-        f"(goal <= 1.2); {fails} case(s) outside the goal"
-    )
+    print(f"\nworst error ratio auto/inf = {worst_e:.3f} (goal <= 2), worst peak ratio = {worst_v:.4f} "
+          f"(goal <= 1.2); {fails} case(s) outside the goal")
     timing(G)
     return 0 if fails == 0 else 1
 

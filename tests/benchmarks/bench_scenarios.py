@@ -21,27 +21,16 @@ def scenarios_section():
             for quick in (False, True):
                 t0 = time.perf_counter()
                 res = run_scenario(load_scenario(p, quick=quick), Path(tmp) / f"{p.stem}_{quick}", quiet=True)
-                row.append(
-                    f"{'quick' if quick else 'full '} {time.perf_counter() - t0:6.1f} s "
-                    f"{sum(c.passed for c in res.checks)}/{len(res.checks)}"
-                )
+                row.append(f"{'quick' if quick else 'full '} {time.perf_counter() - t0:6.1f} s "
+                           f"{sum(c.passed for c in res.checks)}/{len(res.checks)}")
             print("  ".join(row))
 
 
 def study_section():
     spec = load_study(Path(__file__).parents[2] / "scenarios" / "studies" / "actuator_mc.toml")
-    big = parse_study(
-        {
-            "study": {
-                **{k: v for k, v in spec.items() if k not in ("frequencies_hz",)},
-                "samples": 4000,
-                "chunk_size": 250,
-                "fmin_hz": 0.1,
-                "fmax_hz": 10.0,
-                "points": 40,
-            }
-        }
-    )
+    big = parse_study({"study": {**{k: v for k, v in spec.items() if k not in ("frequencies_hz",)},
+                                 "samples": 4000, "chunk_size": 250, "fmin_hz": 0.1, "fmax_hz": 10.0,
+                                 "points": 40}})
     print(f"== study: {big['samples']} samples x {len(big['temperatures_c'])} T x {len(big['frequencies_hz'])} f")
     ref = None
     for label, kw in (("serial", {"backend": "serial"}), ("processes x2", {"workers": 2})):
@@ -57,10 +46,8 @@ def study_section():
             t0 = time.perf_counter()
             tab = run_study(big, scheduler=cl.scheduler_address)
             dt = time.perf_counter() - t0
-        print(
-            f"{'dask ' + ('processes' if procs else 'threads') + ' x2':22s} {dt:6.2f} s  "
-            f"{tab.n_rows / dt / 1e6:5.2f} M rows/s  identical: {tab.equals(ref)}"
-        )
+        print(f"{'dask ' + ('processes' if procs else 'threads') + ' x2':22s} {dt:6.2f} s  "
+              f"{tab.n_rows / dt / 1e6:5.2f} M rows/s  identical: {tab.equals(ref)}")
 
 
 if __name__ == "__main__":

@@ -29,10 +29,8 @@ def main() -> None:
     base = get_parameter_set("seed001_actuator")
     rng = np.random.default_rng(7)
     n_sets = 10_000
-    sets = [
-        base.replace(d=base.d * float(a), E=base.E * float(b))
-        for a, b in zip(rng.lognormal(0, 0.3, n_sets), rng.lognormal(0, 0.1, n_sets), strict=True)
-    ]
+    sets = [base.replace(d=base.d * float(a), E=base.E * float(b))
+            for a, b in zip(rng.lognormal(0, 0.3, n_sets), rng.lognormal(0, 0.1, n_sets), strict=True)]
     temps = [35.0]
     f_few = np.logspace(-1, 1, 10)
     f_many = np.logspace(-1, 1, 100_000)

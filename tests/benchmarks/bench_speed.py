@@ -53,7 +53,7 @@ def _setup_path(root: str | None) -> None:
 
 
 # ============================================================================ data
-NOISE = (0.2, 1.0)  # dB, degrees
+NOISE = (0.2, 1.0)          # dB, degrees
 T000 = [23.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 60.0, 65.0]
 T001 = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
 
@@ -77,17 +77,8 @@ FIT_CASES = [  # label, model, quantity, band [Hz], temperatures, zeros, poles, 
     ("seed 000 sensor 4/4", ("sensor", "seed000_sensor"), "S", (10.0, 100.0), T000, 4, 4, NOISE, [11]),
     ("seed 001 actuator 3/3", ("actuator", "seed001_actuator"), "M", (0.1, 9.0), T001, 3, 3, NOISE, [11]),
     ("seed 001 actuator 4/4", ("actuator", "seed001_actuator"), "M", (0.1, 9.0), T001, 4, 4, NOISE, [11]),
-    (
-        "seed 002 sample 5p/2z",
-        ("actuator", "seed002_table3"),
-        "M",
-        (0.1, 100.0),
-        [26.85],
-        2,
-        5,
-        (0.3, 2.0),
-        [41, 42, 43, 44, 45],
-    ),
+    ("seed 002 sample 5p/2z", ("actuator", "seed002_table3"), "M", (0.1, 100.0), [26.85], 2, 5, (0.3, 2.0),
+     [41, 42, 43, 44, 45]),
 ]
 
 
@@ -103,10 +94,10 @@ class ReferenceLM:
         self.m, self.n = m, n
         x = ca.SX.sym("x", m + 1 + n)
         p = ca.SX.sym("p", 5 * n_lines)
-        w, hr, hi, ia, ib = (p[i * n_lines : (i + 1) * n_lines] for i in range(5))
+        w, hr, hi, ia, ib = (p[i * n_lines:(i + 1) * n_lines] for i in range(5))
         nr, ni = 0 * w, 0 * w
         wp = 1 + 0 * w
-        for i in range(m + 1):  # (jw)^i = w^i j^i
+        for i in range(m + 1):   # (jw)^i = w^i j^i
             re, im = [(1, 0), (0, 1), (-1, 0), (0, -1)][i % 4]
             nr, ni = nr + re * x[i] * wp, ni + im * x[i] * wp
             wp = wp * w
@@ -137,13 +128,13 @@ class ReferenceLM:
         for _ in range(n_iter + 1):
             d = np.ones_like(w) if den is None else np.abs(np.polyval(den[::-1], jw))
             a = np.hstack([jw[:, None] ** np.arange(m + 1), -h[:, None] * jw[:, None] ** np.arange(n)])
-            rhs = h * jw**n
+            rhs = h * jw ** n
             ww = wt / d
             A = np.vstack([(a * ww[:, None]).real, (a * ww[:, None]).imag])
             b = np.concatenate([(rhs * ww).real, (rhs * ww).imag])
             sc = np.linalg.norm(A, axis=0)
             sol = np.linalg.lstsq(A / sc, b, rcond=None)[0] / sc
-            den = np.append(sol[m + 1 :], 1.0)
+            den = np.append(sol[m + 1:], 1.0)
         poles = np.roots(den[::-1])
         poles = -np.abs(poles.real) + 1j * poles.imag
         cplx = sorted([p for p in poles if p.imag > 1e-9 * abs(p)], key=abs)
@@ -192,16 +183,12 @@ def fit_section(args):
     from surrogate import RationalFit, from_sweep
 
     print("\n## Per-temperature fit vs one output-error LM solve (reference)\n")
-    print(
-        "Whole `RationalFit(m, n).fit_data(d)` call vs the reference (SK start + MINPACK LM on a "
-        "CasADi residual, build not timed). Medians over interleaved repeats, summed over the "
-        "temperatures / noise seeds of each case. Cost = ½·mean(r²) of the σ-weighted log residual.\n"
-    )
-    print(
-        "| case | fits | ours [ms/fit] | of which solve [ms] | reference [ms/fit] (to our cost) | "
-        "ours / reference | solve / reference | mean cost ours / ref | worst cost ours / ref | converged | "
-        "starts stopped early |"
-    )
+    print("Whole `RationalFit(m, n).fit_data(d)` call vs the reference (SK start + MINPACK LM on a "
+          "CasADi residual, build not timed). Medians over interleaved repeats, summed over the "
+          "temperatures / noise seeds of each case. Cost = ½·mean(r²) of the σ-weighted log residual.\n")
+    print("| case | fits | ours [ms/fit] | of which solve [ms] | reference [ms/fit] (to our cost) | "
+          "ours / reference | solve / reference | mean cost ours / ref | worst cost ours / ref | converged | "
+          "starts stopped early |")
     print("|:--|--:|--:|--:|--:|--:|--:|--:|--:|:--:|--:|")
     reps = 3 if args.quick else 7
     totals = []
@@ -215,7 +202,7 @@ def fit_section(args):
             sets += [data.at_temperature(t) for t in temps]
         t_ours, t_ref, t_ref_same, c_ours, c_ref, t_solve = [], [], [], [], [], []
         n_conv, n_stop, n_runs = 0, 0, 0
-        RationalFit(m, n, raise_on_failure=False).fit_data(sets[0])  # warm caches (both sides)
+        RationalFit(m, n, raise_on_failure=False).fit_data(sets[0])   # warm caches (both sides)
         for d in sets:
             wref = float(np.sqrt(d.omega.min() * d.omega.max()))
             g = float(np.exp(np.mean(np.log(np.abs(d.response)))))
@@ -246,18 +233,12 @@ def fit_section(args):
         ratio_solve = np.sum(t_solve) / np.sum(t_ref_same)
         cr = np.array(c_ours) / np.array(c_ref)
         totals.append((label, ratio, ratio_solve))
-        print(
-            f"| {label} | {len(sets)} | {1e3 * np.mean(t_ours):.2f} | {1e3 * np.mean(t_solve):.2f} | "
-            f"{1e3 * np.mean(t_ref):.2f} ({1e3 * np.mean(t_ref_same):.2f}) | {ratio:.2f} | {ratio_solve:.2f} | "
-            f"{cr.mean():.4f} | {cr.max():.4f} | {n_conv}/{len(sets)} | {n_stop}/{n_runs} |"
-        )
-    print(
-        "\nGoal: ours / reference ≤ 1.0 at the same accuracy (whole call; solve alone in brackets): "
-        + "; ".join(
-            f"{lab}: {r:.2f} ({rs:.2f}) {'met' if r <= 1.0 else ('met by the solve' if rs <= 1.0 else 'NOT met')}"
-            for lab, r, rs in totals
-        )
-    )
+        print(f"| {label} | {len(sets)} | {1e3 * np.mean(t_ours):.2f} | {1e3 * np.mean(t_solve):.2f} | "
+              f"{1e3 * np.mean(t_ref):.2f} ({1e3 * np.mean(t_ref_same):.2f}) | {ratio:.2f} | {ratio_solve:.2f} | "
+              f"{cr.mean():.4f} | {cr.max():.4f} | {n_conv}/{len(sets)} | {n_stop}/{n_runs} |")
+    print("\nGoal: ours / reference ≤ 1.0 at the same accuracy (whole call; solve alone in brackets): "
+          + "; ".join(f"{lab}: {r:.2f} ({rs:.2f}) {'met' if r <= 1.0 else ('met by the solve' if rs <= 1.0 else 'NOT met')}"
+                      for lab, r, rs in totals))
 
 
 def _init_time(d, m, n, reps):
@@ -271,7 +252,7 @@ def _init_time(d, m, n, reps):
     try:
         from surrogate._init import initial_candidates
         from surrogate._lsq import Evaluator
-    except ImportError:  # an older checkout: no separate solve phase to report
+    except ImportError:          # an older checkout: no separate solve phase to report
         return float("nan")
     st = Structure("sections", m, n, 0)
     ts = []
@@ -280,18 +261,14 @@ def _init_time(d, m, n, reps):
         sc = F.make_scaling(d, None, None, float(d.temperatures()[0]), 1.0)
         pr, _ = F.make_problem(st, d, sc, "auto")
         ev = Evaluator(pr)
-        initial_candidates(
-            st,
-            pr.w,
-            pr.h,
-            lambda s2, th, ev=ev, pr=pr: (ev if s2 == st else Evaluator(replace(pr, structure=s2))).costs(th),
-        )
+        initial_candidates(st, pr.w, pr.h,
+                           lambda s2, th, ev=ev, pr=pr: (ev if s2 == st else Evaluator(replace(pr, structure=s2))).costs(th))
         ts.append(time.perf_counter() - t0)
     return float(np.median(ts))
 
 
 # ============================================================================ joint
-JOINT_HELD = [26.3, 39.7, 48.1]  # °C, between the fitted temperatures for every count below
+JOINT_HELD = [26.3, 39.7, 48.1]   # °C, between the fitted temperatures for every count below
 
 
 def joint_section(args):
@@ -299,18 +276,14 @@ def joint_section(args):
 
     seeds = [1, 2] if args.quick else [1, 2, 3, 4, 5]
     print("\n## Joint zpk schedules on the seed 001 physics\n")
-    print(
-        "seed001_actuator, M [mm/V], 60 log-spaced lines on 0.1–9 Hz, noise 0.2 dB / 1° (noise seeds "
-        f"{seeds}), fitted at n temperatures evenly spaced on 19–55 °C, quadratic schedules; held-out "
-        "error = relative RMS error against the noise-free physics at "
-        f"{JOINT_HELD} °C (mean over those temperatures and the seeds; worst in brackets). Time: the "
-        "whole ScheduledFit call (per-temperature stage included), median over the seeds; 'first' is "
-        "seed 1, the first fit with this number of lines in the process.\n"
-    )
-    print(
-        "| order | temperatures | first [s] | median [s] | max [s] | converged | joint iterations (median) | "
-        "held-out error joint | held-out error two-stage (NLP first stage) |"
-    )
+    print("seed001_actuator, M [mm/V], 60 log-spaced lines on 0.1–9 Hz, noise 0.2 dB / 1° (noise seeds "
+          f"{seeds}), fitted at n temperatures evenly spaced on 19–55 °C, quadratic schedules; held-out "
+          "error = relative RMS error against the noise-free physics at "
+          f"{JOINT_HELD} °C (mean over those temperatures and the seeds; worst in brackets). Time: the "
+          "whole ScheduledFit call (per-temperature stage included), median over the seeds; 'first' is "
+          "seed 1, the first fit with this number of lines in the process.\n")
+    print("| order | temperatures | first [s] | median [s] | max [s] | converged | joint iterations (median) | "
+          "held-out error joint | held-out error two-stage (NLP first stage) |")
     print("|:--|--:|--:|--:|--:|:--:|--:|--:|--:|")
     model = physics("actuator", "seed001_actuator")
     f_hz = np.geomspace(0.1, 9.0, 60)
@@ -332,11 +305,9 @@ def joint_section(args):
                     k = truth.temperature_c == t
                     errs.append(relative_rms_error(res.model.frequency_response(f_hz, t), truth.response[k]))
                     errs2.append(relative_rms_error(res.two_stage.frequency_response(f_hz, t), truth.response[k]))
-            print(
-                f"| zpk {m}/{n} | {n_t} | {times[0]:.2f} | {np.median(times):.2f} | {np.max(times):.2f} | "
-                f"{conv}/{len(seeds)} | {np.median(its):.0f} | {np.mean(errs):.4f} ({np.max(errs):.4f}) | "
-                f"{np.mean(errs2):.4f} ({np.max(errs2):.4f}) |"
-            )
+            print(f"| zpk {m}/{n} | {n_t} | {times[0]:.2f} | {np.median(times):.2f} | {np.max(times):.2f} | "
+                  f"{conv}/{len(seeds)} | {np.median(its):.0f} | {np.mean(errs):.4f} ({np.max(errs):.4f}) | "
+                  f"{np.mean(errs2):.4f} ({np.max(errs2):.4f}) |")
 
 
 # ============================================================================ build
@@ -372,10 +343,8 @@ def build_section(args):
 
     root = str(Path(surrogate.__file__).parents[1])
     print("\n## Problem building against the number of lines\n")
-    print(
-        "Construction of the IPOPT solver (`surrogate._nlp.Solver`) for a joint zpk 3/3 quadratic "
-        "schedule with grid constraints, by number of lines (fresh structure each, median of 3):\n"
-    )
+    print("Construction of the IPOPT solver (`surrogate._nlp.Solver`) for a joint zpk 3/3 quadratic "
+          "schedule with grid constraints, by number of lines (fresh structure each, median of 3):\n")
     print("| lines | build [s] |")
     print("|--:|--:|")
     st = Structure("zpk", 3, 3, 2)
@@ -391,11 +360,9 @@ def build_section(args):
                 _nlp.Solver(st, "log", grid_taus=taus)
             ts.append(time.perf_counter() - t0)
         print(f"| {n_lines} | {np.median(ts):.3f} |")
-    print(
-        "\nFirst vs repeated joint fit in a fresh interpreter: zpk 3/3 quadratic on the seed 001 actuator "
-        "(10 temperatures), and the seed 000 sensor's coefficient 4/4 cubic schedule (7 temperatures) "
-        "whose unconstrained optimum is unstable, so it is re-solved by IPOPT with Hurwitz constraints:\n"
-    )
+    print("\nFirst vs repeated joint fit in a fresh interpreter: zpk 3/3 quadratic on the seed 001 actuator "
+          "(10 temperatures), and the seed 000 sensor's coefficient 4/4 cubic schedule (7 temperatures) "
+          "whose unconstrained optimum is unstable, so it is re-solved by IPOPT with Hurwitz constraints:\n")
     print("| fit | lines per temperature | first [s] | again [s] | first / again | converged | IPOPT used |")
     print("|:--|--:|--:|--:|--:|:--:|:--:|")
     for case, label in (("zpk", "seed 001 zpk 3/3"), ("hurwitz", "seed 000 coefficients 4/4 (Hurwitz)")):
@@ -438,41 +405,32 @@ def stream_section(args):
     def stream(u, chunk):
         inv = StreamingInverter(G, dt, "auto")
         for i in range(0, u.size, chunk):
-            inv.push(u[i : i + chunk])
+            inv.push(u[i:i + chunk])
 
     def lfilter_carried(u):
         zi = zi0
         for i in range(u.size):
-            _, zi = ss.lfilter(b4, a4, u[i : i + 1], zi=zi)
+            _, zi = ss.lfilter(b4, a4, u[i:i + 1], zi=zi)
 
     t = _median_interleaved({"stream": lambda: stream(u1, 1), "lfilter": lambda: lfilter_carried(u1)}, reps)
     print(f"dt = 1 ms, preview auto ({StreamingInverter(G, dt, 'auto').preview_samples} samples).\n")
     print("| chunk | streaming [ns/sample] | reference | reference [ns/sample] | streaming / reference | goal |")
     print("|--:|--:|:--|--:|--:|:--|")
     r1 = t["stream"] / t["lfilter"]
-    print(
-        f"| 1 | {1e9 * t['stream'] / n1:.0f} | lfilter (4th order) with carried state, one sample per call | "
-        f"{1e9 * t['lfilter'] / n1:.0f} | {r1:.2f} | ≤ 5 µs/sample: "
-        f"{'met' if t['stream'] / n1 <= 5e-6 else 'NOT met'} |"
-    )
+    print(f"| 1 | {1e9 * t['stream'] / n1:.0f} | lfilter (4th order) with carried state, one sample per call | "
+          f"{1e9 * t['lfilter'] / n1:.0f} | {r1:.2f} | ≤ 5 µs/sample: "
+          f"{'met' if t['stream'] / n1 <= 5e-6 else 'NOT met'} |")
     n2 = 1 << (18 if args.quick else 20)
     u2 = np.sin(2 * np.pi * 20 * dt * np.arange(n2)) + 0.1 * rng.standard_normal(n2)
-    t = _median_interleaved(
-        {"stream": lambda: stream(u2, 4096), "batch": lambda: invert(G, dt, u2, preview="auto")}, reps
-    )
+    t = _median_interleaved({"stream": lambda: stream(u2, 4096),
+                             "batch": lambda: invert(G, dt, u2, preview="auto")}, reps)
     r2 = t["stream"] / t["batch"]
-    print(
-        f"| 4096 | {1e9 * t['stream'] / n2:.1f} | batch `invert(..., preview='auto')` of the whole record | "
-        f"{1e9 * t['batch'] / n2:.1f} | {r2:.2f} | ≤ 1.5× batch: {'met' if r2 <= 1.5 else 'NOT met'} |"
-    )
-    print(
-        "\nFinite-preview batch throughput as a ratio to `scipy.signal.lfilter` (4th-order Butterworth) "
-        "over the same samples, 2^21 samples:\n"
-    )
-    print(
-        "| sampling rate | preview [samples] | anticausal filter | invert [ns/sample] | lfilter [ns/sample] | "
-        "ratio (lfilter time / invert time) | goal ≥ 0.3 |"
-    )
+    print(f"| 4096 | {1e9 * t['stream'] / n2:.1f} | batch `invert(..., preview='auto')` of the whole record | "
+          f"{1e9 * t['batch'] / n2:.1f} | {r2:.2f} | ≤ 1.5× batch: {'met' if r2 <= 1.5 else 'NOT met'} |")
+    print("\nFinite-preview batch throughput as a ratio to `scipy.signal.lfilter` (4th-order Butterworth) "
+          "over the same samples, 2^21 samples:\n")
+    print("| sampling rate | preview [samples] | anticausal filter | invert [ns/sample] | lfilter [ns/sample] | "
+          "ratio (lfilter time / invert time) | goal ≥ 0.3 |")
     print("|--:|--:|:--|--:|--:|--:|:--|")
     n3 = 1 << (19 if args.quick else 21)
     from inversion import split_inverse
@@ -482,24 +440,14 @@ def stream_section(args):
     for fs in (1e3, 5e3, 20e3):
         d = 1.0 / fs
         u3 = np.sin(2 * np.pi * 20 * d * np.arange(n3)) + 0.1 * rng.standard_normal(n3)
-        t = _median_interleaved(
-            {
-                "invert": lambda d=d, u3=u3: invert(sp, d, u3, preview="auto"),
-                "lfilter": lambda u3=u3: ss.lfilter(b4, a4, u3),
-            },
-            reps,
-        )
+        t = _median_interleaved({"invert": lambda d=d, u3=u3: invert(sp, d, u3, preview="auto"),
+                                 "lfilter": lambda u3=u3: ss.lfilter(b4, a4, u3)}, reps)
         plan = Plan(sp, d, round(sp.auto_preview_s / d))
-        kind = (
-            "fused"
-            if getattr(plan, "fused", None) is not None
-            else (plan.anti.kind if plan.anti is not None else "none")
-        )
+        kind = "fused" if getattr(plan, "fused", None) is not None else (
+            plan.anti.kind if plan.anti is not None else "none")
         ratio = t["lfilter"] / t["invert"]
-        print(
-            f"| {fs / 1e3:g} kHz | {plan.n_preview} | {kind} | {1e9 * t['invert'] / n3:.1f} | "
-            f"{1e9 * t['lfilter'] / n3:.1f} | {ratio:.2f} | {'met' if ratio >= 0.3 else 'NOT met'} |"
-        )
+        print(f"| {fs / 1e3:g} kHz | {plan.n_preview} | {kind} | {1e9 * t['invert'] / n3:.1f} | "
+              f"{1e9 * t['lfilter'] / n3:.1f} | {ratio:.2f} | {'met' if ratio >= 0.3 else 'NOT met'} |")
 
 
 # ============================================================================ main
@@ -516,10 +464,8 @@ def main(argv=None):
     import surrogate
 
     warnings.simplefilter("ignore")
-    print(
-        f"# speed benchmark — packages from {Path(surrogate.__file__).parents[1]}; "
-        f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.2f}"
-    )
+    print(f"# speed benchmark — packages from {Path(surrogate.__file__).parents[1]}; "
+          f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.2f}")
     t0 = time.perf_counter()
     for name in args.sections.split(","):
         SECTIONS[name.strip()](args)

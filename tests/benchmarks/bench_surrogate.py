@@ -55,8 +55,8 @@ from surrogate import (
 SEED001_TEMPS = [19.0, 21.5, 23.3, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 55.0]
 SEED000_TEMPS = [23.0, 25.0, 30.0, 35.0, 40.0, 45.0, 50.0, 60.0, 65.0]
 HELD_OUT = [35.0, 45.0]
-NOISE = MagnitudePhaseNoise(0.2, 1.0)  # per line, given to the fits as std
-ORDER_NOISE = MagnitudePhaseNoise(0.3, 2.0)  # order-selection protocol (as before)
+NOISE = MagnitudePhaseNoise(0.2, 1.0)          # per line, given to the fits as std
+ORDER_NOISE = MagnitudePhaseNoise(0.3, 2.0)    # order-selection protocol (as before)
 
 # name -> (model class, parameter set, overrides, quantity)
 SAMPLES = {
@@ -131,43 +131,35 @@ def _floors(data, truth, m, n):
         f = data.frequency_hz[k]
         exact = RationalFit(m, n, raise_on_failure=False).fit(f, temp, truth[k])
         own = RationalFit(m, n, raise_on_failure=False).fit_data(data.at_temperature(temp))
-        out[temp] = (
-            relative_rms_error(exact.model.frequency_response(f), truth[k]),
-            relative_rms_error(own.model.frequency_response(f), truth[k]),
-        )
+        out[temp] = (relative_rms_error(exact.model.frequency_response(f), truth[k]),
+                     relative_rms_error(own.model.frequency_response(f), truth[k]))
     return out
 
 
 def held_out_section(quick: bool):
     print("\n## 1. Held-out temperatures (35 and 45 °C excluded from the fit)\n")
-    print(
-        f"Actuators: fit on {[t for t in SEED001_TEMPS if t not in HELD_OUT]} °C (seed 001); "
-        f"sensor: fit on {[t for t in SEED000_TEMPS if t not in HELD_OUT]} °C (seed 000); "
-        f"log-spaced lines; noise {NOISE.sigma_db} dB / {NOISE.sigma_deg}° (given to the fit as per-line std; "
-        f"noise floor of one line ≈ {_noise_floor(NOISE):.3f})."
-    )
-    print(
-        "Errors are relative RMS errors against the noise-free physics response at the held-out temperature, "
-        "mean over the noise seeds (worst seed in brackets). Ratios: of the means, and of the medians. "
-        "'joint ok' = joint fits that converged AND whose poles are stable on a 501-point T grid "
-        "(largest pole real part over grid and seeds in brackets, rad/s). "
-        "Floors (means over seeds): 'order' = best fit of this order to the noise-free response AT the held-out "
-        "temperature (no model of this order does better there); 'own data' = fit of this order to the "
-        "held-out temperature's own noisy data; 'joint σ' = RMS relative standard deviation of the joint "
-        "model's response at the held-out temperature from its own parameter covariance (delta method, "
-        "RationalModel.response_std): the noise-induced error the joint fit is expected to have. "
-        "Verdict: 'met'; 'order-limited' when the order floor exceeds half the papers' two-stage error "
-        "(unreachable at this order); 'noise-limited' when the joint fit's own expected noise error σ "
-        "exceeds half the papers' error (reaching the goal would take beating the model's noise floor); "
-        "'joint / own data' < 1 means the joint model predicts the unmeasured temperature better than a fit "
-        "to that temperature's own measurement.\n"
-    )
+    print(f"Actuators: fit on {[t for t in SEED001_TEMPS if t not in HELD_OUT]} °C (seed 001); "
+          f"sensor: fit on {[t for t in SEED000_TEMPS if t not in HELD_OUT]} °C (seed 000); "
+          f"log-spaced lines; noise {NOISE.sigma_db} dB / {NOISE.sigma_deg}° (given to the fit as per-line std; "
+          f"noise floor of one line ≈ {_noise_floor(NOISE):.3f}).")
+    print("Errors are relative RMS errors against the noise-free physics response at the held-out temperature, "
+          "mean over the noise seeds (worst seed in brackets). Ratios: of the means, and of the medians. "
+          "'joint ok' = joint fits that converged AND whose poles are stable on a 501-point T grid "
+          "(largest pole real part over grid and seeds in brackets, rad/s). "
+          "Floors (means over seeds): 'order' = best fit of this order to the noise-free response AT the held-out "
+          "temperature (no model of this order does better there); 'own data' = fit of this order to the "
+          "held-out temperature's own noisy data; 'joint σ' = RMS relative standard deviation of the joint "
+          "model's response at the held-out temperature from its own parameter covariance (delta method, "
+          "RationalModel.response_std): the noise-induced error the joint fit is expected to have. "
+          "Verdict: 'met'; 'order-limited' when the order floor exceeds half the papers' two-stage error "
+          "(unreachable at this order); 'noise-limited' when the joint fit's own expected noise error σ "
+          "exceeds half the papers' error (reaching the goal would take beating the model's noise floor); "
+          "'joint / own data' < 1 means the joint model predicts the unmeasured temperature better than a fit "
+          "to that temperature's own measurement.\n")
     seeds = [1, 2] if quick else [1, 2, 3, 4, 5]
-    print(
-        "| data | band [Hz] × lines | form | order | degree | T [°C] | joint | two-stage (Levy = papers') | "
-        "two-stage (our NLP) | floor: order | floor: own data | joint σ (delta) | joint / papers' (mean; median) | "
-        "joint / NLP two-stage (mean; median) | verdict | joint ok | joint time [s] |"
-    )
+    print("| data | band [Hz] × lines | form | order | degree | T [°C] | joint | two-stage (Levy = papers') | "
+          "two-stage (our NLP) | floor: order | floor: own data | joint σ (delta) | joint / papers' (mean; median) | "
+          "joint / NLP two-stage (mean; median) | verdict | joint ok | joint time [s] |")
     print("|:--|:--|:--|:--|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|:--|:--:|--:|")
     summary = []
     for sample, band, nf, form, m, n, deg, note in HELD_OUT_CASES:
@@ -181,9 +173,8 @@ def held_out_section(quick: bool):
             t0 = time.perf_counter()
             res = ScheduledFit(form, m, n, deg, raise_on_failure=False).fit_data(fit)
             times.append(time.perf_counter() - t0)
-            res_levy = ScheduledFit(
-                form, m, n, deg, method="two-stage", per_temperature="levy", raise_on_failure=False
-            ).fit_data(fit)
+            res_levy = ScheduledFit(form, m, n, deg, method="two-stage", per_temperature="levy",
+                                    raise_on_failure=False).fit_data(fit)
             stab = res.model.stability_check(501)
             n_ok += bool(stab.stable and res.converged)
             max_re = max(max_re, stab.max_pole_real_part_rad_s)
@@ -195,7 +186,7 @@ def held_out_section(quick: bool):
                 acc["own"][temp].append(e_own)
                 k = data.temperature_c == temp
                 rel_std = res.model.response_std(data.frequency_hz[k], temp) / np.abs(truth[k])
-                acc["sigma"][temp].append(float(np.sqrt(np.mean(rel_std**2))))
+                acc["sigma"][temp].append(float(np.sqrt(np.mean(rel_std ** 2))))
         label = sample + (f" ({note})" if note else "")
         for temp in HELD_OUT:
             mean = {k: float(np.mean(acc[k][temp])) for k in acc}
@@ -214,61 +205,41 @@ def held_out_section(quick: bool):
             verdict += f"; joint / own data = {mean['joint'] / mean['own']:.2f}"
             summary.append((label, form, m, temp, r_levy, r_nlp, q_levy, verdict))
             cells = " | ".join(f"{mean[k]:.4g} ({worst[k]:.3g})" for k in ("joint", "levy", "nlp"))
-            print(
-                f"| {label} | {band[0]:g}–{band[1]:g} × {nf} | {form} | {m}/{n} | {deg} | {temp:g} | {cells} | "
-                f"{mean['order']:.4g} | {mean['own']:.4g} | {mean['sigma']:.4g} | {r_levy:.3g}; {q_levy:.3g} | {r_nlp:.3g}; {q_nlp:.3g} | "
-                f"{verdict} | {n_ok}/{len(seeds)} ({max_re:.3g}) | {np.mean(times):.1f} |"
-            )
+            print(f"| {label} | {band[0]:g}–{band[1]:g} × {nf} | {form} | {m}/{n} | {deg} | {temp:g} | {cells} | "
+                  f"{mean['order']:.4g} | {mean['own']:.4g} | {mean['sigma']:.4g} | {r_levy:.3g}; {q_levy:.3g} | {r_nlp:.3g}; {q_nlp:.3g} | "
+                  f"{verdict} | {n_ok}/{len(seeds)} ({max_re:.3g}) | {np.mean(times):.1f} |")
     n_ok = sum(r[4] <= 0.5 for r in summary)
     n_ok2 = sum(r[5] <= 0.5 for r in summary)
     n_okm = sum(r[6] <= 0.5 for r in summary)
-    print(
-        f"\nGoal 'joint error ≤ ½ two-stage (papers' Levy first stage)': met in {n_ok}/{len(summary)} rows "
-        f"(ratio of means; {n_okm}/{len(summary)} by medians); against our NLP two-stage: met in "
-        f"{n_ok2}/{len(summary)} rows."
-    )
-    print(
-        "Rows where it is not met (ratio of means): "
-        + (
-            "; ".join(
-                f"{lab} {form} {m}/{m} at {t:g} °C (×{r:.2f}, {v})"
-                for lab, form, m, t, r, _, _, v in summary
-                if r > 0.5
-            )
-            or "none"
-        )
-    )
+    print(f"\nGoal 'joint error ≤ ½ two-stage (papers' Levy first stage)': met in {n_ok}/{len(summary)} rows "
+          f"(ratio of means; {n_okm}/{len(summary)} by medians); against our NLP two-stage: met in "
+          f"{n_ok2}/{len(summary)} rows.")
+    print("Rows where it is not met (ratio of means): " + ("; ".join(
+        f"{lab} {form} {m}/{m} at {t:g} °C (×{r:.2f}, {v})" for lab, form, m, t, r, _, _, v in summary if r > 0.5)
+        or "none"))
     robustness(quick)
 
 
 def robustness(quick: bool):
     """How often the joint fit converges, over more noise draws (the cheap seed-001 cases)."""
     seeds = range(1, 5) if quick else range(1, 11)
-    print(
-        f"\nJoint-fit convergence over noise seeds {seeds.start}–{seeds.stop - 1} (seed-001 actuator, "
-        "35/45 °C held out); held-out error vs truth at 35 °C, median and worst over the seeds:\n"
-    )
+    print(f"\nJoint-fit convergence over noise seeds {seeds.start}–{seeds.stop - 1} (seed-001 actuator, "
+          "35/45 °C held out); held-out error vs truth at 35 °C, median and worst over the seeds:\n")
     print("| data | form | order | degree | converged | median err 35 °C | worst err 35 °C | seeds not converged |")
     print("|:--|:--|:--|--:|--:|--:|--:|:--|")
     f1 = np.geomspace(0.1, 9.0, 30)
-    for sample, form, m, deg in (
-        ("seed-001 actuator", "zpk", 3, 2),
-        ("seed-001 actuator", "zpk", 4, 2),
-        ("seed-001 actuator", "coefficients", 4, 2),
-    ):
+    for sample, form, m, deg in (("seed-001 actuator", "zpk", 3, 2), ("seed-001 actuator", "zpk", 4, 2),
+                                 ("seed-001 actuator", "coefficients", 4, 2)):
         errs, bad = [], []
         for seed in seeds:
             data, truth = generate_sweep(sample, SEED001_TEMPS, f1, seed)
             res = ScheduledFit(form, m, m, deg, raise_on_failure=False).fit_data(
-                data.select(~np.isin(data.temperature_c, HELD_OUT))
-            )
+                data.select(~np.isin(data.temperature_c, HELD_OUT)))
             if not (res.converged and res.stability.stable):
                 bad.append(seed)
             errs.append(_held_out_errors(res.model, data, truth)[35.0][0])
-        print(
-            f"| {sample} | {form} | {m}/{m} | {deg} | {len(errs) - len(bad)}/{len(errs)} | "
-            f"{np.median(errs):.4f} | {np.max(errs):.4f} | {bad or '–'} |"
-        )
+        print(f"| {sample} | {form} | {m}/{m} | {deg} | {len(errs) - len(bad)}/{len(errs)} | "
+              f"{np.median(errs):.4f} | {np.max(errs):.4f} | {bad or '–'} |")
 
 
 # --------------------------------------------------------------------------- 2. per temperature
@@ -291,14 +262,8 @@ def _vf(f, h, n):
         vf = VectorFitting(nw)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            vf.vector_fit(
-                n_poles_real=n_real,
-                n_poles_cmplx=(n - n_real) // 2,
-                init_pole_spacing="log",
-                fit_constant=True,
-                fit_proportional=False,
-                enforce_dc=False,
-            )
+            vf.vector_fit(n_poles_real=n_real, n_poles_cmplx=(n - n_real) // 2, init_pole_spacing="log",
+                          fit_constant=True, fit_proportional=False, enforce_dc=False)
         hm = vf.get_model_response(0, 0, freqs=f)
         err = relative_rms_error(hm, h)
         if best is None or err < best[0]:
@@ -315,11 +280,8 @@ def _levy(w, h, m, n):
     return g * np.polyval(num[::-1], jw) / np.polyval(den[::-1], jw), wr * np.roots(den[::-1])
 
 
-PER_T_CASES = [
-    ("seed-002 sample", (0.1, 20.0), 60),
-    ("seed-001 actuator", (0.1, 9.0), 60),
-    ("seed-000 sensor", (10.0, 100.0), 60),
-]
+PER_T_CASES = [("seed-002 sample", (0.1, 20.0), 60), ("seed-001 actuator", (0.1, 9.0), 60),
+               ("seed-000 sensor", (10.0, 100.0), 60)]
 
 
 def per_temperature_section(quick: bool):
@@ -327,15 +289,11 @@ def per_temperature_section(quick: bool):
     have_vf = importlib.util.find_spec("skrf") is not None
     if not have_vf:
         print("(scikit-rf not installed: VectorFitting column skipped)\n")
-    print(
-        "Relative RMS error against the noisy data (mean / worst over temperatures), against the "
-        "noise-free response in brackets; 'stable' = all poles in the open left half plane at every "
-        f"temperature; time per temperature. Noise {NOISE.sigma_db} dB / {NOISE.sigma_deg}° "
-        f"(floor ≈ {_noise_floor(NOISE):.3f}).\n"
-    )
-    print(
-        "| data | method | error vs data mean / worst | (vs truth mean / worst) | stable at all T | time per T [ms] |"
-    )
+    print("Relative RMS error against the noisy data (mean / worst over temperatures), against the "
+          "noise-free response in brackets; 'stable' = all poles in the open left half plane at every "
+          f"temperature; time per temperature. Noise {NOISE.sigma_db} dB / {NOISE.sigma_deg}° "
+          f"(floor ≈ {_noise_floor(NOISE):.3f}).\n")
+    print("| data | method | error vs data mean / worst | (vs truth mean / worst) | stable at all T | time per T [ms] |")
     print("|:--|:--|--:|--:|:--:|--:|")
     m = n = 4
     for sample, band, nf in PER_T_CASES:
@@ -351,9 +309,8 @@ def per_temperature_section(quick: bool):
             t0 = time.perf_counter()
             res = RationalFit(m, n, raise_on_failure=False).fit_data(d)
             dt = time.perf_counter() - t0
-            methods["ours (RationalFit)"].append(
-                (res.model.frequency_response(fk), res.model.poles(), dt, res.converged)
-            )
+            methods["ours (RationalFit)"].append((res.model.frequency_response(fk), res.model.poles(), dt,
+                                                         res.converged))
             t0 = time.perf_counter()
             hm, poles = _aaa(w, hk, n)
             methods["scipy AAA"].append((hm, poles, time.perf_counter() - t0, True))
@@ -370,26 +327,20 @@ def per_temperature_section(quick: bool):
             et = [relative_rms_error(r[0], truth[k]) for r, k in zip(rows, masks)]
             n_unstable = sum(not np.all(np.real(r[1]) < 0) for r in rows)
             conv = all(r[3] for r in rows)
-            print(
-                f"| {sample} {band[0]:g}–{band[1]:g} Hz | {name}{'' if conv else ' (NOT all converged)'} | "
-                f"{np.mean(e):.4f} / {np.max(e):.4f} | ({np.mean(et):.4f} / {np.max(et):.4f}) | "
-                f"{'yes' if n_unstable == 0 else f'NO ({n_unstable}/{len(rows)} T unstable)'} | "
-                f"{1e3 * np.mean([r[2] for r in rows]):.1f} |"
-            )
+            print(f"| {sample} {band[0]:g}–{band[1]:g} Hz | {name}{'' if conv else ' (NOT all converged)'} | "
+                  f"{np.mean(e):.4f} / {np.max(e):.4f} | ({np.mean(et):.4f} / {np.max(et):.4f}) | "
+                  f"{'yes' if n_unstable == 0 else f'NO ({n_unstable}/{len(rows)} T unstable)'} | "
+                  f"{1e3 * np.mean([r[2] for r in rows]):.1f} |")
 
 
 # --------------------------------------------------------------------------- 3. timing
 def timing_section(quick: bool):
     print("\n## 3. Fit times: 10 temperatures x 60 frequencies, order 4/4, cubic schedules\n")
-    print(
-        "seed-002 sample, 0.1–20 Hz, all ten seed-001 temperatures. 'first' is the first fit in "
-        "the process (it builds any CasADi solver it needs), 'second' repeats it. Per-temperature fit times are in section 2.\n"
-    )
+    print("seed-002 sample, 0.1–20 Hz, all ten seed-001 temperatures. 'first' is the first fit in "
+          "the process (it builds any CasADi solver it needs), 'second' repeats it. Per-temperature fit times are in section 2.\n")
     data, _ = generate_sweep("seed-002 sample", SEED001_TEMPS, np.geomspace(0.1, 20.0, 60), seed=21)
-    print(
-        "| method | form | run | total [s] | of which per-T stage [s] | of which joint NLP [s] | "
-        "joint iterations | converged |"
-    )
+    print("| method | form | run | total [s] | of which per-T stage [s] | of which joint NLP [s] | "
+          "joint iterations | converged |")
     print("|:--|:--|:--|--:|--:|--:|--:|:--:|")
     for form in ("coefficients", "zpk"):
         for run in ("first", "second"):
@@ -398,23 +349,18 @@ def timing_section(quick: bool):
             total = time.perf_counter() - t0
             joint = [e for e in res.history if e["stage"].startswith("joint")]
             per_t = [e for e in res.history if e["stage"].startswith("per-T")]
-            print(
-                f"| joint (ours) | {form} | {run} | {total:.2f} | {sum(e['time_s'] for e in per_t):.2f} | "
-                f"{sum(e['time_s'] for e in joint):.2f} | {sum(e['iterations'] for e in joint)} | "
-                f"{'yes' if res.converged else 'NO (' + res.status + ')'} |"
-            )
+            print(f"| joint (ours) | {form} | {run} | {total:.2f} | {sum(e['time_s'] for e in per_t):.2f} | "
+                  f"{sum(e['time_s'] for e in joint):.2f} | {sum(e['iterations'] for e in joint)} | "
+                  f"{'yes' if res.converged else 'NO (' + res.status + ')'} |")
         for per_t_name in ("levy", "nlp"):
             t0 = time.perf_counter()
-            res = ScheduledFit(
-                form, 4, 4, 3, method="two-stage", per_temperature=per_t_name, raise_on_failure=False
-            ).fit_data(data)
+            res = ScheduledFit(form, 4, 4, 3, method="two-stage", per_temperature=per_t_name,
+                               raise_on_failure=False).fit_data(data)
             total = time.perf_counter() - t0
             label = "two-stage, Levy first stage (papers')" if per_t_name == "levy" else "two-stage, NLP first stage"
-            print(
-                f"| {label} | {form} | cached | {total:.2f} | "
-                f"{sum(e['time_s'] for e in res.history if e['stage'].startswith('per-T')):.2f} | – | – | "
-                f"{'yes' if res.converged else 'NO (' + res.status + ')'} |"
-            )
+            print(f"| {label} | {form} | cached | {total:.2f} | "
+                  f"{sum(e['time_s'] for e in res.history if e['stage'].startswith('per-T')):.2f} | – | – | "
+                  f"{'yes' if res.converged else 'NO (' + res.status + ')'} |")
     t0 = time.perf_counter()
     for temp in SEED001_TEMPS:
         d = data.at_temperature(temp)
@@ -426,18 +372,13 @@ def timing_section(quick: bool):
 def _orders(sample, temps, f1, orders, seed):
     """Order selection on the noisy protocol sweep and on its noise-free truth."""
     data, truth = generate_sweep(sample, temps, f1, seed, noise=ORDER_NOISE)
-    rep = order_selection(
-        data.frequency_hz, data.temperature_c, data.response, orders, data.magnitude_std_db, data.phase_std_deg
-    )
+    rep = order_selection(data.frequency_hz, data.temperature_c, data.response, orders,
+                          data.magnitude_std_db, data.phase_std_deg)
     rep0 = order_selection(data.frequency_hz, data.temperature_c, truth, orders)
     print(rep.to_markdown())
-    print(
-        "\nNoise-free truth (model bias only): "
-        + "; ".join(
-            f"{r.n_zeros}/{r.n_poles}: worst err {r.worst_relative_rms_error:.4f}, min fit {r.min_fit_percent:.2f} %"
-            for r in rep0.rows
-        )
-    )
+    print("\nNoise-free truth (model bias only): " + "; ".join(
+        f"{r.n_zeros}/{r.n_poles}: worst err {r.worst_relative_rms_error:.4f}, min fit {r.min_fit_percent:.2f} %"
+        for r in rep0.rows))
     return rep, rep0
 
 
@@ -449,11 +390,9 @@ def order_section(quick: bool):
     claims = []
     print("\n## 4. Order selection and the papers' claims on physics sweeps\n")
     floor = _noise_floor(ORDER_NOISE)
-    print(
-        f"Protocol noise {ORDER_NOISE.sigma_db} dB / {ORDER_NOISE.sigma_deg}° (floor ≈ {floor:.3f}); "
-        "'rel. RMS error' and 'fit %' (100·(1 − NRMSE), MATLAB ident) are against the noisy data; "
-        "the noise-free line separates model bias from noise.\n"
-    )
+    print(f"Protocol noise {ORDER_NOISE.sigma_db} dB / {ORDER_NOISE.sigma_deg}° (floor ≈ {floor:.3f}); "
+          "'rel. RMS error' and 'fit %' (100·(1 − NRMSE), MATLAB ident) are against the noisy data; "
+          "the noise-free line separates model bias from noise.\n")
 
     # ---- seed 001
     print("### Seed 001 protocol: 30 log-spaced lines on 0.1–9 Hz, 19 and 55 °C\n")
@@ -468,19 +407,12 @@ def order_section(quick: bool):
         c2 = e[4] > 0.8 * e[3]
         c2b = e23 >= 0.95 * e[3]
         print(f"\n- 2nd order clearly worse than 3rd: error ×{e[2] / e[3]:.1f} → {_verdict(c1)}")
-        print(
-            f"- 4th adds little over 3rd: error 4th/3rd = {e[4] / e[3]:.2f} (noise-free bias "
-            f"{b[3]:.4f} → {b[4]:.4f}) → {_verdict(c2)}"
-        )
-        print(
-            f"- strictly proper 3rd order (2 zeros / 3 poles) fits no better than the proper 3/3: "
-            f"error 2/3 ÷ 3/3 = {e23 / e[3]:.2f} → {_verdict(c2b)}\n"
-        )
-        claims += [
-            (f"001: 2nd order clearly worse ({sample})", c1),
-            (f"001: 4th adds little over 3rd ({sample})", c2),
-            (f"001: strictly proper 3rd no better than proper ({sample})", c2b),
-        ]
+        print(f"- 4th adds little over 3rd: error 4th/3rd = {e[4] / e[3]:.2f} (noise-free bias "
+              f"{b[3]:.4f} → {b[4]:.4f}) → {_verdict(c2)}")
+        print(f"- strictly proper 3rd order (2 zeros / 3 poles) fits no better than the proper 3/3: "
+              f"error 2/3 ÷ 3/3 = {e23 / e[3]:.2f} → {_verdict(c2b)}\n")
+        claims += [(f"001: 2nd order clearly worse ({sample})", c1), (f"001: 4th adds little over 3rd ({sample})", c2),
+                   (f"001: strictly proper 3rd no better than proper ({sample})", c2b)]
 
     # zeros / poles of per-temperature fits at all ten temperatures (seed 001's observations)
     data, truth = generate_sweep("seed-001 actuator", SEED001_TEMPS, f001, seed=32, noise=ORDER_NOISE)
@@ -494,57 +426,37 @@ def order_section(quick: bool):
     c3 = all(rhp_pair)
     c4 = sum(r > 10 for r in big_pole) >= len(big_pole) / 2
     print("Seed-001 actuator, all ten temperatures (noisy protocol):")
-    print(
-        f"- 3/3 fit has a complex pair of right-half-plane zeros at every temperature: "
-        f"{sum(rhp_pair)}/{len(rhp_pair)} temperatures → {_verdict(c3)}"
-    )
-    print(
-        f"- 4/4 fit 'often shows one very large negative pole' (|p| > 10 × band edge): "
-        f"{sum(r > 10 for r in big_pole)}/{len(big_pole)} temperatures (largest |p| / (2π·9 Hz) from "
-        f"{min(big_pole):.1f} to {max(big_pole):.1f}) → {_verdict(c4)}"
-    )
+    print(f"- 3/3 fit has a complex pair of right-half-plane zeros at every temperature: "
+          f"{sum(rhp_pair)}/{len(rhp_pair)} temperatures → {_verdict(c3)}")
+    print(f"- 4/4 fit 'often shows one very large negative pole' (|p| > 10 × band edge): "
+          f"{sum(r > 10 for r in big_pole)}/{len(big_pole)} temperatures (largest |p| / (2π·9 Hz) from "
+          f"{min(big_pole):.1f} to {max(big_pole):.1f}) → {_verdict(c4)}")
     # response shape: resonance shift and the 19 vs 55 °C magnitude difference (noise-free, dense)
     fd = np.geomspace(0.1, 9, 400)
     sw = synthesize_sweep(physics_model("seed-001 actuator"), "M", fd, [19.0, 55.0], None)
     _, _, H = sw.grid()
     fpk = fd[np.argmax(np.abs(H), axis=1)]
-    diff = 20 * np.log10(np.abs(H[0]) / np.abs(H[1]))  # > 0: 19 °C larger
+    diff = 20 * np.log10(np.abs(H[0]) / np.abs(H[1]))   # > 0: 19 °C larger
     i = int(np.argmax(np.abs(diff)))
     j = int(np.argmax(diff))
     k3 = int(np.argmin(np.abs(fd - 3.0)))
     c5 = fpk[1] < fpk[0]
     c6 = diff[i] > 3.5 and 1.5 < fd[i] < 6
-    print(
-        f"- resonance shifts lower as T rises: peak {fpk[0]:.2f} Hz at 19 °C → {fpk[1]:.2f} Hz at 55 °C → {_verdict(c5)}"
-    )
-    print(
-        f"- largest 19 vs 55 °C magnitude difference ≈ 7 dB near 3 Hz, 19 °C larger: the physics' largest "
-        f"difference is {diff[i]:+.2f} dB at {fd[i]:.2f} Hz ({'19' if diff[i] > 0 else '55'} °C larger); "
-        f"19 °C is larger by at most {diff[j]:.2f} dB (at {fd[j]:.2f} Hz), {diff[k3]:+.2f} dB at 3 Hz "
-        f"→ {_verdict(c6)}\n"
-    )
-    claims += [
-        ("001: complex RHP zero pair at every T (3/3)", c3),
-        ("001: 4th order shows a very large pole", c4),
-        ("001: resonance shifts lower with T", c5),
-        ("001: ~7 dB drop near 3 Hz from 19 to 55 °C", c6),
-    ]
+    print(f"- resonance shifts lower as T rises: peak {fpk[0]:.2f} Hz at 19 °C → {fpk[1]:.2f} Hz at 55 °C → {_verdict(c5)}")
+    print(f"- largest 19 vs 55 °C magnitude difference ≈ 7 dB near 3 Hz, 19 °C larger: the physics' largest "
+          f"difference is {diff[i]:+.2f} dB at {fd[i]:.2f} Hz ({'19' if diff[i] > 0 else '55'} °C larger); "
+          f"19 °C is larger by at most {diff[j]:.2f} dB (at {fd[j]:.2f} Hz), {diff[k3]:+.2f} dB at 3 Hz "
+          f"→ {_verdict(c6)}\n")
+    claims += [("001: complex RHP zero pair at every T (3/3)", c3), ("001: 4th order shows a very large pole", c4),
+               ("001: resonance shifts lower with T", c5), ("001: ~7 dB drop near 3 Hz from 19 to 55 °C", c6)]
 
     # ---- seed 002
-    print(
-        "### Seed 002 protocol: seed-002 sample (Table 3), 60 log-spaced lines on 0.1–100 Hz, 300 K, "
-        "the four printed widths\n"
-    )
+    print("### Seed 002 protocol: seed-002 sample (Table 3), 60 log-spaced lines on 0.1–100 Hz, 300 K, "
+          "the four printed widths\n")
     c7 = c8 = True
     for k, width_mm in enumerate((4.0, 2.0, 1.0, 0.5)):
-        data, truth = generate_sweep(
-            "seed-002 sample",
-            [26.85],
-            np.geomspace(0.1, 100, 60),
-            seed=41,
-            noise=ORDER_NOISE,
-            overrides={"W": width_mm * 1e-3},
-        )
+        data, truth = generate_sweep("seed-002 sample", [26.85], np.geomspace(0.1, 100, 60), seed=41,
+                                     noise=ORDER_NOISE, overrides={"W": width_mm * 1e-3})
         rep = order_selection(data, orders=[(1, 4), (2, 5)])
         rep0 = order_selection(data.frequency_hz, data.temperature_c, truth, orders=[(1, 4), (2, 5)])
         if k == 0:
@@ -554,59 +466,43 @@ def order_section(quick: bool):
         c7 &= f25 >= 92.5
         c8 &= f14 < f25 - 2
         print(f"- W = {width_mm:g} mm: fit 4p/1z {f14:.2f} %, 5p/2z {f25:.2f} % (noise-free {g14:.2f} % / {g25:.2f} %)")
-    print(
-        f"\n- 5 poles / 2 zeros fit ≥ 92.5 % at every width → {_verdict(c7)} (the noisy fit % is set by the "
-        f"protocol noise: the noise-free 5p/2z fit is ≈ 100 %)"
-    )
-    print(
-        f"- 4 poles / 1 zero fits the resonance but misses the response (fit % more than 2 points below "
-        f"5p/2z) → {_verdict(c8)}: the physics itself is fitted by 4p/1z nearly as well as by 5p/2z; the "
-        f"paper's misfit is of measured data, not of this model\n"
-    )
+    print(f"\n- 5 poles / 2 zeros fit ≥ 92.5 % at every width → {_verdict(c7)} (the noisy fit % is set by the "
+          f"protocol noise: the noise-free 5p/2z fit is ≈ 100 %)")
+    print(f"- 4 poles / 1 zero fits the resonance but misses the response (fit % more than 2 points below "
+          f"5p/2z) → {_verdict(c8)}: the physics itself is fitted by 4p/1z nearly as well as by 5p/2z; the "
+          f"paper's misfit is of measured data, not of this model\n")
     claims += [("002: 5p/2z fit ≥ 92.5 %", c7), ("002: 4p/1z clearly worse than 5p/2z", c8)]
 
     # ---- seed 000
     print("### Seed 000 protocol: seed-000 sensor, 60 log-spaced lines on 10–100 Hz, 23 and 65 °C\n")
-    rep, rep0 = _orders(
-        "seed-000 sensor", [23.0, 65.0], np.geomspace(10, 100, 60), [(1, 1), (2, 2), (3, 3), (4, 4)], seed=51
-    )
+    rep, rep0 = _orders("seed-000 sensor", [23.0, 65.0], np.geomspace(10, 100, 60),
+                        [(1, 1), (2, 2), (3, 3), (4, 4)], seed=51)
     b = {k: rep0.row(k, k).worst_relative_rms_error for k in (1, 2, 3, 4)}
     need4 = b[3] > 2 * b[4] and rep.row(3, 3).worst_relative_rms_error > 1.2 * rep.row(4, 4).worst_relative_rms_error
-    print(
-        f"\n- does the physics need seed 000's 4/4? noise-free bias 2/2 {b[2]:.2e}, 3/3 {b[3]:.2e}, "
-        f"4/4 {b[4]:.2e} → {'yes' if need4 else 'no: a lower order already reaches the noise floor'}"
-    )
+    print(f"\n- does the physics need seed 000's 4/4? noise-free bias 2/2 {b[2]:.2e}, 3/3 {b[3]:.2e}, "
+          f"4/4 {b[4]:.2e} → {'yes' if need4 else 'no: a lower order already reaches the noise floor'}")
     fd = np.geomspace(10, 100, 200)
     sw = synthesize_sweep(physics_model("seed-000 sensor"), "S", fd, SEED000_TEMPS, None)
     _, temps, H = sw.grid()
     mag, ph = 20 * np.log10(np.abs(H)), np.degrees(np.unwrap(np.angle(H), axis=1))
-    slope = (mag[:, -1] - mag[:, 0]) / 20.0  # dB per decade / 20 = log-log slope
+    slope = (mag[:, -1] - mag[:, 0]) / 20.0   # dB per decade / 20 = log-log slope
     c9 = bool(np.all(np.diff(mag[:, -1]) < 0))
     c10 = bool(np.all(np.diff(ph[:, 0]) < 0))
-    print(
-        f"- high-frequency gain decreases with T: |S(100 Hz)| {mag[0, -1]:.2f} dB at 23 °C → "
-        f"{mag[-1, -1]:.2f} dB at 65 °C, monotone → {_verdict(c9)}"
-    )
-    print(
-        f"- phase lag increases with T: phase at 10 Hz {ph[0, 0]:+.1f}° → {ph[-1, 0]:+.1f}°, monotone → {_verdict(c10)}"
-    )
+    print(f"- high-frequency gain decreases with T: |S(100 Hz)| {mag[0, -1]:.2f} dB at 23 °C → "
+          f"{mag[-1, -1]:.2f} dB at 65 °C, monotone → {_verdict(c9)}")
+    print(f"- phase lag increases with T: phase at 10 Hz {ph[0, 0]:+.1f}° → {ph[-1, 0]:+.1f}°, monotone → {_verdict(c10)}")
     num = [-17.3, 2.2e4, -1.0e7, -9.4e8, 4.5e10]
     den = [1.0, 835.0, 6.3e5, 2.5e8, 4.4e10]
     s = 2j * np.pi * np.array([10.0, 100.0])
     hp = np.polyval(num, s) / np.polyval(den, s)
     k35 = list(temps).index(35.0)
-    print(
-        f"- cutoff frequency decreases with T (high-pass view): not testable — the physics magnitude rises "
-        f"with log-log slope {slope.min():.2f}–{slope.max():.2f} over the whole band (differentiator regime, "
-        f"corner above 100 Hz); seed 000's printed 35 °C model goes {20 * np.log10(abs(hp[0])):.1f} → "
-        f"{20 * np.log10(abs(hp[1])):.1f} dB and {np.degrees(np.angle(hp[0])):+.0f}° at 10 Hz, the physics "
-        f"{mag[k35, 0]:.1f} → {mag[k35, -1]:.1f} dB and {ph[k35, 0]:+.0f}°"
-    )
-    claims += [
-        ("000: HF gain decreases with T", c9),
-        ("000: phase lag increases with T", c10),
-        ("000: physics needs 4/4", need4),
-    ]
+    print(f"- cutoff frequency decreases with T (high-pass view): not testable — the physics magnitude rises "
+          f"with log-log slope {slope.min():.2f}–{slope.max():.2f} over the whole band (differentiator regime, "
+          f"corner above 100 Hz); seed 000's printed 35 °C model goes {20 * np.log10(abs(hp[0])):.1f} → "
+          f"{20 * np.log10(abs(hp[1])):.1f} dB and {np.degrees(np.angle(hp[0])):+.0f}° at 10 Hz, the physics "
+          f"{mag[k35, 0]:.1f} → {mag[k35, -1]:.1f} dB and {ph[k35, 0]:+.0f}°")
+    claims += [("000: HF gain decreases with T", c9), ("000: phase lag increases with T", c10),
+               ("000: physics needs 4/4", need4)]
 
     print("\n### Summary of the claims checked on the physics sweeps\n")
     print("| claim | on physmodel sweeps |")

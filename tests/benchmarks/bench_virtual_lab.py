@@ -55,9 +55,8 @@ def setup():
     truth = base.replace(d=base.d * 1.4, alpha0=base.alpha0 * 0.8, E=base.E * 1.15, name="virtual_strip")
     f = np.unique(np.round(np.geomspace(0.1, 9.0, 30) * PERIOD)) / PERIOD
     ms = multisine(f, FS, PERIOD, rms=1.0)
-    meas = lambda seed: Measurement(
-        output_noise_rms=20e-6, output_adc_step=10e-3 / 2**16, input_adc_step=20.0 / 2**16, seed=seed
-    )
+    meas = lambda seed: Measurement(output_noise_rms=20e-6, output_adc_step=10e-3 / 2**16,
+                                    input_adc_step=20.0 / 2**16, seed=seed)
     return base, truth, f, ms, meas
 
 
@@ -69,17 +68,11 @@ def stage_surrogate_and_inversion(data, truth_model, label, **fit_kw):
     fit = fit_sweep(data.exclude(HELD), 4, 4, 2, form="zpk", method="joint", raise_on_failure=False, **fit_kw)
     t_fit = time.perf_counter() - t0
     exact = synthesize_sweep(truth_model, "M", np.unique(data.frequency_hz), TEMPS)
-    held = [
-        relative_rms_error(
-            fit.model.frequency_response(exact.select(T).frequency_hz, T, extrapolate=True), exact.select(T).response
-        )
-        for T in HELD
-    ]
-    print(
-        f"  [{label}] surrogate zpk 4/4 degree 2, joint on {len(TEMPS) - len(HELD)} temperatures: converged="
-        f"{fit.converged}, held-out rel. RMS vs true physics {', '.join(f'{T:g} °C {e:.4f}' for T, e in zip(HELD, held))}"
-        f" ({t_fit:.2f} s)"
-    )
+    held = [relative_rms_error(fit.model.frequency_response(exact.select(T).frequency_hz, T, extrapolate=True),
+                               exact.select(T).response) for T in HELD]
+    print(f"  [{label}] surrogate zpk 4/4 degree 2, joint on {len(TEMPS) - len(HELD)} temperatures: converged="
+          f"{fit.converged}, held-out rel. RMS vs true physics {', '.join(f'{T:g} °C {e:.4f}' for T, e in zip(HELD, held))}"
+          f" ({t_fit:.2f} s)")
     # demo.toml [inversion]: 8 kHz, 12 s, error window 6-11.5 s, lead 1 s, raised-cosine ramp 2 s
     fs, dur, A, fr, T = 8000.0, 12.0, 0.65, 2.0, 45.0
     t = time_grid(dur, fs)
@@ -97,11 +90,9 @@ def stage_surrogate_and_inversion(data, truth_model, label, **fit_kw):
     emax = float(np.max(np.abs(got - ref)[win]))
     P = truth_model.frequency_response([fr], [T])["M"][0, 0, 0] * 1e3
     pred = A * abs(P / complex(G(2j * np.pi * fr)) - 1)
-    print(
-        f"  [{label}] feedforward 2 Hz, {A} mm at {T:g} °C on the true plant: max |error| {emax:.5f} mm "
-        f"({emax / A:.2%}), steady-state prediction A|P/G − 1| = {pred:.5f} mm, ratio {emax / pred:.3f} "
-        f"(inversion {t_inv:.2f} s, plant simulation {t_sim:.2f} s)"
-    )
+    print(f"  [{label}] feedforward 2 Hz, {A} mm at {T:g} °C on the true plant: max |error| {emax:.5f} mm "
+          f"({emax / A:.2%}), steady-state prediction A|P/G − 1| = {pred:.5f} mm, ratio {emax / pred:.3f} "
+          f"(inversion {t_inv:.2f} s, plant simulation {t_sim:.2f} s)")
     return fit
 
 
@@ -111,46 +102,35 @@ def chain(periods: int, oversample: int):
     real = model_realization(tm, TEMPS[0], FS, 100.0)
     settle = settle_time_s(real.poles, 1e-6)
     tp = math.ceil(settle / PERIOD)
-    print(
-        f"== whole chain: seed 001 actuator with d×1.4, alpha0×0.8, E×1.15 (the truth); {len(TEMPS)} temperatures; "
-        f"multisine {f.size} lines {f[0]:g}-{f[-1]:g} Hz, period {PERIOD:g} s at {FS:g} Hz, crest factor "
-        f"{ms.crest_factor:.2f}; {tp} transient period(s) (slowest pole settles to 1e-6 in {settle:.1f} s) + "
-        f"{periods} measured; laser 20 µm RMS, 16-bit ADCs (±10 V, ±5 mm); simulation oversampled ×{oversample}"
-    )
+    print(f"== whole chain: seed 001 actuator with d×1.4, alpha0×0.8, E×1.15 (the truth); {len(TEMPS)} temperatures; "
+          f"multisine {f.size} lines {f[0]:g}-{f[-1]:g} Hz, period {PERIOD:g} s at {FS:g} Hz, crest factor "
+          f"{ms.crest_factor:.2f}; {tp} transient period(s) (slowest pole settles to 1e-6 in {settle:.1f} s) + "
+          f"{periods} measured; laser 20 µm RMS, 16-bit ADCs (±10 V, ±5 mm); simulation oversampled ×{oversample}")
     t0 = time.perf_counter()
-    r = virtual_lab(
-        tm, ms, TEMPS, meas(2026), periods=periods, transient_periods=tp, oversample=oversample, max_std_db=1.0
-    )
+    r = virtual_lab(tm, ms, TEMPS, meas(2026), periods=periods, transient_periods=tp, oversample=oversample,
+                    max_std_db=1.0)
     t_lab = time.perf_counter() - t0
     ex = synthesize_sweep(tm, "M", r.sweep.frequency_hz[r.sweep.temperature_c == TEMPS[0]], TEMPS)
     d = np.log(r.sweep.response / ex.response)
     tt = np.concatenate([d.real / (r.sweep.magnitude_std_db * LN), d.imag / np.radians(r.sweep.phase_std_deg)])
     nu = 2 * (periods - 1)
-    print(
-        f"  virtual lab: {r.sweep.frequency_hz.size} lines kept of {f.size * len(TEMPS)}; {r.duration_s:g} s of "
-        f"measurement per temperature ({r.duration_s * len(TEMPS) / 60:.1f} min in the lab); wall {t_lab:.2f} s = "
-        + ", ".join(f"{k} {v:.2f} s" for k, v in r.timings_s.items())
-    )
-    print(
-        f"  FRF vs true physics: median σ {np.median(r.sweep.magnitude_std_db):.4f} dB / "
-        f"{np.median(r.sweep.phase_std_deg):.4f}°; max |error| {np.max(np.abs(20 * np.log10(np.abs(r.sweep.response / ex.response)))):.4f} dB; "
-        f"mean t² {np.mean(tt**2):.3f} (t_{nu}: {nu / (nu - 2):.3f}); |t| ≤ 2 for {np.mean(np.abs(tt) <= 2):.3f} "
-        f"(t_{nu}: {stats.t.cdf(2, nu) - stats.t.cdf(-2, nu):.3f})"
-    )
+    print(f"  virtual lab: {r.sweep.frequency_hz.size} lines kept of {f.size * len(TEMPS)}; {r.duration_s:g} s of "
+          f"measurement per temperature ({r.duration_s * len(TEMPS) / 60:.1f} min in the lab); wall {t_lab:.2f} s = "
+          + ", ".join(f"{k} {v:.2f} s" for k, v in r.timings_s.items()))
+    print(f"  FRF vs true physics: median σ {np.median(r.sweep.magnitude_std_db):.4f} dB / "
+          f"{np.median(r.sweep.phase_std_deg):.4f}°; max |error| {np.max(np.abs(20 * np.log10(np.abs(r.sweep.response / ex.response)))):.4f} dB; "
+          f"mean t² {np.mean(tt**2):.3f} (t_{nu}: {nu / (nu - 2):.3f}); |t| ≤ 2 for {np.mean(np.abs(tt) <= 2):.3f} "
+          f"(t_{nu}: {stats.t.cdf(2, nu) - stats.t.cdf(-2, nu):.3f})")
     t0 = time.perf_counter()
     res = calibrate(r.sweep, base, list(FREE), starts=4, seed=0)
     t_cal = time.perf_counter() - t0
-    print(
-        f"  calibration from the published set ({t_cal:.2f} s, converged={res.converged}, cost {res.cost:.1f}, "
-        f"Gaussian expectation {res.expected_cost:.1f}, Student-t {0.5 * (2 * res.n_lines - 3) * nu / (nu - 2):.1f}):"
-    )
+    print(f"  calibration from the published set ({t_cal:.2f} s, converged={res.converged}, cost {res.cost:.1f}, "
+          f"Gaussian expectation {res.expected_cost:.1f}, Student-t {0.5 * (2 * res.n_lines - 3) * nu / (nu - 2):.1f}):")
     for n in FREE:
         true = getattr(truth, n)
-        print(
-            f"    {n:7s} true {true:.5g}  estimate {res.values[n]:.5g}  rel. error {res.values[n] / true - 1:+.2e}  "
-            f"95 % [{res.ci_lower[n]:.5g}, {res.ci_upper[n]:.5g}]  inside {res.ci_lower[n] <= true <= res.ci_upper[n]}  "
-            f"(start {getattr(base, n):.5g})"
-        )
+        print(f"    {n:7s} true {true:.5g}  estimate {res.values[n]:.5g}  rel. error {res.values[n] / true - 1:+.2e}  "
+              f"95 % [{res.ci_lower[n]:.5g}, {res.ci_upper[n]:.5g}]  inside {res.ci_lower[n] <= true <= res.ci_upper[n]}  "
+              f"(start {getattr(base, n):.5g})")
     cal_model = ActuatorModel(res.parameters)
     fd = np.geomspace(0.1, 9.0, 200)
     dev = np.abs(cal_model.frequency_response(fd, TEMPS)["M"][0] / tm.frequency_response(fd, TEMPS)["M"][0] - 1)
@@ -169,16 +149,8 @@ def coverage(draws: int, periods: int, tp: int, oversample: int):
     nu = 2 * (periods - 1)
     inside, z, t_all = [], [], time.perf_counter()
     for k in range(draws):
-        r = virtual_lab(
-            tm,
-            ms,
-            temps,
-            meas(10_000 + k),
-            periods=periods,
-            transient_periods=tp,
-            oversample=oversample,
-            max_std_db=1.0,
-        )
+        r = virtual_lab(tm, ms, temps, meas(10_000 + k), periods=periods, transient_periods=tp, oversample=oversample,
+                        max_std_db=1.0)
         res = calibrate(r.sweep, base, list(FREE), starts=2, seed=0)
         inside.append([res.ci_lower[n] <= getattr(truth, n) <= res.ci_upper[n] for n in FREE])
         z.append([(res.values[n] - getattr(truth, n)) / res.stderr[n] for n in FREE])
@@ -188,18 +160,12 @@ def coverage(draws: int, periods: int, tp: int, oversample: int):
     lo_sd, hi_sd = math.sqrt(nu / (nu - 2)), math.sqrt(nu / (nu - 4))
     cov = lambda sd: 2 * stats.norm.cdf(1.96 / sd) - 1
     band = 1.96 * math.sqrt(0.9 * 0.1 / draws)
-    print(
-        f"== calibration coverage over {draws} draws (2 temperatures, {periods} periods; {time.perf_counter() - t_all:.1f} s)"
-    )
-    print(
-        f"  expected with σ estimated on ν = {nu}: between {cov(hi_sd):.3f} and {cov(lo_sd):.3f} (±{band:.3f} "
-        f"binomial 95 %); nominal 0.95"
-    )
+    print(f"== calibration coverage over {draws} draws (2 temperatures, {periods} periods; {time.perf_counter() - t_all:.1f} s)")
+    print(f"  expected with σ estimated on ν = {nu}: between {cov(hi_sd):.3f} and {cov(lo_sd):.3f} (±{band:.3f} "
+          f"binomial 95 %); nominal 0.95")
     for i, n in enumerate(FREE):
-        print(
-            f"  {n:7s} coverage {inside[:, i].mean():.3f}; standardised error mean {z[:, i].mean():+.3f}, "
-            f"sd {z[:, i].std(ddof=1):.3f} (expected {lo_sd:.3f}-{hi_sd:.3f})"
-        )
+        print(f"  {n:7s} coverage {inside[:, i].mean():.3f}; standardised error mean {z[:, i].mean():+.3f}, "
+              f"sd {z[:, i].std(ddof=1):.3f} (expected {lo_sd:.3f}-{hi_sd:.3f})")
 
 
 def demo():
@@ -209,7 +175,7 @@ def demo():
     from scenarios.demo import DEMO_SCENARIO
     from scenarios.spec import load_scenario
 
-    spec = load_scenario(DEMO_SCENARIO)  # its [sweep] source is the virtual lab
+    spec = load_scenario(DEMO_SCENARIO)          # its [sweep] source is the virtual lab
     with tempfile.TemporaryDirectory() as out:
         res = runner.run_scenario(spec, out, quiet=True)
         print("== flagship demo with its sweep from the virtual lab (seed001_actuator, 20 µm laser noise, 16-bit ADCs)")

@@ -33,7 +33,7 @@ def main():
     ap.add_argument("--memory-gb", type=float, default=4.0)
     ap.add_argument("--show", type=int, default=4, help="bad cases listed per category")
     a = ap.parse_args()
-    lim = int(a.memory_gb * 2**30)
+    lim = int(a.memory_gb * 2 ** 30)
     resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
     sys.path.insert(0, str(Path(a.root).resolve()))
     sys.path.insert(1, str(HERE / "tests" / "reliability"))
@@ -61,11 +61,8 @@ def main():
                 if out.verdict == "bad":
                     bad.append(f"{case.what}: {out.detail}"[:240])
         rows.append((cat, a.n, counts["clear"], counts["bad"] + counts["setup"], time.perf_counter() - t0))
-        print(
-            f"{cat:20s} tried {a.n:4d}  clear {counts['clear']:4d}  bad {counts['bad'] + counts['setup']:4d}"
-            f"  ({rows[-1][4]:.0f} s)",
-            flush=True,
-        )
+        print(f"{cat:20s} tried {a.n:4d}  clear {counts['clear']:4d}  bad {counts['bad'] + counts['setup']:4d}"
+              f"  ({rows[-1][4]:.0f} s)", flush=True)
         for b in bad[: a.show]:
             print(f"    bad: {b}", flush=True)
     tot = [sum(r[k] for r in rows) for k in (1, 2, 3)]

@@ -27,7 +27,7 @@ def _solve_band(A, b, w):
         if k >= 0:
             ab[w - k, k:] = d
         else:
-            ab[w - k, : n + k] = d
+            ab[w - k, :n + k] = d
     return solve_banded((w, w), ab, b)
 
 
@@ -53,31 +53,10 @@ def fe_cantilever_tip(s_values, moment, *, n_el=80, L=1.0, EI=1.0, rhoA=1.0, ray
     (tip, tip_static) : complex ndarray per s, and the static (s = 0) tip deflection. [m]
     """
     le = L / n_el
-    ke = (
-        EI
-        / le**3
-        * np.array(
-            [
-                [12, 6 * le, -12, 6 * le],
-                [6 * le, 4 * le**2, -6 * le, 2 * le**2],
-                [-12, -6 * le, 12, -6 * le],
-                [6 * le, 2 * le**2, -6 * le, 4 * le**2],
-            ]
-        )
-    )
-    me = (
-        rhoA
-        * le
-        / 420
-        * np.array(
-            [
-                [156, 22 * le, 54, -13 * le],
-                [22 * le, 4 * le**2, 13 * le, -3 * le**2],
-                [54, 13 * le, 156, -22 * le],
-                [-13 * le, -3 * le**2, -22 * le, 4 * le**2],
-            ]
-        )
-    )
+    ke = EI / le**3 * np.array([[12, 6 * le, -12, 6 * le], [6 * le, 4 * le**2, -6 * le, 2 * le**2],
+                                [-12, -6 * le, 12, -6 * le], [6 * le, 2 * le**2, -6 * le, 4 * le**2]])
+    me = rhoA * le / 420 * np.array([[156, 22 * le, 54, -13 * le], [22 * le, 4 * le**2, 13 * le, -3 * le**2],
+                                     [54, 13 * le, 156, -22 * le], [-13 * le, -3 * le**2, -22 * le, 4 * le**2]])
     n = 2 * (n_el + 1)
     K = np.zeros((n, n))
     M = np.zeros((n, n))
@@ -89,8 +68,8 @@ def fe_cantilever_tip(s_values, moment, *, n_el=80, L=1.0, EI=1.0, rhoA=1.0, ray
         K[idx, idx] += ke
         M[idx, idx] += me
         m = np.asarray(moment(e * le + le * zq), dtype=complex)
-        f[idx] += _hermite_d2(zq, le) @ (m * wq) * le  # f_i = ∫ m N_i'' dz
-    K, M, f = K[2:, 2:], M[2:, 2:], f[2:]  # clamp: w = θ = 0 at z = 0
+        f[idx] += _hermite_d2(zq, le) @ (m * wq) * le       # f_i = ∫ m N_i'' dz
+    K, M, f = K[2:, 2:], M[2:, 2:], f[2:]                     # clamp: w = θ = 0 at z = 0
     C = rayleigh[0] * M + rayleigh[1] * K
     tip_static = _solve_band(K.astype(complex), f, 3)[-2]
     tip = np.array([_solve_band(K + s * C + s * s * M, f, 3)[-2] for s in np.atleast_1d(s_values)])
@@ -118,11 +97,11 @@ def ladder_with_series(y, r1, L, n, z_series=None, V=1.0):
     def ui(k):
         return 0 if k == 0 else 2 * k - 1
 
-    def li(k):  # k >= 1
+    def li(k):                                   # k >= 1
         return 2 * k
 
     for k in range(n + 1):
-        for kk in (k - 1, k + 1):  # rail neighbours
+        for kk in (k - 1, k + 1):                # rail neighbours
             if 0 <= kk <= n:
                 A[ui(k), ui(k)] += g
                 A[ui(k), ui(kk)] -= g
@@ -130,7 +109,7 @@ def ladder_with_series(y, r1, L, n, z_series=None, V=1.0):
                     A[li(k), li(k)] += g
                     if kk >= 1:
                         A[li(k), li(kk)] -= g
-        A[ui(k), ui(k)] += ysh[k]  # shunt u_k — l_k
+        A[ui(k), ui(k)] += ysh[k]                # shunt u_k — l_k
         if k >= 1:
             A[ui(k), li(k)] -= ysh[k]
             A[li(k), li(k)] += ysh[k]
@@ -145,5 +124,5 @@ def ladder_with_series(y, r1, L, n, z_series=None, V=1.0):
     x = _solve_band(A, b, 2)
     u = x[[ui(k) for k in range(n + 1)]]
     lo = np.concatenate([[0.0], x[[li(k) for k in range(1, n + 1)]]])
-    I_in = g * (u[0] - u[1]) + ysh[0] * (u[0] - lo[0])  # current leaving the top terminal node
+    I_in = g * (u[0] - u[1]) + ysh[0] * (u[0] - lo[0])       # current leaving the top terminal node
     return V / I_in, np.arange(n + 1) * dz, u - lo

@@ -27,9 +27,9 @@ from scipy.optimize import least_squares
 
 from physmodel.data.sweep import FrequencySweep
 
-try:  # imported as tests/discrepancy/independent_generator
+try:                                      # imported as tests/discrepancy/independent_generator
     from . import independent_physics as ip
-except ImportError:  # imported with tests/discrepancy on sys.path
+except ImportError:                       # imported with tests/discrepancy on sys.path
     import independent_physics as ip
 
 #: Sealed seed root of this generator (differs from the library generator's).
@@ -49,24 +49,9 @@ T0_C = 25.0
 #: [J/C], which gives its few-mm/V DC gain.  Laws: physics.md §7 defaults (Ea 15 kJ/mol,
 #: −0.75 %/K log-linear modulus, κe ∝ water permittivity, leakage ∝ d/T).
 START_SEED002 = dict(
-    L=15e-3,
-    W=4e-3,
-    h=0.125e-3,
-    d=3.07e-11,
-    C=941.94,
-    eps=4.47e-7,
-    alpha=-155.0 / 75.4,
-    r1s=56.44,
-    r2s=8.81e-6,
-    Gp=1.0 / 0.37,
-    E=154e6,
-    f1=75.4 / (2 * math.pi),
-    zeta=0.18,
-    T0_c=300.0 - ip.T_ZERO,
-    thermal=True,
-    Q10_d=ip.q10_from_ea(15e3, 300.0 - ip.T_ZERO),
-    E_logslope=-0.0075,
-    eps_water=True,
+    L=15e-3, W=4e-3, h=0.125e-3, d=3.07e-11, C=941.94, eps=4.47e-7, alpha=-155.0 / 75.4,
+    r1s=56.44, r2s=8.81e-6, Gp=1.0 / 0.37, E=154e6, f1=75.4 / (2 * math.pi), zeta=0.18, T0_c=300.0 - ip.T_ZERO,
+    thermal=True, Q10_d=ip.q10_from_ea(15e3, 300.0 - ip.T_ZERO), E_logslope=-0.0075, eps_water=True,
 )
 
 # name -> (library label or None for out-of-library, {param: (draw, lo, hi)}, {param: off value})
@@ -76,101 +61,58 @@ START_SEED002 = dict(
 EFFECT_SPECS: dict[str, tuple] = {
     # +1…2000 Ω sheet resistance: fresh Pt electrodes are a few Ω/sq, cracking under strain and
     # drying raise it by one to two orders (Shahinpoor & Kim 2000, Smart Mater. Struct. 9:543).
-    "electrode_resistance": (
-        "electrode_resistance",
-        {"extra_sheet_ohm": ("log", 1.0, 2000.0)},
-        {"extra_sheet_ohm": 0.0},
-    ),
+    "electrode_resistance": ("electrode_resistance", {"extra_sheet_ohm": ("log", 1.0, 2000.0)},
+                             {"extra_sheet_ohm": 0.0}),
     # +1e-5…1e-2 Ω·m²: from the seed-002 fit (8.8e-6) to ~4× the polymer's own area resistance
     # 2h/(κe K) ≈ 2.4e-3 Ω·m² (seed 002), the range the issue's independent simulator used.
-    "contact_resistance": (
-        "contact_resistance",
-        {"extra_area_resistance": ("log", 1e-5, 1e-2)},
-        {"extra_area_resistance": 0.0},
-    ),
+    "contact_resistance": ("contact_resistance", {"extra_area_resistance": ("log", 1e-5, 1e-2)},
+                           {"extra_area_resistance": 0.0}),
     # +0.3…300 S/m²: 0.1× to 100× seed 002's 1/Rp' = 2.7 S/m², up to the polymer's ionic
     # conductance per area κe K/(2h) ≈ 420 S/m²; electronic (Pt) path, resistance +0.39 %/K.
     "leakage": ("leakage", {"conductance": ("log", 0.3, 300.0)}, {"conductance": 0.0}),
     # Euler-Bernoulli modal sum (6 modes + static residual), Rayleigh damping share of the fluid.
-    "second_mode": (
-        "second_mode",
-        {"n_modes": ("fix", 6, 6), "viscous_share": ("lin", 0.5, 1.0)},
-        {"n_modes": 1, "viscous_share": 1.0},
-    ),
+    "second_mode": ("second_mode", {"n_modes": ("fix", 6, 6), "viscous_share": ("lin", 0.5, 1.0)},
+                    {"n_modes": 1, "viscous_share": 1.0}),
     # Extra fluid load: inviscid mass ratio and Reynolds number at ω1 (Sader 1998 Γ_circ).
-    "added_fluid_mass": (
-        "added_fluid_mass",
-        {"mass_ratio": ("log", 0.01, 1.0), "reynolds": ("log", 300.0, 3.0)},
-        {"mass_ratio": 0.0, "reynolds": 30.0},
-    ),
+    "added_fluid_mass": ("added_fluid_mass", {"mass_ratio": ("log", 0.01, 1.0), "reynolds": ("log", 300.0, 3.0)},
+                         {"mass_ratio": 0.0, "reynolds": 30.0}),
     "modulus_temperature": ("modulus_temperature", {"linear_coeff": ("sym", 3e-4, 0.012)}, {"linear_coeff": 0.0}),
     "diffusivity_temperature": ("diffusivity_temperature", {"q10": ("symlog", 1.01, 1.6)}, {"q10": 1.0}),
-    "permittivity_temperature": (
-        "permittivity_temperature",
-        {"linear_coeff": ("sym", 5e-4, 0.02)},
-        {"linear_coeff": 0.0},
-    ),
+    "permittivity_temperature": ("permittivity_temperature", {"linear_coeff": ("sym", 5e-4, 0.02)},
+                                 {"linear_coeff": 0.0}),
     # Nafion in liquid water holds φ ≈ 0.3-0.4 water by volume; uptake rises with T
     # (Hinatsu et al. 1994, J. Electrochem. Soc. 141:1493).
-    "water_uptake": (
-        "water_uptake",
-        {"phi0": ("lin", 0.3, 0.4), "dphi_dT": ("log", 1e-4, 0.005)},
-        {"phi0": 0.35, "dphi_dT": 0.0},
-    ),
-    "amplifier_bandwidth": (
-        "amplifier_bandwidth",
-        {"f_dominant_hz": ("log", 5000.0, 15.0), "pole_ratio": ("lin", 3.0, 10.0)},
-        {"f_dominant_hz": math.inf, "pole_ratio": 5.0},
-    ),
-    "time_delay": (
-        "time_delay",
-        {"skew_s": ("log", 1e-5, 5e-3), "dac_period_s": ("log", 1e-5, 1e-3)},
-        {"skew_s": 0.0, "dac_period_s": 0.0},
-    ),
+    "water_uptake": ("water_uptake", {"phi0": ("lin", 0.3, 0.4), "dphi_dT": ("log", 1e-4, 0.005)},
+                     {"phi0": 0.35, "dphi_dT": 0.0}),
+    "amplifier_bandwidth": ("amplifier_bandwidth", {"f_dominant_hz": ("log", 5000.0, 15.0),
+                                                    "pole_ratio": ("lin", 3.0, 10.0)},
+                            {"f_dominant_hz": math.inf, "pole_ratio": 5.0}),
+    "time_delay": ("time_delay", {"skew_s": ("log", 1e-5, 5e-3), "dac_period_s": ("log", 1e-5, 1e-3)},
+                   {"skew_s": 0.0, "dac_period_s": 0.0}),
     "series_resistance": ("series_resistance", {"resistance": ("log", 0.5, 200.0)}, {"resistance": 0.0}),
     # The library's fractional_transport mechanism with a free reference frequency.
-    "fractional_transport": (
-        "fractional_transport",
-        {"beta": ("lin", 0.995, 0.7), "f_ref_hz": ("log", 1.0, 30.0)},
-        {"beta": 1.0, "f_ref_hz": 10.0},
-    ),
+    "fractional_transport": ("fractional_transport", {"beta": ("lin", 0.995, 0.7), "f_ref_hz": ("log", 1.0, 30.0)},
+                             {"beta": 1.0, "f_ref_hz": 10.0}),
     # Interface CPE in series, Q = q_area·W·L; n 0.95-0.6 (rough/porous metal electrodes, CPE
     # exponent n = 1/(D − 1) for fractal dimension D), q_area 2000-2 F s^(n−1)/m² around the
     # strip's own double layer κe/(2λ) ≈ 20 F/m² (seed 002); the library's series_cpe.
-    "series_cpe": (
-        "series_cpe",
-        {"n": ("lin", 0.95, 0.6), "q_area": ("log", 2000.0, 2.0)},
-        {"n": 0.8, "q_area": math.inf},
-    ),
+    "series_cpe": ("series_cpe", {"n": ("lin", 0.95, 0.6), "q_area": ("log", 2000.0, 2.0)},
+                   {"n": 0.8, "q_area": math.inf}),
     # out of library
-    "fixture_resonance": (
-        None,
-        {"f_hz": ("log", 1.0, 40.0), "kappa": ("sym", 0.005, 0.5), "zeta": ("lin", 0.02, 0.15)},
-        {"f_hz": 10.0, "kappa": 0.0, "zeta": 0.05},
-    ),
-    "gain_ripple": (
-        None,
-        {"amplitude": ("log", 0.002, 0.08), "period_decades": ("lin", 0.3, 1.0), "phase": ("lin", 0.0, 2 * math.pi)},
-        {"amplitude": 0.0, "period_decades": 0.5, "phase": 0.0},
-    ),
-    "viscoelastic_creep": (
-        None,
-        {"delta": ("log", 0.01, 0.4), "tau_s": ("log", 0.3, 10.0), "a": ("lin", 0.5, 1.0)},
-        {"delta": 0.0, "tau_s": 1.0, "a": 1.0},
-    ),
+    "fixture_resonance": (None, {"f_hz": ("log", 1.0, 40.0), "kappa": ("sym", 0.005, 0.5), "zeta": ("lin", 0.02, 0.15)},
+                          {"f_hz": 10.0, "kappa": 0.0, "zeta": 0.05}),
+    "gain_ripple": (None, {"amplitude": ("log", 0.002, 0.08), "period_decades": ("lin", 0.3, 1.0),
+                           "phase": ("lin", 0.0, 2 * math.pi)}, {"amplitude": 0.0, "period_decades": 0.5, "phase": 0.0}),
+    "viscoelastic_creep": (None, {"delta": ("log", 0.01, 0.4), "tau_s": ("log", 0.3, 10.0), "a": ("lin", 0.5, 1.0)},
+                           {"delta": 0.0, "tau_s": 1.0, "a": 1.0}),
 }
 IN_LIBRARY = tuple(k for k, v in EFFECT_SPECS.items() if v[0] is not None)
 OUT_OF_LIBRARY = tuple(k for k, v in EFFECT_SPECS.items() if v[0] is None)
 #: Effects that need data at several temperatures (always the case here).
 THERMAL_EFFECTS = ("modulus_temperature", "diffusivity_temperature", "permittivity_temperature", "water_uptake")
 #: Two-effect cases named by issue 11, plus contact resistance with a mechanical/measurement effect.
-PAIRS = (
-    "modulus_temperature+diffusivity_temperature",
-    "contact_resistance+time_delay",
-    "contact_resistance+second_mode",
-    "contact_resistance+leakage",
-    "time_delay+leakage",
-)
+PAIRS = ("modulus_temperature+diffusivity_temperature", "contact_resistance+time_delay",
+         "contact_resistance+second_mode", "contact_resistance+leakage", "time_delay+leakage")
 LABELS = ("none",) + IN_LIBRARY + OUT_OF_LIBRARY + PAIRS
 
 
@@ -237,26 +179,11 @@ def library_fields(base: dict) -> dict:
         laws["E"] = {"law": "LogLinear", "slope": float(base["E_logslope"])}
         laws["kappa_e"] = {"law": "WaterPermittivity"} if base.get("eps_water", True) else dict(const)
         laws["Rp_specific"] = {"law": "IonicResistance"}
-    return dict(
-        L=base["L"],
-        W=base["W"],
-        h=base["h"],
-        d=base["d"],
-        C_minus=base["C"],
-        kappa_e=base["eps"],
-        alpha0=base["alpha"],
-        a0=0.0,
-        r1_sheet=base["r1s"],
-        r2_specific=base["r2s"],
-        Rp_specific=(1.0 / base["Gp"] if base["Gp"] > 0 else math.inf),
-        E=base["E"],
-        rho=rho,
-        xi=base["zeta"],
-        T_ref=base["T0_c"] + ip.T_ZERO,
-        laws=laws,
-        name="independent_truth",
-        source="tests/discrepancy/independent_generator.py",
-    )
+    return dict(L=base["L"], W=base["W"], h=base["h"], d=base["d"], C_minus=base["C"], kappa_e=base["eps"],
+                alpha0=base["alpha"], a0=0.0, r1_sheet=base["r1s"], r2_specific=base["r2s"],
+                Rp_specific=(1.0 / base["Gp"] if base["Gp"] > 0 else math.inf), E=base["E"], rho=rho,
+                xi=base["zeta"], T_ref=base["T0_c"] + ip.T_ZERO, laws=laws,
+                name="independent_truth", source="tests/discrepancy/independent_generator.py")
 
 
 def _response(base, effects, f, T):
@@ -297,19 +224,9 @@ def _parse(label: str) -> list[str]:
     return names
 
 
-def make_case(
-    seed: int,
-    label: str,
-    *,
-    start: dict = START_SEED002,
-    thermal: bool = True,
-    frequencies_hz=FREQUENCIES_HZ,
-    temperatures_c=TEMPERATURES_C,
-    perturbed=PERTURBED,
-    size: float | None = None,
-    sigma_rel: float | None = None,
-    baseline_lambda: bool = True,
-):
+def make_case(seed: int, label: str, *, start: dict = START_SEED002, thermal: bool = True,
+              frequencies_hz=FREQUENCIES_HZ, temperatures_c=TEMPERATURES_C, perturbed=PERTURBED,
+              size: float | None = None, sigma_rel: float | None = None, baseline_lambda: bool = True):
     """One blind case: ``(FrequencySweep in mm/V with per-line σ, truth dict)``.
 
     ``label``: "none", an effect name of :data:`EFFECT_SPECS`, or "a+b".  ``thermal``: the base
@@ -326,41 +243,24 @@ def make_case(
     H0 = _response(base, {}, f, T)
     H1 = _response(base, effects, f, T) if effects else H0
     sig_rel = r_noise.uniform(*NOISE_RANGE) if sigma_rel is None else float(sigma_rel)
-    floor = r_noise.uniform(0.0, 1.0) * sig_rel * np.min(np.abs(H1))  # displacement noise floor [m/V]
-    sigma = np.sqrt(sig_rel**2 + (floor / np.abs(H1)) ** 2)  # per-line relative σ
-    sig = sigma / math.sqrt(2.0)  # per-line ln|H| and phase σ
+    floor = r_noise.uniform(0.0, 1.0) * sig_rel * np.min(np.abs(H1))      # displacement noise floor [m/V]
+    sigma = np.sqrt(sig_rel**2 + (floor / np.abs(H1)) ** 2)               # per-line relative σ
+    sig = sigma / math.sqrt(2.0)                                          # per-line ln|H| and phase σ
     noisy = H1 + np.abs(H1) * sig * (r_noise.standard_normal(H1.size) + 1j * r_noise.standard_normal(H1.size))
     Tl = np.repeat(T, f.size)
     fl = np.tile(f, T.size)
-    sweep = FrequencySweep(
-        Tl,
-        fl,
-        noisy * 1e3,
-        20.0 / math.log(10.0) * sig,
-        np.degrees(sig),
-        "voltage",
-        "V",
-        "tip_displacement",
-        "mm",
-        {"source": "independent generator (tests/discrepancy), blind case"},
-    )
+    sweep = FrequencySweep(Tl, fl, noisy * 1e3, 20.0 / math.log(10.0) * sig, np.degrees(sig),
+                           "voltage", "V", "tip_displacement", "mm",
+                           {"source": "independent generator (tests/discrepancy), blind case"})
     expected = sorted(EFFECT_SPECS[n][0] for n in names if EFFECT_SPECS[n][0] is not None)
     truth = {
-        "seed": int(seed),
-        "label": label,
-        "effects": effects,
-        "expected": expected,
+        "seed": int(seed), "label": label, "effects": effects, "expected": expected,
         "out_of_library": any(EFFECT_SPECS[n][0] is None for n in names),
-        "thermal": bool(thermal),
-        "perturbed": tuple(perturbed),
-        "base": base,
-        "library_base": library_fields(base),
-        "library_start": library_fields(_at_reference(start, start["T0_c"], thermal)),
+        "thermal": bool(thermal), "perturbed": tuple(perturbed), "base": base,
+        "library_base": library_fields(base), "library_start": library_fields(_at_reference(start, start["T0_c"], thermal)),
         "noise": {"sigma_rel": sig_rel, "floor_m_per_V": float(floor)},
         "lam": noncentrality(H1, H0, sig) if effects else 0.0,
-        "lam_each": {},
-        "lam_baseline": None,
-        "lam_each_baseline": {},
+        "lam_each": {}, "lam_baseline": None, "lam_each_baseline": {},
     }
     for n in names if len(names) > 1 else []:
         rest = {k: v for k, v in effects.items() if k != n}
@@ -382,23 +282,6 @@ def case_grid(labels=LABELS, n_per_label: int = 1, first_seed: int = 0, **kw) ->
     return out
 
 
-__all__ = [
-    "make_case",
-    "case_grid",
-    "draw_effect",
-    "draw_base",
-    "off_values",
-    "library_fields",
-    "noncentrality",
-    "baseline_noncentrality",
-    "EFFECT_SPECS",
-    "IN_LIBRARY",
-    "OUT_OF_LIBRARY",
-    "PAIRS",
-    "LABELS",
-    "START_SEED002",
-    "SEALED",
-    "FREQUENCIES_HZ",
-    "TEMPERATURES_C",
-    "PERTURBED",
-]
+__all__ = ["make_case", "case_grid", "draw_effect", "draw_base", "off_values", "library_fields", "noncentrality",
+           "baseline_noncentrality", "EFFECT_SPECS", "IN_LIBRARY", "OUT_OF_LIBRARY", "PAIRS", "LABELS",
+           "START_SEED002", "SEALED", "FREQUENCIES_HZ", "TEMPERATURES_C", "PERTURBED"]

@@ -77,12 +77,12 @@ def _mode_parts(lam, xi):
     (cosh − σ sinh)(u) = ((1 − σ) e^u + (1 + σ) e^−u)/2 with 1 − σ computed without cancellation."""
     lam = np.asarray(lam, dtype=float)[:, None]
     e = np.exp(-lam)
-    den = (1.0 - e * e) / 2.0 + e * np.sin(lam)  # (sinh λ + sin λ)·e^−λ
+    den = (1.0 - e * e) / 2.0 + e * np.sin(lam)            # (sinh λ + sin λ)·e^−λ
     one_m_sig = e * (np.sin(lam) - np.cos(lam) - e) / den  # 1 − σ
     sig = 1.0 - one_m_sig
     u = lam * np.asarray(xi, dtype=float)[None, :]
-    hyp_c = (one_m_sig * np.exp(u) + (1.0 + sig) * np.exp(-u)) / 2.0  # cosh u − σ sinh u
-    hyp_s = (one_m_sig * np.exp(u) - (1.0 + sig) * np.exp(-u)) / 2.0  # sinh u − σ cosh u
+    hyp_c = (one_m_sig * np.exp(u) + (1.0 + sig) * np.exp(-u)) / 2.0     # cosh u − σ sinh u
+    hyp_s = (one_m_sig * np.exp(u) - (1.0 + sig) * np.exp(-u)) / 2.0     # sinh u − σ cosh u
     return lam, sig, u, hyp_c, hyp_s
 
 
@@ -130,8 +130,8 @@ def modal_participation(x, n_modes: int) -> np.ndarray:
     Returns shape x.shape + (n_modes,).  Quadrature on graded Gauss panels (exact to rounding
     for |x| ≲ 300)."""
     lam = cantilever_roots(n_modes)
-    d2 = mode_shape(lam, _XI_Q, 2)  # (n, q)
-    prof = line_profile(x, _XI_Q)  # (..., q)
+    d2 = mode_shape(lam, _XI_Q, 2)                               # (n, q)
+    prof = line_profile(x, _XI_Q)                                # (..., q)
     Q = np.einsum("...q,nq->...n", prof * _W_Q, d2)
     tip = mode_shape(lam, [1.0])[:, 0]
     return tip * Q / (lam**4 * bending_kernel(x)[..., None])
@@ -181,7 +181,7 @@ def base_state(base: dict, temperature_c) -> dict:
     if base.get("thermal", False):
         arr = np.exp(-ea_from_q10(base["Q10_d"], base["T0_c"]) / R_GAS * (1.0 / T - 1.0 / T0))
         st["d"] = st["d"] * arr
-        st["Gp"] = st["Gp"] * arr * T0 / T  # Nernst–Einstein: σ ∝ d/T
+        st["Gp"] = st["Gp"] * arr * T0 / T                       # Nernst–Einstein: σ ∝ d/T
         fe = np.exp(base["E_logslope"] * (T - T0))
         st["E"] = st["E"] * fe
         st["f1"] = st["f1"] * np.sqrt(fe)
@@ -253,27 +253,27 @@ PT_TCR = 3.9e-3
 def _parameter_effects(st: dict, eff: dict, T0_c: float) -> dict:
     """Effects that change the strip's parameters at each temperature (own parametrisations)."""
     dT = st["T"] - (T0_c + T_ZERO)
-    if "electrode_resistance" in eff:  # extra sheet resistance of both electrodes [Ω]
+    if "electrode_resistance" in eff:      # extra sheet resistance of both electrodes [Ω]
         st["r1s"] = st["r1s"] + eff["electrode_resistance"]["extra_sheet_ohm"]
-    if "contact_resistance" in eff:  # extra area-specific through-thickness resistance [Ω·m²]
+    if "contact_resistance" in eff:        # extra area-specific through-thickness resistance [Ω·m²]
         st["r2s"] = st["r2s"] + eff["contact_resistance"]["extra_area_resistance"]
-    if "modulus_temperature" in eff:  # extra LINEAR modulus change per kelvin
+    if "modulus_temperature" in eff:       # extra LINEAR modulus change per kelvin
         fac = 1.0 + eff["modulus_temperature"]["linear_coeff"] * dT
         st["E"], st["f1"] = st["E"] * fac, st["f1"] * np.sqrt(fac)
-    if "diffusivity_temperature" in eff:  # extra factor q10 per 10 K on d (and the ionic leakage)
+    if "diffusivity_temperature" in eff:   # extra factor q10 per 10 K on d (and the ionic leakage)
         fac = eff["diffusivity_temperature"]["q10"] ** (dT / 10.0)
         st["d"], st["Gp"] = st["d"] * fac, st["Gp"] * fac
     if "permittivity_temperature" in eff:  # extra LINEAR permittivity change per kelvin
         st["eps"] = st["eps"] * (1.0 + eff["permittivity_temperature"]["linear_coeff"] * dT)
-    if "water_uptake" in eff:  # isotropic swelling from the water volume fraction φ(T)
+    if "water_uptake" in eff:              # isotropic swelling from the water volume fraction φ(T)
         p = eff["water_uptake"]
         vol = (1.0 - p["phi0"]) / (1.0 - (p["phi0"] + p["dphi_dT"] * dT))
         lin = vol ** (1.0 / 3.0)
         st["h"], st["L"], st["W"] = st["h"] * lin, st["L"] * lin, st["W"] * lin
-        st["C"] = st["C"] / vol  # fixed anions diluted
+        st["C"] = st["C"] / vol            # fixed anions diluted
         # ω1 ∝ sqrt(E W h³/m')/L² with m' ∝ W² (fluid added mass dominates) ⇒ ∝ 1/lin
         st["f1"] = st["f1"] / lin
-    if "leakage" in eff:  # electronic leakage through the polymer [S/m²], Pt-like TCR
+    if "leakage" in eff:                   # electronic leakage through the polymer [S/m²], Pt-like TCR
         st["Gp"] = st["Gp"] + eff["leakage"]["conductance"] / (1.0 + PT_TCR * dT)
     return st
 
@@ -292,94 +292,61 @@ def actuator_response(base: dict, frequency_hz, temperature_c, effects: dict | N
     s, w = 2j * np.pi * f, 2 * np.pi * f
     st = _parameter_effects(base_state(base, temperature_c), eff, base["T0_c"])
     s_tr = None
-    if "fractional_transport" in eff:  # anomalous charge relaxation: s → ω_c (s/ω_c)^β in transport only
+    if "fractional_transport" in eff:      # anomalous charge relaxation: s → ω_c (s/ω_c)^β in transport only
         p = eff["fractional_transport"]
         wc = 2 * np.pi * p["f_ref_hz"]
         s_tr = wc * (s / wc) ** p["beta"]
     sr = strip_response(st, s, s_tr)
     Z, H = sr["Z"], sr["Hqs"]
     z_ser = np.zeros_like(s)
-    if "series_resistance" in eff:  # leads, clamp contact, amplifier output resistance [Ω]
+    if "series_resistance" in eff:         # leads, clamp contact, amplifier output resistance [Ω]
         z_ser = z_ser + eff["series_resistance"]["resistance"]
-    if "series_cpe" in eff:  # interface CPE in series, Q = q_area · W L [F s^(n−1)]
+    if "series_cpe" in eff:                # interface CPE in series, Q = q_area · W L [F s^(n−1)]
         p = eff["series_cpe"]
         if p["q_area"] != np.inf:
             z_ser = z_ser + 1.0 / (p["q_area"] * base["W"] * base["L"] * s ** p["n"])
-    if np.any(z_ser != 0):  # actuation follows the voltage across the strip
+    if np.any(z_ser != 0):                 # actuation follows the voltage across the strip
         H = H * Z / (Z + z_ser)
         Z = Z + z_ser
     w1 = 2 * np.pi * st["f1"]
     e = 1.0
-    if "viscoelastic_creep" in eff:  # Cole–Cole relaxation of the modulus, E(s)/E(∞)
+    if "viscoelastic_creep" in eff:        # Cole–Cole relaxation of the modulus, E(s)/E(∞)
         p = eff["viscoelastic_creep"]
         e = 1.0 - p["delta"] / (1.0 + (s * p["tau_s"]) ** p["a"])
     mu = 0.0
-    if "added_fluid_mass" in eff:  # extra hydrodynamic load, Sader's Γ (conjugated for e^{+jωt})
+    if "added_fluid_mass" in eff:          # extra hydrodynamic load, Sader's Γ (conjugated for e^{+jωt})
         p = eff["added_fluid_mass"]
         mu = p["mass_ratio"] * np.conj(hydrodynamic_gamma(p["reynolds"] * w / w1))
     sm = eff.get("second_mode", {})
     mech = modal_mechanics(sr["x"], s, w1, st["zeta"], int(sm.get("n_modes", 1)), sm.get("viscous_share", 1.0), e, mu)
     M = H * mech
-    if "amplifier_bandwidth" in eff:  # dominant pole f_a and a non-dominant one at ratio·f_a
+    if "amplifier_bandwidth" in eff:       # dominant pole f_a and a non-dominant one at ratio·f_a
         p = eff["amplifier_bandwidth"]
         wa = 2 * np.pi * p["f_dominant_hz"]
         M = M / ((1 + s / wa) * (1 + s / (p["pole_ratio"] * wa)))
-    if "time_delay" in eff:  # inter-channel sampling skew + zero-order-hold output DAC
+    if "time_delay" in eff:                # inter-channel sampling skew + zero-order-hold output DAC
         p = eff["time_delay"]
         M = M * np.exp(-s * p["skew_s"])
         if p["dac_period_s"] > 0:
             Tu = p["dac_period_s"]
             M = M * (-np.expm1(-s * Tu)) / (s * Tu)
-    if "fixture_resonance" in eff:  # compliant fixture: DC 1, high-frequency 1 + κ
+    if "fixture_resonance" in eff:         # compliant fixture: DC 1, high-frequency 1 + κ
         p = eff["fixture_resonance"]
         wf, z, k = 2 * np.pi * p["f_hz"], p["zeta"], p["kappa"]
         M = M * (wf * wf + 2 * z * wf * s + (1 + k) * s * s) / (wf * wf + 2 * z * wf * s + s * s)
-    if "gain_ripple" in eff:  # magnitude-only ripple periodic in log frequency (calibration)
+    if "gain_ripple" in eff:               # magnitude-only ripple periodic in log frequency (calibration)
         p = eff["gain_ripple"]
         M = M * (1 + p["amplitude"] * np.sin(2 * np.pi * np.log10(f) / p["period_decades"] + p["phase"]))
     return {"M": M, "Z": np.broadcast_to(Z, M.shape).copy()}
 
 
 #: Every effect this module can hide (library-mappable and out-of-library ones).
-EFFECT_NAMES = (
-    "electrode_resistance",
-    "contact_resistance",
-    "leakage",
-    "second_mode",
-    "added_fluid_mass",
-    "modulus_temperature",
-    "diffusivity_temperature",
-    "permittivity_temperature",
-    "water_uptake",
-    "amplifier_bandwidth",
-    "time_delay",
-    "series_resistance",
-    "fractional_transport",
-    "series_cpe",
-    "fixture_resonance",
-    "gain_ripple",
-    "viscoelastic_creep",
-)
+EFFECT_NAMES = ("electrode_resistance", "contact_resistance", "leakage", "second_mode", "added_fluid_mass",
+                "modulus_temperature", "diffusivity_temperature", "permittivity_temperature", "water_uptake",
+                "amplifier_bandwidth", "time_delay", "series_resistance", "fractional_transport", "series_cpe",
+                "fixture_resonance", "gain_ripple", "viscoelastic_creep")
 
-__all__ = [
-    "FARADAY",
-    "R_GAS",
-    "T_ZERO",
-    "cantilever_roots",
-    "mode_shape",
-    "uniform_moment_participation",
-    "modal_participation",
-    "line_profile",
-    "bending_kernel",
-    "x_coth_x",
-    "water_permittivity",
-    "ea_from_q10",
-    "q10_from_ea",
-    "base_state",
-    "strip_response",
-    "hydrodynamic_gamma",
-    "actuator_response",
-    "modal_mechanics",
-    "EFFECT_NAMES",
-    "PT_TCR",
-]
+__all__ = ["FARADAY", "R_GAS", "T_ZERO", "cantilever_roots", "mode_shape", "uniform_moment_participation",
+           "modal_participation", "line_profile", "bending_kernel", "x_coth_x", "water_permittivity",
+           "ea_from_q10", "q10_from_ea", "base_state", "strip_response", "hydrodynamic_gamma",
+           "actuator_response", "modal_mechanics", "EFFECT_NAMES", "PT_TCR"]

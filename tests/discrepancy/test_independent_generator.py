@@ -38,9 +38,8 @@ def _bases():
     """Seed 002 at 25 °C, drawn bases, and the legal edge values (no leakage, ideal electrodes)."""
     b0 = gen._at_reference(gen.START_SEED002, 25.0, False)
     rng = np.random.default_rng(11)
-    out = [b0] + [
-        gen.draw_base(gen.START_SEED002, rng, ("alpha", "d", "zeta", "f1", "eps", "C"), False) for _ in range(3)
-    ]
+    out = [b0] + [gen.draw_base(gen.START_SEED002, rng, ("alpha", "d", "zeta", "f1", "eps", "C"), False)
+                  for _ in range(3)]
     out += [dict(b0, Gp=0.0), dict(b0, r1s=0.0, r2s=0.0), dict(b0, r1s=2000.0, r2s=5e-3, Gp=100.0)]
     return out
 
@@ -49,7 +48,7 @@ def _bases():
 @pytest.mark.parametrize("k", range(7))
 def test_base_agrees_with_library_isothermal(k):
     base = _bases()[k]
-    T = [19.0, 37.0, 55.0]  # K = F²dC/(κe R T) carries 1/T even without laws
+    T = [19.0, 37.0, 55.0]                     # K = F²dC/(κe R T) carries 1/T even without laws
     lib = _library(base).frequency_response(F_HZ, T, quantities=("M", "Z"))
     mine = ip.actuator_response(base, F_HZ, T)
     np.testing.assert_allclose(mine["M"], lib["M"][0], rtol=1e-9, atol=0)
@@ -94,7 +93,7 @@ def test_cantilever_roots_and_mode_shapes():
     np.testing.assert_allclose(np.abs(phi[:, -1]), 2.0, rtol=1e-10)
     p = ip.uniform_moment_participation(200)
     np.testing.assert_allclose(p[:4], [0.890772, 0.078774, 0.016495, 0.006018], atol=1e-6)
-    assert abs(p.sum() - 1) < 2e-5  # tail Σ_{n>200} 8/λ_n³ ≈ 1.6e-6
+    assert abs(p.sum() - 1) < 2e-5                  # tail Σ_{n>200} 8/λ_n³ ≈ 1.6e-6
 
 
 @pytest.mark.parametrize("x", [0.0, 1 + 1j, 5 + 3j, 20 + 10j])
@@ -103,16 +102,13 @@ def test_second_mode_against_finite_elements(x, nu):
     """Modal sum (12 modes + quasi-static residual) vs 160 Hermite elements, Rayleigh damping,
     moment profile cosh(x(1 − ξ))/cosh x, 0.05-25 ω1 (modes 1-3 and the antiresonance near 3 ω1).
     A-priori error: truncation Σ_{n>12} π_n (ω/ω_n)² < 1e-6, mesh < 1e-5 of the static deflection."""
-    lam1 = 1.8751040687119611  # Blevins Table 8-1
-    w1, z1 = lam1**2, 0.05  # L = EI = ρA = 1
+    lam1 = 1.8751040687119611                      # Blevins Table 8-1
+    w1, z1 = lam1**2, 0.05                          # L = EI = ρA = 1
     s = 1j * w1 * np.array([0.05, 0.5, 0.98, 1.0, 1.5, 3.0, 5.0, 6.27, 8.0, 17.5, 25.0])
     tip, static = oracles.fe_cantilever_tip(
-        s,
-        lambda z: np.cosh(x * (1 - z)) / np.cosh(x) + 0 * z,
-        n_el=160,
-        rayleigh=(2 * z1 * w1 * nu, 2 * z1 * (1 - nu) / w1),
-    )
-    assert abs(static / ip.bending_kernel(x) - 1) < 1e-8  # FE statics = closed-form X(x)
+        s, lambda z: np.cosh(x * (1 - z)) / np.cosh(x) + 0 * z, n_el=160,
+        rayleigh=(2 * z1 * w1 * nu, 2 * z1 * (1 - nu) / w1))
+    assert abs(static / ip.bending_kernel(x) - 1) < 1e-8      # FE statics = closed-form X(x)
     fe = tip / static
     xs = np.full(s.shape, x, dtype=complex)
     assert np.max(np.abs(ip.modal_mechanics(xs, s, w1, z1, 12, nu) - fe)) < 2e-5
@@ -140,7 +136,7 @@ def _ladder_case(base, cpe, f, T_c, n):
         s = 2j * np.pi * fi
         y, fpol, phi = _slice(base, s, T_c)
         Q = cpe["q_area"] * base["W"] * base["L"]
-        zc = np.exp(-0.5j * np.pi * cpe["n"]) / (Q * (2 * np.pi * fi) ** cpe["n"])  # polar form
+        zc = np.exp(-0.5j * np.pi * cpe["n"]) / (Q * (2 * np.pi * fi) ** cpe["n"])   # polar form
         Zin, z, v = oracles.ladder_with_series(y, base["r1s"] / base["W"], base["L"], n, zc)
         wts = np.full(n + 1, base["L"] / n)
         wts[[0, -1]] /= 2
@@ -170,8 +166,8 @@ def test_series_cpe_against_ladder(cpe):
         rich = (4 * errs[1][i] - errs[0][i]) / 3
         assert np.max(np.abs(rich / ref - 1)) < 1e-6
     base_only = ip.actuator_response(base, f, [25.0])
-    assert np.max(np.abs(cf["M"] / base_only["M"] - 1)) > 0.02  # the CPE is visible
-    assert np.all(np.real(cf["Z"] - base_only["Z"]) > 0)  # a passive series element
+    assert np.max(np.abs(cf["M"] / base_only["M"] - 1)) > 0.02          # the CPE is visible
+    assert np.all(np.real(cf["Z"] - base_only["Z"]) > 0)                 # a passive series element
 
 
 # --------------------------------------------------------------------------- (d) off values
@@ -183,9 +179,8 @@ def test_effect_off_and_on(name):
     off = ip.actuator_response(base, gen.FREQUENCIES_HZ, T, {name: gen.off_values(name)})
     np.testing.assert_allclose(off["M"], ref["M"], rtol=1e-13, atol=0)
     np.testing.assert_allclose(off["Z"], ref["Z"], rtol=1e-13, atol=0)
-    on = ip.actuator_response(
-        base, gen.FREQUENCIES_HZ, T, {name: gen.draw_effect(name, np.random.default_rng(0), size=1.0)}
-    )
+    on = ip.actuator_response(base, gen.FREQUENCIES_HZ, T,
+                              {name: gen.draw_effect(name, np.random.default_rng(0), size=1.0)})
     assert np.max(np.abs(on["M"] / ref["M"] - 1)) > 0.02
 
 
@@ -199,11 +194,11 @@ def test_effect_directions():
     r2 = ip.actuator_response(base, f, [25.0], {"contact_resistance": {"extra_area_resistance": 1e-3}})
     assert np.all(np.abs(r2["M"]) < np.abs(r0["M"]))
     w1, w = 2 * np.pi * base["f1"], 2 * np.pi * f
-    mu = 0.5 * np.conj(ip.hydrodynamic_gamma(10.0 * w / w1))  # as actuator_response builds it
+    mu = 0.5 * np.conj(ip.hydrodynamic_gamma(10.0 * w / w1))   # as actuator_response builds it
     g0 = np.abs(ip.modal_mechanics(0.0, 1j * w, w1, base["zeta"]))
     g1 = np.abs(ip.modal_mechanics(0.0, 1j * w, w1, base["zeta"], mu=mu))
     assert f[np.argmax(g1)] < f[np.argmax(g0)] and g1.max() < g0.max()
-    assert np.all(-mu.imag > 0)  # −ω²(1 + μ) adds +j·(damping)
+    assert np.all(-mu.imag > 0)                    # −ω²(1 + μ) adds +j·(damping)
     lk = ip.actuator_response(base, [0.05], [25.0], {"leakage": {"conductance": 30.0}})
     assert abs(lk["Z"][0, 0]) < abs(ip.actuator_response(base, [0.05], [25.0])["Z"][0, 0])
 

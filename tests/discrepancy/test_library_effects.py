@@ -20,7 +20,7 @@ from physmodel import ActuatorModel, IPMCParameters, beam, electrode, get_parame
 from physmodel.effects import EffectModel
 from physmodel.params import STATE_FIELDS
 
-P = get_parameter_set("seed002_table3").replace(r1_sheet=500.0)  # a clearly decaying moment
+P = get_parameter_set("seed002_table3").replace(r1_sheet=500.0)      # a clearly decaying moment
 
 
 def _line_x(params, f_hz, T_c):
@@ -48,20 +48,19 @@ def test_second_mode_against_finite_element_cantilever(nu):
     T_c = 26.85
     f = np.array([0.3, 3.0, 11.0, 25.0, 60.0, 90.0])
     x, st = _line_x(P, f, T_c)
-    assert np.max(np.abs(x)) > 1.0  # the moment really decays along the strip
+    assert np.max(np.abs(x)) > 1.0                     # the moment really decays along the strip
     m = EffectModel(P, "actuator", {"second_mode": {"weight": 1.0, "viscous_share": nu}}).frequency_response(
-        f, [T_c], quantities=("M", "H")
-    )
+        f, [T_c], quantities=("M", "H"))
     lib = m["M"][0, 0] / m["H"][0, 0]
     w1, xi = float(st.omega_n.ravel()[0]), float(st.xi.ravel()[0])
     lam1 = beam.cantilever_roots(1)[0]
-    scale = lam1**2 / w1  # FE beam with EI = ρA = L = 1: ω1 = λ1²
+    scale = lam1**2 / w1                               # FE beam with EI = ρA = L = 1: ω1 = λ1²
     a, b = 2 * xi * nu * lam1**2, 2 * xi * (1 - nu) / lam1**2
     fe = []
     for fk, xk in zip(f, x):
-        tip, tip0 = oracles.fe_cantilever_tip(
-            [2j * np.pi * fk * scale], lambda z, xk=xk: np.cosh(xk * (1 - z)) / np.cosh(xk), n_el=80, rayleigh=(a, b)
-        )
+        tip, tip0 = oracles.fe_cantilever_tip([2j * np.pi * fk * scale],
+                                              lambda z, xk=xk: np.cosh(xk * (1 - z)) / np.cosh(xk),
+                                              n_el=80, rayleigh=(a, b))
         fe.append(tip[0] / tip0)
     np.testing.assert_allclose(lib, np.array(fe), rtol=2e-4)
 
@@ -72,11 +71,8 @@ def test_second_mode_matches_the_independent_generator():
     np.testing.assert_allclose(beam.moment_participation(x, 6), ip.modal_participation(x, 6), rtol=1e-7, atol=1e-12)
     s = 2j * np.pi * np.logspace(-1, 2, 25)
     for nu in (1.0, 0.5):
-        np.testing.assert_allclose(
-            beam.modal_tip_response(s, 70.0, 0.18, 1.2 + 0.8j, 6, nu),
-            ip.modal_mechanics(1.2 + 0.8j, s, 70.0, 0.18, 6, nu),
-            rtol=1e-12,
-        )
+        np.testing.assert_allclose(beam.modal_tip_response(s, 70.0, 0.18, 1.2 + 0.8j, 6, nu),
+                                   ip.modal_mechanics(1.2 + 0.8j, s, 70.0, 0.18, 6, nu), rtol=1e-12)
 
 
 @pytest.mark.parametrize("cpe", [dict(S_area=0.05, n=0.8), dict(S_area=0.5, n=0.95)])
@@ -88,7 +84,7 @@ def test_series_cpe_against_ladder(cpe):
     st = ActuatorModel(P).state([T_c])
     p = {k: getattr(st, k) for k in STATE_FIELDS}
     s = 2j * np.pi * f
-    y = electrode.strip_terms(p, s[None, None, :], want_xcoth=False).A[0, 0] / 2  # per length, both rails
+    y = electrode.strip_terms(p, s[None, None, :], want_xcoth=False).A[0, 0] / 2       # per length, both rails
     r1, L, W = float(p["r1"].ravel()[0]), P.L, P.W
     zc = cpe["S_area"] / (W * L) / (2 * np.pi * f) ** cpe["n"] * np.exp(-0.5j * np.pi * cpe["n"])
     lib = EffectModel(P, "actuator", {"series_cpe": cpe}).frequency_response(f, [T_c], quantities=("M", "Z"))
@@ -117,7 +113,6 @@ def test_series_cpe_matches_the_independent_generator():
     q_area, n = 20.0, 0.8
     mine = ip.actuator_response(b, f, T, {"series_cpe": {"q_area": q_area, "n": n}})
     got = EffectModel(lib, "actuator", {"series_cpe": {"S_area": 1.0 / q_area, "n": n}}).frequency_response(
-        f, T, quantities=("M", "Z")
-    )
+        f, T, quantities=("M", "Z"))
     np.testing.assert_allclose(got["M"][0], mine["M"], rtol=1e-9)
     np.testing.assert_allclose(got["Z"][0], mine["Z"], rtol=1e-9)

@@ -45,7 +45,8 @@ def truth(sysd, frequency_hz, fs: float):
     return np.asarray(sysd(np.exp(2j * np.pi * np.asarray(frequency_hz) / fs)), dtype=complex).reshape(-1)
 
 
-def white_record(sysd, n: int, seed: int, output_noise: float = 0.0, input_noise: float = 0.0, warmup: int = 4000):
+def white_record(sysd, n: int, seed: int, output_noise: float = 0.0, input_noise: float = 0.0,
+                 warmup: int = 4000):
     """Unit-variance white input through the plant (after a warm-up, so no start transient), with
     white measurement noise of the given standard deviations on output and input."""
     rng = np.random.default_rng(seed)

@@ -44,7 +44,7 @@ def test_multisine_has_exactly_the_designed_line_spectrum():
 def test_schroeder_phases_are_the_flat_spectrum_closed_form():
     K = 37
     k = np.arange(1, K + 1)
-    expected = -np.pi * k * (k - 1) / K  # Schroeder 1970 for equal powers
+    expected = -np.pi * k * (k - 1) / K                # Schroeder 1970 for equal powers
     got = schroeder_phases(np.ones(K))
     np.testing.assert_allclose(np.exp(1j * got), np.exp(1j * expected), atol=1e-12)
 
@@ -56,14 +56,14 @@ def test_crest_factor_schroeder_below_random_and_clipping_below_schroeder():
     random = [crest_factor(multisine(lines, FS, 1.0, phases="random", seed=s).period()) for s in range(20)]
     cf_s, cf_c = crest_factor(schroeder), crest_factor(clipped)
     assert cf_s < min(random)
-    assert cf_s < 2.0  # ≈ 1.7 for flat spectra (Schroeder 1970)
+    assert cf_s < 2.0                                   # ≈ 1.7 for flat spectra (Schroeder 1970)
     assert cf_c < cf_s
     assert np.median(random) > 2.5
 
 
 def test_rms_and_bad_designs():
     ms = multisine([1.0, 2.0, 3.0], FS, 1.0, rms=0.3)
-    assert np.sqrt(np.mean(ms.period() ** 2)) == pytest.approx(0.3, rel=1e-12)
+    assert np.sqrt(np.mean(ms.period()**2)) == pytest.approx(0.3, rel=1e-12)
     assert ms.duration_s(10, 2) == pytest.approx(12.0)
     with pytest.raises(IPMCError, match=r"frequencies_hz: \[1.5\]"):
         multisine([1.0, 1.5], FS, 1.0)
@@ -85,16 +85,8 @@ def test_multisine_signal_file_and_its_frf():
     assert rec.t.size == 10 * ms.n_samples
     u = rec.channel("voltage_V")
     y = orc.simulate(sysd, u)
-    e = h1(
-        rec.t,
-        u,
-        y,
-        nperseg=ms.n_samples,
-        noverlap=0,
-        window="boxcar",
-        discard_s=2 * ms.period_s,
-        frequencies_hz=ms.frequency_hz,
-    )
+    e = h1(rec.t, u, y, nperseg=ms.n_samples, noverlap=0, window="boxcar", discard_s=2 * ms.period_s,
+           frequencies_hz=ms.frequency_hz)
     np.testing.assert_allclose(e.response[0], orc.truth(sysd, ms.frequency_hz, FS), rtol=1e-10)
 
 
@@ -128,14 +120,14 @@ def test_stepped_plan_feeds_the_estimator():
     y = orc.simulate(sysd, rec.channel("voltage"))
     e = stepped_sine(rec.t, rec.channel("voltage"), y, plan=plan)
     np.testing.assert_allclose(e.response[0], orc.truth(sysd, f, FS), rtol=1e-9)
-    late = stepped_sine(rec.t + 100.0, rec.channel("voltage"), y, plan=plan)  # a clock not starting at 0
+    late = stepped_sine(rec.t + 100.0, rec.channel("voltage"), y, plan=plan)   # a clock not starting at 0
     np.testing.assert_allclose(late.response, e.response, rtol=1e-10)
 
 
 def test_settle_time_of_the_slowest_pole():
     import control
 
-    sys = control.tf([1.0], [0.2, 1.0]) * control.tf([100.0], [1.0, 20.0, 100.0])  # poles -5, -10 ± 0j
+    sys = control.tf([1.0], [0.2, 1.0]) * control.tf([100.0], [1.0, 20.0, 100.0])   # poles -5, -10 ± 0j
     assert settle_time_s(sys, 1e-3) == pytest.approx(0.2 * math.log(1e3), rel=1e-9)
     with pytest.raises(IPMCError, match="stable"):
         settle_time_s([-1.0, 0.5])
@@ -145,8 +137,8 @@ def test_chirp_sweeps_its_band():
     rec = chirp(5.0, 200.0, 4.0, FS, amplitude=0.5)
     assert rec.metadata["expected_duration_s"] == "4"
     u = rec.channel("voltage")
-    k, T = 200.0 / 5.0, 4.0  # exponential sweep: phase 2π f0 T (k^(t/T) − 1)/ln k
-    np.testing.assert_allclose(u, 0.5 * np.sin(2 * np.pi * 5.0 * T * (k ** (rec.t / T) - 1) / np.log(k)), atol=1e-9)
+    k, T = 200.0 / 5.0, 4.0                  # exponential sweep: phase 2π f0 T (k^(t/T) − 1)/ln k
+    np.testing.assert_allclose(u, 0.5 * np.sin(2 * np.pi * 5.0 * T * (k**(rec.t / T) - 1) / np.log(k)), atol=1e-9)
     assert np.max(np.abs(u)) == pytest.approx(0.5, rel=1e-3)
     with pytest.raises(IPMCError, match="f1_hz"):
         chirp(5.0, 600.0, 1.0, FS)

@@ -44,14 +44,8 @@ def test_oracle_simulation_is_python_controls_own():
 
 
 # ------------------------------------------------------------------------------------- peer check
-@pytest.mark.parametrize(
-    "kw",
-    [
-        dict(nperseg=1024),
-        dict(nperseg=500, noverlap=100, window="boxcar"),
-        dict(nperseg=256, noverlap=192, window=("tukey", 0.3), detrend="linear"),
-    ],
-)
+@pytest.mark.parametrize("kw", [dict(nperseg=1024), dict(nperseg=500, noverlap=100, window="boxcar"),
+                                dict(nperseg=256, noverlap=192, window=("tukey", 0.3), detrend="linear")])
 def test_welch_matches_scipy_csd_and_welch(kw):
     sysd = orc.resonant(FS)
     u, y, _, _ = orc.white_record(sysd, 60_000, seed=1, output_noise=0.2)
@@ -95,9 +89,9 @@ def test_h1_agrees_with_truth_within_its_sigma():
         u, y, _, _ = orc.white_record(sysd, 200_000, seed=seed, output_noise=noise)
         e = h1(FS, u, y, nperseg=1024)
         Ht = orc.truth(sysd, e.frequency_hz, FS)
-        keep = (np.abs(Ht) ** 2 / (np.abs(Ht) ** 2 + noise**2) >= 0.2) & (np.arange(Ht.size) % 3 == 0)
+        keep = (np.abs(Ht)**2 / (np.abs(Ht)**2 + noise**2) >= 0.2) & (np.arange(Ht.size) % 3 == 0)
         tm, tp = _t_stats(e, Ht)
-        t2 += [tm[keep] ** 2, tp[keep] ** 2]
+        t2 += [tm[keep]**2, tp[keep]**2]
     t2 = np.concatenate(t2)
     nu = 2 * (e.settings["effective_averages"] - 1)
     mean, band = _t2_mean_band(nu, t2.size)
@@ -107,7 +101,7 @@ def test_h1_agrees_with_truth_within_its_sigma():
 
 def test_h2_is_unbiased_for_input_noise_and_h1_is_biased_as_predicted():
     sysd = orc.resonant(FS)
-    nu_in = 0.5  # input measurement noise (std) on a unit-variance input
+    nu_in = 0.5                         # input measurement noise (std) on a unit-variance input
     u, y, _, _ = orc.white_record(sysd, 400_000, seed=7, input_noise=nu_in)
     e1, e2 = h1(FS, u, y, nperseg=1024), h2(FS, u, y, nperseg=1024)
     Ht = orc.truth(sysd, e1.frequency_hz, FS)
@@ -116,7 +110,7 @@ def test_h2_is_unbiased_for_input_noise_and_h1_is_biased_as_predicted():
     ratio = np.mean((e1.response[0] / Ht)[band])
     assert ratio.real == pytest.approx(1 / (1 + nu_in**2), abs=0.01)
     tm, tp = _t_stats(e2, Ht)
-    t2 = np.concatenate([tm[band][::3] ** 2, tp[band][::3] ** 2])
+    t2 = np.concatenate([tm[band][::3]**2, tp[band][::3]**2])
     mean, b = _t2_mean_band(2 * (e2.settings["effective_averages"] - 1), t2.size)
     assert abs(t2.mean() - mean) < b
 
@@ -131,10 +125,10 @@ def test_coherence_follows_added_output_noise(noise):
     u, y, _, _ = orc.white_record(sysd, 200_000, seed=3, output_noise=noise)
     e = h1(FS, u, y, nperseg=4096, noverlap=0)
     n = e.settings["effective_averages"]
-    g = np.abs(orc.truth(sysd, e.frequency_hz, FS)) ** 2
+    g = np.abs(orc.truth(sysd, e.frequency_hz, FS))**2
     g = g / (g + noise**2)
-    expected = g + (1 - g) ** 2 / n
-    sd = np.sqrt(2 * g * (1 - g) ** 2 / n + (1 - g) ** 4 / n**2)
+    expected = g + (1 - g)**2 / n
+    sd = np.sqrt(2 * g * (1 - g)**2 / n + (1 - g)**4 / n**2)
     z = (e.coherence[0] - expected) / sd
     assert abs(z.mean()) < 4 / math.sqrt(z.size)
     assert 0.8 < z.std() < 1.2
@@ -152,12 +146,12 @@ def test_coarse_segments_bias_coherence_low_at_a_resonance():
         for win in ("boxcar", "hann"):
             e = h1(FS, u, y, nperseg=nper, noverlap=0, window=win)
             n = e.settings["effective_averages"]
-            g = np.abs(orc.truth(sysd, e.frequency_hz, FS)) ** 2
+            g = np.abs(orc.truth(sysd, e.frequency_hz, FS))**2
             g = g / (g + 0.01)
             band = (e.frequency_hz > 40) & (e.frequency_hz < 60)
-            d = (e.coherence[0] - g - (1 - g) ** 2 / n)[band]
+            d = (e.coherence[0] - g - (1 - g)**2 / n)[band]
             deficit[nper, win] = -d.mean()
-            z[nper, win] = np.mean(d / np.sqrt(2 * g * (1 - g) ** 2 / n)[band])
+            z[nper, win] = np.mean(d / np.sqrt(2 * g * (1 - g)**2 / n)[band])
     assert z[1000, "boxcar"] < -10 and z[1000, "hann"] < -10
     assert 2 < deficit[1000, "boxcar"] / deficit[4000, "boxcar"] < 8
     assert deficit[1000, "hann"] / deficit[4000, "hann"] > 8
@@ -171,16 +165,8 @@ def test_lines_of_a_multisine_period_are_exact_without_noise():
     ms = multisine(np.arange(1, 301) * 1.0, FS, 1.0)
     u = np.tile(ms.period(), 6)
     y = orc.simulate(sysd, u)
-    e = h1(
-        FS,
-        u,
-        y,
-        nperseg=ms.n_samples,
-        noverlap=0,
-        window="boxcar",
-        discard_s=ms.period_s,
-        frequencies_hz=ms.frequency_hz,
-    )
+    e = h1(FS, u, y, nperseg=ms.n_samples, noverlap=0, window="boxcar", discard_s=ms.period_s,
+           frequencies_hz=ms.frequency_hz)
     np.testing.assert_allclose(e.response[0], orc.truth(sysd, ms.frequency_hz, FS), rtol=1e-10)
     assert e.n_averages[0] == 5
 
@@ -195,8 +181,8 @@ def _plan(f, settle, periods, fs=FS):
 
 def test_stepped_sine_exact_with_a_non_integer_number_of_samples_per_period():
     sysd, sysc = orc.slow_resonant(FS)
-    f = np.array([0.7, 3.3, 13.7, 47.1, 123.4])  # fs/f = 1428.6, 303.0, 73.0, 21.2, 8.1 samples
-    settle = math.log(1e12) * 0.2  # transient of the slowest pole down to 1e-12
+    f = np.array([0.7, 3.3, 13.7, 47.1, 123.4])            # fs/f = 1428.6, 303.0, 73.0, 21.2, 8.1 samples
+    settle = math.log(1e12) * 0.2                            # transient of the slowest pole down to 1e-12
     starts, stops = _plan(f, settle, 7)
     t, u, y = orc.stepped_record(sysd, f, starts, stops, FS)
     e = stepped_sine(t, u, y, f, starts, stops, settle_s=settle, periods=7)
@@ -212,14 +198,12 @@ def test_stepped_sine_is_independent_of_settle_once_past_the_slowest_time_consta
     for k in (0.0, 0.5, 3.0, 10.0, 20.0, 30.0):
         starts, stops = _plan(f, k * tau, 10)
         t, u, y = orc.stepped_record(sysd, f, starts, stops, FS)
-        err[k] = np.max(
-            np.abs(stepped_sine(t, u, y, f, starts, stops, settle_s=k * tau, periods=10).response[0] / H - 1)
-        )
+        err[k] = np.max(np.abs(stepped_sine(t, u, y, f, starts, stops, settle_s=k * tau, periods=10).response[0] / H - 1))
     # the transient left after s seconds is ∝ exp(−s/τ): a few % when not waited for, then gone
     assert err[0.0] > 1e-2
     for k in (10.0, 20.0):
         assert err[k] < 2 * math.exp(-k) * max(err[0.0], 1.0)
-    assert err[30.0] < 1e-10  # round-off from here on
+    assert err[30.0] < 1e-10                                   # round-off from here on
 
 
 def test_stepped_sine_uses_whole_periods_and_refuses_fractional_ones():
@@ -251,16 +235,8 @@ def test_stepped_sine_sigma_from_period_scatter_is_consistent():
     t2 = []
     for seed in range(10):
         rng = np.random.default_rng(seed)
-        e = stepped_sine(
-            t,
-            u + 0.002 * rng.standard_normal(u.size),
-            [y0 + 0.05 * rng.standard_normal(u.size)],
-            f,
-            starts,
-            stops,
-            settle_s=0.2,
-            periods=P,
-        )
+        e = stepped_sine(t, u + 0.002 * rng.standard_normal(u.size), [y0 + 0.05 * rng.standard_normal(u.size)],
+                         f, starts, stops, settle_s=0.2, periods=P)
         tm, tp = _t_stats(e, H)
         t2 += [tm**2, tp**2]
     t2 = np.concatenate(t2)
@@ -278,13 +254,13 @@ def test_stepped_sine_on_the_physics_model_matches_its_frequency_response():
 
     m = ActuatorModel(get_parameter_set("seed002_table3"))
     fs, T = 400.0, 25.0
-    f = np.geomspace(0.1, 9.0, 12)  # seed 001: 0.1-9 Hz
+    f = np.geomspace(0.1, 9.0, 12)                         # seed 001: 0.1-9 Hz
     real = model_realization(m, T, fs, 300.0)
     plan = stepped_sine_plan(f, fs, periods=8, min_measure_s=4.0, settle_s=settle_time_s(real.poles, 1e-6))
     t = np.arange(plan.n_samples) / fs
     ts = simulate(m, T, t, plan.signal(), realization=real, output_noise_rms=2e-6, seed=3)
     e = stepped_sine(t, ts.input, ts.output, plan=plan)
-    H = m.frequency_response(f, [T])["M"][0, 0] * np.sinc(f / fs) ** 2
+    H = m.frequency_response(f, [T])["M"][0, 0] * np.sinc(f / fs)**2
     tm, tp = _t_stats(e, H)
     # realisation error (≤ 4e-6 relative here) is far below σ; 24 terms, 4-sd band of t(7)²
     t2 = np.concatenate([tm**2, tp**2])
@@ -300,18 +276,14 @@ def test_several_channels_give_m_and_z_sweeps_usable_by_calibration(tmp_path):
     from physmodel.data.sweep import sweep_layout
 
     rng = np.random.default_rng(5)
-    adm = orc.resonant(FS, f_n=150.0, zeta=0.7, gain=0.02)  # current/voltage [A/V]
-    mob = orc.resonant(FS, f_n=40.0, zeta=0.3, gain=2.0)  # displacement/voltage [mm/V]
+    adm = orc.resonant(FS, f_n=150.0, zeta=0.7, gain=0.02)           # current/voltage [A/V]
+    mob = orc.resonant(FS, f_n=40.0, zeta=0.3, gain=2.0)             # displacement/voltage [mm/V]
     v = rng.standard_normal(120_000 + 4000)
     cur = orc.simulate(adm, v)[4000:] + 1e-3 * rng.standard_normal(120_000)
     disp = orc.simulate(mob, v)[4000:] + 0.05 * rng.standard_normal(120_000)
     v = v[4000:]
-    rec = TimeRecord(
-        np.arange(v.size) / FS,
-        {"voltage": v, "current": cur, "tip_displacement": disp},
-        {"voltage": "V", "current": "A", "tip_displacement": "mm"},
-        {"temperature_c": "25"},
-    )
+    rec = TimeRecord(np.arange(v.size) / FS, {"voltage": v, "current": cur, "tip_displacement": disp},
+                     {"voltage": "V", "current": "A", "tip_displacement": "mm"}, {"temperature_c": "25"})
     e = estimate_record(rec, "voltage", method="h1", nperseg=1024)
     assert e.output_names == ("current", "tip_displacement")
     M = e.to_sweep(25.0, "tip_displacement", band_hz=(1.0, 200.0), quantity="M")
@@ -332,14 +304,8 @@ def test_unexcited_lines_are_flagged_by_coherence_and_unexcitable_ones_refused()
 
     ms = multisine([10.0, 20.0, 30.0], FS, 1.0)
     u = np.tile(ms.period(), 5)
-    e = h1(
-        FS,
-        u,
-        orc.simulate(orc.resonant(FS), u) + 1e-3 * np.random.default_rng(0).standard_normal(u.size),
-        nperseg=ms.n_samples,
-        noverlap=0,
-        window="boxcar",
-    )
+    e = h1(FS, u, orc.simulate(orc.resonant(FS), u) + 1e-3 * np.random.default_rng(0).standard_normal(u.size),
+           nperseg=ms.n_samples, noverlap=0, window="boxcar")
     lines = np.isin(e.frequency_hz, ms.frequency_hz)
     assert np.all(e.coherence[0][lines] > 0.999) and np.all(e.coherence[0][~lines] < 0.9)
     sw = e.to_sweep(25.0, min_coherence=0.9)
@@ -353,30 +319,27 @@ def test_unexcited_lines_are_flagged_by_coherence_and_unexcitable_ones_refused()
 
 
 # ------------------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize(
-    "call,match",
-    [
-        (lambda u, y: h1(FS, u, y, nperseg=10**6), "nperseg"),
-        (lambda u, y: h1(FS, u, y, nperseg=256, noverlap=256), "noverlap"),
-        (lambda u, y: h1(FS, u, y, nperseg=3000, noverlap=0), "segment"),
-        (lambda u, y: h1(FS, u, y[:-1]), "y\\[0\\] has 3999 samples"),
-        (lambda u, y: h1(-1.0, u, y), "t_or_fs"),
-        (lambda u, y: h1(np.r_[0.0, np.cumsum(np.full(3999, 1e-3))] ** 1.01, u, y), "uniform"),
-        (lambda u, y: h1(FS, np.where(np.arange(u.size) == 17, np.nan, u), y), r"u contains NaN .* \[17\]"),
-        (lambda u, y: h1(FS, u, y, nperseg=1000, frequencies_hz=[1.5]), "frequencies_hz"),
-        (lambda u, y: h1(FS, u, y, window="nope"), "window"),
-        (lambda u, y: h1(FS, u, y, detrend="quadratic"), "detrend"),
-        (lambda u, y: h1(FS, u, y, discard_s=-1.0), "discard_s"),
-        (lambda u, y: h1(FS, u, y).to_sweep(25.0, "displacement"), "output"),
-        (lambda u, y: stepped_sine(FS, u, y, [300.0], [0.0]), "frequencies_hz"),
-        (lambda u, y: stepped_sine(FS, u, y, [10.0, 10.0], [0.0, 1.0]), "repeats"),
-        (lambda u, y: stepped_sine(FS, u, y, [10.0, 20.0], [0.0, 3.95]), r"step 1 \(20 Hz\): 1 whole"),
-        (lambda u, y: stepped_sine(FS, u, y, [10.0, 20.0], [0.0, 9.0]), r"step 0 .* must lie in the record"),
-        (lambda u, y: stepped_sine(FS, u, y, [10.0], None), "step_start_s"),
-        (lambda u, y: stepped_sine(FS, u, y, [10.0], [0.0]).to_sweep(25.0, min_coherence=0.5), "min_coherence"),
-        (lambda u, y: stepped_sine(FS, u, y, [10.0], [0.0], settle_s=-1), "settle"),
-    ],
-)
+@pytest.mark.parametrize("call,match", [
+    (lambda u, y: h1(FS, u, y, nperseg=10**6), "nperseg"),
+    (lambda u, y: h1(FS, u, y, nperseg=256, noverlap=256), "noverlap"),
+    (lambda u, y: h1(FS, u, y, nperseg=3000, noverlap=0), "segment"),
+    (lambda u, y: h1(FS, u, y[:-1]), "y\\[0\\] has 3999 samples"),
+    (lambda u, y: h1(-1.0, u, y), "t_or_fs"),
+    (lambda u, y: h1(np.r_[0.0, np.cumsum(np.full(3999, 1e-3))] ** 1.01, u, y), "uniform"),
+    (lambda u, y: h1(FS, np.where(np.arange(u.size) == 17, np.nan, u), y), r"u contains NaN .* \[17\]"),
+    (lambda u, y: h1(FS, u, y, nperseg=1000, frequencies_hz=[1.5]), "frequencies_hz"),
+    (lambda u, y: h1(FS, u, y, window="nope"), "window"),
+    (lambda u, y: h1(FS, u, y, detrend="quadratic"), "detrend"),
+    (lambda u, y: h1(FS, u, y, discard_s=-1.0), "discard_s"),
+    (lambda u, y: h1(FS, u, y).to_sweep(25.0, "displacement"), "output"),
+    (lambda u, y: stepped_sine(FS, u, y, [300.0], [0.0]), "frequencies_hz"),
+    (lambda u, y: stepped_sine(FS, u, y, [10.0, 10.0], [0.0, 1.0]), "repeats"),
+    (lambda u, y: stepped_sine(FS, u, y, [10.0, 20.0], [0.0, 3.95]), r"step 1 \(20 Hz\): 1 whole"),
+    (lambda u, y: stepped_sine(FS, u, y, [10.0, 20.0], [0.0, 9.0]), r"step 0 .* must lie in the record"),
+    (lambda u, y: stepped_sine(FS, u, y, [10.0], None), "step_start_s"),
+    (lambda u, y: stepped_sine(FS, u, y, [10.0], [0.0]).to_sweep(25.0, min_coherence=0.5), "min_coherence"),
+    (lambda u, y: stepped_sine(FS, u, y, [10.0], [0.0], settle_s=-1), "settle"),
+])
 def test_bad_input_names_the_argument(call, match):
     rng = np.random.default_rng(0)
     u = rng.standard_normal(4000)

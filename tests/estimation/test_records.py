@@ -13,16 +13,9 @@ from physmodel.estimation.frf import estimate_record
 def _record(n=2000):
     rng = np.random.default_rng(0)
     t = np.arange(n) / 1000.0
-    return TimeRecord(
-        t,
-        {
-            "voltage": rng.standard_normal(n),
-            "current": 1e-3 * rng.standard_normal(n),
-            "tip_displacement": rng.standard_normal(n),
-        },
-        {"voltage": "V", "current": "uA", "tip_displacement": "mm"},
-        {"temperature_c": "35.5"},
-    )
+    return TimeRecord(t, {"voltage": rng.standard_normal(n), "current": 1e-3 * rng.standard_normal(n),
+                          "tip_displacement": rng.standard_normal(n)},
+                      {"voltage": "V", "current": "uA", "tip_displacement": "mm"}, {"temperature_c": "35.5"})
 
 
 @pytest.mark.parametrize("ext", ["csv", "npz", "mat"])
@@ -66,19 +59,16 @@ def test_estimate_from_a_file_equals_the_arrays(tmp_path):
         estimate_record(rec, "voltage", method="h3")
 
 
-@pytest.mark.parametrize(
-    "text,match",
-    [
-        ("# ipmc-timeseries 1\nt,voltage_V\n0,1\n0.001,2\n", "no 'time_s' column"),
-        ("# ipmc-timeseries 2\ntime_s,voltage_V\n0,1\n0.001,2\n", "version '2'"),
-        ("time_s,voltage\n0,1\n0.001,2\n", "column 'voltage' must be named"),
-        ("# voltage_V: current [A]\ntime_s,voltage_V\n0,1\n0.001,2\n", "disagrees"),
-        ("time_s,voltage_V\n0,1\n0.001,abc\n", "abc"),
-        ("time_s,voltage_V\n0,1\n0.001,nan\n", "not finite at samples \\[1\\]"),
-        ("time_s,voltage_V,current_A\n0,1,2\n0.001,2,3\n", None),
-        ("# only a header\n", "no column header"),
-    ],
-)
+@pytest.mark.parametrize("text,match", [
+    ("# ipmc-timeseries 1\nt,voltage_V\n0,1\n0.001,2\n", "no 'time_s' column"),
+    ("# ipmc-timeseries 2\ntime_s,voltage_V\n0,1\n0.001,2\n", "version '2'"),
+    ("time_s,voltage\n0,1\n0.001,2\n", "column 'voltage' must be named"),
+    ("# voltage_V: current [A]\ntime_s,voltage_V\n0,1\n0.001,2\n", "disagrees"),
+    ("time_s,voltage_V\n0,1\n0.001,abc\n", "abc"),
+    ("time_s,voltage_V\n0,1\n0.001,nan\n", "not finite at samples \\[1\\]"),
+    ("time_s,voltage_V,current_A\n0,1,2\n0.001,2,3\n", None),
+    ("# only a header\n", "no column header"),
+])
 def test_malformed_csv_is_named(tmp_path, text, match):
     p = tmp_path / "bad.csv"
     p.write_text(text)

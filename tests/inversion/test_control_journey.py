@@ -44,7 +44,7 @@ def journey():
     fitter = surrogate.ScheduledFit("coefficients", 4, 4, 2)
     fit = fitter.fit(dense)
     with warnings.catch_warnings():
-        warnings.simplefilter("error")  # a ScheduleWarning would fail here
+        warnings.simplefilter("error")                  # a ScheduleWarning would fail here
         check = check_schedule(fitter, dense, fit.model, physics=physics, step_c=2.5)
     G = fit.model.at(T_OP)
     # 10 kHz: at 1 kHz the inverse's first-order-hold discretisation error, (w dt)^2/12 of the
@@ -53,7 +53,7 @@ def journey():
     # 100x smaller (result.discretisation_error_estimate reports it)
     ref = sine(AMP, F_REF, 8.0, 10_000.0, unit="mm")
     ff = feedforward(G, ref.t, ref.y, limits=Limits(max_voltage=3.0, max_rate=100.0))
-    y = simulate(strip, T_OP, ref.t, ff.output).output * 1e3  # m -> mm
+    y = simulate(strip, T_OP, ref.t, ff.output).output * 1e3          # m -> mm
     assert ff.discretisation_error_estimate < 1e-3 * ff.limit_report.peak
     return dict(truth=truth, strip=strip, cal=cal, fit=fit, check=check, G=G, ref=ref, ff=ff, y=y)
 
@@ -69,14 +69,14 @@ def test_schedule_on_the_calibrated_physics_holds_between_temperatures(journey):
     fit, check = journey["fit"], journey["check"]
     assert fit.converged and check.ok
     assert check.cv.feasible and len(check.cv.held_out) == len(DENSE_C) - 2
-    assert check.dense.between_error < 0.01  # < 1 % everywhere (issue 14)
+    assert check.dense.between_error < 0.01                     # < 1 % everywhere (issue 14)
 
 
 def test_feedforward_tracks_as_the_steady_state_predicts(journey):
     ref, y, ff, strip, G = journey["ref"], journey["y"], journey["ff"], journey["strip"], journey["G"]
     err = np.max(np.abs(y - ref.y)[ref.body])
-    P = strip.frequency_response(np.array([F_REF]), [T_OP])["M"][0, 0, 0] * 1e3  # mm/V
+    P = strip.frequency_response(np.array([F_REF]), [T_OP])["M"][0, 0, 0] * 1e3      # mm/V
     pred = AMP * abs(P / complex(G(2j * np.pi * F_REF)) - 1)
     assert err == pytest.approx(pred, rel=0.15, abs=2e-4)
-    assert err < 0.02 * AMP  # measured-data route: a few um
-    assert ff.limit_report.ok and ff.limit_report.peak < 1.0  # about 0.4 V, not 42 V
+    assert err < 0.02 * AMP                                     # measured-data route: a few um
+    assert ff.limit_report.ok and ff.limit_report.peak < 1.0     # about 0.4 V, not 42 V

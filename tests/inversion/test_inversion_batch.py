@@ -36,7 +36,7 @@ from inversion import (
 from inversion.examples import SEED000_DEN_35C, SEED000_NUM_35C, seed000_sensor_35c, toy_actuator
 
 NMP = (list(SEED000_NUM_35C), list(SEED000_DEN_35C))
-MP = (np.poly([-50.0, -500.0]).tolist(), np.poly([-10.0, -100.0]).tolist())  # minimum phase, biproper
+MP = (np.poly([-50.0, -500.0]).tolist(), np.poly([-10.0, -100.0]).tolist())   # minimum phase, biproper
 
 
 def _H(model, w):
@@ -50,7 +50,7 @@ def _sine_error(model, f, dt, preview="inf"):
     res = invert(model, t, np.sin(w * t), preview=preview)
     H = _H(model, w)
     exact = abs(H) * np.sin(w * t + np.angle(H))
-    m = (t > 1.0) & (t < 1.8)  # edge transients: e^{-50*1} and e^{-35.2*1.2} < 1e-18
+    m = (t > 1.0) & (t < 1.8)     # edge transients: e^{-50*1} and e^{-35.2*1.2} < 1e-18
     return np.max(np.abs(res.output[m] - exact[m])), res, H
 
 
@@ -126,9 +126,7 @@ def test_sensor_decoding_recovers_displacement_from_fine_grid_simulation():
     for dt in (1e-3, 5e-4):
         t = np.arange(0.0, 2.0, dt)
         tf = np.arange(0.0, 2.0 - dt / 2, dt / 20)
-        d = lambda x: (
-            np.where((x > 0.3) & (x < 1.5), np.sin(np.pi * (x - 0.3) / 1.2) ** 2, 0.0) * np.sin(2 * np.pi * 20 * x)
-        )
+        d = lambda x: np.where((x > 0.3) & (x < 1.5), np.sin(np.pi * (x - 0.3) / 1.2) ** 2, 0.0) * np.sin(2 * np.pi * 20 * x)
         _, i_f, _ = ss.lsim(G, d(tf), tf)
         i = i_f[::20][: t.size]
         res = decode_sensor(G, t, i, preview="inf")
@@ -136,8 +134,8 @@ def test_sensor_decoding_recovers_displacement_from_fine_grid_simulation():
         # rigorous-in-spirit a-posteriori estimate (||h||_1 dt^2/8 max|i''|) must cover it
         assert err <= res.discretisation_error_estimate
         errs.append(err)
-    assert 3.0 < errs[0] / errs[1] < 5.0  # O(dt^2)
-    assert errs[1] < 0.002  # mm, for a 1 mm stimulus
+    assert 3.0 < errs[0] / errs[1] < 5.0          # O(dt^2)
+    assert errs[1] < 0.002                          # mm, for a 1 mm stimulus
 
 
 def test_actuator_feedforward_tracks_desired_trajectory():
@@ -147,17 +145,17 @@ def test_actuator_feedforward_tracks_desired_trajectory():
     dt = 2e-3
     t = np.arange(0.0, 24.0, dt)
     env = np.where((t > 4) & (t < 18), np.sin(np.pi * (t - 4) / 14) ** 2, 0.0)
-    desired = 0.325 * (np.sin(np.pi * t) + np.sin(4 * np.pi * t)) * env  # seed 001 two-tone shape
+    desired = 0.325 * (np.sin(np.pi * t) + np.sin(4 * np.pi * t)) * env   # seed 001 two-tone shape
     ff = feedforward(G, t, desired, preview="inf")
     same = invert(G, t, desired, preview="inf")
-    np.testing.assert_array_equal(ff.output, same.output)  # one code path
+    np.testing.assert_array_equal(ff.output, same.output)   # one code path
     achieved = _lsim_fine(model, t, ff.output, 1)
     # as in test_G_applied_to_inverse_returns_signal: only the interpolation of the voltage
     ysp = ff.output - ff.split.feedthrough * desired
     bound = 1.5 * _g_l1(model, horizon=25.0) * np.max(np.abs(np.diff(ysp, 2))) / 8
     err = np.max(np.abs(achieved - desired))
     assert err <= bound
-    assert err < 2e-3 * 0.65  # 0.2 % of the 0.65 mm amplitude
+    assert err < 2e-3 * 0.65                               # 0.2 % of the 0.65 mm amplitude
     assert ff.r0 == pytest.approx(4.0, rel=1e-9)
     # the voltage starts before the motion (pre-actuation of a NMP inverse)
     assert np.max(np.abs(ff.output[(t > 3.0) & (t < 4.0)])) > 1e-4
@@ -167,7 +165,7 @@ def test_finite_preview_equals_truncated_integral_by_quadrature():
     """eq. (6) of seed 000 evaluated independently with residues + adaptive quadrature."""
     dt = 1e-3
     t = np.arange(0.0, 1.0, dt)
-    u = np.sin(2 * np.pi * 13 * t) * np.exp(-(((t - 0.5) / 0.2) ** 2))
+    u = np.sin(2 * np.pi * 13 * t) * np.exp(-((t - 0.5) / 0.2) ** 2)
     Tp = 0.05
     res = invert(NMP, t, u, preview=Tp)
     assert res.preview_samples == 50 and res.preview_s == pytest.approx(0.05)
@@ -178,14 +176,8 @@ def test_finite_preview_equals_truncated_integral_by_quadrature():
         tk = t[k]
         total = 0.0
         for ri, pi in zip(r[unstable], p[unstable]):
-            re = si.quad(
-                lambda x: np.real(-ri * np.exp(pi * (tk - x))) * uf(x),
-                tk,
-                tk + Tp,
-                limit=200,
-                points=t[k : k + 51],
-                epsabs=1e-13,
-            )[0]
+            re = si.quad(lambda x: np.real(-ri * np.exp(pi * (tk - x))) * uf(x), tk, tk + Tp,
+                         limit=200, points=t[k:k + 51], epsabs=1e-13)[0]
             total += re
         assert res.unstable_part[k] == pytest.approx(total, rel=1e-6, abs=1e-10)
 
@@ -197,7 +189,8 @@ def test_chunked_processing_equals_single_pass():
         a = invert(NMP, 1e-3, u, preview=preview)
         b = invert(NMP, 1e-3, u, preview=preview, chunk_size=777)
         np.testing.assert_allclose(b.output, a.output, rtol=0, atol=1e-12 * np.max(np.abs(a.output)))
-        np.testing.assert_allclose(b.unstable_part, a.unstable_part, rtol=0, atol=1e-12 * np.max(np.abs(a.output)))
+        np.testing.assert_allclose(b.unstable_part, a.unstable_part, rtol=0,
+                                   atol=1e-12 * np.max(np.abs(a.output)))
 
 
 def test_invert_to_memmap_bounded_memory_equals_invert(tmp_path):
@@ -262,7 +255,7 @@ def test_preview_spellings():
 
 
 def test_improper_models_differentiate_and_filter_against_analytic():
-    model = ([100.0], [1.0, 14.0, 100.0])  # H = s^2/100 + 0.14 s + 1
+    model = ([100.0], [1.0, 14.0, 100.0])      # H = s^2/100 + 0.14 s + 1
     f, dt = 5.0, 1e-3
     w = 2 * np.pi * f
     t = np.arange(0.0, 2.0, dt)

@@ -35,7 +35,7 @@ def _window_sum_oracle(split, dt, n_prev, u):
     x = np.zeros((n + n_prev + 1, m))
     for k in range(n - 1, -1, -1):
         x[k] = Phi @ x[k + 1] + alpha * up[k] + beta * up[k + 1]
-    xbar = x[:n] - x[n_prev : n_prev + n] @ np.linalg.matrix_power(Phi, n_prev).T
+    xbar = x[:n] - x[n_prev:n_prev + n] @ np.linalg.matrix_power(Phi, n_prev).T
     return xbar @ Cr
 
 
@@ -67,20 +67,17 @@ def test_fused_pass_transfer_function_form_at_1khz_equals_the_window_sum():
 
 
 def _stream(inv, u, size):
-    outs = [inv.push(u[i : i + size]) for i in range(0, u.size, size)]
+    outs = [inv.push(u[i:i + size]) for i in range(0, u.size, size)]
     outs.append(inv.flush())
     return np.concatenate(outs)
 
 
-@pytest.mark.parametrize(
-    "model, dt, preview, improper",
-    [
-        (G35, 1e-3, "4/r0", "error"),  # transfer-function filters
-        (CLUSTERED, 1e-6, 0.002, "error"),  # second-order sections
-        ((np.poly([-50.0, -500.0]), np.poly([-10.0, -100.0])), 1e-3, 0.02, "error"),  # minimum phase
-        (([100.0], [1.0, 14.0, 100.0]), 1e-3, 0.0, "differentiate"),  # stencil only
-    ],
-)
+@pytest.mark.parametrize("model, dt, preview, improper", [
+    (G35, 1e-3, "4/r0", "error"),                                  # transfer-function filters
+    (CLUSTERED, 1e-6, 0.002, "error"),                             # second-order sections
+    ((np.poly([-50.0, -500.0]), np.poly([-10.0, -100.0])), 1e-3, 0.02, "error"),   # minimum phase
+    (([100.0], [1.0, 14.0, 100.0]), 1e-3, 0.0, "differentiate"),   # stencil only
+])
 def test_one_sample_pushes_equal_the_batch_inverse(model, dt, preview, improper):
     u = np.sin(2 * np.pi * 20 * 1e-3 * np.arange(2500)) + 0.3 * np.random.default_rng(7).standard_normal(2500)
     ref = invert(model, dt, u, preview=preview, improper=improper).output
@@ -98,7 +95,7 @@ def test_switching_between_one_sample_and_chunk_paths_keeps_the_state():
     inv = StreamingInverter(CLUSTERED, 1e-6, 0.002)
     outs, i = [], 0
     for size in [1] * 50 + [4096] + [1] * 30 + [700, 1, 1, 1000]:
-        outs.append(inv.push(u[i : i + size]))
+        outs.append(inv.push(u[i:i + size]))
         i += size
     outs.append(inv.push(u[i:]))
     outs.append(inv.flush())
@@ -121,7 +118,7 @@ def test_long_preview_switches_between_kernel_block_sums_and_batch_pass():
     inv = StreamingInverter(G35, 1e-3, 1.0)
     outs, i = [], 0
     for size in [1] * 40 + [300, 5, 2000] + [257] * 3 + [1] * 10 + [300] * 4 + [2000, 7, 300]:
-        outs.append(inv.push(u[i : i + size]))
+        outs.append(inv.push(u[i:i + size]))
         i += size
         assert inv._hist.size <= 2 * inv.preview_samples + 2000
     outs.append(inv.push(u[i:]))

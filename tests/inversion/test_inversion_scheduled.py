@@ -54,16 +54,8 @@ def _warped_sensor_current(t, d, T):
     B, C, D = B.ravel() / sc, C.ravel() * sc, float(D[0, 0])
     kap = lambda TT: 1 - 0.01 * (TT - 35)
     gain = lambda TT: 1 - 0.004 * (TT - 35)
-    sol = solve_ivp(
-        lambda tt, x: kap(T(tt)) * (A @ x + B * d(tt)),
-        (t[0], t[-1]),
-        np.zeros(4),
-        t_eval=t,
-        method="DOP853",
-        rtol=1e-10,
-        atol=1e-12,
-        max_step=2e-4,
-    )
+    sol = solve_ivp(lambda tt, x: kap(T(tt)) * (A @ x + B * d(tt)), (t[0], t[-1]), np.zeros(4),
+                    t_eval=t, method="DOP853", rtol=1e-10, atol=1e-12, max_step=2e-4)
     assert sol.success
     return gain(T(t)) * (C @ sol.y + D * d(t))
 
@@ -72,7 +64,7 @@ def _warped_sensor_current(t, d, T):
 def drift():
     dur = 2.5
     t = np.arange(0.0, dur, DT)
-    T = lambda tt: 30.0 + 10.0 * tt / dur  # bath drifts 30 -> 40 degC
+    T = lambda tt: 30.0 + 10.0 * tt / dur                  # bath drifts 30 -> 40 degC
     d = lambda tt: np.where(tt < 0.3, np.sin(np.pi * tt / 0.6) ** 2, 1.0) * np.sin(2 * np.pi * 20 * tt)
     i = _warped_sensor_current(t, d, T)
     return t, T(t), d(t), i
@@ -82,11 +74,11 @@ def test_drifting_bath_scheduled_inverse_beats_fixed_temperature(drift):
     t, T, d, i = drift
     m = (t > 0.5) & (t < t[-1] - 0.3)
     sched = invert_scheduled(toy_scheduled_sensor, t, i, T, preview="inf")
-    fixed = invert(toy_scheduled_sensor(30.0), t, i, preview="inf")  # calibrated at start
+    fixed = invert(toy_scheduled_sensor(30.0), t, i, preview="inf")   # calibrated at start
     e_s = np.max(np.abs(sched.output[m] - d[m]))
     e_f = np.max(np.abs(fixed.output[m] - d[m]))
-    assert e_s < 3e-3  # mm for a 1 mm stimulus (frozen-time + grid + discretisation)
-    assert e_f / e_s > 20.0  # measured ~90x
+    assert e_s < 3e-3            # mm for a 1 mm stimulus (frozen-time + grid + discretisation)
+    assert e_f / e_s > 20.0      # measured ~90x
     # with the automatic preview both include the same truncation error: still far better
     sched_a = invert_scheduled(toy_scheduled_sensor, t, i, T, preview="4/r0")
     fixed_a = invert(toy_scheduled_sensor(30.0), t, i, preview=sched_a.preview_s)
@@ -98,7 +90,7 @@ def test_scheduled_streaming_and_bounded_memory_match_batch(drift, tmp_path):
     t, T, d, i = drift
     ref = invert_scheduled(toy_scheduled_sensor, DT, i, T, preview=0.1, grid_step=2.0)
     inv = ScheduledStreamingInverter(toy_scheduled_sensor, DT, (T.min(), T.max()), 0.1, grid_step=2.0)
-    outs = [inv.push(i[k : k + 333], T[k : k + 333]) for k in range(0, i.size, 333)]
+    outs = [inv.push(i[k:k + 333], T[k:k + 333]) for k in range(0, i.size, 333)]
     outs.append(inv.flush())
     y = np.concatenate(outs)
     np.testing.assert_allclose(y, ref.output, rtol=0, atol=1e-12 * np.max(np.abs(ref.output)))
@@ -107,7 +99,8 @@ def test_scheduled_streaming_and_bounded_memory_match_batch(drift, tmp_path):
     ti = np.lib.format.open_memmap(tmp_path / "T.npy", mode="w+", dtype=float, shape=(n,))
     yo = np.lib.format.open_memmap(tmp_path / "y.npy", mode="w+", dtype=float, shape=(n,))
     ui[:], ti[:] = i, T
-    g = invert_scheduled_to(toy_scheduled_sensor, DT, ui, ti, yo, preview=0.1, grid_step=2.0, chunk_size=400)
+    g = invert_scheduled_to(toy_scheduled_sensor, DT, ui, ti, yo, preview=0.1, grid_step=2.0,
+                            chunk_size=400)
     np.testing.assert_array_equal(g, ref.grid_c)
     np.testing.assert_allclose(np.asarray(yo), ref.output, rtol=0, atol=1e-12 * np.max(np.abs(ref.output)))
 

@@ -35,8 +35,8 @@ from inversion.examples import (
     toy_scheduled_sensor,
 )
 
-F_STIM = 20.0  # Hz, Fig. 12/16/17
-DT = 1e-4  # s; (w dt)^2/12 = 1.3e-5 relative discretisation error at 20 Hz
+F_STIM = 20.0      # Hz, Fig. 12/16/17
+DT = 1e-4          # s; (w dt)^2/12 = 1.3e-5 relative discretisation error at 20 Hz
 
 
 def _coeffs(G):
@@ -60,7 +60,7 @@ def _tp_star(G):
 def test_split_finds_the_printed_r0_and_the_printed_rule_gives_0114():
     sp = split_inverse(seed000_sensor_35c("zeros"))
     assert float(f"{sp.r0:.3g}") == 35.2
-    assert float(f"{4.0 / sp.r0:.3g}") == 0.114  # the printed T_p*, 3 significant figures
+    assert float(f"{4.0 / sp.r0:.3g}") == 0.114                      # the printed T_p*, 3 significant figures
     z = np.sort_complex(sp.zeros)
     np.testing.assert_allclose(z, np.sort_complex(np.array(SEED000_ZEROS_35C)), rtol=1e-12)
 
@@ -78,14 +78,14 @@ def test_printed_zeros_lie_within_the_rounding_of_the_printed_coefficients():
     G = seed000_sensor_35c("coefficients")
     num, _ = _coeffs(G)
     sp = split_inverse(G)
-    assert float(f"{sp.r0:.4g}") == 35.49 and float(f"{4 / sp.r0:.3g}") == 0.113  # measured, != printed
+    assert float(f"{sp.r0:.4g}") == 35.49 and float(f"{4 / sp.r0:.3g}") == 0.113     # measured, != printed
     z0 = np.roots(num)
     corners = np.array([np.roots(num + np.array(sg) * NUM_ROUNDING) for sg in itertools.product((-1, 1), repeat=5)])
     for zp in SEED000_ZEROS_35C:
         i = int(np.argmin(np.abs(z0 - zp)))
         spread = max(np.min(np.abs(c - z0[i])) for c in corners)
         assert abs(z0[i] - zp) <= spread, (zp, z0[i], spread)
-        assert abs(z0[i] - zp) > 1e-3 * abs(zp)  # but they are not the same numbers
+        assert abs(z0[i] - zp) > 1e-3 * abs(zp)                   # but they are not the same numbers
 
 
 @pytest.fixture(scope="module")
@@ -100,7 +100,7 @@ def preview_experiment():
     current = abs(g) * d0 * np.sin(w * t + np.angle(g))
     disp = d0 * np.sin(w * t)
     Tstar = _tp_star(G)
-    m = (t > 0.6) & (t < 2.0 - 0.7)  # away from both record edges
+    m = (t > 0.6) & (t < 2.0 - 0.7)   # away from both record edges
     errs = {}
     for name, pv in (("inf", "inf"), ("star", Tstar), ("half", 0.5 * Tstar)):
         res = invert(G, t, current, preview=pv)
@@ -110,7 +110,7 @@ def preview_experiment():
 
 def test_preview_errors_match_the_truncated_kernel(preview_experiment):
     G, w, iamp, errs = preview_experiment
-    assert errs["inf"][0] < 1e-4  # discretisation only ((w dt)^2/12 ~ 1.3e-5 mm)
+    assert errs["inf"][0] < 1e-4             # discretisation only ((w dt)^2/12 ~ 1.3e-5 mm)
     for key in ("star", "half"):
         err, Tp = errs[key]
         assert err == pytest.approx(_tail_gain(G, w, Tp) * iamp, rel=0.01)
@@ -126,14 +126,14 @@ def test_seed000_preview_claims_are_not_reproduced_model_exact(preview_experimen
     # 'threefold': halving the preview multiplies the truncation error by exp(r0 T_p*/2) = e^2
     ratio = e_half / e_star
     assert ratio == pytest.approx(np.exp(2.0), rel=0.05)
-    assert not 2.5 <= ratio <= 3.5  # 'about threefold' at one significant figure
+    assert not 2.5 <= ratio <= 3.5                       # 'about threefold' at one significant figure
 
 
 def _released_current(G, t, w0, t_release, f_n, zeta, fine=10):
     """Short-circuit current of the sensor for a cantilever held at w0, then released."""
     num, den = _coeffs(G)
     A, B, C, D = ss.tf2ss(num, den)
-    x0 = -np.linalg.solve(A, B).ravel() * w0  # held long enough: steady state
+    x0 = -np.linalg.solve(A, B).ravel() * w0          # held long enough: steady state
     dtf = (t[1] - t[0]) / fine
     tf = np.arange((t.size - 1) * fine + 1) * dtf
     d = released_cantilever(tf, w0=w0, t_release=t_release, f_n=f_n, zeta=zeta)
@@ -165,15 +165,15 @@ def test_free_vibration_matched_model_has_no_preactuation_error(free_vibration):
     hold = (t > 0.2) & (t < tr - 0.2)
     r_inf = invert(G, t, current, preview="inf")
     e_inf = r_inf.output - disp
-    assert np.max(np.abs(e_inf[pre])) < 5e-4  # mm, for w0 = 1 mm
+    assert np.max(np.abs(e_inf[pre])) < 5e-4                       # mm, for w0 = 1 mm
     post = (t >= tr) & (t < 1.5)
-    assert np.max(np.abs(e_inf[post])) < 5e-3  # (w dt)^2/12 at 25 Hz ~ 2e-3
+    assert np.max(np.abs(e_inf[post])) < 5e-3                      # (w dt)^2/12 at 25 Hz ~ 2e-3
     r_star = invert(G, t, current, preview=_tp_star(G))
     e_star = r_star.output - disp
     num, den = _coeffs(G)
     expected_bias = -_tail_gain_signed(G, 0.0, r_star.preview_s) * (num[-1] / den[-1]) * kw["w0"]
     assert np.mean(e_star[hold]) == pytest.approx(expected_bias, rel=0.02)
-    assert np.ptp(e_star[hold]) < 1e-6  # constant while held
+    assert np.ptp(e_star[hold]) < 1e-6                               # constant while held
     assert np.max(np.abs(e_star[pre])) < 0.05
 
 

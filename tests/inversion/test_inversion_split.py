@@ -41,11 +41,8 @@ def test_seed000_split_reproduces_inverse_and_partitions_zeros():
     assert sp.r0 == pytest.approx(min(z[z.real > 0].real), rel=1e-10)
     assert sp.auto_preview_s == pytest.approx(4 / sp.r0, rel=1e-14)
     # pieces agree with the parts evaluated separately
-    parts = (
-        sp.frequency_response(W, "polynomial")
-        + sp.frequency_response(W, "stable")
-        + sp.frequency_response(W, "unstable")
-    )
+    parts = (sp.frequency_response(W, "polynomial") + sp.frequency_response(W, "stable")
+             + sp.frequency_response(W, "unstable"))
     np.testing.assert_allclose(parts, sp.frequency_response(W), rtol=1e-13)
     # control objects for users
     hu = sp.unstable_tf()
@@ -66,7 +63,8 @@ def test_statespace_and_pair_inputs_agree():
 @given(
     stable=st.lists(st.floats(0.5, 2000.0), min_size=0, max_size=3),
     unstable=st.lists(st.floats(0.5, 2000.0), min_size=0, max_size=3),
-    pair=st.one_of(st.none(), st.tuples(st.floats(-500, 500).filter(lambda x: abs(x) > 1.0), st.floats(1.0, 800.0))),
+    pair=st.one_of(st.none(), st.tuples(st.floats(-500, 500).filter(lambda x: abs(x) > 1.0),
+                                        st.floats(1.0, 800.0))),
     gain=st.floats(0.01, 100.0),
 )
 def test_random_hyperbolic_models(stable, unstable, pair, gain):
@@ -111,12 +109,12 @@ def test_zero_on_imaginary_axis_is_rejected_with_its_value():
     with pytest.raises(NonHyperbolicModelError, match=r"0\+31\.4\dj|31\.4"):
         split_inverse((np.real(np.poly([31.4j, -31.4j, -5.0])), [1, 3, 3, 1]))
     with pytest.raises(NonHyperbolicModelError, match="imaginary axis"):
-        split_inverse(([1.0, 0.0], [1.0, 2.0]))  # zero at s = 0 (high-pass sensor)
+        split_inverse(([1.0, 0.0], [1.0, 2.0]))        # zero at s = 0 (high-pass sensor)
     assert issubclass(NonHyperbolicModelError, ValueError)
 
 
 def test_improper_inverse_default_error_and_options():
-    num, den = [100.0], [1.0, 14.0, 100.0]  # relative degree 2
+    num, den = [100.0], [1.0, 14.0, 100.0]       # relative degree 2
     with pytest.raises(ImproperInverseError, match="relative degree 2"):
         split_inverse((num, den))
     d = split_inverse((num, den), improper="differentiate")

@@ -25,7 +25,7 @@ def _stream(inv, u, sizes):
     for s in sizes:
         if i >= u.size:
             break
-        outs.append(inv.push(u[i : i + s]))
+        outs.append(inv.push(u[i:i + s]))
         i += s
     if i < u.size:
         outs.append(inv.push(u[i:]))
@@ -38,9 +38,8 @@ def _close(a, b):
 
 
 @pytest.mark.parametrize("preview", ["4/r0", 0.01, 0.05, 0.5], ids=["auto", "fir", "blocks50", "blocks500"])
-@pytest.mark.parametrize(
-    "sizes", [[3000], [1] * 3000, [113] * 30, [7, 1000, 2, 2, 500, 1]], ids=["whole", "ones", "preview-sized", "mixed"]
-)
+@pytest.mark.parametrize("sizes", [[3000], [1] * 3000, [113] * 30, [7, 1000, 2, 2, 500, 1]],
+                         ids=["whole", "ones", "preview-sized", "mixed"])
 def test_streaming_equals_batch(preview, sizes):
     ref = invert(G, DT, U, preview=preview).output
     inv = StreamingInverter(G, DT, preview)
@@ -50,9 +49,8 @@ def test_streaming_equals_batch(preview, sizes):
 
 
 @settings(max_examples=25, deadline=None)
-@given(
-    sizes=st.lists(st.integers(1, 400), min_size=1, max_size=40), preview=st.sampled_from([0.003, 0.031, 0.114, 0.2])
-)
+@given(sizes=st.lists(st.integers(1, 400), min_size=1, max_size=40),
+       preview=st.sampled_from([0.003, 0.031, 0.114, 0.2]))
 def test_streaming_equals_batch_any_chunking(sizes, preview):
     u = U[:1500]
     ref = invert(G, DT, u, preview=preview).output
@@ -64,7 +62,7 @@ def test_output_is_delayed_by_exactly_the_preview():
     assert inv.delay_samples == inv.preview_samples == 113
     assert inv.delay_s == pytest.approx(0.113)
     assert inv.push(U[:100]).size == 0
-    assert inv.push(U[100:114]).size == 1  # 114 samples in -> output 0 is final
+    assert inv.push(U[100:114]).size == 1            # 114 samples in -> output 0 is final
     out = inv.push(U[114:1000])
     assert inv.samples_out == 1000 - 113 and out.size == 1000 - 114
     assert inv.samples_in == 1000
@@ -74,7 +72,7 @@ def test_state_stays_bounded_with_long_streams():
     inv = StreamingInverter(G, DT, "4/r0")
     u = np.sin(np.arange(200_000) * 0.05)
     for i in range(0, u.size, 100):
-        inv.push(u[i : i + 100])
+        inv.push(u[i:i + 100])
         assert inv._hist.size <= 2 * inv.preview_samples + 100
         assert inv._ys.size <= inv.delay_samples + 100
 
@@ -82,11 +80,11 @@ def test_state_stays_bounded_with_long_streams():
 def test_minimum_phase_and_differentiate_modes():
     mp = (np.poly([-50.0, -500.0]), np.poly([-10.0, -100.0]))
     inv = StreamingInverter(mp, DT, 0.02)
-    assert inv.delay_samples == 20  # delay is the requested preview
+    assert inv.delay_samples == 20                  # delay is the requested preview
     _close(_stream(inv, U, [50] * 60), invert(mp, DT, U, preview=0.02).output)
     strictly = ([100.0], [1.0, 14.0, 100.0])
     inv = StreamingInverter(strictly, DT, 0.0, improper="differentiate")
-    assert inv.delay_samples == 1  # the central-difference half-width
+    assert inv.delay_samples == 1                   # the central-difference half-width
     ref = invert(strictly, DT, U, preview=0.0, improper="differentiate").output
     _close(_stream(inv, U, [37] * 100), ref)
 

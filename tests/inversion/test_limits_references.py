@@ -46,16 +46,10 @@ def test_output_range_and_earliest_violation_first():
     assert rep.violations[0].limit == 2.0 and rep.violations[1].value == -3.0
 
 
-@pytest.mark.parametrize(
-    "kw, match",
-    [
-        (dict(max_voltage=-1.0), "max_voltage"),
-        (dict(max_rate=float("nan")), "max_rate"),
-        (dict(output_range=(2.0, 1.0)), "lo < hi"),
-        (dict(action="ignore"), "action"),
-        (dict(output_range="wide"), "pair"),
-    ],
-)
+@pytest.mark.parametrize("kw, match", [
+    (dict(max_voltage=-1.0), "max_voltage"), (dict(max_rate=float("nan")), "max_rate"),
+    (dict(output_range=(2.0, 1.0)), "lo < hi"), (dict(action="ignore"), "action"),
+    (dict(output_range="wide"), "pair")])
 def test_bad_limits_are_refused(kw, match):
     with pytest.raises(IPMCError, match=match):
         Limits(**kw)
@@ -81,7 +75,7 @@ def test_sine_reference_fades_smoothly_to_rest():
     ref = R.sine(0.3, 1.0, 8.0, 1 / DT, lead_s=1.0, tail_s=1.5, unit="mm")
     t, y = ref.t, ref.y
     assert t[-1] == pytest.approx(1.0 + 8.0 + 1.5) and R.edge_jump(y) < 1e-6
-    assert R.edge_jump(np.sin(2 * np.pi * t)) > 0.99  # starts with its full slope
+    assert R.edge_jump(np.sin(2 * np.pi * t)) > 0.99                  # starts with its full slope
     assert np.all(y[t <= 1.0] == 0) and np.all(y[t >= 9.0] == 0)
     body = ref.body
     np.testing.assert_allclose(y[body], 0.3 * np.sin(2 * np.pi * (t[body] - 1.0)), atol=1e-12)
@@ -113,16 +107,13 @@ def test_multitone_steps_and_file_roundtrip(tmp_path):
     np.testing.assert_allclose(R.from_file(tmp_path / "ref.npz").y, m.y)
 
 
-@pytest.mark.parametrize(
-    "call, match",
-    [
-        (lambda: R.sine(1, 600, 1, 1000), "below fs_hz/2"),
-        (lambda: R.sine(1, 1, 1.0, 1000, fade_in_s=0.6, fade_out_s=0.6), "exceeds duration"),
-        (lambda: R.multitone([1, 2], [1], 4, 1000), "as many"),
-        (lambda: R.smoothed_steps([], 1, 1000), "non-empty"),
-        (lambda: R.fade([0, 1, 3], [0, 1, 2], 0, 0), "uniformly"),
-    ],
-)
+@pytest.mark.parametrize("call, match", [
+    (lambda: R.sine(1, 600, 1, 1000), "below fs_hz/2"),
+    (lambda: R.sine(1, 1, 1.0, 1000, fade_in_s=0.6, fade_out_s=0.6), "exceeds duration"),
+    (lambda: R.multitone([1, 2], [1], 4, 1000), "as many"),
+    (lambda: R.smoothed_steps([], 1, 1000), "non-empty"),
+    (lambda: R.fade([0, 1, 3], [0, 1, 2], 0, 0), "uniformly"),
+])
 def test_bad_reference_input(call, match):
     with pytest.raises(IPMCError, match=match):
         call()
@@ -132,9 +123,9 @@ def test_unfaded_reference_spikes_at_the_end_faded_one_does_not():
     G = toy_actuator()
     faded = R.sine(1.0, 1.0, 6.0, 1 / DT, lead_s=2.0, tail_s=2.0)
     t = faded.t
-    raw = np.where(t >= 2.0, np.sin(2 * np.pi * (t - 2.0) + 1.0), 0.0)  # starts and stops abruptly
+    raw = np.where(t >= 2.0, np.sin(2 * np.pi * (t - 2.0) + 1.0), 0.0)    # starts and stops abruptly
     v_raw = feedforward(G, t, raw, preview="inf").output
     v_faded = feedforward(G, t, faded.y, preview="inf").output
     steady = np.max(np.abs(v_faded[faded.body]))
     assert np.max(np.abs(v_faded)) <= 1.01 * steady
-    assert np.max(np.abs(v_raw)) > 3 * steady  # the jumps excite the inverse
+    assert np.max(np.abs(v_raw)) > 3 * steady            # the jumps excite the inverse

@@ -120,14 +120,13 @@ def test_4_over_r0_rule_stays_available_by_name():
 
 
 def test_auto_preview_is_capped_at_the_record_where_it_equals_infinite():
-    G = toy_actuator()  # needs ~2 s of preview at 1e-3; give it a 0.5 s record
+    G = toy_actuator()               # needs ~2 s of preview at 1e-3; give it a 0.5 s record
     t = np.arange(0, 0.5, DT)
     u = np.sin(2 * np.pi * 2 * t) * np.sin(np.pi * t / 0.5) ** 2
     r = invert(G, t, u)
     assert r.preview_samples <= t.size - 1
-    np.testing.assert_allclose(
-        r.output, invert(G, t, u, preview="inf").output, rtol=0, atol=1e-3 * np.max(np.abs(r.output))
-    )
+    np.testing.assert_allclose(r.output, invert(G, t, u, preview="inf").output, rtol=0,
+                               atol=1e-3 * np.max(np.abs(r.output)))
 
 
 def test_frequency_rule_bounds_every_sinusoid_in_the_band():
@@ -163,7 +162,7 @@ def seed001_35c():
 
     plant = physmodel.ActuatorModel(physmodel.get_parameter_set("seed001_actuator"))
     F = np.logspace(-1, np.log10(9.0), 30)
-    sw = synthesize_sweep(plant, "M", F, [35.0])  # mm/V, noise-free
+    sw = synthesize_sweep(plant, "M", F, [35.0])                   # mm/V, noise-free
     fit = surrogate.RationalFit(4, 4).fit(sw)
     assert fit.converged
     ref = sine(0.3, 1.0, 6.0, 1 / DT, unit="mm")
@@ -181,8 +180,8 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
         y = simulate(plant, 35.0, ref.t, ff.output, realization=real).output * 1e3
         out[pv] = (float(np.max(np.abs(ff.output))), float(np.max(np.abs(y - ref.y))), ff)
     (va, ea, ffa), (vi, ei, _), (vr, er, _) = out["auto"], out["inf"], out["4/r0"]
-    assert va <= 1.2 * vi and ea <= 2.0 * ei  # the criterion
-    assert vi < 1.0  # 0.40 V measured
+    assert va <= 1.2 * vi and ea <= 2.0 * ei                          # the criterion
+    assert vi < 1.0                                                   # 0.40 V measured
     # the 4/r0 rule asks for tens of volts and misses by more than the reference itself
     assert vr > 10 * vi and er > 0.3
-    assert ffa.preview_s > 2.5 * ffa.auto_preview_s  # measured 0.124 vs 0.034 s
+    assert ffa.preview_s > 2.5 * ffa.auto_preview_s                   # measured 0.124 vs 0.034 s

@@ -62,7 +62,7 @@ def test_residuals_closed_form_and_phase_wrap():
 
 def test_residuals_fallback_without_std():
     sw = FrequencySweep([25.0, 25.0], [1.0, 2.0], [1.0 + 0j, 1.0 + 0j])
-    model = np.array([1.0, 1.0]) * np.exp(-FALLBACK_RELATIVE_STD)  # ln|G_d/G_m| = FALLBACK
+    model = np.array([1.0, 1.0]) * np.exp(-FALLBACK_RELATIVE_STD)    # ln|G_d/G_m| = FALLBACK
     np.testing.assert_allclose(residuals(model, sw), [1, 1, 0, 0], atol=1e-12)
 
 
@@ -117,8 +117,7 @@ def test_fit_parameters_generic_recovery_and_counting():
     assert res.ci_lower["k"] < res.values["k"] < res.ci_upper["k"]
     # log parameter: interval symmetric in log, hence asymmetric in value
     assert math.log(res.ci_upper["fc"] / res.values["fc"]) == pytest.approx(
-        math.log(res.values["fc"] / res.ci_lower["fc"]), rel=1e-9
-    )
+        math.log(res.values["fc"] / res.ci_lower["fc"]), rel=1e-9)
     assert res.expected_cost == pytest.approx(40 - 1.0)
     # unbatched predictor: one evaluation per call; batched: the Jacobian is one call of 2 sets
     assert res.n_evaluations == res.n_model_calls
@@ -193,9 +192,8 @@ def test_recovery_of_temperature_law_parameters_jointly(base):
 def test_sensor_calibration(base):
     p = get_parameter_set("seed000_sensor_dev")
     truth = p.replace(a0=0.45, d=5e-11)
-    sw = synthesize_sweep(
-        SensorModel(truth), "S", np.logspace(-1, 2, 30), [20.0, 40.0], noise=MagnitudePhaseNoise(0.1, 1.0), seed=4
-    )
+    sw = synthesize_sweep(SensorModel(truth), "S", np.logspace(-1, 2, 30), [20.0, 40.0],
+                          noise=MagnitudePhaseNoise(0.1, 1.0), seed=4)
     res = calibrate(sw, p, ["a0", "d"], kind="sensor", starts=1)
     assert res.converged and res.metadata["quantity"] == "S"
     assert all(_inside(res, {"a0": 0.45, "d": 5e-11}).values()), res.summary()
@@ -214,11 +212,11 @@ def test_parameters_acting_above_the_band_are_flagged_and_held(base):
         assert not st.identifiable
         assert "above the measured band" in st.reason
         assert st.sensitivity_peak_hz > 1.0
-        assert res.values[n] == getattr(base, n)  # held at the base value
+        assert res.values[n] == getattr(base, n)              # held at the base value
         assert math.isnan(res.ci_lower[n]) and math.isnan(res.stderr[n])
     assert res.identifiability["d"].identifiable and res.identifiability["alpha0"].identifiable
     assert all(_inside(res, {"d": 4e-11, "alpha0": truth.alpha0}).values()), res.summary()
-    assert res.expected_cost == pytest.approx(30 - 1.0)  # only two parameters fitted
+    assert res.expected_cost == pytest.approx(30 - 1.0)     # only two parameters fitted
     assert "UNDETERMINED" in res.summary()
     # control: over a band that covers the mode, xi is determined
     wide = _sweep(truth, np.logspace(-1, 2, 30), [25.0], seed=1)
@@ -264,18 +262,15 @@ def test_non_convergence_is_reported(base):
 
 
 # ------------------------------------------------------------------------------ bad input
-@pytest.mark.parametrize(
-    "kwargs, match",
-    [
-        (dict(name="k", lower=2.0, upper=1.0), "bounds reversed"),
-        (dict(name="k", lower=1.0, upper=1.0), "bounds reversed"),
-        (dict(name="k", lower=1.0, upper=2.0, initial=3.0), "outside its bounds"),
-        (dict(name="k", lower=-1.0, upper=2.0, scale="log"), "one sign"),
-        (dict(name="k", lower=1.0, upper=2.0, scale="cubic"), "expected 'log' or 'linear'"),
-        (dict(name="k", lower=float("nan"), upper=2.0), "finite"),
-        (dict(name="", lower=1.0, upper=2.0), "name"),
-    ],
-)
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(name="k", lower=2.0, upper=1.0), "bounds reversed"),
+    (dict(name="k", lower=1.0, upper=1.0), "bounds reversed"),
+    (dict(name="k", lower=1.0, upper=2.0, initial=3.0), "outside its bounds"),
+    (dict(name="k", lower=-1.0, upper=2.0, scale="log"), "one sign"),
+    (dict(name="k", lower=1.0, upper=2.0, scale="cubic"), "expected 'log' or 'linear'"),
+    (dict(name="k", lower=float("nan"), upper=2.0), "finite"),
+    (dict(name="", lower=1.0, upper=2.0), "name"),
+])
 def test_free_parameter_validation(kwargs, match):
     with pytest.raises(ParameterError, match=match):
         FreeParameter(**kwargs)
@@ -317,7 +312,7 @@ def test_apply_values_and_default_bounds(base):
     p = apply_values(base, {"d": 5e-11, "laws.d.activation_energy": 20e3, "omega_n": 100.0})
     assert p.d == 5e-11 and p.laws.d.activation_energy == 20e3
     assert p.omega_n == pytest.approx(100.0, rel=1e-12)
-    assert base.laws.d.activation_energy == 15e3  # the base is untouched
+    assert base.laws.d.activation_energy == 15e3          # the base is untouched
     fp = default_free_parameter(base, "alpha0")
     assert fp.scale == "log" and fp.lower == pytest.approx(base.alpha0 * 10) and fp.initial == base.alpha0
     assert default_free_parameter(base, "laws.E.slope").scale == "linear"
@@ -333,9 +328,9 @@ def test_save_writes_a_loadable_parameter_set(base, tmp_path):
     payload = json.loads(path.read_text())
     cal = payload["calibration"]
     entry = {e["name"]: e for e in cal["parameters"]}
-    assert entry["xi"]["held"] and entry["xi"]["ci95_lower"] is None  # NaN → null, never NaN in JSON
+    assert entry["xi"]["held"] and entry["xi"]["ci95_lower"] is None    # NaN → null, never NaN in JSON
     assert cal["noise_estimated"] is False and cal["n_evaluations"] == res.n_evaluations
-    assert [p.name for p in tmp_path.iterdir()] == ["p.json"]  # no temporary leftovers
+    assert [p.name for p in tmp_path.iterdir()] == ["p.json"]            # no temporary leftovers
 
 
 def test_several_sweeps_with_different_grids_and_units(base):

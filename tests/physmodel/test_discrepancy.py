@@ -24,8 +24,9 @@ def _hidden(case: int, effects_fn):
     rng = np.random.default_rng(np.random.SeedSequence(SEALED, spawn_key=(case,)))
     noise = MagnitudePhaseNoise(float(rng.uniform(0.15, 0.3)), float(rng.uniform(0.8, 1.5)))
     effects = effects_fn(rng)
-    data = synthesize_sweep(EffectModel(P, "actuator", effects), "M", F, T, noise, seed=int(rng.integers(2**31)))
-    data = type(data)(**{**data.__dict__, "metadata": {}})  # the workflow never sees the label
+    data = synthesize_sweep(EffectModel(P, "actuator", effects), "M", F, T, noise,
+                            seed=int(rng.integers(2**31)))
+    data = type(data)(**{**data.__dict__, "metadata": {}})       # the workflow never sees the label
     return data, effects
 
 
@@ -35,13 +36,10 @@ def blind():
         "none": lambda r: {},
         "time_delay": lambda r: {"time_delay": {"delay": r.uniform(1.5e-3, 4e-3)}},
         "fractional_transport": lambda r: {"fractional_transport": {"beta": r.uniform(0.85, 0.92)}},
-        "fixture_resonance": lambda r: {
-            "fixture_resonance": {"frequency_hz": r.uniform(1.0, 20.0), "depth": r.uniform(0.5, 0.8), "damping": 0.05}
-        },
-        "two": lambda r: {
-            "time_delay": {"delay": r.uniform(1.5e-3, 3e-3)},
-            "fractional_transport": {"beta": r.uniform(0.85, 0.9)},
-        },
+        "fixture_resonance": lambda r: {"fixture_resonance": {"frequency_hz": r.uniform(1.0, 20.0),
+                                                              "depth": r.uniform(0.5, 0.8), "damping": 0.05}},
+        "two": lambda r: {"time_delay": {"delay": r.uniform(1.5e-3, 3e-3)},
+                          "fractional_transport": {"beta": r.uniform(0.85, 0.9)}},
     }
     out = {}
     for i, (label, fn) in enumerate(cases.items()):
@@ -53,7 +51,7 @@ def blind():
 def _named_ok(d, truth):
     if d.verdict == "named":
         return d.named == [truth]
-    if d.verdict == "ambiguous":  # allowed only between pairs the report declares confusable
+    if d.verdict == "ambiguous":       # allowed only between pairs the report declares confusable
         declared = {frozenset((a, b)) for a, b, _ in d.confusable}
         return truth in d.named and all(frozenset((truth, o)) in declared for o in d.named if o != truth)
     return False
@@ -104,9 +102,7 @@ def test_report_folder(blind, tmp_path):
         assert key in rep["candidates"]["time_delay"]
     assert rep["gap_before"]["cost"] > rep["gap_after"]["cost"]
     assert len(rep["gap_after"]["rms_db"]) == len(T) and rep["localisation_before"]
-    assert {"a": "amplifier_bandwidth", "b": "time_delay"} in [
-        {k: p[k] for k in ("a", "b")} for p in rep["confusable_pairs"]
-    ]
+    assert {"a": "amplifier_bandwidth", "b": "time_delay"} in [{k: p[k] for k in ("a", "b")} for p in rep["confusable_pairs"]]
     assert all(p["what_separates"] for p in rep["confusable_pairs"])
     summ = (tmp_path / "rep" / "summary.md").read_text()
     assert "NAMED" in summ and "## Baseline parameters" in summ and "Multi-start" in summ
@@ -123,23 +119,13 @@ def test_sensor_amplifier_pole_is_named():
     ps = get_parameter_set("seed000_sensor_dev")
     rng = np.random.default_rng(np.random.SeedSequence(SEALED, spawn_key=(99,)))
     tau = rng.uniform(1e-3, 2e-3)
-    data = synthesize_sweep(
-        EffectModel(ps, "sensor", {"amplifier_bandwidth": {"time_constant": tau}}),
-        "S",
-        np.logspace(1, 2, 20),
-        [25, 45, 65],
-        MagnitudePhaseNoise(0.2, 1.0),
-        seed=int(rng.integers(2**31)),
-    )
+    data = synthesize_sweep(EffectModel(ps, "sensor", {"amplifier_bandwidth": {"time_constant": tau}}), "S",
+                            np.logspace(1, 2, 20), [25, 45, 65], MagnitudePhaseNoise(0.2, 1.0), seed=int(rng.integers(2**31)))
     d = diagnose(data, ps, kind="sensor", free=("a0", "d"), seed=1, null_refits=2)
     assert _named_ok(d, "amplifier_bandwidth"), d.message
     fitted = d.final.values["amplifier_bandwidth.time_constant"]
-    assert (
-        d.final.ci_lower["amplifier_bandwidth.time_constant"]
-        <= tau
-        <= d.final.ci_upper["amplifier_bandwidth.time_constant"]
+    assert d.final.ci_lower["amplifier_bandwidth.time_constant"] <= tau <= d.final.ci_upper["amplifier_bandwidth.time_constant"] \
         or abs(fitted / tau - 1) < 0.05
-    )
 
 
 def test_linearised_null_gives_the_chi_bar_squared_boundary_mixture():
@@ -162,15 +148,8 @@ def test_a_candidate_at_its_bound_is_never_a_confident_name():
     contact_resistance stopped at its bound (widen it) instead of naming confidently; with the
     strip-scaled bound contact_resistance is named."""
     data, _ = _hidden(21, lambda r: {"contact_resistance": {"r2_specific": 3e-3}})
-    tight = diagnose(
-        data,
-        P,
-        kind="actuator",
-        free=FREE,
-        seed=0,
-        null_refits=0,
-        candidate_bounds={"contact_resistance.r2_specific": (0.0, 1e-3)},
-    )
+    tight = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0,
+                     candidate_bounds={"contact_resistance.r2_specific": (0.0, 1e-3)})
     assert tight.verdict in ("at_bound", "unexplained"), tight.message
     assert frozenset(("contact_resistance", "diffusivity_temperature")) in {frozenset(c[:2]) for c in tight.confusable}
     assert tight.candidates["contact_resistance"].values["r2_specific"] == pytest.approx(1e-3, rel=1e-3)
@@ -189,16 +168,9 @@ def test_temperature_laws_are_chosen_and_stated():
     d = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0, laws="isothermal")
     assert d.verdict == "none", d.message
     assert "isothermal" in d.laws
-    d2 = diagnose(
-        data,
-        P,
-        kind="actuator",
-        free=FREE,
-        seed=0,
-        null_refits=0,
-        laws={"base": "isothermal", "d": {"law": "Arrhenius", "activation_energy": 20e3}},
-    )
-    assert "Arrhenius(activation_energy=20000)" in d2.laws and d2.verdict != "none"  # the wrong law shows
+    d2 = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0,
+                  laws={"base": "isothermal", "d": {"law": "Arrhenius", "activation_energy": 20e3}})
+    assert "Arrhenius(activation_energy=20000)" in d2.laws and d2.verdict != "none"   # the wrong law shows
     with pytest.raises(ParameterError, match="laws"):
         diagnose(data, P, free=FREE, laws="warm")
     with pytest.raises(ParameterError, match="no temperature law"):
@@ -207,13 +179,12 @@ def test_temperature_laws_are_chosen_and_stated():
 
 def test_cost_inconsistent_with_the_declared_noise_is_reported_with_its_factor():
     data = synthesize_sweep(EffectModel(P, "actuator"), "M", F, T, MagnitudePhaseNoise(0.05, 0.3), seed=8)
-    big = type(data)(
-        **{**data.__dict__, "magnitude_std_db": data.magnitude_std_db * 10, "phase_std_deg": data.phase_std_deg * 10}
-    )
+    big = type(data)(**{**data.__dict__, "magnitude_std_db": data.magnitude_std_db * 10,
+                        "phase_std_deg": data.phase_std_deg * 10})
     d = diagnose(big, P, kind="actuator", free=FREE, seed=0, null_refits=0)
     assert d.cost_warning.startswith("too low") and "Cost vs declared noise" in d.message
     factor = float(d.cost_warning.split("about ")[1].split("×")[0])
-    assert 7 < factor < 14  # the declared σ is 10× the true one
+    assert 7 < factor < 14                               # the declared σ is 10× the true one
     ok = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0)
     assert ok.cost_warning == ""
 
@@ -223,18 +194,9 @@ def test_a_baseline_outside_its_plausible_range_is_reported():
     fit by leaving the range, and the report says that this is evidence of a missing effect."""
     from physmodel.estimation.records import FreeParameter
 
-    data = synthesize_sweep(
-        EffectModel(P.replace(xi=3.0), "actuator"), "M", F, T, MagnitudePhaseNoise(0.2, 1.0), seed=9
-    )
-    d = diagnose(
-        data,
-        P,
-        kind="actuator",
-        free=("alpha0", "d", FreeParameter("xi", 0.01, 10.0, "log", 0.18)),
-        seed=0,
-        null_refits=0,
-        candidates=["time_delay", "leakage"],
-    )
+    data = synthesize_sweep(EffectModel(P.replace(xi=3.0), "actuator"), "M", F, T, MagnitudePhaseNoise(0.2, 1.0), seed=9)
+    d = diagnose(data, P, kind="actuator", free=("alpha0", "d", FreeParameter("xi", 0.01, 10.0, "log", 0.18)),
+                 seed=0, null_refits=0, candidates=["time_delay", "leakage"])
     names = [x["name"] for x in d.baseline_audit["implausible"]]
     assert names == ["xi"] and "plausible range of xi" in d.message
     assert d.baseline_audit["penalty"] > 0
@@ -266,8 +228,7 @@ def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
     (tmp_path / "exp.toml").write_text(
         'data = "sweep.csv"\nkind = "actuator"\nset = "seed002_table3"\nfree = ["alpha0", "d", "xi", "omega_n"]\n'
         'candidates = ["time_delay", "amplifier_bandwidth", "electrode_resistance"]\nnull_refits = 1\n'
-        f'out = "{tmp_path / "out"}"\n[geometry]\nW = 2e-3\n'
-    )
+        f'out = "{tmp_path / "out"}"\n[geometry]\nW = 2e-3\n')
     parser = argparse.ArgumentParser()
     sub = parser.add_subparsers()
     discrepancy_cli.add_parser(sub)
@@ -275,32 +236,13 @@ def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
     assert args.func(args) == 0
     rep = json.loads((tmp_path / "out" / "report.json").read_text())
     assert rep["verdict"] in ("named", "ambiguous") and "amplifier_bandwidth" in rep["named"]
-    args = parser.parse_args(
-        [
-            "diagnose",
-            str(tmp_path / "exp.toml"),
-            "--quiet",
-            "--laws",
-            "isothermal",
-            "--law",
-            "d=Arrhenius:activation_energy=15e3",
-            "--candidate-bound",
-            "electrode_resistance.r1_sheet=0:500",
-            "--candidate-start",
-            "time_delay.delay=1e-3",
-            "--plausible",
-            "d=1e-12:1e-10",
-            "--baseline-starts",
-            "2",
-            "--out",
-            str(tmp_path / "o2"),
-        ]
-    )
+    args = parser.parse_args(["diagnose", str(tmp_path / "exp.toml"), "--quiet", "--laws", "isothermal",
+                              "--law", "d=Arrhenius:activation_energy=15e3", "--candidate-bound",
+                              "electrode_resistance.r1_sheet=0:500", "--candidate-start", "time_delay.delay=1e-3",
+                              "--plausible", "d=1e-12:1e-10", "--baseline-starts", "2", "--out", str(tmp_path / "o2")])
     assert args.func(args) == 0
     rep = json.loads((tmp_path / "o2" / "report.json").read_text())
-    assert (
-        "Arrhenius(activation_energy=15000)" in rep["temperature_laws"] and "E LogLinear" not in rep["temperature_laws"]
-    )
+    assert "Arrhenius(activation_energy=15000)" in rep["temperature_laws"] and "E LogLinear" not in rep["temperature_laws"]
     assert rep["candidates"]["electrode_resistance"]["candidate_bounds"]["r1_sheet"] == [0.0, 500.0]
     assert rep["baseline_audit"]["plausible_ranges"]["d"].startswith("[1e-12, 1e-10]")
     import json as _json
@@ -308,9 +250,8 @@ def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
     d = P.to_dict()
     d.pop("laws")
     (tmp_path / "nolaws.json").write_text(_json.dumps({k: v for k, v in d.items()}))
-    bad = parser.parse_args(
-        ["diagnose", "--data", str(tmp_path / "sweep.csv"), "--set", str(tmp_path / "nolaws.json"), "--quiet"]
-    )
+    bad = parser.parse_args(["diagnose", "--data", str(tmp_path / "sweep.csv"), "--set", str(tmp_path / "nolaws.json"),
+                             "--quiet"])
     with pytest.raises(IPMCError, match="no 'laws'"):
         bad.func(bad)
     bad = parser.parse_args(["diagnose", "--data", str(tmp_path / "missing.csv"), "--set", "seed002_table3", "--quiet"])

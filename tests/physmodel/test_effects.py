@@ -41,9 +41,7 @@ def test_library_has_at_least_ten_documented_candidates():
     assert len(LIBRARY) >= 10
     assert not set(OUT_OF_LIBRARY) & set(LIBRARY)
     for e in LIBRARY.values():
-        assert (
-            e.description and e.reference and e.parameters and e.level in ("parameter", "response", "series", "kernel")
-        )
+        assert e.description and e.reference and e.parameters and e.level in ("parameter", "response", "series", "kernel")
         for p in e.parameters:
             assert p.lower <= p.off <= p.upper and p.typical != p.off
     for kind, q in (("actuator", "M"), ("sensor", "S"), ("actuator", "Z")):
@@ -86,17 +84,14 @@ def test_amplifier_pole_is_first_order_low_pass():
     np.testing.assert_allclose(r, np.broadcast_to(1 / (1 + 2j * np.pi * F * ta), r.shape), rtol=1e-13)
 
 
-@pytest.mark.parametrize(
-    "name,param,field,combine",
-    [
-        ("electrode_resistance", "r1_sheet", "r1_sheet", lambda b, v: b + v),
-        ("contact_resistance", "r2_specific", "r2_specific", lambda b, v: b + v),
-        ("leakage", "conductance", "Rp_specific", lambda b, v: 1.0 / (1.0 / b + v)),
-    ],
-)
+@pytest.mark.parametrize("name,param,field,combine", [
+    ("electrode_resistance", "r1_sheet", "r1_sheet", lambda b, v: b + v),
+    ("contact_resistance", "r2_specific", "r2_specific", lambda b, v: b + v),
+    ("leakage", "conductance", "Rp_specific", lambda b, v: 1.0 / (1.0 / b + v)),
+])
 def test_electrode_effects_equal_the_base_model_with_changed_parameters(name, param, field, combine):
     v = get_effect(name).typical[param]
-    t_ref = [P.T_ref - 273.15]  # leakage is added temperature-independently: compare at T_ref
+    t_ref = [P.T_ref - 273.15]        # leakage is added temperature-independently: compare at T_ref
     oracle = ActuatorModel(P.replace(**{field: combine(getattr(P, field), v)})).frequency_response(F, t_ref)
     got = EffectModel(P, "actuator", {name: {param: v}}).frequency_response(F, t_ref)
     for q in ("M", "Z"):
@@ -115,15 +110,14 @@ def test_series_resistance_is_a_voltage_divider():
     np.testing.assert_allclose(got["Z"], base["Z"] + Rs, rtol=1e-13)
     np.testing.assert_allclose(got["I"], 1 / (base["Z"] + Rs), rtol=1e-13)
     np.testing.assert_allclose(got["M"], base["M"] * got["I"] * base["Z"], rtol=1e-12)
-    assert np.all(np.abs(got["M"]) < np.abs(base["M"]))  # Re Z > 0: a passive divider
+    assert np.all(np.abs(got["M"]) < np.abs(base["M"]))      # Re Z > 0: a passive divider
 
 
 def test_temperature_effects_equal_modified_laws_and_vanish_at_T_ref():
     c, dEa = -0.01, 12e3
     got = act({"modulus_temperature": {"slope": c}, "diffusivity_temperature": {"activation_energy": dEa}})
-    laws = P.laws.with_(
-        E=LogLinear(slope=P.laws.E.slope + c), d=Arrhenius(activation_energy=P.laws.d.activation_energy + dEa)
-    )
+    laws = P.laws.with_(E=LogLinear(slope=P.laws.E.slope + c),
+                        d=Arrhenius(activation_energy=P.laws.d.activation_energy + dEa))
     oracle = ActuatorModel(P.replace(laws=laws)).frequency_response(F, T)
     for q in ("M", "Z"):
         np.testing.assert_allclose(got[q], oracle[q], rtol=1e-12)
@@ -140,12 +134,11 @@ def test_temperature_effects_curvature_is_a_quadratic_in_ln_factor():
     dT = np.asarray(T) + 273.15 - P.T_ref
     for name, field in (("modulus_temperature", "E"), ("permittivity_temperature", "kappa_e")):
         st = EffectModel(P, "actuator", {name: {"slope": c, "curvature": c2}}).state(T)
-        np.testing.assert_allclose(
-            (getattr(st, field) / getattr(st0, field)).ravel(), np.exp(c * dT + c2 * dT**2), rtol=1e-13
-        )
+        np.testing.assert_allclose((getattr(st, field) / getattr(st0, field)).ravel(), np.exp(c * dT + c2 * dT**2),
+                                   rtol=1e-13)
     st = EffectModel(P, "actuator", {"diffusivity_temperature": {"curvature": c2}}).state(T)
     np.testing.assert_allclose((st.d / st0.d).ravel(), np.exp(c2 * dT**2), rtol=1e-13)
-    np.testing.assert_allclose((st.Rp * st.d / (st0.Rp * st0.d)).ravel(), 1.0, rtol=1e-13)  # Nernst-Einstein
+    np.testing.assert_allclose((st.Rp * st.d / (st0.Rp * st0.d)).ravel(), 1.0, rtol=1e-13)   # Nernst-Einstein
 
 
 def test_amplifier_second_pole_multiplies():
@@ -163,11 +156,9 @@ def test_water_uptake_equals_swollen_strip_at_one_temperature():
     np.testing.assert_allclose(got, oracle, rtol=1e-12)
     # isotropic swelling: the strip scaled in all three directions, anions diluted by the volume
     iso = ActuatorModel(P.replace(h=P.h * sw, L=P.L * sw, W=P.W * sw, C_minus=P.C_minus / sw**3)).frequency_response(
-        F, [t], quantities=("M", "Z")
-    )
+        F, [t], quantities=("M", "Z"))
     got = EffectModel(P, "actuator", {"water_uptake": {"swelling": u, "in_plane_share": 1.0}}).frequency_response(
-        F, [t], quantities=("M", "Z")
-    )
+        F, [t], quantities=("M", "Z"))
     for q in ("M", "Z"):
         np.testing.assert_allclose(got[q], iso[q], rtol=1e-12)
 
@@ -193,19 +184,15 @@ def test_second_mode_ratio_is_the_euler_bernoulli_root_and_dc_gain_is_kept():
     st = ActuatorModel(p).state([26.85])
     f2 = SECOND_MODE_RATIO * float(st.omega_n.ravel()[0]) / (2 * np.pi)
     mag = np.abs(m["M"][0, 0, 1:])
-    assert abs(f[1:][np.argmax(mag)] - f2) < 0.01 * f2  # the second mode's resonance
+    assert abs(f[1:][np.argmax(mag)] - f2) < 0.01 * f2      # the second mode's resonance
     # above the first mode the base falls as ω⁻² while the modal sum keeps the higher modes'
     # quasi-static residual: with ideal electrodes (a uniform moment) an antiresonance between the
     # first two modes
     p = p.replace(r1_sheet=0.0)
     f_mid = np.logspace(np.log10(2 * f2 / SECOND_MODE_RATIO), np.log10(0.9 * f2), 300)
-    mm = np.abs(
-        EffectModel(p, "actuator", {"second_mode": {"weight": 1.0}}).frequency_response(f_mid, [26.85])["M"][0, 0]
-    )
+    mm = np.abs(EffectModel(p, "actuator", {"second_mode": {"weight": 1.0}}).frequency_response(f_mid, [26.85])["M"][0, 0])
     i = int(np.argmin(mm))
-    assert 0 < i < f_mid.size - 1 and mm[i] < 0.2 * np.abs(
-        ActuatorModel(p).frequency_response(f_mid, [26.85])["M"][0, 0, i]
-    )
+    assert 0 < i < f_mid.size - 1 and mm[i] < 0.2 * np.abs(ActuatorModel(p).frequency_response(f_mid, [26.85])["M"][0, 0, i])
 
 
 def test_second_mode_weight_interpolates_between_base_and_modal_sum():
@@ -220,9 +207,7 @@ def test_fractional_transport_gives_a_constant_phase_double_layer():
     beta = 0.8
     p = P.replace(r1_sheet=0.0, r2_specific=0.0, Rp_specific=float("inf"))
     f = np.array([1e-5, 1e-4])
-    z = EffectModel(p, "actuator", {"fractional_transport": {"beta": beta}}).frequency_response(
-        f, [26.85], quantities=("Z",)
-    )["Z"][0, 0]
+    z = EffectModel(p, "actuator", {"fractional_transport": {"beta": beta}}).frequency_response(f, [26.85], quantities=("Z",))["Z"][0, 0]
     z0 = ActuatorModel(p).frequency_response(f, [26.85], quantities=("Z",))["Z"][0, 0]
     # low frequency: a constant-phase double layer, phase −β·90° (the capacitive model gives −90°)
     np.testing.assert_allclose(np.degrees(np.angle(z)), -90 * beta, atol=0.05)
@@ -235,10 +220,10 @@ def test_fractional_transport_is_the_transport_at_s_hat_with_the_mode_at_s():
     beta, f = 0.9, np.array([0.3, 3.0, 30.0])
     s = 2j * np.pi * f
     wc = 2 * np.pi * CPE_REFERENCE_HZ
-    s_hat = wc * np.abs(s / wc) ** beta * np.exp(1j * beta * np.pi / 2)  # polar form of ω_c (s/ω_c)^β
+    s_hat = wc * np.abs(s / wc) ** beta * np.exp(1j * beta * np.pi / 2)    # polar form of ω_c (s/ω_c)^β
     got = EffectModel(P, "actuator", {"fractional_transport": {"beta": beta}}).frequency_response(f, [26.85])
     old = EffectModel(P, "actuator", {"constant_phase_element": {"beta": beta}}).frequency_response(f, [26.85])
-    np.testing.assert_array_equal(old["M"], got["M"])  # the old name is an alias
+    np.testing.assert_array_equal(old["M"], got["M"])                   # the old name is an alias
     at_hat = ActuatorModel(P).evaluate(s_hat, [26.85], quantities=("Z", "H"))
     G = ActuatorModel(P).frequency_response(f, [26.85], quantities=("G",))["G"]
     np.testing.assert_allclose(got["Z"], at_hat["Z"], rtol=1e-12)
@@ -248,22 +233,15 @@ def test_fractional_transport_is_the_transport_at_s_hat_with_the_mode_at_s():
 def test_coupling_compliance_divides_the_sensor_gain_quasi_statically():
     eps = 0.3
     f = np.array([1e-6])
-    r = (
-        EffectModel(PS, "sensor", {"coupling_compliance": {"compliance_ratio": eps}}).frequency_response(f, [25])["S"]
-        / SensorModel(PS).frequency_response(f, [25])["S"]
-    )
+    r = (EffectModel(PS, "sensor", {"coupling_compliance": {"compliance_ratio": eps}}).frequency_response(f, [25])["S"]
+         / SensorModel(PS).frequency_response(f, [25])["S"])
     assert r[0, 0, 0] == pytest.approx(1 / (1 + eps), rel=1e-8)
 
 
 def test_composition_commutes_and_multiplies():
-    a = {
-        "time_delay": {"delay": 1e-3},
-        "amplifier_bandwidth": {"time_constant": 2e-3},
-        "second_mode": {"weight": 0.7},
-        "series_resistance": {"resistance": 30.0},
-        "electrode_resistance": {"r1_sheet": 100.0},
-        "modulus_temperature": {"slope": -0.005},
-    }
+    a = {"time_delay": {"delay": 1e-3}, "amplifier_bandwidth": {"time_constant": 2e-3},
+         "second_mode": {"weight": 0.7}, "series_resistance": {"resistance": 30.0},
+         "electrode_resistance": {"r1_sheet": 100.0}, "modulus_temperature": {"slope": -0.005}}
     b = dict(reversed(list(a.items())))
     for q in ("M", "Z", "I"):
         np.testing.assert_allclose(act(a)[q], act(b)[q], rtol=1e-13)
@@ -271,7 +249,7 @@ def test_composition_commutes_and_multiplies():
     prod = act({})["M"]
     for k, v in c.items():
         prod = prod * (act({k: v})["M"] / act({})["M"])
-    np.testing.assert_allclose(act(c)["M"], prod, rtol=1e-9)  # response-level effects compose as products
+    np.testing.assert_allclose(act(c)["M"], prod, rtol=1e-9)   # response-level effects compose as products
 
 
 def test_leakage_resistance_follows_its_temperature_coefficient():
@@ -284,9 +262,8 @@ def test_leakage_resistance_follows_its_temperature_coefficient():
     with pytest.raises(ParameterError, match="tcr"):
         from physmodel.temperature import ISOTHERMAL
 
-        EffectModel(
-            P.replace(laws=ISOTHERMAL), "actuator", {"leakage": {"conductance": g0, "tcr": -0.01}}
-        ).frequency_response(F, [150.0])
+        EffectModel(P.replace(laws=ISOTHERMAL), "actuator",
+                    {"leakage": {"conductance": g0, "tcr": -0.01}}).frequency_response(F, [150.0])
 
 
 def test_series_elements_add_as_one_impedance():
@@ -296,7 +273,7 @@ def test_series_elements_add_as_one_impedance():
     got = act({"series_resistance": {"resistance": Rs}, "series_cpe": {"S_area": Sa, "n": n}})
     base = act({})
     w = 2 * np.pi * F
-    zc = Sa / (P.W * P.L) / (w**n * np.exp(1j * n * np.pi / 2))  # polar form of (jω)^−n
+    zc = Sa / (P.W * P.L) / (w**n * np.exp(1j * n * np.pi / 2))        # polar form of (jω)^−n
     Z = base["Z"] + Rs + zc
     np.testing.assert_allclose(got["Z"], Z, rtol=1e-12)
     np.testing.assert_allclose(got["I"], 1 / Z, rtol=1e-12)
@@ -315,7 +292,7 @@ def test_candidate_bounds_scale_with_the_strip():
 
     K = constants.physical_constants["Faraday constant"][0] ** 2 * P.d * P.C_minus / (P.kappa_e * constants.R * P.T_ref)
     ra = 2 * P.h / (P.kappa_e * K)
-    assert ra == pytest.approx(2.3e-3, rel=0.05)  # the issue's 1.2e-2 / 5 for seed 002
+    assert ra == pytest.approx(2.3e-3, rel=0.05)                 # the issue's 1.2e-2 / 5 for seed 002
     (r2,) = LIBRARY["contact_resistance"].candidate_parameters(P)
     g = LIBRARY["leakage"].candidate_parameters(P)[0]
     assert r2.upper == pytest.approx(5 * ra, rel=1e-12) and g.upper == pytest.approx(3 / ra, rel=1e-12)
@@ -341,14 +318,8 @@ def test_simulates_sweeps_and_predicts_them():
     many = pred.many(vals)
     for k, v in enumerate(vals):
         np.testing.assert_allclose(many[k], pred(v), rtol=1e-13)
-    noisy = synthesize_sweep(
-        EffectModel(P, "actuator", {"leakage": {"conductance": 10.0}}),
-        "M",
-        [1, 2],
-        [25],
-        MagnitudePhaseNoise(0.1, 1.0),
-        seed=1,
-    )
+    noisy = synthesize_sweep(EffectModel(P, "actuator", {"leakage": {"conductance": 10.0}}), "M", [1, 2], [25],
+                             MagnitudePhaseNoise(0.1, 1.0), seed=1)
     assert noisy.magnitude_std_db is not None
 
 

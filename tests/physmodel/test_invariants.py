@@ -59,7 +59,7 @@ def test_conjugate_symmetry(name):
     rng = np.random.default_rng(12345)
     n = 120
     s_plane = rng.uniform(-1, 1, n) * np.logspace(-2, 6, n) + 1j * rng.choice([-1, 1], n) * np.logspace(-3, 6.5, n)
-    s_axis = 1j * rng.choice([-1, 1], 60) * np.logspace(-4, 6.5, 60)  # s = ±jω exactly (frequency-response path)
+    s_axis = 1j * rng.choice([-1, 1], 60) * np.logspace(-4, 6.5, 60)     # s = ±jω exactly (frequency-response path)
     for s in (s_plane, s_axis):
         for p in _variants(name).values():
             for model in (ActuatorModel(p), SensorModel(p), SensorModel(p, kernel="reciprocal")):
@@ -106,10 +106,8 @@ FS_SLOW_HZ, T_PERIOD_SLOW = 2000.0, 2048.0
 
 def _fft_grid_for(p, temp):
     model = ActuatorModel(p)
-    flat = abs(
-        model.frequency_response([1.0 / T_PERIOD], temp, quantities=("M",))["M"][0, 0, 0]
-        / model.dc_gain(temp)["M0"][0, 0]
-    )
+    flat = abs(model.frequency_response([1.0 / T_PERIOD], temp, quantities=("M",))["M"][0, 0, 0]
+               / model.dc_gain(temp)["M0"][0, 0])
     return (FS_HZ, T_PERIOD) if flat > 0.9 else (FS_SLOW_HZ, T_PERIOD_SLOW)
 
 
@@ -132,11 +130,11 @@ def _causality_metrics(n, f, M):
     2 h_e(t) for t > 0 (h_e(0) at t = 0, 0 for t < 0); its FFT gives Im M — a discrete Hilbert
     transform.  The error is max |Im M_rec − Im M| over 0.01–200 Hz relative to max |M|."""
     h = np.fft.irfft(M, n)
-    neg = np.abs(h[n // 2 + 1 :]).max() / np.abs(h).max()
+    neg = np.abs(h[n // 2 + 1:]).max() / np.abs(h).max()
     he = np.fft.irfft(M.real, n)
     hc = np.zeros(n)
     hc[0] = he[0]
-    hc[1 : n // 2] = 2.0 * he[1 : n // 2]
+    hc[1:n // 2] = 2.0 * he[1:n // 2]
     hc[n // 2] = he[n // 2]
     Mrec = np.fft.rfft(hc)
     band = (f > 0.01) & (f < 200.0)
@@ -200,7 +198,7 @@ def test_dc_limits_with_leakage(name, temp):
         Z0 = _leaky_line_z0(v["r1"], v["Rp"], v["L"])
         a0 = v["L"] * np.sqrt(2.0 * v["r1"] / v["Rp"])
         I2 = 2.0 / 3.0 * v["W"] * v["h"] ** 3
-        H0 = -(v["L"] ** 2) * v["alpha0"] * v["W"] * v["kappa_e"] * (g0 - 1.0) * _x_kernel_real(a0) / (v["E"] * I2)
+        H0 = -v["L"] ** 2 * v["alpha0"] * v["W"] * v["kappa_e"] * (g0 - 1.0) * _x_kernel_real(a0) / (v["E"] * I2)
         assert dc["Z0"][0, 0] == pytest.approx(Z0, rel=1e-12)
         assert dc["H0"][0, 0] == pytest.approx(H0, rel=1e-12)
         assert dc["M0"][0, 0] == pytest.approx(H0, rel=1e-12)
@@ -228,14 +226,7 @@ def test_double_layer_capacitor_without_leakage(name, temp):
     dc = model.dc_gain(temp)
     assert np.isinf(dc["Z0"][0, 0])
     g0 = v["h"] / lam
-    H0 = (
-        -(v["L"] ** 2)
-        * v["alpha0"]
-        * v["W"]
-        * v["kappa_e"]
-        * (g0 - 1.0)
-        / (2.0 * v["E"] * 2 / 3 * v["W"] * v["h"] ** 3)
-    )
+    H0 = -v["L"] ** 2 * v["alpha0"] * v["W"] * v["kappa_e"] * (g0 - 1.0) / (2.0 * v["E"] * 2 / 3 * v["W"] * v["h"] ** 3)
     assert dc["H0"][0, 0] == pytest.approx(H0, rel=1e-12)
     errH = np.abs(r["H"][0, 0] / H0 - 1.0)
     assert errH[0] < 1e-5 and 9.0 < errH[1] / errH[0] < 11.0, errH
@@ -296,9 +287,8 @@ def test_width_independence(name):
     for q, arr in (("H", act["H"]), ("M", act["M"]), ("Z*W", act["Z"] * wcol), ("S/W", sen["S"] / wcol)):
         np.testing.assert_allclose(arr, np.broadcast_to(arr[3:4], arr.shape), rtol=1e-12, err_msg=q)
     # and the electrode effect is really present (the check is not vacuous): |x| at 10 Hz is O(1)
-    assert abs(act["H"][0, 0, -1]) < 0.9 * abs(
-        ActuatorModel(base.replace(r1_sheet=0.0)).frequency_response(f[-1:], 0.0)["H"][0, 0, 0]
-    )
+    assert abs(act["H"][0, 0, -1]) < 0.9 * abs(ActuatorModel(base.replace(r1_sheet=0.0)).frequency_response(
+        f[-1:], 0.0)["H"][0, 0, 0])
 
 
 @pytest.mark.parametrize("name", SETS)
@@ -334,24 +324,22 @@ def _log_uniform(lo, hi):
     return st.floats(np.log10(lo), np.log10(hi)).map(lambda e: float(10.0**e))
 
 
-PARAMS = st.fixed_dictionaries(
-    {
-        "L": _log_uniform(3e-3, 8e-2),
-        "W": _log_uniform(2e-4, 3e-2),
-        "h": _log_uniform(1e-5, 1e-3),
-        "d": _log_uniform(1e-13, 1e-8),
-        "C_minus": _log_uniform(1.0, 1e4),
-        "kappa_e": _log_uniform(1e-10, 1e-4),
-        "alpha0": st.tuples(st.sampled_from([-1.0, 1.0]), _log_uniform(1e-4, 1e3)).map(lambda t: t[0] * t[1]),
-        "a0": st.floats(-10.0, 10.0),
-        "r1_sheet": st.one_of(st.just(0.0), _log_uniform(1e-6, 1e5)),
-        "r2_specific": st.one_of(st.just(0.0), _log_uniform(1e-10, 1e-2)),
-        "Rp_specific": st.one_of(st.just(np.inf), _log_uniform(1e-4, 1e4)),
-        "E": _log_uniform(1e7, 1e10),
-        "rho": _log_uniform(500.0, 2e4),
-        "xi": _log_uniform(1e-3, 2.0),
-    }
-)
+PARAMS = st.fixed_dictionaries({
+    "L": _log_uniform(3e-3, 8e-2),
+    "W": _log_uniform(2e-4, 3e-2),
+    "h": _log_uniform(1e-5, 1e-3),
+    "d": _log_uniform(1e-13, 1e-8),
+    "C_minus": _log_uniform(1.0, 1e4),
+    "kappa_e": _log_uniform(1e-10, 1e-4),
+    "alpha0": st.tuples(st.sampled_from([-1.0, 1.0]), _log_uniform(1e-4, 1e3)).map(lambda t: t[0] * t[1]),
+    "a0": st.floats(-10.0, 10.0),
+    "r1_sheet": st.one_of(st.just(0.0), _log_uniform(1e-6, 1e5)),
+    "r2_specific": st.one_of(st.just(0.0), _log_uniform(1e-10, 1e-2)),
+    "Rp_specific": st.one_of(st.just(np.inf), _log_uniform(1e-4, 1e4)),
+    "E": _log_uniform(1e7, 1e10),
+    "rho": _log_uniform(500.0, 2e4),
+    "xi": _log_uniform(1e-3, 2.0),
+})
 
 
 @settings(max_examples=50, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])

@@ -67,13 +67,11 @@ def case(request):
         "Z": act["Z"][0, 0],
         "H": act["H"][0, 0],
         "S": SensorModel(p).frequency_response(FREQ_HZ, temp, quantities=("S",))["S"][0, 0],
-        "S_reciprocal": SensorModel(p, kernel="reciprocal").frequency_response(FREQ_HZ, temp, quantities=("S",))["S"][
-            0, 0
-        ],
+        "S_reciprocal": SensorModel(p, kernel="reciprocal").frequency_response(
+            FREQ_HZ, temp, quantities=("S",))["S"][0, 0],
     }
-    slice_kw = dict(
-        h=v["h"], d=v["d"], K=v["K"], W=v["W"], kappa_e=v["kappa_e"], alpha0=v["alpha0"], r2=v["r2"], Rp=v["Rp"]
-    )
+    slice_kw = dict(h=v["h"], d=v["d"], K=v["K"], W=v["W"], kappa_e=v["kappa_e"], alpha0=v["alpha0"],
+                    r2=v["r2"], Rp=v["Rp"])
     I2 = 2.0 / 3.0 * v["W"] * v["h"] ** 3
     ladder = {}
     for n in GRIDS:
@@ -95,11 +93,9 @@ def test_electrode_line_is_not_negligible(case):
 def test_ladder_converges_at_second_order(case, quantity):
     name, _, s, _, exact, ladder = case
     ref = exact[quantity]
-    errs = np.array([np.abs(ladder[n][quantity] / ref - 1.0) for n in GRIDS])  # (n_grid, n_f)
+    errs = np.array([np.abs(ladder[n][quantity] / ref - 1.0) for n in GRIDS])   # (n_grid, n_f)
     orders = np.log2(errs[:-1] / errs[1:])
-    where = (
-        f"{quantity} [{name}]: errors at N={GRIDS}: {errs.max(axis=1)}, orders {orders.min():.4f}..{orders.max():.4f}"
-    )
+    where = f"{quantity} [{name}]: errors at N={GRIDS}: {errs.max(axis=1)}, orders {orders.min():.4f}..{orders.max():.4f}"
     assert np.all((orders > ORDER_RANGE[0]) & (orders < ORDER_RANGE[1])), where
     assert errs[-1].max() < RAW_RTOL, where
     rich = (4.0 * ladder[GRIDS[-1]][quantity] - ladder[GRIDS[-2]][quantity]) / 3.0
@@ -125,9 +121,8 @@ def test_ladder_with_ideal_electrodes_is_exact():
     p = get_parameter_set("seed002_table3", r1_sheet=1e-9)
     v = _state(p, 25.0)
     s = 2j * np.pi * FREQ_HZ
-    slice_kw = dict(
-        h=v["h"], d=v["d"], K=v["K"], W=v["W"], kappa_e=v["kappa_e"], alpha0=v["alpha0"], r2=v["r2"], Rp=v["Rp"]
-    )
+    slice_kw = dict(h=v["h"], d=v["d"], K=v["K"], W=v["W"], kappa_e=v["kappa_e"], alpha0=v["alpha0"],
+                    r2=v["r2"], Rp=v["Rp"])
     Z, H = actuator_ladder(7, s, L=v["L"], r1=v["r1"], E=v["E"], I2=2 / 3 * v["W"] * v["h"] ** 3, **slice_kw)
     act = ActuatorModel(p).frequency_response(FREQ_HZ, 25.0, quantities=("Z", "H"))
     # midpoint rule for ∫(L−z)dz is exact for a linear integrand; residual line effect ~|x|² ~ 1e-12

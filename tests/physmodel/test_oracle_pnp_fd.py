@@ -49,8 +49,8 @@ GRIDS = (100, 200, 400)
 ORDER_RANGE = (1.9, 2.1)
 RICHARDSON_RTOL = 1e-7
 RAW_RTOL = 2e-3
-ALPHA0 = -0.7  # J/C, any non-zero value (tests the α0 factor and the sign)
-RHO0 = 3.0e4  # C/m³, Dirichlet boundary charge a0·σ0 for the sensing problem
+ALPHA0 = -0.7           # J/C, any non-zero value (tests the α0 factor and the sign)
+RHO0 = 3.0e4            # C/m³, Dirichlet boundary charge a0·σ0 for the sensing problem
 
 # (γ0, grid stretching a): a = 0 is a uniform grid (nothing to resolve at γ0 = 0.05)
 CASES = [(0.05, 0.0), (1.5, 1.0), (12.0, 2.5), (30.0, 3.0)]

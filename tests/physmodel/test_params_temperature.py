@@ -60,7 +60,7 @@ def test_seed002_dc_gain_is_a_few_mm_per_volt():
     M0 = -3 * 0.015**2 * (-155.0) * 4.47e-7 * (g0 - np.tanh(g0)) * 2 * X / (4 * 154e6 * 0.125e-3**3) / 75.4
     got = ActuatorModel(p).dc_gain([300.0 - 273.15])["M0"][0, 0]
     assert got == pytest.approx(M0, rel=1e-12)
-    assert 3e-3 < got < 8e-3  # 5.6 mm/V
+    assert 3e-3 < got < 8e-3   # 5.6 mm/V
 
 
 def test_overrides_and_errors_name_the_field():

@@ -22,7 +22,7 @@ def test_taylor_coefficients_match_the_series_of_x_sinh_and_cosh():
 
 def _errors_db(order):
     m = ActuatorModel(get_parameter_set("seed002_table3", laws=ISOTHERMAL))
-    f = np.logspace(np.log10(2.0), np.log10(30.0), 120)  # around the first mode (12 Hz)
+    f = np.logspace(np.log10(2.0), np.log10(30.0), 120)     # around the first mode (12 Hz)
     exact = m.frequency_response(f, [26.85])["M"][0, 0]
     red = reduced_frequency_response(m.state([26.85]), f, order)
     return np.max(np.abs(20 * np.log10(np.abs(red / exact)))), np.max(np.abs(np.degrees(np.angle(red / exact))))
@@ -30,8 +30,8 @@ def _errors_db(order):
 
 def test_third_order_matches_around_the_first_mode_lower_orders_do_not():
     e1, e2, e3 = (_errors_db(k) for k in (1, 2, 3))
-    assert e3[0] < 0.5 and e3[1] < 3.0  # third order: within 0.5 dB / 3 deg
-    assert e2[0] > 1.0 and e1[0] > 3.0  # lower orders miss by > 1 dB
+    assert e3[0] < 0.5 and e3[1] < 3.0              # third order: within 0.5 dB / 3 deg
+    assert e2[0] > 1.0 and e1[0] > 3.0              # lower orders miss by > 1 dB
     assert e1[0] > e2[0] > e3[0]
 
 

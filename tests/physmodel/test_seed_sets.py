@@ -40,9 +40,7 @@ from physmodel.temperature import LogLinear, TemperatureLaws
 def published():
     from importlib import resources
 
-    return tomllib.loads(
-        resources.files("physmodel.parameter_sets").joinpath(PUBLISHED_FILE).read_text(encoding="utf-8")
-    )
+    return tomllib.loads(resources.files("physmodel.parameter_sets").joinpath(PUBLISHED_FILE).read_text(encoding="utf-8"))
 
 
 def _printed_35c(published, f):
@@ -56,15 +54,11 @@ def _printed_35c(published, f):
 def test_geometries_and_dev_sets_unchanged(published):
     sen, act = get_parameter_set("seed000_sensor"), get_parameter_set("seed001_actuator")
     smp = published["sensor_seed000"]["sample"]
-    assert (sen.L, sen.W, 2 * sen.h) == pytest.approx(
-        (smp["length_mm"] * 1e-3, smp["width_mm"] * 1e-3, smp["thickness_um"] * 1e-6)
-    )
+    assert (sen.L, sen.W, 2 * sen.h) == pytest.approx((smp["length_mm"] * 1e-3, smp["width_mm"] * 1e-3, smp["thickness_um"] * 1e-6))
     smp = published["actuator_seed001"]["sample"]
-    assert (act.L, act.W, 2 * act.h) == pytest.approx(
-        (smp["free_length_mm"] * 1e-3, smp["width_mm"] * 1e-3, smp["thickness_mm"] * 1e-3)
-    )
+    assert (act.L, act.W, 2 * act.h) == pytest.approx((smp["free_length_mm"] * 1e-3, smp["width_mm"] * 1e-3, smp["thickness_mm"] * 1e-3))
     dev = get_parameter_set("seed000_sensor_dev")
-    assert dev.a0 == 0.3 and dev.laws == TemperatureLaws()  # the development sets are kept as they were
+    assert dev.a0 == 0.3 and dev.laws == TemperatureLaws()        # the development sets are kept as they were
     assert "calibrated" in sen.source and "35 C" in sen.source and "7 dB" in act.source
 
 
@@ -78,7 +72,7 @@ def test_json_round_trip(tmp_path, name):
 def test_sensor_calibration_reproduces_stored_values():
     res = sc.calibrate_seed000_sensor()
     assert res.converged
-    assert sorted(res.held) == ["kappa_e", "r1_sheet", "r2_specific"]  # ran to their bounds
+    assert sorted(res.held) == ["kappa_e", "r1_sheet", "r2_specific"]       # ran to their bounds
     for k in ("a0", "d"):
         assert res.values[k] == pytest.approx(SEED000_SENSOR_CAL[k], rel=1e-4)
         assert res.ci_lower[k] <= SEED000_SENSOR_CAL[k] <= res.ci_upper[k]
@@ -107,9 +101,7 @@ def test_sensor_laws_are_chosen_on_the_declared_trends_only():
     assert (c, e) == (SEED000_SENSOR_CAL["C_minus_slope"], SEED000_SENSOR_CAL["E_slope"])
     assert sc.SENSOR_CALIBRATION_TRENDS == ("cutoff_decreases", "hf_gain_decreases")
     assert sorted(k for k in CAL000["seed000_sensor"] if "trends" in k) == [
-        "sensor_seed000.trends_with_rising_temperature[0]",
-        "sensor_seed000.trends_with_rising_temperature[1]",
-    ]
+        "sensor_seed000.trends_with_rising_temperature[0]", "sensor_seed000.trends_with_rising_temperature[1]"]
     # why the laws had to be calibrated at all: with the physics.md default laws the cut-off rises and
     # the lag falls with T (the printed directions are not a consequence of the default physics)
     default = sc.sensor_trends(sen.replace(laws=TemperatureLaws())).monotone()
@@ -132,8 +124,8 @@ def test_stored_actuator_set_satisfies_the_equations_it_was_solved_from():
     f0 = 3.0 * np.array([1 / 1.02, 1.0, 1.02])
     M = np.abs(ActuatorModel(act).frequency_response(f0, [19.0, 55.0])["M"][0])
     D = 20 * np.log10(M[0] / M[1])
-    assert D[1] == pytest.approx(7.0, abs=1e-3)  # rounding of the stored E, slope
-    assert abs(D[2] - D[0]) / math.log(1.02**2) < 1e-2  # dD/dln f = 0 at 3 Hz [dB]
+    assert D[1] == pytest.approx(7.0, abs=1e-3)                           # rounding of the stored E, slope
+    assert abs(D[2] - D[0]) / math.log(1.02**2) < 1e-2                     # dD/dln f = 0 at 3 Hz [dB]
 
 
 def test_resonance_follows_the_modulus_law():
@@ -144,13 +136,11 @@ def test_resonance_follows_the_modulus_law():
     ratio = math.sqrt(act.laws.E.factor(328.15, act.T_ref) / act.laws.E.factor(292.15, act.T_ref))
     assert tr.resonance_hz[-1] / tr.resonance_hz[0] == pytest.approx(ratio, rel=0.02)
     flat = sc.actuator_trends(act.replace(laws=act.laws.with_(E=LogLinear(slope=0.0))))
-    assert max(flat.resonance_hz) / min(flat.resonance_hz) < 1.01  # no modulus law, (almost) no shift
+    assert max(flat.resonance_hz) / min(flat.resonance_hz) < 1.01          # no modulus law, (almost) no shift
 
 
 def test_development_actuator_gain_rises_with_temperature():
     """Why seed001_actuator needed a calibrated C- law: with development values the gain near 2 Hz rises
     with T, opposite to the printed 19-vs-55 °C difference."""
-    dev = np.abs(
-        ActuatorModel(get_parameter_set("seed001_actuator_dev")).frequency_response([2.0], [19.0, 55.0])["M"][0, :, 0]
-    )
+    dev = np.abs(ActuatorModel(get_parameter_set("seed001_actuator_dev")).frequency_response([2.0], [19.0, 55.0])["M"][0, :, 0])
     assert dev[1] > dev[0]

@@ -23,7 +23,7 @@ def noisy():
 def test_exact_sweep_is_the_model_in_display_units():
     m = ActuatorModel(get_parameter_set("seed002_table3"))
     sw = synthesize_sweep(m, "M", F, T)
-    ref = m.frequency_response(F, T)["M"][0] * 1e3  # m/V -> mm/V
+    ref = m.frequency_response(F, T)["M"][0] * 1e3      # m/V -> mm/V
     f, temps, H = sw.grid()
     np.testing.assert_array_equal(temps, T)
     np.testing.assert_allclose(H, ref, rtol=1e-15)
@@ -69,12 +69,7 @@ def test_roundtrip(noisy, tmp_path, ext):
     np.testing.assert_allclose(back.response, noisy.response, rtol=1e-13)
     np.testing.assert_array_equal(back.temperature_c, noisy.temperature_c)
     np.testing.assert_array_equal(back.magnitude_std_db, noisy.magnitude_std_db)
-    assert (back.input_name, back.input_unit, back.output_name, back.output_unit) == (
-        "voltage",
-        "V",
-        "tip_displacement",
-        "mm",
-    )
+    assert (back.input_name, back.input_unit, back.output_name, back.output_unit) == ("voltage", "V", "tip_displacement", "mm")
     assert back.metadata["seed"] == "11"
     assert back.fingerprint() == FrequencySweep(back.temperature_c, back.frequency_hz, back.response).fingerprint()
 
@@ -104,26 +99,18 @@ def test_good_csv_reads(tmp_path):
     assert sw.magnitude_std_db is None
 
 
-@pytest.mark.parametrize(
-    "mutate,message",
-    [
-        (
-            lambda s: s.replace(
-                "temperature_c,frequency_hz,magnitude_db,phase_deg", "temperature_c,frequency_hz,magnitude_db"
-            ),
-            r"missing column.*phase_deg",
-        ),
-        (lambda s: s.replace("25,20,2.0,70", "25,20,nan,70"), r":6: magnitude_db is 'nan'"),
-        (lambda s: s.replace("25,20,2.0,70", "25,20,abc,70"), r":6: magnitude_db = 'abc' is not a number"),
-        (lambda s: s.replace("25,20,2.0,70", "25,5,2.0,70"), r":6: frequencies at 25 °C are not sorted"),
-        (lambda s: s.replace("25,20,2.0,70", "25,10,2.0,70"), r":6: duplicate frequency 10 Hz"),
-        (lambda s: s.replace("[uA]", "[furlong]"), r"unknown output unit 'furlong'"),
-        (lambda s: s.replace("# input: tip_displacement [mm]\n", ""), r"missing header line '# input"),
-        (lambda s: s.replace("25,20,2.0,70", "25,20,2.0"), r":6: expected 4 values, got 3"),
-        (lambda s: s.replace("35,20,1.5,75", "35,20,1.5,75\n25,30,1,1"), r":9: rows at 25 °C are not contiguous"),
-        (lambda s: s.replace("25,10,1.0,80", "25,-10,1.0,80"), r":5: frequency_hz = -10.0 must be > 0"),
-    ],
-)
+@pytest.mark.parametrize("mutate,message", [
+    (lambda s: s.replace("temperature_c,frequency_hz,magnitude_db,phase_deg", "temperature_c,frequency_hz,magnitude_db"), r"missing column.*phase_deg"),
+    (lambda s: s.replace("25,20,2.0,70", "25,20,nan,70"), r":6: magnitude_db is 'nan'"),
+    (lambda s: s.replace("25,20,2.0,70", "25,20,abc,70"), r":6: magnitude_db = 'abc' is not a number"),
+    (lambda s: s.replace("25,20,2.0,70", "25,5,2.0,70"), r":6: frequencies at 25 °C are not sorted"),
+    (lambda s: s.replace("25,20,2.0,70", "25,10,2.0,70"), r":6: duplicate frequency 10 Hz"),
+    (lambda s: s.replace("[uA]", "[furlong]"), r"unknown output unit 'furlong'"),
+    (lambda s: s.replace("# input: tip_displacement [mm]\n", ""), r"missing header line '# input"),
+    (lambda s: s.replace("25,20,2.0,70", "25,20,2.0"), r":6: expected 4 values, got 3"),
+    (lambda s: s.replace("35,20,1.5,75", "35,20,1.5,75\n25,30,1,1"), r":9: rows at 25 °C are not contiguous"),
+    (lambda s: s.replace("25,10,1.0,80", "25,-10,1.0,80"), r":5: frequency_hz = -10.0 must be > 0"),
+])
 def test_malformed_csv_names_line_and_problem(tmp_path, mutate, message):
     with pytest.raises(DataFormatError, match=message):
         read_csv(_write(tmp_path, mutate(GOOD)))
@@ -150,7 +137,6 @@ def test_write_is_atomic(tmp_path, noisy, monkeypatch):
                 if W.n > 5:
                     raise Boom()
                 w.writerow(row)
-
         return W()
 
     monkeypatch.setattr(_csv, "writer", bad_writer)

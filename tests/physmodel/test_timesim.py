@@ -46,9 +46,7 @@ def test_sensor_step_matches_inverse_laplace():
     ts = step(m, 40.0, 1e-3, 0.2, fs)
     fn = transfer_mp(_row(p, 40.0), "S")
     with mp.workdps(30):
-        refs = {
-            t: float(mp.invertlaplace(lambda s: 1e-3 * fn(s) / s, t, method="talbot")) for t in (0.002, 0.01, 0.05, 0.2)
-        }
+        refs = {t: float(mp.invertlaplace(lambda s: 1e-3 * fn(s) / s, t, method="talbot")) for t in (0.002, 0.01, 0.05, 0.2)}
     scale = max(abs(v) for v in refs.values())
     for t, ref in refs.items():
         got = ts.output[int(round(t * fs))]
@@ -61,7 +59,7 @@ def test_sine_reaches_the_steady_state_phasor():
     ts = sine(m, 30.0, 0.5, f0, 3.0, fs)
     H = m.frequency_response([f0], [30.0])["M"][0, 0, 0]
     t = ts.t
-    last = t >= 2.0  # transients decay with ~0.05-0.1 s time constants
+    last = t >= 2.0                                   # transients decay with ~0.05-0.1 s time constants
     expected = 0.5 * np.abs(H) * np.sin(2 * np.pi * f0 * t[last] + np.angle(H))
     assert np.max(np.abs(ts.output[last] - expected)) <= 2e-4 * 0.5 * np.abs(H)
 
@@ -74,7 +72,7 @@ def test_high_sample_rates_realise_and_reach_the_phasor(fs):
     f0 = 40.0
     ts = sine(m, 45.0, 0.5, f0, 12.0, fs)
     H = m.frequency_response([f0], [45.0])["M"][0, 0, 0]
-    last = ts.t >= 10.0  # the start transient decays slowly (~exp(-1.1 t))
+    last = ts.t >= 10.0                               # the start transient decays slowly (~exp(-1.1 t))
     expected = 0.5 * np.abs(H) * np.sin(2 * np.pi * f0 * ts.t[last] + np.angle(H))
     assert np.max(np.abs(ts.output[last] - expected)) <= 3e-3 * 0.5 * np.abs(H)
 
@@ -100,7 +98,7 @@ def test_free_release_sensor_starts_steady_and_rings_at_the_mode():
     after = ts.t >= 0.1
     peak = np.max(np.abs(ts.output[after]))
     assert peak > 0
-    assert np.max(np.abs(ts.output[before])) <= 1e-9 * peak  # a held tip makes no current
+    assert np.max(np.abs(ts.output[before])) <= 1e-9 * peak      # a held tip makes no current
     # ringing frequency = damped first mode (zero crossings of the current after release)
     st = m.state([35.0])
     wn, xi = float(st.omega_n[0, 0, 0]), float(st.xi[0, 0, 0])

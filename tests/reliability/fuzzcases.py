@@ -31,17 +31,17 @@ import numpy as np
 class Case:
     category: str
     what: str
-    argv: list | None = None  # an ``ipmc`` command line ...
-    func: Callable | None = None  # ... or a library call
-    expect: tuple = (2,)  # acceptable exit codes ("ok" results count as 0)
-    tokens: tuple = ()  # one must appear in a refusal's message
-    post: Callable | None = None  # extra check after the call: returns "" or a complaint
+    argv: list | None = None                 # an ``ipmc`` command line ...
+    func: Callable | None = None             # ... or a library call
+    expect: tuple = (2,)                     # acceptable exit codes ("ok" results count as 0)
+    tokens: tuple = ()                       # one must appear in a refusal's message
+    post: Callable | None = None             # extra check after the call: returns "" or a complaint
     cwd: Path | None = None
 
 
 @dataclass
 class Outcome:
-    verdict: str  # "clear" | "bad"
+    verdict: str                             # "clear" | "bad"
     code: int | None
     detail: str = ""
     message: str = field(default="", repr=False)
@@ -68,7 +68,7 @@ def judge(case: Case) -> Outcome:
 
                     try:
                         code = main([str(a) for a in case.argv])
-                    except SystemExit as se:  # argparse: usage error, exit 2
+                    except SystemExit as se:          # argparse: usage error, exit 2
                         code = se.code if isinstance(se.code, int) else 2
                 else:
                     try:
@@ -137,14 +137,8 @@ def valid_sweep(d: Path, name="sweep.csv", temps=(20.0, 40.0), points=8, noise=T
     from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 
     m = ActuatorModel(get_parameter_set("seed002_table3"))
-    sw = synthesize_sweep(
-        m,
-        "M",
-        np.geomspace(0.5, 20, points),
-        list(temps),
-        MagnitudePhaseNoise(0.1, 1.0) if noise else None,
-        1 if noise else None,
-    )
+    sw = synthesize_sweep(m, "M", np.geomspace(0.5, 20, points), list(temps),
+                          MagnitudePhaseNoise(0.1, 1.0) if noise else None, 1 if noise else None)
     return write_sweep(sw, d / name)
 
 
@@ -166,7 +160,6 @@ MINI_SCENARIO = {
 
 def toml_dumps(doc: dict, prefix: str = "") -> str:
     """A small TOML writer for the cases (tables, arrays of tables, scalars and lists)."""
-
     def val(v):
         if isinstance(v, bool):
             return "true" if v else "false"
@@ -225,62 +218,35 @@ def gen_encoding(rnd: random.Random, d: Path) -> Case:
         lines[k] = lines[k][:pos] + bad + lines[k][pos:]
         f = d / "in.csv"
         f.write_bytes(b"\n".join(lines))
-        argv = {
-            "fit": ["fit", f, "--out", d / "o", "--quiet"],
-            "calibrate": ["calibrate", f, "--set", "seed002_table3", "--free", "alpha0", "--out", d / "o", "--quiet"],
-            "invert": ["invert", f, "--num=1", "--den=1,1", "--out", d / "o.csv", "--quiet"],
-        }[target]
+        argv = {"fit": ["fit", f, "--out", d / "o", "--quiet"],
+                "calibrate": ["calibrate", f, "--set", "seed002_table3", "--free", "alpha0", "--out", d / "o", "--quiet"],
+                "invert": ["invert", f, "--num=1", "--den=1,1", "--out", d / "o.csv", "--quiet"]}[target]
         return Case("encoding", f"{target}: {bad!r} in line {k}", argv, tokens=("in.csv",))
     if target in ("run", "study", "diagnose"):
-        text = {
-            "run": toml_dumps(MINI_SCENARIO),
-            "study": 'name = "s"\n'
-            if False
-            else '[study]\nkind = "actuator"\nset = "dev"\nseed = 1\n'
-            'temperatures_c = [20.0]\nsamples = 2\n[study.parameters.d]\ndistribution = "uniform"\n'
-            "low = 1e-11\nhigh = 2e-11\n",
-            "diagnose": 'data = "sweep.csv"\nkind = "actuator"\nset = "seed002_table3"\n',
-        }[target].encode()
+        text = {"run": toml_dumps(MINI_SCENARIO),
+                "study": 'name = "s"\n' if False else '[study]\nkind = "actuator"\nset = "dev"\nseed = 1\n'
+                         'temperatures_c = [20.0]\nsamples = 2\n[study.parameters.d]\ndistribution = "uniform"\n'
+                         'low = 1e-11\nhigh = 2e-11\n',
+                "diagnose": 'data = "sweep.csv"\nkind = "actuator"\nset = "seed002_table3"\n'}[target].encode()
         if target == "diagnose":
             valid_sweep(d)
         pos = rnd.randrange(len(text) + 1)
         f = d / "in.toml"
-        f.write_bytes(
-            text[:pos] + b"# " + bad + b"\n" + text[pos:] if rnd.random() < 0.5 else text[:pos] + bad + text[pos:]
-        )
-        argv = {
-            "run": ["run", f, "--out", d / "o", "--quiet"],
-            "study": ["study", f, "--out", d / "o.csv", "--quiet", "--serial"],
-            "diagnose": ["diagnose", f, "--out", d / "o", "--quiet"],
-        }[target]
+        f.write_bytes(text[:pos] + b"# " + bad + b"\n" + text[pos:] if rnd.random() < 0.5 else text[:pos] + bad + text[pos:])
+        argv = {"run": ["run", f, "--out", d / "o", "--quiet"], "study": ["study", f, "--out", d / "o.csv", "--quiet", "--serial"],
+                "diagnose": ["diagnose", f, "--out", d / "o", "--quiet"]}[target]
         return Case("encoding", f"{target} TOML: {bad!r} at {pos}", argv, tokens=("in.toml",))
     text = json.dumps(_params_record()).encode()
     pos = rnd.randrange(1, len(text))
     f = d / "p.json"
     f.write_bytes(text[:pos] + bad + text[pos:])
-    return Case(
-        "encoding",
-        f"parameter JSON: {bad!r} at {pos}",
-        ["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out", d / "o.csv", "--quiet"],
-        tokens=("p.json",),
-    )
+    return Case("encoding", f"parameter JSON: {bad!r} at {pos}",
+                ["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out", d / "o.csv", "--quiet"],
+                tokens=("p.json",))
 
 
-_CSV_EDITS = (
-    "delete_char",
-    "swap_lines",
-    "garbage_token",
-    "duplicate_line",
-    "truncate",
-    "nonfinite",
-    "extra_column",
-    "drop_column",
-    "empty_field",
-    "header_unit",
-    "reverse_rows",
-    "blank",
-    "bom",
-)
+_CSV_EDITS = ("delete_char", "swap_lines", "garbage_token", "duplicate_line", "truncate", "nonfinite",
+              "extra_column", "drop_column", "empty_field", "header_unit", "reverse_rows", "blank", "bom")
 
 
 def gen_sweep_csv(rnd: random.Random, d: Path) -> Case:
@@ -294,7 +260,7 @@ def gen_sweep_csv(rnd: random.Random, d: Path) -> Case:
     k = rnd.choice(body)
     if edit == "delete_char" and lines[k]:
         j = rnd.randrange(len(lines[k]))
-        lines[k] = lines[k][:j] + lines[k][j + 1 :]
+        lines[k] = lines[k][:j] + lines[k][j + 1:]
     elif edit == "swap_lines":
         a, b = rnd.sample(range(len(lines)), 2)
         lines[a], lines[b] = lines[b], lines[a]
@@ -319,12 +285,8 @@ def gen_sweep_csv(rnd: random.Random, d: Path) -> Case:
         parts[rnd.randrange(len(parts))] = ""
         lines[k] = ",".join(parts)
     elif edit == "header_unit":
-        lines = [
-            rnd.choice(["# input: voltage [furlong]", "# input: voltage", "# output:", "#"])
-            if l.startswith("# input")
-            else l
-            for l in lines
-        ]
+        lines = [rnd.choice(["# input: voltage [furlong]", "# input: voltage", "# output:", "#"]) if l.startswith("# input")
+                 else l for l in lines]
     elif edit == "reverse_rows":
         head = [l for l in lines if l.startswith("#")] + [lines[body[0]]]
         lines = head + list(reversed([lines[i] for i in body[1:]]))
@@ -354,24 +316,9 @@ def gen_sweep_binary(rnd: random.Random, d: Path) -> Case:
     f = d / f"b.{kind}"
     if kind == "npz":
         arrays, _ = _npz_parts(d)
-        edit = rnd.choice(
-            [
-                "no_header",
-                "header_not_json",
-                "header_list",
-                "header_no_input",
-                "no_imag",
-                "length_mismatch",
-                "empty_file",
-                "garbage",
-                "big_extra",
-                "object",
-                "strings",
-                "2d",
-                "nonfinite",
-                "header_bytes_json_number",
-            ]
-        )
+        edit = rnd.choice(["no_header", "header_not_json", "header_list", "header_no_input", "no_imag",
+                           "length_mismatch", "empty_file", "garbage", "big_extra", "object", "strings", "2d",
+                           "nonfinite", "header_bytes_json_number"])
         a = dict(arrays)
         if edit == "no_header":
             a.pop("header")
@@ -416,20 +363,13 @@ def gen_sweep_binary(rnd: random.Random, d: Path) -> Case:
                     b2 = io.BytesIO()
                     np.save(b2, v)
                     zf.writestr(k + ".npy", b2.getvalue())
-                with zf.open("extra.npy", "w", force_zip64=True) as fh:  # 400 MB of zeros, ~0.4 MB on disk
-                    np.lib.format.write_array_header_1_0(
-                        fh, {"descr": "<f8", "fortran_order": False, "shape": (50_000_000,)}
-                    )
+                with zf.open("extra.npy", "w", force_zip64=True) as fh:     # 400 MB of zeros, ~0.4 MB on disk
+                    np.lib.format.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": (50_000_000,)})
                     chunk = bytes(8_000_000)
                     for _ in range(50):
                         fh.write(chunk)
-            return Case(
-                "sweep_binary",
-                "npz with a 400 MB extra array",
-                func=lambda: read_sweep(f),
-                expect=(0, 2),
-                tokens=("b.npz",),
-            )
+            return Case("sweep_binary", "npz with a 400 MB extra array", func=lambda: read_sweep(f), expect=(0, 2),
+                        tokens=("b.npz",))
         else:
             with open(f, "wb") as fh:
                 np.savez(fh, **a)
@@ -437,30 +377,12 @@ def gen_sweep_binary(rnd: random.Random, d: Path) -> Case:
     from scipy.io import savemat
 
     sw = read_sweep(valid_sweep(d, "v.csv", points=5))
-    cols = {
-        "temperature_c": sw.temperature_c,
-        "frequency_hz": sw.frequency_hz,
-        "magnitude_db": sw.magnitude_db,
-        "phase_deg": sw.phase_deg,
-        "response": sw.response,
-        "input": f"{sw.input_name} [{sw.input_unit}]",
-        "output": f"{sw.output_name} [{sw.output_unit}]",
-        "metadata_json": json.dumps(sw.metadata),
-    }
-    edit = rnd.choice(
-        [
-            "no_frequency",
-            "no_input",
-            "metadata_not_json",
-            "length_mismatch",
-            "string_field",
-            "empty_file",
-            "garbage",
-            "complex_frequency",
-            "nonfinite",
-            "cell",
-        ]
-    )
+    cols = {"temperature_c": sw.temperature_c, "frequency_hz": sw.frequency_hz, "magnitude_db": sw.magnitude_db,
+            "phase_deg": sw.phase_deg, "response": sw.response,
+            "input": f"{sw.input_name} [{sw.input_unit}]", "output": f"{sw.output_name} [{sw.output_unit}]",
+            "metadata_json": json.dumps(sw.metadata)}
+    edit = rnd.choice(["no_frequency", "no_input", "metadata_not_json", "length_mismatch", "string_field", "empty_file",
+                       "garbage", "complex_frequency", "nonfinite", "cell"])
     if edit == "no_frequency":
         cols.pop("frequency_hz")
     elif edit == "no_input":
@@ -491,24 +413,8 @@ def gen_params_json(rnd: random.Random, d: Path) -> Case:
     """Parameter JSON with one wrong value, read by ``ipmc sweep --params-json``."""
     rec = _params_record()
     key = rnd.choice(["L", "W", "h", "d", "E", "xi", "alpha0", "T_ref", "Rp_specific"])
-    edit = rnd.choice(
-        [
-            "string",
-            "null",
-            "true",
-            "list",
-            "object",
-            "negative",
-            "missing",
-            "unknown",
-            "law_no_law",
-            "law_unknown",
-            "law_value_string",
-            "top_list",
-            "wrapped_bad_version",
-            "laws_not_object",
-        ]
-    )
+    edit = rnd.choice(["string", "null", "true", "list", "object", "negative", "missing", "unknown", "law_no_law",
+                       "law_unknown", "law_value_string", "top_list", "wrapped_bad_version", "laws_not_object"])
     tok = (key,)
     if edit == "string":
         rec[key] = rnd.choice(["abc", "", "1 m", "nan"])
@@ -552,13 +458,9 @@ def gen_params_json(rnd: random.Random, d: Path) -> Case:
         tok = ("laws",)
     f = d / "p.json"
     f.write_text(json.dumps(rec), encoding="utf-8")
-    return Case(
-        "params_json",
-        f"{key} {edit}",
-        expect=(0, 2) if (edit, key) == ("missing", "T_ref") else (2,),
-        argv=["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out", d / "o.csv", "--quiet"],
-        tokens=tok + ("p.json",) if edit != "unknown" else tok,
-    )
+    return Case("params_json", f"{key} {edit}", expect=(0, 2) if (edit, key) == ("missing", "T_ref") else (2,),
+                argv=["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out", d / "o.csv", "--quiet"],
+                tokens=tok + ("p.json",) if edit != "unknown" else tok)
 
 
 _SURROGATE_CACHE: dict = {}
@@ -579,20 +481,8 @@ def _surrogate_json(d: Path) -> dict:
 
 def gen_surrogate_json(rnd: random.Random, d: Path) -> Case:
     doc = _surrogate_json(d)
-    edit = rnd.choice(
-        [
-            "no_structure",
-            "no_params",
-            "params_string",
-            "params_short",
-            "not_json",
-            "list",
-            "empty",
-            "schema",
-            "structure_wrong",
-            "nan_param",
-        ]
-    )
+    edit = rnd.choice(["no_structure", "no_params", "params_string", "params_short", "not_json", "list", "empty",
+                       "schema", "structure_wrong", "nan_param"])
     if edit == "no_structure":
         doc.pop("structure", None)
     elif edit == "no_params":
@@ -615,69 +505,24 @@ def gen_surrogate_json(rnd: random.Random, d: Path) -> Case:
     f.write_text("{oops" if edit == "not_json" else json.dumps(doc), encoding="utf-8")
     sig = d / "u.csv"
     sig.write_text("time_s,u\n" + "".join(f"{i * 0.01},{math.sin(i / 5)}\n" for i in range(50)))
-    return Case(
-        "surrogate_json",
-        edit,
-        ["invert", sig, "--surrogate", f, "--temperature", 25, "--out", d / "o.csv", "--quiet"],
-        tokens=("m.json",),
-    )
+    return Case("surrogate_json", edit, ["invert", sig, "--surrogate", f, "--temperature", 25, "--out", d / "o.csv",
+                                         "--quiet"], tokens=("m.json",))
 
 
 def gen_scenario(rnd: random.Random, d: Path) -> Case:
     """A small valid scenario with one out-of-domain value."""
     doc = _deep(MINI_SCENARIO)
-    edit = rnd.choice(
-        [
-            "orders_0_0",
-            "orders_30_30",
-            "degree_neg",
-            "weighting",
-            "points_huge",
-            "points_1",
-            "fmin_neg",
-            "fmax_lt_fmin",
-            "held_out_missing",
-            "temps_nan",
-            "preview_long",
-            "amplitude_0",
-            "amplitude_nan",
-            "nyquist",
-            "fixtures_count",
-            "fixtures_count_neg",
-            "check_div0",
-            "sigma_neg",
-            "unknown_set",
-            "param_negative",
-            "temps_cold",
-            "duration_huge",
-            "window_empty",
-        ]
-    )
-    key = {
-        "orders_0_0": "n_zeros",
-        "orders_30_30": "n_poles",
-        "degree_neg": "degree",
-        "weighting": "weighting",
-        "points_huge": "points",
-        "points_1": "points",
-        "fmin_neg": "fmin_hz",
-        "fmax_lt_fmin": "fmax_hz",
-        "held_out_missing": "held_out_c",
-        "temps_nan": "temperatures_c",
-        "preview_long": "preview",
-        "amplitude_0": "amplitude_mm",
-        "amplitude_nan": "amplitude_mm",
-        "nyquist": "frequencies_hz",
-        "fixtures_count": "count",
-        "fixtures_count_neg": "count",
-        "check_div0": "ratio",
-        "sigma_neg": "sigma_db",
-        "unknown_set": "set",
-        "param_negative": "W",
-        "temps_cold": "temperatures_c",
-        "duration_huge": "duration_s",
-        "window_empty": "window_s",
-    }[edit]
+    edit = rnd.choice(["orders_0_0", "orders_30_30", "degree_neg", "weighting", "points_huge", "points_1",
+                       "fmin_neg", "fmax_lt_fmin", "held_out_missing", "temps_nan", "preview_long", "amplitude_0",
+                       "amplitude_nan", "nyquist", "fixtures_count", "fixtures_count_neg", "check_div0", "sigma_neg",
+                       "unknown_set", "param_negative", "temps_cold", "duration_huge", "window_empty"])
+    key = {"orders_0_0": "n_zeros", "orders_30_30": "n_poles", "degree_neg": "degree", "weighting": "weighting",
+           "points_huge": "points", "points_1": "points", "fmin_neg": "fmin_hz", "fmax_lt_fmin": "fmax_hz",
+           "held_out_missing": "held_out_c", "temps_nan": "temperatures_c", "preview_long": "preview",
+           "amplitude_0": "amplitude_mm", "amplitude_nan": "amplitude_mm", "nyquist": "frequencies_hz",
+           "fixtures_count": "count", "fixtures_count_neg": "count", "check_div0": "ratio",
+           "sigma_neg": "sigma_db", "unknown_set": "set", "param_negative": "W", "temps_cold": "temperatures_c",
+           "duration_huge": "duration_s", "window_empty": "window_s"}[edit]
     sur, sweep = doc["surrogate"], doc["sweep"]
     exp = {"name": "e", "temperature_c": 30.0, "amplitude_mm": 0.1, "frequencies_hz": [1.0]}
     inv = {"fs_hz": 200.0, "duration_s": 4.0, "experiments": [exp]}
@@ -713,7 +558,7 @@ def gen_scenario(rnd: random.Random, d: Path) -> Case:
     elif edit == "fixtures_count" or edit == "fixtures_count_neg":
         doc["fixtures"] = {"count": 0 if edit == "fixtures_count" else -2, "formats": ["csv"]}
     elif edit == "check_div0":
-        doc["sweep"]["temperatures_c"] = [20.0]  # one temperature: the difference is 0 dB
+        doc["sweep"]["temperatures_c"] = [20.0]          # one temperature: the difference is 0 dB
         doc.pop("surrogate")
         doc["checks"]["ratio"] = {"metric": "sweep.cold_minus_hot_db_at_max / sweep.max_db_difference", "max": 1.0}
         expect = (3,)
@@ -758,15 +603,11 @@ def gen_scenario_name(rnd: random.Random, d: Path) -> Case:
     def post():
         escaped = set(os.listdir(d)) - before - {"w"}
         outside = [p for p in (d / "w").iterdir() if p.name != "cwd"]
-        return (
-            f"wrote outside the working directory: {sorted(escaped) + [p.name for p in outside]}"
-            if escaped or outside
-            else ""
-        )
+        return f"wrote outside the working directory: {sorted(escaped) + [p.name for p in outside]}" \
+            if escaped or outside else ""
 
-    return Case(
-        "output_folder", f"name {name!r}", ["run", f, "--quiet"], expect=(0, 2), tokens=("name",), post=post, cwd=work
-    )
+    return Case("output_folder", f"name {name!r}", ["run", f, "--quiet"], expect=(0, 2), tokens=("name",),
+                post=post, cwd=work)
 
 
 def gen_output_folder(rnd: random.Random, d: Path) -> Case:
@@ -790,17 +631,8 @@ def gen_output_folder(rnd: random.Random, d: Path) -> Case:
     elif which == "fit":
         argv = ["fit", out / "data" / "sweep.csv", "--out", out, "--quiet", "--zeros", 0, "--poles", 1]
     else:
-        argv = [
-            "calibrate",
-            out / "data" / "sweep.csv",
-            "--set",
-            "seed002_table3",
-            "--free",
-            "alpha0",
-            "--out",
-            out,
-            "--quiet",
-        ]
+        argv = ["calibrate", out / "data" / "sweep.csv", "--set", "seed002_table3", "--free", "alpha0",
+                "--out", out, "--quiet"]
 
     def post():
         now = (out / "report.md").read_text() if (out / "report.md").exists() else ""
@@ -810,233 +642,94 @@ def gen_output_folder(rnd: random.Random, d: Path) -> Case:
 
 
 def gen_cli_options(rnd: random.Random, d: Path) -> Case:
-    edit = rnd.choice(
-        [
-            "seed_neg",
-            "out_dir",
-            "out_file_for_folder",
-            "plot_txt",
-            "scheduler_bad",
-            "fmin_nan",
-            "points_0",
-            "temps_cold",
-            "temps_text",
-            "sigma_neg",
-            "fit_out_file",
-            "calibrate_out_file",
-            "invert_plot_txt",
-            "starts_0",
-            "fit_exclude_all",
-            "fit_zeros_neg",
-            "sweep_points_huge",
-            "study_workers_0",
-        ]
-    )
+    edit = rnd.choice(["seed_neg", "out_dir", "out_file_for_folder", "plot_txt", "scheduler_bad", "fmin_nan",
+                       "points_0", "temps_cold", "temps_text", "sigma_neg", "fit_out_file", "calibrate_out_file",
+                       "invert_plot_txt", "starts_0", "fit_exclude_all", "fit_zeros_neg", "sweep_points_huge",
+                       "study_workers_0"])
     sweep = ["sweep", "--points", 4, "--temperatures", "20", "--quiet"]
     (d / "dir").mkdir(exist_ok=True)
     (d / "file.txt").write_text("x")
     if edit == "seed_neg":
-        return Case(
-            "cli_options", edit, sweep + ["--noise", "magphase", "--seed", -1, "--out", d / "o.csv"], tokens=("--seed",)
-        )
+        return Case("cli_options", edit, sweep + ["--noise", "magphase", "--seed", -1, "--out", d / "o.csv"], tokens=("--seed",))
     if edit == "out_dir":
         return Case("cli_options", edit, sweep + ["--out", d / "dir"], tokens=("dir",))
     if edit == "out_file_for_folder":
-        return Case(
-            "cli_options",
-            edit,
-            ["run", write_scenario(d, MINI_SCENARIO), "--out", d / "file.txt", "--quiet"],
-            tokens=("file.txt",),
-        )
+        return Case("cli_options", edit, ["run", write_scenario(d, MINI_SCENARIO), "--out", d / "file.txt", "--quiet"],
+                    tokens=("file.txt",))
     if edit == "plot_txt":
         return Case("cli_options", edit, sweep + ["--out", d / "o.csv", "--plot", d / "p.txt"], tokens=("p.txt",))
     if edit == "invert_plot_txt":
         sig = d / "u.csv"
         sig.write_text("time_s,u\n0,0\n0.01,1\n0.02,0\n")
-        return Case(
-            "cli_options",
-            edit,
-            ["invert", sig, "--num=1", "--den=1,1", "--out", d / "o.csv", "--plot", d / "p.txt", "--quiet"],
-            tokens=("p.txt",),
-        )
+        return Case("cli_options", edit, ["invert", sig, "--num=1", "--den=1,1", "--out", d / "o.csv", "--plot",
+                                          d / "p.txt", "--quiet"], tokens=("p.txt",))
     if edit == "scheduler_bad":
         sched = rnd.choice(["not a url", "tcp://", "http://[::1", "tcp://host:notaport"])
         spec = d / "st.toml"
-        spec.write_text(
-            '[study]\nkind = "actuator"\nset = "dev"\nseed = 1\ntemperatures_c = [20.0]\nsamples = 2\n'
-            'points = 3\n[study.parameters.d]\ndistribution = "uniform"\nlow = 1e-11\nhigh = 2e-11\n'
-        )
-        return Case(
-            "cli_options",
-            f"{edit} {sched!r}",
-            ["study", spec, "--out", d / "o.csv", "--scheduler", sched, "--quiet"],
-            tokens=("--scheduler", sched),
-        )
+        spec.write_text('[study]\nkind = "actuator"\nset = "dev"\nseed = 1\ntemperatures_c = [20.0]\nsamples = 2\n'
+                        'points = 3\n[study.parameters.d]\ndistribution = "uniform"\nlow = 1e-11\nhigh = 2e-11\n')
+        return Case("cli_options", f"{edit} {sched!r}", ["study", spec, "--out", d / "o.csv", "--scheduler", sched,
+                                                         "--quiet"], tokens=("--scheduler", sched))
     if edit == "fmin_nan":
-        return Case(
-            "cli_options", edit, ["sweep", "--fmin", "nan", "--out", d / "o.csv", "--quiet"], tokens=("--fmin", "nan")
-        )
+        return Case("cli_options", edit, ["sweep", "--fmin", "nan", "--out", d / "o.csv", "--quiet"], tokens=("--fmin", "nan"))
     if edit == "points_0":
-        return Case(
-            "cli_options", edit, ["sweep", "--points", 0, "--out", d / "o.csv", "--quiet"], tokens=("--points",)
-        )
+        return Case("cli_options", edit, ["sweep", "--points", 0, "--out", d / "o.csv", "--quiet"], tokens=("--points",))
     if edit == "sweep_points_huge":
-        return Case(
-            "cli_options",
-            edit,
-            ["sweep", "--points", 10**9, "--out", d / "o.csv", "--quiet"],
-            tokens=("--points", "points"),
-        )
+        return Case("cli_options", edit, ["sweep", "--points", 10 ** 9, "--out", d / "o.csv", "--quiet"],
+                    tokens=("--points", "points"))
     if edit == "temps_cold":
-        return Case(
-            "cli_options",
-            edit,
-            ["sweep", "--points", 4, "--temperatures=-300", "--out", d / "o.csv", "--quiet"],
-            tokens=("-300",),
-        )
+        return Case("cli_options", edit, ["sweep", "--points", 4, "--temperatures=-300", "--out", d / "o.csv", "--quiet"],
+                    tokens=("-300",))
     if edit == "temps_text":
-        return Case(
-            "cli_options",
-            edit,
-            ["sweep", "--points", 4, "--temperatures", "20,abc", "--out", d / "o.csv", "--quiet"],
-            tokens=("--temperatures",),
-        )
+        return Case("cli_options", edit, ["sweep", "--points", 4, "--temperatures", "20,abc", "--out", d / "o.csv",
+                                          "--quiet"], tokens=("--temperatures",))
     if edit == "sigma_neg":
-        return Case(
-            "cli_options",
-            edit,
-            sweep + ["--noise", "magphase", "--sigma-db", "-1", "--seed", 1, "--out", d / "o.csv"],
-            tokens=("sigma",),
-        )
+        return Case("cli_options", edit, sweep + ["--noise", "magphase", "--sigma-db", "-1", "--seed", 1, "--out",
+                                                  d / "o.csv"], tokens=("sigma",))
     if edit in ("fit_out_file", "calibrate_out_file"):
         f = valid_sweep(d)
-        cmd = (
-            ["fit", f, "--zeros", 0, "--poles", 1, "--degree", 1]
-            if edit == "fit_out_file"
-            else ["calibrate", f, "--set", "seed002_table3", "--free", "alpha0"]
-        )
+        cmd = ["fit", f, "--zeros", 0, "--poles", 1, "--degree", 1] if edit == "fit_out_file" else \
+            ["calibrate", f, "--set", "seed002_table3", "--free", "alpha0"]
         return Case("cli_options", edit, cmd + ["--out", d / "file.txt", "--quiet"], tokens=("file.txt",))
     if edit == "starts_0":
-        return Case(
-            "cli_options",
-            edit,
-            [
-                "calibrate",
-                valid_sweep(d),
-                "--set",
-                "seed002_table3",
-                "--free",
-                "alpha0",
-                "--starts",
-                0,
-                "--out",
-                d / "o",
-                "--quiet",
-            ],
-            tokens=("--starts",),
-        )
+        return Case("cli_options", edit, ["calibrate", valid_sweep(d), "--set", "seed002_table3", "--free", "alpha0",
+                                          "--starts", 0, "--out", d / "o", "--quiet"], tokens=("--starts",))
     if edit == "fit_exclude_all":
         f = valid_sweep(d, temps=(20.0,))
-        return Case(
-            "cli_options", edit, ["fit", f, "--exclude", 20, "--out", d / "o", "--quiet"], tokens=("--exclude",)
-        )
+        return Case("cli_options", edit, ["fit", f, "--exclude", 20, "--out", d / "o", "--quiet"], tokens=("--exclude",))
     if edit == "fit_zeros_neg":
-        return Case(
-            "cli_options",
-            edit,
-            ["fit", valid_sweep(d), "--zeros", -1, "--out", d / "o", "--quiet"],
-            tokens=("--zeros", "zeros"),
-        )
+        return Case("cli_options", edit, ["fit", valid_sweep(d), "--zeros", -1, "--out", d / "o", "--quiet"],
+                    tokens=("--zeros", "zeros"))
     spec = d / "st.toml"
-    spec.write_text(
-        '[study]\nkind = "actuator"\nset = "dev"\nseed = 1\ntemperatures_c = [20.0]\nsamples = 2\n'
-        'points = 3\n[study.parameters.d]\ndistribution = "uniform"\nlow = 1e-11\nhigh = 2e-11\n'
-    )
-    return Case(
-        "cli_options", edit, ["study", spec, "--out", d / "o.csv", "--workers", 0, "--quiet"], tokens=("--workers",)
-    )
+    spec.write_text('[study]\nkind = "actuator"\nset = "dev"\nseed = 1\ntemperatures_c = [20.0]\nsamples = 2\n'
+                    'points = 3\n[study.parameters.d]\ndistribution = "uniform"\nlow = 1e-11\nhigh = 2e-11\n')
+    return Case("cli_options", edit, ["study", spec, "--out", d / "o.csv", "--workers", 0, "--quiet"], tokens=("--workers",))
 
 
 def gen_study_diagnose_toml(rnd: random.Random, d: Path) -> Case:
     """Study and diagnose TOML files with a field of the wrong type."""
     bad = rnd.choice(['"x"', "[1, 2]", "{ a = 1 }", "true", "-1", "1.5", "nan"])
     if rnd.random() < 0.5:
-        key = rnd.choice(
-            [
-                "samples",
-                "seed",
-                "temperatures_c",
-                "points",
-                "chunk_size",
-                "fmin_hz",
-                "fmax_hz",
-                "name",
-                "set",
-                "kind",
-                "quantity",
-                "median",
-                "sigma",
-                "sigma_db",
-            ]
-        )
-        base = {
-            "kind": '"actuator"',
-            "set": '"dev"',
-            "seed": "1",
-            "temperatures_c": "[20.0]",
-            "samples": "2",
-            "points": "3",
-            "name": '"s"',
-        }
+        key = rnd.choice(["samples", "seed", "temperatures_c", "points", "chunk_size", "fmin_hz", "fmax_hz", "name",
+                          "set", "kind", "quantity", "median", "sigma", "sigma_db"])
+        base = {"kind": '"actuator"', "set": '"dev"', "seed": "1", "temperatures_c": "[20.0]", "samples": "2",
+                "points": "3", "name": '"s"'}
         if key in base or key in ("chunk_size", "fmin_hz", "fmax_hz", "quantity"):
             base[key] = bad
-        noise = (
-            f'\n[study.noise]\nkind = "magphase"\nsigma_db = {bad if key == "sigma_db" else "0.1"}\nsigma_deg = 1.0\n'
-        )
-        par = (
-            f'\n[study.parameters.d]\ndistribution = "lognormal"\nmedian = {bad if key == "median" else "4e-11"}\n'
-            f"sigma = {bad if key == 'sigma' else '0.3'}\n"
-        )
+        noise = f'\n[study.noise]\nkind = "magphase"\nsigma_db = {bad if key == "sigma_db" else "0.1"}\nsigma_deg = 1.0\n'
+        par = (f'\n[study.parameters.d]\ndistribution = "lognormal"\nmedian = {bad if key == "median" else "4e-11"}\n'
+               f'sigma = {bad if key == "sigma" else "0.3"}\n')
         text = "[study]\n" + "".join(f"{k} = {v}\n" for k, v in base.items()) + noise + par
         f = d / "st.toml"
         f.write_text(text)
-        return Case(
-            "study_diagnose_toml",
-            f"study {key} = {bad}",
-            ["study", f, "--out", d / "o.csv", "--serial", "--quiet"],
-            expect=(0, 2),
-            tokens=(key,),
-            post=lambda: csv_all_finite(d / "o.csv"),
-        )
+        return Case("study_diagnose_toml", f"study {key} = {bad}", ["study", f, "--out", d / "o.csv", "--serial",
+                                                                    "--quiet"], expect=(0, 2), tokens=(key,),
+                    post=lambda: csv_all_finite(d / "o.csv"))
     valid_sweep(d)
-    key = rnd.choice(
-        [
-            "alpha",
-            "seed",
-            "free",
-            "candidates",
-            "null_draws",
-            "null_refits",
-            "kind",
-            "quantity",
-            "data",
-            "set",
-            "geometry",
-            "L",
-            "baseline_effects",
-            "out",
-            "kernel",
-        ]
-    )
-    base = {
-        "data": '"sweep.csv"',
-        "kind": '"actuator"',
-        "set": '"seed002_table3"',
-        "null_draws": "200",
-        "null_refits": "0",
-        "free": '["alpha0"]',
-        "candidates": '["time_delay"]',
-    }
+    key = rnd.choice(["alpha", "seed", "free", "candidates", "null_draws", "null_refits", "kind", "quantity", "data",
+                      "set", "geometry", "L", "baseline_effects", "out", "kernel"])
+    base = {"data": '"sweep.csv"', "kind": '"actuator"', "set": '"seed002_table3"', "null_draws": "200",
+            "null_refits": "0", "free": '["alpha0"]', "candidates": '["time_delay"]'}
     if key not in ("L",):
         base[key] = bad
     text = "".join(f"{k} = {v}\n" for k, v in base.items() if k not in ("geometry", "baseline_effects"))
@@ -1048,13 +741,8 @@ def gen_study_diagnose_toml(rnd: random.Random, d: Path) -> Case:
         text += f"[geometry]\nL = {bad}\n"
     f = d / "ex.toml"
     f.write_text(text)
-    return Case(
-        "study_diagnose_toml",
-        f"diagnose {key} = {bad}",
-        ["diagnose", f, "--out", d / "o", "--quiet"],
-        expect=(0, 2),
-        tokens=(key,),
-    )
+    return Case("study_diagnose_toml", f"diagnose {key} = {bad}", ["diagnose", f, "--out", d / "o", "--quiet"],
+                expect=(0, 2), tokens=(key,))
 
 
 def gen_physics(rnd: random.Random, d: Path) -> Case:
@@ -1064,21 +752,8 @@ def gen_physics(rnd: random.Random, d: Path) -> Case:
     kind = rnd.choice(["actuator", "sensor"])
     p = get_parameter_set("seed002_table3" if kind == "actuator" else "seed000_sensor_dev")
     m = ActuatorModel(p) if kind == "actuator" else SensorModel(p)
-    edit = rnd.choice(
-        [
-            "huge",
-            "tiny",
-            "complex",
-            "nan",
-            "negative",
-            "T_cold",
-            "T_hot",
-            "bool_param",
-            "string_param",
-            "range",
-            "object",
-        ]
-    )
+    edit = rnd.choice(["huge", "tiny", "complex", "nan", "negative", "T_cold", "T_hot", "bool_param", "string_param",
+                       "range", "object"])
     f = [10.0]
     T = [25.0]
     if edit == "huge":
@@ -1102,13 +777,8 @@ def gen_physics(rnd: random.Random, d: Path) -> Case:
     if edit in ("bool_param", "string_param"):
         bad = True if edit == "bool_param" else "0.01"
         return Case("physics", f"L = {bad!r}", func=lambda: p.replace(L=bad), expect=(2,), tokens=("L",))
-    return Case(
-        "physics",
-        f"{kind} {edit} f={f[:1]} T={T}",
-        func=lambda: m.frequency_response(f, T),
-        expect=(0, 2),
-        tokens=("freq", "temperature", str(f[0])[:5], str(T[0])[:5]),
-    )
+    return Case("physics", f"{kind} {edit} f={f[:1]} T={T}", func=lambda: m.frequency_response(f, T),
+                expect=(0, 2), tokens=("freq", "temperature", str(f[0])[:5], str(T[0])[:5]))
 
 
 def gen_invert_values(rnd: random.Random, d: Path) -> Case:
@@ -1121,22 +791,11 @@ def gen_invert_values(rnd: random.Random, d: Path) -> Case:
     sig = d / "u.csv"
     sig.write_text("time_s,u\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t, u)))
     out = d / "o.csv"
-    model = rnd.choice(
-        [
-            ["--num=1,2", "--den=1,1"],
-            ["--num=0.05,0.3,1", "--den=1,3,2"],
-            ["--num=0.01,1", "--den=1,1"],
-            ["--num=1,-1", "--den=1,2"],
-        ]
-    )
-    return Case(
-        "invert_values",
-        f"sample {u[k]:g} at {k}/{n}",
-        ["invert", sig, *model, "--preview", "inf", "--out", out, "--quiet"],
-        expect=(0, 2),
-        tokens=("u.csv",),
-        post=lambda: csv_all_finite(out),
-    )
+    model = rnd.choice([["--num=1,2", "--den=1,1"], ["--num=0.05,0.3,1", "--den=1,3,2"], ["--num=0.01,1", "--den=1,1"],
+                        ["--num=1,-1", "--den=1,2"]])
+    return Case("invert_values", f"sample {u[k]:g} at {k}/{n}", ["invert", sig, *model, "--preview", "inf", "--out",
+                                                               out, "--quiet"], expect=(0, 2),
+                tokens=("u.csv",), post=lambda: csv_all_finite(out))
 
 
 def gen_interop(rnd: random.Random, d: Path) -> Case:
@@ -1147,59 +806,32 @@ def gen_interop(rnd: random.Random, d: Path) -> Case:
 
         sim = d / "sim.csv"
         with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
-            main(
-                [
-                    "simulate",
-                    "--set",
-                    "seed002_table3",
-                    "--experiment",
-                    "sine",
-                    "--duration",
-                    "0.5",
-                    "--fs",
-                    "200",
-                    "--out",
-                    str(sim),
-                    "--quiet",
-                ]
-            )
-        return Case(
-            "interop", which, ["invert", sim, "--num=1,2", "--den=1,1", "--out", d / "o.csv", "--quiet"], expect=(0,)
-        )
+            main(["simulate", "--set", "seed002_table3", "--experiment", "sine", "--duration", "0.5", "--fs", "200",
+                  "--out", str(sim), "--quiet"])
+        return Case("interop", which, ["invert", sim, "--num=1,2", "--den=1,1", "--out", d / "o.csv", "--quiet"],
+                    expect=(0,))
     if which == "params_roundtrip":
         from physmodel import get_parameter_set
         from physmodel.estimation.records import CalibrationResult  # noqa: F401 - the writer's module
         from physmodel.parameter_sets import save_parameter_set
 
         f = save_parameter_set(get_parameter_set("seed002_table3").replace(name="cal"), d / "parameters.json")
-        return Case(
-            "interop",
-            which,
-            ["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out", d / "o.csv", "--quiet"],
-            expect=(0,),
-        )
+        return Case("interop", which, ["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out",
+                                       d / "o.csv", "--quiet"], expect=(0,))
     bom = b"\xef\xbb\xbf"
     if which == "bom_fit":
         f = valid_sweep(d, temps=(25.0,))
         f.write_bytes(bom + f.read_bytes())
-        return Case(
-            "interop", which, ["fit", f, "--zeros", 0, "--poles", 1, "--out", d / "o", "--quiet"], expect=(0, 3)
-        )
+        return Case("interop", which, ["fit", f, "--zeros", 0, "--poles", 1, "--out", d / "o", "--quiet"], expect=(0, 3))
     if which == "bom_invert":
         f = d / "u.csv"
         f.write_bytes(bom + b"time_s,u\n0,0\n0.01,1\n0.02,0.5\n0.03,0\n")
-        return Case(
-            "interop", which, ["invert", f, "--num=1,2", "--den=1,1", "--out", d / "o.csv", "--quiet"], expect=(0,)
-        )
+        return Case("interop", which, ["invert", f, "--num=1,2", "--den=1,1", "--out", d / "o.csv", "--quiet"], expect=(0,))
     if which == "bom_json":
         f = d / "p.json"
         f.write_bytes(bom + json.dumps(_params_record()).encode())
-        return Case(
-            "interop",
-            which,
-            ["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out", d / "o.csv", "--quiet"],
-            expect=(0,),
-        )
+        return Case("interop", which, ["sweep", "--params-json", f, "--points", 4, "--temperatures", "20", "--out",
+                                       d / "o.csv", "--quiet"], expect=(0,))
     doc = _deep(MINI_SCENARIO)
     doc.pop("surrogate")
     f = write_scenario(d, doc)
@@ -1212,45 +844,20 @@ def gen_goodness_of_fit(rnd: random.Random, d: Path) -> Case:
     from physmodel.data.files import read_sweep, write_sweep
 
     sw = read_sweep(valid_sweep(d, temps=(25.0,), points=rnd.randint(15, 30), noise=False))
-    r = np.random.default_rng(rnd.randrange(2**32))
+    r = np.random.default_rng(rnd.randrange(2 ** 32))
     resp = 10 ** r.uniform(-2, 1, sw.response.size) * np.exp(1j * r.uniform(-np.pi, np.pi, sw.response.size))
     declared = rnd.random() < 0.5
     from dataclasses import replace
 
-    sw = replace(
-        sw,
-        response=resp,
-        magnitude_std_db=np.full(resp.size, 0.1) if declared else None,
-        phase_std_deg=np.full(resp.size, 1.0) if declared else None,
-    )
+    sw = replace(sw, response=resp, magnitude_std_db=np.full(resp.size, 0.1) if declared else None,
+                 phase_std_deg=np.full(resp.size, 1.0) if declared else None)
     f = write_sweep(sw, d / "rand.csv")
     if rnd.random() < 0.5:
-        return Case(
-            "goodness_of_fit",
-            f"calibrate, noise {'declared' if declared else 'estimated'}",
-            [
-                "calibrate",
-                f,
-                "--set",
-                "seed002_table3",
-                "--free",
-                "alpha0",
-                "--free",
-                "xi",
-                "--starts",
-                1,
-                "--out",
-                d / "o",
-                "--quiet",
-            ],
-            expect=(3,),
-        )
-    return Case(
-        "goodness_of_fit",
-        f"fit, noise {'declared' if declared else 'estimated'}",
-        ["fit", f, "--zeros", 1, "--poles", 2, "--out", d / "o", "--quiet"],
-        expect=(3,),
-    )
+        return Case("goodness_of_fit", f"calibrate, noise {'declared' if declared else 'estimated'}",
+                    ["calibrate", f, "--set", "seed002_table3", "--free", "alpha0", "--free", "xi", "--starts", 1,
+                     "--out", d / "o", "--quiet"], expect=(3,))
+    return Case("goodness_of_fit", f"fit, noise {'declared' if declared else 'estimated'}",
+                ["fit", f, "--zeros", 1, "--poles", 2, "--out", d / "o", "--quiet"], expect=(3,))
 
 
 #: category -> generator; the order of the report.

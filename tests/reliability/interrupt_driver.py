@@ -24,11 +24,8 @@ def _in_solver_call() -> bool:
 
     frame = sys._current_frames().get(MAIN)
     while frame is not None:
-        if (
-            frame.f_code.co_name == "solve"
-            and os.path.abspath(frame.f_code.co_filename) == NLP_FILE
-            and "self._solver(" in linecache.getline(NLP_FILE, frame.f_lineno)
-        ):
+        if (frame.f_code.co_name == "solve" and os.path.abspath(frame.f_code.co_filename) == NLP_FILE
+                and "self._solver(" in linecache.getline(NLP_FILE, frame.f_lineno)):
             return True
         frame = frame.f_back
     return False

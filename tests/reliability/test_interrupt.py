@@ -20,14 +20,8 @@ def _env():
 
 def test_sigint_during_an_ipopt_solve_exits_130_without_report(tmp_path):
     out = tmp_path / "run"
-    p = subprocess.run(
-        [sys.executable, str(DRIVER), "SIGINT", "run", "seed000_sensor", "--quick", "--quiet", "--out", str(out)],
-        cwd=tmp_path,
-        env=_env(),
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    p = subprocess.run([sys.executable, str(DRIVER), "SIGINT", "run", "seed000_sensor", "--quick", "--quiet",
+                        "--out", str(out)], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=300)
     assert "signalling inside an IPOPT solve" in p.stderr, p.stderr[-2000:]
     # the signal reached CasADi's C++ loop, which caught it (the behaviour this guards against) ...
     assert "KeyboardInterruptException" in p.stderr, p.stderr[-2000:]
@@ -39,26 +33,9 @@ def test_sigint_during_an_ipopt_solve_exits_130_without_report(tmp_path):
 
 def test_sigterm_while_writing_removes_the_partial_file(tmp_path):
     target = tmp_path / "big.csv"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "scenarios.cli",
-            "sweep",
-            "--quiet",
-            "--points",
-            "1500000",
-            "--temperatures",
-            "20",
-            "--out",
-            str(target),
-        ],
-        cwd=tmp_path,
-        env=_env(),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    proc = subprocess.Popen([sys.executable, "-m", "scenarios.cli", "sweep", "--quiet", "--points", "1500000",
+                             "--temperatures", "20", "--out", str(target)], cwd=tmp_path, env=_env(),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and not list(tmp_path.glob(".big.csv.*.part")):
         time.sleep(0.01)

@@ -29,35 +29,16 @@ def _scenario(d: Path, name: str, points: int = 12) -> Path:
 def test_a_second_job_into_a_busy_folder_is_refused(tmp_path):
     out = tmp_path / "Z"
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    slow = _scenario(tmp_path, "slow", points=400_000)  # long enough to still hold the folder
-    first = subprocess.Popen(
-        [sys.executable, "-m", "scenarios.cli", "run", str(slow), "--out", str(out), "--quiet"],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    slow = _scenario(tmp_path, "slow", points=400_000)          # long enough to still hold the folder
+    first = subprocess.Popen([sys.executable, "-m", "scenarios.cli", "run", str(slow), "--out", str(out), "--quiet"],
+                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline and not (out / "data").exists():
             time.sleep(0.02)
         assert (out / "data").exists(), "the first job never started writing"
-        second = subprocess.run(
-            [
-                sys.executable,
-                "-m",
-                "scenarios.cli",
-                "run",
-                str(_scenario(tmp_path, "other")),
-                "--out",
-                str(out),
-                "--quiet",
-            ],
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=300,
-        )
+        second = subprocess.run([sys.executable, "-m", "scenarios.cli", "run", str(_scenario(tmp_path, "other")),
+                                 "--out", str(out), "--quiet"], env=env, capture_output=True, text=True, timeout=300)
         assert second.returncode == 2, second.stderr
         assert "another ipmc run is writing into this folder" in second.stderr and str(out) in second.stderr
     finally:
@@ -74,8 +55,8 @@ def test_another_runs_folder_needs_force(tmp_path, capsys):
     assert main(["run", str(_scenario(tmp_path, "second")), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "ipmc run first" in err and "--force" in err
-    assert (out / "report.md").read_text() == before  # untouched
-    assert main(["run", str(_scenario(tmp_path, "first")), "--out", str(out), "--quiet"]) == 0  # its own: fine
+    assert (out / "report.md").read_text() == before                  # untouched
+    assert main(["run", str(_scenario(tmp_path, "first")), "--out", str(out), "--quiet"]) == 0   # its own: fine
     assert main(["run", str(_scenario(tmp_path, "second")), "--out", str(out), "--quiet", "--force"]) == 0
     assert "Scenario `second`" in (out / "report.md").read_text()
 

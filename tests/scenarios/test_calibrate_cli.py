@@ -19,9 +19,8 @@ TRUTH = dict(d=4.0e-11, kappa_e=3.8e-7)
 @pytest.fixture(scope="module")
 def sweep_file(tmp_path_factory):
     truth = get_parameter_set("seed002_table3", **TRUTH)
-    sw = synthesize_sweep(
-        ActuatorModel(truth), "M", np.logspace(-1, 2, 30), [20.0, 45.0], noise=MagnitudePhaseNoise(0.1, 1.0), seed=9
-    )
+    sw = synthesize_sweep(ActuatorModel(truth), "M", np.logspace(-1, 2, 30), [20.0, 45.0],
+                          noise=MagnitudePhaseNoise(0.1, 1.0), seed=9)
     path = tmp_path_factory.mktemp("data") / "sweep.csv"
     write_sweep(sw, path)
     return path
@@ -29,35 +28,13 @@ def sweep_file(tmp_path_factory):
 
 def test_calibrate_end_to_end(sweep_file, tmp_path, capsys):
     out = tmp_path / "cal"
-    rc = main(
-        [
-            "calibrate",
-            str(sweep_file),
-            "--set",
-            "seed002_table3",
-            "--free",
-            "d",
-            "--free",
-            "kappa_e:1e-7:1e-5",
-            "--free",
-            "alpha0",
-            "--free",
-            "laws.d.activation_energy",
-            "--starts",
-            "2",
-            "--seed",
-            "1",
-            "--out",
-            str(out),
-            "--name",
-            "strip7",
-            "--quiet",
-        ]
-    )
+    rc = main(["calibrate", str(sweep_file), "--set", "seed002_table3", "--free", "d",
+               "--free", "kappa_e:1e-7:1e-5", "--free", "alpha0", "--free", "laws.d.activation_energy",
+               "--starts", "2", "--seed", "1", "--out", str(out), "--name", "strip7", "--quiet"])
     assert rc == 0
-    assert capsys.readouterr().out == ""  # --quiet
+    assert capsys.readouterr().out == ""                       # --quiet
     assert sorted(p.name for p in out.iterdir()) == ["bode.png", "calibration.json", "parameters.json", "report.md"]
-    p = get_parameter_set(str(out / "parameters.json"))  # loadable as a named set by path
+    p = get_parameter_set(str(out / "parameters.json"))        # loadable as a named set by path
     assert p.name == "strip7"
     cal = json.loads((out / "calibration.json").read_text())
     assert cal["converged"] and len(cal["starts"]) == 2
@@ -70,21 +47,8 @@ def test_calibrate_end_to_end(sweep_file, tmp_path, capsys):
     report = (out / "report.md").read_text()
     assert "## Estimates (95 % intervals)" in report and "laws.d.activation_energy" in report
     # the written set can be the base of another calibration
-    rc = main(
-        [
-            "calibrate",
-            str(sweep_file),
-            "--set",
-            str(out / "parameters.json"),
-            "--free",
-            "xi",
-            "--starts",
-            "1",
-            "--out",
-            str(tmp_path / "again"),
-            "--quiet",
-        ]
-    )
+    rc = main(["calibrate", str(sweep_file), "--set", str(out / "parameters.json"), "--free", "xi",
+               "--starts", "1", "--out", str(tmp_path / "again"), "--quiet"])
     assert rc == 0
 
 
@@ -95,10 +59,10 @@ def test_calibrate_bad_input_exits_2(sweep_file, tmp_path, capsys):
     assert main(base + ["--free", "d:1e-10:1e-12"]) == 2
     assert "bounds reversed" in capsys.readouterr().err
     assert main(base + ["--free", "d:1e-12"]) == 2
-    assert main(base + ["--free", "d", "--kind", "sensor"]) == 2  # mm/V data for a sensor model
+    assert main(base + ["--free", "d", "--kind", "sensor"]) == 2          # mm/V data for a sensor model
     assert "needs current/length" in capsys.readouterr().err
     assert main(base + ["--free", "d", "--set", "no_such_set"]) == 2
-    assert not (tmp_path / "x").exists()  # nothing half-written
+    assert not (tmp_path / "x").exists()                                  # nothing half-written
     with pytest.raises(SystemExit) as exc:
         main(["calibrate", "--help"])
     assert exc.value.code == 0
@@ -107,25 +71,8 @@ def test_calibrate_bad_input_exits_2(sweep_file, tmp_path, capsys):
 
 def test_calibrate_not_converged_exits_3(sweep_file, tmp_path, capsys):
     out = tmp_path / "nc"
-    rc = main(
-        [
-            "calibrate",
-            str(sweep_file),
-            "--set",
-            "seed002_table3",
-            "--free",
-            "d",
-            "--free",
-            "alpha0",
-            "--starts",
-            "1",
-            "--max-nfev",
-            "1",
-            "--out",
-            str(out),
-            "--quiet",
-        ]
-    )
+    rc = main(["calibrate", str(sweep_file), "--set", "seed002_table3", "--free", "d", "--free", "alpha0",
+               "--starts", "1", "--max-nfev", "1", "--out", str(out), "--quiet"])
     assert rc == 3
     assert "did not converge" in capsys.readouterr().err
     cal = json.loads((out / "calibration.json").read_text())
@@ -135,27 +82,11 @@ def test_calibrate_not_converged_exits_3(sweep_file, tmp_path, capsys):
 
 def test_calibrate_sensor_sweep(tmp_path):
     truth = get_parameter_set("seed000_sensor_dev", a0=0.5)
-    sw = synthesize_sweep(
-        SensorModel(truth), "S", np.logspace(0, 2, 20), [25.0], noise=MagnitudePhaseNoise(0.1, 1.0), seed=2
-    )
+    sw = synthesize_sweep(SensorModel(truth), "S", np.logspace(0, 2, 20), [25.0],
+                          noise=MagnitudePhaseNoise(0.1, 1.0), seed=2)
     write_sweep(sw, tmp_path / "s.npz")
-    rc = main(
-        [
-            "calibrate",
-            str(tmp_path / "s.npz"),
-            "--set",
-            "seed000_sensor_dev",
-            "--kind",
-            "sensor",
-            "--free",
-            "a0",
-            "--starts",
-            "1",
-            "--out",
-            str(tmp_path / "o"),
-            "--quiet",
-        ]
-    )
+    rc = main(["calibrate", str(tmp_path / "s.npz"), "--set", "seed000_sensor_dev", "--kind", "sensor",
+               "--free", "a0", "--starts", "1", "--out", str(tmp_path / "o"), "--quiet"])
     assert rc == 0
     cal = json.loads((tmp_path / "o" / "calibration.json").read_text())
     e = cal["parameters"][0]

@@ -12,29 +12,8 @@ from scenarios.cli import main
 def test_sweep_writes_csv_and_plot(tmp_path, capsys):
     out = tmp_path / "s.csv"
     png = tmp_path / "s.png"
-    rc = main(
-        [
-            "sweep",
-            "--temperatures",
-            "20,50",
-            "--fmin",
-            "1",
-            "--fmax",
-            "50",
-            "--points",
-            "12",
-            "--noise",
-            "magphase",
-            "--seed",
-            "4",
-            "--out",
-            str(out),
-            "--plot",
-            str(png),
-            "--param",
-            "W=2e-3",
-        ]
-    )
+    rc = main(["sweep", "--temperatures", "20,50", "--fmin", "1", "--fmax", "50", "--points", "12",
+               "--noise", "magphase", "--seed", "4", "--out", str(out), "--plot", str(png), "--param", "W=2e-3"])
     assert rc == 0
     sw = read_csv(out)
     assert sw.temperatures().tolist() == [20.0, 50.0] and sw.frequency_hz.size == 24
@@ -47,61 +26,34 @@ def test_sensor_sweep_mat(tmp_path):
     from physmodel.data.files import read_mat
 
     out = tmp_path / "s.mat"
-    assert (
-        main(
-            ["sweep", "--kind", "sensor", "--set", "seed000_sensor_dev", "--points", "5", "--out", str(out), "--quiet"]
-        )
-        == 0
-    )
+    assert main(["sweep", "--kind", "sensor", "--set", "seed000_sensor_dev", "--points", "5", "--out", str(out), "--quiet"]) == 0
     assert read_mat(out).output_unit == "uA"
 
 
-@pytest.mark.parametrize(
-    "argv,needle",
-    [
-        (["sweep", "--out", "x.txt"], "use a .csv"),
-        (["sweep", "--fmin", "10", "--fmax", "1", "--out", "x.csv"], "0 < --fmin < --fmax"),
-        (["sweep", "--temperatures", "20,abc", "--out", "x.csv"], "--temperatures must be"),
-        (["sweep", "--param", "W2e-3", "--out", "x.csv"], "NAME=VALUE"),
-        (["sweep", "--param", "width=1", "--out", "x.csv"], "unknown parameter"),
-        (["sweep", "--set", "nope", "--out", "x.csv"], "unknown parameter set 'nope'"),
-        (["sweep", "--noise", "magphase", "--out", "x.csv"], "seed"),
-        (["sweep", "--temperatures", "150", "--out", "x.csv"], "valid on"),
-        (["simulate", "--frequency", "900", "--out", "x.csv"], "fs/2"),
-        (["simulate", "--chain", "1,2,3", "--out", "x.csv"], "--kind sensor"),
-    ],
-)
+@pytest.mark.parametrize("argv,needle", [
+    (["sweep", "--out", "x.txt"], "use a .csv"),
+    (["sweep", "--fmin", "10", "--fmax", "1", "--out", "x.csv"], "0 < --fmin < --fmax"),
+    (["sweep", "--temperatures", "20,abc", "--out", "x.csv"], "--temperatures must be"),
+    (["sweep", "--param", "W2e-3", "--out", "x.csv"], "NAME=VALUE"),
+    (["sweep", "--param", "width=1", "--out", "x.csv"], "unknown parameter"),
+    (["sweep", "--set", "nope", "--out", "x.csv"], "unknown parameter set 'nope'"),
+    (["sweep", "--noise", "magphase", "--out", "x.csv"], "seed"),
+    (["sweep", "--temperatures", "150", "--out", "x.csv"], "valid on"),
+    (["simulate", "--frequency", "900", "--out", "x.csv"], "fs/2"),
+    (["simulate", "--chain", "1,2,3", "--out", "x.csv"], "--kind sensor"),
+])
 def test_bad_input_exit_code_2_with_a_named_problem(tmp_path, monkeypatch, capsys, argv, needle):
     monkeypatch.chdir(tmp_path)
     assert main(argv) == 2
     assert needle in capsys.readouterr().err
-    assert list(tmp_path.iterdir()) == []  # nothing half-written
+    assert list(tmp_path.iterdir()) == []        # nothing half-written
 
 
 def test_simulate_release_with_chain(tmp_path):
     out = tmp_path / "r.npz"
-    rc = main(
-        [
-            "simulate",
-            "--kind",
-            "sensor",
-            "--set",
-            "seed000_sensor_dev",
-            "--experiment",
-            "release",
-            "--chain",
-            "470e3,10e3,10e3",
-            "--duration",
-            "0.3",
-            "--fs",
-            "2000",
-            "--out",
-            str(out),
-            "--plot",
-            str(tmp_path / "r.png"),
-            "--quiet",
-        ]
-    )
+    rc = main(["simulate", "--kind", "sensor", "--set", "seed000_sensor_dev", "--experiment", "release",
+               "--chain", "470e3,10e3,10e3", "--duration", "0.3", "--fs", "2000", "--out", str(out),
+               "--plot", str(tmp_path / "r.png"), "--quiet"])
     assert rc == 0
     z = np.load(out)
     assert "amplifier_output_V" in z.files and z["time_s"].size == 601
@@ -116,9 +68,7 @@ def test_sets_lists_and_describes(capsys, tmp_path):
 
     from physmodel import IPMCParameters, get_parameter_set
 
-    assert IPMCParameters.from_dict(json.loads((tmp_path / "p.json").read_text())) == get_parameter_set(
-        "seed002_table3"
-    )
+    assert IPMCParameters.from_dict(json.loads((tmp_path / "p.json").read_text())) == get_parameter_set("seed002_table3")
 
 
 def test_demo_writes_a_complete_report(tmp_path):
@@ -126,15 +76,8 @@ def test_demo_writes_a_complete_report(tmp_path):
     assert main(["demo", "--out", str(out), "--quick", "--quiet"]) == 0
     report = (out / "report.md").read_text()
     assert "FAIL" not in report and report.count("| PASS |") >= 8
-    for name in (
-        "data/sweep.csv",
-        "surrogate.json",
-        "bode.png",
-        "surrogate_bode.png",
-        "pole_zero_locus.png",
-        "inversion_2_hz_sine_at_45_c.png",
-        "metrics.json",
-    ):
+    for name in ("data/sweep.csv", "surrogate.json", "bode.png", "surrogate_bode.png", "pole_zero_locus.png",
+                 "inversion_2_hz_sine_at_45_c.png", "metrics.json"):
         assert (out / name).stat().st_size > 0
     import surrogate
 

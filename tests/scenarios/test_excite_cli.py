@@ -26,38 +26,14 @@ def _run(argv):
 @pytest.mark.parametrize("ext", ["csv", "npz", "mat"])
 def test_multisine_file_holds_exactly_the_designed_lines(tmp_path, capsys, ext):
     out = tmp_path / f"ms.{ext}"
-    assert (
-        _run(
-            [
-                "multisine",
-                "--fs",
-                "200",
-                "--period",
-                "5",
-                "--fmin",
-                "0.2",
-                "--fmax",
-                "20",
-                "--count",
-                "25",
-                "--rms",
-                "0.5",
-                "--periods",
-                "3",
-                "--transient-periods",
-                "2",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
+    assert _run(["multisine", "--fs", "200", "--period", "5", "--fmin", "0.2", "--fmax", "20", "--count", "25",
+                 "--rms", "0.5", "--periods", "3", "--transient-periods", "2", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     rec = read_record(out)
     u = rec.channels["voltage"]
     assert rec.units == {"voltage": "V"} and u.size == 5 * 5 * 200
     one = u[:1000]
-    np.testing.assert_allclose(u, np.tile(one, 5), atol=1e-12)  # periodic
+    np.testing.assert_allclose(u, np.tile(one, 5), atol=1e-12)                  # periodic
     X = np.fft.rfft(one)
     excited = np.flatnonzero(np.abs(X) > 1e-9 * np.abs(X).max())
     design = json.loads(rec.metadata["multisine"])
@@ -74,26 +50,8 @@ def test_stepped_plan_round_trips_and_the_duration_is_the_samples(tmp_path, caps
     from physmodel.data.excitation import SteppedSinePlan
 
     out = tmp_path / "st.csv"
-    assert (
-        _run(
-            [
-                "stepped",
-                "--fs",
-                "500",
-                "--frequencies",
-                "1,2.5,7",
-                "--amplitude",
-                "0.3",
-                "--periods",
-                "4",
-                "--settle-s",
-                "0.5",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
+    assert _run(["stepped", "--fs", "500", "--frequencies", "1,2.5,7", "--amplitude", "0.3", "--periods", "4",
+                 "--settle-s", "0.5", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     rec = read_record(out)
     plan = SteppedSinePlan.from_record(rec)
@@ -107,29 +65,8 @@ def test_stepped_plan_round_trips_and_the_duration_is_the_samples(tmp_path, caps
 
 def test_chirp_repeats_and_sensor_channel(tmp_path):
     out = tmp_path / "ch.npz"
-    assert (
-        _run(
-            [
-                "chirp",
-                "--fs",
-                "1000",
-                "--f0",
-                "1",
-                "--f1",
-                "50",
-                "--sweep-s",
-                "2",
-                "--repeats",
-                "3",
-                "--channel",
-                "tip_displacement",
-                "--quiet",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
+    assert _run(["chirp", "--fs", "1000", "--f0", "1", "--f1", "50", "--sweep-s", "2", "--repeats", "3",
+                 "--channel", "tip_displacement", "--quiet", "--out", str(out)]) == 0
     rec = read_record(out)
     assert rec.units == {"tip_displacement": "mm"}
     x = rec.channels["tip_displacement"]
@@ -137,52 +74,27 @@ def test_chirp_repeats_and_sensor_channel(tmp_path):
     np.testing.assert_array_equal(x[:2000], x[4000:])
 
 
-@pytest.mark.parametrize(
-    "argv, match",
-    [
-        (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1,2", "--out", "x.txt"], "--out"),
-        (
-            ["multisine", "--fs", "100", "--period", "1", "--frequencies", "1,2", "--fmin", "1", "--out", "x.csv"],
-            "--frequencies",
-        ),
-        (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1.5", "--out", "x.csv"], "--frequencies: "),
-        (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1,abc", "--out", "x.csv"], "--frequencies"),
-        (["multisine", "--fs", "100", "--period", "1", "--fmin", "1", "--out", "x.csv"], "--fmax"),
-        (["multisine", "--fs", "100", "--period", "0", "--frequencies", "1", "--out", "x.csv"], "--period"),
-        (
-            ["multisine", "--fs", "100", "--period", "1", "--frequencies", "1", "--phases", "random", "--out", "x.csv"],
-            "--seed",
-        ),
-        (
-            [
-                "multisine",
-                "--fs",
-                "100",
-                "--period",
-                "1",
-                "--frequencies",
-                "1",
-                "--rms",
-                "1",
-                "--amplitude",
-                "2",
-                "--out",
-                "x.csv",
-            ],
-            "--rms",
-        ),
-        (
-            ["multisine", "--fs", "100", "--period", "1", "--frequencies", "1", "--channel", "1bad", "--out", "x.csv"],
-            "--channel",
-        ),
-        (["stepped", "--fs", "100", "--frequencies", "30", "--out", "x.csv"], "--frequencies must .*fs/4"),
-        (["stepped", "--fs", "100", "--fmin", "2", "--fmax", "1", "--count", "3", "--out", "x.csv"], "--fmin"),
-        (["stepped", "--fs", "100", "--frequencies", "1", "--periods", "1", "--out", "x.csv"], "--periods="),
-        (["chirp", "--fs", "100", "--f0", "5", "--f1", "1", "--sweep-s", "1", "--out", "x.csv"], "--f0="),
-    ],
-)
+@pytest.mark.parametrize("argv, match", [
+    (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1,2", "--out", "x.txt"], "--out"),
+    (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1,2", "--fmin", "1", "--out", "x.csv"],
+     "--frequencies"),
+    (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1.5", "--out", "x.csv"], "--frequencies: "),
+    (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1,abc", "--out", "x.csv"], "--frequencies"),
+    (["multisine", "--fs", "100", "--period", "1", "--fmin", "1", "--out", "x.csv"], "--fmax"),
+    (["multisine", "--fs", "100", "--period", "0", "--frequencies", "1", "--out", "x.csv"], "--period"),
+    (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1", "--phases", "random", "--out", "x.csv"],
+     "--seed"),
+    (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1", "--rms", "1", "--amplitude", "2",
+      "--out", "x.csv"], "--rms"),
+    (["multisine", "--fs", "100", "--period", "1", "--frequencies", "1", "--channel", "1bad", "--out", "x.csv"],
+     "--channel"),
+    (["stepped", "--fs", "100", "--frequencies", "30", "--out", "x.csv"], "--frequencies must .*fs/4"),
+    (["stepped", "--fs", "100", "--fmin", "2", "--fmax", "1", "--count", "3", "--out", "x.csv"], "--fmin"),
+    (["stepped", "--fs", "100", "--frequencies", "1", "--periods", "1", "--out", "x.csv"], "--periods="),
+    (["chirp", "--fs", "100", "--f0", "5", "--f1", "1", "--sweep-s", "1", "--out", "x.csv"], "--f0="),
+])
 def test_bad_input_names_the_option(tmp_path, monkeypatch, argv, match):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(IPMCError, match=match):
         _run(argv)
-    assert not list(tmp_path.iterdir())  # nothing (half-)written
+    assert not list(tmp_path.iterdir())                      # nothing (half-)written

@@ -53,50 +53,19 @@ def model_json(tmp_path_factory):
 def test_feedforward_writes_voltage_checks_it_and_simulate_reproduces_it(model_json, tmp_path, capsys):
     path, plant, model = model_json
     out = tmp_path / "ff"
-    rc = _run(
-        [
-            "feedforward",
-            str(path),
-            "--temperature",
-            "37",
-            "--amplitude",
-            "0.3",
-            "--frequency",
-            "1",
-            "--fs",
-            "10000",
-            "--set",
-            "seed001_actuator",
-            "--out",
-            str(out),
-        ]
-    )
+    rc = _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency", "1",
+               "--fs", "10000", "--set", "seed001_actuator", "--out", str(out)])
     assert rc == EXIT_OK
     assert (out / "feedforward.png").stat().st_size > 0 and (out / "report.md").exists()
     c = _cols(out / "voltage.csv")
     assert set(c) == {"time_s", "voltage_V", "reference_mm", "predicted_tip_mm"}
-    assert 0.2 < np.max(np.abs(c["voltage_V"])) < 1.0  # ~0.4 V, not tens of volts
+    assert 0.2 < np.max(np.abs(c["voltage_V"])) < 1.0               # ~0.4 V, not tens of volts
     report = (out / "report.md").read_text()
     assert "preview: auto" in report and "steady-state prediction" in report
     # closing the loop with the other command: the file drives the physics to the same tip
     sim = tmp_path / "sim.csv"
-    assert (
-        _run(
-            [
-                "simulate",
-                "--set",
-                "seed001_actuator",
-                "--temperature",
-                "37",
-                "--input",
-                str(out / "voltage.csv"),
-                "--out",
-                str(sim),
-                "--quiet",
-            ]
-        )
-        == EXIT_OK
-    )
+    assert _run(["simulate", "--set", "seed001_actuator", "--temperature", "37", "--input",
+                 str(out / "voltage.csv"), "--out", str(sim), "--quiet"]) == EXIT_OK
     s = _cols(sim)
     np.testing.assert_allclose(s["tip_displacement_m"] * 1e3, c["predicted_tip_mm"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(s["voltage_V"], c["voltage_V"], rtol=0, atol=1e-12)
@@ -111,129 +80,46 @@ def test_feedforward_writes_voltage_checks_it_and_simulate_reproduces_it(model_j
 def test_voltage_over_the_limit_is_refused_with_the_first_sample(model_json, tmp_path, capsys):
     path, _, _ = model_json
     out = tmp_path / "refused"
-    rc = _run(
-        [
-            "feedforward",
-            str(path),
-            "--temperature",
-            "37",
-            "--amplitude",
-            "0.3",
-            "--frequency",
-            "1",
-            "--max-voltage",
-            "0.2",
-            "--no-check",
-            "--out",
-            str(out),
-        ]
-    )
+    rc = _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency", "1",
+               "--max-voltage", "0.2", "--no-check", "--out", str(out)])
     assert rc == EXIT_FAILED and not out.exists()
     err = capsys.readouterr().err
     assert "refused" in err and "max_voltage = ±0.2 V" in err
     # the same sample, located independently on the unrestricted voltage
     ok = tmp_path / "ok"
-    assert (
-        _run(
-            [
-                "feedforward",
-                str(path),
-                "--temperature",
-                "37",
-                "--amplitude",
-                "0.3",
-                "--frequency",
-                "1",
-                "--no-check",
-                "--quiet",
-                "--out",
-                str(ok),
-            ]
-        )
-        == EXIT_OK
-    )
+    assert _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency", "1",
+                 "--no-check", "--quiet", "--out", str(ok)]) == EXIT_OK
     v = _cols(ok / "voltage.csv")["voltage_V"]
     first = int(np.flatnonzero(np.abs(v) > 0.2)[0])
     assert f"at sample {first} " in err
     warn = tmp_path / "warn"
     with pytest.warns(UserWarning, match="beyond max_voltage"):
-        assert (
-            _run(
-                [
-                    "feedforward",
-                    str(path),
-                    "--temperature",
-                    "37",
-                    "--amplitude",
-                    "0.3",
-                    "--frequency",
-                    "1",
-                    "--max-voltage",
-                    "0.2",
-                    "--on-limit",
-                    "warn",
-                    "--no-check",
-                    "--quiet",
-                    "--out",
-                    str(warn),
-                ]
-            )
-            == EXIT_OK
-        )
+        assert _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency",
+                     "1", "--max-voltage", "0.2", "--on-limit", "warn", "--no-check", "--quiet",
+                     "--out", str(warn)]) == EXIT_OK
     assert "LIMIT VIOLATED" in (warn / "report.md").read_text()
 
 
 def test_reference_kinds_and_file(model_json, tmp_path, capsys):
     path, _, _ = model_json
-    for extra in (
-        ["--reference", "multitone", "--amplitude", "0.1,0.05", "--frequency", "0.5,2"],
-        ["--reference", "steps", "--levels", "0.1,-0.1", "--hold", "1"],
-    ):
+    for extra in (["--reference", "multitone", "--amplitude", "0.1,0.05", "--frequency", "0.5,2"],
+                  ["--reference", "steps", "--levels", "0.1,-0.1", "--hold", "1"]):
         out = tmp_path / extra[1]
-        assert (
-            _run(["feedforward", str(path), "--temperature", "40", *extra, "--no-check", "--quiet", "--out", str(out)])
-            == EXIT_OK
-        )
+        assert _run(["feedforward", str(path), "--temperature", "40", *extra, "--no-check", "--quiet",
+                     "--out", str(out)]) == EXIT_OK
         c = _cols(out / "voltage.csv")
         assert c["reference_mm"][0] == 0 and c["reference_mm"][-1] == 0
     ref = tmp_path / "ref.csv"
     t = np.arange(0, 6, 1e-3)
     np.savetxt(ref, np.c_[t, 0.2 * np.sin(2 * np.pi * t)], delimiter=",", header="time_s,target_mm", comments="")
     out = tmp_path / "file"
-    assert (
-        _run(
-            [
-                "feedforward",
-                str(path),
-                "--temperature",
-                "40",
-                "--reference-file",
-                str(ref),
-                "--fade",
-                "1",
-                "--no-check",
-                "--quiet",
-                "--out",
-                str(out),
-            ]
-        )
-        == EXIT_OK
-    )
-    assert _cols(out / "voltage.csv")["reference_mm"].size == t.size + 2000  # 1 s rest each side
+    assert _run(["feedforward", str(path), "--temperature", "40", "--reference-file", str(ref), "--fade", "1",
+                 "--no-check", "--quiet", "--out", str(out)]) == EXIT_OK
+    assert _cols(out / "voltage.csv")["reference_mm"].size == t.size + 2000     # 1 s rest each side
     # a record that starts and ends mid-swing, not faded: warned about, and its end spike is refused
     np.savetxt(ref, np.c_[t, 0.2 * np.cos(2 * np.pi * t)], delimiter=",", header="time_s,target_mm", comments="")
-    argv = [
-        "feedforward",
-        str(path),
-        "--temperature",
-        "40",
-        "--reference-file",
-        str(ref),
-        "--no-check",
-        "--quiet",
-        "--out",
-        str(tmp_path / "abrupt"),
-    ]
+    argv = ["feedforward", str(path), "--temperature", "40", "--reference-file", str(ref), "--no-check",
+            "--quiet", "--out", str(tmp_path / "abrupt")]
     assert _run(argv) == EXIT_FAILED
     err = capsys.readouterr().err
     assert "100 % of its peak at a record end" in err and "refused" in err
@@ -242,14 +128,11 @@ def test_reference_kinds_and_file(model_json, tmp_path, capsys):
     assert "ends away from rest" in (tmp_path / "abrupt" / "report.md").read_text()
 
 
-@pytest.mark.parametrize(
-    "argv, match",
-    [
-        (["--temperature", "80"], "outside the surrogate's range"),
-        (["--temperature", "35", "--reference", "sine", "--amplitude", "0.1,0.2"], "one --amplitude"),
-        (["--temperature", "35", "--frequency", "600"], "below fs_hz/2"),
-    ],
-)
+@pytest.mark.parametrize("argv, match", [
+    (["--temperature", "80"], "outside the surrogate's range"),
+    (["--temperature", "35", "--reference", "sine", "--amplitude", "0.1,0.2"], "one --amplitude"),
+    (["--temperature", "35", "--frequency", "600"], "below fs_hz/2"),
+])
 def test_bad_input(model_json, tmp_path, argv, match):
     path, _, _ = model_json
     with pytest.raises(IPMCError, match=match):
@@ -272,41 +155,9 @@ def test_a_too_short_preview_is_flagged(model_json, tmp_path, capsys):
     out = tmp_path / "short"
     # the 4/r0 rule asks this 4/4 surrogate for more than 3 V (refused by default); lift the limit
     # to see the preview itself flagged
-    assert (
-        _run(
-            [
-                "feedforward",
-                str(path),
-                "--temperature",
-                "37",
-                "--preview",
-                "4/r0",
-                "--no-check",
-                "--quiet",
-                "--out",
-                str(out),
-            ]
-        )
-        == EXIT_FAILED
-    )
-    assert (
-        _run(
-            [
-                "feedforward",
-                str(path),
-                "--temperature",
-                "37",
-                "--preview",
-                "4/r0",
-                "--max-voltage",
-                "100",
-                "--no-check",
-                "--quiet",
-                "--out",
-                str(out),
-            ]
-        )
-        == EXIT_OK
-    )
+    assert _run(["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", "--no-check", "--quiet",
+                 "--out", str(out)]) == EXIT_FAILED
+    assert _run(["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", "--max-voltage", "100",
+                 "--no-check", "--quiet", "--out", str(out)]) == EXIT_OK
     assert "preview too short" in (out / "report.md").read_text()
     assert "changes the voltage by" in capsys.readouterr().err

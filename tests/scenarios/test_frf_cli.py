@@ -75,34 +75,9 @@ def _t2(sweep):
 @pytest.fixture(scope="module")
 def multisine_signal(tmp_path_factory):
     p = tmp_path_factory.mktemp("sig") / "ms.csv"
-    assert (
-        _run(
-            [
-                "excite",
-                "multisine",
-                "--fs",
-                str(FS),
-                "--period",
-                "5",
-                "--fmin",
-                "0.2",
-                "--fmax",
-                "9",
-                "--count",
-                "20",
-                "--rms",
-                "1",
-                "--periods",
-                "8",
-                "--transient-periods",
-                "2",
-                "--quiet",
-                "--out",
-                str(p),
-            ]
-        )
-        == 0
-    )
+    assert _run(["excite", "multisine", "--fs", str(FS), "--period", "5", "--fmin", "0.2", "--fmax", "9",
+                 "--count", "20", "--rms", "1", "--periods", "8", "--transient-periods", "2", "--quiet",
+                 "--out", str(p)]) == 0
     return p
 
 
@@ -110,25 +85,8 @@ def multisine_signal(tmp_path_factory):
 def test_multisine_round_trip_agrees_with_the_physics_within_sigma(tmp_path, multisine_signal, capsys):
     recs = _records(tmp_path, multisine_signal, [25.0, 45.0], header=False)
     out, png = tmp_path / "sweep.csv", tmp_path / "frf.png"
-    assert (
-        _run(
-            [
-                "frf",
-                *recs,
-                "--lines",
-                str(multisine_signal),
-                "--input",
-                "voltage",
-                "--output",
-                "tip_displacement",
-                "--out",
-                str(out),
-                "--plot",
-                str(png),
-            ]
-        )
-        == 0
-    )
+    assert _run(["frf", *recs, "--lines", str(multisine_signal), "--input", "voltage", "--output",
+                 "tip_displacement", "--out", str(out), "--plot", str(png)]) == 0
     text = capsys.readouterr().out
     sw = read_sweep(out)
     assert (sw.input_unit, sw.output_unit) == ("V", "mm")
@@ -145,51 +103,12 @@ def test_multisine_round_trip_agrees_with_the_physics_within_sigma(tmp_path, mul
 
 def test_stepped_round_trip_takes_the_plan_from_the_record_header(tmp_path, capsys):
     sig = tmp_path / "st.npz"
-    assert (
-        _run(
-            [
-                "excite",
-                "stepped",
-                "--fs",
-                str(FS),
-                "--fmin",
-                "0.3",
-                "--fmax",
-                "9",
-                "--count",
-                "6",
-                "--periods",
-                "8",
-                "--min-measure-s",
-                "2",
-                "--settle-s",
-                "6",
-                "--quiet",
-                "--out",
-                str(sig),
-            ]
-        )
-        == 0
-    )
+    assert _run(["excite", "stepped", "--fs", str(FS), "--fmin", "0.3", "--fmax", "9", "--count", "6",
+                 "--periods", "8", "--min-measure-s", "2", "--settle-s", "6", "--quiet", "--out", str(sig)]) == 0
     recs = _records(tmp_path, sig, [30.0])
     out = tmp_path / "st_sweep.npz"
-    assert (
-        _run(
-            [
-                "frf",
-                *recs,
-                "--method",
-                "stepped",
-                "--input",
-                "voltage_V",
-                "--output",
-                "tip_displacement",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
+    assert _run(["frf", *recs, "--method", "stepped", "--input", "voltage_V", "--output", "tip_displacement",
+                 "--out", str(out)]) == 0
     sw = read_sweep(out)
     assert sw.frequency_hz.size == 6
     t2 = _t2(sw)
@@ -198,73 +117,21 @@ def test_stepped_round_trip_takes_the_plan_from_the_record_header(tmp_path, caps
     assert abs(t2.mean() - mean) < band, (t2.mean(), mean, band)
     # overriding the plan's periods uses fewer periods and widens σ
     out2 = tmp_path / "st2.csv"
-    assert (
-        _run(
-            [
-                "frf",
-                *recs,
-                "--method",
-                "stepped",
-                "--plan",
-                str(sig),
-                "--periods",
-                "3",
-                "--quiet",
-                "--input",
-                "voltage",
-                "--output",
-                "tip_displacement",
-                "--out",
-                str(out2),
-            ]
-        )
-        == 0
-    )
+    assert _run(["frf", *recs, "--method", "stepped", "--plan", str(sig), "--periods", "3", "--quiet",
+                 "--input", "voltage", "--output", "tip_displacement", "--out", str(out2)]) == 0
     assert np.median(read_sweep(out2).magnitude_std_db) > np.median(sw.magnitude_std_db)
 
 
 def test_two_outputs_give_two_files_and_the_reciprocal_is_the_impedance(tmp_path, multisine_signal, capsys):
     recs = _records(tmp_path, multisine_signal, [25.0], current=True)
     out = tmp_path / "s.csv"
-    assert (
-        _run(
-            [
-                "frf",
-                *recs,
-                "--input",
-                "voltage",
-                "--output",
-                "tip_displacement",
-                "--output",
-                "current",
-                "--out",
-                str(out),
-                "--plot",
-                str(tmp_path / "f.png"),
-            ]
-        )
-        == 0
-    )  # lines from the header
+    assert _run(["frf", *recs, "--input", "voltage", "--output", "tip_displacement", "--output", "current",
+                 "--out", str(out), "--plot", str(tmp_path / "f.png")]) == 0        # lines from the header
     m, i = read_sweep(tmp_path / "s_tip_displacement.csv"), read_sweep(tmp_path / "s_current.csv")
     assert (i.output_unit, i.input_unit) == ("mA", "V")
     assert (tmp_path / "f_tip_displacement.png").exists() and (tmp_path / "f_current.png").exists()
-    assert (
-        _run(
-            [
-                "frf",
-                *recs,
-                "--input",
-                "voltage",
-                "--output",
-                "current",
-                "--reciprocal",
-                "--quiet",
-                "--out",
-                str(tmp_path / "z.csv"),
-            ]
-        )
-        == 0
-    )
+    assert _run(["frf", *recs, "--input", "voltage", "--output", "current", "--reciprocal", "--quiet",
+                 "--out", str(tmp_path / "z.csv")]) == 0
     z = read_sweep(tmp_path / "z.csv")
     assert (z.output_name, z.output_unit, z.input_name, z.input_unit) == ("voltage", "V", "current", "mA")
     np.testing.assert_allclose(z.response, 1 / i.response, rtol=1e-12)
@@ -276,37 +143,12 @@ def test_welch_with_band_and_coherence_keeps_and_drops_lines(tmp_path, multisine
     recs = _records(tmp_path, multisine_signal, [25.0], header=False)
     out = tmp_path / "w.csv"
     # plain Welch on the multisine record: most bins are not excited (coherence ~ 0)
-    assert (
-        _run(
-            [
-                "frf",
-                *recs,
-                "--input",
-                "voltage",
-                "--output",
-                "tip_displacement",
-                "--nperseg",
-                "1250",
-                "--noverlap",
-                "0",
-                "--window",
-                "boxcar",
-                "--discard-s",
-                "10",
-                "--min-coherence",
-                "0.9",
-                "--band",
-                "0.1",
-                "5",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
+    assert _run(["frf", *recs, "--input", "voltage", "--output", "tip_displacement", "--nperseg", "1250",
+                 "--noverlap", "0", "--window", "boxcar", "--discard-s", "10", "--min-coherence", "0.9",
+                 "--band", "0.1", "5", "--out", str(out)]) == 0
     sw = read_sweep(out)
     lines = np.unique(np.maximum(np.round(np.geomspace(0.2, 9, 20) * 5), 1)) / 5
-    np.testing.assert_allclose(sw.frequency_hz, lines[lines <= 5])  # exactly the excited lines in band
+    np.testing.assert_allclose(sw.frequency_hz, lines[lines <= 5])      # exactly the excited lines in band
     assert "lines kept" in capsys.readouterr().out
 
 
@@ -324,15 +166,10 @@ def _bad_cases(rec, sig, tmp):
     nofrf = ["frf", str(nometa), "--input", "voltage", "--output", "tip_displacement"]
     return [
         (base + ["--out", str(tmp / "x.txt")], "--out"),
-        (
-            ["frf", str(tmp / "missing.csv"), "--input", "voltage", "--output", "x", "--out", str(tmp / "o.csv")],
-            "missing.csv",
-        ),
+        (["frf", str(tmp / "missing.csv"), "--input", "voltage", "--output", "x", "--out", str(tmp / "o.csv")],
+         "missing.csv"),
         (base[:-1] + ["nothere", "--out", str(tmp / "o.csv")], "--output nothere"),
-        (
-            ["frf", rec, "--input", "volts", "--output", "tip_displacement", "--out", str(tmp / "o.csv")],
-            "--input volts",
-        ),
+        (["frf", rec, "--input", "volts", "--output", "tip_displacement", "--out", str(tmp / "o.csv")], "--input volts"),
         (nofrf + ["--out", str(tmp / "o.csv")], "--temperature"),
         (base + ["--temperature", "20,30", "--out", str(tmp / "o.csv")], "--temperature"),
         (nofrf + ["--temperature", "20", "--method", "stepped", "--out", str(tmp / "o.csv")], "--plan"),
@@ -341,10 +178,8 @@ def _bad_cases(rec, sig, tmp):
         (base + ["--band", "5", "1", "--out", str(tmp / "o.csv")], "--band"),
         (base + ["--min-coherence", "2", "--out", str(tmp / "o.csv")], "--min-coherence"),
         (base + ["--lines", str(nometa), "--out", str(tmp / "o.csv")], "--lines"),
-        (
-            nofrf + ["--temperature", "20", "--frequencies", "0.33", "--nperseg", "1250", "--out", str(tmp / "o.csv")],
-            "--frequencies: ",
-        ),
+        (nofrf + ["--temperature", "20", "--frequencies", "0.33", "--nperseg", "1250", "--out", str(tmp / "o.csv")],
+         "--frequencies: "),
         (base + ["--max-std-db", "1e-9", "--out", str(tmp / "o.csv")], "no lines left"),
     ]
 
@@ -363,46 +198,12 @@ def test_reads_the_files_timesim_writes(tmp_path, multisine_signal):
     ts = simulate(MODEL, 25.0, sig.t, sig.channels["voltage"], output_noise_rms=20e-6, seed=7)
     p = ts.save(tmp_path / "ts.csv")
     out = tmp_path / "ts_sweep.csv"
-    assert (
-        _run(
-            [
-                "frf",
-                str(p),
-                "--lines",
-                str(multisine_signal),
-                "--input",
-                "voltage",
-                "--output",
-                "tip_displacement",
-                "--quiet",
-                "--out",
-                str(out),
-            ]
-        )
-        == 0
-    )
+    assert _run(["frf", str(p), "--lines", str(multisine_signal), "--input", "voltage", "--output",
+                 "tip_displacement", "--quiet", "--out", str(out)]) == 0
     sw = read_sweep(out)
     assert (sw.input_unit, sw.output_unit) == ("V", "m") and sw.temperatures().tolist() == [25.0]
     clean = tmp_path / "clean.csv"
-    assert (
-        _run(
-            [
-                "frf",
-                str(p),
-                "--lines",
-                str(multisine_signal),
-                "--input",
-                "voltage",
-                "--output",
-                "tip_displacement_clean",
-                "--quiet",
-                "--out",
-                str(clean),
-                "--max-std-db",
-                "1",
-            ]
-        )
-        == 0
-    )
+    assert _run(["frf", str(p), "--lines", str(multisine_signal), "--input", "voltage", "--output",
+                 "tip_displacement_clean", "--quiet", "--out", str(clean), "--max-std-db", "1"]) == 0
     exact = read_sweep(clean)
-    np.testing.assert_allclose(exact.response * 1e3, _truth(exact), rtol=1e-4)  # realisation tol
+    np.testing.assert_allclose(exact.response * 1e3, _truth(exact), rtol=1e-4)       # realisation tol

@@ -42,9 +42,8 @@ def _read(path):
 def test_invert_writes_csv_and_plot(signal_csv, tmp_path):
     p, t, cur, ref = signal_csv
     out, png = tmp_path / "out.csv", tmp_path / "out.png"
-    rc = main(
-        ["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "auto", "--reference", "disp_mm", "--plot", str(png)]
-    )
+    rc = main(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "auto",
+                    "--reference", "disp_mm", "--plot", str(png)])
     assert rc == 0
     header, data = _read(out)
     assert header == ["time_s", "current_uA", "reconstruction", "disp_mm", "error"]
@@ -58,7 +57,8 @@ def test_invert_writes_csv_and_plot(signal_csv, tmp_path):
 def test_main_entry_point_and_preview_options(signal_csv, tmp_path):
     p, t, cur, _ = signal_csv
     out = tmp_path / "o.csv"
-    assert main(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "inf", "--column", "current_uA"]) == 0
+    assert main(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "inf",
+                 "--column", "current_uA"]) == 0
     _, data = _read(out)
     expect = invert((list(SEED000_NUM_35C), list(SEED000_DEN_35C)), t, cur, preview="inf").output
     np.testing.assert_allclose(data[:, 2], expect, rtol=1e-10, atol=1e-12)
@@ -93,28 +93,12 @@ def test_bad_model_options_exit_code_2(signal_csv, tmp_path, capsys):
     assert "--num and --den" in capsys.readouterr().err
     assert main(["invert", str(p), "-o", out, "--num=100", "--den=1,14,100"]) == 2
     assert "improper" in capsys.readouterr().err
-    assert (
-        main(
-            [
-                "invert",
-                str(p),
-                "-o",
-                out,
-                "--num=100",
-                "--den=1,14,100",
-                "--improper",
-                "filter",
-                "--filter-bandwidth",
-                "500",
-                "--preview",
-                "inf",
-            ]
-        )
-        == 0
-    )
+    assert main(["invert", str(p), "-o", out, "--num=100", "--den=1,14,100",
+                      "--improper", "filter", "--filter-bandwidth", "500", "--preview", "inf"]) == 0
     assert main(["invert", str(p), "-o", out, "--surrogate", "m.json"]) == 2
     assert "--temperature" in capsys.readouterr().err
-    assert main(["invert", str(p), "-o", out, NUM, DEN, "--surrogate", "m.json", "--temperature", "35"]) == 2
+    assert main(["invert", str(p), "-o", out, NUM, DEN, "--surrogate", "m.json",
+                      "--temperature", "35"]) == 2
     assert main(["invert", str(p), "-o", out, "--num=1,x", DEN]) == 2
     assert "'x'" in capsys.readouterr().err
     assert main(["invert", str(tmp_path / "missing.csv"), "-o", out, NUM, DEN]) == 2
@@ -126,7 +110,7 @@ def test_interrupted_write_leaves_previous_file_intact(signal_csv, tmp_path, mon
     out.write_text("previous result\n")
 
     def boom(fh, *a, **k):
-        fh.write("0,1,2\n0.001,1,")  # half a table, then the "crash"
+        fh.write("0,1,2\n0.001,1,")       # half a table, then the "crash"
         raise OSError("disk full")
 
     monkeypatch.setattr(np, "savetxt", boom)

@@ -44,18 +44,15 @@ def test_failed_check_exits_3_and_says_fail(tmp_path, capsys):
     assert "| w | FAIL |" in (tmp_path / "o" / "report.md").read_text()
 
 
-@pytest.mark.parametrize(
-    "edit,needle",
-    [
-        (("[widths]", "[widhts]"), "unknown table [widhts]"),
-        (("points = 20", "pionts = 20"), "unknown key 'pionts'"),
-        (("points = 20", 'points = "many"'), "[widths].points: expected an integer"),
-        (('kind = "actuator"', 'kind = "motor"'), "[model].kind: expected one of"),
-        (('set = "seed002_table3"', ""), "missing required key 'set'"),
-        (('metric = "widths.max_rel_change"', 'metric = "taylor.order_3_max_db_error"'), "refers to [taylor]"),
-        (("max = -1", ""), "needs min and/or max"),
-    ],
-)
+@pytest.mark.parametrize("edit,needle", [
+    (("[widths]", "[widhts]"), "unknown table [widhts]"),
+    (("points = 20", "pionts = 20"), "unknown key 'pionts'"),
+    (("points = 20", "points = \"many\""), "[widths].points: expected an integer"),
+    (("kind = \"actuator\"", "kind = \"motor\""), "[model].kind: expected one of"),
+    (("set = \"seed002_table3\"", ""), "missing required key 'set'"),
+    (("metric = \"widths.max_rel_change\"", "metric = \"taylor.order_3_max_db_error\""), "refers to [taylor]"),
+    (("max = -1", ""), "needs min and/or max"),
+])
 def test_schema_errors_name_the_key_and_file_and_exit_2(tmp_path, capsys, edit, needle):
     text = SMALL.format(bound="-1").replace(*edit)
     p = _write(tmp_path, text)
@@ -88,7 +85,7 @@ def test_interrupt_leaves_no_report_and_no_partial_files(tmp_path, monkeypatch, 
 
     out = tmp_path / "o"
     p = _write(tmp_path, SMALL.format(bound="1e-12"))
-    assert main(["run", str(p), "--out", str(out), "--quiet"]) == 0  # a complete earlier run
+    assert main(["run", str(p), "--out", str(out), "--quiet"]) == 0        # a complete earlier run
     assert (out / "report.md").exists()
 
     def boom(ctx):
@@ -97,7 +94,7 @@ def test_interrupt_leaves_no_report_and_no_partial_files(tmp_path, monkeypatch, 
     monkeypatch.setitem(R.STEPS, "widths", boom)
     assert main(["run", str(p), "--out", str(out), "--quiet"]) == 130
     assert "interrupted" in capsys.readouterr().err
-    assert not (out / "report.md").exists()  # the stale report no longer vouches for the folder
+    assert not (out / "report.md").exists()            # the stale report no longer vouches for the folder
     assert not [f for f in out.rglob("*") if f.name.endswith(".part")]
 
 
@@ -144,9 +141,7 @@ def test_a_non_converged_fit_is_reported_and_fails_the_run(tmp_path, monkeypatch
         return dataclasses.replace(real(*a, **k), converged=False, status="Maximum_Iterations_Exceeded")
 
     monkeypatch.setattr(surrogate, "fit_sweep", flagged)
-    p = _write(
-        tmp_path,
-        """
+    p = _write(tmp_path, """
         [scenario]
         name = "nc"
         [model]
@@ -165,8 +160,7 @@ def test_a_non_converged_fit_is_reported_and_fails_the_run(tmp_path, monkeypatch
         [checks.loose]
         metric = "surrogate.train_rel_rms_max"
         max = 10
-        """,
-    )
+        """)
     assert main(["run", str(p), "--out", str(tmp_path / "o"), "--quiet"]) == 3
     report = (tmp_path / "o" / "report.md").read_text()
     assert "NOT CONVERGED: Maximum_Iterations_Exceeded" in report

@@ -18,14 +18,8 @@ SCENARIOS = bundled_scenarios()
 
 def test_the_issue_scenarios_are_bundled():
     names = {p.stem for p in SCENARIOS}
-    assert {
-        "seed000_sensor",
-        "seed001_actuator",
-        "seed002_structure",
-        "discrepancy_demo",
-        "fixture_batch",
-        "demo",
-    } <= names
+    assert {"seed000_sensor", "seed001_actuator", "seed002_structure", "discrepancy_demo", "fixture_batch",
+            "demo"} <= names
 
 
 _RUNS: dict = {}
@@ -52,9 +46,7 @@ def _path(name):
 def test_scenario_quick_mode_passes_and_is_complete(path, quick_run):
     spec = load_scenario(path, quick=True)
     if spec.has("discrepancy"):
-        pytest.importorskip(
-            "physmodel.estimation.discrepancy", reason="the discrepancy scenario needs physmodel.estimation.discrepancy"
-        )
+        pytest.importorskip("physmodel.estimation.discrepancy", reason="the discrepancy scenario needs physmodel.estimation.discrepancy")
     res = quick_run(path.stem)
     failed = [(c.name, c.value, c.bound_text()) for c in res.checks if not c.passed]
     assert not failed, failed
@@ -62,7 +54,7 @@ def test_scenario_quick_mode_passes_and_is_complete(path, quick_run):
     report = (res.out / "report.md").read_text()
     for c in res.checks:
         assert f"| {c.name} | PASS |" in report
-    for f in res.files:  # every listed file exists, no temp files left
+    for f in res.files:                                   # every listed file exists, no temp files left
         assert (res.out / f).stat().st_size > 0, f
     assert not list(res.out.rglob("*.part"))
     for png in res.out.rglob("*.png"):
@@ -102,12 +94,8 @@ def test_demo_tracking_error_matches_the_steady_state_oracle(quick_run):
     res = quick_run("demo")
     spec = load_scenario(_path("demo"), quick=True)
     G = surrogate.load(res.out / "surrogate.json")
-    P = (
-        physmodel.ActuatorModel(physmodel.get_parameter_set(spec.section("model")["set"])).frequency_response(
-            [2.0], [45.0]
-        )["M"][0, 0, 0]
-        * 1e3
-    )
+    P = physmodel.ActuatorModel(physmodel.get_parameter_set(spec.section("model")["set"])).frequency_response(
+        [2.0], [45.0])["M"][0, 0, 0] * 1e3
     pred = 0.65 * abs(P / G.frequency_response([2.0], 45.0)[0] - 1)
     assert res.metrics["inversion.2_hz_sine_at_45_c.error_max_mm"] == pytest.approx(pred, rel=0.15)
 
@@ -125,9 +113,8 @@ def test_fixture_files_regenerate_from_their_seeds(quick_run):
     seeds = {int(s.generate_state(1)[0]) for s in np.random.SeedSequence(fx["seed"]).spawn(fx["count"])}
     assert {m["seed"] for m in man} == seeds
     for m in man:
-        truth = synthesize_sweep(
-            model, "M", f, fx["temperatures_c"], MagnitudePhaseNoise(nz["sigma_db"], nz["sigma_deg"]), m["seed"]
-        )
+        truth = synthesize_sweep(model, "M", f, fx["temperatures_c"], MagnitudePhaseNoise(nz["sigma_db"], nz["sigma_deg"]),
+                                 m["seed"])
         back = read_sweep(out / m["file"])
         np.testing.assert_allclose(back.response, truth.response, rtol=1e-12)
         assert truth.fingerprint() == m["fingerprint"]

@@ -11,27 +11,13 @@ import physmodel
 from scenarios.cli import main
 from scenarios.study import StudyError, load_study, parse_study, run_study
 
-SPEC = {
-    "study": {
-        "name": "t",
-        "kind": "actuator",
-        "set": "seed001_actuator_dev",
-        "method": "monte_carlo",
-        "samples": 23,
-        "seed": 5,
-        "temperatures_c": [20.0, 50.0],
-        "fmin_hz": 0.5,
-        "fmax_hz": 5.0,
-        "points": 7,
-        "chunk_size": 4,
-        "noise": {"kind": "magphase", "sigma_db": 0.2, "sigma_deg": 1.0},
-        "parameters": {
-            "d": {"distribution": "lognormal", "median": 4e-11, "sigma": 0.3},
-            "E": {"distribution": "normal", "mean": 3e8, "std": 3e7},
-            "r1_sheet": {"distribution": "uniform", "low": 5.0, "high": 20.0},
-        },
-    }
-}
+SPEC = {"study": {
+    "name": "t", "kind": "actuator", "set": "seed001_actuator_dev", "method": "monte_carlo", "samples": 23,
+    "seed": 5, "temperatures_c": [20.0, 50.0], "fmin_hz": 0.5, "fmax_hz": 5.0, "points": 7, "chunk_size": 4,
+    "noise": {"kind": "magphase", "sigma_db": 0.2, "sigma_deg": 1.0},
+    "parameters": {"d": {"distribution": "lognormal", "median": 4e-11, "sigma": 0.3},
+                   "E": {"distribution": "normal", "mean": 3e8, "std": 3e7},
+                   "r1_sheet": {"distribution": "uniform", "low": 5.0, "high": 20.0}}}}
 
 
 @pytest.fixture(scope="module")
@@ -41,32 +27,17 @@ def serial():
 
 def test_table_is_tidy_and_rows_match_the_model(serial):
     c = serial.columns
-    assert list(c) == [
-        "sample",
-        "d",
-        "E",
-        "r1_sheet",
-        "temperature_c",
-        "frequency_hz",
-        "magnitude_db",
-        "phase_deg",
-        "real",
-        "imag",
-    ]
+    assert list(c) == ["sample", "d", "E", "r1_sheet", "temperature_c", "frequency_hz", "magnitude_db", "phase_deg",
+                       "real", "imag"]
     assert serial.n_rows == 23 * 2 * 7
-    noiseless = run_study(
-        parse_study({"study": {k: v for k, v in SPEC["study"].items() if k != "noise"}}), backend="serial"
-    ).columns
+    noiseless = run_study(parse_study({"study": {k: v for k, v in SPEC["study"].items() if k != "noise"}}),
+                          backend="serial").columns
     i = 17
     row = noiseless["sample"] == i
-    p = physmodel.get_parameter_set(
-        "seed001_actuator_dev",
-        d=noiseless["d"][row][0],
-        E=noiseless["E"][row][0],
-        r1_sheet=noiseless["r1_sheet"][row][0],
-    )
+    p = physmodel.get_parameter_set("seed001_actuator_dev", d=noiseless["d"][row][0], E=noiseless["E"][row][0],
+                                    r1_sheet=noiseless["r1_sheet"][row][0])
     f = np.geomspace(0.5, 5.0, 7)
-    M = physmodel.ActuatorModel(p).frequency_response(f, [20.0, 50.0])["M"][0] * 1e3  # mm/V
+    M = physmodel.ActuatorModel(p).frequency_response(f, [20.0, 50.0])["M"][0] * 1e3   # mm/V
     np.testing.assert_allclose(noiseless["real"][row] + 1j * noiseless["imag"][row], M.ravel(), rtol=1e-12)
     # noise is per sample, seeded: the noisy table differs from the exact one by ~0.2 dB
     d_db = c["magnitude_db"] - noiseless["magnitude_db"]
@@ -74,9 +45,8 @@ def test_table_is_tidy_and_rows_match_the_model(serial):
 
 
 def test_draws_follow_their_distributions():
-    big = parse_study(
-        {"study": {**SPEC["study"], "samples": 4000, "points": 2, "temperatures_c": [25.0], "chunk_size": 4000}}
-    )
+    big = parse_study({"study": {**SPEC["study"], "samples": 4000, "points": 2, "temperatures_c": [25.0],
+                                 "chunk_size": 4000}})
     c = run_study(big, backend="serial").columns
     first = c["sample"] != np.roll(c["sample"], 1)
     d, E, r1 = c["d"][first], c["E"][first], c["r1_sheet"][first]
@@ -88,19 +58,9 @@ def test_draws_follow_their_distributions():
 
 
 def test_grid_study_enumerates_the_product():
-    g = parse_study(
-        {
-            "study": {
-                "kind": "sensor",
-                "set": "seed000_sensor_dev",
-                "method": "grid",
-                "seed": 0,
-                "temperatures_c": [25.0],
-                "frequencies_hz": [10.0, 20.0],
-                "parameters": {"d": {"values": [3e-11, 4e-11, 5e-11]}, "xi": {"values": [0.05, 0.1]}},
-            }
-        }
-    )
+    g = parse_study({"study": {"kind": "sensor", "set": "seed000_sensor_dev", "method": "grid", "seed": 0,
+                               "temperatures_c": [25.0], "frequencies_hz": [10.0, 20.0],
+                               "parameters": {"d": {"values": [3e-11, 4e-11, 5e-11]}, "xi": {"values": [0.05, 0.1]}}}})
     c = run_study(g, backend="serial").columns
     assert g["samples"] == 6
     pairs = {(a, b) for a, b in zip(c["d"], c["xi"])}
@@ -117,9 +77,8 @@ def test_local_processes_give_the_identical_table(serial):
 @pytest.mark.parametrize("processes", [False, True])
 def test_dask_local_cluster_gives_the_identical_table(serial, processes):
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=processes, dashboard_address=None
-    ) as cluster:
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=processes,
+                                  dashboard_address=None) as cluster:
         table = run_study(parse_study(SPEC), scheduler=cluster.scheduler_address)
     assert table.backend == "dask"
     assert table.equals(serial)
@@ -154,20 +113,14 @@ def _to_toml(spec):
     return "\n".join(lines) + "\n"
 
 
-@pytest.mark.parametrize(
-    "edit,needle",
-    [
-        ({"samplez": 3}, "unknown key 'samplez'"),
-        (
-            {"parameters": {"width": {"distribution": "uniform", "low": 1, "high": 2}}},
-            "not a numeric IPMCParameters field",
-        ),
-        ({"parameters": {"d": {"distribution": "beta", "a": 1}}}, "distribution must be one of"),
-        ({"parameters": {"d": {"distribution": "uniform", "low": 2.0, "high": 1.0}}}, "invalid uniform"),
-        ({"samples": 0}, "samples must be a positive integer"),
-        ({"set": "nope"}, "unknown parameter set"),
-    ],
-)
+@pytest.mark.parametrize("edit,needle", [
+    ({"samplez": 3}, "unknown key 'samplez'"),
+    ({"parameters": {"width": {"distribution": "uniform", "low": 1, "high": 2}}}, "not a numeric IPMCParameters field"),
+    ({"parameters": {"d": {"distribution": "beta", "a": 1}}}, "distribution must be one of"),
+    ({"parameters": {"d": {"distribution": "uniform", "low": 2.0, "high": 1.0}}}, "invalid uniform"),
+    ({"samples": 0}, "samples must be a positive integer"),
+    ({"set": "nope"}, "unknown parameter set"),
+])
 def test_bad_specs_are_rejected(edit, needle):
     with pytest.raises(ValueError) as e:
         parse_study({"study": {**SPEC["study"], **edit}})

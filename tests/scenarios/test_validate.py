@@ -35,10 +35,10 @@ def test_every_published_claim_has_one_row_in_file_order(report, claims):
     base = [cid for cid in report.claim_ids if "+" not in cid]
     assert base == [c[0] for c in claims]
     assert len(set(base)) == len(claims) > 40
-    assert set(base) == set(V.CHECKS)  # no stale mapping either
+    assert set(base) == set(V.CHECKS)                       # no stale mapping either
     extra = [cid for cid in report.claim_ids if "+" in cid]
     assert extra == [f"{k}+{e[0]}" for k, v in V.EXTRA_ROWS.items() for e in v if k in base]
-    for cid in extra:  # an extra row follows its claim's row
+    for cid in extra:                                       # an extra row follows its claim's row
         i = report.claim_ids.index(cid)
         assert report.claim_ids[i - 1].split("+")[0] == cid.split("+")[0]
 
@@ -92,7 +92,7 @@ EXPECTED = {
     "sensor_seed000.circuit": ("metadata", "reproduced"),
     "actuator_seed001.model": ("metadata", "reproduced"),
     # independent comparisons
-    "sensor_seed000.trends_with_rising_temperature[2]": ("independent", "reproduced"),  # held out
+    "sensor_seed000.trends_with_rising_temperature[2]": ("independent", "reproduced"),   # held out
     "sensor_seed000.preview_claims[0]": ("independent", "not-reproduced"),
     "sensor_seed000.preview_claims[1]": ("independent", "not-reproduced"),
     "actuator_seed001.validation_temperatures_c": ("independent", "reproduced"),
@@ -121,17 +121,14 @@ def test_calibrated_basis_is_what_the_derivation_used(report):
     assert calibrated == used
     assert derivation.SENSOR_CALIBRATION_TRENDS == ("cutoff_decreases", "hf_gain_decreases")
     trends = {k for k in table["seed000_sensor"] if "trends" in k}
-    assert trends == {
-        "sensor_seed000.trends_with_rising_temperature[0]",
-        "sensor_seed000.trends_with_rising_temperature[1]",
-    }
+    assert trends == {"sensor_seed000.trends_with_rising_temperature[0]", "sensor_seed000.trends_with_rising_temperature[1]"}
     assert report.calibration == table
 
 
 def test_headline_counts_only_independent_reproductions(report):
     n = sum(r.status == "reproduced" and r.basis == "independent" for r in report.rows)
     assert report.independent_reproductions == n
-    assert n < report.counts["reproduced"]  # calibrated/input/paper/metadata rows do not count
+    assert n < report.counts["reproduced"]                    # calibrated/input/paper/metadata rows do not count
     cb = report.counts_by_basis
     assert sum(sum(v.values()) for v in cb.values()) == len(report.rows)
     assert {s: sum(cb[s].values()) for s in V.STATUSES} == report.counts
@@ -155,10 +152,8 @@ def test_35c_misfit_in_table_matches_the_calibration_module(by, report):
 
 def _mini_toml(tmp_path, extra: str = "") -> str:
     path = tmp_path / "published.toml"
-    path.write_text(
-        '[actuator_seed002]\npaper = "002.txt"\nclaims = ["first vibration mode near 10 Hz"]\n' + extra,
-        encoding="utf-8",
-    )
+    path.write_text('[actuator_seed002]\npaper = "002.txt"\nclaims = ["first vibration mode near 10 Hz"]\n'
+                    + extra, encoding="utf-8")
     return str(path)
 
 

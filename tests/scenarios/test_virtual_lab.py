@@ -89,7 +89,7 @@ def test_stepped_sine_design_gives_the_same_physics():
     plan = stepped_sine_plan(f, 100.0, periods=3, min_measure_s=1.0, settle_s=6.0)
     r = virtual_lab(m, plan, [30.0])
     ex = synthesize_sweep(m, "M", f, [30.0])
-    assert np.max(np.abs(r.sweep.response / ex.response - 1)) < 2e-4  # tol 1e-4 + transient left e^{-6·1.59}
+    assert np.max(np.abs(r.sweep.response / ex.response - 1)) < 2e-4    # tol 1e-4 + transient left e^{-6·1.59}
 
 
 # ------------------------------------------------------------------------------------- σ claims
@@ -105,9 +105,8 @@ def test_sigma_of_the_noisy_virtual_lab_is_calibrated():
     ex = synthesize_sweep(m, "M", f, temps)
     t2 = []
     for seed in range(3):
-        meas = Measurement(
-            output_noise_rms=20e-6, output_adc_step=10e-3 / 2**16, input_adc_step=20.0 / 2**16, seed=seed
-        )
+        meas = Measurement(output_noise_rms=20e-6, output_adc_step=10e-3 / 2**16, input_adc_step=20.0 / 2**16,
+                           seed=seed)
         r = virtual_lab(m, ms, temps, meas, periods=8, transient_periods=2, oversample=4)
         t2.append(_t_terms(r.sweep, ex) ** 2)
     t2 = np.concatenate(t2)
@@ -154,11 +153,10 @@ def test_records_carry_the_design_temperature_and_measurement(tmp_path):
     m = ActuatorModel(get_parameter_set("seed001_actuator"))
     ms = multisine([1.0, 2.0], 100.0, 1.0)
     q = 0.5e-3
-    recs = simulate_records(
-        m, ms, [20.0, 30.0], Measurement(output_adc_step=q * 1e-3, seed=None), periods=2, oversample=2
-    )
+    recs = simulate_records(m, ms, [20.0, 30.0], Measurement(output_adc_step=q * 1e-3, seed=None), periods=2,
+                            oversample=2)
     assert [r.temperature_c() for r in recs] == [20.0, 30.0]
-    d = recs[0].channels["tip_displacement"]  # mm, quantised to q mm
+    d = recs[0].channels["tip_displacement"]                     # mm, quantised to q mm
     np.testing.assert_allclose(d / q, np.round(d / q), atol=1e-9)
     back = read_record(recs[1].save(tmp_path / "r.csv"))
     assert back.metadata["excitation"] == "multisine" and back.metadata["oversample"] == "2"
@@ -190,25 +188,18 @@ def test_calibration_on_the_virtual_lab_sweep_covers_the_simulated_truth():
     nu = 2 * (P - 1)
     inside, z, cost_t = [], [], []
     for seed in range(2026, 2026 + draws):
-        meas = Measurement(
-            output_noise_rms=50e-6, output_adc_step=10e-3 / 2**16, input_adc_step=20.0 / 2**16, seed=seed
-        )
-        r = virtual_lab(
-            ActuatorModel(truth), ms, [25.0, 45.0], meas, periods=P, transient_periods=2, oversample=4, max_std_db=1.0
-        )
+        meas = Measurement(output_noise_rms=50e-6, output_adc_step=10e-3 / 2**16, input_adc_step=20.0 / 2**16,
+                           seed=seed)
+        r = virtual_lab(ActuatorModel(truth), ms, [25.0, 45.0], meas, periods=P, transient_periods=2,
+                        oversample=4, max_std_db=1.0)
         res = calibrate(r.sweep, base, list(names), starts=2, seed=0)
         assert res.converged and not res.held, res.message
-        assert all(abs(res.values[n] / getattr(base, n) - 1) > 0.05 for n in names)  # it left the start
+        assert all(abs(res.values[n] / getattr(base, n) - 1) > 0.05 for n in names)   # it left the start
         inside.append([res.ci_lower[n] <= getattr(truth, n) <= res.ci_upper[n] for n in names])
         z.append([(res.values[n] - getattr(truth, n)) / res.stderr[n] for n in names])
         n_terms = 2 * res.n_lines
-        cost_t.append(
-            (
-                res.cost,
-                0.5 * (n_terms - len(names)) * nu / (nu - 2),
-                0.25 * n_terms * 2 * nu**2 * (nu - 1) / ((nu - 2) ** 2 * (nu - 4)),
-            )
-        )
+        cost_t.append((res.cost, 0.5 * (n_terms - len(names)) * nu / (nu - 2),
+                       0.25 * n_terms * 2 * nu**2 * (nu - 1) / ((nu - 2) ** 2 * (nu - 4))))
     inside, z = np.array(inside), np.array(z)
     expect = 2 * stats.norm.cdf(1.96 * math.sqrt((nu - 4) / nu)) - 1
     band = 3 * math.sqrt(expect * (1 - expect) / draws)
@@ -219,17 +210,14 @@ def test_calibration_on_the_virtual_lab_sweep_covers_the_simulated_truth():
 
 
 # ------------------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize(
-    "kw, match",
-    [
-        ({"measurement": Measurement(chain=TransimpedanceChain())}, "chain"),
-        ({"temperatures_c": [25.0, 25.0]}, "temperatures_c"),
-        ({"periods": 1}, "periods"),
-        ({"oversample": 0}, "oversample"),
-        ({"excitation": "multisine"}, "excitation"),
-        ({"excitation": multisine([1.0], 100.0, 1.0, unit="mm", channel="tip_displacement")}, "excitation unit"),
-    ],
-)
+@pytest.mark.parametrize("kw, match", [
+    ({"measurement": Measurement(chain=TransimpedanceChain())}, "chain"),
+    ({"temperatures_c": [25.0, 25.0]}, "temperatures_c"),
+    ({"periods": 1}, "periods"),
+    ({"oversample": 0}, "oversample"),
+    ({"excitation": "multisine"}, "excitation"),
+    ({"excitation": multisine([1.0], 100.0, 1.0, unit="mm", channel="tip_displacement")}, "excitation unit"),
+])
 def test_bad_input_names_the_argument(kw, match):
     m = ActuatorModel(get_parameter_set("seed001_actuator"))
     args = {"excitation": multisine([1.0, 2.0], 100.0, 1.0), "temperatures_c": [25.0], "periods": 2}
@@ -252,20 +240,9 @@ def test_from_config_reads_the_scenario_tables_and_names_bad_keys():
     from scenarios.virtual_lab import from_config
 
     m = ActuatorModel(get_parameter_set("seed001_actuator"))
-    sweep = {
-        "source": "virtual_lab",
-        "temperatures_c": [19.0, 55.0],
-        "fmin_hz": 0.2,
-        "fmax_hz": 9.0,
-        "points": 12,
-        "fs_hz": 100.0,
-        "period_s": 5.0,
-        "periods": 3,
-        "transient_periods": 2,
-        "oversample": 2,
-        "held_out_c": [],
-        "plot_temperatures_c": [19.0],
-    }
+    sweep = {"source": "virtual_lab", "temperatures_c": [19.0, 55.0], "fmin_hz": 0.2, "fmax_hz": 9.0, "points": 12,
+             "fs_hz": 100.0, "period_s": 5.0, "periods": 3, "transient_periods": 2, "oversample": 2,
+             "held_out_c": [], "plot_temperatures_c": [19.0]}
     noise = {"kind": "time", "output_noise_rms": 20e-6, "output_adc_step": 1.5e-7, "seed": 3}
     r = from_config(m, sweep, noise)
     np.testing.assert_array_equal(r.sweep.temperatures(), [19.0, 55.0])

@@ -6,19 +6,16 @@ from surrogate import Scaling
 
 # A known scheduled model (zpk form, 2 zeros, 3 poles, quadratic in T) whose zero pair is
 # non-minimum phase, real below ~26 °C and complex above (the discriminant changes sign).
-TRUE_SCALING = Scaling(
-    omega_ref_rad_s=2 * np.pi * 3.0, gain_ref=2.0, temperature_center_c=37.0, temperature_scale_c=18.0
-)
-TRUE_THETA = np.array(
-    [
-        [1.5, 0.2, 0.0],  # k
-        [-0.5, 0.1, 0.0],  # zc1_0 (negative: right-half-plane zeros)
-        [0.12, 0.1, 0.0],  # zc0_0
-        [np.log(0.4), -0.1, 0.02],  # log_a1_0
-        [0.0, -0.15, 0.0],  # log_a0_0
-        [np.log(0.3), 0.1, 0.0],  # log_c
-    ]
-).ravel()
+TRUE_SCALING = Scaling(omega_ref_rad_s=2 * np.pi * 3.0, gain_ref=2.0,
+                       temperature_center_c=37.0, temperature_scale_c=18.0)
+TRUE_THETA = np.array([
+    [1.5, 0.2, 0.0],                  # k
+    [-0.5, 0.1, 0.0],                 # zc1_0 (negative: right-half-plane zeros)
+    [0.12, 0.1, 0.0],                 # zc0_0
+    [np.log(0.4), -0.1, 0.02],        # log_a1_0
+    [0.0, -0.15, 0.0],                # log_a0_0
+    [np.log(0.3), 0.1, 0.0],          # log_c
+]).ravel()
 FIT_TEMPS = [19.0, 25.0, 31.0, 37.0, 43.0, 49.0, 55.0]
 
 

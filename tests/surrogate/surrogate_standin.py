@@ -30,25 +30,14 @@ R_CONST = 8.314462618  # J/(mol K)
 T_REF_K = 300.0
 
 PARAMS = {
-    "h": 0.125e-3,
-    "L": 15e-3,
-    "W": 4e-3,
-    "d": 3.07e-11,
-    "C": 941.94,
-    "kappa": 4.47e-7,
-    "r1": 56.44,
-    "r2": 8.81e-6,
-    "Rp": 0.37,
-    "wn": 75.4,
-    "xi": 0.18,
-    "E": 154e6,
-    "Ea": 15e3,
-    "E_slope_per_K": -0.0075,
+    "h": 0.125e-3, "L": 15e-3, "W": 4e-3, "d": 3.07e-11, "C": 941.94, "kappa": 4.47e-7,
+    "r1": 56.44, "r2": 8.81e-6, "Rp": 0.37, "wn": 75.4, "xi": 0.18, "E": 154e6,
+    "Ea": 15e3, "E_slope_per_K": -0.0075,
 }
 
 
 def _eps_water(t_c):
-    return 87.740 - 0.40008 * t_c + 9.398e-4 * t_c**2 - 1.410e-6 * t_c**3
+    return 87.740 - 0.40008 * t_c + 9.398e-4 * t_c ** 2 - 1.410e-6 * t_c ** 3
 
 
 def _tanh(z):
@@ -65,11 +54,11 @@ def _x_factor(x):
     out = np.empty_like(x)
     small = np.abs(x) < 1e-2
     xs = x[small]
-    out[small] = 0.5 - xs**2 / 8 + 7 * xs**4 / 144
+    out[small] = 0.5 - xs ** 2 / 8 + 7 * xs ** 4 / 144
     xl = x[~small]
     e = np.exp(-2 * xl)
     sech = 2 * np.exp(-xl) / (1 + e)
-    out[~small] = (xl * _tanh(xl) + sech - 1) / xl**2
+    out[~small] = (xl * _tanh(xl) + sech - 1) / xl ** 2
     return out
 
 
@@ -80,7 +69,7 @@ def _raw(s, t_c, p):
     e_mod = p["E"] * (1 + p["E_slope_per_K"]) ** (t_k - T_REF_K)
     wn = p["wn"] * np.sqrt(e_mod / p["E"])
     rp = p["Rp"] * (t_k / T_REF_K) * (p["d"] / d)
-    k = F_CONST**2 * d * p["C"] / (kappa * R_CONST * t_k)
+    k = F_CONST ** 2 * d * p["C"] / (kappa * R_CONST * t_k)
     h, w_, L = p["h"], p["W"], p["L"]
     gam = h * np.sqrt((s + k) / d)
     th = _tanh(gam)
@@ -90,7 +79,7 @@ def _raw(s, t_c, p):
     b = (p["r1"] / w_) * a
     x = np.sqrt(b) * L
     elec = (gam - th) / (s * gam + k * th) * k * kappa / e_mod
-    mode = wn**2 / (s**2 + 2 * p["xi"] * wn * s + wn**2)
+    mode = wn ** 2 / (s ** 2 + 2 * p["xi"] * wn * s + wn ** 2)
     return elec * 2 * _x_factor(x) / corr * mode
 
 
@@ -107,7 +96,8 @@ def actuator_response(frequency_hz, temperature_c, params=None):
     return _gain(p) * _raw(2j * np.pi * f, t, p)
 
 
-def physics_sweep(temperatures_c, frequency_hz, *, magnitude_std_db=0.0, phase_std_deg=0.0, seed=0, params=None):
+def physics_sweep(temperatures_c, frequency_hz, *, magnitude_std_db=0.0, phase_std_deg=0.0,
+                  seed=0, params=None):
     """Tidy noisy sweep (the benchmark's single swap point for ``physmodel``).
 
     Returns ``(frequency_hz, temperature_c, response, truth, magnitude_std_db, phase_std_deg)``
@@ -119,9 +109,8 @@ def physics_sweep(temperatures_c, frequency_hz, *, magnitude_std_db=0.0, phase_s
     t = np.repeat(temps, f1.size)
     truth = actuator_response(f, t, params)
     rng = np.random.default_rng(seed)
-    noise = rng.normal(size=f.size) * magnitude_std_db * np.log(10) / 20 + 1j * np.deg2rad(
-        rng.normal(size=f.size) * phase_std_deg
-    )
+    noise = (rng.normal(size=f.size) * magnitude_std_db * np.log(10) / 20
+             + 1j * np.deg2rad(rng.normal(size=f.size) * phase_std_deg))
     resp = truth * np.exp(noise)
     if magnitude_std_db > 0 and phase_std_deg > 0:
         smag = np.full(f.size, float(magnitude_std_db))

@@ -48,14 +48,14 @@ def test_issue_case_zpk_schedule_says_it_is_wrong_between_temperatures(plant, th
     fit = fitter.fit(three)
     assert fit.converged
     at = max(e.relative_rms_error for e in fit.per_temperature)
-    assert at < 0.04  # looks fine where it was fitted
+    assert at < 0.04                                           # looks fine where it was fitted
     with pytest.warns(ScheduleWarning, match="exceeds") as rec:
         chk = check_schedule(fitter, three, fit.model, physics=plant)
     assert not chk.ok
     # what it reports between temperatures is what the physics says there
     worst = chk.dense.worst_temperature_c
     assert chk.between_error == pytest.approx(_truth_error(plant, fit.model, worst), rel=1e-9)
-    assert chk.between_error > 10 * at  # measured 1.0 vs 0.026
+    assert chk.between_error > 10 * at                         # measured 1.0 vs 0.026
     assert not chk.cv.feasible and "needs 3" in chk.cv.reason  # degree 2 on 3 temperatures
     assert PHYSICS_ROUTE in str(rec[0].message) and chk.proposal == PHYSICS_ROUTE
 
@@ -67,8 +67,8 @@ def test_coefficient_schedule_on_the_same_data_meets_its_error(plant, three):
         chk = check_schedule(fitter, three, physics=plant)
     assert chk.ok and chk.between_error <= 2 * chk.at_fit_error
     model = fitter.fit(three).model
-    for T in (31.0, 49.0):  # oracle at two in-between points
-        assert _truth_error(plant, model, T) < 0.02  # measured ~1 %
+    for T in (31.0, 49.0):                                      # oracle at two in-between points
+        assert _truth_error(plant, model, T) < 0.02            # measured ~1 %
 
 
 def test_without_physics_an_unverifiable_schedule_is_flagged(three):
@@ -122,9 +122,8 @@ def test_fit_checked_chooses_the_degree_and_reports(plant):
     sw = synthesize_sweep(plant, "M", F_HZ, [20.0, 30.0, 40.0, 50.0, 60.0])
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        cf = surrogate.crossval.fit_checked(
-            surrogate.ScheduledFit("coefficients", 3, 3, 2), sw, degrees=(1, 2), physics=plant
-        )
+        cf = surrogate.crossval.fit_checked(surrogate.ScheduledFit("coefficients", 3, 3, 2), sw,
+                                            degrees=(1, 2), physics=plant)
     assert cf.result.model.structure.degree == cf.selection.best_degree == cf.check.cv.degree
     assert cf.check.ok
     md = cf.to_markdown()

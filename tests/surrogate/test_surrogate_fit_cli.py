@@ -66,9 +66,7 @@ def test_transfer_function_matches_frequency_response(fitted):
 
 
 def _write_csv(path, f, t, h, sm=None, sp=None, header_extra=""):
-    cols = "temperature_c,frequency_hz,magnitude_db,phase_deg" + (
-        ",magnitude_std_db,phase_std_deg" if sm is not None else ""
-    )
+    cols = "temperature_c,frequency_hz,magnitude_db,phase_deg" + (",magnitude_std_db,phase_std_deg" if sm is not None else "")
     lines = ["# input: voltage [V]", "# output: tip_displacement [mm]", "# source: test", header_extra, cols]
     for i in range(f.size):
         row = [t[i], f[i], 20 * np.log10(abs(h[i])), np.degrees(np.angle(h[i]))]
@@ -92,9 +90,7 @@ def test_cli_fit_writes_model_report_and_figures(tmp_path, true_model):
     assert data.input_unit == "V" and data.output_name == "tip_displacement" and data.has_uncertainty
     np.testing.assert_allclose(data.response, h, rtol=1e-12)
     out = tmp_path / "out"
-    args = _args(
-        ["fit", str(csv), "--zeros", "2", "--poles", "3", "--degree", "2", "--exclude", "37", "--out", str(out)]
-    )
+    args = _args(["fit", str(csv), "--zeros", "2", "--poles", "3", "--degree", "2", "--exclude", "37", "--out", str(out)])
     assert args.func is run
     assert run(args) == 0
     model = load(out / "model.json")
@@ -123,27 +119,8 @@ def test_cli_bad_input_and_non_convergence_exit_codes(tmp_path, true_model, caps
     assert run(_args(["fit", str(tmp_path / "nope.csv"), "--out", str(tmp_path / "o3")])) == 2
     good = tmp_path / "good.csv"
     _write_csv(good, f, t, h, sm, sp)
-    assert (
-        run(
-            _args(
-                [
-                    "fit",
-                    str(good),
-                    "--zeros",
-                    "2",
-                    "--poles",
-                    "3",
-                    "--degree",
-                    "2",
-                    "--max-iter",
-                    "1",
-                    "--out",
-                    str(tmp_path / "o4"),
-                ]
-            )
-        )
-        == 3
-    )
+    assert run(_args(["fit", str(good), "--zeros", "2", "--poles", "3", "--degree", "2", "--max-iter", "1",
+                      "--out", str(tmp_path / "o4")])) == 3
     assert "did not converge" in capsys.readouterr().err
     assert not (tmp_path / "o4" / "model.json").exists()
 

@@ -43,7 +43,7 @@ def test_seed001_second_order_is_clearly_worse_at_every_temperature(seed001):
 def test_seed001_strictly_proper_third_order_fits_no_better(seed001):
     _, rep = seed001
     e23, e33 = rep.row(2, 3).relative_rms_error, rep.row(3, 3).relative_rms_error
-    assert all(a >= b * (1 - 1e-3) for a, b in zip(e23, e33))  # nested classes; 1e-3: fitter tolerance
+    assert all(a >= b * (1 - 1e-3) for a, b in zip(e23, e33))        # nested classes; 1e-3: fitter tolerance
 
 
 def test_seed001_fourth_order_adds_little_is_not_reproduced(seed001):
@@ -67,4 +67,4 @@ def test_seed002_five_poles_two_zeros_fit_the_physics_far_better_than_the_printe
     res = RationalFit(2, 5).fit(exact)
     assert res.converged and res.stability.stable
     fit = fit_percent(res.model.frequency_response(f_hz), exact.response)
-    assert fit > 99.0  # printed: 92.57 % (sample 4), 92.96 % (sample 1), against measured data
+    assert fit > 99.0                  # printed: 92.57 % (sample 4), 92.96 % (sample 1), against measured data

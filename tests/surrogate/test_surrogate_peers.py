@@ -11,9 +11,8 @@ from surrogate import RationalFit, levy, relative_rms_error
 
 @pytest.fixture(scope="module")
 def sweep():
-    f, t, h, truth, sm, sp = physics_sweep(
-        [30.0], np.geomspace(0.1, 20, 60), magnitude_std_db=0.2, phase_std_deg=1.0, seed=5
-    )
+    f, t, h, truth, sm, sp = physics_sweep([30.0], np.geomspace(0.1, 20, 60), magnitude_std_db=0.2,
+                                           phase_std_deg=1.0, seed=5)
     res = RationalFit(4, 4).fit(f, t, h, sm, sp)
     return f, h, truth, res
 
@@ -50,13 +49,7 @@ def test_no_worse_than_vector_fitting(sweep):
         vf = VectorFitting(nw)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            vf.vector_fit(
-                n_poles_real=n_real,
-                n_poles_cmplx=(4 - n_real) // 2,
-                init_pole_spacing="log",
-                fit_constant=True,
-                fit_proportional=False,
-                enforce_dc=False,
-            )
+            vf.vector_fit(n_poles_real=n_real, n_poles_cmplx=(4 - n_real) // 2, init_pole_spacing="log",
+                          fit_constant=True, fit_proportional=False, enforce_dc=False)
         errs.append(relative_rms_error(vf.get_model_response(0, 0, freqs=f), h))
     assert relative_rms_error(res.model.frequency_response(f), h) <= min(errs)

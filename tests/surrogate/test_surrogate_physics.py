@@ -51,17 +51,16 @@ def test_from_sweep_carries_units_and_uncertainty(sweeps):
 
 def test_joint_fit_predicts_held_out_temperatures(sweeps, joint):
     data, exact = sweeps
-    papers = ScheduledFit("zpk", 4, 4, 2, method="two-stage", per_temperature="levy", raise_on_failure=False).fit(
-        data.exclude(HELD_OUT)
-    )
+    papers = ScheduledFit("zpk", 4, 4, 2, method="two-stage", per_temperature="levy",
+                          raise_on_failure=False).fit(data.exclude(HELD_OUT))
     assert joint.converged
     for temp in HELD_OUT:
         k = data.temperature_c == temp
         truth = exact.response[k]
         e_joint = relative_rms_error(joint.model.frequency_response(data.frequency_hz[k], temp), truth)
         e_papers = relative_rms_error(papers.model.frequency_response(data.frequency_hz[k], temp), truth)
-        assert e_joint < 0.02  # noise floor of one line is ~0.029
-        assert e_joint <= 0.5 * e_papers  # issue goal, against the papers' two-stage method
+        assert e_joint < 0.02                      # noise floor of one line is ~0.029
+        assert e_joint <= 0.5 * e_papers           # issue goal, against the papers' two-stage method
 
 
 def test_joint_fit_is_stable_on_a_dense_temperature_grid(joint):
@@ -75,18 +74,12 @@ def test_order_selection_on_physics_second_order_is_clearly_worse(sweeps):
     data, _ = sweeps
     sub = from_sweep(data)
     sub = sub.select(np.isin(sub.temperature_c, [19.0, 55.0]))
-    rep = order_selection(
-        sub.frequency_hz,
-        sub.temperature_c,
-        sub.response,
-        [(2, 2), (3, 3), (4, 4)],
-        sub.magnitude_std_db,
-        sub.phase_std_deg,
-    )
+    rep = order_selection(sub.frequency_hz, sub.temperature_c, sub.response, [(2, 2), (3, 3), (4, 4)],
+                          sub.magnitude_std_db, sub.phase_std_deg)
     e2, e3, e4 = (rep.row(k, k).worst_relative_rms_error for k in (2, 3, 4))
     assert all(all(r.stable) for r in rep.rows)
-    assert e2 > 3 * e3 and e3 > e4  # the error falls with order up to 4/4
-    assert e4 < 0.05  # 4/4 reaches the noise floor (≈ 0.029)
+    assert e2 > 3 * e3 and e3 > e4            # the error falls with order up to 4/4
+    assert e4 < 0.05                          # 4/4 reaches the noise floor (≈ 0.029)
 
 
 def test_joint_fit_keeps_the_best_start_on_the_sensor_sweep():

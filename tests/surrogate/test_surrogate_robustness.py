@@ -33,7 +33,7 @@ def test_sensor_coefficient_schedule_is_stable_over_the_whole_range():
     exact = synthesize_sweep(sensor, "S", f_hz, temps, None)
     res = ScheduledFit("coefficients", 4, 4, 3, max_iter=200).fit(sweep.exclude(HELD_OUT))
     assert res.converged and res.stability.stable
-    assert any(e["stage"].startswith("joint (Hurwitz") for e in res.history)  # the constraints were needed
+    assert any(e["stage"].startswith("joint (Hurwitz") for e in res.history)   # the constraints were needed
     worst = max(np.max(np.roots(res.model.coefficients(t)[1]).real) for t in np.linspace(23.0, 65.0, 2001))
     assert worst < 0
     for temp in HELD_OUT:
@@ -47,7 +47,7 @@ def test_actuator_zpk_fourth_order_converges_for_the_former_failure():
     f_hz = np.geomspace(0.1, 9.0, 30)
     sweep = synthesize_sweep(model, "M", f_hz, temps, NOISE, seed=7)
     exact = synthesize_sweep(model, "M", f_hz, temps, None)
-    res = ScheduledFit("zpk", 4, 4, 2).fit(sweep.exclude(HELD_OUT))  # raises if not converged
+    res = ScheduledFit("zpk", 4, 4, 2).fit(sweep.exclude(HELD_OUT))   # raises if not converged
     assert res.stability.stable
     for temp in HELD_OUT:
         k = exact.temperature_c == temp
@@ -56,28 +56,28 @@ def test_actuator_zpk_fourth_order_converges_for_the_former_failure():
 
 def test_slow_per_temperature_fit_is_resumed_not_failed():
     sensor = physmodel.SensorModel(physmodel.get_parameter_set("seed000_sensor"))
-    sweep = synthesize_sweep(sensor, "S", np.geomspace(10.0, 100.0, 60), [23.0], MagnitudePhaseNoise(0.3, 2.0), seed=51)
+    sweep = synthesize_sweep(sensor, "S", np.geomspace(10.0, 100.0, 60), [23.0], MagnitudePhaseNoise(0.3, 2.0),
+                             seed=51)
     res = RationalFit(2, 2, max_iter=300).fit(sweep)
     first = [e for e in res.history if "resumed" not in e["stage"]]
     resumed = [e for e in res.history if "resumed" in e["stage"]]
     cheapest = min(first, key=lambda e: e["cost"])
-    assert cheapest["status"] == "Maximum_Iterations_Exceeded"  # the best start ran out of 300 iterations …
-    assert len(resumed) == 1 and resumed[0]["converged"]  # … it was resumed and converged
+    assert cheapest["status"] == "Maximum_Iterations_Exceeded"   # the best start ran out of 300 iterations …
+    assert len(resumed) == 1 and resumed[0]["converged"]    # … it was resumed and converged
     assert resumed[0]["start"] == cheapest["start"]
     assert res.converged and resumed[0]["cost"] <= min(e["cost"] for e in first)
 
 
 def _out(cost, converged):
-    return SolveOutcome(
-        np.zeros(1), cost, "Solve_Succeeded" if converged else "Maximum_Iterations_Exceeded", converged, 10, 0.0
-    )
+    return SolveOutcome(np.zeros(1), cost, "Solve_Succeeded" if converged else "Maximum_Iterations_Exceeded",
+                        converged, 10, 0.0)
 
 
 def test_a_converged_poor_minimum_does_not_hide_a_better_unconverged_solve():
     name, out = best_outcome([("a", _out(383.0, True)), ("b", _out(0.42, False))])
-    assert name == "b" and not out.converged  # reported, flagged
+    assert name == "b" and not out.converged               # reported, flagged
     name, _ = best_outcome([("a", _out(0.421, True)), ("b", _out(0.42, False))])
-    assert name == "a"  # within 2 %: the converged one
+    assert name == "a"                                      # within 2 %: the converged one
 
 
 @pytest.mark.parametrize("form", ["coefficients", "sections", "zpk"])
@@ -97,4 +97,4 @@ def test_response_std_is_exact_for_a_parameter_entering_linearly():
     model = RationalModel(st, np.array([1.0, 0.5, 2.0, 0.3]), Scaling(10.0, 3.0, 0.0, 1.0), None, cov)
     f = np.array([0.5, 1.0, 2.0, 5.0])
     s = 2j * np.pi * f / 10.0
-    np.testing.assert_allclose(model.response_std(f), 3.0 * 0.1 / np.abs(s**2 + 0.3 * s + 2.0), rtol=1e-7)
+    np.testing.assert_allclose(model.response_std(f), 3.0 * 0.1 / np.abs(s ** 2 + 0.3 * s + 2.0), rtol=1e-7)

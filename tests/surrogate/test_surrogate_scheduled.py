@@ -6,12 +6,9 @@ from surrogate_fixtures import FIT_TEMPS, TRUE_SCALING, TRUE_THETA, noisy_sweep
 
 from surrogate import ConvergenceError, RationalModel, ScheduledFit, Structure, relative_rms_error
 
-SCALES = dict(
-    omega_ref_rad_s=TRUE_SCALING.omega_ref_rad_s,
-    gain_ref=TRUE_SCALING.gain_ref,
-    temperature_center_c=TRUE_SCALING.temperature_center_c,
-    temperature_scale_c=TRUE_SCALING.temperature_scale_c,
-)
+SCALES = dict(omega_ref_rad_s=TRUE_SCALING.omega_ref_rad_s, gain_ref=TRUE_SCALING.gain_ref,
+              temperature_center_c=TRUE_SCALING.temperature_center_c,
+              temperature_scale_c=TRUE_SCALING.temperature_scale_c)
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +31,7 @@ def test_synthetic_scheduled_recovery_within_confidence_intervals(joint_zpk):
     # every coefficient within 3.5 standard errors …
     assert np.max(np.abs(z)) < 3.5, z
     # … and the intervals are honest, neither inflated nor too narrow
-    assert 0.5 < np.sqrt(np.mean(z**2)) < 1.6, z
+    assert 0.5 < np.sqrt(np.mean(z ** 2)) < 1.6, z
     inside = (TRUE_THETA >= res.ci95_low) & (TRUE_THETA <= res.ci95_high)
     assert inside.mean() >= 0.8
     # correct uncertainties: weighted residual RMS close to 1
@@ -82,11 +79,8 @@ def test_levy_two_stage_is_the_papers_baseline(synthetic_sweep):
     f, t, h, sm, sp = synthetic_sweep
     res = ScheduledFit("coefficients", 2, 3, 2, per_temperature="levy").fit(f, t, h, sm, sp)
     assert all(e["start"] == "levy" for e in res.history if e["stage"].startswith("per-T"))
-    assert (
-        res.converged
-        and res.cost
-        <= ScheduledFit("coefficients", 2, 3, 2, per_temperature="levy", method="two-stage").fit(f, t, h, sm, sp).cost
-    )
+    assert res.converged and res.cost <= ScheduledFit(
+        "coefficients", 2, 3, 2, per_temperature="levy", method="two-stage").fit(f, t, h, sm, sp).cost
 
 
 def test_joint_non_convergence_is_reported(synthetic_sweep):
@@ -144,4 +138,4 @@ def test_hurwitz_constraints_keep_the_coefficients_form_stable():
     margin = held.model.info["settings"]["stability_margin"] * held.model.scaling.omega_ref_rad_s
     re = [np.max(np.roots(held.model.coefficients(T)[1]).real) for T in np.linspace(19.0, 55.0, 41)]
     assert max(re) <= -margin * (1 - 1e-6)
-    assert max(re) == pytest.approx(-margin, rel=0.1)  # active (the truth is unstable)
+    assert max(re) == pytest.approx(-margin, rel=0.1)       # active (the truth is unstable)

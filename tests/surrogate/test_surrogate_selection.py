@@ -22,13 +22,12 @@ SEED001_SAMPLE = dict(L=45e-3, h=0.15e-3, W=11e-3, wn=75.4 * (0.15 / 0.125) * (1
 
 
 def test_order_selection_on_the_seed001_protocol():
-    f, t, h, _, sm, sp = physics_sweep(
-        [19.0, 55.0], np.geomspace(0.1, 9, 30), magnitude_std_db=0.3, phase_std_deg=2.0, params=SEED001_SAMPLE
-    )
+    f, t, h, _, sm, sp = physics_sweep([19.0, 55.0], np.geomspace(0.1, 9, 30), magnitude_std_db=0.3,
+                                       phase_std_deg=2.0, params=SEED001_SAMPLE)
     rep = order_selection(f, t, h, [(2, 2), (3, 3), (4, 4)], sm, sp)
     e2, e3, e4 = (rep.row(k, k).worst_relative_rms_error for k in (2, 3, 4))
     assert all(all(r.converged) and all(r.stable) for r in rep.rows)
-    assert e2 > 2 * e3  # 'second order clearly worse' (read as at least twice the error)
+    assert e2 > 2 * e3                       # 'second order clearly worse' (read as at least twice the error)
     # 'fourth order adds little' is NOT reproduced: 4/4 more than halves the 3/3 error
     assert e4 < 0.5 * e3, "fourth order now adds little: update the docstring and ipmc validate"
     md = rep.to_markdown()
@@ -41,7 +40,8 @@ def test_order_selection_on_the_seed001_protocol():
     temperature=st.floats(0.0, 80.0),
 )
 def test_zpk_poles_are_stable_for_any_parameters_and_temperature(coeffs, temperature):
-    model = RationalModel(Structure("zpk", 2, 3, 2), np.array(coeffs), Scaling(10.0, 1.0, 40.0, 20.0), (0.0, 80.0))
+    model = RationalModel(Structure("zpk", 2, 3, 2), np.array(coeffs), Scaling(10.0, 1.0, 40.0, 20.0),
+                          (0.0, 80.0))
     poles = model.poles(temperature)
     assert poles.size == 3 and np.all(poles.real < 0)
     num, den = model.coefficients(temperature)

@@ -16,17 +16,9 @@ from surrogate._lsq import STATUS_STOPPED, Evaluator, LevenbergMarquardt
 from surrogate._nlp import BLOCK_LINES, Problem, Solver, covariance, residual
 from surrogate._structure import CasadiBackend, denominators, polynomials
 
-CASES = [
-    ("coefficients", 2, 3, 0),
-    ("coefficients", 3, 3, 2),
-    ("sections", 4, 4, 0),
-    ("sections", 1, 2, 3),
-    ("sections", 2, 5, 0),
-    ("zpk", 3, 3, 2),
-    ("zpk", 4, 4, 1),
-    ("zpk", 2, 3, 0),
-    ("zpk", 0, 1, 0),
-]
+CASES = [("coefficients", 2, 3, 0), ("coefficients", 3, 3, 2), ("sections", 4, 4, 0),
+         ("sections", 1, 2, 3), ("sections", 2, 5, 0), ("zpk", 3, 3, 2), ("zpk", 4, 4, 1),
+         ("zpk", 2, 3, 0), ("zpk", 0, 1, 0)]
 
 
 def _problem(form, m, n, deg, kind, n_lines=37, seed=0):
@@ -58,7 +50,8 @@ def test_jacobian_matches_finite_differences_and_casadi(form, m, n, deg, kind):
         fd[:, i] = (ev.residual(tp) - ev.residual(tm)) / (2 * step)
     np.testing.assert_allclose(jac, fd, rtol=0, atol=1e-6 * np.max(np.abs(jac)))
     x = ca.SX.sym("x", st.n_params)
-    rs = residual(st, x, pr.w, pr.tau, pr.h.real, pr.h.imag, pr.inv_sig_a, pr.inv_sig_b, kind, CasadiBackend())
+    rs = residual(st, x, pr.w, pr.tau, pr.h.real, pr.h.imag, pr.inv_sig_a, pr.inv_sig_b, kind,
+                  CasadiBackend())
     ad = np.asarray(ca.Function("j", [x], [ca.jacobian(rs, x)])(theta), float)
     np.testing.assert_allclose(jac, ad, rtol=0, atol=1e-12 * np.max(np.abs(ad)))
     # a stack of parameter vectors gives the stack of Jacobians
@@ -88,7 +81,7 @@ def test_lockstep_recovers_a_noise_free_model_and_stops_the_beaten_start():
     assert lm.converged[0] and lm.status[1] == STATUS_STOPPED and not lm.converged[1]
     assert lm.cost[1] > lm.cost[0]
     np.testing.assert_allclose(lm.theta[0], truth, rtol=0, atol=1e-6)
-    assert lm.iterations[1] == lm.iterations[0]  # stopped when the other converged
+    assert lm.iterations[1] == lm.iterations[0]        # stopped when the other converged
     # revived, the stopped start runs on (and is never stopped again)
     before = lm.cost[1]
     lm.revive(1)
@@ -105,11 +98,10 @@ def test_a_start_with_a_margin_keeps_running():
     # the exact start converges at once; the other, far above it then, is stopped …
     assert lm.converged[0] and lm.cost[0] < 1e-20
     assert lm.status[1] == STATUS_STOPPED
-    lm2 = LevenbergMarquardt(
-        Evaluator(pr), np.stack([truth, truth + 0.3]), *st.bounds(0.05, 20.0), 1e-12, margins=[0.0, np.inf]
-    )
+    lm2 = LevenbergMarquardt(Evaluator(pr), np.stack([truth, truth + 0.3]), *st.bounds(0.05, 20.0), 1e-12,
+                             margins=[0.0, np.inf])
     lm2.run(500)
-    assert lm2.converged[1]  # … unless its margin lets it run (a warm start)
+    assert lm2.converged[1]                    # … unless its margin lets it run (a warm start)
     np.testing.assert_allclose(lm2.theta[1], truth, rtol=0, atol=1e-6)
 
 
@@ -126,7 +118,7 @@ def test_block_mapped_ipopt_problem_agrees_with_levenberg_marquardt(n_lines):
     pr = Problem(st, w, tau, h, "log", np.full(n_lines, 100.0), np.full(n_lines, 100.0))
     out = Solver(st, n_lines, "log", grid_taus=np.linspace(-1, 1, 11)).solve(pr, truth + 0.02)
     assert out.converged
-    assert out.cost == pytest.approx(pr.cost(out.theta), rel=1e-12)  # padding lines add nothing
+    assert out.cost == pytest.approx(pr.cost(out.theta), rel=1e-12)   # padding lines add nothing
     lm = LevenbergMarquardt(Evaluator(pr), truth + 0.02, *st.bounds(), 1e-12).run(300)
     assert lm.converged[0]
     assert out.cost == pytest.approx(lm.cost[0], rel=1e-8)
@@ -140,11 +132,11 @@ def test_covariance_from_the_r_factor_equals_the_svd_of_the_jacobian(shape, spre
     r = rng.normal(size=shape[0])
     cov, deficient = covariance(jac, r, True)
     _, s, vt = np.linalg.svd(jac, full_matrices=False)
-    ref = (vt.T / s**2) @ vt * (r @ r) / (shape[0] - shape[1])
+    ref = (vt.T / s ** 2) @ vt * (r @ r) / (shape[0] - shape[1])
     sd = np.sqrt(np.diag(ref))
     np.testing.assert_allclose(cov / np.outer(sd, sd), ref / np.outer(sd, sd), rtol=0, atol=1e-6)
     assert not deficient
-    jac[:, -1] = jac[:, 0]  # exactly dependent columns
+    jac[:, -1] = jac[:, 0]                                   # exactly dependent columns
     assert covariance(jac, r, True)[1]
 
 
@@ -155,6 +147,7 @@ def test_vectorised_denominators_equal_polynomials_per_temperature(form, m, n, d
     taus = np.linspace(-1.2, 1.2, 9)
     ref = np.array([polynomials(st, theta, t)[1] for t in taus])
     np.testing.assert_allclose(denominators(st, theta, taus), ref, rtol=1e-13, atol=1e-13)
+
 
 
 def test_joint_zpk_fourth_order_converges_at_five_temperatures():
@@ -168,7 +161,7 @@ def test_joint_zpk_fourth_order_converges_at_five_temperatures():
     model = physmodel.ActuatorModel(physmodel.get_parameter_set("seed001_actuator"))
     f_hz = np.geomspace(0.1, 9.0, 60)
     sweep = synthesize_sweep(model, "M", f_hz, [19.0, 28.0, 37.0, 46.0, 55.0], MagnitudePhaseNoise(0.2, 1.0), seed=1)
-    res = ScheduledFit("zpk", 4, 4, 2).fit(sweep)  # raises if not converged
+    res = ScheduledFit("zpk", 4, 4, 2).fit(sweep)           # raises if not converged
     assert res.stability.stable
     for temp in (26.3, 39.7, 48.1):
         exact = synthesize_sweep(model, "M", f_hz, [temp], None).response
@@ -193,5 +186,4 @@ def test_reported_errors_equal_the_saved_models_own_response():
     k = t == FIT_TEMPS[0]
     one = RationalFit(2, 3).fit(f[k], None, h[k])
     assert one.per_temperature[0].relative_rms_error == pytest.approx(
-        relative_rms_error(one.model.frequency_response(f[k]), h[k]), rel=1e-12
-    )
+        relative_rms_error(one.model.frequency_response(f[k]), h[k]), rel=1e-12)

@@ -14,17 +14,15 @@ H = 1.0 / (1 + 1j * F / 10.0)
 
 @pytest.mark.parametrize(
     "kwargs, message",
-    [  # FrequencyData is validated by physmodel.data.sweep.FrequencySweep's checks (one code path)
+    [   # FrequencyData is validated by physmodel.data.sweep.FrequencySweep's checks (one code path)
         (dict(frequency_hz=np.append(F[:-1], np.nan)), r"frequency_hz contains NaN or inf at rows \[11\]"),
         (dict(response=np.append(H[:-1], np.nan)), r"response contains NaN or inf at rows \[11\]"),
         (dict(response=H[:-1]), r"one value per line; got 12, 12, 11"),
         (dict(temperature_c=np.full(11, 25.0)), r"temperature_c has shape \(11,\) but frequency_hz has 12 lines"),
         (dict(frequency_hz=-F), r"frequencies must be > 0 Hz; got \[-1.0"),
         (dict(frequency_hz=F[::-1]), r"frequencies at 25 °C must strictly increase"),
-        (
-            dict(magnitude_std_db=np.zeros(12), phase_std_deg=np.ones(12)),
-            r"magnitude_std_db must be > 0 \(it becomes a weight 1/σ\), got 0.0 at index 0",
-        ),
+        (dict(magnitude_std_db=np.zeros(12), phase_std_deg=np.ones(12)),
+         r"magnitude_std_db must be > 0 \(it becomes a weight 1/σ\), got 0.0 at index 0"),
         (dict(phase_std_deg=np.full(12, np.inf), magnitude_std_db=np.ones(12)), r"phase_std_deg must be finite"),
         (dict(magnitude_std_db=np.ones(12)), r"give both magnitude_std_db and phase_std_deg, or neither"),
         (dict(response=np.where(np.arange(12) == 3, 0, H)), r"response is exactly 0 at rows \[3\]"),
@@ -85,7 +83,8 @@ def test_evaluation_outside_the_validity_range_is_an_error():
 
 
 def test_rational_non_convergence_raises_or_is_flagged():
-    f, t, h, _, smag, sph = physics_sweep([25.0], np.geomspace(0.1, 20, 40), magnitude_std_db=0.2, phase_std_deg=1.0)
+    f, t, h, _, smag, sph = physics_sweep([25.0], np.geomspace(0.1, 20, 40), magnitude_std_db=0.2,
+                                          phase_std_deg=1.0)
     with pytest.raises(ConvergenceError, match="Maximum_Iterations_Exceeded") as info:
         RationalFit(4, 4, max_iter=1).fit(f, t, h, smag, sph)
     assert info.value.result is not None and not info.value.result.converged
@@ -96,18 +95,8 @@ def test_rational_non_convergence_raises_or_is_flagged():
 
 def test_from_sweep_uses_only_the_documented_attributes():
     class Sweep:  # duck-typed stand-in for physmodel.data.sweep.FrequencySweep
-        __slots__ = (
-            "temperature_c",
-            "frequency_hz",
-            "response",
-            "magnitude_std_db",
-            "phase_std_deg",
-            "input_name",
-            "input_unit",
-            "output_name",
-            "output_unit",
-            "metadata",
-        )
+        __slots__ = ("temperature_c", "frequency_hz", "response", "magnitude_std_db", "phase_std_deg",
+                     "input_name", "input_unit", "output_name", "output_unit", "metadata")
 
         def temperatures(self):
             return np.unique(self.temperature_c)
@@ -118,12 +107,8 @@ def test_from_sweep_uses_only_the_documented_attributes():
     s.input_name, s.input_unit, s.output_name, s.output_unit = "voltage", "V", "tip_displacement", "mm"
     s.metadata = {"source": "test"}
     d = from_sweep(s)
-    assert d.labels() == {
-        "input_name": "voltage",
-        "input_unit": "V",
-        "output_name": "tip_displacement",
-        "output_unit": "mm",
-    }
+    assert d.labels() == {"input_name": "voltage", "input_unit": "V",
+                          "output_name": "tip_displacement", "output_unit": "mm"}
     from surrogate import fit_sweep
 
     res = fit_sweep(s, 0, 1)

@@ -31,9 +31,9 @@ def slice_terms(s, *, h, d, K, W, kappa_e, alpha0, r2, Rp):
     """
     s = np.asarray(s, dtype=complex)
     g = np.sqrt((s + K) / d) * h
-    t = np.tanh(g)  # safe for huge Re g (returns 1)
+    t = np.tanh(g)                       # safe for huge Re g (returns 1)
     theta = s * W * kappa_e * g * (s + K) / (h * (s * g + K * t))
-    z_branch = 2.0 / theta + 2.0 * r2  # two polymer halves + the contact resistance of each electrode
+    z_branch = 2.0 / theta + 2.0 * r2    # two polymer halves + the contact resistance of each electrode
     Y = 1.0 / z_branch + (0.0 if np.isinf(Rp) else 1.0 / Rp)
     frac = (2.0 / theta) / z_branch
     Phi = alpha0 * W * kappa_e * K * (g - t) / (s * g + K * t)
@@ -55,8 +55,8 @@ def solve_two_rail(n, L, r1, Y, *, v_top=0.5, v_bottom=-0.5, source=None):
     z = (np.arange(n) + 0.5) * dz
     if r1 == 0:
         raise ValueError("ladder oracle needs r1 > 0 (r1 = 0 is the trivial uniform case)")
-    g_seg = 1.0 / (r1 * dz)  # conductance between adjacent nodes
-    g_end = 2.0 * g_seg  # half segment to the terminal
+    g_seg = 1.0 / (r1 * dz)              # conductance between adjacent nodes
+    g_end = 2.0 * g_seg                  # half segment to the terminal
     ys = Y * dz
     # unknown ordering: [u_1, l_1, u_2, l_2, ...]; banded storage with 2 sub/super-diagonals
     m = 2 * n
@@ -102,9 +102,9 @@ def actuator_ladder(n, s, *, L, r1, E, I2, **slice_kw):
         sl = slice_terms(sj, **slice_kw)
         z, u, lo, I = solve_two_rail(n, L, r1, sl["Y"], v_top=0.5, v_bottom=-0.5)
         Z[j] = 1.0 / I
-        vp = sl["frac"] * (u - lo)  # polymer voltage of each slice
-        m = -sl["Phi"] * vp  # bending moment per length
-        H[j] = np.sum((L - z) * m) * (L / n) / (E * I2)  # midpoint rule for ∫ (L − z) m dz / EI
+        vp = sl["frac"] * (u - lo)                   # polymer voltage of each slice
+        m = -sl["Phi"] * vp                          # bending moment per length
+        H[j] = np.sum((L - z) * m) * (L / n) / (E * I2)   # midpoint rule for ∫ (L − z) m dz / EI
     return Z, H
 
 

@@ -52,17 +52,16 @@ def _trapezoid(y, x):
 
 @dataclass(frozen=True)
 class SliceSolution:
-    x: np.ndarray  # dimensionless nodes x̂
-    rho: np.ndarray  # dimensionless charge density ρ̂
-    phi: np.ndarray  # dimensionless potential φ̂
-    dphi_wall: complex  # dφ̂/dx̂ at x̂ = +1 from the half-cell Gauss balance
+    x: np.ndarray          # dimensionless nodes x̂
+    rho: np.ndarray        # dimensionless charge density ρ̂
+    phi: np.ndarray        # dimensionless potential φ̂
+    dphi_wall: complex     # dφ̂/dx̂ at x̂ = +1 from the half-cell Gauss balance
     dphi_wall_minus: complex  # dφ̂/dx̂ at x̂ = −1
-    flux_wall: complex  # discrete charge flux −(ρ̂' + q φ̂') through the last interior face
+    flux_wall: complex     # discrete charge flux −(ρ̂' + q φ̂') through the last interior face
 
 
-def solve_slice(
-    s_hat: complex, q: float, n: int, stretch: float, *, rho_wall=None, phi_wall=(-0.5, 0.5)
-) -> SliceSolution:
+def solve_slice(s_hat: complex, q: float, n: int, stretch: float, *, rho_wall=None,
+                phi_wall=(-0.5, 0.5)) -> SliceSolution:
     """Solve ŝ ρ = ρ'' + q φ'', φ'' = −ρ on [−1, 1].
 
     ``phi_wall`` = (φ̂(−1), φ̂(+1)).  ``rho_wall`` None: blocking walls (zero charge flux);
@@ -71,12 +70,12 @@ def solve_slice(
     """
     x = clustered_grid(n, stretch)
     m = n + 1
-    dx = np.diff(x)  # face spacings, length n
+    dx = np.diff(x)                         # face spacings, length n
     vol = np.empty(m)
     vol[1:-1] = 0.5 * (x[2:] - x[:-2])
     vol[0] = 0.5 * dx[0]
     vol[-1] = 0.5 * dx[-1]
-    gface = 1.0 / dx  # face "conductances"
+    gface = 1.0 / dx                        # face "conductances"
 
     rows, cols, vals = [], [], []
     rhs = np.zeros(2 * m, dtype=complex)
@@ -86,8 +85,8 @@ def solve_slice(
         cols.append(c)
         vals.append(v)
 
-    R = lambda i: i  # noqa: E731  index of ρ_i
-    P = lambda i: m + i  # noqa: E731  index of φ_i
+    R = lambda i: i          # noqa: E731  index of ρ_i
+    P = lambda i: m + i      # noqa: E731  index of φ_i
 
     # --- Nernst-Planck (charge conservation) in every control volume:
     #     ŝ ρ_i V_i − Σ_faces g (ρ_nb − ρ_i + q (φ_nb − φ_i)) = 0   (wall faces: zero flux)
@@ -132,11 +131,11 @@ def solve_slice(
 class Material:
     """Physical slice parameters (SI)."""
 
-    h: float  # half-thickness [m]
-    d: float  # diffusivity [m²/s]
+    h: float        # half-thickness [m]
+    d: float        # diffusivity [m²/s]
     C_minus: float  # [mol/m³]
     kappa_e: float  # [F/m]
-    T: float  # [K]
+    T: float        # [K]
     W: float = 1.0  # width [m]
 
     @property
@@ -153,7 +152,8 @@ class Material:
         return s * self.h**2 / self.d
 
 
-def blocking_response(mat: Material, s: complex, n: int, stretch: float, V: float = 1.0, alpha0: float = 1.0):
+def blocking_response(mat: Material, s: complex, n: int, stretch: float, V: float = 1.0,
+                      alpha0: float = 1.0):
     """Blocking electrodes, φ(±h) = ±V/2.
 
     Returns ``(current_per_area, moment_per_length, sol)``:
