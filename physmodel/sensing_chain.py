@@ -310,8 +310,8 @@ def _P(*a, **k):
 _OPAMPS = ("single-pole op-amp 1/A = 1/A0 + s/ω_t (Franco, Design with Operational Amplifiers, 4th ed., ch. 6); "
            "GBW: µA741 1 MHz (TI SLOS094), LM324 1.2 MHz (TI SLOS066), TL071 3 MHz (TI SLOS080); "
            "A0: µA741 2e5 typ, 2e4 min (TI SLOS094)")
-_ZETA_BEAM = ("water: Sader 1998 (Γ_i ≈ 0.04 at Re ≈ 5e3 for a 6.5 mm strip, ζ ≈ 0.02); hydrated Nafion "
-              "loss tangent 0.05-0.15 (ζ ≈ 0.03-0.08)")
+_ZETA_BEAM = ("water alone: Sader 1998 (Γ_i ≈ 0.04 at Re ≈ 5e3 for a 6.5 mm strip, ζ ≈ 0.02); an IPMC strip "
+              "in water: seed 002 Table 2, ξ = 0.18 (first mode, 12 Hz)")
 _ELEMENTS = (
     ChainElement(
         "polarity", "sign convention", "current or displacement",
@@ -384,7 +384,7 @@ _ELEMENTS = (
         "added mass Sader 1998; E ≈ 0.1-0.6 GPa (physics.md §8) -> f1 ≈ 28-69 Hz",
         (_P("time_constant", "s", 0.0, 0.0, 1.0 / (2 * math.pi * 10.0), 1.0 / (2 * math.pi * 50.0),
             (1.0 / (2 * math.pi * 89.0), 1.0 / (2 * math.pi * 28.0)), "E 0.1-1 GPa with water added mass"),
-         _P("damping", "1", 0.05, 0.005, 1.0, 0.05, (0.02, 0.15), _ZETA_BEAM),
+         _P("damping", "1", 0.05, 0.005, 1.0, 0.05, (0.02, 0.3), _ZETA_BEAM),
          _P("coupling_ratio", "1", 0.0, 0.0, 10.0, 0.05, (0.0, 0.1),
             "k_tip/k_slit; seed 000 Sec. II-A: the strip 'presents little resistance' to the wood piece")),
         lambda s, v, Z: tip_driven_beam(s, v["time_constant"], v["damping"], v["coupling_ratio"])),

@@ -17,10 +17,24 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from physmodel import IPMCError
-from physmodel.sensing_chain import (CLAMPED_PINNED_LAMBDA1, ELEMENTS, base_excited_resonance, chain_elements,
-                                     chain_response, clamped_pinned_frequency_hz, first_order_lag, get_element,
-                                     highpass, laser_lag, polarity, pure_delay, second_order_lowpass,
-                                     tip_driven_beam, transimpedance, transimpedance_factor)
+from physmodel.sensing_chain import (
+    CLAMPED_PINNED_LAMBDA1,
+    ELEMENTS,
+    base_excited_resonance,
+    chain_elements,
+    chain_response,
+    clamped_pinned_frequency_hz,
+    first_order_lag,
+    get_element,
+    highpass,
+    laser_lag,
+    polarity,
+    pure_delay,
+    second_order_lowpass,
+    tip_driven_beam,
+    transimpedance,
+    transimpedance_factor,
+)
 from physmodel.sensor import TransimpedanceChain
 
 W = 2 * np.pi * np.array([3.0, 10.0, 31.6, 100.0, 316.0])      # rad/s
@@ -81,17 +95,18 @@ def test_first_order_current_lag_and_laser_lag_from_their_odes():
 
 def test_second_order_lowpass_and_highpasses_from_their_odes():
     tau, z = 1.7e-3, 0.4
-    lp = lambda t, x, u: [x[1], (u - x[0] - 2 * z * tau * x[1]) / tau**2]                  # noqa: E731
+    lp = lambda t, x, u: [x[1], (u - x[0] - 2 * z * tau * x[1]) / tau**2]  # noqa: E731
     fc = 18.0
     wc = 2 * np.pi * fc
     rc = lambda t, x, u: [wc * (u - x[0])]                  # capacitor voltage; output u − v_C  # noqa: E731
-    hp2 = lambda t, x, u: [x[1], u - 2 * z * wc * x[1] - wc**2 * x[0]]        # output x'' # noqa: E731
+    hp2 = lambda t, x, u: [x[1], u - 2 * z * wc * x[1] - wc**2 * x[0]]        # output x''  # noqa: E731
     for w in (2 * np.pi * 25, 2 * np.pi * 90):
         got = ode_phasor(lp, 2, lambda t, x: x[0], w, 40 * tau / z)
         assert abs(got - second_order_lowpass(1j * w, tau, z)) < 1e-7
-        got = ode_phasor(rc, 1, lambda t, x: math.cos(w * t) - x[0], w, 30 / wc)
+        got = ode_phasor(rc, 1, lambda t, x, w=w: math.cos(w * t) - x[0], w, 30 / wc)
         assert abs(got - highpass(1j * w, fc, 1)) < 1e-7
-        got = ode_phasor(hp2, 2, lambda t, x: math.cos(w * t) - 2 * z * wc * x[1] - wc**2 * x[0], w, 40 / (z * wc))
+        got = ode_phasor(hp2, 2, lambda t, x, w=w: math.cos(w * t) - 2 * z * wc * x[1] - wc**2 * x[0], w,
+                         40 / (z * wc))
         assert abs(got - highpass(1j * w, fc, 2, z)) < 1e-7
 
 
@@ -99,7 +114,7 @@ def test_base_excited_fixture_from_its_equation_of_motion():
     wf, z = 2 * np.pi * 95.0, 0.2                               # m x'' + c(x' − y') + k(x − y) = 0, y = cos ωt
 
     for w in (2 * np.pi * 40, 2 * np.pi * 95, 2 * np.pi * 160):
-        rhs = lambda t, x, u: [x[1], -2 * z * wf * (x[1] + w * math.sin(w * t)) - wf**2 * (x[0] - u)]  # noqa: E731
+        rhs = lambda t, x, u, w=w: [x[1], -2 * z * wf * (x[1] + w * math.sin(w * t)) - wf**2 * (x[0] - u)]  # noqa: E731
         got = ode_phasor(rhs, 2, lambda t, x: x[0], w, 40 / (z * wf))
         assert abs(got - base_excited_resonance(1j * w, 1 / wf, z)) < 1e-7
 
@@ -218,7 +233,7 @@ def node_solution(s, Z, R1, R2, R3, C1, C3, gbw1, A01, gbw2, A02):
 
 @pytest.mark.parametrize("Z", [Z_RC, 26.0 + 0j, 1500.0 - 700.0j])
 def test_transimpedance_equals_node_equations(Z):
-    kw = dict(R1=470e3, R2=10e3, R3=33e3, C1=2e-10, C3=1e-11)
+    kw = {"R1": 470e3, "R2": 10e3, "R3": 33e3, "C1": 2e-10, "C3": 1e-11}
     for g1, a1, g2, a2 in ((1e6, 2e5, 1e6, 2e5), (3e6, 1e5, 0.7e6, 5e4)):
         ref = node_solution(S, Z, kw["R1"], kw["R2"], kw["R3"], kw["C1"], kw["C3"], g1, a1, g2, a2)
         got = transimpedance(S, Z, kw["R1"], kw["R2"], kw["R3"], C1=kw["C1"], C3=kw["C3"],
