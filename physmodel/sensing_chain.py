@@ -2,7 +2,7 @@ r"""The sensing experiment of seed 000 as a chain of documented elements around 
 
 Seed 000 (Sec. II-A, Figs. 2-4) measures G(s) = I(s)/D(s): the short-circuit current i of a
 cantilevered strip (18 x 6.5 x 0.21 mm, in water) per the displacement d read by a laser sensor
-(Baumer OADM 20I6441/S14F) on a lightweight cup glued to a subwoofer membrane; the strip's tip
+(Baumer OADM 20I6441/S14F) on a lightweight cup coupled to a subwoofer membrane; the strip's tip
 sits in a slit cut in a wooden piece fixed to the cup; i is read through two cascaded op-amps and
 both signals are sampled by a dSPACE DS1104.  What the paper's G contains besides the strip::
 
