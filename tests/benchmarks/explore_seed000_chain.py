@@ -15,7 +15,7 @@ printed model follows the measured points (not printed; the convention of
 Model: physics (``SensorModel``, boundary-charge kernel, ``seed000_sensor_dev`` at T_ref = 35 °C;
 free a0, d, κe on ``scenarios.seed_calibration`` bounds; r1', r2' held at the development values,
 which that calibration could not determine either; polarity = the sign of a0, both tried) ×
-elements of :mod:`physmodel.sensing_chain`.
+elements of :mod:`physmodel.effects.sensing`.
 
 1. Greedy forward selection: every remaining element is added in turn and the whole model refitted
    (``physmodel.calibration.fit_parameters``, multi-start); the best is kept if LR = 2 Δcost exceeds
@@ -49,9 +49,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from inversion.examples import SEED000_DEN_35C, SEED000_NUM_35C  # noqa: E402
 from physmodel import SensorModel, get_parameter_set  # noqa: E402
-from physmodel.calibration import FreeParameter, apply_values, fit_parameters  # noqa: E402
-from physmodel.sensing_chain import ELEMENTS  # noqa: E402
-from physmodel.sweep import FrequencySweep  # noqa: E402
+from physmodel.estimation.lsq import fit_parameters  # noqa: E402
+from physmodel.estimation.records import FreeParameter  # noqa: E402
+from physmodel.parameter_paths import apply_values  # noqa: E402
+from physmodel.effects.sensing import ELEMENTS  # noqa: E402
+from physmodel.data.sweep import FrequencySweep  # noqa: E402
 from surrogate import RationalFit  # noqa: E402
 
 T_C = 35.0

@@ -1,4 +1,4 @@
-"""Sensing-chain elements (physmodel.sensing_chain) against independent evaluations.
+"""Sensing-chain elements (physmodel.effects.sensing) against independent evaluations.
 
 Oracles: the circuit's node equations solved numerically per frequency (numpy.linalg.solve, with
 the op-amp written as A0/(1 + s A0/ω_t)); steady states of the elements' ODEs integrated in time
@@ -17,7 +17,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from physmodel import IPMCError
-from physmodel.sensing_chain import (
+from physmodel.effects.sensing import (
     CLAMPED_PINNED_LAMBDA1,
     ELEMENTS,
     base_excited_resonance,
@@ -276,3 +276,50 @@ def test_chain_composes_and_broadcasts_parameter_batches():
 def test_bad_input_raises_ipmc_error(call):
     with pytest.raises(IPMCError):
         call()
+
+
+# ------------------------------------------------------------------ the chain as library effects
+def test_registered_effects_compose_with_the_sensor_model_and_match_the_node_equations():
+    """EffectModel(S) with the transimpedance effect = SensorModel S × the circuit solved from its
+    node equations with the model's own Z as source; every registered effect is sensor-only on S."""
+    from physmodel import SensorModel, get_parameter_set
+    from physmodel.effects import LIBRARY, EffectModel
+    from physmodel.effects.sensing import EFFECTS, PLAUSIBLE
+
+    p = get_parameter_set("seed000_sensor_dev", T_ref=308.15)
+    f = np.array([10.0, 31.6, 100.0])
+    r = SensorModel(p).frequency_response(f, [35.0], quantities=("S", "Z"))
+    S0, Z = r["S"][0, 0], r["Z"][0, 0]
+    gbw, a0 = 1e6, 2e5
+    got = EffectModel(p, "sensor", {"transimpedance": {"unity_gain_time": 1 / (2 * np.pi * gbw),
+                                                       "inverse_dc_gain": 1 / a0}}).frequency_response(f, [35.0])["S"][0, 0]
+    ref = S0 * node_solution(2j * np.pi * f, Z, 470e3, 10e3, 10e3, 0.0, 0.0, gbw, a0, gbw, a0) / 470e3
+    assert np.max(np.abs(got / ref - 1)) < 1e-9
+    assert abs(got[-1] / S0[-1]) < 0.9                       # the effect is not negligible in the band
+    for e in EFFECTS:
+        assert LIBRARY[e.name] is e and e.kinds == ("sensor",) and e.quantities == ("S",)
+        m = EffectModel(p, "sensor", {e.name: e.typical}).frequency_response(f, [35.0])["S"][0, 0]
+        assert not np.allclose(m, S0, rtol=1e-3), e.name
+        for k in PLAUSIBLE:
+            lo, hi, src = PLAUSIBLE[k]
+            assert lo < hi and src
+    s = 2j * np.pi * f
+    beam = EffectModel(p, "sensor", {"tip_driven_beam": {"time_constant": 3e-3, "damping": 0.1}}).frequency_response(
+        f, [35.0])["S"][0, 0]
+    assert np.allclose(beam / S0, tip_driven_beam(s, 3e-3, 0.1, 0.0), rtol=1e-12)
+    with pytest.raises(IPMCError):
+        EffectModel(p, "actuator", {"laser_lag": {"time_constant": 1e-3}})
+
+
+def test_transimpedance_chain_with_finite_opamps_matches_the_node_equations_and_keeps_its_defaults():
+    Z = 26.0 + 1.0 / (S * 3e-4)
+    ch = TransimpedanceChain(R3=33e3, gbw_hz=3e6, dc_gain=1e5)
+    ref = node_solution(S, Z, 470e3, 10e3, 33e3, 0.0, 0.0, 3e6, 1e5, 3e6, 1e5)
+    assert np.max(np.abs(ch.response(S, Z) / ref - 1)) < 1e-10
+    assert np.array_equal(TransimpedanceChain().response(S), np.full_like(S, 470e3))
+    with pytest.raises(IPMCError):
+        ch.response(S)
+    with pytest.raises(IPMCError):
+        ch.transfer_function()
+    with pytest.raises(IPMCError):
+        TransimpedanceChain(gbw_hz=-1.0)

@@ -1,4 +1,5 @@
-r"""The sensing experiment of seed 000 as a chain of documented elements around the strip.
+r"""The sensing experiment of seed 000 as a chain of documented elements around the strip, and
+the chain elements registered as sensor effects of the library (:data:`EFFECTS`).
 
 Seed 000 (Sec. II-A, Figs. 2-4) measures G(s) = I(s)/D(s): the short-circuit current i of a
 cantilevered strip (18 x 6.5 x 0.21 mm, in water) per the displacement d read by a laser sensor
@@ -55,7 +56,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from .errors import IPMCError, ParameterError
+from ..errors import IPMCError, ParameterError
+from .base import Effect, EffectParameter
 
 #: First root of tan λ = tanh λ (clamped-pinned beam), and of cos λ cosh λ = −1 (clamped-free).
 CLAMPED_PINNED_LAMBDA1 = 3.926602312047919
@@ -384,7 +386,7 @@ _ELEMENTS = (
         "added mass Sader 1998; E ≈ 0.1-0.6 GPa (physics.md §8) -> f1 ≈ 28-69 Hz",
         (_P("time_constant", "s", 0.0, 0.0, 1.0 / (2 * math.pi * 10.0), 1.0 / (2 * math.pi * 50.0),
             (1.0 / (2 * math.pi * 89.0), 1.0 / (2 * math.pi * 28.0)), "E 0.1-1 GPa with water added mass"),
-         _P("damping", "1", 0.05, 0.005, 1.0, 0.05, (0.02, 0.3), _ZETA_BEAM),
+         _P("damping", "1", 0.05, 0.005, 1.0, 0.1, (0.02, 0.3), _ZETA_BEAM),
          _P("coupling_ratio", "1", 0.0, 0.0, 10.0, 0.05, (0.0, 0.1),
             "k_tip/k_slit; seed 000 Sec. II-A: the strip 'presents little resistance' to the wood piece")),
         lambda s, v, Z: tip_driven_beam(s, v["time_constant"], v["damping"], v["coupling_ratio"])),
@@ -426,8 +428,56 @@ def chain_response(s, settings: Mapping[str, Mapping[str, float]], source_impeda
     return out
 
 
+# ================================================================ as library effects
+#: Elements registered as sensor effects (kinds ("sensor",), quantity "S"; parameters, bounds and
+#: sources from the declarations above).  Not registered, because the library already has them:
+#: ``acquisition_delay`` (``time_delay``: e^{-sτ}, τ in [0, 50 ms]), ``current_lag`` and real-pole
+#: ``current_lowpass2`` (``amplifier_bandwidth``: two real poles); ``polarity`` is the sign of a0,
+#: not an effect; ``ac_coupling2`` has no source beyond ``ac_coupling``.
+REGISTERED = ("laser_lag", "ac_coupling", "fixture_joint", "tip_driven_beam", "transimpedance")
+#: Sourced ranges of the parameters of library effects that model seed 000's chain (``time_delay``
+#: and ``amplifier_bandwidth`` included): {"effect.param": (lower, upper, source)}.
+PLAUSIBLE = {f"{n}.{p.name}": (p.plausible[0], p.plausible[1], p.source)
+             for n in REGISTERED for p in ELEMENTS[n].parameters if p.plausible is not None}
+PLAUSIBLE["time_delay.delay"] = (0.0, 1e-3, ELEMENTS["acquisition_delay"].source)
+
+
+def _strip_impedance(ctx) -> np.ndarray:
+    """The strip's terminal impedance Z [Ω] at the effect context's points (the Norton source's)."""
+    if "Z" in ctx.base:
+        return ctx.base["Z"]
+    from .. import electrode
+    from ..params import STATE_FIELDS
+
+    p = {k: getattr(ctx.st, k) for k in STATE_FIELDS}
+    t = electrode.strip_terms(p, ctx.s_kernel, want_xcoth=True)
+    return electrode.terminal_impedance(t.A, p["L"], t.xcoth)
+
+
+def _as_effect(el: ChainElement) -> Effect:
+    pars = []
+    for p in el.parameters:
+        typical = p.start if p.start != p.off else p.off + 0.5 * (p.upper - p.off)
+        rng = f"; sourced range [{p.plausible[0]:.3g}, {p.plausible[1]:.3g}]" if p.plausible else ""
+        pars.append(EffectParameter(p.name, p.unit, p.off, p.lower, p.upper, typical, f"{p.doc or p.name}{rng} "
+                                    f"({p.source})"))
+    switch = "time_constant" if el.name in ("fixture_joint", "tip_driven_beam") else None
+
+    def apply(q, ctx, v, _el=el):
+        Z = _strip_impedance(ctx) if _el.needs_source_impedance else None
+        return _el.response(ctx.s, v, Z)
+
+    return Effect(el.name, el.title, el.description, el.source, "response", tuple(pars), kinds=("sensor",),
+                  quantities=("S",), apply=apply, switch=switch,
+                  bounds_doc="the element's fit bounds (physical limits); sourced ranges in "
+                             "physmodel.effects.sensing.PLAUSIBLE")
+
+
+EFFECTS = [_as_effect(ELEMENTS[n]) for n in REGISTERED]
+
+
 __all__ = ["polarity", "pure_delay", "first_order_lag", "laser_lag", "second_order_lowpass", "highpass",
            "base_excited_resonance", "tip_driven_beam", "clamped_pinned_frequency_hz", "transimpedance",
            "transimpedance_factor", "ChainParameter", "ChainElement", "ELEMENTS", "get_element",
            "chain_elements", "chain_response", "CLAMPED_PINNED_LAMBDA1", "SEED000_R1", "SEED000_R2",
-           "SEED000_R3"]
+           "SEED000_R3", "EFFECTS", "REGISTERED", "PLAUSIBLE"]
