@@ -61,23 +61,23 @@ def pole_zero_maps(models: dict, path, title: str = "") -> Path:
 def effect_intervals(rows: list, path, title: str = "") -> Path:
     """Fitted values with 95 % intervals against their sourced range, one panel per parameter.
 
-    ``rows``: dicts with name, value, ci (lo, hi) or None, plausible (lo, hi) or None, unit."""
+    ``rows``: dicts with name, value, ci (lo, hi) or None, identifiable, plausible (lo, hi) or None,
+    unit; an undetermined parameter is marked so, without its (meaningless) interval."""
     n = max(len(rows), 1)
     fig, axes = _subplots(n, 1, figsize=(7.0, 0.9 * n + 0.8), squeeze=False)
     for ax, r in zip(axes[:, 0], rows):
-        vals = [abs(r["value"])]
-        if r.get("ci") is not None and all(np.isfinite(r["ci"])):
-            lo, hi = r["ci"]
-            ax.plot([lo, hi], [0, 0], "-", color="C0", lw=3)
-            vals += [abs(lo), abs(hi)]
+        v = r["value"]
+        pts = [v] + list(r.get("plausible") or [])
+        if r.get("identifiable", True) and r.get("ci") is not None and all(np.isfinite(r["ci"])):
+            ax.plot(list(r["ci"]), [0, 0], "-", color="C0", lw=3)
+            pts += list(r["ci"])
+        else:
+            ax.text(0.99, 0.5, "undetermined", transform=ax.transAxes, ha="right", va="center", fontsize=7, color="C3")
         if r.get("plausible") is not None:
             ax.axvspan(*r["plausible"], color="C2", alpha=0.25)
-            vals += [abs(x) for x in r["plausible"]]
-        ax.plot([r["value"]], [0], "o", color="C0")
-        pos = [v for v in vals if v > 0]
-        if pos and min(pos) > 0 and r["value"] > 0 and max(pos) / min(pos) > 30 and all(
-                v > 0 for v in [r["value"]] + list(r.get("plausible") or []) + list(r.get("ci") or [])
-                if math.isfinite(v)):
+        ax.plot([v], [0], "o", color="C0")
+        pos = [abs(x) for x in pts if x != 0 and math.isfinite(x)]
+        if all(x > 0 for x in pts) and pos and max(pos) / min(pos) > 30:
             ax.set_xscale("log")
         ax.set_yticks([])
         ax.set_ylabel(r["name"], rotation=0, ha="right", va="center", fontsize=8)
@@ -89,4 +89,4 @@ def effect_intervals(rows: list, path, title: str = "") -> Path:
     return _save(fig, path)
 
 
-__all__ = ["bode_overlay", "pole_zero_maps", "effect_intervals"]
+__all__ = ["bode_overlay", "effect_intervals", "pole_zero_maps"]

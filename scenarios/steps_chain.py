@@ -45,7 +45,7 @@ import numpy as np
 
 from .spec import INT, NUM, NUM_OR_STR, NUMS, STRS, ScenarioError
 
-__all__ = ["step_chain", "CHAIN_SCHEMA", "printed_sweep", "misfit"]
+__all__ = ["CHAIN_SCHEMA", "misfit", "printed_sweep", "step_chain"]
 
 CHAIN_SCHEMA = {"temperature_c": NUM, "fmin_hz": NUM, "fmax_hz": NUM, "points": INT, "floor_db": NUM,
                 "floor_deg": NUM, "free": STRS, "candidates": STRS, "documented": STRS, "max_steps": INT,
@@ -61,7 +61,7 @@ PHYS_SOURCED = {"d": (1e-11, 1e-10, "literature (issue 16); seed 002 Table 3: 3.
                 "kappa_e": (1e-7, 1e-5, "seed 002 Table 3: 4.47e-7; physics.md §8: 1.3e-6 F/m")}
 #: Not printed, so held off in the documented fit (no capacitor is printed across R1).
 HELD_OFF = {"transimpedance.feedback_capacitance"}
-_UNITS = {"d": "m²/s", "kappa_e": "F/m", "a0": "C/N"}
+_UNITS = {"d": "m²/s", "kappa_e": "F/m", "a0": "C/J"}
 
 
 # ----------------------------------------------------------------------------- data
@@ -79,7 +79,7 @@ def _rounding_std(f_hz, draws: int = 4000, seed: int = 0):
     from physmodel.parameter_sets.published import seed000_printed_model_35c
 
     num, den, _ = (np.asarray(x) for x in seed000_printed_model_35c())
-    half = lambda c: np.array([0.5 * 10.0 ** (math.floor(math.log10(abs(x))) - 1) if x not in (0.0, 1.0) else 0.0  # noqa: E731
+    half = lambda c: np.array([0.5 * 10.0 ** (math.floor(math.log10(abs(x))) - 1) if x not in (0.0, 1.0) else 0.0
                                for x in c])          # two significant digits printed (den[0] = 1 exact)
     rng = np.random.default_rng(seed)
     s = 2j * np.pi * np.asarray(f_hz, float)
@@ -358,8 +358,8 @@ def step_chain(ctx) -> None:
                                       f"seed 000 printed {T:g} °C model: verdict {final_verdict}"))
     ctx.file(plots_chain.pole_zero_maps({k: (r["zeros"], r["poles"]) for k, r in rat.items()},
                                         ctx.out / "chain_pole_zero.png", "4/4 fits over the band"))
-    ctx.file(plots_chain.effect_intervals([r for r in rows if r["fit"] == "chain"], ctx.out / "chain_effects.png",
-                                          "physics + named chain"))
+    ctx.file(plots_chain.effect_intervals([dict(r, name=f"{r['fit']}: {r['name']}") for r in rows],
+                                          ctx.out / "chain_effects.png", "greedy chain and documented fit"))
     _report(ctx, data, sign, steps, chosen, f"{final_verdict}: {why}", mis, rows, rat, dec, docres, doc_effects, prof,
             ts)
 
@@ -387,7 +387,7 @@ def _temperature_series(base, vals, effects, fd):
         lo, hi = TSERIES_C
         out[_slug(name)] = {"label": name, "a0_ratio": a0[hi] / a0[lo], "hf_gain_ratio": abs(G[hi][-1] / G[lo][-1]),
                             "phase_change_deg": float(np.degrees(np.angle(G[hi][-1] / G[lo][-1])))}
-    pa = lambda T: float(np.polyval(A0_POLY[::-1], T - A0_CENTER_C))  # noqa: E731
+    pa = lambda T: float(np.polyval(A0_POLY[::-1], T - A0_CENTER_C))
     out["printed"] = {"label": "printed", "a0_ratio": pa(TSERIES_C[1]) / pa(TSERIES_C[0]), "hf_gain_ratio": math.nan,
                       "phase_change_deg": math.nan}
     return out
@@ -407,9 +407,9 @@ def _profile_d(data, base, vals, effects, cfg):
             free.append(FreeParameter(f"{e}.{p.name}", p.lower, p.upper, "linear",
                                       min(max(vals[f"{e}.{p.name}"], p.lower), p.upper)))
     out = []
+    pm = EffectModel(base, "sensor", {e: {} for e in effects}).predictor(data, "S").many
     for dv in cfg.get("d_profile", [1e-13, 1e-12, 1e-11, 3e-11, 1e-10] if cfg.get("null_refits", 0) else
                       [1e-13, 1e-11, 1e-10]):
-        pm = EffectModel(base, "sensor", {e: {} for e in effects}).predictor(data, "S").many
         r = fit_parameters(data, None, free, predict_many=lambda vl, dv=dv: pm([{**v, "d": dv} for v in vl]),
                            starts=1, seed=cfg.get("seed", 0), max_nfev=400, identify=False)
         out.append((dv, 2 * r.cost))

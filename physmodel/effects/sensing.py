@@ -51,8 +51,8 @@ data.  Sources are cited per parameter; where no source bounds a value the decla
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
-from typing import Callable, Mapping
 
 import numpy as np
 
@@ -476,8 +476,8 @@ def _as_effect(el: ChainElement) -> Effect:
 EFFECTS = [_as_effect(ELEMENTS[n]) for n in REGISTERED]
 
 
-__all__ = ["polarity", "pure_delay", "first_order_lag", "laser_lag", "second_order_lowpass", "highpass",
-           "base_excited_resonance", "tip_driven_beam", "clamped_pinned_frequency_hz", "transimpedance",
-           "transimpedance_factor", "ChainParameter", "ChainElement", "ELEMENTS", "get_element",
-           "chain_elements", "chain_response", "CLAMPED_PINNED_LAMBDA1", "SEED000_R1", "SEED000_R2",
-           "SEED000_R3", "EFFECTS", "REGISTERED", "PLAUSIBLE"]
+__all__ = ["CLAMPED_PINNED_LAMBDA1", "EFFECTS", "ELEMENTS", "PLAUSIBLE", "REGISTERED", "SEED000_R1", "SEED000_R2",
+           "SEED000_R3", "ChainElement", "ChainParameter", "base_excited_resonance", "chain_elements",
+           "chain_response", "clamped_pinned_frequency_hz", "first_order_lag", "get_element", "highpass",
+           "laser_lag", "polarity", "pure_delay", "second_order_lowpass", "tip_driven_beam", "transimpedance",
+           "transimpedance_factor"]

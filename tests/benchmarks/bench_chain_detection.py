@@ -38,13 +38,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "discrepancy")]
 
-import independent_sensor as isn  # noqa: E402
-from physmodel import get_parameter_set  # noqa: E402
-from physmodel.data.sweep import FrequencySweep  # noqa: E402
-from physmodel.effects import EffectModel  # noqa: E402
-from physmodel.estimation.discrepancy import diagnose  # noqa: E402
-from physmodel.estimation.lsq import fit_parameters  # noqa: E402
-from scenarios.steps_chain import CANDIDATES, _physics_free  # noqa: E402
+import independent_sensor as isn
+
+from physmodel import get_parameter_set
+from physmodel.data.sweep import FrequencySweep
+from physmodel.effects import EffectModel
+from physmodel.estimation.discrepancy import diagnose
+from physmodel.estimation.lsq import fit_parameters
+from scenarios.steps_chain import CANDIDATES, _physics_free
 
 DETECTABLE = 25.0
 T_C = 35.0
@@ -57,7 +58,7 @@ def start_set():
 
 def library_effect(name: str, v: dict) -> tuple:
     """The independent generator's physical sizes in the library's parametrisation."""
-    tau = lambda f: 1.0 / (2 * math.pi * f)  # noqa: E731
+    tau = lambda f: 1.0 / (2 * math.pi * f)
     if name == "amplifier":
         return "amplifier_bandwidth", {"time_constant": tau(v["f_a"]), "second_time_constant": tau(v["f_a"] * v["ratio"])}
     if name == "delay":
@@ -90,7 +91,7 @@ def library_case(seed: int, label: str):
     H1 = EffectModel(base, "sensor", eff).frequency_response(f, [T_C])["S"][0, 0] * 1e3
     sig = rng.uniform(*isn.NOISE_RANGE) / math.sqrt(2)
     noisy = H1 * (1 + sig * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)))
-    mk = lambda H: FrequencySweep(np.full(f.size, T_C), f, H, np.full(f.size, 20 / math.log(10) * sig),  # noqa: E731
+    mk = lambda H: FrequencySweep(np.full(f.size, T_C), f, H, np.full(f.size, 20 / math.log(10) * sig),
                                   np.full(f.size, math.degrees(sig)), "tip_displacement", "mm", "current", "uA")
     lam = 0.0
     if eff:

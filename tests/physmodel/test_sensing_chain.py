@@ -95,11 +95,11 @@ def test_first_order_current_lag_and_laser_lag_from_their_odes():
 
 def test_second_order_lowpass_and_highpasses_from_their_odes():
     tau, z = 1.7e-3, 0.4
-    lp = lambda t, x, u: [x[1], (u - x[0] - 2 * z * tau * x[1]) / tau**2]  # noqa: E731
+    lp = lambda t, x, u: [x[1], (u - x[0] - 2 * z * tau * x[1]) / tau**2]
     fc = 18.0
     wc = 2 * np.pi * fc
-    rc = lambda t, x, u: [wc * (u - x[0])]                  # capacitor voltage; output u − v_C  # noqa: E731
-    hp2 = lambda t, x, u: [x[1], u - 2 * z * wc * x[1] - wc**2 * x[0]]        # output x''  # noqa: E731
+    rc = lambda t, x, u: [wc * (u - x[0])]                  # capacitor voltage; output u − v_C
+    hp2 = lambda t, x, u: [x[1], u - 2 * z * wc * x[1] - wc**2 * x[0]]        # output x''
     for w in (2 * np.pi * 25, 2 * np.pi * 90):
         got = ode_phasor(lp, 2, lambda t, x: x[0], w, 40 * tau / z)
         assert abs(got - second_order_lowpass(1j * w, tau, z)) < 1e-7
@@ -114,7 +114,7 @@ def test_base_excited_fixture_from_its_equation_of_motion():
     wf, z = 2 * np.pi * 95.0, 0.2                               # m x'' + c(x' − y') + k(x − y) = 0, y = cos ωt
 
     for w in (2 * np.pi * 40, 2 * np.pi * 95, 2 * np.pi * 160):
-        rhs = lambda t, x, u, w=w: [x[1], -2 * z * wf * (x[1] + w * math.sin(w * t)) - wf**2 * (x[0] - u)]  # noqa: E731
+        rhs = lambda t, x, u, w=w: [x[1], -2 * z * wf * (x[1] + w * math.sin(w * t)) - wf**2 * (x[0] - u)]
         got = ode_phasor(rhs, 2, lambda t, x: x[0], w, 40 / (z * wf))
         assert abs(got - base_excited_resonance(1j * w, 1 / wf, z)) < 1e-7
 

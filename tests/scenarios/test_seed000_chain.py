@@ -9,7 +9,13 @@ import numpy as np
 import pytest
 
 from scenarios import runner, spec
-from scenarios.steps_chain import CHAIN_SCHEMA, misfit, printed_response, printed_sweep, step_chain
+from scenarios.steps_chain import (
+    CHAIN_SCHEMA,
+    misfit,
+    printed_response,
+    printed_sweep,
+    step_chain,
+)
 
 
 @pytest.fixture
