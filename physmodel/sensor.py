@@ -88,16 +88,23 @@ class SensorModel(PhysicsModel):
 
 @dataclass(frozen=True)
 class TransimpedanceChain:
-    """Seed 000 Fig. 4: two op-amp stages, v1 = R1 i (virtual-ground short circuit), v2 = (R3 R1/R2) i.
+    """Seed 000 Fig. 4: two inverting op-amp stages, v1 = R1 i, v2 = (R3 R1/R2) i. Gain in V/A.
 
-    R1, R2, R3 [Ω] (seed 000: 470 kΩ, 10 kΩ, 0-50 kΩ).  ``bandwidth_hz`` adds an optional
-    first-order amplifier pole [Hz] (None: ideal).  Gain is in V/A.
+    R1, R2, R3 [Ω] (seed 000: 470 kΩ, 10 kΩ, 0-50 kΩ).  ``bandwidth_hz``: an optional first-order
+    pole [Hz] of the whole chain (None: none).  ``gbw_hz``: the op-amps' gain-bandwidth product [Hz]
+    (None: ideal op-amps, the "virtual ground" of the defaults); with it the chain depends on the
+    strip's impedance Z (the first stage's noise gain is 1 + R1/Z, so it closes its loop near
+    GBW·|Z|/R1, in the band for a strip of tens of ohms) and :meth:`response` needs
+    ``source_impedance``; ``dc_gain`` A0 [-] (None: infinite).  The circuit is solved in
+    :func:`physmodel.effects.sensing.transimpedance`.
     """
 
     R1: float = 470e3
     R2: float = 10e3
     R3: float = 10e3
     bandwidth_hz: float | None = None
+    gbw_hz: float | None = None
+    dc_gain: float | None = None
 
     def __post_init__(self):
         for name in ("R1", "R2"):
@@ -106,23 +113,44 @@ class TransimpedanceChain:
                 raise IPMCError(f"{name}={v!r} Ω must be a positive finite resistance")
         if not (np.isfinite(self.R3) and self.R3 >= 0):
             raise IPMCError(f"R3={self.R3!r} Ω must be a finite resistance >= 0")
-        if self.bandwidth_hz is not None and not (np.isfinite(self.bandwidth_hz) and self.bandwidth_hz > 0):
-            raise IPMCError(f"bandwidth_hz={self.bandwidth_hz!r} must be > 0 Hz or None")
+        for name in ("bandwidth_hz", "gbw_hz", "dc_gain"):
+            v = getattr(self, name)
+            if v is not None and not (np.isfinite(v) and v > 0):
+                raise IPMCError(f"{name}={v!r} must be a positive finite number or None")
 
     @property
     def gain(self) -> float:
-        """DC transimpedance v2/i [V/A]."""
+        """DC transimpedance v2/i with ideal op-amps [V/A]."""
         return self.R3 * self.R1 / self.R2
 
-    def response(self, s):
+    @property
+    def ideal_opamps(self) -> bool:
+        return self.gbw_hz is None and self.dc_gain is None
+
+    def response(self, s, source_impedance=None):
+        """v2/i at s [rad/s] [V/A]; ``source_impedance`` Z [Ω] of the strip (needed with finite op-amps)."""
         s = np.asarray(s, dtype=complex)
-        if self.bandwidth_hz is None:
-            return np.full_like(s, self.gain)
-        return self.gain / (1.0 + s / (2 * np.pi * self.bandwidth_hz))
+        if self.ideal_opamps or self.R3 == 0:
+            g = np.full_like(s, self.gain)
+        else:
+            if source_impedance is None:
+                raise IPMCError("TransimpedanceChain with gbw_hz or dc_gain needs the strip's source_impedance [Ohm]")
+            from .effects.sensing import transimpedance
+
+            g = transimpedance(s, source_impedance, self.R1, self.R2, self.R3,
+                               unity_gain_time=0.0 if self.gbw_hz is None else 1.0 / (2 * np.pi * self.gbw_hz),
+                               inverse_dc_gain=0.0 if self.dc_gain is None else 1.0 / self.dc_gain)
+        if self.bandwidth_hz is not None:
+            g = g / (1.0 + s / (2 * np.pi * self.bandwidth_hz))
+        return g
 
     def transfer_function(self):
+        """python-control transfer function (ideal op-amps only: with finite ones the chain depends on Z)."""
         import control
 
+        if not self.ideal_opamps:
+            raise IPMCError("transfer_function() needs ideal op-amps (gbw_hz = dc_gain = None): the finite-op-amp "
+                            "chain depends on the strip's impedance; use response(s, source_impedance)")
         if self.bandwidth_hz is None:
             return control.tf([self.gain], [1.0])
         wc = 2 * np.pi * self.bandwidth_hz

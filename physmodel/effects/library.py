@@ -35,14 +35,14 @@ from ..model import DEFAULT_CHUNK, FrequencyResponse, check_frequencies, evaluat
 from ..params import STATE_FIELDS, IPMCParameters, State, first_mode_omega
 from ..sensor import SensorModel
 from ..transport import debye_rate
-from . import chain, physical
+from . import chain, physical, sensing
 from .base import KINDS, Effect, EffectParameter
 from .physical import CPE_REFERENCE_HZ, SECOND_MODE_RATIO
 
 DEFAULT_QUANTITY = {"actuator": "M", "sensor": "S"}
 
 #: The candidate library, by name.
-LIBRARY: dict[str, Effect] = {e.name: e for e in physical.EFFECTS + chain.EFFECTS}
+LIBRARY: dict[str, Effect] = {e.name: e for e in physical.EFFECTS + chain.EFFECTS + sensing.EFFECTS}
 #: Effects kept OUT of the candidate list: used by blind generators only.
 OUT_OF_LIBRARY: dict[str, Effect] = {e.name: e for e in chain.OUT_OF_LIBRARY}
 ALL_EFFECTS = {**LIBRARY, **OUT_OF_LIBRARY}

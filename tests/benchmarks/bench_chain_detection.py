@@ -1,0 +1,234 @@
+"""Blind detection of seed 000's measurement-chain elements by the discrepancy workflow (issue 16).
+
+    python3 tests/benchmarks/bench_chain_detection.py                    # both generators (~6 min)
+    python3 tests/benchmarks/bench_chain_detection.py --n-per-label 1 --null 4 --generator independent
+
+Cases: a seed 000 sensor (18 × 6.5 × 0.21 mm, development polymer values at 35 °C) with a0, d, κe
+drawn ×/÷ up to 1.35 from the user's starting set, 31 lines 10-100 Hz, complex relative noise
+0.5-2 % per line (σ given with the data), one hidden chain element of random size (or none, or one
+out of the library):
+
+``library``      :class:`physmodel.effects.EffectModel` with a library chain effect
+                 (time_delay, amplifier_bandwidth, laser_lag, ac_coupling, fixture_joint,
+                 tip_driven_beam, transimpedance); out of library: ``fixture_resonance`` (a notch).
+``independent``  tests/discrepancy/independent_sensor.py: its own strip, its own chain elements
+                 (a beam boundary-value problem, the op-amp node equations, ...) in its own
+                 parametrisation; out of library: a gain ripple and a notch.
+
+The workflow (``diagnose``) frees a0, d, κe and tests the seven chain effects as candidates
+(null_draws 1000 linearised Monte Carlo draws, null_refits 2 full-refit bootstrap draws for the
+nonlinearity correction of the threshold; both options).  Detectable: the baseline refitted to the noiseless data keeps
+λ = 2·cost ≥ 25 (library: physmodel's own fit; independent: the generator's own fit).  Reported:
+naming rate on detectable cases (verdict ``named`` with exactly the hidden element; ``at_bound``
+names apart), false-positive rate on null data (anything named; any verdict but ``none``), and the
+verdicts of out-of-library cases (should be ``unexplained``), each with a Wilson interval.
+
+Measured at commit b6611f9 (defaults, 407 s; 95 % Wilson intervals in the output):
+
+==================  ==================  ==================  ============  ==================
+generator           naming (detect.)    + 'at bound' names  FPR (null)    out of lib. unexpl.
+==================  ==================  ==================  ============  ==================
+library             8/15 = 53 %         9/15 = 60 %         0/8           3/3
+independent         5/11 = 45 %         7/11 = 64 %         0/8           4/4
+--exclude tip_driven_beam (diagnostic; its cases count as out of library):
+library             7/12 = 58 %         8/12 = 67 %         0/8           6/6
+independent         6/8 = 75 %          6/8 = 75 %          0/8           7/7
+==================  ==================  ==================  ============  ==================
+
+Misses are confusions inside the chain, not false alarms: a damped strip resonating above the band
+is a phase lead in it (tip_driven_beam ~ laser_lag: 'ambiguous'), the fixture joint and the strip
+are both resonances (fixture_joint -> tip_driven_beam), the first op-amp stage with a nearly
+resistive strip is one pole (transimpedance ~ amplifier_bandwidth); and one transimpedance refit
+(λ = 1e5) stayed in the basin of a baseline that had absorbed the effect with κe = 1.8e-4 F/m
+(outside its plausible range): diagnose starts candidate refits only at the baseline optimum.
+The issue's targets (naming ≥ 90 %, FPR ≤ 5 %, out of library -> unexplained) are met for the
+last two only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "discrepancy")]
+
+import independent_sensor as isn
+
+from physmodel import get_parameter_set
+from physmodel.data.sweep import FrequencySweep
+from physmodel.effects import EffectModel
+from physmodel.estimation.discrepancy import diagnose
+from physmodel.estimation.lsq import fit_parameters
+from scenarios.steps_chain import CANDIDATES, _physics_free
+
+DETECTABLE = 25.0
+T_C = 35.0
+LIB_OF = {k: v[0] for k, v in isn.EFFECT_SPECS.items()}
+
+
+def start_set():
+    return get_parameter_set("seed000_sensor_dev", T_ref=T_C + 273.15)
+
+
+def library_effect(name: str, v: dict) -> tuple:
+    """The independent generator's physical sizes in the library's parametrisation."""
+    tau = lambda f: 1.0 / (2 * math.pi * f)
+    if name == "amplifier":
+        return "amplifier_bandwidth", {"time_constant": tau(v["f_a"]), "second_time_constant": tau(v["f_a"] * v["ratio"])}
+    if name == "delay":
+        return "time_delay", {"delay": v["tau"]}
+    if name == "laser":
+        return "laser_lag", {"time_constant": tau(v["f_l"])}
+    if name == "ac_coupling":
+        return "ac_coupling", {"corner_hz": v["f_c"]}
+    if name == "joint":
+        return "fixture_joint", {"time_constant": tau(v["f_j"]), "damping": v["zeta"]}
+    if name == "slit_beam":
+        return "tip_driven_beam", {"time_constant": tau(v["f_cp"]), "damping": v["zeta"]}
+    if name == "opamp":
+        return "transimpedance", {"unity_gain_time": tau(v["gbw"]), "inverse_dc_gain": 1.0 / isn.A0}
+    if name == "notch":
+        return "fixture_resonance", {"frequency_hz": v["f_n"], "depth": v["depth"], "damping": v["zeta"]}
+    raise ValueError(name)
+
+
+def library_case(seed: int, label: str):
+    """(sweep, truth) from EffectModel: same draws of size and base as the independent generator."""
+    rng = np.random.default_rng([0x11B, seed])
+    p0 = start_set()
+    base = p0.replace(**{k: getattr(p0, k) * math.exp(rng.uniform(-1, 1) * math.log(1.35))
+                         for k in ("a0", "d", "kappa_e")})
+    eff = {}
+    if label != "none":
+        eff = dict([library_effect(label, isn.draw_effect(label, rng))])
+    f = isn.FREQUENCIES_HZ
+    H1 = EffectModel(base, "sensor", eff).frequency_response(f, [T_C])["S"][0, 0] * 1e3
+    sig = rng.uniform(*isn.NOISE_RANGE) / math.sqrt(2)
+    noisy = H1 * (1 + sig * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)))
+    mk = lambda H: FrequencySweep(np.full(f.size, T_C), f, H, np.full(f.size, 20 / math.log(10) * sig),
+                                  np.full(f.size, math.degrees(sig)), "tip_displacement", "mm", "current", "uA")
+    lam = 0.0
+    if eff:
+        exact = mk(H1)
+        pm = EffectModel(p0, "sensor", {}).predictor(exact, "S").many
+        r = fit_parameters(exact, None, _physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
+                           predict_many=pm, starts=2, seed=0, max_nfev=400, identify=False)
+        lam = 2 * r.cost
+    exp = [] if label == "none" or LIB_OF[label] is None else [LIB_OF[label]]
+    return mk(noisy), {"label": label, "expected": exp, "out_of_library": label in isn.OUT_OF_LIBRARY,
+                       "lam_baseline": lam, "effects": eff}
+
+
+def run_case(sweep, truth, args):
+    p0 = start_set()
+    t = time.perf_counter()
+    d = diagnose(sweep, p0, kind="sensor", free=_physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
+                 candidates=[c for c in CANDIDATES if c not in args.exclude], null_draws=args.null_draws, null_refits=args.null_refits,
+                 baseline_starts=2, seed=1)
+    return {"label": truth["label"], "expected": truth["expected"], "lam": truth["lam_baseline"],
+            "detectable": truth["lam_baseline"] >= DETECTABLE, "oo": truth["out_of_library"],
+            "verdict": d.verdict, "named": sorted(d.named), "dt": time.perf_counter() - t}
+
+
+def wilson(k, n, z=1.96):
+    if n == 0:
+        return "n = 0"
+    p = k / n
+    den = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / den
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return f"{k}/{n} = {100 * p:.0f} % (95 %: {100 * max(0, c - h):.0f}-{100 * min(1, c + h):.0f} %)"
+
+
+def report(rows, name):
+    print(f"\n=== {name} generator: {len(rows)} cases, {np.mean([r['dt'] for r in rows]):.1f} s per diagnosis ===")
+    for lab in sorted({r["label"] for r in rows}):
+        rr = [r for r in rows if r["label"] == lab]
+        cnt = Counter(f"{r['verdict']}:{'+'.join(r['named']) or '-'}" + ("*" if r["detectable"] else "") for r in rr)
+        print(f"  {lab:14s} " + ", ".join(f"{k} ×{v}" for k, v in cnt.items()))
+    det = [r for r in rows if r["expected"] and r["detectable"]]
+    ok = sum(r["verdict"] == "named" and r["named"] == r["expected"] for r in det)
+    ab = sum(r["verdict"] == "at_bound" and r["named"] == r["expected"] for r in det)
+    nul = [r for r in rows if r["label"] == "none"]
+    oo = [r for r in rows if r["oo"]]
+    print(f"  naming, detectable (λ ≥ {DETECTABLE:g}): {wilson(ok, len(det))}; incl. 'at bound' names: "
+          f"{wilson(ok + ab, len(det))}")
+    for r in det:
+        if not (r["verdict"] in ("named", "at_bound") and r["named"] == r["expected"]):
+            print(f"    missed {r['label']:12s} λ = {r['lam']:.0f} -> {r['verdict']} {r['named']}")
+    und = [r for r in rows if r["expected"] and not r["detectable"]]
+    print(f"  not detectable (λ < {DETECTABLE:g}): {len(und)} cases, named correctly anyway: "
+          f"{sum(r['named'] == r['expected'] for r in und)}, wrongly named: "
+          f"{sum(bool(r['named']) and r['named'] != r['expected'] for r in und)}")
+    print(f"  FPR on null data (anything named): {wilson(sum(bool(r['named']) for r in nul), len(nul))}; "
+          f"any verdict but 'none': {wilson(sum(r['verdict'] != 'none' for r in nul), len(nul))}")
+    print(f"  out of library -> unexplained: {wilson(sum(r['verdict'] == 'unexplained' for r in oo), len(oo))}; "
+          f"-> none: {sum(r['verdict'] == 'none' for r in oo)}; named something: {sum(bool(r['named']) for r in oo)}")
+    return {"naming": (ok, len(det)), "fpr": (sum(bool(r["named"]) for r in nul), len(nul)),
+            "oo_unexplained": (sum(r["verdict"] == "unexplained" for r in oo), len(oo))}
+
+
+def validate_generator():
+    """The independent sensor agrees with physmodel where both model the same thing (it must, or
+    the blind cases would test the generator rather than the workflow)."""
+    from scipy.optimize import brentq
+
+    from physmodel import SensorModel
+
+    lam = brentq(lambda x: math.tan(x) - math.tanh(x), 3.5, 4.5, xtol=1e-15)
+    f = isn.FREQUENCIES_HZ
+    G, Z = isn.strip_sensor(isn.START, 2j * np.pi * f)
+    r = SensorModel(start_set()).frequency_response(f, [T_C], quantities=("S", "Z"))
+    worst = max(np.max(np.abs(G / r["S"][0, 0] - 1)), np.max(np.abs(Z / r["Z"][0, 0] - 1)))
+    for n in isn.IN_LIBRARY:
+        v = isn.draw_effect(n, np.random.default_rng(5), 0.7)
+        le = dict([library_effect(n, v)])
+        a = isn.response(isn.START, {n: v}, f)
+        b = EffectModel(start_set(), "sensor", le).frequency_response(f, [T_C])["S"][0, 0]
+        worst = max(worst, float(np.max(np.abs(a / b - 1))))
+    print(f"generator check: tan λ = tanh λ root {lam:.15f} (module {isn.LAMBDA_CP}); independent strip and chain "
+          f"vs physmodel: max relative difference {worst:.2g}")
+    if abs(lam - isn.LAMBDA_CP) > 1e-12 or worst > 1e-9:
+        raise SystemExit("the independent generator disagrees with physmodel: fix it before benchmarking")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--generator", choices=("both", "library", "independent"), default="both")
+    ap.add_argument("--n-per-label", type=int, default=3)
+    ap.add_argument("--null", type=int, default=8)
+    ap.add_argument("--null-draws", type=int, default=1000)
+    ap.add_argument("--null-refits", type=int, default=2)
+    ap.add_argument("--exclude", nargs="*", default=[], help="candidates left out (a diagnostic variant; cases "
+                    "whose hidden element is left out count as out of library)")
+    args = ap.parse_args(argv)
+    validate_generator()
+    t0 = time.perf_counter()
+    labels = [lab for lab in isn.IN_LIBRARY for _ in range(args.n_per_label)]
+    out = {}
+    for gen in (("library", "independent") if args.generator == "both" else (args.generator,)):
+        oo = ["notch"] * 3 if gen == "library" else ["gain_ripple", "notch"] * 2
+        cases = labels + ["none"] * args.null + oo
+        print(f"\n{gen}: candidates {[c for c in CANDIDATES if c not in args.exclude]}")
+        rows = []
+        for i, lab in enumerate(cases):
+            sw, tr = library_case(i, lab) if gen == "library" else isn.make_case(i, lab)
+            if set(tr["expected"]) & set(args.exclude):
+                tr = dict(tr, expected=[], out_of_library=True)
+            rows.append(run_case(sw, tr, args))
+            print(f"  [{gen} {i + 1}/{len(cases)}] {lab:12s} λ = {tr['lam_baseline']:8.1f} -> {rows[-1]['verdict']} "
+                  f"{rows[-1]['named']} ({rows[-1]['dt']:.1f} s)", flush=True)
+        out[gen] = report(rows, gen)
+    print(f"\nelapsed {time.perf_counter() - t0:.0f} s")
+    return out
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,76 @@
+"""The independent sensor generator (independent_sensor.py) against physmodel where both model the
+same thing, and its own invariants.  Agreement is required: otherwise blind cases would test the
+generator, not the workflow.  (Collected by pytest's default ``*_test.py`` pattern.)"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+try:
+    from . import independent_sensor as isn
+except ImportError:
+    import independent_sensor as isn
+
+from physmodel import SensorModel, get_parameter_set
+from physmodel.effects import EffectModel
+
+F = isn.FREQUENCIES_HZ
+TAU = lambda f: 1.0 / (2 * math.pi * f)  # noqa: E731
+LIBRARY_FORM = {
+    "amplifier": lambda v: ("amplifier_bandwidth", {"time_constant": TAU(v["f_a"]),
+                                                    "second_time_constant": TAU(v["f_a"] * v["ratio"])}),
+    "delay": lambda v: ("time_delay", {"delay": v["tau"]}),
+    "laser": lambda v: ("laser_lag", {"time_constant": TAU(v["f_l"])}),
+    "ac_coupling": lambda v: ("ac_coupling", {"corner_hz": v["f_c"]}),
+    "joint": lambda v: ("fixture_joint", {"time_constant": TAU(v["f_j"]), "damping": v["zeta"]}),
+    "slit_beam": lambda v: ("tip_driven_beam", {"time_constant": TAU(v["f_cp"]), "damping": v["zeta"]}),
+    "opamp": lambda v: ("transimpedance", {"unity_gain_time": TAU(v["gbw"]), "inverse_dc_gain": 1 / isn.A0}),
+}
+
+
+@pytest.fixture(scope="module")
+def start():
+    return get_parameter_set("seed000_sensor_dev", T_ref=isn.START["T"])
+
+
+def test_strip_agrees_with_the_library_sensor(start):
+    G, Z = isn.strip_sensor(isn.START, 2j * np.pi * F)
+    r = SensorModel(start).frequency_response(F, [isn.TEMPERATURE_C], quantities=("S", "Z"))
+    assert np.max(np.abs(G / r["S"][0, 0] - 1)) < 1e-9
+    assert np.max(np.abs(Z / r["Z"][0, 0] - 1)) < 1e-9
+
+
+@pytest.mark.parametrize("name", isn.IN_LIBRARY)
+def test_each_chain_element_agrees_with_its_library_effect(name, start):
+    v = isn.draw_effect(name, np.random.default_rng(3), 0.8)
+    lib, lv = LIBRARY_FORM[name](v)
+    assert isn.EFFECT_SPECS[name][0] == lib
+    a = isn.response(isn.START, {name: v}, F)
+    b = EffectModel(start, "sensor", {lib: lv}).frequency_response(F, [isn.TEMPERATURE_C])["S"][0, 0]
+    assert np.max(np.abs(a / b - 1)) < 1e-9
+    assert np.max(np.abs(a / isn.response(isn.START, {}, F) - 1)) > 1e-3       # the element shows
+
+
+def test_clamped_pinned_root_and_beam_limits():
+    assert isn.LAMBDA_CP == pytest.approx(brentq(lambda x: math.tan(x) - math.tanh(x), 3.5, 4.5, xtol=1e-15), abs=1e-14)
+    s = 2j * np.pi * np.array([1e-3, 1.0])
+    dev = isn.slit_beam(s, 1e4, 0.1) - 1.0        # far below resonance: static, plus the damping's lead ∝ s
+    assert abs(dev[0]) < 1e-7 and dev[0] / dev[1] == pytest.approx(1e-3, rel=1e-3)
+    # resonance at the first clamped-pinned mode: the tip slope per tip displacement peaks there
+    f = np.linspace(30.0, 70.0, 401)
+    peak = f[np.argmax(np.abs(isn.slit_beam(2j * np.pi * f, 50.0, 0.01)))]
+    assert peak == pytest.approx(50.0, abs=0.2)
+
+
+def test_cases_are_reproducible_and_labelled():
+    a, ta = isn.make_case(4, "laser")
+    b, tb = isn.make_case(4, "laser")
+    assert np.array_equal(a.response, b.response) and ta["expected"] == ["laser_lag"]
+    _, tn = isn.make_case(5, "notch")
+    assert tn["expected"] == [] and tn["out_of_library"]
+    _, t0 = isn.make_case(6, "none")
+    assert t0["lam_baseline"] == 0.0 and t0["expected"] == []
+    with pytest.raises(ValueError):
+        isn.make_case(1, "nope")

@@ -1,0 +1,90 @@
+"""The ``seed000_chain`` scenario (issue 16), run quick with the ``[chain]`` step registered the way
+the merge will register it.  Oracles: the printed coefficients' own roots (numpy.roots of the
+published numerator), the steady-state decoding error A|P/G − 1| computed from the printed model and
+the decoder's own transfer function, and the misfit recomputed directly from the written metrics."""
+
+import json
+
+import numpy as np
+import pytest
+
+from scenarios import runner, spec
+from scenarios.steps_chain import (
+    CHAIN_SCHEMA,
+    misfit,
+    printed_response,
+    printed_sweep,
+    step_chain,
+)
+
+
+@pytest.fixture
+def registered(monkeypatch):
+    monkeypatch.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
+    monkeypatch.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
+    monkeypatch.setitem(runner.STEPS, "chain", step_chain)
+
+
+@pytest.fixture(scope="module")
+def quick_result(tmp_path_factory):
+    mp = pytest.MonkeyPatch()
+    mp.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
+    mp.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
+    mp.setitem(runner.STEPS, "chain", step_chain)
+    out = tmp_path_factory.mktemp("chain")
+    try:
+        path = spec.bundled_scenarios()[0].parent / "seed000_chain.toml"
+        res = runner.run_scenario(spec.load_scenario(path, quick=True), out, quiet=True)
+    finally:
+        mp.undo()
+    return res, out
+
+
+def test_scenario_passes_its_checks_and_writes_its_figures(quick_result):
+    res, out = quick_result
+    assert not [(c.name, c.value) for c in res.checks if not c.passed]
+    for f in ("chain_bode.png", "chain_pole_zero.png", "chain_effects.png", "metrics.json", "report.md"):
+        assert (out / f).exists(), f
+    rep = (out / "report.md").read_text()
+    assert "Verdict: **" in rep and "Temperature series" in rep
+
+
+def test_printed_model_fit_finds_the_printed_right_half_plane_zeros(quick_result):
+    from physmodel.parameter_sets.published import seed000_printed_model_35c
+
+    m = quick_result[0].metrics
+    num, _, _ = seed000_printed_model_35c()
+    assert m["chain.rhp_zeros.printed_model"] == int(np.sum(np.roots(num).real > 0)) == 3
+    # the polymer alone (fitted to the same data) has none: the non-minimum phase is not the physics'
+    assert m["chain.rhp_zeros.physics_alone"] == 0
+    assert m["chain.rhp_zeros.chain_s_physics_part"] == 0
+
+
+def test_decoding_errors_follow_the_steady_state_prediction(quick_result):
+    m = quick_result[0].metrics
+    for fr in ("20hz", "54hz"):
+        for dec in ("physics_alone", "physics_chain", "documented_sourced_ranges"):
+            err, pred = m[f"chain.decode_{fr}.{dec}_error_rel"], m[f"chain.decode_{fr}.{dec}_predicted_rel"]
+            # up to what the inversion itself reports it adds by sampling, plus 5 % (as control_route)
+            allow = m[f"chain.decode_{fr}.{dec}_sampling_bound_rel"] + 0.05 * pred
+            assert abs(err - pred) <= allow, (fr, dec, err, pred, allow)
+
+
+def test_misfit_is_what_it_says_and_the_verdict_is_consistent(quick_result):
+    m = quick_result[0].metrics
+    data = printed_sweep()
+    assert misfit(data.response, data.response)["rms_db"] < 1e-12
+    assert misfit(2 * data.response, data.response)["max_db"] == pytest.approx(20 * np.log10(2), rel=1e-12)
+    assert np.allclose(data.response, printed_response(data.frequency_hz))
+    assert m["chain.misfit_chain_rms_db"] < m["chain.misfit_physics_rms_db"]
+    assert m["chain.named"] == (m["chain.closes_gap"] and m["chain.implausible_count"] == 0 and m["chain.plausible"])
+    written = json.loads((quick_result[1] / "metrics.json").read_text())["metrics"]
+    assert written["chain.misfit_documented_rms_deg"] == m["chain.misfit_documented_rms_deg"]
+
+
+def test_chain_step_needs_a_sensor_model(registered, tmp_path):
+    toml = tmp_path / "bad.toml"
+    toml.write_text('[scenario]\nname = "bad"\n[model]\nkind = "actuator"\nset = "seed002_table3"\n[chain]\n'
+                    'points = 11\n[checks.x]\nmetric = "chain.named"\nmin = 0\n')
+    with pytest.raises(spec.ScenarioError, match="sensor"):
+        runner.run_scenario(spec.load_scenario(toml), tmp_path / "out", quiet=True)
