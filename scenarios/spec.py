@@ -55,7 +55,7 @@ from physmodel.errors import IPMCError
 from surrogate import FORMS
 
 #: The order in which the runner executes the step tables.
-STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy", "fixtures")
+STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy", "chain", "fixtures")
 
 
 class ScenarioError(IPMCError):
@@ -118,7 +118,15 @@ CONTROL_ROUTE_SCHEMA = {"free": STRS, "prior": _Map(NUM), "starts": INT, "seed":
                         "form": _choice(*FORMS), "n_zeros": INT, "n_poles": INT,
                         "degree": INT, "temperature_c": NUM, "frequency_hz": NUM, "amplitude_mm": NUM,
                         "fs_hz": NUM, "duration_s": NUM, "max_voltage_v": NUM, "note": STR}
+#: [chain]: seed 000's printed model vs physics × sensing chain (scenarios/steps_chain.py).
+CHAIN_SCHEMA = {"temperature_c": NUM, "fmin_hz": NUM, "fmax_hz": NUM, "points": INT, "floor_db": NUM,
+                "floor_deg": NUM, "free": STRS, "candidates": STRS, "documented": STRS, "max_steps": INT,
+                "null_draws": INT, "null_refits": INT, "baseline_starts": INT, "alpha": NUM, "seed": INT,
+                "preview": NUM_OR_STR, "decode_frequencies_hz": NUMS, "amplitude_mm": NUM, "fs_hz": NUM,
+                "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM, "d_profile": NUMS}
+
 SECTIONS = {
+    "chain": CHAIN_SCHEMA,
     "control_route": CONTROL_ROUTE_SCHEMA,
     "scenario": {"name": STR, "title": STR, "description": STR, "source": STR},
     "model": {"kind": _choice("actuator", "sensor"), "set": STR, "quantity": STR,

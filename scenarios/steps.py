@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .spec import ScenarioError
+from .steps_chain import step_chain
 from .steps_control import step_control_route
 
 if TYPE_CHECKING:
@@ -474,4 +475,4 @@ def step_fixtures(ctx: _Ctx):
 
 STEPS = {"sweep": step_sweep, "surrogate": step_surrogate, "control_route": step_control_route,
          "inversion": step_inversion, "widths": step_widths, "taylor": step_taylor, "blackbox": step_blackbox,
-         "discrepancy": step_discrepancy, "fixtures": step_fixtures}
+         "discrepancy": step_discrepancy, "chain": step_chain, "fixtures": step_fixtures}

@@ -43,15 +43,10 @@ import math
 
 import numpy as np
 
-from .spec import INT, NUM, NUM_OR_STR, NUMS, STRS, ScenarioError
+from .spec import ScenarioError
 
-__all__ = ["CHAIN_SCHEMA", "misfit", "printed_sweep", "step_chain"]
+__all__ = ["misfit", "printed_sweep", "step_chain"]
 
-CHAIN_SCHEMA = {"temperature_c": NUM, "fmin_hz": NUM, "fmax_hz": NUM, "points": INT, "floor_db": NUM,
-                "floor_deg": NUM, "free": STRS, "candidates": STRS, "documented": STRS, "max_steps": INT,
-                "null_draws": INT, "null_refits": INT, "baseline_starts": INT, "alpha": NUM, "seed": INT,
-                "preview": NUM_OR_STR, "decode_frequencies_hz": NUMS, "amplitude_mm": NUM, "fs_hz": NUM,
-                "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM, "d_profile": NUMS}
 CANDIDATES = ("time_delay", "amplifier_bandwidth", "laser_lag", "ac_coupling", "fixture_joint", "tip_driven_beam",
               "transimpedance")
 DOCUMENTED = ("time_delay", "laser_lag", "transimpedance", "tip_driven_beam", "fixture_joint")
@@ -288,7 +283,7 @@ def step_chain(ctx) -> None:
     # ---- parameters with intervals, identifiability, plausibility
     rows = []
     final_res = last.final if verdict in ("named", "at_bound", "ambiguous") else last.baseline
-    for label, res, extra in (("chain", final_res, {}), ("documented", docres, held)):
+    for label, res, _extra in (("chain", final_res, {}), ("documented", docres, held)):
         for n in res.names:
             ident = res.identifiability.get(n)
             rng = PLAUSIBLE.get(n) or PHYS_SOURCED.get(n)

@@ -49,11 +49,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from inversion.examples import SEED000_DEN_35C, SEED000_NUM_35C  # noqa: E402
 from physmodel import SensorModel, get_parameter_set  # noqa: E402
+from physmodel.data.sweep import FrequencySweep  # noqa: E402
+from physmodel.effects.sensing import ELEMENTS  # noqa: E402
 from physmodel.estimation.lsq import fit_parameters  # noqa: E402
 from physmodel.estimation.records import FreeParameter  # noqa: E402
 from physmodel.parameter_paths import apply_values  # noqa: E402
-from physmodel.effects.sensing import ELEMENTS  # noqa: E402
-from physmodel.data.sweep import FrequencySweep  # noqa: E402
 from surrogate import RationalFit  # noqa: E402
 
 T_C = 35.0

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from scenarios import runner, spec
+from scenarios.spec import CHAIN_SCHEMA
 from scenarios.steps_chain import (
-    CHAIN_SCHEMA,
     misfit,
     printed_response,
     printed_sweep,
