@@ -43,10 +43,13 @@ def public_submodules(package) -> list[str]:
 
 def module_public_names(module) -> list[str]:
     """``__all__`` if the module defines it, else its own public functions and classes and the
-    module-level constants it documents with ``#:`` comments."""
+    module-level constants it documents with ``#:`` comments.  Submodules are left out: each has
+    its own page (:func:`public_submodules`)."""
     names = getattr(module, "__all__", None)
     if names is not None:
-        return [n for n in names if hasattr(module, n)]
+        # a submodule listed in a package's ``__all__`` (``inversion.references``) has its own
+        # page from public_submodules; stubbing it too would document every member twice
+        return [n for n in names if hasattr(module, n) and not inspect.ismodule(getattr(module, n))]
     try:
         from sphinx.pycode import ModuleAnalyzer
 
