@@ -159,9 +159,24 @@ def generate(app, config) -> None:
             (out / fname).write_text(text, encoding="utf-8")
 
 
+def refresh_found_docs(app) -> None:
+    """Let autosummary see the pages :func:`generate` just wrote, on incremental builds too.
+
+    ``sphinx.ext.autosummary`` writes its stubs at ``builder-inited`` for the documents in
+    ``env.found_docs``.  A fresh environment lists the source files before that event, but a
+    pickled one (``docs/_build`` from an earlier run) still holds the old list until
+    ``Builder.read`` scans again, so a module added since the last build got its page here and
+    no stubs: every name on it was "stub file not found" / "reference target not found".
+    Scanning now (``Builder.read`` scans once more anyway) gives autosummary the current list.
+    """
+    app.env.find_files(app.config, app.builder)
+
+
 def setup(app):
     app.add_config_value("ipmc_api_packages", ["physmodel", "surrogate", "inversion", "scenarios"], "env")
     # at config-inited, so that the files exist when Sphinx lists the sources and
     # sphinx.ext.autosummary (builder-inited) writes the stub pages they ask for
     app.connect("config-inited", generate)
+    # before autosummary's own builder-inited handler (priority 500) writes the stubs
+    app.connect("builder-inited", refresh_found_docs, priority=100)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
