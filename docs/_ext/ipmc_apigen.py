@@ -43,10 +43,13 @@ def public_submodules(package) -> list[str]:
 
 def module_public_names(module) -> list[str]:
     """``__all__`` if the module defines it, else its own public functions and classes and the
-    module-level constants it documents with ``#:`` comments."""
+    module-level constants it documents with ``#:`` comments.  Submodules are left out: each has
+    its own page (:func:`public_submodules`)."""
     names = getattr(module, "__all__", None)
     if names is not None:
-        return [n for n in names if hasattr(module, n)]
+        # a submodule listed in a package's ``__all__`` (``inversion.references``) has its own
+        # page from public_submodules; stubbing it too would document every member twice
+        return [n for n in names if hasattr(module, n) and not inspect.ismodule(getattr(module, n))]
     try:
         from sphinx.pycode import ModuleAnalyzer
 
@@ -156,9 +159,24 @@ def generate(app, config) -> None:
             (out / fname).write_text(text, encoding="utf-8")
 
 
+def refresh_found_docs(app) -> None:
+    """Let autosummary see the pages :func:`generate` just wrote, on incremental builds too.
+
+    ``sphinx.ext.autosummary`` writes its stubs at ``builder-inited`` for the documents in
+    ``env.found_docs``.  A fresh environment lists the source files before that event, but a
+    pickled one (``docs/_build`` from an earlier run) still holds the old list until
+    ``Builder.read`` scans again, so a module added since the last build got its page here and
+    no stubs: every name on it was "stub file not found" / "reference target not found".
+    Scanning now (``Builder.read`` scans once more anyway) gives autosummary the current list.
+    """
+    app.env.find_files(app.config, app.builder)
+
+
 def setup(app):
     app.add_config_value("ipmc_api_packages", ["physmodel", "surrogate", "inversion", "scenarios"], "env")
     # at config-inited, so that the files exist when Sphinx lists the sources and
     # sphinx.ext.autosummary (builder-inited) writes the stub pages they ask for
     app.connect("config-inited", generate)
+    # before autosummary's own builder-inited handler (priority 500) writes the stubs
+    app.connect("builder-inited", refresh_found_docs, priority=100)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
