@@ -52,8 +52,8 @@ class RationalFit:
     scale_covariance : bool
         Scale the Gauss–Newton covariance by the reduced χ².
 
-    Attributes (after ``fit``)
-    --------------------------
+    Attributes
+    ----------
     model_ : RationalModel
     result_ : FitResult
     history_ : list of dict, one per start (and resumed solve).

@@ -70,8 +70,8 @@ class ScheduledFit:
         Scales (defaults from the data: geometric means; mid-range and half-range). [rad/s],
         [output/input], [°C], [°C]
 
-    Attributes (after ``fit``)
-    --------------------------
+    Attributes
+    ----------
     model_, result_, history_, two_stage_model_, per_temperature_models_
     """
 
