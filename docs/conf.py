@@ -45,7 +45,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "examples/README.rst", "examples_pending", "**/.ipynb_checkpoints"]
+exclude_patterns = ["_build", "examples/README.rst", "**/.ipynb_checkpoints"]
 templates_path = ["_templates"]
 
 # Every unresolved cross-reference to our own objects is a warning (so an error under -W);
