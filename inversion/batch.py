@@ -14,6 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from physmodel.data.timerecord import UNIFORM_RTOL as _UNIFORM_RTOL
+from physmodel.data.timerecord import uniform_interval
+from physmodel.errors import IPMCError
+
 from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
 from .preview import DEFAULT_PREVIEW_TOL, PreviewChoice, TruncationModes, choose_preview, preview_rule, resolve_preview
@@ -36,8 +40,8 @@ __all__ = [
 #: Samples processed per chunk (bounds the working memory to a few times 8 MiB).
 DEFAULT_CHUNK = 1 << 20
 
-#: Relative tolerance on the spread of the time steps.
-UNIFORM_RTOL = 1e-6
+#: Relative tolerance on the spread of the time steps (the library's default).
+UNIFORM_RTOL = _UNIFORM_RTOL
 
 
 class SampledRecord:
@@ -149,41 +153,20 @@ def time_base(t: Any, u: np.ndarray) -> tuple[np.ndarray | None, float]:
 
 
 def sampling_interval(t: Any) -> float:
-    """Return the sampling interval of uniformly spaced time stamps ``t`` [s].
+    """Return the sampling interval [s] of uniformly spaced time stamps ``t`` [s] (or of a scalar
+    interval): :func:`physmodel.data.timerecord.uniform_interval`, the library's one uniform-time
+    check, with its default tolerance (a step within ``UNIFORM_RTOL`` of the mean step).
 
     Raises
     ------
     NonUniformSamplingError
-        if ``t`` has fewer than 2 samples, is not finite, not strictly increasing, or a step
-        differs from the mean step by more than ``UNIFORM_RTOL`` relative.
+        if ``t`` has fewer than 2 samples, is not finite, not increasing, or not uniform (the
+        message names the offending sample and step).
     """
-    if np.ndim(t) == 0:
-        dt = float(t)
-        if not (math.isfinite(dt) and dt > 0):
-            raise NonUniformSamplingError(
-                f"the sampling interval must be a positive finite number of seconds; got {t!r}")
-        return dt
-    ta = np.asarray(t, dtype=float)
-    if ta.ndim != 1 or ta.size < 2:
-        raise NonUniformSamplingError(
-            f"time stamps must be a 1-D array with at least 2 samples; got shape {ta.shape}")
-    if not np.all(np.isfinite(ta)):
-        i = int(np.flatnonzero(~np.isfinite(ta))[0])
-        raise NonUniformSamplingError(f"time stamp {i} is {ta[i]!r}; time stamps must be finite")
-    steps = np.diff(ta)
-    dt = (ta[-1] - ta[0]) / (ta.size - 1)
-    if not dt > 0:
-        raise NonUniformSamplingError(
-            f"time stamps must increase; got t[0] = {ta[0]!r} and t[-1] = {ta[-1]!r}")
-    tol = UNIFORM_RTOL * dt + 8 * np.finfo(float).eps * float(np.max(np.abs(ta)))
-    dev = np.abs(steps - dt)
-    i = int(np.argmax(dev))
-    if dev[i] > tol:
-        raise NonUniformSamplingError(
-            f"time stamps are not uniformly spaced: step t[{i + 1}] - t[{i}] = {steps[i]!r} s "
-            f"differs from the mean step {dt!r} s by {dev[i]:.3g} s (> {UNIFORM_RTOL:g} relative);"
-            " resample the signal onto a uniform grid first")
-    return float(dt)
+    try:
+        return uniform_interval(t, rtol=UNIFORM_RTOL)
+    except IPMCError as exc:
+        raise NonUniformSamplingError(str(exc)) from None
 
 
 def _as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:

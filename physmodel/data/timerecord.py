@@ -56,32 +56,94 @@ def split_column(column: str, where: str = "") -> tuple[str, str]:
 
 
 
-def sample_rate(t_or_fs, n: int, block_samples: int = TIME_BLOCK_SAMPLES) -> float:
-    """Sample rate [Hz] from a scalar ``fs`` or from uniform sample times ``t`` [s] (checked in blocks).
+#: Largest deviation of one time step from the mean step, relative to the mean step (default).
+UNIFORM_RTOL = 1e-6
+#: Largest deviation of a sample from the uniform grid through the end points [samples]
+#: (a slow clock drift passes the step test but not this one).
+GRID_TOL = 1e-3
 
-    A time base that strays from the uniform grid through its end points by more than 1e-3 of a
-    sample is refused.
+
+def uniform_interval(t, n: int | None = None, *, rtol: float = UNIFORM_RTOL, what: str = "time stamps",
+                     block_samples: int = TIME_BLOCK_SAMPLES) -> float:
+    """The sampling interval [s] of uniform sample times ``t`` [s], or of a scalar interval ``t``.
+
+    The one uniform-time check of the library (simulation, inversion, frequency-response
+    estimation).  ``t`` is checked in blocks of ``block_samples`` (long memory-mapped records):
+    finite, increasing end to end, every step within ``rtol`` of the mean step
+    ``(t[-1] - t[0])/(n - 1)`` (plus float rounding, 8 eps max|t|), and every sample within
+    :data:`GRID_TOL` of a step of the uniform grid through the end points.  ``n``: the length
+    ``t`` must have (e.g. the signal's).
+
+    Raises
+    ------
+    IPMCError
+        naming ``what``, the offending sample, its time, the step before it and the mean step.
+    """
+    if np.ndim(t) == 0:
+        try:
+            h = float(t)
+        except (TypeError, ValueError):
+            raise IPMCError(f"{what}: the sampling interval must be a number of seconds; got {t!r}") from None
+        if not (math.isfinite(h) and h > 0):
+            raise IPMCError(f"{what}: the sampling interval must be a positive finite number of seconds; got {t!r}")
+        return h
+    if np.ndim(t) != 1 or len(t) < 2 or (n is not None and len(t) != n):
+        want = "at least 2 samples" if n is None else f"shape ({n},) like the signal"
+        raise IPMCError(f"{what}: time vector has shape {np.shape(t)}; expected a 1-D array with {want}")
+    n = len(t)
+    t0, t1 = float(t[0]), float(t[-1])
+    if not (math.isfinite(t0) and math.isfinite(t1)):
+        k = 0 if not math.isfinite(t0) else n - 1
+        raise IPMCError(f"{what}: sample {k} is at {float(t[k])!r} s; time stamps must be finite")
+    h = (t1 - t0) / (n - 1)
+    if not h > 0:
+        raise IPMCError(f"{what}: time stamps must increase; got t[0] = {t0!r} s and t[-1] = {t1!r} s")
+    rounding = 8 * np.finfo(float).eps * max(abs(t0), abs(t1))
+    step_tol = rtol * h + rounding
+    grid_tol = GRID_TOL * h + rounding
+    worst_step, k_step, worst_grid, k_grid = 0.0, 0, 0.0, 0
+    for a in range(0, n, block_samples):
+        b = min(n, a + block_samples + 1)            # one sample of overlap: the step into the next block
+        tb = np.asarray(t[a:b], dtype=float)
+        bad = ~np.isfinite(tb)
+        if bad.any():
+            k = a + int(np.flatnonzero(bad)[0])
+            raise IPMCError(f"{what}: sample {k} is at {float(t[k])!r} s; time stamps must be finite")
+        if tb.size > 1:
+            step_dev = np.abs(np.diff(tb) - h)
+            i = int(np.argmax(step_dev))
+            if step_dev[i] > worst_step:
+                worst_step, k_step = float(step_dev[i]), a + 1 + i
+        grid_dev = np.abs(tb - (t0 + np.arange(a, b) * h))
+        i = int(np.argmax(grid_dev))
+        if grid_dev[i] > worst_grid:
+            worst_grid, k_grid = float(grid_dev[i]), a + i
+    if worst_step > step_tol or worst_grid > grid_tol:
+        k = k_step if worst_step > step_tol else max(k_grid, 1)     # the worst step first: it is the cause
+        step = float(t[k]) - float(t[k - 1])
+        raise IPMCError(
+            f"{what} are not uniformly spaced: sample {k} is at t = {float(t[k])!r} s, step t[{k}] - t[{k - 1}] "
+            f"= {step!r} s, mean step {h!r} s (uniform grid: t[{k}] = {t0 + k * h!r} s; tolerance {rtol:g} of a "
+            f"step per step, {GRID_TOL:g} of a step from the grid); resample the record onto a uniform time base")
+    return float(h)
+
+
+def sample_rate(t_or_fs, n: int, block_samples: int = TIME_BLOCK_SAMPLES) -> float:
+    """Sample rate [Hz] from a scalar ``fs`` [Hz] or from uniform sample times ``t`` [s] of length ``n``.
+
+    The times are checked by :func:`uniform_interval` with the tolerance of measured records
+    (steps within 2e-3 of the mean step, samples within 1e-3 of a step from the uniform grid).
     """
     if np.ndim(t_or_fs) == 0:
-        fs = float(t_or_fs)
+        try:
+            fs = float(t_or_fs)
+        except (TypeError, ValueError):
+            fs = math.nan
         if not (math.isfinite(fs) and fs > 0):
             raise IPMCError(f"t_or_fs: sample rate {t_or_fs!r} Hz must be a finite number > 0")
         return fs
-    t = t_or_fs
-    if np.ndim(t) != 1 or len(t) != n:
-        raise IPMCError(f"t_or_fs: time vector has shape {np.shape(t)}; expected ({n},) like the input")
-    t0, t1 = float(t[0]), float(t[-1])
-    h = (t1 - t0) / (n - 1)
-    if not (math.isfinite(h) and h > 0):
-        raise IPMCError(f"t_or_fs: time runs from {t0!r} to {t1!r} s; expected increasing finite times")
-    for a in range(0, n, block_samples):
-        b = min(n, a + block_samples)
-        dev = np.abs(np.asarray(t[a:b], dtype=float) - (t0 + np.arange(a, b) * h))
-        if not np.all(dev <= 1e-3 * h):
-            k = a + int(np.argmax(np.where(np.isfinite(dev), dev, np.inf)))
-            raise IPMCError(f"t_or_fs: sample {k} is at {float(t[k])!r} s, off the uniform grid "
-                            f"t0 + k·{h:.6g} s; resample the record to a uniform time base")
-    return 1.0 / h
+    return 1.0 / uniform_interval(t_or_fs, n, rtol=2 * GRID_TOL, what="t_or_fs: time stamps",
+                                  block_samples=block_samples)
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,7 @@ from scipy import signal
 from ..errors import IPMCError
 from ..numerics import weighted_complex_lstsq
 from .files import atomic_write, by_extension
+from .timerecord import uniform_interval
 
 
 class RealizationError(IPMCError):
@@ -226,17 +227,8 @@ def _modal_states(a: complex, h: float, u: np.ndarray, hold: str, initial: str) 
 
 
 def check_uniform_time(t) -> float:
-    t = np.asarray(t, dtype=float)
-    if t.ndim != 1 or t.size < 2:
-        raise IPMCError(f"time vector must be 1-D with at least 2 samples, got shape {t.shape}")
-    if not np.all(np.isfinite(t)):
-        raise IPMCError("time vector contains NaN or inf")
-    dt = np.diff(t)
-    h = (t[-1] - t[0]) / (t.size - 1)
-    if h <= 0 or np.max(np.abs(dt - h)) > 1e-9 * max(h, 1e-300) * max(1.0, t.size / 1e3):
-        k = int(np.argmax(np.abs(dt - h)))
-        raise IPMCError(f"time stamps must be uniform and increasing; step {k} is {dt[k]!r} s, expected {h!r} s")
-    return float(h)
+    """The sampling interval [s] of uniform times ``t`` [s]: :func:`~physmodel.data.timerecord.uniform_interval`."""
+    return uniform_interval(t)
 
 
 def realize(fn: Callable[[np.ndarray], np.ndarray], band_hz: tuple[float, float], dc_value: float | None = None,
