@@ -15,7 +15,7 @@ Generators (amplitudes in the model's output units, e.g. mm; time in s; frequenc
     sine(amplitude, frequency_hz, duration_s, fs_hz, ...)
     multitone(amplitudes, frequencies_hz, duration_s, fs_hz, phases_deg=None, ...)
     smoothed_steps(levels, hold_s, fs_hz, transition_s=..., ...)
-    from_file(path, fs_hz=None, column=None, ...)    a CSV / NPZ record, faded and padded
+    from_file(path, column=None, unit="", ...)        a time record (.csv/.npz/.mat), faded and padded
     fade(t, y, fade_in_s, fade_out_s)                window an existing record
 All return a :class:`Reference` (``t``, ``y``, ``body`` mask of the unfaded part, ``.save()``).
 """
@@ -32,7 +32,11 @@ import numpy as np
 from ._errors import InversionError
 
 __all__ = ["Reference", "sine", "multitone", "smoothed_steps", "from_file", "fade", "smootherstep",
-           "edge_jump", "read_columns"]
+           "edge_jump", "DEFAULT_UNIT"]
+
+#: Unit of a reference saved without one: the feedforward reference is a desired actuator tip
+#: displacement, in SI.
+DEFAULT_UNIT = "m"
 
 
 def smootherstep(x: Any) -> np.ndarray:
@@ -58,7 +62,8 @@ class Reference:
         Window and rest lengths [s].
     description : str
     unit : str
-        Unit label of ``y`` (free form, e.g. ``"mm"``).
+        Unit of ``y`` (e.g. ``"mm"``; letters and digits, as a time-record column suffix); empty:
+        saved as :data:`DEFAULT_UNIT`.
     """
 
     t: np.ndarray
@@ -77,34 +82,16 @@ class Reference:
         return float(self.t[1] - self.t[0])
 
     def save(self, path: Any) -> Path:
-        """Write ``time_s, reference_<unit>`` as CSV (``#`` header lines) or NPZ, atomically."""
-        from physmodel.data.files import atomic_write
+        """Write the reference as a time record (:class:`physmodel.data.timerecord.TimeRecord`):
+        columns ``time_s, reference_<unit>`` (``unit`` empty: :data:`DEFAULT_UNIT`), the fade
+        windows and the description as metadata; .csv, .npz or .mat by extension, atomically."""
+        from physmodel.data.timerecord import TimeRecord
 
-        path = Path(path)
-        col = f"reference_{self.unit}" if self.unit else "reference"
         meta = {"description": self.description, "fade_in_s": f"{self.fade_in_s:g}",
                 "fade_out_s": f"{self.fade_out_s:g}", "lead_s": f"{self.lead_s:g}",
                 "tail_s": f"{self.tail_s:g}", **self.metadata}
-        if path.suffix.lower() == ".npz":
-            import json
-
-            def write_npz(fh: Any) -> None:
-                np.savez(fh, header=np.array(json.dumps({"format": "ipmc-reference", "metadata": meta})),
-                         time_s=self.t, **{col: self.y})
-
-            return atomic_write(path, write_npz, "wb")
-        if path.suffix.lower() != ".csv":
-            raise InversionError(f"{path}: a reference is saved as .csv or .npz")
-
-        def write_csv(fh: Any) -> None:
-            fh.write("# ipmc-reference 1\n")
-            for k, v in meta.items():
-                fh.write(f"# {k}: {str(v).replace(chr(10), ' ')}\n")
-            fh.write(f"time_s,{col}\n")
-            for a, b in zip(self.t, self.y):
-                fh.write(f"{float(a)!r},{float(b)!r}\n")
-
-        return atomic_write(path, write_csv)
+        rec = TimeRecord(self.t, {"reference": self.y}, {"reference": self.unit or DEFAULT_UNIT}, meta)
+        return rec.save(path)
 
 
 def _positive(name: str, v: Any, allow_zero: bool = False) -> float:
@@ -275,25 +262,43 @@ def fade(t: Any, y: Any, fade_in_s: float, fade_out_s: float, *, lead_s: float =
 
 def from_file(path: Any, *, column: str | None = None, fade_in_s: float = 0.0, fade_out_s: float = 0.0,
               lead_s: float = 0.0, tail_s: float = 0.0, unit: str = "") -> Reference:
-    """A reference from a CSV (``#`` header lines, a header row with ``time_s`` and one value
-    column) or an NPZ (arrays ``time_s`` and the value column), optionally faded and padded.
+    """A reference from a time-record file (.csv, .npz or .mat as
+    :func:`physmodel.data.timerecord.read_record` reads them: ``time_s`` and value columns
+    ``<name>_<unit>``), optionally faded and padded.
 
-    ``column``: the value column (default: the first one that is not ``time_s``).
+    ``column``: the value column or channel name (default: the first one).  ``unit``: the unit of
+    the returned reference; a column in another unit of the same kind (``target_m`` for
+    ``unit="mm"``) is converted, one of another kind is refused.  Empty: the column's own unit.
+    A column without a unit suffix (a bare ``reference`` written by older versions of
+    :meth:`Reference.save`, or ``target`` in a hand-made file) is taken to be in ``unit`` (empty:
+    :data:`DEFAULT_UNIT`).
+
+    Raises
+    ------
+    IPMCError
+        naming the file and the problem (a malformed record, a missing column, a unit mismatch).
     """
-    cols = read_columns(path)
-    if "time_s" not in cols:
-        raise InversionError(f"{path}: needs a time_s column; found {list(cols)}")
-    names = [c for c in cols if c != "time_s"]
+    from physmodel.data.timerecord import read_record
+    from physmodel.data.units import UNITS
+    from physmodel.errors import IPMCError
+
+    rec = read_record(path, unitless=unit or DEFAULT_UNIT)
     if column is None:
-        if not names:
-            raise InversionError(f"{path}: no value column besides time_s")
-        column = names[0]
-    if column not in cols:
-        raise InversionError(f"{path}: no column {column!r}; found {list(cols)}")
-    if not unit and "_" in column:
-        unit = column.rsplit("_", 1)[1]
-    return fade(cols["time_s"], cols[column], fade_in_s, fade_out_s, lead_s=lead_s, tail_s=tail_s,
-                unit=unit, description=f"{Path(path).name}:{column}")
+        name = next(iter(rec.channels))
+    else:
+        try:
+            name = rec.resolve(column)
+        except IPMCError:
+            raise InversionError(f"{path}: no column {column!r}; found {rec.columns_names()}") from None
+    y = rec.channels[name]
+    have = rec.units[name]
+    if unit and unit != have:
+        if have not in UNITS or unit not in UNITS or UNITS[have][0] != UNITS[unit][0]:
+            raise InversionError(f"{path}: column {name}_{have} is in {have!r}, which cannot be converted to the "
+                                 f"requested unit {unit!r}")
+        y = y * (UNITS[have][1] / UNITS[unit][1])
+    return fade(rec.t, y, fade_in_s, fade_out_s, lead_s=lead_s, tail_s=tail_s,
+                unit=unit or have, description=f"{Path(path).name}:{name}_{have}")
 
 
 def edge_jump(y: Any) -> float:
@@ -315,53 +320,3 @@ def edge_jump(y: Any) -> float:
     value = max(abs(float(ya[i0])), abs(float(ya[i1]))) / peak
     kink = max(d[i0 + 1], d[i1]) / float(np.max(d)) if ya.size > 1 else 0.0
     return max(value, kink)
-
-
-def read_columns(path: Any) -> dict[str, np.ndarray]:
-    """Columns of a time-series file as written by ``ipmc simulate`` / :meth:`TimeSeries.save`
-    or :meth:`Reference.save`: CSV with ``#`` header lines then a header row, or NPZ (the
-    ``header`` entry is skipped).  Every column must be numeric and finite, all of one length.
-
-    Raises
-    ------
-    InversionError
-        naming the file, the line and the problem.
-    """
-    path = Path(path)
-    if not path.exists():
-        raise InversionError(f"{path}: no such file")
-    suffix = path.suffix.lower()
-    if suffix == ".npz":
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                cols = {k: np.asarray(z[k], dtype=float).ravel() for k in z.files if k != "header"}
-        except (OSError, ValueError) as exc:
-            raise InversionError(f"{path}: not a readable NPZ time series ({exc})") from None
-    elif suffix == ".csv":
-        import csv
-
-        with open(path, encoding="utf-8", newline="") as fh:
-            rows = [(i, r) for i, r in enumerate(csv.reader(fh), start=1)
-                    if r and not r[0].lstrip().startswith("#")]
-        if len(rows) < 3:
-            raise InversionError(f"{path}: needs a header row and at least 2 data rows")
-        names = [c.strip() for c in rows[0][1]]
-        data = np.empty((len(rows) - 1, len(names)))
-        for j, (line, r) in enumerate(rows[1:]):
-            if len(r) != len(names):
-                raise InversionError(f"{path}, line {line}: {len(r)} values for {len(names)} columns {names}")
-            try:
-                data[j] = [float(v) for v in r]
-            except ValueError:
-                raise InversionError(f"{path}, line {line}: non-numeric value in {r}") from None
-        cols = {n: data[:, k] for k, n in enumerate(names)}
-    else:
-        raise InversionError(f"{path}: expected a .csv or .npz time series")
-    lengths = {k: v.size for k, v in cols.items()}
-    if not cols or len(set(lengths.values())) != 1:
-        raise InversionError(f"{path}: columns must have equal lengths; got {lengths}")
-    for k, v in cols.items():
-        if not np.all(np.isfinite(v)):
-            i = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise InversionError(f"{path}: column {k!r} is not finite at row {i}")
-    return cols

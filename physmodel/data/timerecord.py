@@ -23,22 +23,27 @@ present, must agree with their column.  NPZ files hold one array per column plus
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import re
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import DataFormatError, IPMCError
-from .files import atomic_write, by_extension
+from .files import atomic_write, by_extension, read_text
 
 #: Samples read per block when checking long (memory-mapped) time bases.
 TIME_BLOCK_SAMPLES = 1 << 20
 
 FORMAT = "ipmc-timeseries"
 FORMAT_VERSION = 1
+#: The format name :meth:`inversion.references.Reference.save` wrote before it wrote through
+#: :class:`TimeRecord` (still read; its CSV marker line is skipped like any comment).
+LEGACY_REFERENCE_FORMAT = "ipmc-reference"
 TIME_COLUMN = "time_s"
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _UNIT = re.compile(r"^[A-Za-zµΩ0-9]+$")
@@ -304,37 +309,35 @@ def _apply_channel_headers(rec_cols: dict, header: dict, where: str) -> dict:
     return meta
 
 
-def read_csv(path) -> TimeRecord:
-    """Read an ``ipmc-timeseries`` CSV (see module doc)."""
+def read_csv(path, unitless: str | None = None) -> TimeRecord:
+    """Read an ``ipmc-timeseries`` CSV (see module doc); ``unitless``: see :func:`read_record`."""
     path = Path(path)
     where = f"{path}: "
+    text = read_text(path, "time-record")
     header: dict[str, str] = {}
+    lines = text.splitlines()
     n_head = 0
-    try:
-        with open(path, encoding="utf-8") as fh:
-            for line in fh:
-                s = line.strip()
-                if s.startswith("#") or not s:
-                    body = s.lstrip("#").strip()
-                    if body.startswith(FORMAT):
-                        _check_version(body, where)
-                    elif ":" in body:
-                        k, v = body.split(":", 1)
-                        header[k.strip()] = v.strip()
-                    n_head += 1
-                    continue
-                names = [c.strip() for c in s.split(",")]
-                break
-            else:
-                raise DataFormatError(f"{where}no column header line after the '#' header")
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
+    for line in lines:
+        s = line.strip()
+        if s.startswith("#") or not s:
+            body = s.lstrip("#").strip()
+            if body.startswith(FORMAT):
+                _check_version(body, where)
+            elif ":" in body:
+                k, v = body.split(":", 1)
+                header[k.strip()] = v.strip()
+            n_head += 1
+            continue
+        names = [c.strip() for c in s.split(",")]
+        break
+    else:
+        raise DataFormatError(f"{where}no column header line after the '#' header")
     if len(set(names)) != len(names):
         raise DataFormatError(f"{path}:{n_head + 1}: repeated column names in {names}")
     try:
-        data = np.loadtxt(path, delimiter=",", comments="#", skiprows=n_head + 1, ndmin=2)
+        data = np.loadtxt(io.StringIO("\n".join(lines[n_head + 1:])), delimiter=",", comments="#", ndmin=2)
     except ValueError as exc:
-        raise DataFormatError(f"{where}{exc}") from None
+        raise DataFormatError(f"{where}{exc} (data rows start at line {n_head + 2})") from None
     if data.shape[0] == 0:
         raise DataFormatError(f"{where}no data rows")
     if data.shape[1] != len(names):
@@ -342,10 +345,12 @@ def read_csv(path) -> TimeRecord:
     cols = {n: data[:, i] for i, n in enumerate(names)}
     _check_finite(cols, where)
     meta = _apply_channel_headers(cols, header, where)
-    return _build(cols, meta, where)
+    return _build(cols, meta, where, unitless)
 
 
-def _build(cols: dict, meta: dict, where: str) -> TimeRecord:
+def _build(cols: dict, meta: dict, where: str, unitless: str | None = None) -> TimeRecord:
+    if unitless is not None:
+        cols = {(k if k == TIME_COLUMN or "_" in k else f"{k}_{unitless}"): v for k, v in cols.items()}
     try:
         return TimeRecord.from_columns(cols, meta, where)
     except DataFormatError:
@@ -354,41 +359,77 @@ def _build(cols: dict, meta: dict, where: str) -> TimeRecord:
         raise DataFormatError(f"{where}{exc}") from None
 
 
-def read_npz(path) -> TimeRecord:
+def _load_failed(path, exc: BaseException, what: str):
+    if isinstance(exc, FileNotFoundError):
+        return DataFormatError(f"{path}: no such file")
+    if isinstance(exc, IsADirectoryError):
+        return DataFormatError(f"{path} is a folder; expected a {what} file")
+    return DataFormatError(f"{path}: not a readable {what} time record ({type(exc).__name__}: {exc})")
+
+
+def read_npz(path, unitless: str | None = None) -> TimeRecord:
+    """Read an ``ipmc-timeseries`` NPZ (also the ``ipmc-reference`` NPZ of older versions)."""
     where = f"{path}: "
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
+    try:   # the file is opened here so that it is closed whatever np.load makes of it
+        with open(path, "rb") as fh:
+            archive = np.load(fh, allow_pickle=False)
+            if isinstance(archive, np.ndarray):        # an .npy array under an .npz name
+                raise DataFormatError(f"{where}one .npy array, not an NPZ archive of columns")
+            with archive as z:
+                data = {k: z[k] for k in z.files}
+    except DataFormatError:
+        raise
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise _load_failed(path, exc, "NPZ") from None
     meta = {}
     if "header" in data:
-        hdr = json.loads(str(data.pop("header")))
-        if hdr.get("format") != FORMAT:
-            raise DataFormatError(f"{where}header format {hdr.get('format')!r} is not {FORMAT!r}")
-        _check_version(f"{FORMAT} {hdr.get('version')}", where)
-        meta = {k: str(v) for k, v in hdr.get("metadata", {}).items()}
-    cols = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items()}
+        try:
+            hdr = json.loads(str(data.pop("header")))
+        except ValueError:
+            raise DataFormatError(f"{where}the 'header' entry is not JSON") from None
+        if not isinstance(hdr, dict) or hdr.get("format") not in (FORMAT, LEGACY_REFERENCE_FORMAT):
+            fmt = hdr.get("format") if isinstance(hdr, dict) else hdr
+            raise DataFormatError(f"{where}header format {fmt!r} is not {FORMAT!r}")
+        if hdr["format"] == FORMAT:
+            _check_version(f"{FORMAT} {hdr.get('version')}", where)
+        meta = {k: str(v) for k, v in (hdr.get("metadata") or {}).items()}
+    try:
+        cols = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items()}
+    except (TypeError, ValueError):
+        raise DataFormatError(f"{where}every entry but 'header' must be a numeric column") from None
     _check_finite(cols, where)
-    return _build(cols, meta, where)
+    return _build(cols, meta, where, unitless)
 
 
-def read_mat(path) -> TimeRecord:
+def read_mat(path, unitless: str | None = None) -> TimeRecord:
+    """Read an ``ipmc-timeseries`` MATLAB file (one column vector per column, ``metadata_json``)."""
     from scipy.io import loadmat
 
     where = f"{path}: "
-    try:
+    try:   # scipy's parser raises many exception types on a malformed file; all mean "not readable"
         data = loadmat(path)
-    except FileNotFoundError:
-        raise DataFormatError(f"{path}: no such file") from None
-    meta = json.loads(str(data["metadata_json"][0])) if "metadata_json" in data else {}
+    except Exception as exc:  # noqa: BLE001
+        raise _load_failed(path, exc, "MAT") from None
+    try:
+        meta = json.loads(str(data["metadata_json"][0])) if "metadata_json" in data else {}
+    except (ValueError, IndexError):
+        raise DataFormatError(f"{where}metadata_json is not JSON") from None
     skip = {"format", "metadata_json"}
-    cols = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items()
-            if not k.startswith("__") and k not in skip}
+    try:
+        cols = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in data.items()
+                if not k.startswith("__") and k not in skip}
+    except (TypeError, ValueError):
+        raise DataFormatError(f"{where}every variable but format/metadata_json must be a numeric column") from None
     _check_finite(cols, where)
-    return _build(cols, {k: str(v) for k, v in meta.items()}, where)
+    return _build(cols, {k: str(v) for k, v in dict(meta).items()}, where, unitless)
 
 
-def read_record(path) -> TimeRecord:
-    """Read a time record by extension (.csv, .npz, .mat)."""
-    return by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "time-record")(path)
+def read_record(path, unitless: str | None = None) -> TimeRecord:
+    """Read a time record by extension (.csv, .npz, .mat).
+
+    ``unitless``: unit given to a column named without a ``_<unit>`` suffix (files of the older
+    ``inversion.references.Reference.save``, which wrote a bare ``reference`` column when the
+    reference had no unit; hand-made files with e.g. ``time_s,target``); None refuses such a column.
+    """
+    reader = by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "time-record")
+    return reader(path, unitless)

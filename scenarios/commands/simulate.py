@@ -1,9 +1,10 @@
 """``ipmc simulate``: a time-domain virtual experiment (sine, step, free release, or any recorded input).
 
-``--input FILE`` drives the model with a recorded input: a time-series CSV (``#`` header lines,
-then a header row) or NPZ as ``ipmc simulate`` / ``ipmc feedforward`` write them, with a
-``time_s`` column (uniform) and an input column named ``<name>_<unit>`` (``voltage_V`` for an
-actuator, ``tip_displacement_m``/``_mm`` for a sensor; the unit suffix converts it to SI).
+``--input FILE`` drives the model with a recorded input: a time record (CSV with ``#`` header
+lines then a header row, NPZ or MAT, read by :func:`physmodel.data.timerecord.read_record`) as
+``ipmc simulate`` / ``ipmc feedforward`` write them, with a ``time_s`` column (uniform) and
+columns named ``<name>_<unit>`` (``voltage_V`` for an actuator, ``tip_displacement_m``/``_mm`` for
+a sensor; the unit suffix converts it to SI).
 ``--input-column`` picks the column (default: ``voltage_*`` for an actuator,
 ``tip_displacement_*`` for a sensor, else the first non-time column).
 """
@@ -23,7 +24,7 @@ def add_parser(sub):
     p.add_argument("--experiment", choices=("sine", "step", "release"), default=None,
                    help="built-in excitation (default sine); not with --input")
     p.add_argument("--input", dest="input_file", metavar="FILE",
-                   help="drive the model with a recorded input (time-series CSV/NPZ with time_s and "
+                   help="drive the model with a recorded input (time-record CSV/NPZ/MAT with time_s and "
                         "e.g. voltage_V); see the module help")
     p.add_argument("--input-column", help="column of --input to use (default: voltage_* / tip_displacement_*)")
     p.add_argument("--temperature", type=float, default=25.0, help="bath temperature [°C]")
@@ -99,13 +100,11 @@ def read_input(path, kind: str, column: str | None = None):
     The column's unit suffix (``voltage_V``, ``voltage_mV``, ``tip_displacement_mm`` ...) converts
     it to SI; an actuator needs a voltage, a sensor a displacement.
     """
-    from inversion.references import read_columns
+    from physmodel.data.timerecord import read_record
     from physmodel.data.timesim import check_uniform_time
     from physmodel.data.units import UNITS
 
-    cols = read_columns(path)
-    if "time_s" not in cols:
-        raise CLIError(f"--input {path}: needs a time_s column; found {list(cols)}")
+    cols = read_record(path).columns()
     want = ("voltage", "V", "voltage") if kind == "actuator" else ("tip_displacement", "m", "length")
     names = [c for c in cols if c != "time_s"]
     if column is None:

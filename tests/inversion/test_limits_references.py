@@ -129,3 +129,56 @@ def test_unfaded_reference_spikes_at_the_end_faded_one_does_not():
     steady = np.max(np.abs(v_faded[faded.body]))
     assert np.max(np.abs(v_faded)) <= 1.01 * steady
     assert np.max(np.abs(v_raw)) > 3 * steady            # the jumps excite the inverse
+
+
+# ------------------------------------------------------------------- reference files
+def _old_csv(path, unit_suffix=""):
+    """A file as the old ``Reference.save`` wrote it (written here by hand, not by the library)."""
+    col = f"reference_{unit_suffix}" if unit_suffix else "reference"
+    lines = ["# ipmc-reference 1", "# description: sine 0.3 at 1 Hz", "# fade_in_s: 2", "# fade_out_s: 2",
+             "# lead_s: 1", "# tail_s: 1", f"time_s,{col}"]
+    t = np.arange(6) * 0.25
+    y = np.r_[0.0, 0.1, -0.2, 0.3, 0.05, 0.0]
+    lines += [f"{float(a)!r},{float(b)!r}" for a, b in zip(t, y)]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return t, y
+
+
+def test_old_reference_files_stay_readable(tmp_path):
+    t, y = _old_csv(tmp_path / "old.csv")
+    back = R.from_file(tmp_path / "old.csv")
+    np.testing.assert_array_equal(back.t, t)
+    np.testing.assert_array_equal(back.y, y)
+    assert back.unit == R.DEFAULT_UNIT == "m"                  # a unit-less column: the default unit
+    assert R.from_file(tmp_path / "old.csv", unit="mm").unit == "mm"   # ... or the caller's
+    _old_csv(tmp_path / "old_mm.csv", "mm")
+    assert R.from_file(tmp_path / "old_mm.csv").unit == "mm"
+    # the old NPZ: a JSON header of format 'ipmc-reference' without a version
+    import json
+
+    np.savez(tmp_path / "old.npz", header=np.array(json.dumps({"format": "ipmc-reference", "metadata": {"lead_s": "1"}})),
+             time_s=t, reference=y)
+    np.testing.assert_array_equal(R.from_file(tmp_path / "old.npz").y, y)
+
+
+def test_saved_references_are_time_records_with_a_unit(tmp_path):
+    from physmodel.data.timerecord import read_record
+
+    ref = R.sine(0.3, 1.0, 4.0, 200.0)                           # no unit given
+    rec = read_record(ref.save(tmp_path / "r.csv"))
+    assert rec.units == {"reference": "m"} and rec.metadata["fade_in_s"] == "2"
+    assert "# reference_m: reference [m]" in (tmp_path / "r.csv").read_text().splitlines()
+    mm = R.sine(0.3, 1.0, 4.0, 200.0, unit="mm")
+    for ext in ("csv", "npz", "mat"):
+        back = R.from_file(mm.save(tmp_path / f"r.{ext}"))
+        assert back.unit == "mm"
+        np.testing.assert_array_equal(back.y, mm.y)
+    # a column in another unit of the same kind is converted, of another kind refused
+    um = R.from_file(tmp_path / "r.csv", unit="um")
+    np.testing.assert_allclose(um.y, mm.y * 1e3, rtol=1e-15)
+    with pytest.raises(IPMCError, match="cannot be converted"):
+        R.from_file(tmp_path / "r.csv", unit="V")
+    with pytest.raises(IPMCError, match="no column 'target'"):
+        R.from_file(tmp_path / "r.csv", column="target")
+    with pytest.raises(IPMCError, match="unknown time-record file type"):
+        mm.save(tmp_path / "r.txt")
