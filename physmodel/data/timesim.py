@@ -329,10 +329,12 @@ class TimeSeries:
 
 
 def model_realization(model, temperature_c: float, fs: float, duration: float, output: str = "auto",
-                      set_index: int = 0, tol: float = 1e-4) -> Realization:
+                      set_index: int = 0, tol: float = 1e-4, chain=None) -> Realization:
     """Realise the model's main transfer function at one temperature for a simulation at ``fs`` [Hz]
     lasting ``duration`` [s].  ``output``: actuator "displacement" (M) or "current" (1/Z);
-    sensor "current" (S)."""
+    sensor "current" (S).  ``chain``: a sensor's :class:`~physmodel.sensor.TransimpedanceChain`
+    with finite op-amps (``gbw_hz``/``dc_gain``), realised with S as one transfer function
+    S(s)·A(s, Z(s)) [V/m] (the amplifier's response depends on the strip's impedance Z)."""
     is_act = getattr(model, "kind", None) == "actuator"
     if output == "auto":
         output = "displacement" if is_act else "current"
@@ -346,12 +348,20 @@ def model_realization(model, temperature_c: float, fs: float, duration: float, o
         raise IPMCError(f"output {output!r} is not available for {type(model).__name__}; "
                         f"expected {'displacement or current' if is_act else 'current'}")
     T = [float(temperature_c)]
+    if chain is not None and q != "S":
+        raise IPMCError(f"a transimpedance chain with finite op-amps (gbw_hz={chain.gbw_hz}, dc_gain={chain.dc_gain}) "
+                        "is simulated for a sensor's current (its source is the strip's impedance); "
+                        f"{type(model).__name__} output {output!r} supports only ideal op-amps")
 
     def fn(s):
-        return model.evaluate(s, T, quantities=(q,))[q][set_index, 0]
+        if chain is None:
+            return model.evaluate(s, T, quantities=(q,))[q][set_index, 0]
+        ev = model.evaluate(s, T, quantities=("S", "Z"))
+        return ev["S"][set_index, 0] * chain.response(s, ev["Z"][set_index, 0])
 
+    what = q if chain is None else f"{q}·A(Z) (op-amps gbw_hz={chain.gbw_hz}, dc_gain={chain.dc_gain})"
     return realize(fn, (f_lo, f_hi), dc_value=dc, derivative=deriv, tol=tol,
-                   description=f"{type(model).__name__} {q} at {temperature_c:g} °C, set {model.params[set_index].name}")
+                   description=f"{type(model).__name__} {what} at {temperature_c:g} °C, set {model.params[set_index].name}")
 
 
 def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None, output_noise_rms: float = 0.0,
@@ -360,7 +370,9 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
     """Run a virtual experiment: input samples ``u`` (SI: V for actuators, m for sensors) at ``t`` [s].
 
     ``chain``: optional :class:`~physmodel.sensor.TransimpedanceChain` applied to a current output
-    (output becomes volts).  Noise: white Gaussian of the given RMS added to the recorded output
+    (output becomes volts); with finite op-amps (``gbw_hz``/``dc_gain``, sensors only) the chain's
+    response depends on the strip's impedance and is realised together with it
+    (:func:`model_realization`), so ``realization`` must then be None.  Noise: white Gaussian of the given RMS added to the recorded output
     and input (the laser/voltage measurement), seeded.
     """
     t = np.asarray(t, dtype=float)
@@ -374,13 +386,21 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
     for k, v in (("output_noise_rms", output_noise_rms), ("input_noise_rms", input_noise_rms)):
         if not (np.isfinite(v) and v >= 0):
             raise IPMCError(f"{k}={v!r} must be a finite number >= 0")
-    real = realization or model_realization(model, temperature_c, 1.0 / dt, t[-1] - t[0], output, set_index, tol)
+    if chain is not None and output != "current":
+        raise IPMCError("a transimpedance chain needs a current output")
+    finite_opamps = chain is not None and not chain.ideal_opamps and chain.R3 != 0
+    if finite_opamps and realization is not None:
+        raise IPMCError(f"realization= cannot be combined with a chain of finite op-amps (gbw_hz={chain.gbw_hz}, "
+                        f"dc_gain={chain.dc_gain}): the chain is realised together with the strip "
+                        "(model_realization(..., chain=chain)); pass one or the other")
+    real = realization or model_realization(model, temperature_c, 1.0 / dt, t[-1] - t[0], output, set_index, tol,
+                                            chain=chain if finite_opamps else None)
     y = real.simulate(t, u, hold=hold, initial=initial)
     out_name, out_unit = ("tip_displacement", "m") if output == "displacement" else ("current", "A")
     if chain is not None:
-        if output != "current":
-            raise IPMCError("a transimpedance chain needs a current output")
-        if chain.bandwidth_hz is None:
+        if finite_opamps:
+            pass                      # in the realisation already, with its bandwidth pole
+        elif chain.bandwidth_hz is None:
             y = y * chain.gain
         else:
             wc = 2 * np.pi * chain.bandwidth_hz
@@ -400,7 +420,8 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
             "hold": hold, "initial": initial, "output_noise_rms": f"{output_noise_rms:g}",
             "input_noise_rms": f"{input_noise_rms:g}", "seed": str(seed)}
     if chain is not None:
-        meta["chain"] = f"R1={chain.R1:g} R2={chain.R2:g} R3={chain.R3:g} bandwidth_hz={chain.bandwidth_hz}"
+        meta["chain"] = (f"R1={chain.R1:g} R2={chain.R2:g} R3={chain.R3:g} bandwidth_hz={chain.bandwidth_hz} "
+                         f"gbw_hz={chain.gbw_hz} dc_gain={chain.dc_gain}")
     return TimeSeries(t, u_meas, y_meas, in_name, in_unit, out_name, out_unit, y, u, meta)
 
 

@@ -158,3 +158,65 @@ def test_time_series_files_roundtrip(tmp_path):
     np.testing.assert_array_equal(vals[:, 2], ts.output)
     z = np.load(ts.save(tmp_path / "run.npz"))
     np.testing.assert_array_equal(z["time_s"], ts.t)
+
+
+def _opamp_nodes(s, Z, R1, R2, R3, gbw_hz, dc_gain):
+    """v2/i_s of the two inverting stages, from their four node equations solved numerically
+    (single-pole op-amps 1/A = 1/A0 + s/(2 pi GBW); Norton source i_s = 1 in parallel with Z).
+    ``s``, ``Z``: arrays of one shape (one 4x4 system per entry)."""
+    s, Z = np.broadcast_arrays(np.asarray(s, dtype=complex), np.asarray(Z, dtype=complex))
+    inv_a = (0.0 if dc_gain is None else 1.0 / dc_gain) + (0.0 if gbw_hz is None else s / (2 * np.pi * gbw_hz))
+    M = np.zeros(s.shape + (4, 4), dtype=complex)      # unknowns v_n1, v1, v_n2, v2
+    M[..., 0, 0], M[..., 0, 1] = 1 / Z + 1 / R1, -1 / R1  # node n1: i_s = v_n1/Z + (v_n1 - v1)/R1
+    M[..., 1, 0], M[..., 1, 1] = 1.0, inv_a              # op-amp 1: v1 = -A v_n1
+    M[..., 2, 1], M[..., 2, 2], M[..., 2, 3] = 1 / R2, -1 / R2 - 1 / R3, 1 / R3   # node n2: (v1 - v_n2)/R2 = (v_n2 - v2)/R3
+    M[..., 3, 2], M[..., 3, 3] = 1.0, inv_a              # op-amp 2: v2 = -A v_n2
+    rhs = np.zeros(s.shape + (4, 1), dtype=complex)
+    rhs[..., 0, 0] = 1.0
+    return np.linalg.solve(M, rhs)[..., 3, 0]
+
+
+def _sampled_phasor(H, f0, fs, K=200):
+    """Steady-state phasor at the sample instants of a linearly interpolated (first-order-hold)
+    sine of f0 [Hz] sampled at fs [Hz] through H(f) (H of an array of frequencies > 0 [Hz]):
+    sum over k of H(f0 + k fs) sinc^2((f0 + k fs)/fs) (the interpolant's images alias back onto the
+    samples; H(-f) = conj H(f)), |k| <= K."""
+    f = f0 + fs * np.arange(-K, K + 1)
+    Hf = H(np.abs(f))
+    Hf = np.where(f < 0, np.conj(Hf), Hf)
+    return complex(np.sum(Hf * np.sinc(f / fs) ** 2))
+
+
+@pytest.mark.parametrize("f0, gbw_hz, dc_gain", [(20.0, 1e6, 1e5), (80.0, 1e6, None), (20.0, None, 2e3)])
+def test_finite_opamps_reach_the_node_equation_phasor(f0, gbw_hz, dc_gain):
+    m = SensorModel(get_parameter_set("seed000_sensor_dev"))
+    T, A, fs, dur = 25.0, 1e-3, 4000.0, 3.0
+    R1, R2, R3 = 470e3, 10e3, 20e3
+    ts = sine(m, T, A, f0, dur, fs, chain=TransimpedanceChain(R1, R2, R3, gbw_hz=gbw_hz, dc_gain=dc_gain))
+
+    def H(f):
+        fr = m.frequency_response(f, [T], quantities=("S", "Z"))
+        return fr["S"][0, 0] * _opamp_nodes(2j * np.pi * f, fr["Z"][0, 0], R1, R2, R3, gbw_hz, dc_gain)
+
+    want = _sampled_phasor(H, f0, fs)
+    sel = ts.t >= dur - 1.0                       # 20 periods at least, transients long gone
+    basis = np.c_[np.sin(2 * np.pi * f0 * ts.t[sel]), np.cos(2 * np.pi * f0 * ts.t[sel])]
+    (a, b), *_ = np.linalg.lstsq(basis, ts.output[sel], rcond=None)
+    got = complex(a, b) / A                       # A sin(wt) -> A (Re H sin + Im H cos)
+    assert abs(got - want) <= 5e-4 * abs(want), f"simulated {got}, node equations {want}"
+    # the finite op-amps matter here: the ideal chain is far off (the test could not pass by ignoring them)
+    ideal = _sampled_phasor(lambda f: m.frequency_response(f, [T], quantities=("S",))["S"][0, 0] * R3 * R1 / R2, f0, fs)
+    assert abs(ideal - want) > 0.05 * abs(want)
+    assert ts.output_unit == "V" and f"gbw_hz={gbw_hz}" in ts.metadata["chain"]
+
+
+def test_finite_opamps_are_refused_where_they_cannot_be_honoured():
+    chain = TransimpedanceChain(gbw_hz=1e6)
+    act = ActuatorModel(get_parameter_set("dev"))
+    with pytest.raises(IPMCError, match="gbw_hz=1000000.0"):
+        sine(act, 25.0, 1.0, 5.0, 0.5, 1000.0, output="current", chain=chain)
+    sen = SensorModel(get_parameter_set("seed000_sensor_dev"))
+    t = np.arange(500) / 1000.0
+    real = Realization(np.array([complex(-10.0, 0.0)]), np.array([complex(1.0, 0.0)]), 0.0, (1.0, 10.0), 0.0)
+    with pytest.raises(IPMCError, match="realization= cannot be combined"):
+        simulate(sen, 25.0, t, np.sin(t), chain=chain, realization=real)
