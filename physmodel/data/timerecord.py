@@ -15,8 +15,10 @@ same way::
     ...
 
 Column names are ``time_s`` and ``<name>_<unit>`` (the unit after the last underscore); the
-per-channel header lines are optional when reading (TimeSeries files do not write them) and, when
-present, must agree with their column.  NPZ files hold one array per column plus a JSON ``header``
+per-channel header lines are optional when reading (files of older versions of TimeSeries and
+hand-made files have none) and, when present, must agree with their column.  TimeSeries,
+:meth:`inversion.references.Reference.save` and the excitation plans all write through
+:class:`TimeRecord`.  NPZ files hold one array per column plus a JSON ``header``
 (format, version, metadata); MATLAB ``.mat`` files one column vector per column plus
 ``metadata_json``.
 """

@@ -18,8 +18,6 @@ with ``scipy.signal.lfilter`` — no Python loop over samples.
 
 from __future__ import annotations
 
-import csv
-import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,8 +27,7 @@ from scipy import signal
 
 from ..errors import IPMCError
 from ..numerics import weighted_complex_lstsq
-from .files import atomic_write, by_extension
-from .timerecord import uniform_interval
+from .timerecord import TimeRecord, uniform_interval
 
 
 class RealizationError(IPMCError):
@@ -303,29 +300,25 @@ class TimeSeries:
             cols[f"{self.input_name}_clean_{self.input_unit}"] = self.clean_input
         return cols
 
+    def record(self) -> TimeRecord:
+        """The series as a :class:`~physmodel.data.timerecord.TimeRecord` (its columns and metadata)."""
+        return TimeRecord.from_columns(self.columns(), self.metadata)
+
     def to_csv(self, path) -> Path:
-        cols = self.columns()
-
-        def write(fh):
-            fh.write("# ipmc-timeseries 1\n")
-            for k, v in self.metadata.items():
-                fh.write(f"# {k}: {str(v).replace(chr(10), ' ')}\n")
-            w = csv.writer(fh, lineterminator="\n")
-            w.writerow(list(cols))
-            for row in zip(*cols.values()):
-                w.writerow([repr(float(v)) for v in row])
-
-        return atomic_write(path, write)
+        """Write the ``ipmc-timeseries`` CSV (:meth:`TimeRecord.to_csv <physmodel.data.timerecord.TimeRecord.to_csv>`)."""
+        return self.record().to_csv(path)
 
     def to_npz(self, path) -> Path:
-        def write(fh):
-            np.savez(fh, header=np.array(json.dumps({"format": "ipmc-timeseries", "version": 1, "metadata": self.metadata})),
-                     **self.columns())
+        """Write the ``ipmc-timeseries`` NPZ (one array per column, JSON ``header``)."""
+        return self.record().to_npz(path)
 
-        return atomic_write(path, write, "wb")
+    def to_mat(self, path) -> Path:
+        """Write the ``ipmc-timeseries`` MATLAB file (one column vector per column, ``metadata_json``)."""
+        return self.record().to_mat(path)
 
     def save(self, path) -> Path:
-        return by_extension(path, {".csv": self.to_csv, ".npz": self.to_npz}, "time-series")(path)
+        """Write by extension (.csv, .npz, .mat), atomically, through :class:`~physmodel.data.timerecord.TimeRecord`."""
+        return self.record().save(path)
 
 
 def model_realization(model, temperature_c: float, fs: float, duration: float, output: str = "auto",

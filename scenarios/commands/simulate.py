@@ -38,7 +38,7 @@ def add_parser(sub):
     p.add_argument("--input-noise-rms", type=float, default=0.0, help="white noise on the recorded input (SI)")
     p.add_argument("--chain", help="sensor: transimpedance chain R1,R2,R3 [ohm] (seed 000: 470e3,10e3,R3)")
     p.add_argument("--seed", type=int, help="noise seed (required with noise)")
-    p.add_argument("--out", required=True, help="output file (.csv or .npz)")
+    p.add_argument("--out", required=True, help="output file (.csv, .npz or .mat)")
     p.add_argument("--plot", help="also write a plot of the traces (PNG)")
     p.set_defaults(func=run)
 
@@ -47,8 +47,8 @@ def run(args) -> int:
     from physmodel.data.timesim import free_release, simulate, sine, step
 
     out = Path(args.out)
-    if out.suffix.lower() not in (".csv", ".npz"):
-        raise CLIError(f"--out {out}: use a .csv or .npz file name")
+    if out.suffix.lower() not in (".csv", ".npz", ".mat"):
+        raise CLIError(f"--out {out}: use a .csv, .npz or .mat file name")
     if args.plot:
         check_plot_path(args.plot)
     model = _model(args, _load_params(args))

@@ -220,3 +220,36 @@ def test_finite_opamps_are_refused_where_they_cannot_be_honoured():
     real = Realization(np.array([complex(-10.0, 0.0)]), np.array([complex(1.0, 0.0)]), 0.0, (1.0, 10.0), 0.0)
     with pytest.raises(IPMCError, match="realization= cannot be combined"):
         simulate(sen, 25.0, t, np.sin(t), chain=chain, realization=real)
+
+
+def test_time_series_write_time_records_old_files_read_the_same(tmp_path):
+    import csv
+
+    from physmodel.data.timerecord import read_record
+
+    m = SensorModel(get_parameter_set("seed000_sensor_dev"))
+    ts = sine(m, 25.0, 1e-3, 20.0, 0.2, 1000.0, output_noise_rms=1e-9, seed=3)
+    cols = ts.columns()
+    # the file of the older TimeSeries.to_csv (no per-channel header lines, repr of each value),
+    # written here with the csv module
+    with open(tmp_path / "old.csv", "w", newline="", encoding="utf-8") as fh:
+        fh.write("# ipmc-timeseries 1\n")
+        for k, v in ts.metadata.items():
+            fh.write(f"# {k}: {v}\n")
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(list(cols))
+        w.writerows([repr(float(x)) for x in row] for row in zip(*cols.values()))
+    old = read_record(tmp_path / "old.csv")
+    for ext in ("csv", "npz", "mat"):
+        new = read_record(ts.save(tmp_path / f"new.{ext}"))
+        assert new.columns_names() == old.columns_names() == list(cols)[1:]
+        assert new.units == {"tip_displacement": "m", "current": "A", "current_clean": "A", "tip_displacement_clean": "m"}
+        for k, v in cols.items():
+            np.testing.assert_array_equal(new.columns()[k], v)
+            np.testing.assert_array_equal(old.columns()[k], v)
+        assert new.metadata == old.metadata
+    text = (tmp_path / "new.csv").read_text().splitlines()
+    assert text[0] == "# ipmc-timeseries 1" and "# current_A: current [A]" in text
+    # the NPZ keeps its layout: a JSON header and one array per column
+    with np.load(tmp_path / "new.npz") as z:
+        assert sorted(z.files) == sorted(["header", *cols])
