@@ -243,7 +243,7 @@ def calibrate_laws(data: A0Series, respond, frequency_hz, free, starts: int = 3,
         return den[..., -1]                                              # (n_sets, n_T)
 
     def res_of(a0):
-        return np.log(np.abs(a0) / data.a0) / data.sigma_ln
+        return np.log(np.abs(a0 / data.a0)) / data.sigma_ln          # a sign flip is reported, not fitted
 
     def jac(z):
         steps = np.where(z + FD_STEP <= hi, FD_STEP, -FD_STEP)
