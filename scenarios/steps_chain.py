@@ -355,7 +355,10 @@ def step_chain(ctx) -> None:
     from .steps_chain_temperature import step_temperature
 
     eff = {c: {p.name: vals[f"{c}.{p.name}"] for p in get_effect(c).parameters} for c in chosen}
-    step_temperature(ctx, base, vals, eff, data, mis["chain"], d_row, seed=cfg.get("seed", 0))
+    dvals = {**docres.values, **held}
+    deff = {e: {p.name: dvals[f"{e}.{p.name}"] for p in get_effect(e).parameters} for e in doc_effects}
+    step_temperature(ctx, base, vals, eff, data, mis["chain"], d_row, seed=cfg.get("seed", 0),
+                     documented=(dvals, deff, mis["documented"]))
 
 
 def _profile_d(data, base, vals, effects, cfg):

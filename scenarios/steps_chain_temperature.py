@@ -325,7 +325,10 @@ def calibrate_laws(data: A0Series, respond, frequency_hz, free, starts: int = 3,
 VARIANTS = (("chain fixed", False, False, (_EA, _SK, _SE)),
             ("chain fixed, κe ∝ ε_water", False, True, (_EA, _SE)),
             ("beam mode follows E(T)", True, False, (_EA, _SK, _SE)),
-            ("beam mode follows E(T), κe ∝ ε_water", True, True, (_EA, _SE)))
+            ("beam mode follows E(T), κe ∝ ε_water", True, True, (_EA, _SE)),
+            ("chain fixed, κe ∝ ε_water, Ea bound opened", False, True, (_EA,)))
+#: Upper bound of Ea in the "bound opened" calibration (calibrate's default is 60 kJ/mol) [J/mol].
+EA_OPENED = 250e3
 #: Literature ranges of the laws (physics.md §7; physmodel.temperature): Ea of d, slope of E.
 LITERATURE = {_EA: (10.5e3, 18e3, "Nafion conductivity and NMR self-diffusion, 10.5-18 kJ/mol (physics.md §7)"),
               _SE: (-0.0075, -0.0075, "water-soaked Nafion -0.75 %/K (DuPont; physics.md §7); seed 000 Fig. 6: "
@@ -344,17 +347,21 @@ def _factor_ratio(name, value, t_lo=23.0, t_hi=65.0):
     return math.exp(min(x, 700.0)) if math.isfinite(x) else math.nan
 
 
-def run_series(base, vals, effects, sweep35, seed=0, draws=A0_DRAWS):
-    """All :data:`VARIANTS` on the printed a0(T): {label: dict}, plus the data (A0Series)."""
+def run_series(base, vals, effects, sweep35, seed=0, draws=A0_DRAWS, variants=VARIANTS, prefix=""):
+    """``variants`` (default all :data:`VARIANTS`) on the printed a0(T): (data, {prefix + label: dict},
+    {Ea: χ²} profile)."""
+    from physmodel.estimation.records import FreeParameter
     from physmodel.temperature import T0_K
 
     data = a0_series(sweep35, draws=draws, seed=seed)
     f = sweep35.frequency_hz
     phys = {k: v for k, v in vals.items() if "." not in k}
     out = {}
-    for label, beam, water, names in VARIANTS:
+    for label, beam, water, names in variants:
         b = base if water else loglinear_kappa(base)
         free = law_free_parameters(b, names)
+        if "opened" in label:
+            free = [FreeParameter(_EA, 0.0, EA_OPENED, "linear", free[0].initial)]
         respond = series_model(b, phys, effects, f, data.temperatures_c, beam_follows_E=beam)
         cal = calibrate_laws(data, respond, f, free, starts=3, seed=seed)
         r = cal.result
@@ -363,13 +370,14 @@ def run_series(base, vals, effects, sweep35, seed=0, draws=A0_DRAWS):
         a0_dense = levy_4_4(f, series_model(b, phys, effects, f, dense_t, beam_follows_E=beam)(
             [cal.values, {}]))[1][..., -1]
         pct = 100 * (cal.a0_model / data.a0 - 1)
-        out[label] = {"label": label, "cal": cal, "result": r, "free": names, "trends": trend_signs(f, tr),
+        out[prefix + label] = {"label": prefix + label, "cal": cal, "result": r, "free": names, "trends": trend_signs(f, tr),
                       "trend_response": tr, "a0_dense": (dense_t, a0_dense[0], a0_dense[1]),
                       "a0_pct": pct, "a0_rms_pct": float(np.sqrt(np.mean(pct ** 2))),
                       "a0_max_pct": float(np.abs(pct).max()),
                       "ratios": {n: (_factor_ratio(n, r.values[n]), _factor_ratio(n, r.ci_lower[n]),
                                      _factor_ratio(n, r.ci_upper[n])) for n in names},
-                      "kappa_water": water, "beam": beam, "T_ref_c": b.T_ref - T0_K}
+                      "kappa_water": water, "beam": beam, "T_ref_c": b.T_ref - T0_K,
+                      "defaults": {_EA: b.laws.d.activation_energy, _SE: b.laws.E.slope}}
     # χ² profile over Ea with the chain fixed and κe by the water permittivity (E does not act on a0)
     a0p = levy_4_4(f, series_model(base, phys, effects, f, data.temperatures_c)([{_EA: e} for e in EA_PROFILE]))[1]
     chi2 = np.sum((np.log(np.abs(a0p[..., -1]) / data.a0) / data.sigma_ln) ** 2, axis=1)
@@ -388,14 +396,19 @@ def _slug(s):
     return re.sub(r"[^a-z0-9]+", "_", s.lower().replace("κe", "kappa").replace("ε", "eps")).strip("_")
 
 
-def step_temperature(ctx, base, vals, effects, sweep35, mis35, d_row, seed=0) -> None:
-    """Run :func:`run_series`, write metrics, the figure(s) and the report section."""
+def step_temperature(ctx, base, vals, effects, sweep35, mis35, d_row, seed=0, documented=None) -> None:
+    """Run :func:`run_series` on the greedy chain's values (and, given ``documented = (values,
+    effects, misfit)``, the first two variants on the documented fit: every parameter in its sourced
+    range, d at 35 °C plausible or at its range's edge), write metrics, figures and the section."""
     import time
 
     from . import plots_chain
 
     t0 = time.perf_counter()
     data, out, prof = run_series(base, vals, effects, sweep35, seed=seed)
+    if documented is not None:
+        out.update(run_series(base, documented[0], documented[1], sweep35, seed=seed, variants=VARIANTS[:2],
+                              prefix="documented chain: ")[1])
     for ea, c2 in prof.items():
         ctx.metric(f"chain.temperature.ea_profile_chi2.{ea / 1e3:g}kJ", c2)
     ctx.metric("chain.temperature.a0_sigma_ln_identification", data.identification_ln)
@@ -436,7 +449,7 @@ def step_temperature(ctx, base, vals, effects, sweep35, mis35, d_row, seed=0) ->
     curves["printed 35 °C model"] = (sweep35.response, {"color": "k", "lw": 2.0})
     ctx.file(plots_chain.bode_overlay(sweep35.frequency_hz, curves, ctx.out / "chain_bode_temperatures.png",
                                       None, "physics + chain at the Fig. 5 temperatures, calibrated laws"))
-    _section(ctx, data, out, prof, mis35, d_row, d_ok, time.perf_counter() - t0)
+    _section(ctx, data, out, prof, mis35, d_row, d_ok, time.perf_counter() - t0, documented)
 
 
 def _fmt_par(r, n):
@@ -447,7 +460,7 @@ def _fmt_par(r, n):
     return (n, f"{v * sc:.4g} {unit}", ci, "yes" if idf.identifiable else "NO", idf.reason[:120])
 
 
-def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed):
+def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed, documented=None):
     from .steps_chain import _table
 
     dt = _table(["T [°C]", "printed a0 [1e10/s⁴]", "σ ln a0"] + [f"{v['label']}: model a0 (Δ %)" for v in out.values()],
@@ -467,7 +480,8 @@ def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed):
         impl.append((v["label"],) + tuple(
             (f"{v['ratios'][n][0]:.3g}" + (f" [{min(v['ratios'][n][1:]):.3g}, {max(v['ratios'][n][1:]):.3g}]"
                                            if r.identifiability[n].identifiable else " (undetermined)"))
-            if n in v["ratios"] else f"{_water_ratio():.3g} (water law, fixed)" for n in (_EA, _SK, _SE)))
+            if n in v["ratios"] else f"{_water_ratio():.3g} (water law, fixed)" if n == _SK and v["kappa_water"]
+            else f"{_factor_ratio(n, v['defaults'][n]):.3g} (default law, not fitted)" for n in (_EA, _SK, _SE)))
     lit = "; ".join(f"{n}: {s}" for n, (_, _, s) in LITERATURE.items())
     ctx.section(
         "Temperature series: the polymer's laws with the chain fixed",
@@ -499,6 +513,10 @@ def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed):
         + ("determined and inside its sourced range" if d_ok else
            f"{'determined' if d_row['identifiable'] else 'undetermined'}"
            f"{'' if d_row['inside'] else ', outside its sourced range [1e-11, 1e-10] m²/s'}")
-        + "; the laws are relative to 35 °C, so the temperature series cannot change d(35 °C).", "",
+        + "; the laws are relative to 35 °C, so the temperature series cannot change d(35 °C)."
+        + ("" if documented is None else
+           f"  The documented chain (every parameter in its sourced range) has d = {documented[0]['d']:.3g} m²/s "
+           f"at 35 °C, with a 35 °C misfit of {documented[2]['rms_db']:.3g} dB / {documented[2]['rms_deg']:.3g}° "
+           "RMS; its rows above ('documented chain: ...') show what the a0(T) data say with a plausible d."), "",
         "![a0(T)](chain_a0_temperature.png)", "![Bode at 25/45/65 °C](chain_bode_temperatures.png)", "",
         f"Temperature series computed in {elapsed:.2g} s.")
