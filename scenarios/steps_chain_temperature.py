@@ -6,8 +6,7 @@ What is printed per temperature (seed 000 Sec. II-B, III, IV-A; ``published.toml
     * a0(T), the constant of the 4/4 model's monic denominator, as a cubic in T − 23.07 fitted to the
       invfreqs identifications at 23, 25, 30, 40, 50, 60, 65 °C (Fig. 7; the identified points are
       not printed, only the polynomial);
-    * three qualitative trends with rising T read off Fig. 5 (25, 45, 65 °C): the cutoff frequency
-      (high-pass view) and the high-frequency gain fall, the phase lag grows.
+    * trends with rising T read off Fig. 5 (25, 45, 65 °C): cutoff and high-frequency gain fall, lag grows.
 
 Data and noise model (stated, not tuned)
     a0(T_i) = the printed polynomial at the fit temperatures.  σ of ln a0 per temperature: the
@@ -27,13 +26,11 @@ Model of the observation
     ``beam_follows_E``: the tip-driven strip's mode is the strip's own (ω1 ∝ sqrt(E)), so its time
     constant follows E(T): τ(T) = τ(35 °C)·exp(−slope_E (T − 35)/2) (the rest of the chain fixed).
 
-Calibration: weighted least squares in the scaled space of :class:`FreeParameter` (scipy
-``least_squares``, multi-start), 95 % intervals from the Gauss-Newton covariance, a parameter is
-undetermined when its interval is wider than its bounds or it ends at a bound, χ² against its
-expectation (:func:`physmodel.estimation.residuals.goodness_of_fit`) and, if the model does not fit,
-the same policy as :func:`physmodel.estimation.calibration.calibrate` (no identifiability verdict,
-intervals widened by the Birge ratio).  ``calibrate`` itself cannot be used: it evaluates the
-physics alone (no chain effects) and takes only frequency sweeps, not a0(T).
+Calibration: weighted least squares in :class:`FreeParameter`'s scaled space (scipy, multi-start),
+95 % Gauss-Newton intervals, undetermined = interval wider than the bounds, at a bound or zero
+sensitivity (held), χ² vs expectation (``goodness_of_fit``) and, on a misfit, ``calibrate``'s policy
+(Birge-widened intervals, no identifiability verdict).  ``calibrate`` itself cannot be used: it
+evaluates the physics alone (no chain effects) and takes only frequency sweeps, not a0(T).
 """
 
 from __future__ import annotations
@@ -46,9 +43,8 @@ import numpy as np
 __all__ = ["A0Series", "LawCalibration", "a0_series", "calibrate_laws", "law_free_parameters", "levy_4_4",
            "printed_a0", "series_model", "trend_signs"]
 
-#: The seed's fit temperatures (Sec. III) and the Fig. 5 temperatures of the printed trends [°C].
+#: The Fig. 5 temperatures of the printed trends [°C].
 TRENDS_C = (25.0, 45.0, 65.0)
-T_CHAIN_C = 35.0
 _EA, _SK, _SE = "laws.d.activation_energy", "laws.kappa_e.slope", "laws.E.slope"
 
 
@@ -68,12 +64,9 @@ def printed_a0(temperature_c, coeffs=None) -> np.ndarray:
 
 
 def _half_digit(c: float) -> float:
-    """Half the last printed digit of a coefficient printed with the digits shown in published.toml."""
-    s = f"{abs(c):.6g}"
-    mant = s.split("e")[0]
-    exp = int(s.split("e")[1]) if "e" in s else 0
-    dec = len(mant.split(".")[1]) if "." in mant else 0
-    return 0.5 * 10.0 ** (exp - dec)
+    """Half the last printed digit of ``c`` as written in published.toml (e.g. 8.56e-5 -> 5e-8)."""
+    mant, _, exp = f"{abs(c):.6g}".partition("e")
+    return 0.5 * 10.0 ** (int(exp or 0) - len(mant.partition(".")[2]))
 
 
 def levy_4_4(frequency_hz, G) -> tuple[np.ndarray, np.ndarray]:
@@ -212,16 +205,11 @@ class LawCalibration:
     values: dict = field(default_factory=dict)
 
 
-def _lhs(n, k, seed):
-    from scipy.stats import qmc
-
-    return qmc.LatinHypercube(d=k, seed=seed).random(n) if n > 0 else np.empty((0, k))
-
-
 def calibrate_laws(data: A0Series, respond, frequency_hz, free, starts: int = 3, seed: int = 0,
                    max_nfev: int = 200) -> LawCalibration:
     """Fit ``free`` law parameters so that a0 of :func:`levy_4_4` of ``respond`` matches ``data``."""
     from scipy.optimize import least_squares
+    from scipy.stats import qmc
 
     from physmodel.estimation.calibration import apply_misfit_policy
     from physmodel.estimation.lsq import BOUND_TOL, FD_STEP, Z95
@@ -255,7 +243,7 @@ def calibrate_laws(data: A0Series, respond, frequency_hz, free, starts: int = 3,
     zb = np.clip(z0[None, :] + 0.1 * (hi - lo) * np.eye(z0.size), lo, hi)   # 10 % of each range
     R0 = res_of(a0_of(np.vstack([z0, zb])))
     live = np.abs(R0[1:] - R0[0]).max(axis=1) > 1e-6                      # in units of σ
-    zs = np.vstack([z0, lo + _lhs(starts - 1, z0.size, seed) * (hi - lo)])
+    zs = np.vstack([z0, lo + qmc.LatinHypercube(d=z0.size, seed=seed).random(max(starts - 1, 0)) * (hi - lo)])
     zs[:, ~live] = z0[~live]
     fits, records = [], []
     for i, zi in enumerate(zs):
@@ -384,12 +372,6 @@ def run_series(base, vals, effects, sweep35, seed=0, draws=A0_DRAWS, variants=VA
     return data, out, dict(zip(EA_PROFILE, chi2.tolist()))
 
 
-def _water_ratio(t_lo=23.0, t_hi=65.0):
-    from physmodel.temperature import water_permittivity
-
-    return float(water_permittivity(t_hi) / water_permittivity(t_lo))
-
-
 def _slug(s):
     import re
 
@@ -419,20 +401,16 @@ def step_temperature(ctx, base, vals, effects, sweep35, mis35, d_row, seed=0, do
     for label, v in out.items():
         k, r = f"chain.temperature.{_slug(label)}", v["result"]
         g = r.goodness_of_fit
-        ctx.metric(f"{k}.chi2", g.chi2)
-        ctx.metric(f"{k}.dof", g.dof)
-        ctx.metric(f"{k}.p_value", g.p_value)
-        ctx.metric(f"{k}.adequate", bool(g.adequate))
-        ctx.metric(f"{k}.converged", bool(r.converged))
-        ctx.metric(f"{k}.a0_misfit_rms_pct", v["a0_rms_pct"])
-        ctx.metric(f"{k}.a0_misfit_max_pct", v["a0_max_pct"])
-        ctx.metric(f"{k}.a0_model_ratio_65_23", float(v["cal"].a0_model[-1] / v["cal"].a0_model[0]))
+        for q, x in {"chi2": g.chi2, "dof": g.dof, "p_value": g.p_value, "adequate": bool(g.adequate),
+                     "converged": bool(r.converged), "a0_misfit_rms_pct": v["a0_rms_pct"],
+                     "a0_misfit_max_pct": v["a0_max_pct"],
+                     "a0_model_ratio_65_23": float(v["cal"].a0_model[-1] / v["cal"].a0_model[0])}.items():
+            ctx.metric(f"{k}.{q}", x)
         for n in v["free"]:
             p = f"{k}.{n.split('.', 1)[1].replace('.', '_')}"
-            ctx.metric(f"{p}", r.values[n])
-            ctx.metric(f"{p}_ci_lower", r.ci_lower[n])
-            ctx.metric(f"{p}_ci_upper", r.ci_upper[n])
-            ctx.metric(f"{p}_identifiable", bool(r.identifiability[n].identifiable))
+            for q, x in {"": r.values[n], "_ci_lower": r.ci_lower[n], "_ci_upper": r.ci_upper[n],
+                         "_identifiable": bool(r.identifiability[n].identifiable)}.items():
+                ctx.metric(f"{p}{q}", x)
         for t, ok in v["trends"]["as_printed"].items():
             ctx.metric(f"{k}.trend_{_slug(t)}", ok)
     d_ok = bool(d_row["identifiable"] and d_row["inside"])
@@ -461,6 +439,9 @@ def _fmt_par(r, n):
 
 
 def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed, documented=None):
+    from physmodel.temperature import water_permittivity
+
+    wr = float(water_permittivity(65.0) / water_permittivity(23.0))
     from .steps_chain import _table
 
     dt = _table(["T [°C]", "printed a0 [1e10/s⁴]", "σ ln a0"] + [f"{v['label']}: model a0 (Δ %)" for v in out.values()],
@@ -480,7 +461,7 @@ def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed, documented=None)
         impl.append((v["label"],) + tuple(
             (f"{v['ratios'][n][0]:.3g}" + (f" [{min(v['ratios'][n][1:]):.3g}, {max(v['ratios'][n][1:]):.3g}]"
                                            if r.identifiability[n].identifiable else " (undetermined)"))
-            if n in v["ratios"] else f"{_water_ratio():.3g} (water law, fixed)" if n == _SK and v["kappa_water"]
+            if n in v["ratios"] else f"{wr:.3g} (water law, fixed)" if n == _SK and v["kappa_water"]
             else f"{_factor_ratio(n, v['defaults'][n]):.3g} (default law, not fitted)" for n in (_EA, _SK, _SE)))
     lit = "; ".join(f"{n}: {s}" for n, (_, _, s) in LITERATURE.items())
     ctx.section(
