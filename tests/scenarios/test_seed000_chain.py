@@ -18,19 +18,24 @@ from scenarios.steps_chain import (
 )
 
 
+def _register(mp):
+    """Register the [chain] step the way the merge did, unless it already is (registering it twice
+    would run the step twice)."""
+    if "chain" not in spec.STEP_ORDER:
+        mp.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
+    mp.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
+    mp.setitem(runner.STEPS, "chain", step_chain)
+
+
 @pytest.fixture
 def registered(monkeypatch):
-    monkeypatch.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
-    monkeypatch.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
-    monkeypatch.setitem(runner.STEPS, "chain", step_chain)
+    _register(monkeypatch)
 
 
 @pytest.fixture(scope="module")
 def quick_result(tmp_path_factory):
     mp = pytest.MonkeyPatch()
-    mp.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
-    mp.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
-    mp.setitem(runner.STEPS, "chain", step_chain)
+    _register(mp)
     out = tmp_path_factory.mktemp("chain")
     try:
         path = spec.bundled_scenarios()[0].parent / "seed000_chain.toml"
@@ -43,6 +48,7 @@ def quick_result(tmp_path_factory):
 def test_scenario_passes_its_checks_and_writes_its_figures(quick_result):
     res, out = quick_result
     assert not [(c.name, c.value) for c in res.checks if not c.passed]
+    assert list(spec.STEP_ORDER).count("chain") == 1
     for f in ("chain_bode.png", "chain_pole_zero.png", "chain_effects.png", "chain_a0_temperature.png",
               "chain_bode_temperatures.png", "metrics.json", "report.md"):
         assert (out / f).exists(), f
