@@ -184,3 +184,16 @@ def test_interval_coverage_under_noise():
         for n, v in TRUTH.items():
             hits[n] += bool(r.identifiability[n].identifiable and r.ci_lower[n] <= v <= r.ci_upper[n])
     assert min(hits.values()) >= 16, hits
+
+
+def test_laws_do_nothing_at_the_reference_temperature():
+    """At T_ref = 35 °C every law factor is 1, so the series model is the step's 35 °C response
+    (physmodel's EffectModel called directly) whatever the law parameters."""
+    from scenarios.steps_chain import _response
+
+    base, effects = _library_side()
+    vals = {f"{e}.{p}": v for e, pv in effects.items() for p, v in pv.items()}
+    want = _response(base, vals, list(effects), F_HZ, T35) / 1e3                       # µA/mm -> A/m
+    respond = series_model(base, {}, effects, F_HZ, [T35], beam_follows_E=True)
+    got = respond([{}, {"laws.d.activation_energy": 90e3, "laws.E.slope": 0.03, "laws.kappa_e.slope": -0.04}])
+    np.testing.assert_allclose(got[:, 0, :], np.broadcast_to(want, (2, F_HZ.size)), rtol=1e-12)
