@@ -89,4 +89,31 @@ def effect_intervals(rows: list, path, title: str = "") -> Path:
     return _save(fig, path)
 
 
-__all__ = ["bode_overlay", "effect_intervals", "pole_zero_maps"]
+def a0_series(data, fits: dict, path) -> Path:
+    """Printed a0(T) (polynomial and its data points with ±σ of ln a0) against each calibration's model
+    a0(T) (solid: calibrated laws; dotted: the set's default laws) [1e10 rad⁴/s⁴] vs T [°C].
+
+    ``data``: :class:`~scenarios.steps_chain_temperature.A0Series`; ``fits``: {label: {"a0_dense": (T,
+    calibrated, default)}}."""
+    from .steps_chain_temperature import printed_a0
+
+    fig, ax = _subplots(1, 1, figsize=(7.0, 4.6))
+    t = np.linspace(20.0, 70.0, 101)
+    ax.plot(t, printed_a0(t) / 1e10, color="k", lw=2.5, label="printed a0(T) polynomial")
+    a, s = data.a0 / 1e10, data.sigma_ln
+    ax.errorbar(data.temperatures_c, a, yerr=[a * (1 - np.exp(-s)), a * (np.exp(s) - 1)], fmt="o", color="k",
+                capsize=3, label="data (fit temperatures, ±σ)")
+    for i, (label, v) in enumerate(fits.items()):
+        tt, cal, dflt = v["a0_dense"]
+        ax.plot(tt, np.asarray(cal) / 1e10, color=f"C{i}", label=f"{label}: calibrated")
+        ax.plot(tt, np.asarray(dflt) / 1e10, color=f"C{i}", ls=":", lw=1)
+    ax.set_xlabel("temperature [°C]")
+    ax.set_ylabel("a0 [1e10 rad⁴/s⁴]")
+    ax.set_title("a0(T) of the 4/4 equation-error fit: printed vs physics + chain (dotted: default laws)",
+                 fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    return _save(fig, path)
+
+
+__all__ = ["a0_series", "bode_overlay", "effect_intervals", "pole_zero_maps"]

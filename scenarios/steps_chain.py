@@ -24,9 +24,10 @@ The step
 5. decodes the seed 000 sines (the printed model as the plant, current simulated from it) with
    each model's 4/4 fit by stable inversion (``inversion.decode_sensor``, explicit ``preview``).
 
-6. temperature series, partly: with the chain fixed, the a0(T) of 4/4 fits of physics + chain at
-   23 and 65 °C under variants of the polymer's laws, against the printed polynomial (a sensitivity,
-   not a calibration of the laws).
+6. temperature series (:mod:`scenarios.steps_chain_temperature`): with the chain fixed at its
+   35 °C values, the polymer's temperature laws (Ea of d, slopes of κe and E) calibrated to the
+   printed a0(T) polynomial (as data, with its printed and identification precision), with
+   intervals, identifiability and χ²; the printed trends checked on the calibrated model.
 
 Schema (to add to :data:`scenarios.spec.SECTIONS` as ``"chain"``; no dependency on other steps)::
 
@@ -335,12 +336,6 @@ def step_chain(ctx) -> None:
         ctx.metric(f"chain.decode_{fr:g}hz.{_slug(name)}_error_rel", r["error_rel"])
         ctx.metric(f"chain.decode_{fr:g}hz.{_slug(name)}_predicted_rel", r["predicted_rel"])
         ctx.metric(f"chain.decode_{fr:g}hz.{_slug(name)}_sampling_bound_rel", r["sampling_bound_rel"])
-    # ---- temperature series: chain fixed, the polymer's laws varied, a0(T) of the 4/4 fits vs printed
-    ts = _temperature_series(base, vals, list(chosen), fd)
-    for k, v in ts.items():
-        ctx.metric(f"chain.tseries.{k}.a0_ratio_hot_cold", v["a0_ratio"])
-        ctx.metric(f"chain.tseries.{k}.hf_gain_ratio_hot_cold", v["hf_gain_ratio"])
-        ctx.metric(f"chain.tseries.{k}.phase_change_deg", v["phase_change_deg"])
     # ---- figures
     fp = np.geomspace(max(1.0, data.frequency_hz[0] / 2), data.frequency_hz[-1] * 2, 200)
     curves = {"printed model (data)": (printed_response(fp), {"color": "k", "lw": 2.5}),
@@ -355,37 +350,15 @@ def step_chain(ctx) -> None:
                                         ctx.out / "chain_pole_zero.png", "4/4 fits over the band"))
     ctx.file(plots_chain.effect_intervals([dict(r, name=f"{r['fit']}: {r['name']}") for r in rows],
                                           ctx.out / "chain_effects.png", "greedy chain and documented fit"))
-    _report(ctx, data, sign, steps, chosen, f"{final_verdict}: {why}", mis, rows, rat, dec, docres, doc_effects, prof,
-            ts)
+    _report(ctx, data, sign, steps, chosen, f"{final_verdict}: {why}", mis, rows, rat, dec, docres, doc_effects, prof)
+    # ---- temperature series: chain fixed at its 35 °C values, the polymer's laws calibrated to a0(T)
+    from .steps_chain_temperature import step_temperature
 
-
-#: Printed a0(T) (seed 000: the 4/4 model's denominator constant), ascending powers of T − 23.07, × 1e10.
-A0_POLY, A0_CENTER_C = (4.81, -0.043, -0.00028, 8.56e-5), 23.07
-TSERIES_C = (23.0, 65.0)
-LAW_VARIANTS = {"set laws": {}, "d Ea 0": {"laws.d.activation_energy": 0.0},
-                "d Ea 40 kJ/mol": {"laws.d.activation_energy": 40e3}, "E slope 0": {"laws.E.slope": 0.0},
-                "E slope -2 %/K": {"laws.E.slope": -0.02}}
-
-
-def _temperature_series(base, vals, effects, fd):
-    """Chain fixed at its 35 °C values; for each law variant the physics + chain at 23 and 65 °C:
-    the 4/4 fit's denominator constant a0 (hot/cold ratio; printed: the polynomial's), the
-    high-frequency gain ratio and the change of phase at the top of the band (printed trends:
-    the gain falls, the lag grows)."""
-    from physmodel.parameter_paths import apply_values
-
-    out = {}
-    for name, law in LAW_VARIANTS.items():
-        b = apply_values(base, law) if law else base
-        G = {T: _response(b, vals, effects, fd, T) for T in TSERIES_C}
-        a0 = {T: float(np.real(np.prod(-rational_4_4(fd, G[T], T)["poles"]))) for T in TSERIES_C}
-        lo, hi = TSERIES_C
-        out[_slug(name)] = {"label": name, "a0_ratio": a0[hi] / a0[lo], "hf_gain_ratio": abs(G[hi][-1] / G[lo][-1]),
-                            "phase_change_deg": float(np.degrees(np.angle(G[hi][-1] / G[lo][-1])))}
-    pa = lambda T: float(np.polyval(A0_POLY[::-1], T - A0_CENTER_C))
-    out["printed"] = {"label": "printed", "a0_ratio": pa(TSERIES_C[1]) / pa(TSERIES_C[0]), "hf_gain_ratio": math.nan,
-                      "phase_change_deg": math.nan}
-    return out
+    eff = {c: {p.name: vals[f"{c}.{p.name}"] for p in get_effect(c).parameters} for c in chosen}
+    dvals = {**docres.values, **held}
+    deff = {e: {p.name: dvals[f"{e}.{p.name}"] for p in get_effect(e).parameters} for e in doc_effects}
+    step_temperature(ctx, base, vals, eff, data, mis["chain"], d_row, seed=cfg.get("seed", 0),
+                     documented=(dvals, deff, mis["documented"]))
 
 
 def _profile_d(data, base, vals, effects, cfg):
@@ -440,7 +413,7 @@ def _table(header, rows):
                      + ["| " + " | ".join(str(c) for c in r) + " |" for r in rows])
 
 
-def _report(ctx, data, sign, steps, chosen, verdict, mis, rows, rat, dec, docres, doc_effects, prof, ts):
+def _report(ctx, data, sign, steps, chosen, verdict, mis, rows, rat, dec, docres, doc_effects, prof):
     st = [(s["step"], s["verdict"], f"{s['baseline_two_cost']:.4g}", f"{s['threshold']:.3g}",
            ", ".join(s.get("added", [])) or "–", s["message"][:400].replace("|", "/")) for s in steps]
     pr = [(r["fit"], r["name"], f"{r['value']:.4g}", f"[{r['ci'][0]:.3g}, {r['ci'][1]:.3g}]" if r["identifiable"]
@@ -469,11 +442,4 @@ def _report(ctx, data, sign, steps, chosen, verdict, mis, rows, rat, dec, docres
         _table(["model", "RHP zeros", "zeros [rad/s]", "poles [rad/s]", "4/4 misfit"], rz), "",
         "![pole-zero](chain_pole_zero.png)", "![effects](chain_effects.png)", "",
         "Decoding (plant: the printed model; decoder: each model's 4/4 fit; max |error|/amplitude and the "
-        "steady-state prediction |P/G − 1|):", "", _table(["sine", "decoder", "error / A", "|P/G − 1|"], dr), "",
-        f"Temperature series, chain fixed at its {data.temperature_c[0]:g} °C values, {TSERIES_C[0]:g} → "
-        f"{TSERIES_C[1]:g} °C (a0 = the 4/4 fit's denominator constant; printed trends: high-frequency gain falls, "
-        "phase lag grows).  Not a calibration: the sensitivity of a0(T) to each law shows what the printed a0(T) "
-        "can say about d(T), E(T) (κe follows the water permittivity in every variant).", "",
-        _table(["laws", "a0 hot/cold", "|G(f_max)| hot/cold", "Δ∠G(f_max) [°]"],
-               [(v["label"], f"{v['a0_ratio']:.3g}", f"{v['hf_gain_ratio']:.3g}", f"{v['phase_change_deg']:.3g}")
-                for v in ts.values()]))
+        "steady-state prediction |P/G − 1|):", "", _table(["sine", "decoder", "error / A", "|P/G − 1|"], dr))

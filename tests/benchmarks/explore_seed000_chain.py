@@ -3,6 +3,11 @@
     python3 tests/benchmarks/explore_seed000_chain.py                 # full (~9 CPU-minutes)
     python3 tests/benchmarks/explore_seed000_chain.py --quick         # fewer starts, subsets of ≤ 2 (~1.5)
     python3 tests/benchmarks/explore_seed000_chain.py --out chain.json
+    python3 tests/benchmarks/explore_seed000_chain.py --temperature-floors OUT/metrics.json   # ~10 s
+
+``--temperature-floors``: the temperature series of ``ipmc run seed000_chain`` (its chain values read
+from that run's metrics.json) redone with the 35 °C noise floor at 0.25 dB / 2.5°, 0.5 dB / 5° (the
+scenario's) and 1 dB / 10°: the floor sets the a0 identification σ, hence χ² and the intervals.
 
 Data: the printed 35 °C model (Sec. IV-A; ``inversion.examples.SEED000_NUM/DEN_35C``) at 31
 log-spaced lines over 10-100 Hz, in µA/mm.  Noise model, stated: per line, the spread of the model
@@ -267,7 +272,11 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="fewer multi-starts; subsets of at most 2 elements")
     ap.add_argument("--out", help="write the results as JSON")
+    ap.add_argument("--temperature-floors", metavar="METRICS_JSON",
+                    help="only the floor sensitivity of the temperature series (see the module doc)")
     args = ap.parse_args(argv)
+    if args.temperature_floors:
+        return temperature_floors(args.temperature_floors)
     starts = 3 if args.quick else 8
     t0 = time.perf_counter()
     data = printed_sweep()
@@ -391,6 +400,31 @@ def main(argv=None):
     if args.out:
         Path(args.out).write_text(json.dumps(out, indent=2, default=float) + "\n")
         print(f"wrote {args.out}")
+
+
+def temperature_floors(metrics_json):
+    from scenarios.steps_chain import printed_sweep as scenario_sweep
+    from scenarios.steps_chain_temperature import VARIANTS, run_series
+
+    m = json.loads(Path(metrics_json).read_text())["metrics"]
+    vals = {k[len("chain.chain."):]: v for k, v in m.items() if k.startswith("chain.chain.")}
+    eff: dict = {}
+    for k, v in vals.items():
+        if "." in k:
+            eff.setdefault(k.split(".")[0], {})[k.split(".")[1]] = v
+    base = get_parameter_set("seed000_sensor_dev", T_ref=T_C + 273.15)
+    for fdb, fdeg in ((0.25, 2.5), (0.5, 5.0), (1.0, 10.0)):
+        t0 = time.perf_counter()
+        data, out, prof = run_series(base, vals, eff, scenario_sweep(T_C, floor_db=fdb, floor_deg=fdeg),
+                                     variants=[VARIANTS[i] for i in (0, 1, 2, 4)])
+        print(f"\nfloor {fdb:g} dB / {fdeg:g}°: σ ln a0 {data.sigma_ln.max():.3g}; Ea profile χ² "
+              + ", ".join(f"{e / 1e3:g}: {c:.3g}" for e, c in prof.items()) + f"  ({time.perf_counter() - t0:.1f} s)")
+        for label, v in out.items():
+            r = v["result"]
+            g = r.goodness_of_fit
+            print(f"  {label}: χ² {g.chi2:.3g}/{g.dof} p {g.p_value:.2g}; " + "; ".join(
+                f"{n.split('.', 1)[1]} {r.values[n]:.4g} [{r.ci_lower[n]:.3g}, {r.ci_upper[n]:.3g}]"
+                f"{'' if r.identifiability[n].identifiable else ' undetermined'}" for n in v["free"]))
 
 
 if __name__ == "__main__":

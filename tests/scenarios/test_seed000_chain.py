@@ -18,19 +18,24 @@ from scenarios.steps_chain import (
 )
 
 
+def _register(mp):
+    """Register the [chain] step the way the merge did, unless it already is (registering it twice
+    would run the step twice)."""
+    if "chain" not in spec.STEP_ORDER:
+        mp.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
+    mp.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
+    mp.setitem(runner.STEPS, "chain", step_chain)
+
+
 @pytest.fixture
 def registered(monkeypatch):
-    monkeypatch.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
-    monkeypatch.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
-    monkeypatch.setitem(runner.STEPS, "chain", step_chain)
+    _register(monkeypatch)
 
 
 @pytest.fixture(scope="module")
 def quick_result(tmp_path_factory):
     mp = pytest.MonkeyPatch()
-    mp.setattr(spec, "STEP_ORDER", spec.STEP_ORDER + ("chain",))
-    mp.setitem(spec.SECTIONS, "chain", CHAIN_SCHEMA)
-    mp.setitem(runner.STEPS, "chain", step_chain)
+    _register(mp)
     out = tmp_path_factory.mktemp("chain")
     try:
         path = spec.bundled_scenarios()[0].parent / "seed000_chain.toml"
@@ -43,7 +48,9 @@ def quick_result(tmp_path_factory):
 def test_scenario_passes_its_checks_and_writes_its_figures(quick_result):
     res, out = quick_result
     assert not [(c.name, c.value) for c in res.checks if not c.passed]
-    for f in ("chain_bode.png", "chain_pole_zero.png", "chain_effects.png", "metrics.json", "report.md"):
+    assert list(spec.STEP_ORDER).count("chain") == 1
+    for f in ("chain_bode.png", "chain_pole_zero.png", "chain_effects.png", "chain_a0_temperature.png",
+              "chain_bode_temperatures.png", "metrics.json", "report.md"):
         assert (out / f).exists(), f
     rep = (out / "report.md").read_text()
     assert "Verdict: **" in rep and "Temperature series" in rep
@@ -88,3 +95,32 @@ def test_chain_step_needs_a_sensor_model(registered, tmp_path):
                     'points = 11\n[checks.x]\nmetric = "chain.named"\nmin = 0\n')
     with pytest.raises(spec.ScenarioError, match="sensor"):
         runner.run_scenario(spec.load_scenario(toml), tmp_path / "out", quiet=True)
+
+
+def test_temperature_series_has_estimates_intervals_and_misfits(quick_result):
+    """The temperature step: every calibration reports finite values and intervals for the law parameters
+    a0(T) depends on, its χ² and the a0 misfit; the 35 °C misfit is the chain fit's (laws are 1 there);
+    the printed a0 ratio is recomputed from the printed polynomial coefficients."""
+    from scenarios.steps_chain_temperature import VARIANTS, _slug
+
+    m = quick_result[0].metrics
+    for label, _beam, _water, names in VARIANTS:
+        k = f"chain.temperature.{_slug(label)}"
+        assert m[f"{k}.dof"] >= 4 and np.isfinite(m[f"{k}.chi2"]) and 0.0 <= m[f"{k}.p_value"] <= 1.0
+        assert m[f"{k}.a0_misfit_max_pct"] >= m[f"{k}.a0_misfit_rms_pct"] > 0.0
+        for n in names:
+            p = f"{k}.{n.split('.', 1)[1].replace('.', '_')}"
+            assert np.isfinite(m[p])
+            if n != "laws.E.slope" or "beam" in label:       # E acts on a0 only through the beam's mode
+                assert m[f"{p}_ci_lower"] <= m[p] <= m[f"{p}_ci_upper"], p
+            else:
+                assert not m[f"{p}_identifiable"]
+        for t in ("cutoff_falls", "gain_falls", "lag_grows"):
+            assert m[f"{k}.trend_{t}"] in (0, 1)
+    for q in ("rms_db", "max_db", "rms_deg", "max_deg"):
+        assert m[f"chain.temperature.misfit_35c_{q}"] == m[f"chain.misfit_chain_{q}"]
+    c, x = np.array([4.81, -0.043, -0.00028, 8.56e-5]), np.array([23.0, 65.0]) - 23.07
+    ratio = np.polyval(c[::-1], x[1]) / np.polyval(c[::-1], x[0])
+    assert m["chain.temperature.a0_printed_ratio_65_23"] == pytest.approx(ratio, rel=1e-12)
+    assert m["chain.temperature.d_35c"] == m["chain.chain.d"]
+    assert "Temperature series: the polymer's laws with the chain fixed" in (quick_result[1] / "report.md").read_text()
