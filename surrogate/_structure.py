@@ -351,6 +351,32 @@ def denominators(structure: Structure, theta, taus) -> np.ndarray:
     return den
 
 
+def section_max_real_part(structure: Structure, theta, taus) -> np.ndarray:
+    """Largest real part of the poles in s̃ of a section denominator ('sections', 'zpk') at
+    many scaled temperatures at once, shape (len(taus),).  Each section s̃² + a1 s̃ + a0 in
+    closed form: −a1/2 for a complex pair, else the root nearer zero, a0/q with
+    q = −(a1 + sign(a1)·√disc)/2 (cancellation-free, as ``_factor_roots``); (s̃ + c): −c."""
+    if structure.form == "coefficients":
+        raise ValueError("section_max_real_part needs a section denominator ('sections' or 'zpk')")
+    taus = np.atleast_1d(np.asarray(taus, float))
+    ix = {s: i for i, s in enumerate(structure.slots)}
+    n = structure.n_poles
+    mat = structure.slot_matrix(theta)
+    tp = taus[None, :] ** np.arange(structure.n_coef)[:, None]          # (n_coef, K)
+    best = np.full(taus.size, -np.inf)
+    if n // 2:
+        a1 = np.exp(mat[[ix[f"log_a1_{k}"] for k in range(n // 2)]] @ tp)   # (sections, K)
+        a0 = np.exp(mat[[ix[f"log_a0_{k}"] for k in range(n // 2)]] @ tp)
+        disc = a1 * a1 - 4 * a0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            q = -(a1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), a1)) / 2
+            near = np.where(q != 0.0, a0 / q, 0.0)
+        best = np.maximum(best, np.where(disc < 0, -a1 / 2, np.maximum(q, near)).max(axis=0))
+    if n % 2:
+        best = np.maximum(best, -np.exp(mat[ix["log_c"]] @ tp))
+    return best
+
+
 def _factor_roots(poly_asc) -> np.ndarray:
     """Roots of c0 + c1 s + s² (or c0 + s); real pairs by the cancellation-free formula
     q = −(c1 + sign(c1)·√disc)/2, roots q and c0/q (a root much smaller than the other is
