@@ -11,9 +11,13 @@ ratio is the goal's, the "one-shot" ratio also counts building the 10k-set model
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))   # this checkout's packages
 
 from physmodel import ActuatorModel, get_parameter_set, state_at
 
