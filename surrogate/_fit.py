@@ -68,11 +68,12 @@ def make_scaling(data: FrequencyData, omega_ref=None, gain_ref=None, t_center=No
         omega_ref = float(np.sqrt(w.min() * w.max()))
     if gain_ref is None:
         gain_ref = float(np.exp(np.mean(np.log(np.abs(data.response)))))
-    temps = data.temperatures()
-    if t_center is None:
-        t_center = float(0.5 * (temps.min() + temps.max())) if temps.size else 0.0
-    if t_scale is None:
-        t_scale = float(0.5 * (temps.max() - temps.min())) if temps.size > 1 else 1.0
+    if t_center is None or t_scale is None:
+        temps = data.temperatures()
+        if t_center is None:
+            t_center = float(0.5 * (temps.min() + temps.max())) if temps.size else 0.0
+        if t_scale is None:
+            t_scale = float(0.5 * (temps.max() - temps.min())) if temps.size > 1 else 1.0
     return Scaling(float(omega_ref), float(gain_ref), float(t_center), float(t_scale))
 
 
@@ -86,11 +87,16 @@ def make_problem(structure: Structure, data: FrequencyData, scaling: Scaling, we
     return Problem(structure, w, tau, data.response / scaling.gain_ref, kind, ia, ib), name
 
 
-def check_order_per_temperature(structure: Structure, data: FrequencyData):
-    """Each temperature must carry at least as many real equations as a per-T fit has unknowns."""
+def check_order_per_temperature(structure: Structure, data: FrequencyData, temps=None):
+    """Each temperature must carry at least as many real equations as a per-T fit has unknowns.
+    ``temps``: ``data.temperatures()`` if already at hand."""
     n_unknown = structure.n_zeros + 1 + structure.n_poles
-    groups = [(None, data.n)] if data.temperature_c is None else [
-        (t, int(np.sum(data.temperature_c == t))) for t in data.temperatures()]
+    if data.temperature_c is None:
+        groups = [(None, data.n)]
+    else:
+        temps = data.temperatures() if temps is None else temps
+        groups = [(temps[0], data.n)] if temps.size == 1 else [
+            (t, int(np.sum(data.temperature_c == t))) for t in temps]
     for t, count in groups:
         if 2 * count < n_unknown:
             where = "" if t is None else f" at temperature_c={t:g}"
@@ -336,10 +342,10 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
            data: FrequencyData, *, weighting_name: str, method: str, settings: dict,
            scale_covariance: bool, history: list, time_s: float, temperature_range,
            compute_covariance: bool = True, two_stage=None, per_temperature_models=None,
-           raise_on_failure: bool = True, stability_grid: int = 501) -> FitResult:
+           raise_on_failure: bool = True, stability_grid: int = 501, temperatures=None) -> FitResult:
     """The ``FitResult`` of ``outcome``.  The covariance (from the Jacobian at the optimum),
     the per-temperature errors and the stability check are deferred: computed, the same
-    way, when first read."""
+    way, when first read.  ``temperatures``: ``data.temperatures()`` if already at hand."""
     theta = outcome.theta
     cov = None
     at_bounds = []
@@ -353,7 +359,7 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
         names = structure.param_names()
         at_bounds = [names[i] for i in np.flatnonzero((theta <= lo + 1e-6) | (theta >= hi - 1e-6))]
     r = (evaluator or problem).residual(theta)
-    temps = data.temperatures()
+    temps = data.temperatures() if temperatures is None else temperatures
     fingerprint = data.fingerprint()
     info = {
         "method": method,

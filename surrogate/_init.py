@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from physmodel.numerics import weighted_complex_lstsq
+from physmodel.numerics import stacked_weighted_lstsq, weighted_complex_lstsq
 
 from ._convert import group_roots, pole_slots_from_groups, stabilise_roots
 from ._structure import Structure
@@ -18,6 +18,15 @@ __all__ = ["levy", "numerator_ls", "initial_candidates"]
 
 def _solve_weighted(a: np.ndarray, rhs: np.ndarray, row_weight: np.ndarray) -> np.ndarray:
     return weighted_complex_lstsq(a, rhs, np.asarray(row_weight, dtype=float))
+
+
+def _horner(x: np.ndarray, c) -> np.ndarray:
+    """Σ c_i x^i by Horner's rule, the operations of ``numpy.polynomial.polynomial.polyval``
+    (the same numbers) without its argument handling."""
+    c0 = c[-1] + x * 0
+    for i in range(2, len(c) + 1):
+        c0 = c[-i] + c0 * x
+    return c0
 
 
 def levy(w, h, n_zeros: int, n_poles: int, row_weight=None):
@@ -42,7 +51,7 @@ def numerator_ls(w, h, n_zeros: int, den, relative: bool = True):
     """Best numerator for a fixed denominator (linear least squares, relative error)."""
     jw = 1j * np.asarray(w, float)
     h = np.asarray(h, complex)
-    d = np.polynomial.polynomial.polyval(jw, den)
+    d = _horner(jw, den)
     a = jw[:, None] ** np.arange(n_zeros + 1)
     wt = 1.0 / np.abs(d)
     if relative:
@@ -60,15 +69,22 @@ def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8):
                    -h[:, None] * vd[:, :n_poles]])
     rhs = h * vd[:, n_poles]
     rel = 1.0 / np.abs(h)
-    wt, out = rel, []
+    n_w = w.size
+    ar = np.concatenate([a.real, a.imag])               # the system stacked once, reweighted below
+    br = np.concatenate([rhs.real, rhs.imag])
+    wt2 = np.empty(2 * n_w)
+    wt2[:n_w] = wt2[n_w:] = rel
+    out = []
     for _ in range(n_iter + 1):
-        sol = _solve_weighted(a, rhs, wt)
-        den = np.append(sol[n_zeros + 1:], 1.0)
+        sol = stacked_weighted_lstsq(ar, br, wt2)
+        den = np.empty(n_poles + 1)
+        den[:n_poles], den[n_poles] = sol[n_zeros + 1:], 1.0
         out.append((sol[:n_zeros + 1], den))
         d = np.abs(vd @ den)
-        if not np.all(np.isfinite(d)) or np.any(d == 0):
+        if not (np.isfinite(d).all() and d.all()):
             break
-        wt = rel / d
+        np.divide(rel, d, out=wt2[:n_w])
+        wt2[n_w:] = wt2[:n_w]
     return out
 
 

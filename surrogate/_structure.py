@@ -160,10 +160,10 @@ class Structure:
         return lo, hi
 
     def with_degree(self, degree: int) -> Structure:
-        return Structure(self.form, self.n_zeros, self.n_poles, degree)
+        return _structure(self.form, self.n_zeros, self.n_poles, degree)
 
     def with_form(self, form: str) -> Structure:
-        return Structure(form, self.n_zeros, self.n_poles, self.degree)
+        return _structure(form, self.n_zeros, self.n_poles, self.degree)
 
     def to_dict(self) -> dict:
         return {"form": self.form, "n_zeros": self.n_zeros, "n_poles": self.n_poles,
@@ -173,6 +173,12 @@ class Structure:
     def slot_matrix(self, theta) -> np.ndarray:
         """Parameters as an array (n_slots, degree+1) (numpy only)."""
         return np.asarray(theta, float).reshape(len(self.slots), self.n_coef)
+
+
+@functools.lru_cache(maxsize=256)
+def _structure(form, n_zeros, n_poles, degree) -> Structure:
+    """A (frozen, hence shareable) ``Structure``, built and validated once per value."""
+    return Structure(form, n_zeros, n_poles, degree)
 
 
 @functools.lru_cache(maxsize=256)

@@ -43,7 +43,8 @@ class Scaling:
     temperature_scale_c: float = 1.0
 
     def __post_init__(self):
-        for name, v in asdict(self).items():
+        for name in ("omega_ref_rad_s", "gain_ref", "temperature_center_c", "temperature_scale_c"):
+            v = getattr(self, name)
             if not math.isfinite(v):
                 raise ValueError(f"{name} must be finite, got {v!r}")
         if self.omega_ref_rad_s <= 0 or self.gain_ref <= 0 or self.temperature_scale_c <= 0:

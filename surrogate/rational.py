@@ -111,7 +111,7 @@ class RationalFit:
                 f"{temps.tolist()} °C; use ScheduledFit or select one temperature"
             )
         st = self.structure
-        F.check_order_per_temperature(st, data)
+        F.check_order_per_temperature(st, data, temps)
         scaling = F.make_scaling(data, self.omega_ref_rad_s, self.gain_ref,
                                  float(temps[0]) if temps.size else 0.0, 1.0)
         problem, wname = F.make_problem(st, data, scaling, self.weighting)
@@ -145,7 +145,7 @@ class RationalFit:
                        method="rational", settings=self.settings(),
                        scale_covariance=self.scale_covariance, history=history,
                        time_s=time.perf_counter() - t_start, temperature_range=temp_range,
-                       raise_on_failure=self.raise_on_failure)
+                       raise_on_failure=self.raise_on_failure, temperatures=temps)
         self.model_, self.result_, self.history_ = res.model, res, history
         return res
 
