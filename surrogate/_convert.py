@@ -48,9 +48,10 @@ def group_roots(rts, reference=None):
     """
     rts = np.asarray(rts, complex)
     n = len(rts)
-    real = [r.real for r in rts if _is_real(r)]
-    upper = [r for r in rts if not _is_real(r) and r.imag > 0]
-    lower = [r for r in rts if not _is_real(r) and r.imag < 0]
+    is_real = np.abs(rts.imag) <= 1e-9 * np.maximum(1.0, np.abs(rts))     # _is_real, vectorised
+    real = rts.real[is_real].tolist()
+    upper = list(rts[~is_real & (rts.imag > 0)])
+    lower = list(rts[~is_real & (rts.imag < 0)])
     if len(upper) != len(lower):  # numerically broken conjugate symmetry: treat as reals
         real = sorted(r.real for r in rts)
         upper = []

@@ -206,6 +206,7 @@ class Evaluator:
         return c
 
 
+@lru_cache(maxsize=64)
 def block_rows(p: int) -> int:
     """Rows per block of the products with a Jacobian of ``p`` columns.  OpenBLAS runs a
     matrix product on several threads above about 2.6e5 multiply-adds (a matrix-vector
@@ -217,8 +218,11 @@ def block_rows(p: int) -> int:
 
 def _normal_equations(J: np.ndarray, r: np.ndarray):
     """JᵀJ (S, p, p) and Jᵀr (S, p), summed over blocks of rows (see ``block_rows``)."""
-    a = g = None
     rows = block_rows(J.shape[2])
+    if J.shape[1] <= rows:                       # one block
+        jt = J.transpose(0, 2, 1)
+        return jt @ J, (jt @ r[..., None])[..., 0]
+    a = g = None
     for i in range(0, J.shape[1], rows):
         jb = J[:, i:i + rows]
         jt = jb.transpose(0, 2, 1)
