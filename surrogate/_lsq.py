@@ -94,6 +94,17 @@ class Evaluator:
                                        np.asarray(problem.inv_sig_b, float)])
         self.n_params = st.n_params
 
+    def with_structure(self, structure: Structure) -> Evaluator:
+        """The same problem in another form with the same orders and degree (e.g. the
+        coefficient form, to score Sanathanan–Koerner iterates), sharing the data arrays."""
+        st = self.structure
+        if (structure.n_zeros, structure.n_poles, structure.degree) != (st.n_zeros, st.n_poles, st.degree):
+            raise ValueError(f"{structure} does not have the orders and degree of {st}")
+        ev = object.__new__(Evaluator)
+        ev.__dict__.update(self.__dict__)
+        ev.structure, ev.lay, ev.n_params = structure, _layout(structure), structure.n_params
+        return ev
+
     def _slots(self, theta: np.ndarray) -> np.ndarray:
         """Slot values (S, N or 1, slots)."""
         st = self.structure
@@ -145,12 +156,13 @@ class Evaluator:
             den = None
             if n > 1:
                 e1, e0 = np.exp(v[..., lay["p1"]]), np.exp(v[..., lay["p0"]])
-                sec = s2 + e1 * s + e0
+                e1s = e1 * s
+                sec = s2 + e1s + e0
                 den = sec[..., 0] if n < 4 else np.prod(sec, axis=-1)
                 if grad:
                     inv = 1.0 / sec
-                    g[..., lay["p1"]] = -(e1 * s) * inv
-                    g[..., lay["p0"]] = -e0 * inv
+                    np.multiply(np.negative(e1s, out=e1s), inv, out=g[..., lay["p1"]])
+                    np.multiply(-e0, inv, out=g[..., lay["p0"]])
             if lay["pc"] is not None:
                 c = np.exp(v[..., lay["pc"]])
                 d1 = s[:, 0] + c

@@ -124,7 +124,7 @@ class RationalFit:
         evaluator = Evaluator(problem)
 
         def costs(structure, thetas):
-            ev = evaluator if structure == st else Evaluator(replace(problem, structure=structure))
+            ev = evaluator if structure == st else evaluator.with_structure(structure)
             return ev.costs(thetas)
 
         cands = initial_candidates(st, problem.w, problem.h, costs)
