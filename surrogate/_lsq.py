@@ -252,6 +252,39 @@ def _matvec(J: np.ndarray, x: np.ndarray) -> np.ndarray:
                            for i in range(0, J.shape[1], rows)], axis=1)
 
 
+def _step_control(rr, rrt, pred, stationary, mu, nu, dx):
+    """Gain ratio, acceptance and damping update of every start, on Python floats:
+
+        actual = rr − rrt,  ρ = actual/pred (NaN unless pred > 0),
+        accepted = ρ > 1e-4 and not stationary,
+        μ ← μ·max(1/3, 1 − (2ρ − 1)³) if accepted else μ·ν,   ν ← 2 if accepted else 2ν,
+        ended = stationary or (not accepted and (μ > 1e30 or the step is zero)).
+
+    The same IEEE operations as the array expressions they replace (the cube by numpy's
+    power, which can differ from libm's in the last bit).  Returns (accepted, μ array,
+    ν array, ended, actual) (lists of bools / floats but μ, ν)."""
+    rr_l, rrt_l, pred_l = rr.tolist(), rrt.tolist(), pred.tolist()
+    st_l, mu_l, nu_l = stationary.tolist(), mu.tolist(), nu.tolist()
+    moved = dx.any(axis=1).tolist()
+    nan = float("nan")
+    actual = [a - b for a, b in zip(rr_l, rrt_l, strict=True)]    # NaN where rt is not finite
+    rho = [a / p if p > 0 else nan for a, p in zip(actual, pred_l, strict=True)]
+    with np.errstate(all="ignore"):
+        cube = ((2 * np.array(rho) - 1) ** 3).tolist()           # numpy's power, not libm's
+    acc, end = [], []
+    for j in range(len(rr_l)):
+        ok = rho[j] > 1e-4 and not st_l[j]
+        if ok:
+            mu_l[j] = mu_l[j] * max(1 / 3, 1 - cube[j])
+            nu_l[j] = 2.0
+        else:
+            mu_l[j] = mu_l[j] * nu_l[j]
+            nu_l[j] = nu_l[j] * 2.0
+        acc.append(ok)
+        end.append(bool(st_l[j] or (not ok and (mu_l[j] > 1e30 or not moved[j]))))
+    return acc, np.array(mu_l), np.array(nu_l), end, actual
+
+
 class LevenbergMarquardt:
     """Levenberg–Marquardt on ½·mean(r²) from several starts in lockstep, with box bounds.
 
@@ -397,19 +430,16 @@ class LevenbergMarquardt:
             pred = rr - np.einsum("si,si->s", lin, lin)
             rt, jt_new = ev.residual(xt, jacobian=True)   # the Jacobian serves if accepted
             rrt = np.einsum("si,si->s", rt, rt)
-            actual = rr - rrt                               # NaN where rt is not finite
-            rho = actual / np.where(pred > 0, pred, np.nan)
-            acc = (rho > 1e-4) & ~stationary
-            mu = np.where(acc, mu * np.maximum(1 / 3, 1 - (2 * rho - 1) ** 3), mu * nu)
-            nu = np.where(acc, 2.0, nu * 2.0)
-            end_now = stationary | (~acc & ((mu > 1e30) | ~dx.any(axis=1)))
-            if end_now.any():
+            # per-start bookkeeping on Python floats (a few starts: cheaper than array
+            # operations, the same numbers)
+            acc, mu, nu, end_now, actual = _step_control(rr, rrt, pred, stationary, mu, nu, dx)
+            if any(end_now):
                 for j in np.flatnonzero(end_now):
                     # first-order optimal, or no decrease along any damped direction
                     self._end(act[j], STATUS_OK, True)
                 ended = True
-            if acc.any():
-                if acc.all():
+            if any(acc):
+                if all(acc):
                     ja = slice(None)
                     x, r, J, rr = xt, rt, jt_new, rrt
                     idx = range(act.size)
@@ -417,15 +447,16 @@ class LevenbergMarquardt:
                     ja = np.flatnonzero(acc)
                     x[ja], r[ja], J[ja], rr[ja] = xt[ja], rt[ja], jt_new[ja], rrt[ja]
                     idx = ja
-                bad = ~np.isfinite(np.einsum("sij->s", jt_new[ja]))
-                small = (actual[ja] <= tol * rrt[ja]) & (pred[ja] <= tol * rrt[ja])
+                bad = (~np.isfinite(np.einsum("sij->s", jt_new[ja]))).tolist()
+                rrt_l, pred_l = rrt.tolist(), pred.tolist()
                 for k, j in enumerate(idx):
                     i = act[j]
                     tr = self.traces[i]
-                    tr.append(0.5 * float(rrt[j]) / self._m)
+                    tr.append(0.5 * rrt_l[j] / self._m)
+                    lim = tol * rrt_l[j]
                     if bad[k]:
                         self._end(i, STATUS_FAILED, False)
-                    elif small[k]:
+                    elif actual[j] <= lim and pred_l[j] <= lim:
                         self._end(i, STATUS_OK, True)
                     elif len(tr) > w and tr[-1 - w] - tr[-1] <= w * self.ACCEPTABLE_RATE * tr[-1]:
                         self._end(i, STATUS_ACCEPTABLE, True)
