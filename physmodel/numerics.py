@@ -169,7 +169,7 @@ def stacked_weighted_lstsq(Mr, rr, row_weight):
     Mw = Mr * row_weight[:, None]
     rw = rr * row_weight
     rows, n = Mw.shape
-    scale = np.sqrt(np.einsum("ij,ij->j", Mw, Mw))
+    scale = np.sqrt(_einsum("ij,ij->j", Mw, Mw))
     scale[scale == 0] = 1.0
     Mw /= scale
     cond = np.finfo(float).eps * max(rows, n)
@@ -185,6 +185,10 @@ def stacked_weighted_lstsq(Mr, rr, row_weight):
 
 
 _GELSD: list = []
+try:        # what numpy.einsum calls (optimize=False), without its dispatch layer
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # pragma: no cover - other numpy layouts
+    _einsum = np.einsum
 
 
 @functools.lru_cache(maxsize=64)

@@ -12,10 +12,6 @@ from ._structure import Structure, _factor_roots, _section_polys, polynomials, r
 
 
 # --------------------------------------------------- grouping roots into factors
-def _is_real(r, tol=1e-9):
-    return abs(r.imag) <= tol * max(1.0, abs(r))
-
-
 def _pairings(reals, n_pairs, single):
     """All ways to split the real roots into n_pairs pairs (+ one single if requested)."""
     idx = list(range(len(reals)))
@@ -48,7 +44,7 @@ def group_roots(rts, reference=None):
     """
     rts = np.asarray(rts, complex)
     n = len(rts)
-    is_real = np.abs(rts.imag) <= 1e-9 * np.maximum(1.0, np.abs(rts))     # _is_real, vectorised
+    is_real = np.abs(rts.imag) <= 1e-9 * np.maximum(1.0, np.abs(rts))     # |Im r| <= 1e-9·max(1, |r|)
     real = rts.real[is_real].tolist()
     upper = list(rts[~is_real & (rts.imag > 0)])
     lower = list(rts[~is_real & (rts.imag < 0)])

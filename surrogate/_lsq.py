@@ -28,6 +28,11 @@ import numpy as np
 
 from ._structure import Structure
 
+try:        # what numpy.einsum calls (optimize=False), without its dispatch layer
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # pragma: no cover - other numpy layouts
+    _einsum = np.einsum
+
 __all__ = ["Evaluator", "LevenbergMarquardt", "STATUS_OK", "STATUS_ACCEPTABLE", "STATUS_MAXITER",
            "STATUS_STOPPED", "STATUS_FAILED"]
 
@@ -213,7 +218,7 @@ class Evaluator:
     def costs(self, thetas) -> np.ndarray:
         """½·mean(r²) for a stack of parameter vectors (S, p); +inf where not finite."""
         r = self.residual(np.asarray(thetas, float).reshape(-1, self.n_params))
-        c = 0.5 * np.einsum("si,si->s", r, r) / r.shape[1]
+        c = 0.5 * _einsum("si,si->s", r, r) / r.shape[1]
         c[~np.isfinite(c)] = np.inf
         return c
 
@@ -269,8 +274,7 @@ def _step_control(rr, rrt, pred, stationary, mu, nu, dx):
     nan = float("nan")
     actual = [a - b for a, b in zip(rr_l, rrt_l, strict=True)]    # NaN where rt is not finite
     rho = [a / p if p > 0 else nan for a, p in zip(actual, pred_l, strict=True)]
-    with np.errstate(all="ignore"):
-        cube = ((2 * np.array(rho) - 1) ** 3).tolist()           # numpy's power, not libm's
+    cube = ((2 * np.array(rho) - 1) ** 3).tolist()               # numpy's power, not libm's
     acc, end = [], []
     for j in range(len(rr_l)):
         ok = rho[j] > 1e-4 and not st_l[j]
@@ -397,7 +401,7 @@ class LevenbergMarquardt:
         while done < budget and not ended:
             done += 1
             a, g = _normal_equations(J, r)
-            diag = np.einsum("sii->si", a)                    # a view
+            diag = _einsum("sii->si", a)                    # a view
             cn = np.sqrt(diag)
             np.maximum(scale, cn, out=scale)
             d = np.where(scale > 0, scale, 1.0)
@@ -427,14 +431,14 @@ class LevenbergMarquardt:
                 np.minimum(xt, ub, out=xt)
             dx = xt - x
             lin = r + _matvec(J, dx)
-            pred = rr - np.einsum("si,si->s", lin, lin)
+            pred = rr - _einsum("si,si->s", lin, lin)
             rt, jt_new = ev.residual(xt, jacobian=True)   # the Jacobian serves if accepted
-            rrt = np.einsum("si,si->s", rt, rt)
+            rrt = _einsum("si,si->s", rt, rt)
             # per-start bookkeeping on Python floats (a few starts: cheaper than array
             # operations, the same numbers)
             acc, mu, nu, end_now, actual = _step_control(rr, rrt, pred, stationary, mu, nu, dx)
             if any(end_now):
-                for j in np.flatnonzero(end_now):
+                for j in [j for j, e in enumerate(end_now) if e]:
                     # first-order optimal, or no decrease along any damped direction
                     self._end(act[j], STATUS_OK, True)
                 ended = True
@@ -444,10 +448,10 @@ class LevenbergMarquardt:
                     x, r, J, rr = xt, rt, jt_new, rrt
                     idx = range(act.size)
                 else:
-                    ja = np.flatnonzero(acc)
+                    ja = np.array([j for j, a in enumerate(acc) if a])
                     x[ja], r[ja], J[ja], rr[ja] = xt[ja], rt[ja], jt_new[ja], rrt[ja]
                     idx = ja
-                bad = (~np.isfinite(np.einsum("sij->s", jt_new[ja]))).tolist()
+                bad = (~np.isfinite(_einsum("sij->s", jt_new[ja]))).tolist()
                 rrt_l, pred_l = rrt.tolist(), pred.tolist()
                 for k, j in enumerate(idx):
                     i = act[j]

@@ -4,7 +4,6 @@ parametrisation, several starts raced in lockstep."""
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 
 import numpy as np
 
