@@ -72,6 +72,7 @@ def _layout(structure: Structure) -> dict:
     else:
         lay["p1"] = span([f"log_a1_{k}" for k in range(n // 2)], 2)
         lay["p0"] = span([f"log_a0_{k}" for k in range(n // 2)], 2)
+        lay["p10"] = slice(lay["p1"].start, lay["p1"].start + 2 * (n // 2)) if n > 1 else slice(0, 0)
         lay["pc"] = ix["log_c"] if n % 2 else None
     return lay
 
@@ -145,7 +146,7 @@ class Evaluator:
         elif v.shape[1] == 1:                     # one temperature: a matrix product
             num = v[:, 0, lay["b"]] @ self._sp_num_t
             if grad:
-                g[..., lay["b"]] = sp[:, :m + 1] / num[..., None]
+                np.divide(sp[:, :m + 1], num[..., None], out=g[..., lay["b"]])
         else:
             num = (v[..., lay["b"]] * sp[:, :m + 1]).sum(axis=-1)
             if grad:
@@ -160,7 +161,8 @@ class Evaluator:
         else:
             den = None
             if n > 1:
-                e1, e0 = np.exp(v[..., lay["p1"]]), np.exp(v[..., lay["p0"]])
+                e = np.exp(v[..., lay["p10"]])          # (a1_0, a0_0, a1_1, a0_1, ...)
+                e1, e0 = e[..., 0::2], e[..., 1::2]
                 e1s = e1 * s
                 sec = s2 + e1s + e0
                 den = sec[..., 0] if n < 4 else np.prod(sec, axis=-1)
