@@ -400,6 +400,7 @@ class LevenbergMarquardt:
         w = self.ACCEPTABLE_WINDOW
         done = 0
         ended = False
+        mu_unset = bool(np.isnan(mu).any())         # only before a start's first iteration
         while done < budget and not ended:
             done += 1
             a, g = _normal_equations(J, r)
@@ -414,11 +415,12 @@ class LevenbergMarquardt:
                 if at_bound.any():
                     free = ~(at_bound & (((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))))
                     cos = np.where(free, cos, 0.0)
-            stationary = cos.max(axis=1) <= sqrt_tol * np.sqrt(rr)
+            stationary = np.maximum.reduce(cos, axis=1) <= sqrt_tol * np.sqrt(rr)
             a /= d[:, :, None] * d[:, None, :]
             b = g / d
-            if np.isnan(mu).any():
+            if mu_unset:
                 mu = np.where(np.isnan(mu), 1e-3 * np.maximum(diag.max(axis=1), 1e-300), mu)
+                mu_unset = False
             if free is None:
                 diag += mu[:, None]
             else:

@@ -74,6 +74,9 @@ class Structure:
 
     @property
     def slots(self) -> list[str]:
+        return list(_slots(self.form, self.n_zeros, self.n_poles))
+
+    def _slot_names(self) -> list[str]:
         m, n = self.n_zeros, self.n_poles
         num = [f"b{i}" for i in range(m + 1)]
         if self.form == "coefficients":
@@ -173,6 +176,12 @@ class Structure:
     def slot_matrix(self, theta) -> np.ndarray:
         """Parameters as an array (n_slots, degree+1) (numpy only)."""
         return np.asarray(theta, float).reshape(len(self.slots), self.n_coef)
+
+
+@functools.lru_cache(maxsize=256)
+def _slots(form, n_zeros, n_poles) -> tuple:
+    """Slot names of a form and orders (computed once)."""
+    return tuple(Structure(form, n_zeros, n_poles, 0)._slot_names())
 
 
 @functools.lru_cache(maxsize=256)
