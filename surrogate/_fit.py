@@ -349,6 +349,7 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
     theta = outcome.theta
     cov = None
     at_bounds = []
+    param_names = structure.param_names()
     if compute_covariance and evaluator is not None:
         def _cov(ev=evaluator, th=theta, scale=scale_covariance):
             r, jac = ev.residual(th, jacobian=True)
@@ -356,7 +357,7 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
 
         cov = _Deferred(_cov)
         lo, hi = structure.bounds(float(problem.w.min()), float(problem.w.max()))
-        names = structure.param_names()
+        names = param_names
         at_bounds = [names[i] for i in np.flatnonzero((theta <= lo + 1e-6) | (theta >= hi - 1e-6))]
     r = (evaluator or problem).residual(theta)
     temps = data.temperatures() if temperatures is None else temperatures
@@ -383,7 +384,7 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
         model=model, converged=outcome.converged, status=outcome.status,
         iterations=outcome.iterations, cost=outcome.cost,
         weighted_rms=float(np.sqrt(np.mean(r ** 2))), weighting=weighting_name, method=method,
-        param_names=structure.param_names(), params=theta.copy(), at_bounds=at_bounds,
+        param_names=param_names, params=theta.copy(), at_bounds=at_bounds,
         time_s=time_s, data_fingerprint=fingerprint,
         history=history, two_stage=two_stage, per_temperature_models=per_temperature_models,
         _covariance=cov, _per_temperature=_Deferred(_errors),

@@ -47,24 +47,26 @@ def levy(w, h, n_zeros: int, n_poles: int, row_weight=None):
     return sol[: n_zeros + 1], np.append(sol[n_zeros + 1:], 1.0)
 
 
-def numerator_ls(w, h, n_zeros: int, den, relative: bool = True):
-    """Best numerator for a fixed denominator (linear least squares, relative error)."""
+def numerator_ls(w, h, n_zeros: int, den, relative: bool = True, powers=None):
+    """Best numerator for a fixed denominator (linear least squares, relative error).
+    ``powers``: (jw̃)^k for k = 0..≥n_zeros (columns), if already at hand."""
     jw = 1j * np.asarray(w, float)
     h = np.asarray(h, complex)
     d = _horner(jw, den)
-    a = jw[:, None] ** np.arange(n_zeros + 1)
+    a = jw[:, None] ** np.arange(n_zeros + 1) if powers is None else powers[:, :n_zeros + 1]
     wt = 1.0 / np.abs(d)
     if relative:
         wt = wt / np.abs(h)
     return _solve_weighted(a, h * d, wt)
 
 
-def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8):
-    """SK iterations (relative weighting); returns every iterate, Levy's first."""
+def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8, powers=None):
+    """SK iterations (relative weighting); returns every iterate, Levy's first.
+    ``powers``: (jw̃)^k for k = 0..n_poles (columns), if already at hand."""
     w = np.asarray(w, float)
     h = np.asarray(h, complex)
     jw = 1j * w
-    vd = jw[:, None] ** np.arange(n_poles + 1)
+    vd = jw[:, None] ** np.arange(n_poles + 1) if powers is None else powers[:, :n_poles + 1]
     a = np.hstack([vd[:, :n_zeros + 1] if n_zeros <= n_poles else jw[:, None] ** np.arange(n_zeros + 1),
                    -h[:, None] * vd[:, :n_poles]])
     rhs = h * vd[:, n_poles]
@@ -88,7 +90,7 @@ def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8):
     return out
 
 
-def _stable_sections_theta(w, h, n_zeros, den_roots, num=None):
+def _stable_sections_theta(w, h, n_zeros, den_roots, num=None, powers=None):
     """Sections parameters for the given poles (unstable ones reflected).  ``num`` (the
     numerator that came with these poles) is kept when no pole had to be moved; otherwise
     the numerator is refitted by linear least squares."""
@@ -98,7 +100,7 @@ def _stable_sections_theta(w, h, n_zeros, den_roots, num=None):
     poles_part = pole_slots_from_groups(quads, single)
     if num is None or np.any(stable != rts):
         den = np.real(np.poly(stable)[::-1])
-        num = numerator_ls(w, h, n_zeros, den)
+        num = numerator_ls(w, h, n_zeros, den, powers=powers)
     return np.concatenate([num, poles_part])
 
 
@@ -146,7 +148,9 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
     """
     m, n = structure.n_zeros, structure.n_poles
     cands = []
-    sk = sanathanan_koerner(w, h, m, n)
+    w = np.asarray(w, float)
+    powers = (1j * w)[:, None] ** np.arange(max(m, n) + 1)      # shared by SK and the numerators
+    sk = sanathanan_koerner(w, h, m, n, powers=powers)
     with np.errstate(all="ignore"):
         if structure.form == "coefficients":
             for i, (num, den) in enumerate(sk):
@@ -161,9 +165,9 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
             for i in picks:
                 num, den = sk[i]
                 if np.all(np.isfinite(poles[i])):
-                    theta = _stable_sections_theta(w, h, m, poles[i], num)
+                    theta = _stable_sections_theta(w, h, m, poles[i], num, powers)
                     cands.append(("levy" if i == 0 else f"sk{i}", theta))
-            cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n))))
+            cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n), powers=powers)))
     cands = [(name, th) for name, th in cands if np.all(np.isfinite(th))]
     if not cands:
         return []
