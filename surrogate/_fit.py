@@ -160,6 +160,12 @@ class _Deferred:
             self._value, self._fn = self._fn(), None
         return self._value
 
+    def __getstate__(self):            # pickled / deep-copied as the computed value
+        return self()
+
+    def __setstate__(self, value):
+        self._fn, self._value = None, value
+
 
 @dataclass
 class FitResult:

@@ -133,6 +133,11 @@ class RationalModel:
         c.setflags(write=False)
         return c
 
+    def __getstate__(self):            # pickled / deep-copied with the covariance computed
+        state = self.__dict__.copy()
+        state["_covariance"], state["_covariance_fn"] = self.covariance, None
+        return state
+
     # ------------------------------------------------------------ parameters
     @property
     def covariance(self) -> np.ndarray | None:

@@ -89,3 +89,17 @@ def test_deferred_errors_and_pole_check_are_those_of_the_returned_model():
     # read twice: the same objects (computed once)
     assert res.per_temperature is res.per_temperature and res.stability is res.stability
     assert "stable" in res.summary()
+
+
+def test_an_unread_result_pickles_and_copies_with_its_deferred_parts():
+    import copy
+    import pickle
+
+    _, _, _, _, fresh = _noisy_fit()
+    _, _, _, _, read = _noisy_fit()
+    expect = (read.stderr, read.per_temperature, read.stability, read.covariance_rank_deficient)
+    for clone in (pickle.loads(pickle.dumps(fresh)), copy.deepcopy(_noisy_fit()[-1])):
+        np.testing.assert_array_equal(clone.stderr, expect[0])
+        np.testing.assert_array_equal(clone.model.covariance, read.model.covariance)
+        assert clone.per_temperature == expect[1] and clone.stability == expect[2]
+        assert clone.covariance_rank_deficient == expect[3]
