@@ -172,7 +172,7 @@ def stacked_weighted_lstsq(Mr, rr, row_weight):
     scale = np.sqrt(_einsum("ij,ij->j", Mw, Mw))
     scale[scale == 0] = 1.0
     Mw /= scale
-    cond = np.finfo(float).eps * max(rows, n)
+    cond = _EPS * max(rows, n)
     if rows < n:                        # underdetermined: numpy pads the right-hand side
         x, *_ = np.linalg.lstsq(Mw, rw, rcond=cond)
         return x / scale
@@ -184,6 +184,7 @@ def stacked_weighted_lstsq(Mr, rr, row_weight):
     return x[:n] / scale
 
 
+_EPS = float(np.finfo(float).eps)
 _GELSD: list = []
 try:        # what numpy.einsum calls (optimize=False), without its dispatch layer
     from numpy._core.multiarray import c_einsum as _einsum

@@ -133,7 +133,7 @@ def _sk_costs(sk, structure, costs):
         poles[ok] = np.linalg.eigvals(comp[ok])
     stable = np.all(poles.real < 0, axis=1)
     coef = structure.with_form("coefficients")
-    thetas = np.array([np.concatenate([num, den[:-1]]) for num, den in sk])
+    thetas = np.concatenate([np.array([num for num, _ in sk]), dens[:, :-1]], axis=1)
     c = np.asarray(costs(coef, thetas), float)
     return np.where(stable & np.isfinite(c), c, np.inf), poles
 
@@ -168,7 +168,7 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
                     theta = _stable_sections_theta(w, h, m, poles[i], num, powers)
                     cands.append(("levy" if i == 0 else f"sk{i}", theta))
             cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n), powers=powers)))
-    cands = [(name, th) for name, th in cands if np.all(np.isfinite(th))]
+    cands = [(name, th) for name, th in cands if np.isfinite(th).all()]
     if not cands:
         return []
     c = np.asarray(costs(structure, np.array([th for _, th in cands])), float)

@@ -182,30 +182,34 @@ class Evaluator:
         """Weighted residuals ((S,) 2N) and, with ``jacobian``, their Jacobian ((S,) 2N × p).
 
         Non-finite values are returned as such (no warnings)."""
+        with np.errstate(all="ignore"):
+            return self._residual(theta, jacobian)
+
+    def _residual(self, theta, jacobian: bool):
+        """``residual`` for callers that already ignore floating-point warnings."""
         theta = np.asarray(theta, float)
         single = theta.ndim == 1
         th = theta[None, :] if single else theta
         n = self.n_lines
-        with np.errstate(all="ignore"):
-            q, g = self._model(th, jacobian)
-            r = np.empty((th.shape[0], 2 * n))
-            if self.kind == "log":
-                np.log(np.abs(q), out=r[:, :n])
-                np.arctan2(q.imag, q.real, out=r[:, n:])
-            else:
-                np.subtract(q.real, 1.0, out=r[:, :n])
-                r[:, n:] = q.imag
-            r *= self.weights
-            if not jacobian:
-                return r[0] if single else r
-            if self.kind != "log":
-                g = g * q[..., None]
-            nc = self.structure.n_coef
-            if nc > 1:
-                g = (g[..., None] * self.tpow[:, None, :]).reshape(g.shape[0], self.n_lines, -1)
-            jac = np.empty((g.shape[0], 2 * n, g.shape[2]))
-            np.multiply(g.real, self.weights[:n, None], out=jac[:, :n])
-            np.multiply(g.imag, self.weights[n:, None], out=jac[:, n:])
+        q, g = self._model(th, jacobian)
+        r = np.empty((th.shape[0], 2 * n))
+        if self.kind == "log":
+            np.log(np.abs(q), out=r[:, :n])
+            np.arctan2(q.imag, q.real, out=r[:, n:])
+        else:
+            np.subtract(q.real, 1.0, out=r[:, :n])
+            r[:, n:] = q.imag
+        r *= self.weights
+        if not jacobian:
+            return r[0] if single else r
+        if self.kind != "log":
+            g = g * q[..., None]
+        nc = self.structure.n_coef
+        if nc > 1:
+            g = (g[..., None] * self.tpow[:, None, :]).reshape(g.shape[0], self.n_lines, -1)
+        jac = np.empty((g.shape[0], 2 * n, g.shape[2]))
+        np.multiply(g.real, self.weights[:n, None], out=jac[:, :n])
+        np.multiply(g.imag, self.weights[n:, None], out=jac[:, n:])
         return (r[0], jac[0]) if single else (r, jac)
 
     def ratio(self, theta) -> np.ndarray:
@@ -334,10 +338,12 @@ class LevenbergMarquardt:
         self.ev, self.tol = evaluator, float(tol)
         x = np.atleast_2d(np.asarray(starts, float))
         S, p = x.shape
-        lb, ub = np.broadcast_to(np.asarray(lb, float), (p,)), np.broadcast_to(np.asarray(ub, float), (p,))
+        lb, ub = np.asarray(lb, float), np.asarray(ub, float)
+        if lb.shape != (p,) or ub.shape != (p,):
+            lb, ub = np.broadcast_to(lb, (p,)), np.broadcast_to(ub, (p,))
         width = np.where(np.isfinite(ub - lb), ub - lb, 1.0)
         self.lb, self.ub = lb, ub
-        self.theta = np.clip(x, lb + 1e-9 * width, ub - 1e-9 * width)
+        self.theta = np.minimum(np.maximum(x, lb + 1e-9 * width), ub - 1e-9 * width)   # np.clip
         self.margins = np.zeros(S) if margins is None else np.array(margins, float)
         self._r, self._J = evaluator.residual(self.theta, jacobian=True)
         self._m = self._r.shape[1]
@@ -378,11 +384,14 @@ class LevenbergMarquardt:
         t0 = time.perf_counter()
         allowed = np.ones(self.n_starts, bool) if only is None else np.isin(np.arange(self.n_starts), only)
         left = int(max_iterations)
-        while left > 0:
-            act = np.flatnonzero(self.running & allowed)
-            if act.size == 0:
-                break
-            left -= self._iterate(act, left)
+        # one floating-point context for the whole run: non-finite trial values are rejected
+        # by the step control (the evaluator ignores them the same way)
+        with np.errstate(all="ignore"):
+            while left > 0:
+                act = np.flatnonzero(self.running & allowed)
+                if act.size == 0:
+                    break
+                left -= self._iterate(act, left)
         for i in np.flatnonzero(self.running & allowed):
             self.status[i] = STATUS_MAXITER
         self.time_s += time.perf_counter() - t0
@@ -436,7 +445,7 @@ class LevenbergMarquardt:
             dx = xt - x
             lin = r + _matvec(J, dx)
             pred = rr - _einsum("si,si->s", lin, lin)
-            rt, jt_new = ev.residual(xt, jacobian=True)   # the Jacobian serves if accepted
+            rt, jt_new = ev._residual(xt, True)            # the Jacobian serves if accepted
             rrt = _einsum("si,si->s", rt, rt)
             # per-start bookkeeping on Python floats (a few starts: cheaper than array
             # operations, the same numbers)
