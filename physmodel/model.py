@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import IPMCError
-from .params import STATE_FIELDS, IPMCParameters, State, as_parameter_list, state_at
+from .params import STATE_FIELDS, IPMCParameters, ParameterTable, State, as_parameter_list
 
 #: Default number of points per chunk (keeps temporaries in L2/L3 cache).
 DEFAULT_CHUNK = 16384
@@ -166,10 +166,22 @@ class PhysicsModel:
     descriptions: dict = {}
 
     def __init__(self, params: IPMCParameters | Sequence[IPMCParameters], chunk_size: int = DEFAULT_CHUNK):
-        self.params = as_parameter_list(params)
+        self.params = params
         if int(chunk_size) < 1:
             raise IPMCError(f"chunk_size must be >= 1, got {chunk_size}")
         self.chunk_size = int(chunk_size)
+
+    @property
+    def params(self) -> list[IPMCParameters]:
+        """The parameter sets (first axis of every result)."""
+        return self._params
+
+    @params.setter
+    def params(self, params: IPMCParameters | Sequence[IPMCParameters]) -> None:
+        # the sets' numbers as arrays and their names, once per batch (not per evaluation)
+        self._params = as_parameter_list(params)
+        self._table = ParameterTable.of(self._params)
+        self._names = tuple(p.name for p in self._params)
 
     # subclasses provide _kernel(params, s, quantities) -> dict
     def _kernel(self, p, s, quantities):  # pragma: no cover - abstract
@@ -183,7 +195,7 @@ class PhysicsModel:
         return qs
 
     def state(self, temperature_c) -> State:
-        return state_at(self.params, temperature_c)
+        return self._table.state(temperature_c)
 
     def evaluate(self, s, temperature_c, quantities=None, out=None, progress=None) -> dict:
         """Quantities at complex Laplace points ``s`` [1/s]; arrays (n_sets, n_T, n_s)."""
@@ -213,7 +225,7 @@ class PhysicsModel:
             vals = evaluate_grid(self.state(T), 2j * np.pi * f, self._kernel, qs, self.chunk_size, out, progress)
         check_finite_output(vals, f, T)
         return FrequencyResponse(
-            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
+            frequency_hz=f, temperature_c=T, parameter_sets=self._names,
             values=vals, units={q: self.units[q] for q in qs},
             descriptions={q: self.descriptions[q] for q in qs},
         )

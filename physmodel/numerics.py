@@ -15,6 +15,8 @@ mpmath at 50 digits.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 #: |γ| below which γ − tanh γ is summed from its Taylor series.
@@ -142,17 +144,65 @@ def weighted_complex_lstsq(M, rhs, row_weight):
     """Real least-squares solution of the complex system ``M x ≈ rhs`` (x real), rows weighted.
 
     Real and imaginary parts are stacked, columns scaled to unit norm for conditioning, solved
-    with ``numpy.linalg.lstsq`` and unscaled.  Shared by vector fitting (timesim) and the Levy /
+    by LAPACK ``gelsd`` (what ``numpy.linalg.lstsq`` runs, with its default cutoff
+    ``eps·max(rows, columns)`` on the singular values; called directly, as these systems are
+    small and solved many times) and unscaled.  Shared by vector fitting (timesim) and the Levy /
     Sanathanan-Koerner initialisers (surrogate).
     """
-    Mw = M * row_weight[:, None]
-    rw = rhs * row_weight
-    Mr = np.vstack([Mw.real, Mw.imag])
-    rr = np.concatenate([rw.real, rw.imag])
-    scale = np.linalg.norm(Mr, axis=0)
+    M = np.asarray(M)
+    rhs = np.asarray(rhs)
+    m = M.shape[0]
+    Mr = np.empty((2 * m, M.shape[1]))
+    Mr[:m], Mr[m:] = M.real, M.imag
+    rr = np.empty(2 * m)
+    rr[:m], rr[m:] = rhs.real, rhs.imag
+    w = np.asarray(row_weight, float)
+    return stacked_weighted_lstsq(Mr, rr, np.concatenate([w, w]))
+
+
+def stacked_weighted_lstsq(Mr, rr, row_weight):
+    """``weighted_complex_lstsq`` with the real and imaginary parts already stacked:
+    ``Mr`` (2m, n) = [Re M; Im M], ``rr`` (2m,) = [Re rhs; Im rhs], ``row_weight`` (2m,) =
+    the line weights twice.  (The same numbers: a real weight scales the real and imaginary
+    parts of a complex row exactly.)  For a system solved with many weightings (the
+    Sanathanan–Koerner iterations) the stacking is done once."""
+    Mw = Mr * row_weight[:, None]
+    rw = rr * row_weight
+    rows, n = Mw.shape
+    scale = np.sqrt(_einsum("ij,ij->j", Mw, Mw))
     scale[scale == 0] = 1.0
-    x, *_ = np.linalg.lstsq(Mr / scale, rr, rcond=None)
-    return x / scale
+    Mw /= scale
+    cond = _EPS * max(rows, n)
+    if rows < n:                        # underdetermined: numpy pads the right-hand side
+        x, *_ = np.linalg.lstsq(Mw, rw, rcond=cond)
+        return x / scale
+    lwork, liwork = _gelsd_work(rows, n, cond)
+    x, _, _, info = _GELSD[0](Mw, rw, lwork, liwork, cond, True, True)
+    if info != 0:                       # not converged (or bad input): numpy's path raises clearly
+        x, *_ = np.linalg.lstsq(Mw, rw, rcond=cond)
+        return x / scale
+    return x[:n] / scale
+
+
+_EPS = float(np.finfo(float).eps)
+_GELSD: list = []
+try:        # what numpy.einsum calls (optimize=False), without its dispatch layer
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # pragma: no cover - other numpy layouts
+    _einsum = np.einsum
+
+
+@functools.lru_cache(maxsize=64)
+def _gelsd_work(rows: int, cols: int, cond: float) -> tuple[int, int]:
+    """Workspace sizes of ``gelsd`` for one right-hand side (LAPACK's query, once per shape)."""
+    from scipy.linalg import lapack
+
+    if not _GELSD:
+        _GELSD.extend(lapack.get_lapack_funcs(("gelsd", "gelsd_lwork"), (np.zeros((1, 1)),)))
+    work, iwork, info = _GELSD[1](rows, cols, 1, cond)
+    if info != 0:
+        raise ValueError(f"gelsd workspace query failed (info={info}) for a {rows}x{cols} system")
+    return int(np.real(work)), int(iwork)
 
 
 def principal_sqrt(z):

@@ -229,9 +229,81 @@ def as_parameter_list(params) -> list[IPMCParameters]:
     return out
 
 
-#: The numeric fields ``state_at`` reads, fetched with one attribute getter per set.
-_NUMERIC_STATE = ("L", "W", "alpha0", "a0", "rho", "xi") + tuple(LAW_PARAMETERS)
-_FIELD_GETTER = operator.attrgetter(*_NUMERIC_STATE)
+#: The numeric fields ``state_at`` reads, one array each over the sets.
+_NUMERIC_STATE = ("L", "W", "alpha0", "a0", "rho", "xi", "T_ref") + tuple(LAW_PARAMETERS)
+_FIELD_GETTERS = {name: operator.attrgetter(name) for name in _NUMERIC_STATE}
+_LAWS_GETTER = operator.attrgetter("laws")
+
+
+@dataclass(frozen=True)
+class ParameterTable:
+    """The numbers of a batch of parameter sets as arrays, built once (no per-set work when
+    the batch is evaluated again, e.g. by a model at other temperatures).
+
+    Attributes
+    ----------
+    columns : dict[str, ndarray]
+        Each numeric field of ``_NUMERIC_STATE`` over the sets, shape (n_sets, 1). [SI]
+    groups : list of (IPMCParameters, ndarray or None)
+        Sets sharing a temperature-laws object and ``T_ref``: a representative and the
+        indices of its members (None: every set).
+    n : int
+        Number of sets.
+    """
+
+    columns: dict
+    groups: list
+    n: int
+
+    @classmethod
+    def of(cls, params: IPMCParameters | Sequence[IPMCParameters]) -> ParameterTable:
+        plist = as_parameter_list(params)
+        n = len(plist)
+        columns = {name: np.fromiter(map(getter, plist), float, count=n)[:, None]
+                   for name, getter in _FIELD_GETTERS.items()}
+        # the temperature laws once per (laws object, T_ref): sets made by ``replace`` share theirs
+        laws = list(map(_LAWS_GETTER, plist))
+        first = laws[0]
+        t_ref = columns["T_ref"][:, 0]
+        if all(law is first for law in laws) and np.all(t_ref == t_ref[0]):
+            return cls(columns, [(plist[0], None)], n)
+        members: dict[tuple, list[int]] = {}
+        for i, key in enumerate(zip(map(id, laws), t_ref.tolist(), strict=True)):
+            members.setdefault(key, []).append(i)
+        return cls(columns, [(plist[idx[0]], np.asarray(idx)) for idx in members.values()], n)
+
+    def state(self, temperature_c) -> State:
+        """The :class:`State` of the batch at ``temperature_c`` [°C]."""
+        T = np.atleast_1d(celsius_to_kelvin(temperature_c)).astype(float)
+        if T.ndim != 1:
+            raise ParameterError(f"temperature_c must be a scalar or 1-D array, got shape {T.shape}")
+        n, col = self.n, self.columns
+        if len(self.groups) == 1:
+            p = self.groups[0][0]
+            fac = {k: v[None, :] for k, v in p.laws.factors(T, p.T_ref).items()}
+        else:
+            fac = {name: np.empty((n, T.size)) for name in LAW_PARAMETERS}
+            for p, idx in self.groups:
+                f = p.laws.factors(T, p.T_ref)
+                for name in LAW_PARAMETERS:
+                    fac[name][idx] = f[name]
+        shape = (n, T.size, 1)
+        vals = {name: np.broadcast_to(col[name][:, :, None], shape) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
+        for name in LAW_PARAMETERS:
+            vals[name] = (col[name] * fac[name])[:, :, None]
+        W = vals["W"]
+        vals["T"] = np.broadcast_to(T[None, :, None], shape)
+        vals["r1"] = vals.pop("r1_sheet") / W
+        vals["r2"] = vals.pop("r2_specific") / W
+        vals["Rp"] = vals.pop("Rp_specific") / W
+        vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * vals["T"])
+        vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
+        # fresh arrays as they are; the broadcast views (constant along T) copied
+        return State(**{k: np.array(v, dtype=float) if k in _BROADCAST else v
+                        for k, v in ((k, vals[k]) for k in STATE_FIELDS)})
+
+
+_BROADCAST = frozenset({"L", "W", "alpha0", "a0", "rho", "xi", "T"})
 
 
 def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -> State:
@@ -239,36 +311,7 @@ def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -
 
     Returns a :class:`State` whose arrays have shape (n_sets, n_T, 1).
     """
-    plist = as_parameter_list(params)
-    T = np.atleast_1d(celsius_to_kelvin(temperature_c)).astype(float)
-    if T.ndim != 1:
-        raise ParameterError(f"temperature_c must be a scalar or 1-D array, got shape {T.shape}")
-    n = len(plist)
-    # the temperature laws once per (laws object, T_ref): sets made by ``replace`` share theirs
-    groups: dict[tuple, list[int]] = {}
-    for i, p in enumerate(plist):
-        groups.setdefault((id(p.laws), p.T_ref), []).append(i)
-    fac = {name: np.empty((n, T.size)) for name in LAW_PARAMETERS}
-    for members in groups.values():
-        first = plist[members[0]]
-        f = first.laws.factors(T, first.T_ref)
-        idx = slice(None) if len(members) == n else np.asarray(members)
-        for name in LAW_PARAMETERS:
-            fac[name][idx] = f[name]
-    names = ("L", "W", "alpha0", "a0", "rho", "xi") + tuple(LAW_PARAMETERS)
-    table = np.array([_FIELD_GETTER(p) for p in plist], dtype=float)          # (n, len(_NUMERIC_STATE))
-    col = {name: table[:, _NUMERIC_STATE.index(name)][:, None] for name in names}
-    W = col["W"]
-    vals = {name: np.broadcast_to(col[name], (n, T.size)) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
-    for name in LAW_PARAMETERS:
-        vals[name] = col[name] * fac[name]
-    vals["T"] = np.broadcast_to(T, (n, T.size))
-    vals["r1"] = vals.pop("r1_sheet") / W
-    vals["r2"] = vals.pop("r2_specific") / W
-    vals["Rp"] = vals.pop("Rp_specific") / W
-    vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * vals["T"])
-    vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
-    return State(**{k: np.array(vals[k], dtype=float)[:, :, None] for k in STATE_FIELDS})
+    return ParameterTable.of(params).state(temperature_c)
 
 
 def describe(p: IPMCParameters) -> str:
@@ -284,5 +327,5 @@ def describe(p: IPMCParameters) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["IPMCParameters", "State", "state_at", "first_mode_omega", "density_for_mode", "describe",
+__all__ = ["IPMCParameters", "State", "ParameterTable", "state_at", "first_mode_omega", "density_for_mode", "describe",
            "as_parameter_list"]

@@ -12,10 +12,6 @@ from ._structure import Structure, _factor_roots, _section_polys, polynomials, r
 
 
 # --------------------------------------------------- grouping roots into factors
-def _is_real(r, tol=1e-9):
-    return abs(r.imag) <= tol * max(1.0, abs(r))
-
-
 def _pairings(reals, n_pairs, single):
     """All ways to split the real roots into n_pairs pairs (+ one single if requested)."""
     idx = list(range(len(reals)))
@@ -48,9 +44,10 @@ def group_roots(rts, reference=None):
     """
     rts = np.asarray(rts, complex)
     n = len(rts)
-    real = [r.real for r in rts if _is_real(r)]
-    upper = [r for r in rts if not _is_real(r) and r.imag > 0]
-    lower = [r for r in rts if not _is_real(r) and r.imag < 0]
+    is_real = np.abs(rts.imag) <= 1e-9 * np.maximum(1.0, np.abs(rts))     # |Im r| <= 1e-9·max(1, |r|)
+    real = rts.real[is_real].tolist()
+    upper = list(rts[~is_real & (rts.imag > 0)])
+    lower = list(rts[~is_real & (rts.imag < 0)])
     if len(upper) != len(lower):  # numerically broken conjugate symmetry: treat as reals
         real = sorted(r.real for r in rts)
         upper = []

@@ -68,11 +68,12 @@ def make_scaling(data: FrequencyData, omega_ref=None, gain_ref=None, t_center=No
         omega_ref = float(np.sqrt(w.min() * w.max()))
     if gain_ref is None:
         gain_ref = float(np.exp(np.mean(np.log(np.abs(data.response)))))
-    temps = data.temperatures()
-    if t_center is None:
-        t_center = float(0.5 * (temps.min() + temps.max())) if temps.size else 0.0
-    if t_scale is None:
-        t_scale = float(0.5 * (temps.max() - temps.min())) if temps.size > 1 else 1.0
+    if t_center is None or t_scale is None:
+        temps = data.temperatures()
+        if t_center is None:
+            t_center = float(0.5 * (temps.min() + temps.max())) if temps.size else 0.0
+        if t_scale is None:
+            t_scale = float(0.5 * (temps.max() - temps.min())) if temps.size > 1 else 1.0
     return Scaling(float(omega_ref), float(gain_ref), float(t_center), float(t_scale))
 
 
@@ -86,11 +87,16 @@ def make_problem(structure: Structure, data: FrequencyData, scaling: Scaling, we
     return Problem(structure, w, tau, data.response / scaling.gain_ref, kind, ia, ib), name
 
 
-def check_order_per_temperature(structure: Structure, data: FrequencyData):
-    """Each temperature must carry at least as many real equations as a per-T fit has unknowns."""
+def check_order_per_temperature(structure: Structure, data: FrequencyData, temps=None):
+    """Each temperature must carry at least as many real equations as a per-T fit has unknowns.
+    ``temps``: ``data.temperatures()`` if already at hand."""
     n_unknown = structure.n_zeros + 1 + structure.n_poles
-    groups = [(None, data.n)] if data.temperature_c is None else [
-        (t, int(np.sum(data.temperature_c == t))) for t in data.temperatures()]
+    if data.temperature_c is None:
+        groups = [(None, data.n)]
+    else:
+        temps = data.temperatures() if temps is None else temps
+        groups = [(temps[0], data.n)] if temps.size == 1 else [
+            (t, int(np.sum(data.temperature_c == t))) for t in temps]
     for t, count in groups:
         if 2 * count < n_unknown:
             where = "" if t is None else f" at temperature_c={t:g}"
@@ -139,6 +145,28 @@ def per_temperature_errors(model: RationalModel, data: FrequencyData, extrapolat
     return out
 
 
+class _Deferred:
+    """A value computed on first use (then kept): the parts of a fit result that cost more
+    than the fit's last iterations but are often not read (covariance, pole check,
+    per-temperature errors)."""
+
+    __slots__ = ("_fn", "_value")
+
+    def __init__(self, fn):
+        self._fn, self._value = fn, None
+
+    def __call__(self):
+        if self._fn is not None:
+            self._value, self._fn = self._fn(), None
+        return self._value
+
+    def __getstate__(self):            # pickled / deep-copied as the computed value
+        return self()
+
+    def __setstate__(self, value):
+        self._fn, self._value = None, value
+
+
 @dataclass
 class FitResult:
     """What a fit returns.  Every array is in the model's parameter layout.
@@ -150,10 +178,18 @@ class FitResult:
         correct uncertainties with weighting 'uncertainty'). [-]
     stderr, ci95_low, ci95_high : from the Gauss–Newton covariance at the optimum
         (None when not available, e.g. for the two-stage baseline).
+    covariance_rank_deficient : the Jacobian at the optimum is rank deficient (the
+        covariance is then a pseudo-inverse).
     at_bounds : parameters that ended on a bound (their intervals are unreliable).
+    per_temperature : list of ``TemperatureError``, one per temperature of the data.
     stability : independent pole check (dense temperature grid for scheduled models).
     history : one dict per solver run (stage, start, status, iterations, cost, time_s,
         objective trace).
+
+    The covariance (hence ``stderr``, ``ci95_low``, ``ci95_high``,
+    ``covariance_rank_deficient`` and ``model.covariance``), ``per_temperature`` and
+    ``stability`` are computed when first read, not by the fit: a fit whose caller reads
+    only the model does not pay for them.
     """
 
     model: RationalModel
@@ -166,18 +202,47 @@ class FitResult:
     method: str
     param_names: list
     params: np.ndarray
-    stderr: np.ndarray | None
-    ci95_low: np.ndarray | None
-    ci95_high: np.ndarray | None
-    covariance_rank_deficient: bool
     at_bounds: list
-    per_temperature: list
-    stability: StabilityCheck
     time_s: float
     data_fingerprint: str
     history: list = field(default_factory=list)
     two_stage: RationalModel | None = None
     per_temperature_models: dict | None = None
+    _covariance: _Deferred | None = field(default=None, repr=False, compare=False)
+    _per_temperature: _Deferred | None = field(default=None, repr=False, compare=False)
+    _stability: _Deferred | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def stderr(self) -> np.ndarray | None:
+        """Standard errors of ``params`` (Gauss–Newton covariance), or None. [-]"""
+        return self.model.stderr
+
+    @property
+    def ci95_low(self) -> np.ndarray | None:
+        """Lower ends of the normal-approximation 95 % intervals of ``params``, or None. [-]"""
+        ci = self.model.confidence_intervals()
+        return None if ci is None else ci[0]
+
+    @property
+    def ci95_high(self) -> np.ndarray | None:
+        """Upper ends of the normal-approximation 95 % intervals of ``params``, or None. [-]"""
+        ci = self.model.confidence_intervals()
+        return None if ci is None else ci[1]
+
+    @property
+    def covariance_rank_deficient(self) -> bool:
+        """True when the Jacobian at the optimum is rank deficient."""
+        return False if self._covariance is None else bool(self._covariance()[1])
+
+    @property
+    def per_temperature(self) -> list:
+        """``TemperatureError`` per temperature of the data."""
+        return [] if self._per_temperature is None else self._per_temperature()
+
+    @property
+    def stability(self) -> StabilityCheck:
+        """Pole check of the fitted model (see ``RationalModel.stability_check``)."""
+        return self._stability()
 
     def summary(self) -> str:
         st = self.model.structure
@@ -283,18 +348,26 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
            data: FrequencyData, *, weighting_name: str, method: str, settings: dict,
            scale_covariance: bool, history: list, time_s: float, temperature_range,
            compute_covariance: bool = True, two_stage=None, per_temperature_models=None,
-           raise_on_failure: bool = True, stability_grid: int = 501) -> FitResult:
+           raise_on_failure: bool = True, stability_grid: int = 501, temperatures=None) -> FitResult:
+    """The ``FitResult`` of ``outcome``.  The covariance (from the Jacobian at the optimum),
+    the per-temperature errors and the stability check are deferred: computed, the same
+    way, when first read.  ``temperatures``: ``data.temperatures()`` if already at hand."""
     theta = outcome.theta
-    cov, rank_def = None, False
+    cov = None
     at_bounds = []
+    param_names = structure.param_names()
     if compute_covariance and evaluator is not None:
-        r, jac = evaluator.residual(theta, jacobian=True)
-        cov, rank_def = covariance(jac, r, scale_covariance)
+        def _cov(ev=evaluator, th=theta, scale=scale_covariance):
+            r, jac = ev.residual(th, jacobian=True)
+            return covariance(jac, r, scale)
+
+        cov = _Deferred(_cov)
         lo, hi = structure.bounds(float(problem.w.min()), float(problem.w.max()))
-        names = structure.param_names()
+        names = param_names
         at_bounds = [names[i] for i in np.flatnonzero((theta <= lo + 1e-6) | (theta >= hi - 1e-6))]
-    else:
-        r = (evaluator or problem).residual(theta)
+    r = (evaluator or problem).residual(theta)
+    temps = data.temperatures() if temperatures is None else temperatures
+    fingerprint = data.fingerprint()
     info = {
         "method": method,
         "settings": settings,
@@ -302,25 +375,26 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
         "converged": outcome.converged,
         "status": outcome.status,
         "cost": outcome.cost if np.isfinite(outcome.cost) else None,
-        "data_fingerprint": data.fingerprint(),
+        "data_fingerprint": fingerprint,
         "n_lines": data.n,
-        "temperatures_c": data.temperatures().tolist(),
+        "temperatures_c": temps.tolist(),
     }
-    model = RationalModel(structure, theta, scaling, temperature_range, cov, data.labels(), info)
-    stability = model.stability_check(stability_grid)
-    # the model's response on the data lines: H_model = R · H_data, R from the residual model
-    errs = per_temperature_errors(model, data, response=None if evaluator is None
-                                  else evaluator.ratio(theta) * data.response)
-    ci = model.confidence_intervals()
+    model = RationalModel(structure, theta, scaling, temperature_range,
+                          None if cov is None else (lambda c=cov: c()[0]), data.labels(), info)
+
+    def _errors(model=model, ev=evaluator, th=theta, data=data):
+        # the model's response on the data lines: H_model = R · H_data, R from the residual model
+        return per_temperature_errors(model, data, response=None if ev is None else ev.ratio(th) * data.response)
+
     res = FitResult(
         model=model, converged=outcome.converged, status=outcome.status,
         iterations=outcome.iterations, cost=outcome.cost,
         weighted_rms=float(np.sqrt(np.mean(r ** 2))), weighting=weighting_name, method=method,
-        param_names=structure.param_names(), params=theta.copy(), stderr=model.stderr,
-        ci95_low=None if ci is None else ci[0], ci95_high=None if ci is None else ci[1],
-        covariance_rank_deficient=rank_def, at_bounds=at_bounds, per_temperature=errs,
-        stability=stability, time_s=time_s, data_fingerprint=info["data_fingerprint"],
+        param_names=param_names, params=theta.copy(), at_bounds=at_bounds,
+        time_s=time_s, data_fingerprint=fingerprint,
         history=history, two_stage=two_stage, per_temperature_models=per_temperature_models,
+        _covariance=cov, _per_temperature=_Deferred(_errors),
+        _stability=_Deferred(lambda m=model, k=stability_grid: m.stability_check(k)),
     )
     if not outcome.converged and raise_on_failure:
         raise ConvergenceError(

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from physmodel.numerics import weighted_complex_lstsq
+from physmodel.numerics import stacked_weighted_lstsq, weighted_complex_lstsq
 
 from ._convert import group_roots, pole_slots_from_groups, stabilise_roots
 from ._structure import Structure
@@ -18,6 +18,15 @@ __all__ = ["levy", "numerator_ls", "initial_candidates"]
 
 def _solve_weighted(a: np.ndarray, rhs: np.ndarray, row_weight: np.ndarray) -> np.ndarray:
     return weighted_complex_lstsq(a, rhs, np.asarray(row_weight, dtype=float))
+
+
+def _horner(x: np.ndarray, c) -> np.ndarray:
+    """Σ c_i x^i by Horner's rule, the operations of ``numpy.polynomial.polynomial.polyval``
+    (the same numbers) without its argument handling."""
+    c0 = c[-1] + x * 0
+    for i in range(2, len(c) + 1):
+        c0 = c[-i] + c0 * x
+    return c0
 
 
 def levy(w, h, n_zeros: int, n_poles: int, row_weight=None):
@@ -38,41 +47,50 @@ def levy(w, h, n_zeros: int, n_poles: int, row_weight=None):
     return sol[: n_zeros + 1], np.append(sol[n_zeros + 1:], 1.0)
 
 
-def numerator_ls(w, h, n_zeros: int, den, relative: bool = True):
-    """Best numerator for a fixed denominator (linear least squares, relative error)."""
+def numerator_ls(w, h, n_zeros: int, den, relative: bool = True, powers=None):
+    """Best numerator for a fixed denominator (linear least squares, relative error).
+    ``powers``: (jw̃)^k for k = 0..≥n_zeros (columns), if already at hand."""
     jw = 1j * np.asarray(w, float)
     h = np.asarray(h, complex)
-    d = np.polynomial.polynomial.polyval(jw, den)
-    a = jw[:, None] ** np.arange(n_zeros + 1)
+    d = _horner(jw, den)
+    a = jw[:, None] ** np.arange(n_zeros + 1) if powers is None else powers[:, :n_zeros + 1]
     wt = 1.0 / np.abs(d)
     if relative:
         wt = wt / np.abs(h)
     return _solve_weighted(a, h * d, wt)
 
 
-def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8):
-    """SK iterations (relative weighting); returns every iterate, Levy's first."""
+def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8, powers=None):
+    """SK iterations (relative weighting); returns every iterate, Levy's first.
+    ``powers``: (jw̃)^k for k = 0..n_poles (columns), if already at hand."""
     w = np.asarray(w, float)
     h = np.asarray(h, complex)
     jw = 1j * w
-    vd = jw[:, None] ** np.arange(n_poles + 1)
+    vd = jw[:, None] ** np.arange(n_poles + 1) if powers is None else powers[:, :n_poles + 1]
     a = np.hstack([vd[:, :n_zeros + 1] if n_zeros <= n_poles else jw[:, None] ** np.arange(n_zeros + 1),
                    -h[:, None] * vd[:, :n_poles]])
     rhs = h * vd[:, n_poles]
     rel = 1.0 / np.abs(h)
-    wt, out = rel, []
+    n_w = w.size
+    ar = np.concatenate([a.real, a.imag])               # the system stacked once, reweighted below
+    br = np.concatenate([rhs.real, rhs.imag])
+    wt2 = np.empty(2 * n_w)
+    wt2[:n_w] = wt2[n_w:] = rel
+    out = []
     for _ in range(n_iter + 1):
-        sol = _solve_weighted(a, rhs, wt)
-        den = np.append(sol[n_zeros + 1:], 1.0)
+        sol = stacked_weighted_lstsq(ar, br, wt2)
+        den = np.empty(n_poles + 1)
+        den[:n_poles], den[n_poles] = sol[n_zeros + 1:], 1.0
         out.append((sol[:n_zeros + 1], den))
         d = np.abs(vd @ den)
-        if not np.all(np.isfinite(d)) or np.any(d == 0):
+        if not (np.isfinite(d).all() and d.all()):
             break
-        wt = rel / d
+        np.divide(rel, d, out=wt2[:n_w])
+        wt2[n_w:] = wt2[:n_w]
     return out
 
 
-def _stable_sections_theta(w, h, n_zeros, den_roots, num=None):
+def _stable_sections_theta(w, h, n_zeros, den_roots, num=None, powers=None):
     """Sections parameters for the given poles (unstable ones reflected).  ``num`` (the
     numerator that came with these poles) is kept when no pole had to be moved; otherwise
     the numerator is refitted by linear least squares."""
@@ -82,7 +100,7 @@ def _stable_sections_theta(w, h, n_zeros, den_roots, num=None):
     poles_part = pole_slots_from_groups(quads, single)
     if num is None or np.any(stable != rts):
         den = np.real(np.poly(stable)[::-1])
-        num = numerator_ls(w, h, n_zeros, den)
+        num = numerator_ls(w, h, n_zeros, den, powers=powers)
     return np.concatenate([num, poles_part])
 
 
@@ -115,7 +133,7 @@ def _sk_costs(sk, structure, costs):
         poles[ok] = np.linalg.eigvals(comp[ok])
     stable = np.all(poles.real < 0, axis=1)
     coef = structure.with_form("coefficients")
-    thetas = np.array([np.concatenate([num, den[:-1]]) for num, den in sk])
+    thetas = np.concatenate([np.array([num for num, _ in sk]), dens[:, :-1]], axis=1)
     c = np.asarray(costs(coef, thetas), float)
     return np.where(stable & np.isfinite(c), c, np.inf), poles
 
@@ -130,7 +148,9 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
     """
     m, n = structure.n_zeros, structure.n_poles
     cands = []
-    sk = sanathanan_koerner(w, h, m, n)
+    w = np.asarray(w, float)
+    powers = (1j * w)[:, None] ** np.arange(max(m, n) + 1)      # shared by SK and the numerators
+    sk = sanathanan_koerner(w, h, m, n, powers=powers)
     with np.errstate(all="ignore"):
         if structure.form == "coefficients":
             for i, (num, den) in enumerate(sk):
@@ -145,10 +165,10 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
             for i in picks:
                 num, den = sk[i]
                 if np.all(np.isfinite(poles[i])):
-                    theta = _stable_sections_theta(w, h, m, poles[i], num)
+                    theta = _stable_sections_theta(w, h, m, poles[i], num, powers)
                     cands.append(("levy" if i == 0 else f"sk{i}", theta))
-            cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n))))
-    cands = [(name, th) for name, th in cands if np.all(np.isfinite(th))]
+            cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n), powers=powers)))
+    cands = [(name, th) for name, th in cands if np.isfinite(th).all()]
     if not cands:
         return []
     c = np.asarray(costs(structure, np.array([th for _, th in cands])), float)

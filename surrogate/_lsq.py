@@ -26,7 +26,13 @@ from functools import lru_cache
 
 import numpy as np
 
+from ._lm_control import step_control
 from ._structure import Structure
+
+try:        # what numpy.einsum calls (optimize=False), without its dispatch layer
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # pragma: no cover - other numpy layouts
+    _einsum = np.einsum
 
 __all__ = ["Evaluator", "LevenbergMarquardt", "STATUS_OK", "STATUS_ACCEPTABLE", "STATUS_MAXITER",
            "STATUS_STOPPED", "STATUS_FAILED"]
@@ -67,6 +73,7 @@ def _layout(structure: Structure) -> dict:
     else:
         lay["p1"] = span([f"log_a1_{k}" for k in range(n // 2)], 2)
         lay["p0"] = span([f"log_a0_{k}" for k in range(n // 2)], 2)
+        lay["p10"] = slice(lay["p1"].start, lay["p1"].start + 2 * (n // 2)) if n > 1 else slice(0, 0)
         lay["pc"] = ix["log_c"] if n % 2 else None
     return lay
 
@@ -93,6 +100,17 @@ class Evaluator:
         self.weights = np.concatenate([np.asarray(problem.inv_sig_a, float),
                                        np.asarray(problem.inv_sig_b, float)])
         self.n_params = st.n_params
+
+    def with_structure(self, structure: Structure) -> Evaluator:
+        """The same problem in another form with the same orders and degree (e.g. the
+        coefficient form, to score Sanathanan–Koerner iterates), sharing the data arrays."""
+        st = self.structure
+        if (structure.n_zeros, structure.n_poles, structure.degree) != (st.n_zeros, st.n_poles, st.degree):
+            raise ValueError(f"{structure} does not have the orders and degree of {st}")
+        ev = object.__new__(Evaluator)
+        ev.__dict__.update(self.__dict__)
+        ev.structure, ev.lay, ev.n_params = structure, _layout(structure), structure.n_params
+        return ev
 
     def _slots(self, theta: np.ndarray) -> np.ndarray:
         """Slot values (S, N or 1, slots)."""
@@ -129,7 +147,7 @@ class Evaluator:
         elif v.shape[1] == 1:                     # one temperature: a matrix product
             num = v[:, 0, lay["b"]] @ self._sp_num_t
             if grad:
-                g[..., lay["b"]] = sp[:, :m + 1] / num[..., None]
+                np.divide(sp[:, :m + 1], num[..., None], out=g[..., lay["b"]])
         else:
             num = (v[..., lay["b"]] * sp[:, :m + 1]).sum(axis=-1)
             if grad:
@@ -144,13 +162,15 @@ class Evaluator:
         else:
             den = None
             if n > 1:
-                e1, e0 = np.exp(v[..., lay["p1"]]), np.exp(v[..., lay["p0"]])
-                sec = s2 + e1 * s + e0
+                e = np.exp(v[..., lay["p10"]])          # (a1_0, a0_0, a1_1, a0_1, ...)
+                e1, e0 = e[..., 0::2], e[..., 1::2]
+                e1s = e1 * s
+                sec = s2 + e1s + e0
                 den = sec[..., 0] if n < 4 else np.prod(sec, axis=-1)
                 if grad:
                     inv = 1.0 / sec
-                    g[..., lay["p1"]] = -(e1 * s) * inv
-                    g[..., lay["p0"]] = -e0 * inv
+                    np.multiply(np.negative(e1s, out=e1s), inv, out=g[..., lay["p1"]])
+                    np.multiply(-e0, inv, out=g[..., lay["p0"]])
             if lay["pc"] is not None:
                 c = np.exp(v[..., lay["pc"]])
                 d1 = s[:, 0] + c
@@ -163,30 +183,34 @@ class Evaluator:
         """Weighted residuals ((S,) 2N) and, with ``jacobian``, their Jacobian ((S,) 2N × p).
 
         Non-finite values are returned as such (no warnings)."""
+        with np.errstate(all="ignore"):
+            return self._residual(theta, jacobian)
+
+    def _residual(self, theta, jacobian: bool):
+        """``residual`` for callers that already ignore floating-point warnings."""
         theta = np.asarray(theta, float)
         single = theta.ndim == 1
         th = theta[None, :] if single else theta
         n = self.n_lines
-        with np.errstate(all="ignore"):
-            q, g = self._model(th, jacobian)
-            r = np.empty((th.shape[0], 2 * n))
-            if self.kind == "log":
-                np.log(np.abs(q), out=r[:, :n])
-                np.arctan2(q.imag, q.real, out=r[:, n:])
-            else:
-                np.subtract(q.real, 1.0, out=r[:, :n])
-                r[:, n:] = q.imag
-            r *= self.weights
-            if not jacobian:
-                return r[0] if single else r
-            if self.kind != "log":
-                g = g * q[..., None]
-            nc = self.structure.n_coef
-            if nc > 1:
-                g = (g[..., None] * self.tpow[:, None, :]).reshape(g.shape[0], self.n_lines, -1)
-            jac = np.empty((g.shape[0], 2 * n, g.shape[2]))
-            np.multiply(g.real, self.weights[:n, None], out=jac[:, :n])
-            np.multiply(g.imag, self.weights[n:, None], out=jac[:, n:])
+        q, g = self._model(th, jacobian)
+        r = np.empty((th.shape[0], 2 * n))
+        if self.kind == "log":
+            np.log(np.abs(q), out=r[:, :n])
+            np.arctan2(q.imag, q.real, out=r[:, n:])
+        else:
+            np.subtract(q.real, 1.0, out=r[:, :n])
+            r[:, n:] = q.imag
+        r *= self.weights
+        if not jacobian:
+            return r[0] if single else r
+        if self.kind != "log":
+            g = g * q[..., None]
+        nc = self.structure.n_coef
+        if nc > 1:
+            g = (g[..., None] * self.tpow[:, None, :]).reshape(g.shape[0], self.n_lines, -1)
+        jac = np.empty((g.shape[0], 2 * n, g.shape[2]))
+        np.multiply(g.real, self.weights[:n, None], out=jac[:, :n])
+        np.multiply(g.imag, self.weights[n:, None], out=jac[:, n:])
         return (r[0], jac[0]) if single else (r, jac)
 
     def ratio(self, theta) -> np.ndarray:
@@ -201,11 +225,12 @@ class Evaluator:
     def costs(self, thetas) -> np.ndarray:
         """½·mean(r²) for a stack of parameter vectors (S, p); +inf where not finite."""
         r = self.residual(np.asarray(thetas, float).reshape(-1, self.n_params))
-        c = 0.5 * np.einsum("si,si->s", r, r) / r.shape[1]
+        c = 0.5 * _einsum("si,si->s", r, r) / r.shape[1]
         c[~np.isfinite(c)] = np.inf
         return c
 
 
+@lru_cache(maxsize=64)
 def block_rows(p: int) -> int:
     """Rows per block of the products with a Jacobian of ``p`` columns.  OpenBLAS runs a
     matrix product on several threads above about 2.6e5 multiply-adds (a matrix-vector
@@ -217,8 +242,11 @@ def block_rows(p: int) -> int:
 
 def _normal_equations(J: np.ndarray, r: np.ndarray):
     """JᵀJ (S, p, p) and Jᵀr (S, p), summed over blocks of rows (see ``block_rows``)."""
-    a = g = None
     rows = block_rows(J.shape[2])
+    if J.shape[1] <= rows:                       # one block
+        jt = J.transpose(0, 2, 1)
+        return jt @ J, (jt @ r[..., None])[..., 0]
+    a = g = None
     for i in range(0, J.shape[1], rows):
         jb = J[:, i:i + rows]
         jt = jb.transpose(0, 2, 1)
@@ -279,10 +307,12 @@ class LevenbergMarquardt:
         self.ev, self.tol = evaluator, float(tol)
         x = np.atleast_2d(np.asarray(starts, float))
         S, p = x.shape
-        lb, ub = np.broadcast_to(np.asarray(lb, float), (p,)), np.broadcast_to(np.asarray(ub, float), (p,))
+        lb, ub = np.asarray(lb, float), np.asarray(ub, float)
+        if lb.shape != (p,) or ub.shape != (p,):
+            lb, ub = np.broadcast_to(lb, (p,)), np.broadcast_to(ub, (p,))
         width = np.where(np.isfinite(ub - lb), ub - lb, 1.0)
         self.lb, self.ub = lb, ub
-        self.theta = np.clip(x, lb + 1e-9 * width, ub - 1e-9 * width)
+        self.theta = np.minimum(np.maximum(x, lb + 1e-9 * width), ub - 1e-9 * width)   # np.clip
         self.margins = np.zeros(S) if margins is None else np.array(margins, float)
         self._r, self._J = evaluator.residual(self.theta, jacobian=True)
         self._m = self._r.shape[1]
@@ -323,11 +353,14 @@ class LevenbergMarquardt:
         t0 = time.perf_counter()
         allowed = np.ones(self.n_starts, bool) if only is None else np.isin(np.arange(self.n_starts), only)
         left = int(max_iterations)
-        while left > 0:
-            act = np.flatnonzero(self.running & allowed)
-            if act.size == 0:
-                break
-            left -= self._iterate(act, left)
+        # one floating-point context for the whole run: non-finite trial values are rejected
+        # by the step control (the evaluator ignores them the same way)
+        with np.errstate(all="ignore"):
+            while left > 0:
+                act = np.flatnonzero(self.running & allowed)
+                if act.size == 0:
+                    break
+                left -= self._iterate(act, left)
         for i in np.flatnonzero(self.running & allowed):
             self.status[i] = STATUS_MAXITER
         self.time_s += time.perf_counter() - t0
@@ -345,10 +378,11 @@ class LevenbergMarquardt:
         w = self.ACCEPTABLE_WINDOW
         done = 0
         ended = False
+        mu_unset = bool(np.isnan(mu).any())         # only before a start's first iteration
         while done < budget and not ended:
             done += 1
             a, g = _normal_equations(J, r)
-            diag = np.einsum("sii->si", a)                    # a view
+            diag = _einsum("sii->si", a)                    # a view
             cn = np.sqrt(diag)
             np.maximum(scale, cn, out=scale)
             d = np.where(scale > 0, scale, 1.0)
@@ -359,11 +393,12 @@ class LevenbergMarquardt:
                 if at_bound.any():
                     free = ~(at_bound & (((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))))
                     cos = np.where(free, cos, 0.0)
-            stationary = cos.max(axis=1) <= sqrt_tol * np.sqrt(rr)
+            stationary = np.maximum.reduce(cos, axis=1) <= sqrt_tol * np.sqrt(rr)
             a /= d[:, :, None] * d[:, None, :]
             b = g / d
-            if np.isnan(mu).any():
+            if mu_unset:
                 mu = np.where(np.isnan(mu), 1e-3 * np.maximum(diag.max(axis=1), 1e-300), mu)
+                mu_unset = False
             if free is None:
                 diag += mu[:, None]
             else:
@@ -378,38 +413,36 @@ class LevenbergMarquardt:
                 np.minimum(xt, ub, out=xt)
             dx = xt - x
             lin = r + _matvec(J, dx)
-            pred = rr - np.einsum("si,si->s", lin, lin)
-            rt, jt_new = ev.residual(xt, jacobian=True)   # the Jacobian serves if accepted
-            rrt = np.einsum("si,si->s", rt, rt)
-            actual = rr - rrt                               # NaN where rt is not finite
-            rho = actual / np.where(pred > 0, pred, np.nan)
-            acc = (rho > 1e-4) & ~stationary
-            mu = np.where(acc, mu * np.maximum(1 / 3, 1 - (2 * rho - 1) ** 3), mu * nu)
-            nu = np.where(acc, 2.0, nu * 2.0)
-            end_now = stationary | (~acc & ((mu > 1e30) | ~dx.any(axis=1)))
-            if end_now.any():
-                for j in np.flatnonzero(end_now):
+            pred = rr - _einsum("si,si->s", lin, lin)
+            rt, jt_new = ev._residual(xt, True)            # the Jacobian serves if accepted
+            rrt = _einsum("si,si->s", rt, rt)
+            # per-start bookkeeping on Python floats (a few starts: cheaper than array
+            # operations, the same numbers)
+            acc, mu, nu, end_now, actual = step_control(rr, rrt, pred, stationary, mu, nu, dx)
+            if any(end_now):
+                for j in [j for j, e in enumerate(end_now) if e]:
                     # first-order optimal, or no decrease along any damped direction
                     self._end(act[j], STATUS_OK, True)
                 ended = True
-            if acc.any():
-                if acc.all():
+            if any(acc):
+                if all(acc):
                     ja = slice(None)
                     x, r, J, rr = xt, rt, jt_new, rrt
                     idx = range(act.size)
                 else:
-                    ja = np.flatnonzero(acc)
+                    ja = np.array([j for j, a in enumerate(acc) if a])
                     x[ja], r[ja], J[ja], rr[ja] = xt[ja], rt[ja], jt_new[ja], rrt[ja]
                     idx = ja
-                bad = ~np.isfinite(np.einsum("sij->s", jt_new[ja]))
-                small = (actual[ja] <= tol * rrt[ja]) & (pred[ja] <= tol * rrt[ja])
+                bad = (~np.isfinite(_einsum("sij->s", jt_new[ja]))).tolist()
+                rrt_l, pred_l = rrt.tolist(), pred.tolist()
                 for k, j in enumerate(idx):
                     i = act[j]
                     tr = self.traces[i]
-                    tr.append(0.5 * float(rrt[j]) / self._m)
+                    tr.append(0.5 * rrt_l[j] / self._m)
+                    lim = tol * rrt_l[j]
                     if bad[k]:
                         self._end(i, STATUS_FAILED, False)
-                    elif small[k]:
+                    elif actual[j] <= lim and pred_l[j] <= lim:
                         self._end(i, STATUS_OK, True)
                     elif len(tr) > w and tr[-1 - w] - tr[-1] <= w * self.ACCEPTABLE_RATE * tr[-1]:
                         self._end(i, STATUS_ACCEPTABLE, True)

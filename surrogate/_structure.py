@@ -74,6 +74,9 @@ class Structure:
 
     @property
     def slots(self) -> list[str]:
+        return list(_slots(self.form, self.n_zeros, self.n_poles))
+
+    def _slot_names(self) -> list[str]:
         m, n = self.n_zeros, self.n_poles
         num = [f"b{i}" for i in range(m + 1)]
         if self.form == "coefficients":
@@ -160,10 +163,10 @@ class Structure:
         return lo, hi
 
     def with_degree(self, degree: int) -> Structure:
-        return Structure(self.form, self.n_zeros, self.n_poles, degree)
+        return _structure(self.form, self.n_zeros, self.n_poles, degree)
 
     def with_form(self, form: str) -> Structure:
-        return Structure(form, self.n_zeros, self.n_poles, self.degree)
+        return _structure(form, self.n_zeros, self.n_poles, self.degree)
 
     def to_dict(self) -> dict:
         return {"form": self.form, "n_zeros": self.n_zeros, "n_poles": self.n_poles,
@@ -173,6 +176,18 @@ class Structure:
     def slot_matrix(self, theta) -> np.ndarray:
         """Parameters as an array (n_slots, degree+1) (numpy only)."""
         return np.asarray(theta, float).reshape(len(self.slots), self.n_coef)
+
+
+@functools.lru_cache(maxsize=256)
+def _slots(form, n_zeros, n_poles) -> tuple:
+    """Slot names of a form and orders (computed once)."""
+    return tuple(Structure(form, n_zeros, n_poles, 0)._slot_names())
+
+
+@functools.lru_cache(maxsize=256)
+def _structure(form, n_zeros, n_poles, degree) -> Structure:
+    """A (frozen, hence shareable) ``Structure``, built and validated once per value."""
+    return Structure(form, n_zeros, n_poles, degree)
 
 
 @functools.lru_cache(maxsize=256)
@@ -349,6 +364,32 @@ def denominators(structure: Structure, theta, taus) -> np.ndarray:
             out[:, j:j + den.shape[1]] += den * c[:, None]
         den = out
     return den
+
+
+def section_max_real_part(structure: Structure, theta, taus) -> np.ndarray:
+    """Largest real part of the poles in s̃ of a section denominator ('sections', 'zpk') at
+    many scaled temperatures at once, shape (len(taus),).  Each section s̃² + a1 s̃ + a0 in
+    closed form: −a1/2 for a complex pair, else the root nearer zero, a0/q with
+    q = −(a1 + sign(a1)·√disc)/2 (cancellation-free, as ``_factor_roots``); (s̃ + c): −c."""
+    if structure.form == "coefficients":
+        raise ValueError("section_max_real_part needs a section denominator ('sections' or 'zpk')")
+    taus = np.atleast_1d(np.asarray(taus, float))
+    ix = {s: i for i, s in enumerate(structure.slots)}
+    n = structure.n_poles
+    mat = structure.slot_matrix(theta)
+    tp = taus[None, :] ** np.arange(structure.n_coef)[:, None]          # (n_coef, K)
+    best = np.full(taus.size, -np.inf)
+    if n // 2:
+        a1 = np.exp(mat[[ix[f"log_a1_{k}"] for k in range(n // 2)]] @ tp)   # (sections, K)
+        a0 = np.exp(mat[[ix[f"log_a0_{k}"] for k in range(n // 2)]] @ tp)
+        disc = a1 * a1 - 4 * a0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            q = -(a1 + np.copysign(np.sqrt(np.maximum(disc, 0.0)), a1)) / 2
+            near = np.where(q != 0.0, a0 / q, 0.0)
+        best = np.maximum(best, np.where(disc < 0, -a1 / 2, np.maximum(q, near)).max(axis=0))
+    if n % 2:
+        best = np.maximum(best, -np.exp(mat[ix["log_c"]] @ tp))
+    return best
 
 
 def _factor_roots(poly_asc) -> np.ndarray:

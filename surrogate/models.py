@@ -43,7 +43,8 @@ class Scaling:
     temperature_scale_c: float = 1.0
 
     def __post_init__(self):
-        for name, v in asdict(self).items():
+        for name in ("omega_ref_rad_s", "gain_ref", "temperature_center_c", "temperature_scale_c"):
+            v = getattr(self, name)
             if not math.isfinite(v):
                 raise ValueError(f"{name} must be finite, got {v!r}")
         if self.omega_ref_rad_s <= 0 or self.gain_ref <= 0 or self.temperature_scale_c <= 0:
@@ -86,8 +87,9 @@ class RationalModel:
         Frequency, gain and temperature scales.
     temperature_range_c : (float, float) or None
         Validity range; evaluating outside it raises unless ``extrapolate=True``. [°C]
-    covariance : array (p, p) or None
-        Parameter covariance from the fit, in the scaled variables. [-]
+    covariance : array (p, p), callable or None
+        Parameter covariance from the fit, in the scaled variables; a callable returning
+        it is called when the covariance is first read. [-]
     labels : dict
         ``input_name``, ``input_unit``, ``output_name``, ``output_unit``.
     info : dict
@@ -115,16 +117,37 @@ class RationalModel:
         elif structure.degree > 0:
             raise ValueError("a scheduled model (degree > 0) needs temperature_range_c")
         self.temperature_range_c = temperature_range_c
-        if covariance is not None:
-            covariance = np.array(covariance, float)
-            if covariance.shape != (p.shape[0], p.shape[0]):
-                raise ValueError(f"covariance must be {p.shape[0]}x{p.shape[0]}")
-            covariance.setflags(write=False)
-        self.covariance = covariance
+        self._covariance, self._covariance_fn = None, None
+        if callable(covariance):        # computed on first use (a fit's result)
+            self._covariance_fn = covariance
+        elif covariance is not None:
+            self._covariance = self._checked_covariance(covariance)
         self.labels = dict(labels or {})
         self.info = dict(info or {})
 
+    def _checked_covariance(self, covariance) -> np.ndarray:
+        c = np.array(covariance, float)
+        n = self._params.shape[0]
+        if c.shape != (n, n):
+            raise ValueError(f"covariance must be {n}x{n}")
+        c.setflags(write=False)
+        return c
+
+    def __getstate__(self):            # pickled / deep-copied with the covariance computed
+        state = self.__dict__.copy()
+        state["_covariance"], state["_covariance_fn"] = self.covariance, None
+        return state
+
     # ------------------------------------------------------------ parameters
+    @property
+    def covariance(self) -> np.ndarray | None:
+        """Parameter covariance (read-only, in the scaled variables), or None. [-]"""
+        if self._covariance_fn is not None:
+            fn, self._covariance_fn = self._covariance_fn, None
+            c = fn()
+            self._covariance = None if c is None else self._checked_covariance(c)
+        return self._covariance
+
     @property
     def params(self) -> np.ndarray:
         """The parameter vector (read-only), in the scaled variables. [-]"""
@@ -341,8 +364,10 @@ class RationalModel:
         return self.scaling.omega_ref_rad_s * S.roots(self.structure, self._params, tau)[1]
 
     def max_pole_real_part(self, temperature_c=None, *, extrapolate=False) -> np.ndarray:
-        """Largest pole real part at each temperature [rad/s] (shape of ``temperature_c``);
-        eigenvalues of the stacked companion matrices, one batched call.
+        """Largest pole real part at each temperature [rad/s] (shape of ``temperature_c``).
+        Section denominators ('sections', 'zpk'): every section's roots in closed form,
+        vectorised over the temperatures; free coefficients: eigenvalues of the stacked
+        companion matrices, one batched call.
 
         Parameters
         ----------
@@ -354,13 +379,16 @@ class RationalModel:
         t = None if temperature_c is None else np.asarray(temperature_c, float)
         shape = () if t is None else t.shape
         taus = np.atleast_1d(self._tau(t, shape, extrapolate)).ravel()
-        den = S.denominators(self.structure, self._params, taus)
-        n = den.shape[1] - 1
-        comp = np.zeros((taus.size, n, n))
-        comp[:, 0, :] = -den[:, -2::-1] / den[:, -1:]
-        comp[:, np.arange(1, n), np.arange(n - 1)] = 1.0
-        re = np.linalg.eigvals(comp).real.max(axis=1) * self.scaling.omega_ref_rad_s
-        return re.reshape(shape)
+        if self.structure.form == "coefficients":
+            den = S.denominators(self.structure, self._params, taus)
+            n = den.shape[1] - 1
+            comp = np.zeros((taus.size, n, n))
+            comp[:, 0, :] = -den[:, -2::-1] / den[:, -1:]
+            comp[:, np.arange(1, n), np.arange(n - 1)] = 1.0
+            re = np.linalg.eigvals(comp).real.max(axis=1)
+        else:
+            re = S.section_max_real_part(self.structure, self._params, taus)
+        return (re * self.scaling.omega_ref_rad_s).reshape(shape)
 
     def stability_check(self, n_temperatures: int = 501) -> StabilityCheck:
         """Largest pole real part over a dense grid of the validity range.

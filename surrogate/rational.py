@@ -4,7 +4,6 @@ parametrisation, several starts raced in lockstep."""
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 
 import numpy as np
 
@@ -111,7 +110,7 @@ class RationalFit:
                 f"{temps.tolist()} °C; use ScheduledFit or select one temperature"
             )
         st = self.structure
-        F.check_order_per_temperature(st, data)
+        F.check_order_per_temperature(st, data, temps)
         scaling = F.make_scaling(data, self.omega_ref_rad_s, self.gain_ref,
                                  float(temps[0]) if temps.size else 0.0, 1.0)
         problem, wname = F.make_problem(st, data, scaling, self.weighting)
@@ -124,7 +123,7 @@ class RationalFit:
         evaluator = Evaluator(problem)
 
         def costs(structure, thetas):
-            ev = evaluator if structure == st else Evaluator(replace(problem, structure=structure))
+            ev = evaluator if structure == st else evaluator.with_structure(structure)
             return ev.costs(thetas)
 
         cands = initial_candidates(st, problem.w, problem.h, costs)
@@ -145,7 +144,7 @@ class RationalFit:
                        method="rational", settings=self.settings(),
                        scale_covariance=self.scale_covariance, history=history,
                        time_s=time.perf_counter() - t_start, temperature_range=temp_range,
-                       raise_on_failure=self.raise_on_failure)
+                       raise_on_failure=self.raise_on_failure, temperatures=temps)
         self.model_, self.result_, self.history_ = res.model, res, history
         return res
 

@@ -5,13 +5,19 @@ frequencies against one set × many frequencies, and the cost of ``state_at`` pe
 
 Goal: 10k sets × 10 frequencies within 2× the per-point cost of 1 set × 100k frequencies.
 The sets differ in d and E (as a Monte Carlo study's do) and share their temperature laws.
+A model turns its sets into arrays once, when built (``ParameterTable``); the evaluation
+ratio is the goal's, the "one-shot" ratio also counts building the 10k-set model.
 """
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))   # this checkout's packages
 
 from physmodel import ActuatorModel, get_parameter_set, state_at
 
@@ -39,11 +45,14 @@ def main() -> None:
     t_sets = best_of(lambda: many_sets.frequency_response(f_few, temps, quantities=("M",)), 3)
     t_freq = best_of(lambda: one_set.frequency_response(f_many, temps, quantities=("M",)), 3)
     t_state = best_of(lambda: state_at(sets, [20.0, 35.0, 50.0]), 3)
+    t_build = best_of(lambda: ActuatorModel(sets), 3)
     per_sets = t_sets / (n_sets * f_few.size) * 1e9
     per_freq = t_freq / f_many.size * 1e9
     print(f"10k sets x 10 f      : {t_sets * 1e3:8.1f} ms  {per_sets:7.1f} ns/point")
     print(f"1 set x 100k f       : {t_freq * 1e3:8.1f} ms  {per_freq:7.1f} ns/point")
     print(f"ratio (goal <= 2)    : {per_sets / per_freq:8.2f}")
+    print(f"building the 10k-set model: {t_build * 1e3:.1f} ms; one-shot ratio (build + evaluate): "
+          f"{(t_sets + t_build) / (n_sets * f_few.size) * 1e9 / per_freq:.2f}")
     print(f"state_at, 10k sets x 3 T: {t_state * 1e3:.1f} ms ({t_state / n_sets * 1e6:.2f} us/set)")
 
 

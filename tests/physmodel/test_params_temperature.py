@@ -155,3 +155,56 @@ def test_parameter_file_errors_name_the_file(tmp_path):
     other.write_text('{"format": "something-else", "parameters": {}}')
     with pytest.raises(ParameterError, match="format"):
         get_parameter_set(str(other))
+
+
+def _mixed_batch():
+    """Sets that differ in values, in T_ref and in their temperature laws (shared and distinct
+    law objects, equal laws built separately), in an interleaved order."""
+    base = get_parameter_set("seed001_actuator")
+    other = get_parameter_set("seed002_table3")
+    iso = base.replace(laws=ISOTHERMAL, name="iso")
+    rng = np.random.default_rng(3)
+    out = []
+    for i in range(60):
+        src = (base, other, iso)[i % 3]
+        changes = {"d": src.d * rng.lognormal(0, 0.3), "E": src.E * rng.lognormal(0, 0.1),
+                   "W": src.W * rng.uniform(0.8, 1.2), "xi": src.xi * rng.uniform(0.5, 2.0)}
+        if i % 7 == 0:
+            changes["T_ref"] = src.T_ref + 5.0
+        if i % 11 == 0:
+            changes["laws"] = TemperatureLaws.from_dict(src.laws.to_dict())   # equal, not the same object
+        out.append(src.replace(**changes))
+    return out
+
+
+def test_many_set_evaluation_equals_per_set_evaluation():
+    """A batch is a vectorised loop over its sets: every state field and every quantity of
+    ActuatorModel / SensorModel(batch) equals what each set gives alone (to rounding)."""
+    from physmodel import SensorModel
+
+    sets = _mixed_batch()
+    temps = [20.0, 35.0, 50.0]
+    f = np.logspace(-1, 1.5, 10)
+    st = state_at(sets, temps)
+    for i, p in enumerate(sets):
+        one = state_at(p, temps)
+        for k in ("L", "W", "h", "d", "C_minus", "kappa_e", "alpha0", "a0", "r1", "r2", "Rp", "E", "rho",
+                  "xi", "T", "K", "omega_n"):
+            np.testing.assert_allclose(getattr(st, k)[i], getattr(one, k)[0], rtol=1e-14, atol=0, err_msg=k)
+    for cls in (ActuatorModel, SensorModel):
+        many = cls(sets).frequency_response(f, temps)
+        assert many.parameter_sets == tuple(p.name for p in sets)
+        for i, p in enumerate(sets):
+            alone = cls(p).frequency_response(f, temps)
+            for q, v in alone.values.items():
+                np.testing.assert_allclose(many[q][i], v[0], rtol=1e-13, atol=0, err_msg=f"{cls.__name__} {q} set {i}")
+
+
+def test_batch_checks_every_sets_law_ranges():
+    """A temperature outside one set's law validity range is an error for the batch too."""
+    base = get_parameter_set("seed001_actuator")
+    narrow = base.replace(laws=base.laws.with_(E=Linear(alpha=-1e-3, valid_c=(0.0, 40.0))))
+    with pytest.raises(TemperatureRangeError):
+        state_at([base, base.replace(d=2 * base.d), narrow], [60.0])
+    with pytest.raises(TemperatureRangeError):
+        ActuatorModel([base, narrow]).frequency_response([1.0], [60.0])
