@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy import signal
+from threadpoolctl import threadpool_limits
 
 from ..errors import IPMCError
 from ..numerics import weighted_complex_lstsq
@@ -252,21 +253,22 @@ def realize(fn: Callable[[np.ndarray], np.ndarray], band_hz: tuple[float, float]
     if dc_value is not None and not derivative:
         s_data = np.concatenate([[0.0 + 0.0j], s_fit])
         target_fit = np.concatenate([[dc_value], target_fit])
-    best = None
-    order = 6
-    while order <= max_order:
-        poles, res, d = vector_fit(s_data, target_fit, order, direct=not derivative)
-        if derivative:
-            # s·r/(s − a) = r + r a/(s − a)
-            d = float(sum(r.real if a.imag == 0 else 2 * r.real for a, r in zip(poles, res)))
-            res = res * poles
-        err = np.max(np.abs(_eval_modal(s_val, poles, res, d) - H_val) / np.abs(H_val))
-        err = max(err, np.max(np.abs(_eval_modal(s_fit, poles, res, d) - H_fit) / np.abs(H_fit)))
-        if best is None or err < best[-1]:
-            best = (poles, res, d, err)
-        if err <= tol:
-            break
-        order += 4
+    with threadpool_limits(limits=1, user_api="blas"):  # small tall solves: threads only stall
+        best = None
+        order = 6
+        while order <= max_order:
+            poles, res, d = vector_fit(s_data, target_fit, order, direct=not derivative)
+            if derivative:
+                # s·r/(s − a) = r + r a/(s − a)
+                d = float(sum(r.real if a.imag == 0 else 2 * r.real for a, r in zip(poles, res)))
+                res = res * poles
+            err = np.max(np.abs(_eval_modal(s_val, poles, res, d) - H_val) / np.abs(H_val))
+            err = max(err, np.max(np.abs(_eval_modal(s_fit, poles, res, d) - H_fit) / np.abs(H_fit)))
+            if best is None or err < best[-1]:
+                best = (poles, res, d, err)
+            if err <= tol:
+                break
+            order += 4
     poles, res, d, err = best
     if err > tol:
         raise RealizationError(
