@@ -14,7 +14,7 @@ import numpy as np
 from ..data.interop import as_sweep
 from ..data.sweep import FrequencySweep, sweep_layout
 from ..errors import IPMCError, ParameterError
-from ..parameter_paths import apply_values, base_value, check_parameter_name
+from ..parameter_paths import StateMap, apply_values, base_value, check_parameter_name
 from ..params import IPMCParameters
 from .lsq import CalibrationResult, FreeParameter, SensitivityProbe, fit_parameters
 from .records import Identifiability
@@ -49,10 +49,19 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
 
 
 def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "actuator",
-                      quantity: str | None = None, kernel: str = "boundary_charge"):
+                      quantity: str | None = None, kernel: str = "boundary_charge",
+                      free: Sequence[FreeParameter] | None = None):
     """``predict_many(list of values) -> (n_sets, N)`` in the sweep's units, plus a wide-band
     :class:`SensitivityProbe` at the median data temperature.  One model call per batch
-    (sets × temperatures × union of frequencies)."""
+    (sets × temperatures × union of frequencies).
+
+    With ``free`` (bounds and initial values known), ``predict_many`` also carries
+    ``predict_many.array(X) -> (n_sets, N)`` for rows of physical values of ``free`` (and the probe
+    a ``predict_array``): states built as arrays by a :class:`~physmodel.parameter_paths.StateMap`,
+    no parameter set per row; None when the state is not log-affine in those parameters.
+    """
+    from ..model import evaluate_grid
+    from ..params import STATE_FIELDS, State
     from ..protocol import physics_model
 
     lay = sweep_layout(data, kind, quantity)
@@ -67,13 +76,36 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
         R = model_of(values_list).frequency_response(fu, Tu, quantities=(q,))[q]
         return R[:, inv_T, inv_f] * factor
 
-    t_probe = float(Tu[np.argmin(np.abs(Tu - np.median(data.temperature_c)))])
+    i_probe = int(np.argmin(np.abs(Tu - np.median(data.temperature_c))))
+    t_probe = float(Tu[i_probe])
     f_probe = np.logspace(math.log10(fu[0]) - 3, math.log10(fu[-1]) + 3, 121)
 
     def probe_many(values_list):
         return model_of(values_list).frequency_response(f_probe, [t_probe], quantities=(q,))[q][:, 0, :] * factor
 
-    return predict_many, SensitivityProbe(f_probe, probe_many), q
+    predict_many.array = probe_array = None
+    smap = None if not free else StateMap.build(base, [fp.name for fp in free], [fp.lower for fp in free],
+                                                [fp.upper for fp in free],
+                                                [base_value(base, fp.name) if fp.initial is None else fp.initial
+                                                 for fp in free], Tu)
+    if smap is not None:
+        # the kernel of the same model class, evaluated on states built as arrays (model.evaluate_grid)
+        kern = physics_model(kind, base, kernel=kernel)._kernel
+        s_data, s_probe = 2j * np.pi * fu, 2j * np.pi * f_probe
+
+        def predict_array(X):
+            with np.errstate(all="ignore"):     # a non-finite response is refused by the residuals
+                R = evaluate_grid(smap(X), s_data, kern, (q,))[q]
+            return R[:, inv_T, inv_f] * factor
+
+        def probe_array(X):
+            st = smap(X)
+            st = State(**{k: getattr(st, k)[:, i_probe:i_probe + 1] for k in STATE_FIELDS})
+            with np.errstate(all="ignore"):
+                return evaluate_grid(st, s_probe, kern, (q,))[q][:, 0, :] * factor
+
+        predict_many.array = predict_array
+    return predict_many, SensitivityProbe(f_probe, probe_many, probe_array), q
 
 
 def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParameters,
@@ -121,10 +153,12 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
             fps.append(item)
         else:
             raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
-    predict_many, probe, q = physics_predictor(data, base, kind, quantity, kernel)
+    fixed = kwargs.get("fixed") or {}
+    predict_many, probe, q = physics_predictor(data, apply_values(base, fixed) if fixed else base, kind, quantity,
+                                               kernel, free=fps)
     res = fit_parameters(data, None, fps, starts=starts, seed=seed, predict_many=predict_many,
-                         max_nfev=max_nfev, identify=identify, hold_undetermined=hold_undetermined,
-                         probe=probe, progress=progress, **kwargs)
+                         predict_array=predict_many.array, max_nfev=max_nfev, identify=identify,
+                         hold_undetermined=hold_undetermined, probe=probe, progress=progress, **kwargs)
     label = name or f"{base.name}_calibrated"
     src = (f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
            f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"

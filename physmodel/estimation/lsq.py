@@ -66,28 +66,51 @@ FD_STEP = 1e-6
 
 
 # =============================================================================== the engine
-class _Counter:
-    def __init__(self):
+class _Batch:
+    """Rows of physical values of ``free`` (n_sets, n_free) -> (n_sets, N) complex responses,
+    through ``predict_array`` (one call, no per-set Python) or else ``predict_many``/``predict``
+    with one values dict per set; counts evaluations and calls."""
+
+    def __init__(self, free, fixed: dict, predict, predict_many, predict_array, probe, n_lines: int):
+        self.names = [fp.name for fp in free]
+        self.fixed, self.n_lines, self.probe_ = fixed, n_lines, probe
+        self.predict, self.predict_many, self.predict_array = predict, predict_many, predict_array
         self.evaluations = 0
         self.calls = 0
 
+    def _dicts(self, X):
+        return [dict(self.fixed, **dict(zip(self.names, map(float, row)))) for row in X]
 
-def _as_batch(predict, predict_many, counter: _Counter, n_lines: int):
-    """A function list-of-values -> (n_sets, N) complex, counting evaluations."""
-
-    def many(values_list):
-        counter.calls += 1 if predict_many is not None else len(values_list)
-        counter.evaluations += len(values_list)
-        if predict_many is not None:
-            out = np.asarray(predict_many(values_list), dtype=complex)
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        n_sets = len(X)
+        self.evaluations += n_sets
+        self.calls += n_sets if self.predict_array is None and self.predict_many is None else 1
+        if self.predict_array is not None:
+            out = np.asarray(self.predict_array(X), dtype=complex)
+        elif self.predict_many is not None:
+            out = np.asarray(self.predict_many(self._dicts(X)), dtype=complex)
         else:
-            out = np.stack([np.asarray(predict(v), dtype=complex).reshape(-1) for v in values_list])
-        if out.shape != (len(values_list), n_lines):
-            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(len(values_list), n_lines)} "
+            out = np.stack([np.asarray(self.predict(v), dtype=complex).reshape(-1) for v in self._dicts(X)])
+        if out.shape != (n_sets, self.n_lines):
+            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(n_sets, self.n_lines)} "
                             "(one complex value per data line and parameter set)")
         return out
 
-    return many
+    def probe(self, X: np.ndarray) -> np.ndarray:
+        """The :class:`SensitivityProbe`'s responses (n_sets, n_f) at the rows of ``X``."""
+        self.calls += 1
+        self.evaluations += len(X)
+        if self.probe_.predict_array is not None:
+            return np.asarray(self.probe_.predict_array(X), dtype=complex)
+        return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
+
+
+def _rows(free, x_full: np.ndarray, active: Sequence[int], Z: np.ndarray) -> np.ndarray:
+    """Physical rows (n_sets, n_free): ``x_full`` with the ``active`` columns at scaled ``Z``."""
+    X = np.repeat(x_full[None, :], len(Z), axis=0)
+    for j, k in enumerate(active):
+        X[:, k] = free[k].from_z(Z[:, j])
+    return X
 
 
 def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
@@ -115,37 +138,28 @@ class _Fit:
     message: str
 
 
-def _solve(free, fixed: dict, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_step) -> _Fit:
-    """least_squares in the scaled space of ``free`` (others fixed); one batched call per Jacobian."""
-    lo = np.array([fp.z_bounds[0] for fp in free])
-    hi = np.array([fp.z_bounds[1] for fp in free])
-
-    def values_of(z):
-        v = dict(fixed)
-        for fp, zi in zip(free, z):
-            v[fp.name] = float(fp.from_z(zi))
-        return v
-
+def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: _Batch, data, s_ln, s_ph, max_nfev, ftol,
+           fd_step) -> _Fit:
+    """least_squares over the ``active`` parameters of ``free`` in their scaled space (the others at
+    ``x_full``); one batched model call per Jacobian."""
+    act = [free[k] for k in active]
+    lo = np.array([fp.z_bounds[0] for fp in act])
+    hi = np.array([fp.z_bounds[1] for fp in act])
     cache: dict = {}
 
     def fun(z):
         key = z.tobytes()
         if key not in cache:
             cache.clear()
-            G = many([values_of(z)])[0]
+            G = batch(_rows(free, x_full, active, z[None, :]))[0]
             cache[key] = standardised_residuals(G, data, s_ln, s_ph)
         return cache[key]
 
     def jac(z):
         f0 = fun(z)
         steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
-        pts = []
-        for i in range(z.size):
-            zz = z.copy()
-            zz[i] += steps[i]
-            pts.append(values_of(zz))
-        G = many(pts)
-        R = standardised_residuals(G, data, s_ln, s_ph)
+        Z = z[None, :] + np.diag(steps)
+        R = standardised_residuals(batch(_rows(free, x_full, active, Z)), data, s_ln, s_ph)
         return ((R - f0[None, :]) / steps[:, None]).T
 
     z0 = np.clip(np.asarray(z0, dtype=float), lo, hi)
@@ -168,8 +182,8 @@ def _covariance(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (Vt.T * inv) @ Vt, s
 
 
-def _sensitivity_peaks(free, values: dict, J: np.ndarray, data: FrequencySweep, probe: SensitivityProbe | None,
-                       many_counter: _Counter, fd_step: float):
+def _sensitivity_peaks(free, active, x_full: np.ndarray, J: np.ndarray, data: FrequencySweep,
+                       probe: SensitivityProbe | None, batch: _Batch, fd_step: float):
     """Per free parameter: (frequency of peak |∂lnG/∂z| [Hz], in-band max / overall max)."""
     n = data.frequency_hz.size
     out = {}
@@ -178,25 +192,25 @@ def _sensitivity_peaks(free, values: dict, J: np.ndarray, data: FrequencySweep, 
     in_band = np.sqrt((J[:n] * s_ln[:, None]) ** 2 + (J[n:] * s_ph[:, None]) ** 2)   # (N, n_free)
     band_max = in_band.max(axis=0)
     if probe is None:
-        for j, fp in enumerate(free):
-            out[fp.name] = (float(data.frequency_hz[np.argmax(in_band[:, j])]), 1.0)
+        for j, k in enumerate(active):
+            out[free[k].name] = (float(data.frequency_hz[np.argmax(in_band[:, j])]), 1.0)
         return out
     f = np.asarray(probe.frequency_hz, dtype=float)
-    pts = [dict(values)]
-    for fp in free:
-        v = dict(values)
-        z = float(fp.to_z(values[fp.name]))
+    X = np.repeat(x_full[None, :], len(active) + 1, axis=0)
+    steps = []
+    for j, k in enumerate(active):
+        fp = free[k]
+        z = float(fp.to_z(x_full[k]))
         step = fd_step * 100 if z + fd_step * 100 <= fp.z_bounds[1] else -fd_step * 100
-        v[fp.name] = float(fp.from_z(z + step))
-        pts.append((v, step))
-    G = np.asarray(probe.predict_many([pts[0]] + [p[0] for p in pts[1:]]), dtype=complex)
-    many_counter.calls += 1
-    many_counter.evaluations += len(pts)
+        X[j + 1, k] = float(fp.from_z(z + step))
+        steps.append(step)
+    G = batch.probe(X)
     base = np.log(G[0])
     fmin, fmax = data.frequency_hz.min(), data.frequency_hz.max()
     inside = (f >= fmin) & (f <= fmax)
-    for j, fp in enumerate(free):
-        sens = np.abs((np.log(G[j + 1]) - base) / pts[j + 1][1])
+    for j, k in enumerate(active):
+        fp = free[k]
+        sens = np.abs((np.log(G[j + 1]) - base) / steps[j])
         k = int(np.argmax(sens))
         peak = float(sens[k])
         frac = float(sens[inside].max() / peak) if np.any(inside) and peak > 0 else float(band_max[j] > 0)
@@ -204,12 +218,13 @@ def _sensitivity_peaks(free, values: dict, J: np.ndarray, data: FrequencySweep, 
     return out
 
 
-def _identifiability(free, z, J, cov, values, data, probe, counter, fd_step):
-    """Flags and reasons for every free parameter of one fit (no holding here)."""
+def _identifiability(free_all, active, z, J, cov, x_full, data, probe, batch, fd_step):
+    """Flags and reasons for every active free parameter of one fit (no holding here)."""
+    free = [free_all[k] for k in active]
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
     corr = cov / np.outer(d, d)
-    peaks = _sensitivity_peaks(free, values, J, data, probe, counter, fd_step)
+    peaks = _sensitivity_peaks(free_all, active, x_full, J, data, probe, batch, fd_step)
     fmin, fmax = float(data.frequency_hz.min()), float(data.frequency_hz.max())
     report, badness = {}, {}
     for j, fp in enumerate(free):
@@ -268,11 +283,14 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
                    fixed: Values | None = None, max_nfev: int | None = None, ftol: float = 1e-10,
                    identify: bool = True, hold_undetermined: bool = True,
                    probe: SensitivityProbe | None = None, fd_step: float = FD_STEP,
-                   progress: Callable[[int], None] | None = None) -> CalibrationResult:
+                   progress: Callable[[int], None] | None = None,
+                   predict_array: Callable[[np.ndarray], np.ndarray] | None = None) -> CalibrationResult:
     """Fit ``free`` parameters of a generic predictor to ``data`` by weighted least squares.
 
     ``predict(values) -> (N,) complex`` at every line of ``data`` (same order and units);
-    ``predict_many(list of values) -> (n_sets, N)`` is used when given (one call per Jacobian).
+    ``predict_many(list of values) -> (n_sets, N)`` is used when given (one call per Jacobian);
+    ``predict_array(X) -> (n_sets, N)``, with ``X`` the physical values (n_sets, len(free)) in the
+    order of ``free`` and ``fixed`` built in, replaces both when given (no values dict per set).
     ``fixed``: extra values passed to the predictor unchanged.  ``starts``: start 0 is each
     parameter's ``initial`` (else the mid-point); the others are seeded Latin-hypercube points in
     the scaled boxes; all are reported, the best is kept.  With ``identify`` undetermined parameters
@@ -291,8 +309,8 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise ParameterError(f"free parameter(s) {dup} given more than once")
-    if predict is None and predict_many is None:
-        raise IPMCError("give predict or predict_many")
+    if predict is None and predict_many is None and predict_array is None:
+        raise IPMCError("give predict, predict_many or predict_array")
     if int(starts) < 1:
         raise IPMCError(f"starts must be >= 1, got {starts}")
     if max_nfev is not None and int(max_nfev) < 1:
@@ -302,15 +320,15 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     n_lines = data.frequency_hz.size
     if 2 * n_lines <= len(free):
         raise IPMCError(f"{n_lines} lines (2 residuals each) cannot determine {len(free)} parameters")
-    counter = _Counter()
-    many = _as_batch(predict, predict_many, counter, n_lines)
+    batch = _Batch(free, fixed, predict, predict_many, predict_array, probe, n_lines)
 
     x_init = [fp.initial if fp.initial is not None else fp.midpoint() for fp in free]
+    x_full = np.array(x_init, dtype=float)
     z_init = np.array([fp.to_z(x) for fp, x in zip(free, x_init)], float)
     z_starts = np.vstack([z_init[None, :], _lhs_starts(free, int(starts) - 1, seed)])
     records, fits = [], []
     for i, z0 in enumerate(z_starts):
-        fit = _solve(free, fixed, z0, many, data, s_ln, s_ph, max_nfev, ftol, fd_step)
+        fit = _solve(free, range(len(free)), x_full, z0, batch, data, s_ln, s_ph, max_nfev, ftol, fd_step)
         fits.append(fit)
         initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
         records.append(StartRecord(i, initial,
@@ -330,9 +348,8 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     report: dict = {}
     while True:
         act = [free[k] for k in active]
-        values = dict(fixed)
-        values.update({fp.name: (x_init[k] if fp.name in held else float(fp.from_z(z_full[k])))
-                       for k, fp in enumerate(free)})
+        x_full = np.array([x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))
+                           for k, fp in enumerate(free)])
         cov, _ = _covariance(fit.J)
         noise_scale = 1.0
         dof = 2 * n_lines - len(act)
@@ -346,7 +363,8 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
             d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
             corr = cov / np.outer(d, d)
             break
-        report, badness, se, corr = _identifiability(act, fit.z, fit.J, cov, values, data, probe, counter, fd_step)
+        report, badness, se, corr = _identifiability(free, active, fit.z, fit.J, cov, x_full, data, probe, batch,
+                                                     fd_step)
         if not badness or not hold_undetermined:
             break
         pinned = [n for n, b in badness.items() if b == np.inf]
@@ -359,10 +377,9 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
                 z_full[k] = z_init[k]
         if not active:
             break
-        fixed_now = dict(fixed)
-        fixed_now.update({free[k].name: x_init[k] for k in range(len(free)) if free[k].name in held})
-        fit = _solve([free[k] for k in active], fixed_now, z_full[active], many, data, s_ln, s_ph,
-                     max_nfev, ftol, fd_step)
+        x_full = np.array([x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))
+                           for k, fp in enumerate(free)])
+        fit = _solve(free, active, x_full, z_full[active], batch, data, s_ln, s_ph, max_nfev, ftol, fd_step)
         z_full[active] = fit.z
         converged = fit.status > 0
         message += f"; refit without {', '.join(to_hold)}: {fit.message}"
@@ -388,7 +405,8 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
         for k2 in active:
             C[k, k2] = corr[i, pos[k2]]
     if not active:
-        cost = float(0.5 * np.sum(standardised_residuals(many([dict(fixed, **values)])[0], data, s_ln, s_ph) ** 2))
+        G = batch(np.array([[values[n] for n in names]]))[0]
+        cost = float(0.5 * np.sum(standardised_residuals(G, data, s_ln, s_ph) ** 2))
     else:
         cost = fit.cost
     expected = n_lines - n_act / 2.0
@@ -398,7 +416,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     return CalibrationResult(
         names=names, values=values, parameters=None, stderr=stderr, ci_lower=lo_ci, ci_upper=hi_ci,
         correlation=C, cost=cost, expected_cost=expected, cost_std=math.sqrt(max(expected, 0.0)),
-        n_lines=n_lines, n_evaluations=counter.evaluations, n_model_calls=counter.calls,
+        n_lines=n_lines, n_evaluations=batch.evaluations, n_model_calls=batch.calls,
         converged=bool(converged), message=message, starts=records, identifiability=ident,
         noise_estimated=estimated, noise_scale=float(noise_scale), held=list(held), free=list(free),
         band_hz=(float(data.frequency_hz.min()), float(data.frequency_hz.max())),

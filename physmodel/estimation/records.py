@@ -172,11 +172,13 @@ class SensitivityProbe:
     """A wide-band evaluation used to locate where each parameter acts.
 
     ``predict_many(list_of_value_dicts) -> (n_sets, n_f) complex`` at ``frequency_hz`` [Hz]
-    (one representative temperature).
+    (one representative temperature); ``predict_array(X) -> (n_sets, n_f)``, when given, takes
+    the rows of physical values (n_sets, n_free) in the order of the free parameters instead.
     """
 
     frequency_hz: np.ndarray
     predict_many: Callable[[Sequence[Values]], np.ndarray]
+    predict_array: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 @dataclass
