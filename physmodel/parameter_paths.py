@@ -119,6 +119,7 @@ class StateMap:
         self._log_ref = log_ref        # (n_var, n_T) ln|state| at the reference row
         self._slope = slope            # (n_var, n_T, n_names) ∂ln|state|/∂u
         self._sign = sign              # (n_var, n_T) sign of each moving field
+        self._logged = np.array([not m.startswith("laws.") for m in self.names])
 
     @classmethod
     def build(cls, base: IPMCParameters, names, lower, upper, reference, temperature_c) -> StateMap | None:
@@ -184,7 +185,7 @@ class StateMap:
 
     def _log_state(self, U):
         """ln|state| of the moving fields, (n_rows, n_var, n_T), at natural coordinates ``U``."""
-        return self._log_ref[None] + np.einsum("vtk,rk->rvt", self._slope, U - self._u_ref[None, :])
+        return self._log_ref[None] + np.moveaxis(self._slope @ (U - self._u_ref[None, :]).T, -1, 0)
 
     def __call__(self, X):
         """The :class:`~physmodel.params.State` (n_rows, n_T, 1) of the rows of ``X`` (n_rows, n_names)
@@ -194,7 +195,8 @@ class StateMap:
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != len(self.names):
             raise ParameterError(f"StateMap: {X.shape[1]} columns for {len(self.names)} parameters {self.names}")
-        U = np.column_stack([_natural(m, X[:, k]) for k, m in enumerate(self.names)])
+        U = X.copy()
+        U[:, self._logged] = np.log(np.abs(X[:, self._logged]))      # _natural, all columns at once
         moving = self._sign[None] * np.exp(self._log_state(U))              # (n_rows, n_var, n_T)
         n_rows, n_T = X.shape[0], self.temperature_c.size
         vals = {}

@@ -105,12 +105,24 @@ class _Batch:
         return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
 
 
-def _rows(free, x_full: np.ndarray, active: Sequence[int], Z: np.ndarray) -> np.ndarray:
-    """Physical rows (n_sets, n_free): ``x_full`` with the ``active`` columns at scaled ``Z``."""
-    X = np.repeat(x_full[None, :], len(Z), axis=0)
-    for j, k in enumerate(active):
-        X[:, k] = free[k].from_z(Z[:, j])
-    return X
+class _Rows:
+    """Physical rows (n_sets, n_free): ``x_full`` with the ``active`` columns at scaled
+    coordinates ``Z`` (n_sets, n_active), vectorised over sets and parameters
+    (:meth:`FreeParameter.from_z` column by column)."""
+
+    def __init__(self, free, x_full: np.ndarray, active: Sequence[int]):
+        act = [free[k] for k in active]
+        self.x_full, self.active = np.asarray(x_full, dtype=float), np.asarray(active, dtype=int)
+        self.log = np.array([fp.scale == "log" for fp in act])
+        self.sign = np.array([fp.sign for fp in act])
+        self.lower = np.array([fp.lower for fp in act])
+        self.span = np.array([fp.upper - fp.lower for fp in act])
+
+    def __call__(self, Z: np.ndarray) -> np.ndarray:
+        X = np.repeat(self.x_full[None, :], len(Z), axis=0)
+        # clipped as in FreeParameter.from_z, so that the interval of an undetermined parameter stays finite
+        X[:, self.active] = np.where(self.log, self.sign * 10.0 ** np.clip(Z, -300.0, 300.0), self.lower + Z * self.span)
+        return X
 
 
 def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
@@ -141,33 +153,31 @@ class _Fit:
 def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: _Batch, data, s_ln, s_ph, max_nfev, ftol,
            fd_step) -> _Fit:
     """least_squares over the ``active`` parameters of ``free`` in their scaled space (the others at
-    ``x_full``); one batched model call per Jacobian."""
+    ``x_full``).  The forward-difference Jacobian is computed with the residuals, in one batched
+    model call: scipy asks for it at every accepted point, which is most of the points it tries
+    (a Broyden-updated Jacobian, tried instead, needed about three times the iterations)."""
     act = [free[k] for k in active]
     lo = np.array([fp.z_bounds[0] for fp in act])
     hi = np.array([fp.z_bounds[1] for fp in act])
+    rows = _Rows(free, x_full, active)
     cache: dict = {}
 
-    def fun(z):
+    def evaluate(z):
+        """Residuals and forward-difference Jacobian at ``z``, cached for the last point."""
         key = z.tobytes()
         if key not in cache:
             cache.clear()
-            G = batch(_rows(free, x_full, active, z[None, :]))[0]
-            cache[key] = standardised_residuals(G, data, s_ln, s_ph)
+            steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
+            Z = z[None, :] + np.vstack([np.zeros_like(z), np.diag(steps)])
+            R = standardised_residuals(batch(rows(Z)), data, s_ln, s_ph)
+            cache[key] = (R[0], ((R[1:] - R[0][None, :]) / steps[:, None]).T)
         return cache[key]
 
-    def jac(z):
-        f0 = fun(z)
-        steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
-        Z = z[None, :] + np.diag(steps)
-        R = standardised_residuals(batch(_rows(free, x_full, active, Z)), data, s_ln, s_ph)
-        return ((R - f0[None, :]) / steps[:, None]).T
-
     z0 = np.clip(np.asarray(z0, dtype=float), lo, hi)
-    sol = least_squares(fun, z0, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0,
-                        ftol=ftol, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+    sol = least_squares(lambda z: evaluate(z)[0], z0, jac=lambda z: evaluate(z)[1], bounds=(lo, hi), method="trf",
+                        x_scale=1.0, ftol=ftol, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
     z = sol.x
-    r = fun(z)
-    J = jac(z)
+    r, J = evaluate(z)
     msg = sol.message.rstrip(".") if sol.status > 0 else (
         f"stopped after {sol.nfev} function evaluations (max_nfev={max_nfev}) before converging"
         if sol.status == 0 else sol.message)

@@ -42,12 +42,17 @@ def standardised_residuals(model_response, data: FrequencySweep, s_ln, s_ph) -> 
     n = data.response.size
     if G.shape[-1] != n:
         raise IPMCError(f"model response has {G.shape[-1]} values per set for {n} data lines")
-    bad = ~np.isfinite(G) | (G == 0)
-    if np.any(bad):
+    with np.errstate(all="ignore"):
+        q = data.response / G
+        # ln q = ln|q| + i arg q (principal branch), without the much slower complex logarithm
+        out = np.concatenate([np.log(np.abs(q)) / s_ln, np.angle(q) / s_ph], axis=-1)
+    if not np.all(np.isfinite(out)):
+        bad = ~np.isfinite(G) | (G == 0)
+        if not np.any(bad):     # a data value that is zero or not finite: FrequencySweep refuses these
+            bad = ~np.isfinite(q) | (q == 0)
         raise IPMCError(f"model response is zero or not finite at {int(bad.sum())} line(s) "
                         f"(first at frequency {data.frequency_hz[np.flatnonzero(bad.reshape(-1, n).any(0))[0]]:g} Hz)")
-    lr = np.log(data.response / G)
-    return np.concatenate([lr.real / s_ln, lr.imag / s_ph], axis=-1)
+    return out
 
 
 def residuals(model_response: np.ndarray, data: FrequencySweep) -> np.ndarray:
