@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import fields, replace
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -124,7 +125,8 @@ class StateMap:
     @classmethod
     def build(cls, base: IPMCParameters, names, lower, upper, reference, temperature_c) -> StateMap | None:
         """The map for ``names`` over the box [``lower``, ``upper``] (physical units, per name),
-        measured at the row ``reference``; None when the state is not log-affine there.
+        measured at the row ``reference``; None when the state is not log-affine there.  Maps are
+        kept (the last 32): repeated calibrations of one problem (Monte Carlo draws) reuse theirs.
 
         Parameters
         ----------
@@ -137,6 +139,15 @@ class StateMap:
         temperature_c : array_like
             Temperatures of the states. [°C]
         """
+        lo, hi, ref, temps = (tuple(np.asarray(a, dtype=float).reshape(-1).tolist())
+                              for a in (lower, upper, reference, temperature_c))
+        try:
+            return _cached_map(base, tuple(names), lo, hi, ref, temps)
+        except TypeError:           # unhashable (a law holding a list, ...): not kept
+            return cls._build(base, tuple(names), lo, hi, ref, temps)
+
+    @classmethod
+    def _build(cls, base, names, lower, upper, reference, temperature_c) -> StateMap | None:
         from .params import STATE_FIELDS, State, state_at
 
         names = list(names)
@@ -206,3 +217,8 @@ class StateMap:
             else:
                 vals[f] = np.broadcast_to(getattr(self._ref, f), (n_rows, n_T, 1))
         return State(**vals)
+
+
+@lru_cache(maxsize=32)
+def _cached_map(base, names, lower, upper, reference, temperature_c):
+    return StateMap._build(base, names, lower, upper, reference, temperature_c)

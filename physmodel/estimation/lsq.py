@@ -62,6 +62,12 @@ MAX_CI_DECADES = 1.0
 BOUND_TOL = 1e-3
 #: Forward finite-difference step in the scaled space.
 FD_STEP = 1e-6
+#: A search ends when a Gauss–Newton step would gain less than this (times s², see ``_solve``).
+GN_DECREMENT = 1e-12
+#: A later start stops in an earlier start's basin: cost within JOIN_COST·s² of its optimum and a
+#: Gauss–Newton step landing within JOIN_DISTANCE standard errors of it (see ``_solve``).
+JOIN_COST = 25.0
+JOIN_DISTANCE = 0.1
 
 
 
@@ -141,6 +147,7 @@ def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
 
 @dataclass
 class _Fit:
+    index: int
     z: np.ndarray
     cost: float
     J: np.ndarray
@@ -150,17 +157,55 @@ class _Fit:
     message: str
 
 
+class _Stop(Exception):
+    """Ends a search from inside the residual function (see :func:`_solve`)."""
+
+    def __init__(self, status: int, message: str):
+        super().__init__(message)
+        self.status, self.message = status, message
+
+
 def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: _Batch, data, s_ln, s_ph, max_nfev, ftol,
-           fd_step) -> _Fit:
+           fd_step, optima: Sequence[_Fit] = ()) -> _Fit:
     """least_squares over the ``active`` parameters of ``free`` in their scaled space (the others at
-    ``x_full``).  The forward-difference Jacobian is computed with the residuals, in one batched
-    model call: scipy asks for it at every accepted point, which is most of the points it tries
-    (a Broyden-updated Jacobian, tried instead, needed about three times the iterations)."""
+    ``x_full``).
+
+    The forward-difference Jacobian is computed with the residuals, in one batched model call:
+    scipy asks for it at every accepted point, which is most of the points it tries (a
+    Broyden-updated Jacobian, tried instead, needed about three times the iterations).  With it,
+    every point gets the Gauss–Newton step δ = −(JᵀJ)⁻¹Jᵀr, and the search ends (status 1) when
+    the cost that step would still gain, ½ gᵀ(JᵀJ)⁻¹g, is below :data:`GN_DECREMENT`·s² (s² =
+    2·cost/dof, 1 for a model that fits its noise): the estimate is then within
+    sqrt(2·GN_DECREMENT) standard errors of the optimum (scipy's own tests, kept, often need
+    several more evaluations to see it).  A search stops early (status −2) once its cost is within
+    :data:`JOIN_COST`·s² above a converged earlier start's (``optima``) and its Gauss–Newton step
+    lands within :data:`JOIN_DISTANCE` standard errors of that start's optimum: it would end there.
+    """
     act = [free[k] for k in active]
     lo = np.array([fp.z_bounds[0] for fp in act])
     hi = np.array([fp.z_bounds[1] for fp in act])
     rows = _Rows(free, x_full, active)
+    dof = 2 * data.frequency_hz.size - len(act)
     cache: dict = {}
+    count = [0]
+
+    def monitor(z, r, J):
+        c = 0.5 * float(r @ r)
+        s2 = 2.0 * c / dof if dof > 0 else 1.0
+        H, g = J.T @ J, J.T @ r
+        try:
+            step = np.linalg.solve(H, -g)
+        except np.linalg.LinAlgError:
+            return
+        decrement = -0.5 * float(g @ step)
+        if 0 <= decrement < GN_DECREMENT * s2:
+            raise _Stop(1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})")
+        for opt in optima:
+            if opt.status > 0 and opt.cost <= c <= opt.cost + JOIN_COST * s2:
+                d = z + step - opt.z
+                if float(d @ (opt.J.T @ opt.J) @ d) <= JOIN_DISTANCE**2 * s2:
+                    raise _Stop(-2, f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
+                                    f"errors of start {opt.index}'s optimum")
 
     def evaluate(z):
         """Residuals and forward-difference Jacobian at ``z``, cached for the last point."""
@@ -170,18 +215,26 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: _Batch, d
             steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
             Z = z[None, :] + np.vstack([np.zeros_like(z), np.diag(steps)])
             R = standardised_residuals(batch(rows(Z)), data, s_ln, s_ph)
-            cache[key] = (R[0], ((R[1:] - R[0][None, :]) / steps[:, None]).T)
+            cache[key] = (z.copy(), R[0], ((R[1:] - R[0][None, :]) / steps[:, None]).T)
+            monitor(*cache[key])
         return cache[key]
 
+    def fun(z):
+        count[0] += 1
+        return evaluate(z)[1]
+
     z0 = np.clip(np.asarray(z0, dtype=float), lo, hi)
-    sol = least_squares(lambda z: evaluate(z)[0], z0, jac=lambda z: evaluate(z)[1], bounds=(lo, hi), method="trf",
-                        x_scale=1.0, ftol=ftol, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
-    z = sol.x
-    r, J = evaluate(z)
-    msg = sol.message.rstrip(".") if sol.status > 0 else (
-        f"stopped after {sol.nfev} function evaluations (max_nfev={max_nfev}) before converging"
-        if sol.status == 0 else sol.message)
-    return _Fit(z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=int(sol.nfev), status=int(sol.status), message=msg)
+    try:
+        sol = least_squares(fun, z0, jac=lambda z: evaluate(z)[2], bounds=(lo, hi), method="trf",
+                            x_scale=1.0, ftol=ftol, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+        z, status = sol.x, int(sol.status)
+        msg = sol.message.rstrip(".") if sol.status > 0 else (
+            f"stopped after {sol.nfev} function evaluations (max_nfev={max_nfev}) before converging"
+            if sol.status == 0 else sol.message)
+    except _Stop as stop:
+        (z, _, _), status, msg = next(iter(cache.values())), stop.status, stop.message
+    _, r, J = evaluate(z)
+    return _Fit(index=-1, z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=count[0], status=status, message=msg)
 
 
 def _covariance(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -338,7 +391,8 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     z_starts = np.vstack([z_init[None, :], _lhs_starts(free, int(starts) - 1, seed)])
     records, fits = [], []
     for i, z0 in enumerate(z_starts):
-        fit = _solve(free, range(len(free)), x_full, z0, batch, data, s_ln, s_ph, max_nfev, ftol, fd_step)
+        fit = _solve(free, range(len(free)), x_full, z0, batch, data, s_ln, s_ph, max_nfev, ftol, fd_step, fits)
+        fit.index = i
         fits.append(fit)
         initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
         records.append(StartRecord(i, initial,
@@ -346,7 +400,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
                                    fit.cost, fit.nfev, fit.status, fit.message))
         if progress:
             progress(1)
-    best = min(range(len(fits)), key=lambda k: fits[k].cost)
+    best = min((k for k in range(len(fits)) if fits[k].status != -2), key=lambda k: fits[k].cost)
     fit = fits[best]
     converged = fit.status > 0
     message = f"best of {len(fits)} start(s) is start {best}: {fit.message}"
