@@ -51,7 +51,15 @@ from scipy.optimize import least_squares
 
 from ..data.sweep import FrequencySweep
 from ..errors import IPMCError, ParameterError
-from .records import CalibrationResult, FreeParameter, Identifiability, SensitivityProbe, StartRecord, Values
+from .records import (
+    CalibrationResult,
+    FreeParameter,
+    Identifiability,
+    ScaledRows,
+    SensitivityProbe,
+    StartRecord,
+    Values,
+)
 from .residuals import goodness_of_fit, noise_std, standardised_residuals
 
 #: Two-sided 95 % normal quantile.
@@ -111,26 +119,6 @@ class _Batch:
         return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
 
 
-class _Rows:
-    """Physical rows (n_sets, n_free): ``x_full`` with the ``active`` columns at scaled
-    coordinates ``Z`` (n_sets, n_active), vectorised over sets and parameters
-    (:meth:`FreeParameter.from_z` column by column)."""
-
-    def __init__(self, free, x_full: np.ndarray, active: Sequence[int]):
-        act = [free[k] for k in active]
-        self.x_full, self.active = np.asarray(x_full, dtype=float), np.asarray(active, dtype=int)
-        self.log = np.array([fp.scale == "log" for fp in act])
-        self.sign = np.array([fp.sign for fp in act])
-        self.lower = np.array([fp.lower for fp in act])
-        self.span = np.array([fp.upper - fp.lower for fp in act])
-
-    def __call__(self, Z: np.ndarray) -> np.ndarray:
-        X = np.repeat(self.x_full[None, :], len(Z), axis=0)
-        # clipped as in FreeParameter.from_z, so that the interval of an undetermined parameter stays finite
-        X[:, self.active] = np.where(self.log, self.sign * 10.0 ** np.clip(Z, -300.0, 300.0), self.lower + Z * self.span)
-        return X
-
-
 def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
     """``n`` Latin-hypercube points in the scaled boxes (n, n_free), seeded."""
     from scipy.stats import qmc
@@ -155,6 +143,40 @@ class _Fit:
     nfev: int
     status: int
     message: str
+
+
+def _residuals_and_jacobian(batch: _Batch, rows: ScaledRows, z, hi, fd_step, data, s_ln, s_ph):
+    """Standardised residuals (2N,) at scaled ``z`` and their forward-difference Jacobian (2N, n)
+    (step ``fd_step``, backwards at the upper bound ``hi``), in one batched model call."""
+    steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
+    Z = z[None, :] + np.vstack([np.zeros_like(z), np.diag(steps)])
+    R = standardised_residuals(batch(rows(Z)), data, s_ln, s_ph)
+    return R[0], ((R[1:] - R[0][None, :]) / steps[:, None]).T
+
+
+def residual_jacobian(data: FrequencySweep, free: Sequence[FreeParameter], values: Values, *,
+                      predict: Callable[[Values], np.ndarray] | None = None,
+                      predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
+                      predict_array: Callable[[np.ndarray], np.ndarray] | None = None,
+                      fixed: Values | None = None, fd_step: float = FD_STEP) -> tuple[np.ndarray, np.ndarray]:
+    """The standardised residuals and their Jacobian with respect to the scaled coordinates z of
+    ``free`` (see the module doc) at physical ``values``, exactly as :func:`fit_parameters`
+    computes them (predictors as there).
+
+    Returns
+    -------
+    r : ndarray
+        (2N,) residuals ``[ln|G_d/G_m|/σ_ln, arg(G_d/G_m)/σ_φ]``. [-]
+    J : ndarray
+        (2N, len(free)) forward differences ∂r/∂z. [-]
+    """
+    free = list(free)
+    s_ln, s_ph, _ = noise_std(data)
+    batch = _Batch(free, dict(fixed or {}), predict, predict_many, predict_array, None, data.frequency_hz.size)
+    x = np.array([float(values[fp.name]) for fp in free])
+    z = np.array([float(fp.to_z(v)) for fp, v in zip(free, x)])
+    hi = np.array([fp.z_bounds[1] for fp in free])
+    return _residuals_and_jacobian(batch, ScaledRows(free, x, range(len(free))), z, hi, fd_step, data, s_ln, s_ph)
 
 
 class _Stop(Exception):
@@ -184,7 +206,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: _Batch, d
     act = [free[k] for k in active]
     lo = np.array([fp.z_bounds[0] for fp in act])
     hi = np.array([fp.z_bounds[1] for fp in act])
-    rows = _Rows(free, x_full, active)
+    rows = ScaledRows(free, x_full, active)
     dof = 2 * data.frequency_hz.size - len(act)
     cache: dict = {}
     count = [0]
@@ -212,10 +234,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: _Batch, d
         key = z.tobytes()
         if key not in cache:
             cache.clear()
-            steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
-            Z = z[None, :] + np.vstack([np.zeros_like(z), np.diag(steps)])
-            R = standardised_residuals(batch(rows(Z)), data, s_ln, s_ph)
-            cache[key] = (z.copy(), R[0], ((R[1:] - R[0][None, :]) / steps[:, None]).T)
+            cache[key] = (z.copy(), *_residuals_and_jacobian(batch, rows, z, hi, fd_step, data, s_ln, s_ph))
             monitor(*cache[key])
         return cache[key]
 

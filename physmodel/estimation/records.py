@@ -138,6 +138,26 @@ class FreeParameter:
         """
         return replace(self, initial=float(value))
 
+class ScaledRows:
+    """Physical rows (n_sets, n_free) of parameter values: ``x_full`` [each parameter's SI unit]
+    with the ``active`` columns of ``free`` at scaled coordinates ``Z`` (n_sets, n_active) [-];
+    :meth:`FreeParameter.from_z` vectorised over sets and parameters."""
+
+    def __init__(self, free, x_full: np.ndarray, active: Sequence[int]):
+        act = [free[k] for k in active]
+        self.x_full, self.active = np.asarray(x_full, dtype=float), np.asarray(active, dtype=int)
+        self.log = np.array([fp.scale == "log" for fp in act])
+        self.sign = np.array([fp.sign for fp in act])
+        self.lower = np.array([fp.lower for fp in act])
+        self.span = np.array([fp.upper - fp.lower for fp in act])
+
+    def __call__(self, Z: np.ndarray) -> np.ndarray:
+        X = np.repeat(self.x_full[None, :], len(Z), axis=0)
+        # clipped as in FreeParameter.from_z, so that the interval of an undetermined parameter stays finite
+        X[:, self.active] = np.where(self.log, self.sign * 10.0 ** np.clip(Z, -300.0, 300.0), self.lower + Z * self.span)
+        return X
+
+
 # =============================================================================== results
 @dataclass(frozen=True)
 class StartRecord:
