@@ -20,10 +20,21 @@ Residuals (discrepancy.md §1)
 Scaled space
     A ``"log"`` parameter is fitted as z = log10(|x|) (both bounds of one sign; its sign is kept),
     a ``"linear"`` one as z = (x − lower)/(upper − lower).  Jacobians are forward finite
-    differences in z, evaluated in ONE batched model call (all perturbed parameter sets at once).
-    Confidence intervals are z ± 1.96·se(z) mapped back: asymmetric in physical units for log
-    parameters.  ``n_evaluations`` counts full-data model evaluations (one per parameter set
-    predicted, also inside batched calls); ``n_model_calls`` counts the batched calls.
+    differences in z (step :data:`FD_STEP`), evaluated with the residuals in ONE batched model call
+    (the point and all perturbed parameter sets at once; :func:`residual_jacobian` gives them).
+    Parameter sets travel as arrays of physical values (``predict_array``) when the predictor
+    takes them — :func:`~physmodel.estimation.calibration.calibrate` builds their states as arrays —
+    else as one values dict per set.  Confidence intervals are z ± 1.96·se(z) mapped back:
+    asymmetric in physical units for log parameters.  ``n_evaluations`` counts full-data model
+    evaluations (one per parameter set predicted, also inside batched calls); ``n_model_calls``
+    counts the batched calls.
+
+Stopping (see ``_solve``)
+    A start ends when scipy's tests are met or when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
+    below :data:`GN_DECREMENT`·s² (the estimate is then within 1.4e-6 standard errors of the
+    optimum; status 1).  A later start stops early (status −2, never chosen as best) once its
+    Gauss–Newton step lands within :data:`JOIN_DISTANCE` standard errors of a converged earlier
+    start's optimum.
 
 Identifiability (see :func:`fit_parameters`)
     From the SVD of the weighted, scaled Jacobian at the optimum a parameter is *undetermined* if
