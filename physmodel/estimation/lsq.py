@@ -32,9 +32,10 @@ Scaled space
 Stopping (see ``_solve``)
     A start ends when scipy's tests are met or when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
     below :data:`GN_DECREMENT`·s² (the estimate is then within 1.4e-6 standard errors of the
-    optimum; status 1).  A later start stops early (status −2, never chosen as best) once its
-    Gauss–Newton step lands within :data:`JOIN_DISTANCE` standard errors of a converged earlier
-    start's optimum.
+    optimum; status 1; scipy's own tests, kept, often need several more evaluations to see it).
+    A later start stops early (status −2, never chosen as best) once its cost is within
+    :data:`JOIN_COST`·s² above a converged earlier start's and its Gauss–Newton step lands within
+    :data:`JOIN_DISTANCE` standard errors of that start's optimum: it would end there.
 
 Identifiability (see :func:`fit_parameters`)
     From the SVD of the weighted, scaled Jacobian at the optimum a parameter is *undetermined* if
@@ -66,6 +67,7 @@ from .records import (
     CalibrationResult,
     FreeParameter,
     Identifiability,
+    ModelBatch,
     ScaledRows,
     SensitivityProbe,
     StartRecord,
@@ -83,53 +85,15 @@ BOUND_TOL = 1e-3
 FD_STEP = 1e-6
 #: A search ends when a Gauss–Newton step would gain less than this (times s², see ``_solve``).
 GN_DECREMENT = 1e-12
-#: A later start stops in an earlier start's basin: cost within JOIN_COST·s² of its optimum and a
-#: Gauss–Newton step landing within JOIN_DISTANCE standard errors of it (see ``_solve``).
+#: A later start stops in an earlier start's basin when its cost is within this (times s²) above
+#: that start's optimum and ...
 JOIN_COST = 25.0
+#: ... its Gauss–Newton step lands within this many standard errors of that optimum.
 JOIN_DISTANCE = 0.1
 
 
 
 # =============================================================================== the engine
-class _Batch:
-    """Rows of physical values of ``free`` (n_sets, n_free) -> (n_sets, N) complex responses,
-    through ``predict_array`` (one call, no per-set Python) or else ``predict_many``/``predict``
-    with one values dict per set; counts evaluations and calls."""
-
-    def __init__(self, free, fixed: dict, predict, predict_many, predict_array, probe, n_lines: int):
-        self.names = [fp.name for fp in free]
-        self.fixed, self.n_lines, self.probe_ = fixed, n_lines, probe
-        self.predict, self.predict_many, self.predict_array = predict, predict_many, predict_array
-        self.evaluations = 0
-        self.calls = 0
-
-    def _dicts(self, X):
-        return [dict(self.fixed, **dict(zip(self.names, map(float, row)))) for row in X]
-
-    def __call__(self, X: np.ndarray) -> np.ndarray:
-        n_sets = len(X)
-        self.evaluations += n_sets
-        self.calls += n_sets if self.predict_array is None and self.predict_many is None else 1
-        if self.predict_array is not None:
-            out = np.asarray(self.predict_array(X), dtype=complex)
-        elif self.predict_many is not None:
-            out = np.asarray(self.predict_many(self._dicts(X)), dtype=complex)
-        else:
-            out = np.stack([np.asarray(self.predict(v), dtype=complex).reshape(-1) for v in self._dicts(X)])
-        if out.shape != (n_sets, self.n_lines):
-            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(n_sets, self.n_lines)} "
-                            "(one complex value per data line and parameter set)")
-        return out
-
-    def probe(self, X: np.ndarray) -> np.ndarray:
-        """The :class:`SensitivityProbe`'s responses (n_sets, n_f) at the rows of ``X``."""
-        self.calls += 1
-        self.evaluations += len(X)
-        if self.probe_.predict_array is not None:
-            return np.asarray(self.probe_.predict_array(X), dtype=complex)
-        return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
-
-
 def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
     """``n`` Latin-hypercube points in the scaled boxes (n, n_free), seeded."""
     from scipy.stats import qmc
@@ -156,7 +120,7 @@ class _Fit:
     message: str
 
 
-def _residuals_and_jacobian(batch: _Batch, rows: ScaledRows, z, hi, fd_step, data, s_ln, s_ph):
+def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step, data, s_ln, s_ph):
     """Standardised residuals (2N,) at scaled ``z`` and their forward-difference Jacobian (2N, n)
     (step ``fd_step``, backwards at the upper bound ``hi``), in one batched model call."""
     steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
@@ -183,7 +147,7 @@ def residual_jacobian(data: FrequencySweep, free: Sequence[FreeParameter], value
     """
     free = list(free)
     s_ln, s_ph, _ = noise_std(data)
-    batch = _Batch(free, dict(fixed or {}), predict, predict_many, predict_array, None, data.frequency_hz.size)
+    batch = ModelBatch(free, dict(fixed or {}), predict, predict_many, predict_array, None, data.frequency_hz.size)
     x = np.array([float(values[fp.name]) for fp in free])
     z = np.array([float(fp.to_z(v)) for fp, v in zip(free, x)])
     hi = np.array([fp.z_bounds[1] for fp in free])
@@ -198,21 +162,13 @@ class _Stop(Exception):
         self.status, self.message = status, message
 
 
-def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: _Batch, data, s_ln, s_ph, max_nfev, ftol,
+def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatch, data, s_ln, s_ph, max_nfev, ftol,
            fd_step, optima: Sequence[_Fit] = ()) -> _Fit:
     """least_squares over the ``active`` parameters of ``free`` in their scaled space (the others at
-    ``x_full``).
-
-    The forward-difference Jacobian is computed with the residuals, in one batched model call:
-    scipy asks for it at every accepted point, which is most of the points it tries (a
-    Broyden-updated Jacobian, tried instead, needed about three times the iterations).  With it,
-    every point gets the Gauss–Newton step δ = −(JᵀJ)⁻¹Jᵀr, and the search ends (status 1) when
-    the cost that step would still gain, ½ gᵀ(JᵀJ)⁻¹g, is below :data:`GN_DECREMENT`·s² (s² =
-    2·cost/dof, 1 for a model that fits its noise): the estimate is then within
-    sqrt(2·GN_DECREMENT) standard errors of the optimum (scipy's own tests, kept, often need
-    several more evaluations to see it).  A search stops early (status −2) once its cost is within
-    :data:`JOIN_COST`·s² above a converged earlier start's (``optima``) and its Gauss–Newton step
-    lands within :data:`JOIN_DISTANCE` standard errors of that start's optimum: it would end there.
+    ``x_full``).  The forward-difference Jacobian comes with the residuals, in one batched model
+    call (scipy asks for it at most points it tries; a Broyden-updated Jacobian, tried instead,
+    needed three times the iterations).  Stopping rules and statuses: module doc; s² = 2·cost/dof
+    (1 for a model that fits its noise) scales them to the standard errors.
     """
     act = [free[k] for k in active]
     lo = np.array([fp.z_bounds[0] for fp in act])
@@ -276,7 +232,7 @@ def _covariance(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _sensitivity_peaks(free, active, x_full: np.ndarray, J: np.ndarray, data: FrequencySweep,
-                       probe: SensitivityProbe | None, batch: _Batch, fd_step: float):
+                       probe: SensitivityProbe | None, batch: ModelBatch, fd_step: float):
     """Per free parameter: (frequency of peak |∂lnG/∂z| [Hz], in-band max / overall max)."""
     n = data.frequency_hz.size
     out = {}
@@ -380,17 +336,35 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
                    predict_array: Callable[[np.ndarray], np.ndarray] | None = None) -> CalibrationResult:
     """Fit ``free`` parameters of a generic predictor to ``data`` by weighted least squares.
 
-    ``predict(values) -> (N,) complex`` at every line of ``data`` (same order and units);
-    ``predict_many(list of values) -> (n_sets, N)`` is used when given (one call per Jacobian);
-    ``predict_array(X) -> (n_sets, N)``, with ``X`` the physical values (n_sets, len(free)) in the
-    order of ``free`` and ``fixed`` built in, replaces both when given (no values dict per set).
-    ``fixed``: extra values passed to the predictor unchanged.  ``starts``: start 0 is each
-    parameter's ``initial`` (else the mid-point); the others are seeded Latin-hypercube points in
-    the scaled boxes; all are reported, the best is kept.  With ``identify`` undetermined parameters
-    are flagged (module doc) and, with ``hold_undetermined``, held at their start-0 value while the
-    others are refitted.  ``max_nfev``: residual evaluations per start (scipy's meaning).
-    ``progress(1)`` is called after each start.  ``parameters`` of the result is None (see
-    :func:`calibrate` for the physics wrapper).
+    Parameters
+    ----------
+    data : FrequencySweep
+        The measured lines; their per-line σ weight the residuals (without them: module doc).
+    predict, predict_many, predict_array : callable or None
+        The model at every line of ``data`` (same order and units), the first given of:
+        ``predict_array(X) -> (n_sets, N)`` with ``X`` the physical values (n_sets, len(free)) in
+        the order of ``free`` (``fixed`` built in; no values dict per set), ``predict_many(list of
+        values) -> (n_sets, N)``, ``predict(values) -> (N,)`` complex.
+    free : sequence of FreeParameter
+        The parameters to fit.  Start 0 is each one's ``initial`` (else the mid-point); ``starts``
+        − 1 more are Latin-hypercube points in the scaled boxes (``seed``); all are reported.
+    starts, seed : int
+    fixed : mapping or None
+        Extra values passed to ``predict``/``predict_many`` unchanged. [SI]
+    max_nfev, ftol, fd_step : int or None, float, float
+        Residual evaluations per start and relative cost tolerance (scipy's meaning); the
+        forward-difference step in the scaled coordinates. [-]
+    identify, hold_undetermined : bool
+        Flag undetermined parameters (module doc); hold them at their start-0 value and refit.
+    probe : SensitivityProbe or None
+        Wide-band evaluation locating where each parameter acts.
+    progress : callable or None
+        ``progress(1)`` after each start.
+
+    Returns
+    -------
+    CalibrationResult
+        ``parameters`` is None (see :func:`calibrate` for the physics wrapper).
     """
     t0 = time.perf_counter()
     if not isinstance(data, FrequencySweep):
@@ -413,7 +387,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     n_lines = data.frequency_hz.size
     if 2 * n_lines <= len(free):
         raise IPMCError(f"{n_lines} lines (2 residuals each) cannot determine {len(free)} parameters")
-    batch = _Batch(free, fixed, predict, predict_many, predict_array, probe, n_lines)
+    batch = ModelBatch(free, fixed, predict, predict_many, predict_array, probe, n_lines)
 
     x_init = [fp.initial if fp.initial is not None else fp.midpoint() for fp in free]
     x_full = np.array(x_init, dtype=float)

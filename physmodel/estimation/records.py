@@ -1,6 +1,7 @@
 """Records of the least-squares engine (:mod:`physmodel.estimation.lsq`): what is free
 (:class:`FreeParameter`), how a start went (:class:`StartRecord`), what the data determine
-(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`).  Physical units throughout.
+(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`); with the engine's
+array helpers (:class:`ScaledRows`, :class:`ModelBatch`).  Physical units throughout.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..data.files import atomic_write
-from ..errors import ParameterError
+from ..errors import IPMCError, ParameterError
 from ..params import IPMCParameters
 
 Values = Mapping[str, float]
@@ -156,6 +157,46 @@ class ScaledRows:
         # clipped as in FreeParameter.from_z, so that the interval of an undetermined parameter stays finite
         X[:, self.active] = np.where(self.log, self.sign * 10.0 ** np.clip(Z, -300.0, 300.0), self.lower + Z * self.span)
         return X
+
+
+class ModelBatch:
+    """A predictor called on rows of physical values of ``free`` (n_sets, n_free) [SI] ->
+    (n_sets, N) complex responses, through ``predict_array`` (one call, no per-set Python) or else
+    ``predict_many``/``predict`` with one values dict per set (``fixed`` added); counts the
+    parameter sets evaluated (``evaluations``) and the calls (``calls``)."""
+
+    def __init__(self, free, fixed: dict, predict, predict_many, predict_array, probe, n_lines: int):
+        self.names = [fp.name for fp in free]
+        self.fixed, self.n_lines, self.probe_ = fixed, n_lines, probe
+        self.predict, self.predict_many, self.predict_array = predict, predict_many, predict_array
+        self.evaluations = 0
+        self.calls = 0
+
+    def _dicts(self, X):
+        return [dict(self.fixed, **dict(zip(self.names, map(float, row)))) for row in X]
+
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        n_sets = len(X)
+        self.evaluations += n_sets
+        self.calls += n_sets if self.predict_array is None and self.predict_many is None else 1
+        if self.predict_array is not None:
+            out = np.asarray(self.predict_array(X), dtype=complex)
+        elif self.predict_many is not None:
+            out = np.asarray(self.predict_many(self._dicts(X)), dtype=complex)
+        else:
+            out = np.stack([np.asarray(self.predict(v), dtype=complex).reshape(-1) for v in self._dicts(X)])
+        if out.shape != (n_sets, self.n_lines):
+            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(n_sets, self.n_lines)} "
+                            "(one complex value per data line and parameter set)")
+        return out
+
+    def probe(self, X: np.ndarray) -> np.ndarray:
+        """The :class:`SensitivityProbe`'s responses (n_sets, n_f) at the rows of ``X``."""
+        self.calls += 1
+        self.evaluations += len(X)
+        if self.probe_.predict_array is not None:
+            return np.asarray(self.probe_.predict_array(X), dtype=complex)
+        return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
 
 
 # =============================================================================== results
