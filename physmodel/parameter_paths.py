@@ -121,6 +121,11 @@ class StateMap:
         self._slope = slope            # (n_var, n_T, n_names) ∂ln|state|/∂u
         self._sign = sign              # (n_var, n_T) sign of each moving field
         self._logged = np.array([not m.startswith("laws.") for m in self.names])
+        from .params import STATE_FIELDS
+
+        self._fixed_names = [f for f in STATE_FIELDS if f not in varying]
+        self._fixed = np.array([getattr(ref_state, f)[:, :, 0] for f in self._fixed_names]).reshape(
+            len(self._fixed_names), 1, -1)                                                    # (n_fixed, 1, n_T)
 
     @classmethod
     def build(cls, base: IPMCParameters, names, lower, upper, reference, temperature_c) -> StateMap | None:
@@ -208,15 +213,11 @@ class StateMap:
             raise ParameterError(f"StateMap: {X.shape[1]} columns for {len(self.names)} parameters {self.names}")
         U = X.copy()
         U[:, self._logged] = np.log(np.abs(X[:, self._logged]))      # _natural, all columns at once
-        moving = self._sign[None] * np.exp(self._log_state(U))              # (n_rows, n_var, n_T)
-        n_rows, n_T = X.shape[0], self.temperature_c.size
-        vals = {}
-        for f in STATE_FIELDS:
-            if f in self._varying:
-                vals[f] = moving[:, self._varying.index(f), :, None]
-            else:
-                vals[f] = np.broadcast_to(getattr(self._ref, f), (n_rows, n_T, 1))
-        return State(**vals)
+        moving = self._sign[:, None, :] * np.exp(self._log_state(U).transpose(1, 0, 2))   # (n_var, n_rows, n_T)
+        fixed = np.repeat(self._fixed, X.shape[0], axis=1)                                # (n_fixed, n_rows, n_T)
+        vals = {f: moving[i, :, :, None] for i, f in enumerate(self._varying)}
+        vals.update({f: fixed[i, :, :, None] for i, f in enumerate(self._fixed_names)})
+        return State(**{f: vals[f] for f in STATE_FIELDS})
 
 
 @lru_cache(maxsize=32)
