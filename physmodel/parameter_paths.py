@@ -199,6 +199,11 @@ class StateMap:
             return None
         return out
 
+    def log_slopes(self) -> tuple[list, np.ndarray]:
+        """(moving state fields, ∂ln|field(T)|/∂u (n_fields, n_T, n_names)), u the natural
+        coordinate of each name (ln|x| for fields and ``omega_n``, x for law parameters)."""
+        return list(self._varying), self._slope.copy()
+
     def _log_state(self, U):
         """ln|state| of the moving fields, (n_rows, n_var, n_T), at natural coordinates ``U``."""
         return self._log_ref[None] + np.moveaxis(self._slope @ (U - self._u_ref[None, :]).T, -1, 0)

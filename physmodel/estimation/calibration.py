@@ -104,8 +104,66 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
             with np.errstate(all="ignore"):
                 return evaluate_grid(st, s_probe, kern, (q,))[q][:, 0, :] * factor
 
+        key = (smap, tuple(free), kind, q, kernel, fu.tobytes(), Tu.tobytes(), inv_T.tobytes(), inv_f.tobytes())
+        if key not in _PLANS:
+            if len(_PLANS) >= 32:
+                _PLANS.pop(next(iter(_PLANS)))
+            _PLANS[key] = _jacobian_plan(smap, list(free), predict_array, inv_T)
+        predict_array.jacobian_plan = _PLANS[key]
         predict_many.array = predict_array
     return predict_many, SensitivityProbe(f_probe, probe_many, probe_array), q
+
+
+#: Largest spread of ∂ln G/∂u over lines and rows for a response taken as exponential in u.
+AFFINE_TOL = 1e-10
+#: Jacobian plans per (state map, model, data grid): repeated calibrations of one problem reuse theirs.
+_PLANS: dict = {}
+
+
+def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
+    """Columns of the Jacobian in z known without a finite difference of their own (the chain
+    rule through the state map), {k: ("scaled", j, c) | ("constant", dlnG)}:
+
+    * ("scaled", j, c): parameter k moves the state at every temperature T along c(T) times
+      parameter j's direction (e.g. ``laws.E.slope`` and ``E``), so ∂r/∂z_k = c(T_line)·∂r/∂z_j;
+    * ("constant", dlnG): ln G is affine in k's coordinate, with the same slope at every line,
+      measured at two rows and two steps (e.g. M ∝ α0): ∂ln G/∂z_k = dlnG.
+
+    Only parameters whose natural coordinate u is affine in z (log-scale fields, linear-scale
+    law parameters) qualify.
+    """
+    _, slope = smap.log_slopes()
+    dudz = [math.log(10.0) if fp.scale == "log" and not fp.name.startswith("laws.") else
+            (fp.upper - fp.lower) if fp.scale == "linear" and fp.name.startswith("laws.") else None for fp in free]
+    A = slope * np.array([0.0 if d is None else d for d in dudz])               # ∂ln|state|/∂z
+    plan: dict = {}
+    x0 = np.array([fp.initial if fp.initial is not None else fp.midpoint() for fp in free])
+    X1 = np.vstack([x0, [float(fp.from_z(0.3 * fp.z_bounds[0] + 0.7 * fp.z_bounds[1])) for fp in free]])
+    for k, fp in enumerate(free):
+        if dudz[k] is None:
+            continue
+        for j in range(k):
+            if dudz[j] is None or j in plan:
+                continue
+            nj = np.einsum("vt,vt->t", A[:, :, j], A[:, :, j])
+            c = np.divide(np.einsum("vt,vt->t", A[:, :, k], A[:, :, j]), nj, out=np.zeros(nj.size), where=nj > 0)
+            if np.allclose(A[:, :, k], c * A[:, :, j], rtol=0, atol=1e-12 * np.abs(A[:, :, k]).max()):
+                plan[k] = ("scaled", j, c[inv_T])
+                break
+        if k in plan or np.count_nonzero(np.abs(A[:, :, k]).max(axis=1)) != 1:
+            continue                # the affine test below only for a parameter moving one field
+        rows = []
+        for x in X1:
+            for h in (0.5, 1.0):           # two steps in u
+                xx = x.copy()
+                xx[k] = np.sign(x[k]) * np.exp(np.log(abs(x[k])) + h) if fp.scale == "log" else x[k] + h * dudz[k] * 0.1
+                rows += [x, xx]
+        G = predict_array(np.array(rows))
+        du = np.array([(0.5 if i % 4 < 2 else 1.0) * (1.0 if fp.scale == "log" else 0.1 * dudz[k]) for i in range(len(rows))])
+        rates = np.log(G[1::2] / G[0::2]) / du[1::2, None]                        # ∂ln G/∂u per step, row, line
+        if np.all(np.isfinite(rates)) and np.ptp(rates.real) <= AFFINE_TOL and np.ptp(rates.imag) <= AFFINE_TOL:
+            plan[k] = ("constant", complex(rates.mean()) * dudz[k])
+    return plan
 
 
 def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParameters,

@@ -121,12 +121,20 @@ class _Fit:
 
 
 def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step, data, s_ln, s_ph):
-    """Standardised residuals (2N,) at scaled ``z`` and their forward-difference Jacobian (2N, n)
-    (step ``fd_step``, backwards at the upper bound ``hi``), in one batched model call."""
-    steps = np.where(z + fd_step <= hi, fd_step, -fd_step)
-    Z = z[None, :] + np.vstack([np.zeros_like(z), np.diag(steps)])
+    """Standardised residuals (2N,) at scaled ``z`` and their Jacobian (2N, n) in one batched model
+    call: forward differences (step ``fd_step``, backwards at the upper bound ``hi``) except for
+    the columns the predictor knows by the chain rule (:meth:`ModelBatch.jacobian_plan`)."""
+    plan = batch.jacobian_plan(rows.active)
+    fd = [i for i in range(z.size) if i not in plan]
+    steps = np.where(z + fd_step <= hi, fd_step, -fd_step)[fd]
+    Z = z[None, :] + np.vstack([np.zeros_like(z), np.eye(z.size)[fd] * steps[:, None]])
     R = standardised_residuals(batch(rows(Z)), data, s_ln, s_ph)
-    return R[0], ((R[1:] - R[0][None, :]) / steps[:, None]).T
+    J = np.empty((R.shape[1], z.size))
+    J[:, fd] = ((R[1:] - R[0][None, :]) / steps[:, None]).T
+    for i, p in plan.items():     # r = [ln|G_d/G_m|/σ_ln, arg(G_d/G_m)/σ_φ]
+        J[:, i] = J[:, p[1]] * np.tile(p[2], 2) if p[0] == "scaled" else np.concatenate(
+            [np.full(s_ln.size, -p[1].real) / s_ln, np.full(s_ph.size, -p[1].imag) / s_ph])
+    return R[0], J
 
 
 def residual_jacobian(data: FrequencySweep, free: Sequence[FreeParameter], values: Values, *,

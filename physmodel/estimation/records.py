@@ -172,6 +172,14 @@ class ModelBatch:
         self.evaluations = 0
         self.calls = 0
 
+    def jacobian_plan(self, active) -> dict:
+        """The predictor's known Jacobian columns (``predict_array.jacobian_plan``: {k: ("scaled",
+        j, c) | ("constant", dlnG)} over ``free``) re-indexed to the ``active`` columns."""
+        plan = getattr(self.predict_array, "jacobian_plan", None) or {}
+        pos = {int(k): i for i, k in enumerate(active)}
+        return {pos[k]: (p if p[0] == "constant" else ("scaled", pos[p[1]], p[2])) for k, p in plan.items()
+                if k in pos and (p[0] == "constant" or (p[1] in pos and p[1] not in plan))}
+
     def _dicts(self, X):
         return [dict(self.fixed, **dict(zip(self.names, map(float, row)))) for row in X]
 
