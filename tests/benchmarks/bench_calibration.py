@@ -142,24 +142,40 @@ def monte_carlo_estimated_noise(base, truth, true, draws):
     print(f"  all parameters (mean) {np.mean([hits[n] / draws for n in FREE]):.3f}")
 
 
+def _clear_problem_caches():
+    """Forget what this checkout keeps per problem (state maps, Jacobian plans), if anything."""
+    try:
+        from physmodel.estimation import calibration
+        from physmodel.parameter_paths import _cached_map
+    except ImportError:
+        return
+    _cached_map.cache_clear()
+    calibration._PLANS.clear()
+
+
 def worker(reps: int, draws: int):
     """Time (in this interpreter) the 4-start calibration and ``draws`` 1-start ones; JSON on stdout."""
     base, truth, true = setup()
     sw = synthesize_sweep(ActuatorModel(truth), "M", FREQS, TEMPS, noise=NOISE, seed=2026)
     sws = [synthesize_sweep(ActuatorModel(truth), "M", FREQS, TEMPS, noise=NOISE, seed=10_000 + k) for k in range(draws)]
     calibrate(sw, base, FREE, starts=4, seed=0)          # warm-up (imports, caches)
-    single_s, one_start_s = [], []
+    single_s, cold_s, one_start_s = [], [], []
     for _ in range(reps):
         t0 = time.perf_counter()
         res = calibrate(sw, base, FREE, starts=4, seed=0)
         single_s.append(time.perf_counter() - t0)
+        _clear_problem_caches()
+        t0 = time.perf_counter()
+        calibrate(sw, base, FREE, starts=4, seed=0)
+        cold_s.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
         for s in sws:
             calibrate(s, base, FREE, starts=1)
         one_start_s.append((time.perf_counter() - t0) / draws)
     import physmodel
 
-    print(json.dumps({"physmodel": physmodel.__file__, "single": float(np.median(single_s)), "one_start": float(np.median(one_start_s)),
+    print(json.dumps({"physmodel": physmodel.__file__, "single": float(np.median(single_s)),
+                      "single_cold": float(np.median(cold_s)), "one_start": float(np.median(one_start_s)),
                       "values": res.values, "cost": res.cost, "n_evaluations": res.n_evaluations}))
 
 
@@ -176,6 +192,7 @@ def speed(pairs: int, root: str, reps: int, draws: int):
     print(f"== speed: this checkout ({here}) against {root}; {pairs} interleaved pairs of fresh interpreters, "
           f"each the median of {reps} timed repeats after one warm-up")
     for key, what in (("single", "8-parameter calibration, 4 starts"),
+                      ("single_cold", "the same, first of its problem (per-problem caches cleared)"),
                       ("one_start", f"8-parameter calibration, 1 start (mean over {draws} noise draws)")):
         a = np.array([r[key] for r in runs["this"]])
         b = np.array([r[key] for r in runs["other"]])
