@@ -71,6 +71,15 @@ def weighted_cost(model_response, data: FrequencySweep) -> float:
     return float(0.5 * np.sum(r * r))
 
 
+def gauss_newton_covariance(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Newton covariance (JᵀJ)⁻¹ of the fitted coordinates, via the SVD of the (standardised)
+    Jacobian ``J`` (n_residuals, n_parameters); returns (cov, singular values) [-]."""
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    tiny = s.max() * 1e-14 if s.size and s.max() > 0 else 1e-300
+    inv = 1.0 / np.maximum(s, tiny) ** 2
+    return (Vt.T * inv) @ Vt, s
+
+
 #: A cost whose χ² tail probability is below this is inconsistent with the declared noise.
 GOF_ALPHA = 1e-3
 #: With estimated noise (no per-line standard deviations) the residuals imply a relative noise per
