@@ -139,7 +139,8 @@ def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
     plan: dict = {}
     x0 = np.array([fp.initial if fp.initial is not None else fp.midpoint() for fp in free])
     X1 = np.vstack([x0, [float(fp.from_z(0.3 * fp.z_bounds[0] + 0.7 * fp.z_bounds[1])) for fp in free]])
-    for k, fp in enumerate(free):
+    single = []
+    for k in range(len(free)):
         if dudz[k] is None:
             continue
         for j in range(k):
@@ -150,19 +151,25 @@ def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
             if np.allclose(A[:, :, k], c * A[:, :, j], rtol=0, atol=1e-12 * np.abs(A[:, :, k]).max()):
                 plan[k] = ("scaled", j, c[inv_T])
                 break
-        if k in plan or np.count_nonzero(np.abs(A[:, :, k]).max(axis=1)) != 1:
-            continue                # the affine test below only for a parameter moving one field
-        rows = []
+        if k not in plan and np.count_nonzero(np.abs(A[:, :, k]).max(axis=1)) == 1:
+            single.append(k)        # the affine test below only for a parameter moving one field
+    if not single:
+        return plan
+    rows, du = list(X1), []
+    for k in single:                # two rows, two steps in u each, all in one model call
+        step = 1.0 if free[k].scale == "log" else 0.1 * dudz[k]
         for x in X1:
-            for h in (0.5, 1.0):           # two steps in u
+            for h in (0.5, 1.0):
                 xx = x.copy()
-                xx[k] = np.sign(x[k]) * np.exp(np.log(abs(x[k])) + h) if fp.scale == "log" else x[k] + h * dudz[k] * 0.1
-                rows += [x, xx]
-        G = predict_array(np.array(rows))
-        du = np.array([(0.5 if i % 4 < 2 else 1.0) * (1.0 if fp.scale == "log" else 0.1 * dudz[k]) for i in range(len(rows))])
-        rates = np.log(G[1::2] / G[0::2]) / du[1::2, None]                        # ∂ln G/∂u per step, row, line
-        if np.all(np.isfinite(rates)) and np.ptp(rates.real) <= AFFINE_TOL and np.ptp(rates.imag) <= AFFINE_TOL:
-            plan[k] = ("constant", complex(rates.mean()) * dudz[k])
+                xx[k] = np.sign(x[k]) * np.exp(np.log(abs(x[k])) + h) if free[k].scale == "log" else x[k] + h * step
+                rows.append(xx)
+                du.append(h * step)
+    G = predict_array(np.array(rows))
+    base_rows = np.tile([0, 0, 1, 1], len(single))
+    rates = (np.log(G[2:] / G[base_rows]) / np.array(du)[:, None]).reshape(len(single), 4, -1)   # ∂ln G/∂u
+    for k, rk in zip(single, rates):
+        if np.all(np.isfinite(rk)) and np.ptp(rk.real) <= AFFINE_TOL and np.ptp(rk.imag) <= AFFINE_TOL:
+            plan[k] = ("constant", complex(rk.mean()) * dudz[k])
     return plan
 
 
