@@ -11,7 +11,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import fields, replace
+from functools import lru_cache
 from typing import Any
+
+import numpy as np
 
 from .errors import ParameterError
 from .params import IPMCParameters
@@ -79,3 +82,149 @@ def apply_values(base: IPMCParameters, values: Values) -> IPMCParameters:
         plain["laws"] = laws
     p = replace(base, **plain) if plain else base
     return p.replace(omega_n=wn) if wn is not None else p
+
+
+# =============================================================================== many sets as arrays
+#: Largest disagreement in ln|state| between :class:`StateMap` and :func:`~physmodel.params.state_at`
+#: at its check points for the map to be used (exact up to rounding when the state is log-affine).
+STATE_MAP_TOL = 1e-10
+
+
+def _natural(name: str, x):
+    """Coordinate in which the state's logarithm is affine: the value of a temperature-law
+    parameter, ln|x| of a field or ``omega_n``."""
+    x = np.asarray(x, dtype=float)
+    return x if name.startswith("laws.") else np.log(np.abs(x))
+
+
+class StateMap:
+    """States of ``base`` with the parameters ``names`` set to the rows of an array, built as
+    arrays (no parameter set per row).
+
+    The fields, ``omega_n`` and the Arrhenius/log-linear temperature-law parameters act on the
+    state (:class:`~physmodel.params.State`) multiplicatively: ln|state| is affine in u = ln|x|
+    (fields, ``omega_n``) or u = x (temperature-law parameters), with coefficients that depend on
+    the temperature.  :meth:`build` measures these coefficients with
+    :func:`~physmodel.params.state_at` (the reference path) at a reference row and one move per
+    parameter across its box, then checks the map at two rows inside the box where every
+    parameter moves at once; where the state is not log-affine in a parameter (a linear law's
+    ``alpha``, a box containing zero, ...) it returns None and callers build parameter sets.
+    """
+
+    def __init__(self, names, temperature_c, ref_state, u_ref, varying, log_ref, slope, sign):
+        self.names = tuple(names)
+        self.temperature_c = np.asarray(temperature_c, dtype=float)
+        self._ref = ref_state          # State of the reference row, arrays (1, n_T, 1)
+        self._u_ref = u_ref            # (n_names,)
+        self._varying = varying        # state fields that move with the parameters
+        self._log_ref = log_ref        # (n_var, n_T) ln|state| at the reference row
+        self._slope = slope            # (n_var, n_T, n_names) ∂ln|state|/∂u
+        self._sign = sign              # (n_var, n_T) sign of each moving field
+        self._logged = np.array([not m.startswith("laws.") for m in self.names])
+        from .params import STATE_FIELDS
+
+        self._fixed_names = [f for f in STATE_FIELDS if f not in varying]
+        self._fixed = np.array([getattr(ref_state, f)[:, :, 0] for f in self._fixed_names]).reshape(
+            len(self._fixed_names), 1, -1)                                                    # (n_fixed, 1, n_T)
+
+    @classmethod
+    def build(cls, base: IPMCParameters, names, lower, upper, reference, temperature_c) -> StateMap | None:
+        """The map for ``names`` over the box [``lower``, ``upper``] (physical units, per name),
+        measured at the row ``reference``; None when the state is not log-affine there.  Maps are
+        kept (the last 32): repeated calibrations of one problem (Monte Carlo draws) reuse theirs.
+
+        Parameters
+        ----------
+        base : IPMCParameters
+            The set whose other parameters are kept.
+        names : sequence of str
+            Parameter names (see :func:`apply_values`).
+        lower, upper, reference : array_like
+            Box and reference row, one value per name. [each parameter's SI unit]
+        temperature_c : array_like
+            Temperatures of the states. [°C]
+        """
+        lo, hi, ref, temps = (tuple(np.asarray(a, dtype=float).reshape(-1).tolist())
+                              for a in (lower, upper, reference, temperature_c))
+        try:
+            return _cached_map(base, tuple(names), lo, hi, ref, temps)
+        except TypeError:           # unhashable (a law holding a list, ...): not kept
+            return cls._build(base, tuple(names), lo, hi, ref, temps)
+
+    @classmethod
+    def _build(cls, base, names, lower, upper, reference, temperature_c) -> StateMap | None:
+        from .params import STATE_FIELDS, State, state_at
+
+        names = list(names)
+        lo, hi, ref = (np.asarray(a, dtype=float).reshape(-1) for a in (lower, upper, reference))
+        n = len(names)
+        if not names or not (lo.size == hi.size == ref.size == n):
+            raise ParameterError("StateMap needs one lower, upper and reference value per name")
+        for k, name in enumerate(names):
+            check_parameter_name(base, name)
+            if not name.startswith("laws.") and not (lo[k] > 0 or hi[k] < 0):
+                return None      # ln|x| crosses zero inside the box
+        u_lo, u_hi = np.array([_natural(m, v) for m, v in zip(names, lo)]), np.array([_natural(m, v) for m, v in zip(names, hi)])
+        u_ref = np.array([_natural(m, v) for m, v in zip(names, ref)])
+        # reference row, one far move per parameter, two check rows moving every parameter
+        far = np.where(np.abs(u_hi - u_ref) >= np.abs(u_lo - u_ref), hi, lo)
+        rows = [ref]
+        for k in range(n):
+            r = ref.copy()
+            r[k] = far[k]
+            rows.append(r)
+        frac = (np.arange(1, n + 1) * 0.6180339887498949) % 1.0
+        for c in (0.15 + 0.7 * frac, 0.85 - 0.7 * frac):
+            u = u_lo + c * (u_hi - u_lo)
+            rows.append(np.array([v if m.startswith("laws.") else np.sign(lo[k]) * np.exp(v)
+                                  for k, (m, v) in enumerate(zip(names, u))]))
+        try:
+            st = state_at([apply_values(base, dict(zip(names, r))) for r in rows], temperature_c)
+        except (ParameterError, ValueError):
+            return None
+        arrays = {f: getattr(st, f)[:, :, 0] for f in STATE_FIELDS}
+        varying = [f for f in STATE_FIELDS if not np.array_equal(arrays[f], np.broadcast_to(arrays[f][:1], arrays[f].shape))]
+        if not varying:
+            return None
+        S = np.stack([arrays[f] for f in varying])                       # (n_var, rows, n_T)
+        if not np.all(np.isfinite(S)) or np.any(S == 0) or np.any(np.sign(S) != np.sign(S[:, :1])):
+            return None
+        L = np.log(np.abs(S))
+        du = np.array([_natural(m, f) for m, f in zip(names, far)]) - u_ref     # never 0: far is the other end
+        slope = np.stack([(L[:, 1 + k] - L[:, 0]) / du[k] for k in range(n)], axis=-1)
+        ref_state = State(**{f: getattr(st, f)[:1] for f in STATE_FIELDS})
+        out = cls(names, temperature_c, ref_state, u_ref, varying, L[:, 0], slope, np.sign(S[:, 0]))
+        U_check = np.array([[_natural(m, v) for m, v in zip(names, r)] for r in rows[n + 1:]])
+        if np.max(np.abs(out._log_state(U_check) - np.moveaxis(L[:, n + 1:], 1, 0))) > STATE_MAP_TOL:
+            return None
+        return out
+
+    def log_slopes(self) -> tuple[list, np.ndarray]:
+        """(moving state fields, ∂ln|field(T)|/∂u (n_fields, n_T, n_names)), u the natural
+        coordinate of each name (ln|x| for fields and ``omega_n``, x for law parameters)."""
+        return list(self._varying), self._slope.copy()
+
+    def _log_state(self, U):
+        """ln|state| of the moving fields, (n_rows, n_var, n_T), at natural coordinates ``U``."""
+        return self._log_ref[None] + np.moveaxis(self._slope @ (U - self._u_ref[None, :]).T, -1, 0)
+
+    def __call__(self, X):
+        """The :class:`~physmodel.params.State` (n_rows, n_T, 1) of the rows of ``X`` (n_rows, n_names)
+        [each parameter's SI unit]."""
+        from .params import STATE_FIELDS, State
+
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if X.shape[1] != len(self.names):
+            raise ParameterError(f"StateMap: {X.shape[1]} columns for {len(self.names)} parameters {self.names}")
+        U = X.copy()
+        U[:, self._logged] = np.log(np.abs(X[:, self._logged]))      # _natural, all columns at once
+        moving = self._sign[:, None, :] * np.exp(self._log_state(U).transpose(1, 0, 2))   # (n_var, n_rows, n_T)
+        fixed = np.repeat(self._fixed, X.shape[0], axis=1)                                # (n_fixed, n_rows, n_T)
+        vals = {f: moving[i, :, :, None] for i, f in enumerate(self._varying)}
+        vals.update({f: fixed[i, :, :, None] for i, f in enumerate(self._fixed_names)})
+        return State(**{f: vals[f] for f in STATE_FIELDS})
+
+
+@lru_cache(maxsize=32)
+def _cached_map(base, names, lower, upper, reference, temperature_c):
+    return StateMap._build(base, names, lower, upper, reference, temperature_c)

@@ -14,7 +14,7 @@ import numpy as np
 from ..data.interop import as_sweep
 from ..data.sweep import FrequencySweep, sweep_layout
 from ..errors import IPMCError, ParameterError
-from ..parameter_paths import apply_values, base_value, check_parameter_name
+from ..parameter_paths import StateMap, apply_values, base_value, check_parameter_name
 from ..params import IPMCParameters
 from .lsq import CalibrationResult, FreeParameter, SensitivityProbe, fit_parameters
 from .records import Identifiability
@@ -49,10 +49,19 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
 
 
 def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "actuator",
-                      quantity: str | None = None, kernel: str = "boundary_charge"):
+                      quantity: str | None = None, kernel: str = "boundary_charge",
+                      free: Sequence[FreeParameter] | None = None):
     """``predict_many(list of values) -> (n_sets, N)`` in the sweep's units, plus a wide-band
     :class:`SensitivityProbe` at the median data temperature.  One model call per batch
-    (sets × temperatures × union of frequencies)."""
+    (sets × temperatures × union of frequencies).
+
+    With ``free`` (bounds and initial values known), ``predict_many`` also carries
+    ``predict_many.array(X) -> (n_sets, N)`` for rows of physical values of ``free`` (and the probe
+    a ``predict_array``): states built as arrays by a :class:`~physmodel.parameter_paths.StateMap`,
+    no parameter set per row; None when the state is not log-affine in those parameters.
+    """
+    from ..model import evaluate_grid
+    from ..params import STATE_FIELDS, State
     from ..protocol import physics_model
 
     lay = sweep_layout(data, kind, quantity)
@@ -67,13 +76,101 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
         R = model_of(values_list).frequency_response(fu, Tu, quantities=(q,))[q]
         return R[:, inv_T, inv_f] * factor
 
-    t_probe = float(Tu[np.argmin(np.abs(Tu - np.median(data.temperature_c)))])
+    i_probe = int(np.argmin(np.abs(Tu - np.median(data.temperature_c))))
+    t_probe = float(Tu[i_probe])
     f_probe = np.logspace(math.log10(fu[0]) - 3, math.log10(fu[-1]) + 3, 121)
 
     def probe_many(values_list):
         return model_of(values_list).frequency_response(f_probe, [t_probe], quantities=(q,))[q][:, 0, :] * factor
 
-    return predict_many, SensitivityProbe(f_probe, probe_many), q
+    predict_many.array = probe_array = None
+    smap = None if not free else StateMap.build(base, [fp.name for fp in free], [fp.lower for fp in free],
+                                                [fp.upper for fp in free],
+                                                [base_value(base, fp.name) if fp.initial is None else fp.initial
+                                                 for fp in free], Tu)
+    if smap is not None:
+        # the kernel of the same model class, evaluated on states built as arrays (model.evaluate_grid)
+        kern = physics_model(kind, base, kernel=kernel)._kernel
+        s_data, s_probe = 2j * np.pi * fu, 2j * np.pi * f_probe
+
+        def predict_array(X):
+            with np.errstate(all="ignore"):     # a non-finite response is refused by the residuals
+                R = evaluate_grid(smap(X), s_data, kern, (q,))[q]
+            return R[:, inv_T, inv_f] * factor
+
+        def probe_array(X):
+            st = smap(X)
+            st = State(**{k: getattr(st, k)[:, i_probe:i_probe + 1] for k in STATE_FIELDS})
+            with np.errstate(all="ignore"):
+                return evaluate_grid(st, s_probe, kern, (q,))[q][:, 0, :] * factor
+
+        key = (smap, tuple(free), kind, q, kernel, fu.tobytes(), Tu.tobytes(), inv_T.tobytes(), inv_f.tobytes())
+        if key not in _PLANS:
+            if len(_PLANS) >= 32:
+                _PLANS.pop(next(iter(_PLANS)))
+            _PLANS[key] = _jacobian_plan(smap, list(free), predict_array, inv_T)
+        predict_array.jacobian_plan = _PLANS[key]
+        predict_many.array = predict_array
+    return predict_many, SensitivityProbe(f_probe, probe_many, probe_array), q
+
+
+#: Largest spread of ∂ln G/∂u over lines and rows for a response taken as exponential in u.
+AFFINE_TOL = 1e-10
+#: Jacobian plans per (state map, model, data grid): repeated calibrations of one problem reuse theirs.
+_PLANS: dict = {}
+
+
+def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
+    """Columns of the Jacobian in z known without a finite difference of their own (the chain
+    rule through the state map), {k: ("scaled", j, c) | ("constant", dlnG)}:
+
+    * ("scaled", j, c): parameter k moves the state at every temperature T along c(T) times
+      parameter j's direction (e.g. ``laws.E.slope`` and ``E``), so ∂r/∂z_k = c(T_line)·∂r/∂z_j;
+    * ("constant", dlnG): ln G is affine in k's coordinate, with the same slope at every line,
+      measured at two rows and two steps (e.g. M ∝ α0): ∂ln G/∂z_k = dlnG.
+
+    Only parameters whose natural coordinate u is affine in z (log-scale fields, linear-scale
+    law parameters) qualify.
+    """
+    _, slope = smap.log_slopes()
+    dudz = [math.log(10.0) if fp.scale == "log" and not fp.name.startswith("laws.") else
+            (fp.upper - fp.lower) if fp.scale == "linear" and fp.name.startswith("laws.") else None for fp in free]
+    A = slope * np.array([0.0 if d is None else d for d in dudz])               # ∂ln|state|/∂z
+    plan: dict = {}
+    x0 = np.array([fp.initial if fp.initial is not None else fp.midpoint() for fp in free])
+    X1 = np.vstack([x0, [float(fp.from_z(0.3 * fp.z_bounds[0] + 0.7 * fp.z_bounds[1])) for fp in free]])
+    single = []
+    for k in range(len(free)):
+        if dudz[k] is None:
+            continue
+        for j in range(k):
+            if dudz[j] is None or j in plan:
+                continue
+            nj = np.einsum("vt,vt->t", A[:, :, j], A[:, :, j])
+            c = np.divide(np.einsum("vt,vt->t", A[:, :, k], A[:, :, j]), nj, out=np.zeros(nj.size), where=nj > 0)
+            if np.allclose(A[:, :, k], c * A[:, :, j], rtol=0, atol=1e-12 * np.abs(A[:, :, k]).max()):
+                plan[k] = ("scaled", j, c[inv_T])
+                break
+        if k not in plan and np.count_nonzero(np.abs(A[:, :, k]).max(axis=1)) == 1:
+            single.append(k)        # the affine test below only for a parameter moving one field
+    if not single:
+        return plan
+    rows, du = list(X1), []
+    for k in single:                # two rows, two steps in u each, all in one model call
+        step = 1.0 if free[k].scale == "log" else 0.1 * dudz[k]
+        for x in X1:
+            for h in (0.5, 1.0):
+                xx = x.copy()
+                xx[k] = np.sign(x[k]) * np.exp(np.log(abs(x[k])) + h) if free[k].scale == "log" else x[k] + h * step
+                rows.append(xx)
+                du.append(h * step)
+    G = predict_array(np.array(rows))
+    base_rows = np.tile([0, 0, 1, 1], len(single))
+    rates = (np.log(G[2:] / G[base_rows]) / np.array(du)[:, None]).reshape(len(single), 4, -1)   # ∂ln G/∂u
+    for k, rk in zip(single, rates):
+        if np.all(np.isfinite(rk)) and np.ptp(rk.real) <= AFFINE_TOL and np.ptp(rk.imag) <= AFFINE_TOL:
+            plan[k] = ("constant", complex(rk.mean()) * dudz[k])
+    return plan
 
 
 def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParameters,
@@ -121,10 +218,12 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
             fps.append(item)
         else:
             raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
-    predict_many, probe, q = physics_predictor(data, base, kind, quantity, kernel)
+    fixed = kwargs.get("fixed") or {}
+    predict_many, probe, q = physics_predictor(data, apply_values(base, fixed) if fixed else base, kind, quantity,
+                                               kernel, free=fps)
     res = fit_parameters(data, None, fps, starts=starts, seed=seed, predict_many=predict_many,
-                         max_nfev=max_nfev, identify=identify, hold_undetermined=hold_undetermined,
-                         probe=probe, progress=progress, **kwargs)
+                         predict_array=predict_many.array, max_nfev=max_nfev, identify=identify,
+                         hold_undetermined=hold_undetermined, probe=probe, progress=progress, **kwargs)
     label = name or f"{base.name}_calibrated"
     src = (f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
            f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"

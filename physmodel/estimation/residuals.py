@@ -42,12 +42,17 @@ def standardised_residuals(model_response, data: FrequencySweep, s_ln, s_ph) -> 
     n = data.response.size
     if G.shape[-1] != n:
         raise IPMCError(f"model response has {G.shape[-1]} values per set for {n} data lines")
-    bad = ~np.isfinite(G) | (G == 0)
-    if np.any(bad):
+    with np.errstate(all="ignore"):
+        q = data.response / G
+        # ln q = ln|q| + i arg q (principal branch), without the much slower complex logarithm
+        out = np.concatenate([np.log(np.abs(q)) / s_ln, np.angle(q) / s_ph], axis=-1)
+    if not np.all(np.isfinite(out)):
+        bad = ~np.isfinite(G) | (G == 0)
+        if not np.any(bad):     # a data value that is zero or not finite: FrequencySweep refuses these
+            bad = ~np.isfinite(q) | (q == 0)
         raise IPMCError(f"model response is zero or not finite at {int(bad.sum())} line(s) "
                         f"(first at frequency {data.frequency_hz[np.flatnonzero(bad.reshape(-1, n).any(0))[0]]:g} Hz)")
-    lr = np.log(data.response / G)
-    return np.concatenate([lr.real / s_ln, lr.imag / s_ph], axis=-1)
+    return out
 
 
 def residuals(model_response: np.ndarray, data: FrequencySweep) -> np.ndarray:
@@ -64,6 +69,15 @@ def weighted_cost(model_response, data: FrequencySweep) -> float:
     """½·Σ r² of :func:`residuals`; for a correct model its mean is ≈ F − nθ/2 (F lines)."""
     r = residuals(model_response, data)
     return float(0.5 * np.sum(r * r))
+
+
+def gauss_newton_covariance(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Newton covariance (JᵀJ)⁻¹ of the fitted coordinates, via the SVD of the (standardised)
+    Jacobian ``J`` (n_residuals, n_parameters); returns (cov, singular values) [-]."""
+    U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    tiny = s.max() * 1e-14 if s.size and s.max() > 0 else 1e-300
+    inv = 1.0 / np.maximum(s, tiny) ** 2
+    return (Vt.T * inv) @ Vt, s
 
 
 #: A cost whose χ² tail probability is below this is inconsistent with the declared noise.

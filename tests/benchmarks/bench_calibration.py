@@ -6,15 +6,36 @@
 2. a Monte Carlo check of the intervals: the same calibration over N noise draws (default 400),
    coverage of the nominal 95 % intervals per parameter (with the binomial 95 % band of the
    coverage estimate), mean cost against its expectation F − nθ/2;
-3. the same coverage check on sweeps without per-line std, where the noise level is estimated.
+3. the same coverage check on sweeps without per-line std, where the noise level is estimated;
+4. ``--speed PAIRS --root OTHER``: wall time of the calibrations above against another checkout
+   (e.g. the commit before the speed work), paired and interleaved: each pair runs one fresh
+   interpreter per checkout (order alternating), each times ``--reps`` calls after one warm-up
+   call; the ratio OTHER/this is taken pair by pair and reported as median [min, max].
 
     python3 tests/benchmarks/bench_calibration.py [--draws 400] [--starts 4]
+    python3 tests/benchmarks/bench_calibration.py --speed 7 --root /path/to/baseline/checkout
+
+Measured (2 shared cores, 2026-11-23, issue 17), against a06d884 (the engine before the issue-17
+work; main at df39d69 timed the same), ``--speed 7 --reps 3 --speed-draws 10``, ratio
+baseline/this, median [min, max] over the 7 pairs:
+
+* 4 starts: 24.4 ms vs 128.2 ms, 5.26x [5.17, 5.76]; the first calibration of a problem (state
+  map and Jacobian plan built): 28.5 ms, 4.46x [4.37, 4.65];
+* 1 start (the Monte Carlo calibrations): 5.0 ms vs 24.6 ms, 4.91x [4.85, 5.12];
+* model evaluations 240 vs 492 (4 starts), 62 vs 102 per 1-start calibration;
+* estimates: the same to 1.2e-6 (4 starts) and 1.3e-5 (40 one-start draws) relative; the
+  difference is the baseline's own stopping error (its Gauss–Newton step from its estimate is
+  up to 6e-5 standard errors, ours below 3e-6);
+* coverage over 200 draws, identical hit for hit: 0.950/0.945/0.945/0.955/0.950/0.950/0.970/0.945
+  (mean 0.951); with estimated noise mean 0.953 (0.925 for laws.E.slope, in both).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import subprocess
 import sys
 import time
 from dataclasses import replace
@@ -22,16 +43,22 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+_ROOT = sys.argv[sys.argv.index("--root") + 1] if "--worker" in sys.argv else Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(_ROOT))
 
 from physmodel import ActuatorModel, get_parameter_set  # noqa: E402
-from physmodel.data.sweep import (
-    ComplexGaussianNoise,
-    MagnitudePhaseNoise,
-    synthesize_sweep,  # noqa: E402
-)
-from physmodel.estimation.calibration import calibrate  # noqa: E402
 from physmodel.temperature import Arrhenius, LogLinear  # noqa: E402
+
+try:
+    from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise, synthesize_sweep
+    from physmodel.estimation.calibration import calibrate
+except ImportError:  # the layout before issue 19 (for --root at an older commit)
+    from physmodel.calibration import calibrate  # type: ignore[no-redef]
+    from physmodel.sweep import (  # type: ignore[no-redef]
+        ComplexGaussianNoise,
+        MagnitudePhaseNoise,
+        synthesize_sweep,
+    )
 
 FREE = ["d", "kappa_e", "alpha0", "E", "xi", "r1_sheet", "laws.d.activation_energy", "laws.E.slope"]
 TEMPS = np.linspace(5.0, 75.0, 10)
@@ -129,13 +156,90 @@ def monte_carlo_estimated_noise(base, truth, true, draws):
     print(f"  all parameters (mean) {np.mean([hits[n] / draws for n in FREE]):.3f}")
 
 
+def _clear_problem_caches():
+    """Forget what this checkout keeps per problem (state maps, Jacobian plans), if anything."""
+    try:
+        from physmodel.estimation import calibration
+        from physmodel.parameter_paths import _cached_map
+    except ImportError:
+        return
+    _cached_map.cache_clear()
+    calibration._PLANS.clear()
+
+
+def worker(reps: int, draws: int):
+    """Time (in this interpreter) the 4-start calibration and ``draws`` 1-start ones; JSON on stdout."""
+    base, truth, true = setup()
+    sw = synthesize_sweep(ActuatorModel(truth), "M", FREQS, TEMPS, noise=NOISE, seed=2026)
+    sws = [synthesize_sweep(ActuatorModel(truth), "M", FREQS, TEMPS, noise=NOISE, seed=10_000 + k) for k in range(draws)]
+    calibrate(sw, base, FREE, starts=4, seed=0)          # warm-up (imports, caches)
+    single_s, cold_s, one_start_s = [], [], []
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        res = calibrate(sw, base, FREE, starts=4, seed=0)
+        single_s.append(time.perf_counter() - t0)
+        _clear_problem_caches()
+        t0 = time.perf_counter()
+        calibrate(sw, base, FREE, starts=4, seed=0)
+        cold_s.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        for s in sws:
+            calibrate(s, base, FREE, starts=1)
+        one_start_s.append((time.perf_counter() - t0) / draws)
+    import physmodel
+
+    print(json.dumps({"physmodel": physmodel.__file__, "single": float(np.median(single_s)),
+                      "single_cold": float(np.median(cold_s)), "one_start": float(np.median(one_start_s)),
+                      "values": res.values, "cost": res.cost, "n_evaluations": res.n_evaluations}))
+
+
+def speed(pairs: int, root: str, reps: int, draws: int):
+    here = str(Path(__file__).resolve().parents[2])
+    cmd = lambda r: [sys.executable, __file__, "--worker", "--root", r, "--reps", str(reps),  # noqa: E731
+                     "--speed-draws", str(draws)]
+    runs: dict = {"this": [], "other": []}
+    for i in range(pairs):
+        order = [("this", here), ("other", root)] if i % 2 == 0 else [("other", root), ("this", here)]
+        for label, r in order:
+            out = subprocess.run(cmd(r), capture_output=True, text=True, check=True).stdout
+            runs[label].append(json.loads(out.strip().splitlines()[-1]))
+    print(f"== speed: this checkout ({here}) against {root}; {pairs} interleaved pairs of fresh interpreters, "
+          f"each the median of {reps} timed repeats after one warm-up")
+    for key, what in (("single", "8-parameter calibration, 4 starts"),
+                      ("single_cold", "the same, first of its problem (per-problem caches cleared)"),
+                      ("one_start", f"8-parameter calibration, 1 start (mean over {draws} noise draws)")):
+        a = np.array([r[key] for r in runs["this"]])
+        b = np.array([r[key] for r in runs["other"]])
+        ratio = b / a
+        print(f"{what}: this {np.median(a) * 1e3:.1f} ms [{a.min() * 1e3:.1f}, {a.max() * 1e3:.1f}], "
+              f"other {np.median(b) * 1e3:.1f} ms [{b.min() * 1e3:.1f}, {b.max() * 1e3:.1f}]; "
+              f"other/this {np.median(ratio):.2f} [{ratio.min():.2f}, {ratio.max():.2f}]")
+    a, b = runs["this"][0], runs["other"][0]
+    print(f"imported: this {a['physmodel']}, other {b['physmodel']}")
+    rel = max(abs(a["values"][n] / b["values"][n] - 1) for n in FREE)
+    print(f"estimates (4 starts): largest relative difference {rel:.2g}; cost {a['cost']:.6f} vs {b['cost']:.6f}; "
+          f"model evaluations {a['n_evaluations']} vs {b['n_evaluations']}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--draws", type=int, default=400)
     ap.add_argument("--starts", type=int, default=4)
     ap.add_argument("--draws-estimated", type=int, default=200,
                     help="draws of the estimated-noise coverage check (0 to skip)")
+    ap.add_argument("--speed", type=int, default=0, metavar="PAIRS",
+                    help="only the paired speed comparison against --root, with this many pairs")
+    ap.add_argument("--root", default=None, help="the other checkout for --speed")
+    ap.add_argument("--reps", type=int, default=5, help="timed repeats per interpreter in --speed")
+    ap.add_argument("--speed-draws", type=int, default=10, help="1-start calibrations per repeat in --speed")
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.worker:
+        return worker(args.reps, args.speed_draws)
+    if args.speed:
+        if not args.root:
+            ap.error("--speed needs --root")
+        return speed(args.speed, args.root, args.reps, args.speed_draws)
     base, truth, true = setup()
     single(base, truth, true, args.starts)
     monte_carlo(base, truth, true, args.draws)
