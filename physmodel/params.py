@@ -257,6 +257,18 @@ class ParameterTable:
 
     @classmethod
     def of(cls, params: IPMCParameters | Sequence[IPMCParameters]) -> ParameterTable:
+        """The table of one set or a sequence of sets (one column per field, one row per set).
+
+        Parameters
+        ----------
+        params : IPMCParameters or sequence of IPMCParameters
+            The sets, in row order.
+
+        Returns
+        -------
+        ParameterTable
+            Columns of shape (n, 1) in SI units; sets sharing a laws object and ``T_ref`` form one group.
+        """
         plist = as_parameter_list(params)
         n = len(plist)
         columns = {name: np.fromiter(map(getter, plist), float, count=n)[:, None]
