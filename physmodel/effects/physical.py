@@ -3,12 +3,14 @@
 Every effect composes the physmodel sub-models rather than re-deriving them:
 
 * parameter-level effects change the :class:`~physmodel.params.State` (r1, r2, Rp, E, d, κe,
-  h, C⁻, ρ, ξ); the model then recomputes K with :func:`physmodel.transport.debye_rate` and the
+  h, C⁻); the model then recomputes K with :func:`physmodel.transport.debye_rate` and the
   first mode with :func:`physmodel.params.first_mode_omega`; the temperature effects multiply by
   the factors of the laws in :mod:`physmodel.temperature` (Arrhenius, LogLinear);
 * ``second_mode`` is the Euler–Bernoulli modal expansion of :mod:`physmodel.beam`
   (:func:`~physmodel.beam.modal_tip_response`) driven by the moment profile of the electrode line
   (:func:`physmodel.electrode.strip_terms`), with as many modes as the band needs;
+* ``viscous_fluid`` is Sader's hydrodynamic load on the beam (:mod:`physmodel.effects.fluid`): the first
+  mode of :mod:`physmodel.beam` with a frequency-dependent complex modal mass;
 * ``fractional_transport`` replaces s by ŝ = ω_c (s/ω_c)^β inside the charge dynamics only.
 
 Fractional transport (derivation).  Replace the first-order time derivative of the linearised
@@ -30,6 +32,7 @@ import math
 import numpy as np
 
 from .. import beam
+from . import fluid
 from ..temperature import Arrhenius, LogLinear
 from ..transport import debye_rate
 from .base import Effect, P
@@ -69,13 +72,6 @@ def _p_leakage(st, T_ref, v):
     with np.errstate(divide="ignore"):
         g = 1.0 / st["Rp"] + v["conductance"] * st["W"] / tf  # 1/Rp [S/m] per slice
         st["Rp"] = np.where(g > 0, 1.0 / np.where(g > 0, g, 1.0), np.inf)
-    return st
-
-
-def _p_fluid(st, T_ref, v):
-    mu, zf = v["mass_ratio"], v["damping_ratio"]
-    st["rho"] = st["rho"] * (1.0 + mu)
-    st["xi"] = (st["xi"] + zf) / math.sqrt(1.0 + mu)
     return st
 
 
@@ -188,15 +184,22 @@ EFFECTS = [
             P("viscous_share", "1", 1.0, 0.0, 1.0, 0.75, "mass-proportional share ν of the damping",
               limits=("lower", "upper"))),
            kinds=("actuator",), quantities=("M",), apply=_r_second_mode, switch="weight"),
-    Effect("added_fluid_mass", "added fluid mass and damping",
-           "Hydrodynamic added mass μ (fraction of the modelled modal mass; negative when the model "
-           "already holds more fluid mass than the strip carries, e.g. a narrower strip, since the added "
-           "mass per length π ρ_f W²/4 grows faster with W than the beam's) and fluid damping ζf: "
-           "ωn → ωn/√(1+μ), ξ → (ξ + ζf)/√(1+μ).",
-           "Sader 1998, J. Appl. Phys. 84:64 (cantilevers in fluid)", "parameter",
-           (P("mass_ratio", "1", 0.0, -0.9, 5.0, 0.5, "added mass / modelled modal mass"),
-            P("damping_ratio", "1", 0.0, 0.0, 1.0, 0.1, "added damping ratio")),
-           kinds=("actuator",), quantities=("M",), apply=_p_fluid),
+    Effect("viscous_fluid", "beam in a viscous fluid (frequency-dependent added mass and damping)",
+           "Sader's hydrodynamic load on the strip: the modal mass becomes ρ·2hW + (π/4) ρ_f W² Γ_rect*(Re), "
+           "Re = ω W²/(4ν), with the added mass (Re Γ) falling and the viscous damping (Im Γ) rising as the "
+           "frequency falls; ν follows an Andrade law with energy E_η.  The inviscid limit (ν → 0) is the "
+           "constant added mass π ρ_f W²/4 per length, which a free ωn absorbs (see physmodel.effects.fluid).",
+           "Sader 1998, J. Appl. Phys. 84:64, eqs. (10), (19)-(21); water/glycerol viscosity (CRC Handbook)",
+           "response",
+           (P("density", "kg/m^3", 0.0, 0.0, 1500.0, 1000.0, "fluid density ρ_f (water 1000, glycerol 1260)"),
+            P("log10_viscosity", "log10(m^2/s)", -6.0, -6.6, -2.5, -5.0,
+              "log10 of the kinematic viscosity ν at T_ref (water −6.0 at 20 °C, glycerol −2.95)"),
+            P("viscosity_energy", "J/mol", 16e3, 0.0, 70e3, 30e3,
+              "Andrade activation energy E_η of the viscosity (water ≈ 16e3, glycerol ≈ 60e3)", limits=("lower",))),
+           kinds=("actuator",), quantities=("M",), apply=fluid.response_factor, switch="density",
+           bounds_doc="ρ_f in [0, 1500] kg/m³ (no liquid, up to dense ionic liquids; glycerol 1260); ν from hot "
+                      "water (2.5e-7 m²/s, −6.6) to glycerol near 15 °C (3e-3 m²/s, −2.5); E_η in [0, 70] kJ/mol "
+                      "(liquids' viscosity falls with T; glycerol ≈ 60 kJ/mol)."),
     Effect("modulus_temperature", "temperature dependence of the modulus",
            "An extra log-linear slope of E with temperature (physmodel.temperature.LogLinear) and a "
            "curvature, E → E·exp(c (T − T_ref) + c2 (T − T_ref)²): gain and resonance move with T "

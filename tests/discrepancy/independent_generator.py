@@ -73,8 +73,9 @@ EFFECT_SPECS: dict[str, tuple] = {
     # Euler-Bernoulli modal sum (6 modes + static residual), Rayleigh damping share of the fluid.
     "second_mode": ("second_mode", {"n_modes": ("fix", 6, 6), "viscous_share": ("lin", 0.5, 1.0)},
                     {"n_modes": 1, "viscous_share": 1.0}),
-    # Extra fluid load: inviscid mass ratio and Reynolds number at ω1 (Sader 1998 Γ_circ).
-    "added_fluid_mass": ("added_fluid_mass", {"mass_ratio": ("log", 0.01, 1.0), "reynolds": ("log", 300.0, 3.0)},
+    # Extra fluid load: inviscid mass ratio and Reynolds number at ω1 (Sader 1998 Γ_circ); the
+    # library's viscous_fluid (its own Γ_rect, fluid density and viscosity parametrisation).
+    "added_fluid_mass": ("viscous_fluid", {"mass_ratio": ("log", 0.01, 1.0), "reynolds": ("log", 300.0, 3.0)},
                          {"mass_ratio": 0.0, "reynolds": 30.0}),
     "modulus_temperature": ("modulus_temperature", {"linear_coeff": ("sym", 3e-4, 0.012)}, {"linear_coeff": 0.0}),
     "diffusivity_temperature": ("diffusivity_temperature", {"q10": ("symlog", 1.01, 1.6)}, {"q10": 1.0}),
