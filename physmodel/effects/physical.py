@@ -27,14 +27,12 @@ a different mechanism from the interface constant-phase element in series with t
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .. import beam
-from . import fluid
 from ..temperature import Arrhenius, LogLinear
 from ..transport import debye_rate
+from . import fluid
 from .base import Effect, P
 
 #: Frequency [Hz] at which |ŝ| = |s| for the fractional transport (ŝ = ω_c (s/ω_c)^β).
@@ -192,14 +190,16 @@ EFFECTS = [
            "Sader 1998, J. Appl. Phys. 84:64, eqs. (10), (19)-(21); water/glycerol viscosity (CRC Handbook)",
            "response",
            (P("density", "kg/m^3", 0.0, 0.0, 1500.0, 1000.0, "fluid density ρ_f (water 1000, glycerol 1260)"),
-            P("log10_viscosity", "log10(m^2/s)", -6.0, -6.6, -2.5, -5.0,
+            P("log10_viscosity", "log10(m^2/s)", -6.0, -6.6, -2.5, -4.55,
               "log10 of the kinematic viscosity ν at T_ref (water −6.0 at 20 °C, glycerol −2.95)"),
-            P("viscosity_energy", "J/mol", 16e3, 0.0, 70e3, 30e3,
+            P("viscosity_energy", "J/mol", 16e3, 0.0, 70e3, 35e3,
               "Andrade activation energy E_η of the viscosity (water ≈ 16e3, glycerol ≈ 60e3)", limits=("lower",))),
            kinds=("actuator",), quantities=("M",), apply=fluid.response_factor, switch="density",
            bounds_doc="ρ_f in [0, 1500] kg/m³ (no liquid, up to dense ionic liquids; glycerol 1260); ν from hot "
                       "water (2.5e-7 m²/s, −6.6) to glycerol near 15 °C (3e-3 m²/s, −2.5); E_η in [0, 70] kJ/mol "
-                      "(liquids' viscosity falls with T; glycerol ≈ 60 kJ/mol)."),
+                      "(liquids' viscosity falls with T; glycerol ≈ 60 kJ/mol).  Off values (the signature's probe and "
+                      "the first start): water; typical (a second start): ρ_f = 1000 and the geometric/arithmetic "
+                      "centre of the ν and E_η ranges."),
     Effect("modulus_temperature", "temperature dependence of the modulus",
            "An extra log-linear slope of E with temperature (physmodel.temperature.LogLinear) and a "
            "curvature, E → E·exp(c (T − T_ref) + c2 (T − T_ref)²): gain and resonance move with T "

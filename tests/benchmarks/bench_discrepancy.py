@@ -64,6 +64,8 @@ F = np.logspace(-1, 1.7, 30)
 T = [20.0, 40.0, 60.0]
 FREE = ("alpha0", "d", "xi", "omega_n")
 FREE_INDEPENDENT = ("alpha0", "d", "kappa_e", "xi", "omega_n")
+#: The same freedom in the independent generator's own parametrisation (for its λ after the refit).
+WORKFLOW_FREE_GENERATOR = ("alpha", "d", "eps", "zeta", "f1")
 NOISE = {"low": (0.1, 0.5), "moderate": (0.25, 1.5), "high": (0.6, 4.0)}
 DETECTABLE = 25.0
 CANDS = candidates_for("actuator", "M", len(T))
@@ -180,7 +182,7 @@ def run_case(item):
                          dt=dt, level=level)
     import independent_generator as ig
 
-    sweep, truth = ig.make_case(key, label)
+    sweep, truth = ig.make_case(key, label, workflow_free=WORKFLOW_FREE_GENERATOR)
     base = IPMCParameters.from_dict(dict(truth["library_start"]))
     t0 = time.perf_counter()
     d = diagnose(sweep, base, kind="actuator", free=FREE_INDEPENDENT, alpha=ALPHA, seed=key)
@@ -189,8 +191,14 @@ def run_case(item):
         det = min(truth["lam_each_baseline"].values()) >= DETECTABLE
     else:
         det = (truth["lam_baseline"] or 0.0) >= DETECTABLE
-    return summarise(d, generator=gen, label=label, expected=truth["expected"], lam=truth["lam_baseline"] or 0.0,
-                     detectable=det, out_of_library=truth["out_of_library"], dt=dt)
+    if truth["lam_each_workflow"]:
+        det_w = min(truth["lam_each_workflow"].values()) >= DETECTABLE
+    else:
+        det_w = (truth["lam_workflow"] or 0.0) >= DETECTABLE
+    r = summarise(d, generator=gen, label=label, expected=truth["expected"], lam=truth["lam_baseline"] or 0.0,
+                  detectable=det, out_of_library=truth["out_of_library"], dt=dt)
+    r["detectable_workflow"] = det_w
+    return r
 
 
 def run_all(plan, workers: int):
@@ -270,8 +278,11 @@ def report(rows, title):
     print(f"\n=== False positives on null data (nominal α = {ALPHA}) ===\n  a name (named/ambiguous/at bound): "
           f"{_rate(k, len(nulls))}\n  any verdict but 'none': {_rate(k2, len(nulls))}")
     det = [r for r in singles if r["detectable"]]
+    det_w = [r for r in singles if r.get("detectable_workflow", r["detectable"])]
     print(f"\n=== Naming accuracy, single library effects ===\n  detectable (λ ≥ {DETECTABLE:g}), confident name: "
-          f"{_rate(sum(correct(r) for r in det), len(det))}\n  detectable, incl. 'at bound' names: "
+          f"{_rate(sum(correct(r) for r in det), len(det))}\n  detectable after refitting the workflow's own free "
+          f"set (κe too), confident name: {_rate(sum(correct(r) for r in det_w), len(det_w))}"
+          f"\n  detectable, incl. 'at bound' names: "
           f"{_rate(sum(correct(r, False) for r in det), len(det))}\n  all single cases: "
           f"{_rate(sum(correct(r) for r in singles), len(singles))}")
     wrong = [r for r in singles if r["verdict"] in ("named", "ambiguous") and not correct(r)]
@@ -342,24 +353,26 @@ def real_data():
 
     print("\n=== Seed 002 width series (W = 4, 2, 1, 0.5 mm) ===")
     print("  (seed 002 prints no width data; (a) the model itself at each width vs the 4 mm calibration;")
-    print("   (b) hypothesis: strips in water, hydrodynamic added mass π ρ_f W²/4 per length scaled with W)")
+    print("   (b) strips in water: Sader's viscous load vs a model holding only the constant added mass)")
     f2 = np.logspace(-1, 1.7, 30)
     for W in (4e-3, 2e-3, 1e-3, 0.5e-3):
         pw = P.replace(W=W)
         noise = MagnitudePhaseNoise(0.25, 1.5)
         data_a = synthesize_sweep(EffectModel(pw, "actuator"), "M", f2, [26.85], noise, seed=int(W * 1e5))
         da = diagnose(data_a, P, kind="actuator", free=("alpha0", "d", "xi"), seed=1)
-        # (b) polymer 2000 kg/m³ + added water mass; the calibrated 4 mm set holds the 4 mm added mass
-        mass = lambda w: 2000.0 * 2 * P.h * w + 1000.0 * math.pi * w**2 / 4        # kg/m, beam + water
-        mu = mass(W) / mass(4e-3) * (4e-3 / W) - 1.0                                  # per-width modal mass change
-        data_b = synthesize_sweep(EffectModel(pw, "actuator", {"added_fluid_mass": {"mass_ratio": mu}}), "M", f2,
-                                  [26.85], noise, seed=int(W * 1e5) + 1)
-        db = diagnose(data_b, pw, kind="actuator", free=("alpha0", "d", "xi"), seed=1)
-        fitted = db.final.values.get("added_fluid_mass.mass_ratio") if db.final else None
+        # (b) a bare strip (2000 kg/m³) in water with Sader's load; the user's model holds the inviscid
+        # added mass π ρ_f W²/4 per length in its density (what a calibration in water at one width gives)
+        water = {"density": 1000.0, "log10_viscosity": math.log10(0.85e-6), "viscosity_energy": 16e3}
+        bare = pw.replace(rho=2000.0)
+        data_b = synthesize_sweep(EffectModel(bare, "actuator", {"viscous_fluid": water}), "M", f2, [26.85], noise,
+                                  seed=int(W * 1e5) + 1)
+        db = diagnose(data_b, bare.replace(rho=2000.0 + 1000.0 * math.pi * W / (8 * P.h)), kind="actuator",
+                      free=("alpha0", "d", "xi"), seed=1)
+        fitted = db.final.values.get("viscous_fluid.density") if db.final else None
         print(f"  W = {W * 1e3:3.1f} mm: (a) model at W vs 4 mm set: {da.verdict} (best LR "
               f"{max(c.lr for c in da.candidates.values()):.2g}, threshold {da.threshold:.2g}); "
-              f"(b) water added mass μ = {mu:+.3f}: {db.verdict} {db.named}"
-              + (f" μ̂ = {fitted:+.3f}" if fitted is not None else "") + f"; cost {db.gap_before['cost']:.4g} -> "
+              f"(b) bare strip in water (Sader), model with constant added mass: {db.verdict} {db.named}"
+              + (f" ρ̂_f = {fitted:.0f} kg/m³" if fitted is not None else "") + f"; cost {db.gap_before['cost']:.4g} -> "
               f"{db.gap_after['cost']:.4g}")
 
 
