@@ -288,9 +288,13 @@ def report(rows, title):
     wrong = [r for r in singles if r["verdict"] in ("named", "ambiguous") and not correct(r)]
     undeclared = [r for r in wrong if not all(frozenset((r["expected"][0], n)) in r["declared"]
                                               for n in r["named"] if n != r["expected"][0]) or r["expected"][0] not in r["named"]]
-    print(f"  wrong confident names: {len(wrong)}; not between pairs the report declares confusable: {len(undeclared)}")
+    named_wrong = [r for r in wrong if r["verdict"] == "named"]
+    print(f"  wrong names: {len(wrong)} (confident, verdict 'named': {len(named_wrong)}; 'ambiguous' lists naming a "
+          f"candidate the report does not declare confusable with the truth, or missing it: {len(wrong) - len(named_wrong)})"
+          f"; not between pairs the report declares confusable: {len(undeclared)}")
     for r in wrong:
-        print(f"    truth {r['label']:28s} -> {outcome(r)} (λ={r['lam']:.0f})")
+        print(f"    truth {r['label']:28s} -> {outcome(r)}" + (f" {r['named']}" if r["verdict"] == "ambiguous" else "")
+              + f" (λ={r['lam']:.0f})")
     for r in det:
         if not correct(r) and r not in wrong:
             print(f"    missed (detectable) {r['label']:28s} λ={r['lam']:.0f} -> {outcome(r)}")
