@@ -31,6 +31,16 @@ fluidity of a liquid rises with temperature like a diffusivity (water E_η ≈ 1
 ≈ 60 kJ/mol, from their tabulated viscosities at 20 and 50 °C).  The fluid density is held
 constant (water changes by 1.2 % from 20 to 55 °C).
 
+Parametrisation.  With a free ωn the inviscid added mass is invisible and, at Re ≫ 1, the load
+that remains is the Stokes boundary layer's, μ (Γ − 1) ∝ ρ_f √ν/√ω: the data determine
+√(ρ_f η) = ρ_f √ν (the fluid's "viscous load", kg m⁻² s^-½; water 1.0, glycerol at 20 °C 42) far
+better than ρ_f and ν apart, which slide along that ridge.  The effect is therefore parametrised by
+``viscous_load`` √(ρ_f η) (the switch, linear: the load is proportional to it at fixed ν),
+``log10_viscosity`` log10 ν and ``viscosity_energy`` E_η, all at T_ref; ρ_f = √(ρ_f η)/√ν.  As
+ν → 0 at fixed √(ρ_f η) the load tends to the boundary-layer asymptote plus an inviscid added mass
+that a free ωn absorbs, so a fit that stops at the smallest ν of the range is in that regime (ν not
+determined) rather than beyond a physical limit.
+
 ``ρ`` is the model's modal density: the strip's own density when this effect is on.  A parameter
 set calibrated in the fluid already holds a constant added mass in ``ρ`` (seed 002: ≈ 6× the
 strip's mass); freeing ``omega_n`` lets the refit move that mass into the fluid term.
@@ -90,13 +100,20 @@ def kinematic_viscosity(v, T, T_ref):
     return 10.0 ** v["log10_viscosity"] / Arrhenius(activation_energy=v["viscosity_energy"]).factor(T, T_ref)
 
 
+def fluid_density(v):
+    """ρ_f = √(ρ_f η)/√ν [kg/m³] at T_ref from the effect values ``v`` (``viscous_load`` √(ρ_f η)
+    [kg m⁻² s^-½], ``log10_viscosity``)."""
+    return v["viscous_load"] / math.sqrt(10.0 ** v["log10_viscosity"])
+
+
 def mass_factor(s, st, T_ref, v):
     """m(ω) = 1 + μ Γ_rect*(Re(ω)) [-]: the modal mass in the fluid over the strip's own, e^{+st}.
 
     ``s`` = jω [1/s] on the imaginary axis; ``st`` a :class:`~physmodel.params.State` (W, h, rho,
-    T); ``T_ref`` [K] broadcastable to it; ``v`` the effect values (``density`` ρ_f [kg/m³])."""
+    T); ``T_ref`` [K] broadcastable to it; ``v`` the effect values (:func:`fluid_density`,
+    :func:`kinematic_viscosity`; the density is held constant with temperature)."""
     omega = np.abs(np.imag(s))
-    mu = math.pi * v["density"] * st.W / (8.0 * st.rho * st.h)
+    mu = math.pi * fluid_density(v) * st.W / (8.0 * st.rho * st.h)
     re = reynolds_number(omega, st.W, kinematic_viscosity(v, st.T, T_ref))
     return 1.0 + mu * np.conj(gamma_rectangular(re))
 
@@ -115,4 +132,5 @@ def response_factor(q, ctx, v):
 
 
 __all__ = ["reynolds_number", "gamma_circular", "rectangular_correction", "gamma_rectangular", "kinematic_viscosity",
+           "fluid_density",
            "mass_factor", "loaded_first_mode", "response_factor", "OMEGA_LOG10_RE_RANGE"]

@@ -366,17 +366,18 @@ def real_data():
         da = diagnose(data_a, P, kind="actuator", free=("alpha0", "d", "xi"), seed=1)
         # (b) a bare strip (2000 kg/m³) in water with Sader's load; the user's model holds the inviscid
         # added mass π ρ_f W²/4 per length in its density (what a calibration in water at one width gives)
-        water = {"density": 1000.0, "log10_viscosity": math.log10(0.85e-6), "viscosity_energy": 16e3}
+        water = {"viscous_load": math.sqrt(997.0 * 0.85e-3), "log10_viscosity": math.log10(0.85e-3 / 997.0),
+                 "viscosity_energy": 16e3}
         bare = pw.replace(rho=2000.0)
         data_b = synthesize_sweep(EffectModel(bare, "actuator", {"viscous_fluid": water}), "M", f2, [26.85], noise,
                                   seed=int(W * 1e5) + 1)
         db = diagnose(data_b, bare.replace(rho=2000.0 + 1000.0 * math.pi * W / (8 * P.h)), kind="actuator",
                       free=("alpha0", "d", "xi"), seed=1)
-        fitted = db.final.values.get("viscous_fluid.density") if db.final else None
+        fitted = db.final.values.get("viscous_fluid.viscous_load") if db.final else None
         print(f"  W = {W * 1e3:3.1f} mm: (a) model at W vs 4 mm set: {da.verdict} (best LR "
               f"{max(c.lr for c in da.candidates.values()):.2g}, threshold {da.threshold:.2g}); "
               f"(b) bare strip in water (Sader), model with constant added mass: {db.verdict} {db.named}"
-              + (f" ρ̂_f = {fitted:.0f} kg/m³" if fitted is not None else "") + f"; cost {db.gap_before['cost']:.4g} -> "
+              + (f" √(ρ_f η) = {fitted:.3g} kg m⁻² s^-½ (water {math.sqrt(0.85):.3g})" if fitted is not None else "") + f"; cost {db.gap_before['cost']:.4g} -> "
               f"{db.gap_after['cost']:.4g}")
 
 

@@ -64,13 +64,14 @@ def test_gamma_rectangular_published_fit_and_limits():
 
 
 def test_effect_against_single_mode_with_complex_mass_solved_by_hand():
-    rho_f, lg, ea = 1100.0, -5.3, 25e3
+    load, lg, ea = 3.0, -5.3, 25e3                                   # √(ρ_f η) [kg m⁻² s^-½]
     f = np.logspace(-1.3, 1.7, 40)
     T = [20.0, 45.0]
-    got = EffectModel(P, "actuator", {"viscous_fluid": {"density": rho_f, "log10_viscosity": lg,
+    got = EffectModel(P, "actuator", {"viscous_fluid": {"viscous_load": load, "log10_viscosity": lg,
                                                          "viscosity_energy": ea}}).frequency_response(f, T)["M"][0]
     base = ActuatorModel(P).frequency_response(f, T)["M"][0]
     st = ActuatorModel(P).state(T)
+    rho_f = load / math.sqrt(10**lg)                                 # √(ρ_f η)/√ν at T_ref
     mu = math.pi * rho_f * P.W / (8 * P.rho * P.h)
     for i, tc in enumerate(T):
         Tk = tc + 273.15
@@ -96,7 +97,7 @@ def test_inviscid_limit_is_the_constant_added_mass():
                                wn**2 / ((1 + mu) * s * s + 2 * xi * wn * s + wn * wn), rtol=1e-13)
     # ν → 0: m − 1 → μ Ω*(Re → ∞) with the boundary-layer correction 4 e^{−iπ/4}/√Re of Γ_circ
     st = SimpleNamespace(W=np.array(P.W), h=np.array(P.h), rho=np.array(P.rho), T=np.array(300.0))
-    v = {"density": 1000.0, "log10_viscosity": -14.0, "viscosity_energy": 0.0}
+    v = {"viscous_load": 1000.0 * 1e-7, "log10_viscosity": -14.0, "viscosity_energy": 0.0}   # ρ_f = 1000
     mu = math.pi * 1000.0 * P.W / (8 * P.rho * P.h)
     m = fl.mass_factor(s, st, 300.0, v)
     re = np.abs(s) * P.W**2 / (4 * 1e-14)
@@ -106,12 +107,13 @@ def test_inviscid_limit_is_the_constant_added_mass():
 
 def test_off_switch_and_declaration():
     e = LIBRARY["viscous_fluid"]
-    assert e.switch == "density" and e.is_off({"density": 0.0, "log10_viscosity": -3.0, "viscosity_energy": 1.0})
+    assert e.switch == "viscous_load" and e.is_off({"viscous_load": 0.0, "log10_viscosity": -3.0, "viscosity_energy": 1.0})
     f = np.logspace(-1, 1.5, 9)
-    off = EffectModel(P, "actuator", {"viscous_fluid": {"density": 0.0, "log10_viscosity": -3.0}}).frequency_response(f, [30.0])
+    off = EffectModel(P, "actuator", {"viscous_fluid": {"viscous_load": 0.0, "log10_viscosity": -3.0}}).frequency_response(f, [30.0])
     np.testing.assert_array_equal(off["M"], ActuatorModel(P).frequency_response(f, [30.0])["M"])
     assert get_effect("added_fluid_mass") is e                       # the old name: its inviscid limit
     with pytest.raises(ParameterError, match="mass_ratio"):
         EffectModel(P, "actuator", {"added_fluid_mass": {"mass_ratio": 0.5}})
-    with pytest.raises(ParameterError, match="density"):
-        EffectModel(P, "actuator", {"viscous_fluid": {"density": 5000.0}})
+    with pytest.raises(ParameterError, match="viscous_load"):
+        EffectModel(P, "actuator", {"viscous_fluid": {"viscous_load": 500.0}})
+    assert fl.fluid_density({"viscous_load": math.sqrt(1000 * 1e-3), "log10_viscosity": -6.0}) == pytest.approx(1000.0)

@@ -169,7 +169,7 @@ def test_viscous_fluid_lowers_and_damps_the_resonance():
     p = P.replace(xi=0.05)
     f = np.linspace(2.0, 30.0, 600)
     base = np.abs(ActuatorModel(p).frequency_response(f, [26.85])["M"][0, 0])
-    wet = np.abs(EffectModel(p, "actuator", {"viscous_fluid": {"density": 1000.0}}).frequency_response(f, [26.85])["M"][0, 0])
+    wet = np.abs(EffectModel(p, "actuator", {"viscous_fluid": {"viscous_load": 1.0}}).frequency_response(f, [26.85])["M"][0, 0])
     assert f[np.argmax(wet)] < f[np.argmax(base)] and wet.max() < base.max()
 
 
