@@ -185,8 +185,9 @@ EFFECTS = [
     Effect("viscous_fluid", "beam in a viscous fluid (frequency-dependent added mass and damping)",
            "Sader's hydrodynamic load on the strip: the modal mass becomes ρ·2hW + (π/4) ρ_f W² Γ_rect*(Re), "
            "Re = ω W²/(4ν), with the added mass (Re Γ) falling and the viscous damping (Im Γ) rising as the "
-           "frequency falls; parametrised by √(ρ_f η) (what the data determine), ν and an Andrade energy E_η.  The inviscid limit (ν → 0) is the "
-           "constant added mass π ρ_f W²/4 per length, which a free ωn absorbs (see physmodel.effects.fluid).",
+           "frequency falls; parametrised by √(ρ_f η) (what the data determine), ν and an Andrade energy "
+           "E_η.  The inviscid limit (ν → 0) is the constant added mass π ρ_f W²/4 per length, which a free "
+           "ωn absorbs (see physmodel.effects.fluid).",
            "Sader 1998, J. Appl. Phys. 84:64, eqs. (10), (19)-(21); water/glycerol viscosity (CRC Handbook)",
            "response",
            (P("viscous_load", "kg m^-2 s^-0.5", 0.0, 0.0, 70.0, 1.0,
@@ -197,10 +198,11 @@ EFFECTS = [
             P("viscosity_energy", "J/mol", 16e3, 0.0, 70e3, 35e3,
               "Andrade activation energy E_η of the viscosity (water ≈ 16e3, glycerol ≈ 60e3)", limits=("lower",))),
            kinds=("actuator",), quantities=("M",), apply=fluid.response_factor, switch="viscous_load",
-           bounds_doc="√(ρ_f η) in [0, 70] kg m⁻² s^-½ (no liquid, up to glycerol near 7 °C: 1263 kg/m³, 4 Pa·s); "
-                      "ν from hot water (2.5e-7 m²/s, −6.6: the high-Re end, where ν is not determined and "
-                      "the load tends to the boundary-layer asymptote — a limit, not a bound to widen) to glycerol "
-                      "near 7 °C (3.2e-3 m²/s, −2.5); E_η in [0, 70] kJ/mol (liquids' viscosity falls with T; "
+           bounds_doc="√(ρ_f η) in [0, 70] kg m⁻² s^-½ (no liquid, up to glycerol near 10 °C: 1263 kg/m³, 3.9 Pa·s); "
+                      "ν from hot water (2.5e-7 m²/s, −6.6: the high-Re end, where ν is not determined and, with "
+                      "ωn free, the load tends to the boundary-layer asymptote — a limit, not a bound to widen; "
+                      "with ωn held, ρ_f = √(ρ_f η)/√ν keeps growing there) to glycerol "
+                      "near 10 °C (3.1e-3 m²/s, −2.5); E_η in [0, 70] kJ/mol (liquids' viscosity falls with T; "
                       "glycerol ≈ 60 kJ/mol).  Off values (the signature's probe and the first start): water; "
                       "typical (a second start): water's √(ρ_f η) and the centre of the ν and E_η ranges."),
     Effect("modulus_temperature", "temperature dependence of the modulus",
