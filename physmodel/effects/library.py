@@ -17,7 +17,9 @@ base model, and acts at one of four levels:
 with any effect switched on) and gives the ``predict(values)`` closure used by the calibration
 engine (:meth:`EffectModel.predictor`).  Effect parameters are addressed as ``"effect.param"``.
 Out-of-library effects for blind tests live in :data:`OUT_OF_LIBRARY` and are never candidates.
-``constant_phase_element`` is accepted as an old name of ``fractional_transport`` (:data:`ALIASES`).
+``constant_phase_element`` is accepted as an old name of ``fractional_transport``, and
+``added_fluid_mass`` of ``viscous_fluid`` (its parameters changed: the constant added mass is its
+inviscid limit) (:data:`ALIASES`).
 """
 
 from __future__ import annotations
@@ -47,15 +49,16 @@ LIBRARY: dict[str, Effect] = {e.name: e for e in physical.EFFECTS + chain.EFFECT
 OUT_OF_LIBRARY: dict[str, Effect] = {e.name: e for e in chain.OUT_OF_LIBRARY}
 ALL_EFFECTS = {**LIBRARY, **OUT_OF_LIBRARY}
 #: Old names still accepted on input.
-ALIASES = {"constant_phase_element": "fractional_transport"}
+ALIASES = {"constant_phase_element": "fractional_transport", "added_fluid_mass": "viscous_fluid"}
 
 
 class _Context:
     """What response and series effects see: s (1, 1, n_f), ŝ of the charge dynamics, the State,
-    the base responses (n_sets, n_T, n_f) and, on demand, the electrode line argument x at ŝ."""
+    the base responses (n_sets, n_T, n_f), the reference temperatures T_ref (n_sets, 1, 1) [K] and,
+    on demand, the electrode line argument x at ŝ."""
 
-    def __init__(self, s, s_kernel, st: State, base: dict):
-        self.s, self.s_kernel, self.st, self.base = s, s_kernel, st, base
+    def __init__(self, s, s_kernel, st: State, base: dict, T_ref=None):
+        self.s, self.s_kernel, self.st, self.base, self.T_ref = s, s_kernel, st, base, T_ref
         self._x = None
 
     @property
@@ -188,7 +191,8 @@ class _EffectMixin:
                     vals["G"] = G
                 if "M" in need:
                     vals["M"] = vals["H"] * G
-        ctx = _Context(s[None, None, :], s_kernel[None, None, :], st, dict(vals))
+        T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
+        ctx = _Context(s[None, None, :], s_kernel[None, None, :], st, dict(vals), T_ref)
         for q in qs:
             fac = [e.apply(q, ctx, ev) for e, ev in resp if q in e.quantities]
             if fac:

@@ -3,12 +3,14 @@
 Every effect composes the physmodel sub-models rather than re-deriving them:
 
 * parameter-level effects change the :class:`~physmodel.params.State` (r1, r2, Rp, E, d, κe,
-  h, C⁻, ρ, ξ); the model then recomputes K with :func:`physmodel.transport.debye_rate` and the
+  h, C⁻); the model then recomputes K with :func:`physmodel.transport.debye_rate` and the
   first mode with :func:`physmodel.params.first_mode_omega`; the temperature effects multiply by
   the factors of the laws in :mod:`physmodel.temperature` (Arrhenius, LogLinear);
 * ``second_mode`` is the Euler–Bernoulli modal expansion of :mod:`physmodel.beam`
   (:func:`~physmodel.beam.modal_tip_response`) driven by the moment profile of the electrode line
   (:func:`physmodel.electrode.strip_terms`), with as many modes as the band needs;
+* ``viscous_fluid`` is Sader's hydrodynamic load on the beam (:mod:`physmodel.effects.fluid`): the first
+  mode of :mod:`physmodel.beam` with a frequency-dependent complex modal mass;
 * ``fractional_transport`` replaces s by ŝ = ω_c (s/ω_c)^β inside the charge dynamics only.
 
 Fractional transport (derivation).  Replace the first-order time derivative of the linearised
@@ -25,13 +27,12 @@ a different mechanism from the interface constant-phase element in series with t
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .. import beam
 from ..temperature import Arrhenius, LogLinear
 from ..transport import debye_rate
+from . import fluid
 from .base import Effect, P
 
 #: Frequency [Hz] at which |ŝ| = |s| for the fractional transport (ŝ = ω_c (s/ω_c)^β).
@@ -69,13 +70,6 @@ def _p_leakage(st, T_ref, v):
     with np.errstate(divide="ignore"):
         g = 1.0 / st["Rp"] + v["conductance"] * st["W"] / tf  # 1/Rp [S/m] per slice
         st["Rp"] = np.where(g > 0, 1.0 / np.where(g > 0, g, 1.0), np.inf)
-    return st
-
-
-def _p_fluid(st, T_ref, v):
-    mu, zf = v["mass_ratio"], v["damping_ratio"]
-    st["rho"] = st["rho"] * (1.0 + mu)
-    st["xi"] = (st["xi"] + zf) / math.sqrt(1.0 + mu)
     return st
 
 
@@ -188,15 +182,29 @@ EFFECTS = [
             P("viscous_share", "1", 1.0, 0.0, 1.0, 0.75, "mass-proportional share ν of the damping",
               limits=("lower", "upper"))),
            kinds=("actuator",), quantities=("M",), apply=_r_second_mode, switch="weight"),
-    Effect("added_fluid_mass", "added fluid mass and damping",
-           "Hydrodynamic added mass μ (fraction of the modelled modal mass; negative when the model "
-           "already holds more fluid mass than the strip carries, e.g. a narrower strip, since the added "
-           "mass per length π ρ_f W²/4 grows faster with W than the beam's) and fluid damping ζf: "
-           "ωn → ωn/√(1+μ), ξ → (ξ + ζf)/√(1+μ).",
-           "Sader 1998, J. Appl. Phys. 84:64 (cantilevers in fluid)", "parameter",
-           (P("mass_ratio", "1", 0.0, -0.9, 5.0, 0.5, "added mass / modelled modal mass"),
-            P("damping_ratio", "1", 0.0, 0.0, 1.0, 0.1, "added damping ratio")),
-           kinds=("actuator",), quantities=("M",), apply=_p_fluid),
+    Effect("viscous_fluid", "beam in a viscous fluid (frequency-dependent added mass and damping)",
+           "Sader's hydrodynamic load on the strip: the modal mass becomes ρ·2hW + (π/4) ρ_f W² Γ_rect*(Re), "
+           "Re = ω W²/(4ν), with the added mass (Re Γ) falling and the viscous damping (Im Γ) rising as the "
+           "frequency falls; parametrised by √(ρ_f η) (what the data determine), ν and an Andrade energy "
+           "E_η.  The inviscid limit (ν → 0) is the constant added mass π ρ_f W²/4 per length, which a free "
+           "ωn absorbs (see physmodel.effects.fluid).",
+           "Sader 1998, J. Appl. Phys. 84:64, eqs. (10), (19)-(21); water/glycerol viscosity (CRC Handbook)",
+           "response",
+           (P("viscous_load", "kg m^-2 s^-0.5", 0.0, 0.0, 70.0, 1.0,
+              "√(ρ_f η) = ρ_f √ν at T_ref (water 1.0, glycerol 42 at 20 °C); ρ_f = it/√ν"),
+            P("log10_viscosity", "log10(m^2/s)", -6.0, -6.6, -2.5, -4.55,
+              "log10 of the kinematic viscosity ν at T_ref (water −6.0 at 20 °C, glycerol −2.95)",
+              limits=("lower",)),
+            P("viscosity_energy", "J/mol", 16e3, 0.0, 70e3, 35e3,
+              "Andrade activation energy E_η of the viscosity (water ≈ 16e3, glycerol ≈ 60e3)", limits=("lower",))),
+           kinds=("actuator",), quantities=("M",), apply=fluid.response_factor, switch="viscous_load",
+           bounds_doc="√(ρ_f η) in [0, 70] kg m⁻² s^-½ (no liquid, up to glycerol near 10 °C: 1263 kg/m³, 3.9 Pa·s); "
+                      "ν from hot water (2.5e-7 m²/s, −6.6: the high-Re end, where ν is not determined and, with "
+                      "ωn free, the load tends to the boundary-layer asymptote — a limit, not a bound to widen; "
+                      "with ωn held, ρ_f = √(ρ_f η)/√ν keeps growing there) to glycerol "
+                      "near 10 °C (3.1e-3 m²/s, −2.5); E_η in [0, 70] kJ/mol (liquids' viscosity falls with T; "
+                      "glycerol ≈ 60 kJ/mol).  Off values (the signature's probe and the first start): water; "
+                      "typical (a second start): water's √(ρ_f η) and the centre of the ν and E_η ranges."),
     Effect("modulus_temperature", "temperature dependence of the modulus",
            "An extra log-linear slope of E with temperature (physmodel.temperature.LogLinear) and a "
            "curvature, E → E·exp(c (T − T_ref) + c2 (T − T_ref)²): gain and resonance move with T "

@@ -30,6 +30,34 @@ data with its Wilson interval, naming accuracy on detectable single effects (con
 rate for two effects, out-of-library outcomes, verdicts resting on a parameter at a bound without
 saying so, the gap-shrink ratio and the time per diagnosis.  Cases run in ``--workers`` processes
 (each diagnosis is single-threaded: OMP/BLAS threads are pinned to 1).
+
+Measured (issue 11, 2026-11-23, shared 2-core machine; "before" = df39d69 with the constant
+``added_fluid_mass``, "after" = 95da746 with Sader's ``viscous_fluid``)::
+
+    A  ... --generator independent --first-seed 1000 --n-per-label 3 --null 24 --workers 2 --no-real
+    B  ... --generator independent --first-seed 5000 --n-per-label 3 --null 24 --workers 2 --no-real
+       (5000-5089: held out, run once per commit after development, never inspected before)
+    C  ... --generator library --library-reps 1 --library-null 30 --workers 2 --no-real
+
+    figure                                         A before  A after  B before  B after  C before  C after
+    FPR on null data (a name)                       1/24      1/24     1/24      1/24     3/42      3/42
+    detectable single effects, confident name       33/38     33/38    33/39     34/39    32/35     33/36
+      the same, λ after the workflow's free set      -        30/34     -        34/36     -        33/36
+    confident wrong names (verdict 'named')         2         0        1         0        0         0
+    two effects, both named (each detectable)       9/10      9/10     7/10      7/10     1/3       2/3
+    out of library -> unexplained (not 'none')      7/7       7/7      6/6       6/6      6/6       6/6
+    verdicts at a bound without saying so           0         0        0         0        0         0
+    wall s per diagnosis (mean; machine load varies) 3.1      8.8      2.3       7.5      -         4.7
+
+Paired CPU time (farm-bench -n 3, after vs before interleaved, one process running 8 diagnoses of
+seeds 5000-5055 incl. start-up): median 29.9 s vs 17.4 s CPU, ratio 1.72 (1.62-1.87), i.e. about
+3.6 s vs 2.1 s per diagnosis: the three-parameter viscous_fluid candidate (refits, null refits).
+Misses left (after): independent fluid loading -> ambiguous between viscous_fluid and
+fractional_transport (AIC within 6, pair not declared confusable; λ 41-76); electrode resistance
+-> none where κe absorbs it (λ after the workflow's free set 0.03-3.7); contact resistance ->
+ambiguous with series_resistance (λ 31); a marginal second effect added on top of water_uptake
+(LR 9.10 vs 8.80); a large series CPE -> unexplained after the baseline drove κe to its bound
+(the candidate refit starts there); leakage on top of a delay absorbed by κe.
 """
 
 from __future__ import annotations
@@ -64,6 +92,8 @@ F = np.logspace(-1, 1.7, 30)
 T = [20.0, 40.0, 60.0]
 FREE = ("alpha0", "d", "xi", "omega_n")
 FREE_INDEPENDENT = ("alpha0", "d", "kappa_e", "xi", "omega_n")
+#: The same freedom in the independent generator's own parametrisation (for its λ after the refit).
+WORKFLOW_FREE_GENERATOR = ("alpha", "d", "eps", "zeta", "f1")
 NOISE = {"low": (0.1, 0.5), "moderate": (0.25, 1.5), "high": (0.6, 4.0)}
 DETECTABLE = 25.0
 CANDS = candidates_for("actuator", "M", len(T))
@@ -180,7 +210,7 @@ def run_case(item):
                          dt=dt, level=level)
     import independent_generator as ig
 
-    sweep, truth = ig.make_case(key, label)
+    sweep, truth = ig.make_case(key, label, workflow_free=WORKFLOW_FREE_GENERATOR)
     base = IPMCParameters.from_dict(dict(truth["library_start"]))
     t0 = time.perf_counter()
     d = diagnose(sweep, base, kind="actuator", free=FREE_INDEPENDENT, alpha=ALPHA, seed=key)
@@ -189,8 +219,14 @@ def run_case(item):
         det = min(truth["lam_each_baseline"].values()) >= DETECTABLE
     else:
         det = (truth["lam_baseline"] or 0.0) >= DETECTABLE
-    return summarise(d, generator=gen, label=label, expected=truth["expected"], lam=truth["lam_baseline"] or 0.0,
-                     detectable=det, out_of_library=truth["out_of_library"], dt=dt)
+    if truth["lam_each_workflow"]:
+        det_w = min(truth["lam_each_workflow"].values()) >= DETECTABLE
+    else:
+        det_w = (truth["lam_workflow"] or 0.0) >= DETECTABLE
+    r = summarise(d, generator=gen, label=label, expected=truth["expected"], lam=truth["lam_baseline"] or 0.0,
+                  detectable=det, out_of_library=truth["out_of_library"], dt=dt)
+    r["detectable_workflow"] = det_w
+    return r
 
 
 def run_all(plan, workers: int):
@@ -270,16 +306,23 @@ def report(rows, title):
     print(f"\n=== False positives on null data (nominal α = {ALPHA}) ===\n  a name (named/ambiguous/at bound): "
           f"{_rate(k, len(nulls))}\n  any verdict but 'none': {_rate(k2, len(nulls))}")
     det = [r for r in singles if r["detectable"]]
+    det_w = [r for r in singles if r.get("detectable_workflow", r["detectable"])]
     print(f"\n=== Naming accuracy, single library effects ===\n  detectable (λ ≥ {DETECTABLE:g}), confident name: "
-          f"{_rate(sum(correct(r) for r in det), len(det))}\n  detectable, incl. 'at bound' names: "
+          f"{_rate(sum(correct(r) for r in det), len(det))}\n  detectable after refitting the workflow's own free "
+          f"set (κe too), confident name: {_rate(sum(correct(r) for r in det_w), len(det_w))}"
+          f"\n  detectable, incl. 'at bound' names: "
           f"{_rate(sum(correct(r, False) for r in det), len(det))}\n  all single cases: "
           f"{_rate(sum(correct(r) for r in singles), len(singles))}")
     wrong = [r for r in singles if r["verdict"] in ("named", "ambiguous") and not correct(r)]
     undeclared = [r for r in wrong if not all(frozenset((r["expected"][0], n)) in r["declared"]
                                               for n in r["named"] if n != r["expected"][0]) or r["expected"][0] not in r["named"]]
-    print(f"  wrong confident names: {len(wrong)}; not between pairs the report declares confusable: {len(undeclared)}")
+    named_wrong = [r for r in wrong if r["verdict"] == "named"]
+    print(f"  wrong names: {len(wrong)} (confident, verdict 'named': {len(named_wrong)}; 'ambiguous' lists naming a "
+          f"candidate the report does not declare confusable with the truth, or missing it: {len(wrong) - len(named_wrong)})"
+          f"; not between pairs the report declares confusable: {len(undeclared)}")
     for r in wrong:
-        print(f"    truth {r['label']:28s} -> {outcome(r)} (λ={r['lam']:.0f})")
+        print(f"    truth {r['label']:28s} -> {outcome(r)}" + (f" {r['named']}" if r["verdict"] == "ambiguous" else "")
+              + f" (λ={r['lam']:.0f})")
     for r in det:
         if not correct(r) and r not in wrong:
             print(f"    missed (detectable) {r['label']:28s} λ={r['lam']:.0f} -> {outcome(r)}")
@@ -342,24 +385,27 @@ def real_data():
 
     print("\n=== Seed 002 width series (W = 4, 2, 1, 0.5 mm) ===")
     print("  (seed 002 prints no width data; (a) the model itself at each width vs the 4 mm calibration;")
-    print("   (b) hypothesis: strips in water, hydrodynamic added mass π ρ_f W²/4 per length scaled with W)")
+    print("   (b) strips in water: Sader's viscous load vs a model holding only the constant added mass)")
     f2 = np.logspace(-1, 1.7, 30)
     for W in (4e-3, 2e-3, 1e-3, 0.5e-3):
         pw = P.replace(W=W)
         noise = MagnitudePhaseNoise(0.25, 1.5)
         data_a = synthesize_sweep(EffectModel(pw, "actuator"), "M", f2, [26.85], noise, seed=int(W * 1e5))
         da = diagnose(data_a, P, kind="actuator", free=("alpha0", "d", "xi"), seed=1)
-        # (b) polymer 2000 kg/m³ + added water mass; the calibrated 4 mm set holds the 4 mm added mass
-        mass = lambda w: 2000.0 * 2 * P.h * w + 1000.0 * math.pi * w**2 / 4        # kg/m, beam + water
-        mu = mass(W) / mass(4e-3) * (4e-3 / W) - 1.0                                  # per-width modal mass change
-        data_b = synthesize_sweep(EffectModel(pw, "actuator", {"added_fluid_mass": {"mass_ratio": mu}}), "M", f2,
-                                  [26.85], noise, seed=int(W * 1e5) + 1)
-        db = diagnose(data_b, pw, kind="actuator", free=("alpha0", "d", "xi"), seed=1)
-        fitted = db.final.values.get("added_fluid_mass.mass_ratio") if db.final else None
+        # (b) a bare strip (2000 kg/m³) in water with Sader's load; the user's model holds the inviscid
+        # added mass π ρ_f W²/4 per length in its density (what a calibration in water at one width gives)
+        water = {"viscous_load": math.sqrt(997.0 * 0.85e-3), "log10_viscosity": math.log10(0.85e-3 / 997.0),
+                 "viscosity_energy": 16e3}
+        bare = pw.replace(rho=2000.0)
+        data_b = synthesize_sweep(EffectModel(bare, "actuator", {"viscous_fluid": water}), "M", f2, [26.85], noise,
+                                  seed=int(W * 1e5) + 1)
+        db = diagnose(data_b, bare.replace(rho=2000.0 + 1000.0 * math.pi * W / (8 * P.h)), kind="actuator",
+                      free=("alpha0", "d", "xi"), seed=1)
+        fitted = db.final.values.get("viscous_fluid.viscous_load") if db.final else None
         print(f"  W = {W * 1e3:3.1f} mm: (a) model at W vs 4 mm set: {da.verdict} (best LR "
               f"{max(c.lr for c in da.candidates.values()):.2g}, threshold {da.threshold:.2g}); "
-              f"(b) water added mass μ = {mu:+.3f}: {db.verdict} {db.named}"
-              + (f" μ̂ = {fitted:+.3f}" if fitted is not None else "") + f"; cost {db.gap_before['cost']:.4g} -> "
+              f"(b) bare strip in water (Sader), model with constant added mass: {db.verdict} {db.named}"
+              + (f" √(ρ_f η) = {fitted:.3g} kg m⁻² s^-½ (water {math.sqrt(997.0 * 0.85e-3):.3g})" if fitted is not None else "") + f"; cost {db.gap_before['cost']:.4g} -> "
               f"{db.gap_after['cost']:.4g}")
 
 

@@ -73,8 +73,9 @@ EFFECT_SPECS: dict[str, tuple] = {
     # Euler-Bernoulli modal sum (6 modes + static residual), Rayleigh damping share of the fluid.
     "second_mode": ("second_mode", {"n_modes": ("fix", 6, 6), "viscous_share": ("lin", 0.5, 1.0)},
                     {"n_modes": 1, "viscous_share": 1.0}),
-    # Extra fluid load: inviscid mass ratio and Reynolds number at ω1 (Sader 1998 Γ_circ).
-    "added_fluid_mass": ("added_fluid_mass", {"mass_ratio": ("log", 0.01, 1.0), "reynolds": ("log", 300.0, 3.0)},
+    # Extra fluid load: inviscid mass ratio and Reynolds number at ω1 (Sader 1998 Γ_circ); the
+    # library's viscous_fluid (its own Γ_rect, fluid density and viscosity parametrisation).
+    "added_fluid_mass": ("viscous_fluid", {"mass_ratio": ("log", 0.01, 1.0), "reynolds": ("log", 300.0, 3.0)},
                          {"mass_ratio": 0.0, "reynolds": 30.0}),
     "modulus_temperature": ("modulus_temperature", {"linear_coeff": ("sym", 3e-4, 0.012)}, {"linear_coeff": 0.0}),
     "diffusivity_temperature": ("diffusivity_temperature", {"q10": ("symlog", 1.01, 1.6)}, {"q10": 1.0}),
@@ -226,13 +227,16 @@ def _parse(label: str) -> list[str]:
 
 def make_case(seed: int, label: str, *, start: dict = START_SEED002, thermal: bool = True,
               frequencies_hz=FREQUENCIES_HZ, temperatures_c=TEMPERATURES_C, perturbed=PERTURBED,
-              size: float | None = None, sigma_rel: float | None = None, baseline_lambda: bool = True):
+              size: float | None = None, sigma_rel: float | None = None, baseline_lambda: bool = True,
+              workflow_free: tuple | None = None):
     """One blind case: ``(FrequencySweep in mm/V with per-line σ, truth dict)``.
 
     ``label``: "none", an effect name of :data:`EFFECT_SPECS`, or "a+b".  ``thermal``: the base
     follows the starting set's temperature laws (else every parameter is constant: give the workflow
     isothermal laws too).  ``size``: quantile of the effect ranges (random if None).
-    ``sigma_rel``: relative noise (drawn from 0.5-2 % if None).
+    ``sigma_rel``: relative noise (drawn from 0.5-2 % if None).  ``workflow_free``: base keys the
+    workflow frees (e.g. ``("alpha", "d", "eps", "zeta", "f1")``); if given, ``lam_workflow`` (and
+    ``lam_each_workflow`` for a pair) is λ after refitting those instead of the perturbed ones.
     """
     names = _parse(label)
     r_base, r_eff, r_noise = (np.random.default_rng(s) for s in np.random.SeedSequence([SEALED, int(seed)]).spawn(3))
@@ -260,7 +264,7 @@ def make_case(seed: int, label: str, *, start: dict = START_SEED002, thermal: bo
         "library_base": library_fields(base), "library_start": library_fields(_at_reference(start, start["T0_c"], thermal)),
         "noise": {"sigma_rel": sig_rel, "floor_m_per_V": float(floor)},
         "lam": noncentrality(H1, H0, sig) if effects else 0.0,
-        "lam_each": {}, "lam_baseline": None, "lam_each_baseline": {},
+        "lam_each": {}, "lam_baseline": None, "lam_each_baseline": {}, "lam_workflow": None, "lam_each_workflow": {},
     }
     for n in names if len(names) > 1 else []:
         rest = {k: v for k, v in effects.items() if k != n}
@@ -269,6 +273,11 @@ def make_case(seed: int, label: str, *, start: dict = START_SEED002, thermal: bo
             truth["lam_each_baseline"][n] = baseline_noncentrality(H1, base, rest, f, T, sig, perturbed)
     if baseline_lambda:
         truth["lam_baseline"] = baseline_noncentrality(H1, base, {}, f, T, sig, perturbed) if effects else 0.0
+    if workflow_free is not None:
+        truth["lam_workflow"] = baseline_noncentrality(H1, base, {}, f, T, sig, workflow_free) if effects else 0.0
+        for n in names if len(names) > 1 else []:
+            rest = {k: v for k, v in effects.items() if k != n}
+            truth["lam_each_workflow"][n] = baseline_noncentrality(H1, base, rest, f, T, sig, workflow_free)
     return sweep, truth
 
 

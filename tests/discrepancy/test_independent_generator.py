@@ -252,6 +252,14 @@ def test_lambda_properties():
     small = gen.make_case(0, "series_resistance", size=0.0)[1]["lam_baseline"]
     large = gen.make_case(0, "series_resistance", size=1.0)[1]["lam_baseline"]
     assert small < 25 < large
+    # λ after refitting a larger free set (the workflow's, κe too) can only be smaller (nested fits);
+    # the same free set gives the same λ
+    _, tw = gen.make_case(0, "contact_resistance+leakage", workflow_free=gen.PERTURBED + ("eps",))
+    assert 0 <= tw["lam_workflow"] <= tw["lam_baseline"] * (1 + 1e-6)
+    for n in tw["lam_each"]:
+        assert 0 <= tw["lam_each_workflow"][n] <= tw["lam_each_baseline"][n] * (1 + 1e-6)
+    _, ts = gen.make_case(0, "leakage", workflow_free=gen.PERTURBED)
+    assert ts["lam_workflow"] == pytest.approx(ts["lam_baseline"], rel=1e-9)
 
 
 def test_bad_labels_and_sizes():
