@@ -60,9 +60,18 @@ def numerator_ls(w, h, n_zeros: int, den, relative: bool = True, powers=None):
     return _solve_weighted(a, h * d, wt)
 
 
-def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8, powers=None):
+#: SK stops once its weights 1/|D(jw̃)| change by less than this (largest relative change over
+#: the lines): the next iterate would move the start by about as much, which the
+#: Levenberg–Marquardt solve that follows removes in its first step
+SK_WEIGHT_CHANGE = 1e-3
+
+
+def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8, powers=None,
+                       weight_change: float = SK_WEIGHT_CHANGE):
     """SK iterations (relative weighting); returns every iterate, Levy's first.
-    ``powers``: (jw̃)^k for k = 0..n_poles (columns), if already at hand."""
+    ``powers``: (jw̃)^k for k = 0..n_poles (columns), if already at hand.  Stops after
+    ``n_iter`` reweightings, or earlier once the weights have converged: the largest relative
+    change of |D(jw̃)| between two iterates is at most ``weight_change`` (0: never early)."""
     w = np.asarray(w, float)
     h = np.asarray(h, complex)
     jw = 1j * w
@@ -77,14 +86,20 @@ def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8, powers=None):
     wt2 = np.empty(2 * n_w)
     wt2[:n_w] = wt2[n_w:] = rel
     out = []
-    for _ in range(n_iter + 1):
+    d_old = None
+    for i in range(n_iter + 1):
         sol = stacked_weighted_lstsq(ar, br, wt2)
         den = np.empty(n_poles + 1)
         den[:n_poles], den[n_poles] = sol[n_zeros + 1:], 1.0
         out.append((sol[:n_zeros + 1], den))
+        if i == n_iter:
+            break
         d = np.abs(vd @ den)
         if not (np.isfinite(d).all() and d.all()):
             break
+        if d_old is not None and np.abs(d / d_old - 1.0).max() <= weight_change:
+            break
+        d_old = d
         np.divide(rel, d, out=wt2[:n_w])
         wt2[n_w:] = wt2[:n_w]
     return out
