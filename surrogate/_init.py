@@ -6,6 +6,8 @@ vectors of a ``sections`` (stable) or ``coefficients`` (free) structure.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from physmodel.numerics import stacked_weighted_lstsq, weighted_complex_lstsq
@@ -133,6 +135,18 @@ def spread_poles(w, n_poles: int, damping: float = 0.5) -> np.ndarray:
     return np.array(rts, complex)
 
 
+@lru_cache(maxsize=64)
+def _spread_sections(w_min: float, w_max: float, n_poles: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pole slots and monic denominator (ascending) of ``spread_poles`` over [w_min, w_max]:
+    they depend on the band only, so the fits of a sweep's temperatures (one band) share
+    them.  The same operations as ``_stable_sections_theta`` applies to any poles."""
+    stable = stabilise_roots(spread_poles(np.array([w_min, w_max]), n_poles))
+    slots = np.array(pole_slots_from_groups(*group_roots(stable)), float)
+    den = np.real(np.poly(stable)[::-1])
+    slots.flags.writeable = den.flags.writeable = False
+    return slots, den
+
+
 def _sk_costs(sk, structure, costs):
     """Cost of each SK iterate as it stands (coefficient form, one batched evaluation),
     +inf where a pole is unstable (those would be reflected before use), and the poles of
@@ -182,7 +196,8 @@ def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.
                 if np.all(np.isfinite(poles[i])):
                     theta = _stable_sections_theta(w, h, m, poles[i], num, powers)
                     cands.append(("levy" if i == 0 else f"sk{i}", theta))
-            cands.append(("spread", _stable_sections_theta(w, h, m, spread_poles(w, n), powers=powers)))
+            slots, den = _spread_sections(float(w.min()), float(w.max()), n)
+            cands.append(("spread", np.concatenate([numerator_ls(w, h, m, den, powers=powers), slots])))
     cands = [(name, th) for name, th in cands if np.isfinite(th).all()]
     if not cands:
         return []

@@ -33,6 +33,11 @@ try:        # what numpy.einsum calls (optimize=False), without its dispatch lay
     from numpy._core.multiarray import c_einsum as _einsum
 except ImportError:  # pragma: no cover - other numpy layouts
     _einsum = np.einsum
+try:        # the gufunc numpy.linalg.solve calls, without its checks and error-state switching
+    from numpy.linalg._umath_linalg import solve as _gesv
+except ImportError:  # pragma: no cover - other numpy layouts
+    def _gesv(a, b, signature=None):
+        return np.linalg.solve(a, b)
 
 __all__ = ["Evaluator", "LevenbergMarquardt", "STATUS_OK", "STATUS_ACCEPTABLE", "STATUS_MAXITER",
            "STATUS_STOPPED", "STATUS_FAILED"]
@@ -405,7 +410,9 @@ class LevenbergMarquardt:
                 a = np.where(free[:, :, None] & free[:, None, :], a, 0.0)
                 b = np.where(free, b, 0.0)
                 np.einsum("sii->si", a)[...] = np.where(free, np.einsum("sii->si", a) + mu[:, None], 1.0)
-            step = np.linalg.solve(a, b[..., None])[..., 0]
+            # LAPACK gesv as numpy.linalg.solve runs it; a singular system (not expected: μ > 0
+            # on a unit diagonal) gives a non-finite step, which the step control rejects
+            step = _gesv(a, b[..., None], signature="dd->d")[..., 0]
             step /= -d
             xt = x + step
             if bounded:
