@@ -348,10 +348,14 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
            data: FrequencyData, *, weighting_name: str, method: str, settings: dict,
            scale_covariance: bool, history: list, time_s: float, temperature_range,
            compute_covariance: bool = True, two_stage=None, per_temperature_models=None,
-           raise_on_failure: bool = True, stability_grid: int = 501, temperatures=None) -> FitResult:
+           raise_on_failure: bool = True, stability_grid: int = 501, temperatures=None,
+           cost_is_mean_square: bool = False) -> FitResult:
     """The ``FitResult`` of ``outcome``.  The covariance (from the Jacobian at the optimum),
     the per-temperature errors and the stability check are deferred: computed, the same
-    way, when first read.  ``temperatures``: ``data.temperatures()`` if already at hand."""
+    way, when first read.  ``temperatures``: ``data.temperatures()`` if already at hand.
+    ``cost_is_mean_square``: ``outcome.cost`` is ½·mean(r²) of ``evaluator``'s residuals at
+    ``outcome.theta`` (a Levenberg–Marquardt outcome), so the weighted RMS is √(2·cost)
+    without evaluating the residuals again."""
     theta = outcome.theta
     cov = None
     at_bounds = []
@@ -365,7 +369,11 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
         lo, hi = structure.bounds(float(problem.w.min()), float(problem.w.max()))
         names = param_names
         at_bounds = [names[i] for i in np.flatnonzero((theta <= lo + 1e-6) | (theta >= hi - 1e-6))]
-    r = (evaluator or problem).residual(theta)
+    if cost_is_mean_square and np.isfinite(outcome.cost):
+        weighted_rms = float(np.sqrt(2.0 * outcome.cost))
+    else:
+        r = (evaluator or problem).residual(theta)
+        weighted_rms = float(np.sqrt(np.mean(r ** 2)))
     temps = data.temperatures() if temperatures is None else temperatures
     fingerprint = data.fingerprint()
     info = {
@@ -389,7 +397,7 @@ def finish(structure, problem: Problem, evaluator, outcome: SolveOutcome, scalin
     res = FitResult(
         model=model, converged=outcome.converged, status=outcome.status,
         iterations=outcome.iterations, cost=outcome.cost,
-        weighted_rms=float(np.sqrt(np.mean(r ** 2))), weighting=weighting_name, method=method,
+        weighted_rms=weighted_rms, weighting=weighting_name, method=method,
         param_names=param_names, params=theta.copy(), at_bounds=at_bounds,
         time_s=time_s, data_fingerprint=fingerprint,
         history=history, two_stage=two_stage, per_temperature_models=per_temperature_models,

@@ -65,7 +65,7 @@ def numerator_ls(w, h, n_zeros: int, den, relative: bool = True, powers=None):
 #: SK stops once its weights 1/|D(jw̃)| change by less than this (largest relative change over
 #: the lines): the next iterate would move the start by about as much, which the
 #: Levenberg–Marquardt solve that follows removes in its first step
-SK_WEIGHT_CHANGE = 1e-3
+SK_WEIGHT_CHANGE = 1e-2
 
 
 def sanathanan_koerner(w, h, n_zeros, n_poles, n_iter: int = 8, powers=None,

@@ -144,7 +144,8 @@ class RationalFit:
                        method="rational", settings=self.settings(),
                        scale_covariance=self.scale_covariance, history=history,
                        time_s=time.perf_counter() - t_start, temperature_range=temp_range,
-                       raise_on_failure=self.raise_on_failure, temperatures=temps)
+                       raise_on_failure=self.raise_on_failure, temperatures=temps,
+                       cost_is_mean_square=True)
         self.model_, self.result_, self.history_ = res.model, res, history
         return res
 
