@@ -167,18 +167,20 @@ def _sk_costs(sk, structure, costs):
     return np.where(stable & np.isfinite(c), c, np.inf), poles
 
 
-def initial_candidates(structure: Structure, w, h, costs) -> list[tuple[str, np.ndarray]]:
+def initial_candidates(structure: Structure, w, h, costs, powers=None) -> list[tuple[str, np.ndarray]]:
     """Distinct starting points, best first: Levy's answer, the best Sanathanan–Koerner
     iterate and (stable forms) poles log-spread over the band.
 
     ``costs(structure, thetas)`` scores a stack of parameter vectors (k, p) of a structure
     with these orders (the fit's own, or the coefficient form for ranking the raw SK
-    iterates, so that only the best stable one is converted to sections).
+    iterates, so that only the best stable one is converted to sections).  ``powers``:
+    (jw̃)^k for k = 0..max(orders) (columns), if already at hand (``Evaluator.spow``).
     """
     m, n = structure.n_zeros, structure.n_poles
     cands = []
     w = np.asarray(w, float)
-    powers = (1j * w)[:, None] ** np.arange(max(m, n) + 1)      # shared by SK and the numerators
+    if powers is None:                                          # shared by SK and the numerators
+        powers = (1j * w)[:, None] ** np.arange(max(m, n) + 1)
     sk = sanathanan_koerner(w, h, m, n, powers=powers)
     with np.errstate(all="ignore"):
         if structure.form == "coefficients":

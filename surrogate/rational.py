@@ -126,7 +126,7 @@ class RationalFit:
             ev = evaluator if structure == st else evaluator.with_structure(structure)
             return ev.costs(thetas)
 
-        cands = initial_candidates(st, problem.w, problem.h, costs)
+        cands = initial_candidates(st, problem.w, problem.h, costs, powers=evaluator.spow)
         if self.init == "auto":
             starts += cands
         else:

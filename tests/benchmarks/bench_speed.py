@@ -25,6 +25,11 @@ fit     Per-temperature fit (``RationalFit``, whole call) against a reference: o
         time to our cost scaled by the same fraction of its run), which other processes on a
         shared machine disturb less than wall time.  The result's covariance, per-temperature
         errors and stability check are computed when first read (none is read in the timing).
+        Measured 2026-11-23 (3 runs each, interleaved with ``--root`` = main at c5c4bf8; median
+        [min–max], wall): before 0.72 [0.71–0.73] / 1.10 [1.09–1.12] / 1.17 [1.15–1.17] /
+        0.35 [0.34–0.35], after 0.68 [0.67–0.69] / 0.94 [0.81–0.97] / 0.97 [0.97–1.00] /
+        0.31 [0.31–0.33] (CPU after: 0.68 / 0.93 / 0.97 / 0.32); final costs equal to main's
+        within 3.4e-10 (relative) on these cases and two more noise seeds per case.
 build   Cost of building the CasADi/IPOPT problem against the number of lines, and the first
         vs the cached joint fit (fresh interpreter each) at 10 temperatures × 240 lines.
 joint   Joint zpk schedules on the seed 001 physics (``seed001_actuator``, 0.1–9 Hz, 60 lines,
