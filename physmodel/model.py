@@ -197,6 +197,15 @@ class PhysicsModel:
     def state(self, temperature_c) -> State:
         return self._table.state(temperature_c)
 
+    def evaluate_state(self, state: State, s, quantities=None) -> dict[str, np.ndarray]:
+        """Quantities at complex Laplace points ``s`` [1/s] for a :class:`~physmodel.params.State`
+        built by the caller (e.g. by a :class:`~physmodel.parameter_paths.StateMap`, one row per
+        parameter set), whatever this model's own parameter sets; arrays (n_rows, n_T, n_s) in
+        the units of :attr:`units`.  Nothing is checked but the quantity names: the fast path of
+        calibration, which validates its points once."""
+        qs = self._check_quantities(quantities or self.quantities)
+        return evaluate_grid(state, np.asarray(s), self._kernel, qs, self.chunk_size)
+
     def evaluate(self, s, temperature_c, quantities=None, out=None, progress=None) -> dict:
         """Quantities at complex Laplace points ``s`` [1/s]; arrays (n_sets, n_T, n_s)."""
         qs = self._check_quantities(quantities or self.quantities)

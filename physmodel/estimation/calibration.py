@@ -60,7 +60,6 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
     a ``predict_array``): states built as arrays by a :class:`~physmodel.parameter_paths.StateMap`,
     no parameter set per row; None when the state is not log-affine in those parameters.
     """
-    from ..model import evaluate_grid
     from ..params import STATE_FIELDS, State
     from ..protocol import physics_model
 
@@ -89,20 +88,27 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
                                                 [base_value(base, fp.name) if fp.initial is None else fp.initial
                                                  for fp in free], Tu)
     if smap is not None:
-        # the kernel of the same model class, evaluated on states built as arrays (model.evaluate_grid)
-        kern = physics_model(kind, base, kernel=kernel)._kernel
+        # the same model class, evaluated on states built as arrays
+        model = physics_model(kind, base, kernel=kernel)
         s_data, s_probe = 2j * np.pi * fu, 2j * np.pi * f_probe
+
+        # lines laid out as the (temperature × frequency) grid, row-major: a reshape, not a gather
+        on_grid = inv_T.size == Tu.size * fu.size and np.array_equal(inv_T * fu.size + inv_f, np.arange(inv_T.size))
 
         def predict_array(X):
             with np.errstate(all="ignore"):     # a non-finite response is refused by the residuals
-                R = evaluate_grid(smap(X), s_data, kern, (q,))[q]
+                R = model.evaluate_state(smap(X), s_data, (q,))[q]
+            if on_grid:
+                R = R.reshape(R.shape[0], -1)
+                R *= factor
+                return R
             return R[:, inv_T, inv_f] * factor
 
         def probe_array(X):
             st = smap(X)
             st = State(**{k: getattr(st, k)[:, i_probe:i_probe + 1] for k in STATE_FIELDS})
             with np.errstate(all="ignore"):
-                return evaluate_grid(st, s_probe, kern, (q,))[q][:, 0, :] * factor
+                return model.evaluate_state(st, s_probe, (q,))[q][:, 0, :] * factor
 
         key = (smap, tuple(free), kind, q, kernel, fu.tobytes(), Tu.tobytes(), inv_T.tobytes(), inv_f.tobytes())
         if key not in _PLANS:
@@ -140,18 +146,22 @@ def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
     x0 = np.array([fp.initial if fp.initial is not None else fp.midpoint() for fp in free])
     X1 = np.vstack([x0, [float(fp.from_z(0.3 * fp.z_bounds[0] + 0.7 * fp.z_bounds[1])) for fp in free]])
     single = []
+    # every pair (k, j) at once: c_kj(T) = <A_k, A_j>/<A_j, A_j> per temperature, and whether
+    # A_k = c_kj A_j to 1e-12 of max|A_k| (the loop below only picks the first match)
+    gram = np.einsum("vtk,vtj->tkj", A, A)                                            # (n_T, n, n)
+    nj = np.diagonal(gram, axis1=1, axis2=2)                                          # (n_T, n)
+    cs = np.divide(gram, nj[:, None, :], out=np.zeros_like(gram), where=nj[:, None, :] > 0)
+    atol = 1e-12 * np.abs(A).max(axis=(0, 1))                                         # (n,)
+    match = np.all(np.abs(A[:, :, :, None] - cs[None] * A[:, :, None, :]) <= atol[None, None, :, None], axis=(0, 1))
+    moves = np.count_nonzero(np.abs(A).max(axis=1), axis=0)                          # fields moved per parameter
     for k in range(len(free)):
         if dudz[k] is None:
             continue
         for j in range(k):
-            if dudz[j] is None or j in plan:
-                continue
-            nj = np.einsum("vt,vt->t", A[:, :, j], A[:, :, j])
-            c = np.divide(np.einsum("vt,vt->t", A[:, :, k], A[:, :, j]), nj, out=np.zeros(nj.size), where=nj > 0)
-            if np.allclose(A[:, :, k], c * A[:, :, j], rtol=0, atol=1e-12 * np.abs(A[:, :, k]).max()):
-                plan[k] = ("scaled", j, c[inv_T])
+            if dudz[j] is not None and j not in plan and match[k, j]:
+                plan[k] = ("scaled", j, cs[:, k, j][inv_T])
                 break
-        if k not in plan and np.count_nonzero(np.abs(A[:, :, k]).max(axis=1)) == 1:
+        if k not in plan and moves[k] == 1:
             single.append(k)        # the affine test below only for a parameter moving one field
     if not single:
         return plan
