@@ -152,7 +152,22 @@ class ActuatorModel(PhysicsModel):
     def evaluate_state(self, state: State, s, quantities=None) -> dict[str, np.ndarray]:
         """As :meth:`PhysicsModel.evaluate_state`; a batch that fits one chunk and whose later sets
         repeat the first one's electrode line or slice (:func:`shared_rows`) evaluates those
-        terms once (the same numbers bit for bit)."""
+        terms once (the same numbers bit for bit).
+
+        Parameters
+        ----------
+        state : State
+            Parameter values as arrays (n_rows, n_T, 1). [SI]
+        s : array_like
+            1-D complex Laplace points, nonzero and finite (not checked). [1/s]
+        quantities : sequence of str or None
+            Names from :attr:`quantities` (default all).
+
+        Returns
+        -------
+        dict of str to ndarray
+            Complex arrays (n_rows, n_T, n_s) [Ω, m/V, -, m/V, A/V].
+        """
         qs = self._check_quantities(quantities or self.quantities)
         s = np.asarray(s)
         n_sets, n_T = state.T.shape[:2]

@@ -6,7 +6,7 @@ one or many :class:`~physmodel.data.sweep.FrequencySweep` by weighted nonlinear 
 returned as a :class:`CalibrationResult` with 95 % confidence intervals, the correlation matrix
 and an identifiability report.
 
-Residuals (discrepancy.md §1)
+Residuals (discrepancy.md §1; :class:`~physmodel.estimation.residuals.SweepResiduals`)
     For each line the relative error ln(G_data/G_model) is split into log-magnitude and phase:
     ``r = [ln|G_d/G_m| / σ_ln, wrap(∠G_d − ∠G_m) / σ_φ]`` with σ_ln = magnitude_std_db·ln10/20 and
     σ_φ = phase_std_deg·π/180 from the sweep.  The cost ½Σr² of a correct model averages
@@ -15,7 +15,8 @@ Residuals (discrepancy.md §1)
     Fallback when the sweep carries no per-line standard deviations: every line gets
     σ_ln = σ_φ = :data:`FALLBACK_RELATIVE_STD` (1 % relative error), the result says
     ``noise_estimated=True``, and the covariance is rescaled by the residual variance
-    2·cost/(2F − nθ) (the usual estimated-σ² least-squares covariance).
+    2·cost/(2F − nθ) (the usual estimated-σ² least-squares covariance).  Scalar observations
+    (:class:`ScalarObservations`, e.g. a0(T)) give one residual each, ln|y_model/y|/σ_ln.
 
 Scaled space
     A ``"log"`` parameter is fitted as z = log10(|x|) (both bounds of one sign; its sign is kept),
@@ -73,8 +74,17 @@ from .records import (
     SensitivityProbe,
     StartRecord,
     Values,
+    lhs_starts,
 )
-from .residuals import gauss_newton_covariance, goodness_of_fit, residual_model
+from .residuals import (
+    ZERO_REASON,
+    ZERO_SENSITIVITY,
+    gauss_newton_covariance,
+    goodness_of_fit,
+    insensitive,
+    residual_model,
+    tenth_moves,
+)
 
 #: Two-sided 95 % normal quantile.
 Z95 = 1.959963984540054
@@ -95,20 +105,6 @@ JOIN_DISTANCE = 0.1
 
 
 # =============================================================================== the engine
-def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
-    """``n`` Latin-hypercube points in the scaled boxes (n, n_free), seeded."""
-    from scipy.stats import qmc
-
-    if n <= 0:
-        return np.empty((0, len(free)))
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ParameterError(f"seed must be a non-negative integer, got {seed!r}")
-    u = qmc.LatinHypercube(d=len(free), seed=seed).random(n)
-    lo = np.array([fp.z_bounds[0] for fp in free])
-    hi = np.array([fp.z_bounds[1] for fp in free])
-    return lo + u * (hi - lo)
-
-
 @dataclass
 class _Fit:
     index: int
@@ -189,8 +185,8 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         g = J.T @ r
         try:
             step = np.linalg.solve(J.T @ J, -g)
-        except np.linalg.LinAlgError:
-            return None, "", None, c
+        except np.linalg.LinAlgError:       # e.g. a zero column: the minimum-norm step
+            step = np.linalg.lstsq(J, -r, rcond=None)[0]
         decrement = -0.5 * float(g @ step)
         if 0 <= decrement < GN_DECREMENT * s2:
             return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c
@@ -295,7 +291,7 @@ def _identifiability(free_all, active, z, J, cov, x_full, res, probe, batch, fd_
     corr = cov / np.outer(d, d)
     peaks = _sensitivity_peaks(free_all, active, x_full, J, res, probe, batch, fd_step)
     fmin, fmax = res.band_hz
-    report, badness = {}, {}
+    report, badness, dead = {}, {}, []
     for j, fp in enumerate(free):
         lo, hi = fp.z_bounds
         width = 2 * Z95 * se[j]
@@ -311,6 +307,11 @@ def _identifiability(free_all, active, z, J, cov, x_full, res, probe, batch, fd_
         elif hi - z[j] <= BOUND_TOL * (hi - lo):
             pinned = "upper" if fp.scale == "linear" or fp.sign > 0 else "lower"
         peak_hz, frac = peaks[fp.name]
+        if np.abs(J[:, j]).max() * 0.1 * (hi - lo) <= ZERO_SENSITIVITY:
+            report[fp.name] = Identifiability(False, ZERO_REASON, peak_hz, frac)
+            badness[fp.name] = np.inf
+            dead.append(fp.name)
+            continue
         where = ""
         if frac < 0.5:
             side = "above" if peak_hz > fmax else "below" if peak_hz < fmin else "inside"
@@ -337,7 +338,7 @@ def _identifiability(free_all, active, z, J, cov, x_full, res, probe, batch, fd_
         else:
             report[fp.name] = Identifiability(True, "determined by the data" + (f" ({where})" if where else ""),
                                               peak_hz, frac)
-    return report, badness, se, corr
+    return report, badness, se, corr, dead
 
 
 def _fmt_hz(f: float) -> str:
@@ -350,7 +351,7 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
                    free: Sequence[FreeParameter], *, starts: int = 1, seed: int = 0,
                    predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
                    fixed: Values | None = None, max_nfev: int | None = None, ftol: float = 1e-10,
-                   identify: bool = True, hold_undetermined: bool = True,
+                   identify: bool = True, hold_undetermined: bool | str = True,
                    probe: SensitivityProbe | None = None, fd_step: float = FD_STEP,
                    progress: Callable[[int], None] | None = None,
                    predict_array: Callable[[np.ndarray], np.ndarray] | None = None) -> CalibrationResult:
@@ -376,8 +377,12 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     max_nfev, ftol, fd_step : int or None, float, float
         Residual evaluations per start and relative cost tolerance (scipy's meaning); the
         forward-difference step in the scaled coordinates. [-]
-    identify, hold_undetermined : bool
-        Flag undetermined parameters (module doc); hold them at their start-0 value and refit.
+    identify : bool
+        Flag undetermined parameters (module doc).
+    hold_undetermined : bool or "insensitive"
+        Hold undetermined parameters at their start-0 value and refit (one at a time, the worst
+        first; those at a bound or with zero sensitivity at once); ``"insensitive"``: only those
+        the data do not depend on (the others keep their fitted value and interval).
     probe : SensitivityProbe or None
         Wide-band evaluation locating where each parameter acts.
     progress : callable or None
@@ -401,6 +406,8 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         raise IPMCError("give predict, predict_many or predict_array")
     if int(starts) < 1:
         raise IPMCError(f"starts must be >= 1, got {starts}")
+    if hold_undetermined not in (True, False, "insensitive"):
+        raise IPMCError(f"hold_undetermined must be True, False or 'insensitive', got {hold_undetermined!r}")
     if max_nfev is not None and int(max_nfev) < 1:
         raise IPMCError(f"max_nfev must be >= 1, got {max_nfev}")
     fixed = dict(fixed or {})
@@ -412,15 +419,25 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     x_init = [fp.initial if fp.initial is not None else fp.midpoint() for fp in free]
     x_full = np.array(x_init, dtype=float)
     z_init = np.array([fp.to_z(x) for fp, x in zip(free, x_init)], float)
-    z_starts = np.vstack([z_init[None, :], _lhs_starts(free, int(starts) - 1, seed)])
-    records, fits = [], []
+    held: dict[str, Identifiability] = {}
+    if hold_undetermined == "insensitive":
+        R = res(batch(ScaledRows(free, x_full, range(len(free)))(tenth_moves(free, z_init))))
+        held = {free[k].name: Identifiability(False, ZERO_REASON + "; held at its start value") for k in insensitive(R)}
+        if len(held) == len(free):
+            raise IPMCError(f"the data depend on none of the free parameters {list(held)} (zero sensitivity)")
+    active = [k for k, fp in enumerate(free) if fp.name not in held]
+    z_starts = np.vstack([z_init[None, :], lhs_starts(free, int(starts) - 1, seed)])
+    z_starts[:, [k for k in range(len(free)) if k not in active]] = z_init[[k for k in range(len(free)) if k not in active]]
+    records, fits, ends = [], [], []
     for i, z0 in enumerate(z_starts):
-        fit = _solve(free, range(len(free)), x_full, z0, batch, res, max_nfev, ftol, fd_step, fits)
+        fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits)
         fit.index = i
         fits.append(fit)
+        ends.append(z0.copy())
+        ends[-1][active] = fit.z
         initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
         records.append(StartRecord(i, initial,
-                                   {fp.name: float(fp.from_z(v)) for fp, v in zip(free, fit.z)},
+                                   {fp.name: float(fp.from_z(v)) for fp, v in zip(free, ends[-1])},
                                    fit.cost, fit.nfev, fit.status, fit.message))
         if progress:
             progress(1)
@@ -430,9 +447,7 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     message = f"best of {len(fits)} start(s) is start {best}: {fit.message}"
 
     # identifiability: flag, hold the worst, refit the rest; repeat
-    active = list(range(len(free)))
-    z_full = fit.z.copy()
-    held: dict[str, Identifiability] = {}
+    z_full = ends[best].copy()
     report: dict = {}
     while True:
         act = [free[k] for k in active]
@@ -451,12 +466,12 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
             d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
             corr = cov / np.outer(d, d)
             break
-        report, badness, se, corr = _identifiability(free, active, fit.z, fit.J, cov, x_full, res, probe, batch,
-                                                     fd_step)
-        if not badness or not hold_undetermined:
+        report, badness, se, corr, dead = _identifiability(free, active, fit.z, fit.J, cov, x_full, res, probe,
+                                                           batch, fd_step)
+        if not badness or not hold_undetermined or (hold_undetermined == "insensitive" and not dead):
             break
         pinned = [n for n, b in badness.items() if b == np.inf]
-        to_hold = pinned or [max(badness, key=badness.get)]
+        to_hold = dead if hold_undetermined == "insensitive" else pinned or [max(badness, key=badness.get)]
         for n in to_hold:
             held[n] = report[n]
         active = [k for k in active if free[k].name not in held]

@@ -139,6 +139,21 @@ class FreeParameter:
         """
         return replace(self, initial=float(value))
 
+
+def lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
+    """``n`` Latin-hypercube points in the scaled boxes (n, n_free), seeded."""
+    from scipy.stats import qmc
+
+    if n <= 0:
+        return np.empty((0, len(free)))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be a non-negative integer, got {seed!r}")
+    u = qmc.LatinHypercube(d=len(free), seed=seed).random(n)
+    lo = np.array([fp.z_bounds[0] for fp in free])
+    hi = np.array([fp.z_bounds[1] for fp in free])
+    return lo + u * (hi - lo)
+
+
 class ScaledRows:
     """Physical rows (n_sets, n_free) of parameter values: ``x_full`` [each parameter's SI unit]
     with the ``active`` columns of ``free`` at scaled coordinates ``Z`` (n_sets, n_active) [-];

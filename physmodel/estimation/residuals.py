@@ -214,6 +214,28 @@ class ObservationResiduals:
         return np.abs(J * self.s_ln[:, None])
 
 
+#: A parameter whose move across a tenth of its scaled range changes no standardised residual by
+#: more than this has zero sensitivity: the data do not depend on it (held, not fitted).
+ZERO_SENSITIVITY = 1e-6
+ZERO_REASON = (f"the data do not depend on it (zero sensitivity: a move across a tenth of its bounds changes no "
+               f"residual by more than {ZERO_SENSITIVITY:g} σ)")
+
+
+def tenth_moves(free, z) -> np.ndarray:
+    """Rows (1 + n, n) of scaled coordinates: ``z``, then each parameter moved by a tenth of its
+    scaled range (away from its nearer bound) [-]."""
+    lo = np.array([fp.z_bounds[0] for fp in free])
+    hi = np.array([fp.z_bounds[1] for fp in free])
+    step = np.where(z + 0.1 * (hi - lo) <= hi, 0.1, -0.1) * (hi - lo)
+    return np.vstack([z, z + np.diag(step)])
+
+
+def insensitive(R: np.ndarray) -> list[int]:
+    """Indices of the parameters whose move (rows 1.. of ``R``, the residuals at
+    :func:`tenth_moves`) changes no residual by more than :data:`ZERO_SENSITIVITY`."""
+    return np.flatnonzero(np.abs(R[1:] - R[0]).max(axis=1) <= ZERO_SENSITIVITY).tolist()
+
+
 def residual_model(data):
     """:class:`SweepResiduals` or :class:`ObservationResiduals` for ``data``; anything else is an
     IPMCError."""
