@@ -100,33 +100,31 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
 
 
 def shared_rows(state: State):
-    """For a batch of states (n_sets, n_T, 1) whose later sets repeat the first one's electrode
+    """For a batch of states (n_sets, n_T, 1) in which some sets repeat an earlier set's electrode
     line (:data:`LINE_FIELDS`) or slice (:data:`SLICE_FIELDS`) at every temperature — e.g. the
     finite-difference sets of a parameter acting only on the mode or the gain — the ``shared``
     argument of :func:`actuator_kernel` for its flat rows (set-major); None when no set does."""
     n_sets, n_T = state.T.shape[:2]
     cols = [getattr(state, f) for f in LINE_FIELDS]
-    if any(c.shape != (n_sets, n_T, 1) for c in cols):
+    if n_sets < 2 or any(c.shape != (n_sets, n_T, 1) for c in cols):
         return None
-    F = np.concatenate(cols, axis=2)
-    eq = (F == F[:1]).all(axis=1)                                      # (n_sets, n_fields)
-    same_line, same_slice = eq.all(axis=1), eq[:, :len(SLICE_FIELDS)].all(axis=1)
-    same_line[0] = same_slice[0] = False
-    if not same_slice.any():
-        return None
+    F = np.concatenate(cols, axis=2)                                  # (n_sets, n_T, n_fields)
     t = np.arange(n_T)
 
-    def level(keep_mask):
-        """(first, inverse) over rows for sets where keep_mask, others mapped onto set 0."""
-        kept = np.flatnonzero(keep_mask)
-        pos = np.zeros(keep_mask.size, dtype=int)
-        pos[kept] = np.arange(kept.size)
-        return (kept[:, None] * n_T + t).ravel(), (pos[:, None] * n_T + t).ravel(), kept
+    def level(sets, n_fields):
+        """(first, inverse) over the rows of ``sets``: each set mapped onto the first identical one."""
+        seen: dict = {}
+        first = [seen.setdefault(F[i, :, :n_fields].tobytes(), j) for j, i in enumerate(sets)]
+        kept = sorted(set(first))
+        if len(kept) == len(sets):
+            return None, list(sets)
+        pos = {j: k for k, j in enumerate(kept)}
+        inv = np.array([pos[j] for j in first])
+        return ((np.array(kept)[:, None] * n_T + t).ravel(), (inv[:, None] * n_T + t).ravel()), [sets[j] for j in kept]
 
-    line = level(~same_line) if same_line.any() else None
-    kept_line = np.arange(n_sets) if line is None else line[2]
-    sl = level(~same_slice[kept_line]) if same_slice[kept_line].any() else None
-    return (None if line is None else line[:2]), (None if sl is None else sl[:2])
+    line, kept = level(list(range(n_sets)), len(LINE_FIELDS))
+    sl, _ = level(kept, len(SLICE_FIELDS))
+    return None if line is None and sl is None else (line, sl)
 
 
 class ActuatorModel(PhysicsModel):

@@ -55,12 +55,13 @@ QUANTITY_SETS = [qs for n in range(1, 6) for qs in itertools.combinations(Actuat
 
 
 def _batch():
-    """Sets like a calibration's finite-difference rows: some repeat the first set's line or slice
+    """Sets like a calibration's finite-difference rows: some repeat an earlier set's line or slice
     (xi, E: the mode and gain only; r1_sheet: the line only), others move the charge dynamics."""
     b = get_parameter_set("seed002_table3")
     sets = [b, b.replace(xi=0.3), b.replace(d=b.d * 2), b.replace(E=b.E * 1.1), b,
             b.replace(r1_sheet=b.r1_sheet * 3), b.replace(alpha0=b.alpha0 * 2), b.replace(kappa_e=b.kappa_e * 0.7),
-            b.replace(r2_specific=b.r2_specific * 2 + 1e-4)]
+            b.replace(r2_specific=b.r2_specific * 2 + 1e-4), b.replace(d=b.d * 2, xi=0.5),
+            b.replace(d=b.d * 2, r1_sheet=b.r1_sheet * 3)]
     return state_at(sets, [5.0, 25.0, 60.0])
 
 
