@@ -109,12 +109,13 @@ def shared_rows(state: State):
     if n_sets < 2 or any(c.shape != (n_sets, n_T, 1) for c in cols):
         return None
     F = np.concatenate(cols, axis=2)                                  # (n_sets, n_T, n_fields)
+    keys = {n: np.ascontiguousarray(F[:, :, :n]).reshape(n_sets, -1) for n in (len(LINE_FIELDS), len(SLICE_FIELDS))}
     t = np.arange(n_T)
 
     def level(sets, n_fields):
         """(first, inverse) over the rows of ``sets``: each set mapped onto the first identical one."""
         seen: dict = {}
-        first = [seen.setdefault(F[i, :, :n_fields].tobytes(), j) for j, i in enumerate(sets)]
+        first = [seen.setdefault(keys[n_fields][i].tobytes(), j) for j, i in enumerate(sets)]
         kept = sorted(set(first))
         if len(kept) == len(sets):
             return None, list(sets)

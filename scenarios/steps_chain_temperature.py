@@ -28,7 +28,8 @@ Model of the observation
 
 Calibration: the engine of ``calibrate`` (:func:`~physmodel.estimation.lsq.fit_parameters`) on a0(T)
 as scalar observations (multi-start, 95 % Gauss-Newton intervals; undetermined = an interval wider than
-the bounds, at a bound, or zero sensitivity (only these held); χ² vs expectation) and, on a misfit,
+the bounds, at a bound, or zero sensitivity, only the last held at its start value; χ² vs expectation)
+and, on a misfit,
 ``calibrate``'s policy (Birge-widened intervals, no identifiability verdict).
 """
 

@@ -185,7 +185,8 @@ def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
                 du.append(h * step)
     G = predict_array(np.array(rows))
     base_rows = np.tile([0, 0, 1, 1], len(single))
-    rates = (np.log(G[2:] / G[base_rows]) / np.array(du)[:, None]).reshape(len(single), 4, -1)   # ∂ln G/∂u
+    q = G[2:] / G[base_rows]            # ln q = ln|q| + i arg q, without the slower complex logarithm
+    rates = ((np.log(np.abs(q)) + 1j * np.angle(q)) / np.array(du)[:, None]).reshape(len(single), 4, -1)  # ∂lnG/∂u
     for k, rk in zip(single, rates):
         if np.all(np.isfinite(rk)) and np.ptp(rk.real) <= AFFINE_TOL and np.ptp(rk.imag) <= AFFINE_TOL:
             plan[k] = ("constant", complex(rk.mean()) * dudz[k])
