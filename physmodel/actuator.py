@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import beam, electrode
+from . import beam, electrode, transport
 from .model import PhysicsModel
 from .numerics import line_kernels, principal_sqrt, tanh_and_gmt
+from .params import STATE_FIELDS, State
 
 UNITS = {"Z": "Ohm", "H": "m/V", "G": "1", "M": "m/V", "I": "A/V"}
 DESCRIPTIONS = {
@@ -31,35 +32,64 @@ DESCRIPTIONS = {
 }
 
 
-def actuator_kernel(p, s, quantities=("Z", "H", "G", "M")) -> dict:
-    """All actuator quantities at points ``s`` for parameter values ``p`` (see :class:`State`)."""
-    K = p["K"]
-    W, h, L = p["W"], p["h"], p["L"]
-    want_z = "Z" in quantities or "I" in quantities
-    c, frac, A, X, xcoth = electrode.strip_terms(p, s, want_xcoth=want_z)
+#: Fields the charge dynamics, polymer admittance and slice terms (γ, θ, A, 1/(1 + r2 θ)) depend on.
+SLICE_FIELDS = ("h", "d", "K", "W", "kappa_e", "r2", "Rp")
+#: ... and, with these, the electrode line (X, x coth x).
+LINE_FIELDS = SLICE_FIELDS + ("r1", "L")
+
+
+def _take(p, idx, fields):
+    return p if idx is None else {f: p[f][idx] for f in fields}
+
+
+def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
+    """The actuator ``quantities`` at points ``s`` for parameter values ``p`` (see :class:`State`).
+
+    Only what the quantities need is computed: G alone needs no charge dynamics or electrode
+    line (:func:`~physmodel.electrode.strip_terms`), H and M no x coth x.  ``shared``: optional
+    ``(line, slice)`` for ``p`` as (n, 1) columns (see :func:`shared_rows`), each None or
+    ``(first, inverse)``: the electrode line is evaluated only on the rows ``line[0]`` (row r takes
+    the values of ``line[0][line[1][r]]``), the slice terms only on ``slice[0]`` of those; the
+    same operations on the same numbers, so the same results bit for bit.
+    """
     out = {}
-    if want_z:
-        Z = electrode.terminal_impedance(A, L, xcoth)
-        if "Z" in quantities:
-            out["Z"] = Z
-        if "I" in quantities:
-            out["I"] = 1.0 / Z
-    need_g = "G" in quantities or "M" in quantities
     wn = p["omega_n"]
-    if need_g:
+    if "G" in quantities or "M" in quantities:
         # G = ωn²/(s² + 2ξωn s + ωn²); keep the denominator, fold ωn² into the gain below
         gden = s + 2.0 * p["xi"] * wn
         gden *= s
         gden += wn * wn
     if "G" in quantities:
         out["G"] = (wn * wn) / gden
-    if "H" in quantities or "M" in quantities:
+    want_z = "Z" in quantities or "I" in quantities
+    want_h = "H" in quantities or "M" in quantities
+    if not (want_z or want_h):
+        return out
+    line, sl = shared if shared is not None else (None, None)
+    pl = _take(p, None if line is None else line[0], LINE_FIELDS)
+    ps = _take(pl, None if sl is None else sl[0], SLICE_FIELDS)
+    up = (lambda a: a) if sl is None else (lambda a: a[sl[1]])          # slice rows -> line rows
+    full = (lambda a: a) if line is None else (lambda a: a[line[1]])    # line rows -> all rows
+    c = transport.charge_terms(s, ps["h"], ps["d"], ps["K"])
+    theta = transport.polymer_admittance(ps["W"], ps["h"], ps["kappa_e"], c)
+    A, frac = electrode.slice_admittance(theta, ps["r2"], ps["Rp"])
+    A = up(A)
+    X, xcoth = line_kernels(electrode.line_argument(A, pl["r1"], pl["L"]), want_xcoth=want_z)
+    if want_z:
+        Z = full(electrode.terminal_impedance(A, pl["L"], xcoth))
+        if "Z" in quantities:
+            out["Z"] = Z
+        if "I" in quantities:
+            out["I"] = 1.0 / Z
+    if want_h:
         # H = −L² Φ X frac/(E I), with Φ = α0 W κe K (γ − tanh γ)/(sγ + K tanh γ)
         # (transport.moment_coupling); constants folded into one scalar multiplication.
-        gain = -(L * L) / (p["E"] * beam.second_moment(W, h)) * (p["alpha0"] * W * p["kappa_e"] * K)
-        H = c.gmt / c.den
+        K, W, L = p["K"], p["W"], p["L"]
+        gain = -(L * L) / (p["E"] * beam.second_moment(W, p["h"])) * (p["alpha0"] * W * p["kappa_e"] * K)
+        H = up(c.gmt / c.den)
         H *= X
-        H *= frac
+        H *= up(frac)
+        H = full(H)
         if "H" in quantities:
             out["H"] = H * gain
         if "M" in quantities:
@@ -67,6 +97,35 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M")) -> dict:
             H *= gain * wn * wn
             out["M"] = H
     return out
+
+
+def shared_rows(state: State):
+    """For a batch of states (n_sets, n_T, 1) in which some sets repeat an earlier set's electrode
+    line (:data:`LINE_FIELDS`) or slice (:data:`SLICE_FIELDS`) at every temperature — e.g. the
+    finite-difference sets of a parameter acting only on the mode or the gain — the ``shared``
+    argument of :func:`actuator_kernel` for its flat rows (set-major); None when no set does."""
+    n_sets, n_T = state.T.shape[:2]
+    cols = [getattr(state, f) for f in LINE_FIELDS]
+    if n_sets < 2 or any(c.shape != (n_sets, n_T, 1) for c in cols):
+        return None
+    F = np.concatenate(cols, axis=2)                                  # (n_sets, n_T, n_fields)
+    keys = {n: np.ascontiguousarray(F[:, :, :n]).reshape(n_sets, -1) for n in (len(LINE_FIELDS), len(SLICE_FIELDS))}
+    t = np.arange(n_T)
+
+    def level(sets, n_fields):
+        """(first, inverse) over the rows of ``sets``: each set mapped onto the first identical one."""
+        seen: dict = {}
+        first = [seen.setdefault(keys[n_fields][i].tobytes(), j) for j, i in enumerate(sets)]
+        kept = sorted(set(first))
+        if len(kept) == len(sets):
+            return None, list(sets)
+        pos = {j: k for k, j in enumerate(kept)}
+        inv = np.array([pos[j] for j in first])
+        return ((np.array(kept)[:, None] * n_T + t).ravel(), (inv[:, None] * n_T + t).ravel()), [sets[j] for j in kept]
+
+    line, kept = level(list(range(n_sets)), len(LINE_FIELDS))
+    sl, _ = level(kept, len(SLICE_FIELDS))
+    return None if line is None and sl is None else (line, sl)
 
 
 class ActuatorModel(PhysicsModel):
@@ -88,6 +147,36 @@ class ActuatorModel(PhysicsModel):
 
     def _kernel(self, p, s, quantities):
         return actuator_kernel(p, s, quantities)
+
+    def evaluate_state(self, state: State, s, quantities=None) -> dict[str, np.ndarray]:
+        """As :meth:`PhysicsModel.evaluate_state`; a batch that fits one chunk and whose later sets
+        repeat the first one's electrode line or slice (:func:`shared_rows`) evaluates those
+        terms once (the same numbers bit for bit).
+
+        Parameters
+        ----------
+        state : State
+            Parameter values as arrays (n_rows, n_T, 1). [SI]
+        s : array_like
+            1-D complex Laplace points, nonzero and finite (not checked). [1/s]
+        quantities : sequence of str or None
+            Names from :attr:`quantities` (default all).
+
+        Returns
+        -------
+        dict of str to ndarray
+            Complex arrays (n_rows, n_T, n_s) [Ω, m/V, -, m/V, A/V].
+        """
+        qs = self._check_quantities(quantities or self.quantities)
+        s = np.asarray(s)
+        n_sets, n_T = state.T.shape[:2]
+        shared = shared_rows(state) if 1 < n_sets and n_sets * n_T * s.size <= self.chunk_size else None
+        if shared is None:
+            return super().evaluate_state(state, s, qs)
+        n = n_sets * n_T
+        p = {k: np.ascontiguousarray(getattr(state, k).reshape(n))[:, None] for k in STATE_FIELDS}
+        vals = actuator_kernel(p, s[None, :], qs, shared)
+        return {q: vals[q].reshape(n_sets, n_T, s.size) for q in qs}
 
     def dc_gain(self, temperature_c) -> dict:
         """Closed-form DC limits (n_sets, n_T): ``H0 = M0`` [m/V] and ``Z0`` [Ω] (inf without leakage).

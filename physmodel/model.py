@@ -197,6 +197,29 @@ class PhysicsModel:
     def state(self, temperature_c) -> State:
         return self._table.state(temperature_c)
 
+    def evaluate_state(self, state: State, s, quantities=None) -> dict[str, np.ndarray]:
+        """Quantities at complex Laplace points for a state built by the caller (e.g. by a
+        :class:`~physmodel.parameter_paths.StateMap`, one row per parameter set), whatever this
+        model's own parameter sets.  Nothing is checked but the quantity names: the fast path of
+        calibration, which validates its points once.
+
+        Parameters
+        ----------
+        state : State
+            Parameter values as arrays (n_rows, n_T, 1) (see :class:`~physmodel.params.State`). [SI]
+        s : array_like
+            1-D complex Laplace points, nonzero and finite (not checked). [1/s]
+        quantities : sequence of str or None
+            Names from :attr:`quantities` (default all).
+
+        Returns
+        -------
+        dict of str to ndarray
+            Complex arrays (n_rows, n_T, n_s) in the units of :attr:`units`.
+        """
+        qs = self._check_quantities(quantities or self.quantities)
+        return evaluate_grid(state, np.asarray(s), self._kernel, qs, self.chunk_size)
+
     def evaluate(self, s, temperature_c, quantities=None, out=None, progress=None) -> dict:
         """Quantities at complex Laplace points ``s`` [1/s]; arrays (n_sets, n_T, n_s)."""
         qs = self._check_quantities(quantities or self.quantities)

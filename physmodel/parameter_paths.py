@@ -70,8 +70,9 @@ def apply_values(base: IPMCParameters, values: Values) -> IPMCParameters:
     wn: float | None = None
     for name, v in values.items():
         if name.startswith("laws."):
-            q, attr, _ = _law_target(base, name)
-            law_changes.setdefault(q, {})[attr] = float(v)
+            q, attr, law = _law_target(base, name)
+            if float(v) != getattr(law, attr):      # unchanged laws stay one object (one group in state_at)
+                law_changes.setdefault(q, {})[attr] = float(v)
         elif name == "omega_n":
             wn = float(v)
         else:

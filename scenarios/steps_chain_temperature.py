@@ -26,11 +26,11 @@ Model of the observation
     ``beam_follows_E``: the tip-driven strip's mode is the strip's own (ω1 ∝ sqrt(E)), so its time
     constant follows E(T): τ(T) = τ(35 °C)·exp(−slope_E (T − 35)/2) (the rest of the chain fixed).
 
-Calibration: weighted least squares in :class:`FreeParameter`'s scaled space (scipy, multi-start),
-95 % Gauss-Newton intervals, undetermined = interval wider than the bounds, at a bound or zero
-sensitivity (held), χ² vs expectation (``goodness_of_fit``) and, on a misfit, ``calibrate``'s policy
-(Birge-widened intervals, no identifiability verdict).  ``calibrate`` itself cannot be used: it
-evaluates the physics alone (no chain effects) and takes only frequency sweeps, not a0(T).
+Calibration: the engine of ``calibrate`` (:func:`~physmodel.estimation.lsq.fit_parameters`) on a0(T)
+as scalar observations (multi-start, 95 % Gauss-Newton intervals; undetermined = an interval wider than
+the bounds, at a bound, or zero sensitivity, only the last held at its start value; χ² vs expectation)
+and, on a misfit,
+``calibrate``'s policy (Birge-widened intervals, no identifiability verdict).
 """
 
 from __future__ import annotations
@@ -207,105 +207,30 @@ class LawCalibration:
 
 def calibrate_laws(data: A0Series, respond, frequency_hz, free, starts: int = 3, seed: int = 0,
                    max_nfev: int = 200) -> LawCalibration:
-    """Fit ``free`` law parameters so that a0 of :func:`levy_4_4` of ``respond`` matches ``data``."""
-    from scipy.optimize import least_squares
-    from scipy.stats import qmc
-
+    """Fit ``free`` law parameters so that a0 of :func:`levy_4_4` of ``respond`` matches ``data``:
+    the calibration engine (:func:`~physmodel.estimation.lsq.fit_parameters`) on the a0 values as
+    :class:`~physmodel.estimation.records.ScalarObservations` (residuals ln|a0_model/a0|/σ_ln; a
+    sign flip is a misfit of the magnitude only), ``max_nfev`` residual evaluations per start.  Only
+    parameters a0(T) does not depend on are held at their start value; other undetermined ones keep
+    their fitted value and interval.  On a misfit ``calibrate``'s policy (Birge-widened intervals,
+    no identifiability verdict)."""
     from physmodel.estimation.calibration import apply_misfit_policy
-    from physmodel.estimation.lsq import BOUND_TOL, FD_STEP, Z95
-    from physmodel.estimation.records import CalibrationResult, Identifiability, StartRecord
-    from physmodel.estimation.residuals import goodness_of_fit
+    from physmodel.estimation.lsq import fit_parameters
+    from physmodel.estimation.records import ScalarObservations
 
-    names = [fp.name for fp in free]
-    lo = np.array([fp.z_bounds[0] for fp in free])
-    hi = np.array([fp.z_bounds[1] for fp in free])
-    count = [0, 0]
+    obs = ScalarObservations(data.a0, data.sigma_ln, tuple(f"a0({t:g} °C)" for t in data.temperatures_c),
+                             data.temperatures_c, data.source)
 
-    def vals(z):
-        return {fp.name: float(fp.from_z(zi)) for fp, zi in zip(free, z)}
+    def a0_many(values_list):
+        return levy_4_4(frequency_hz, respond(list(values_list)))[1][..., -1]     # (n_sets, n_T)
 
-    def a0_of(zs):
-        count[0] += 1
-        count[1] += len(zs)
-        den = levy_4_4(frequency_hz, respond([vals(z) for z in zs]))[1]
-        return den[..., -1]                                              # (n_sets, n_T)
-
-    def res_of(a0):
-        return np.log(np.abs(a0 / data.a0)) / data.sigma_ln          # a sign flip is reported, not fitted
-
-    def jac(z):
-        steps = np.where(z + FD_STEP <= hi, FD_STEP, -FD_STEP)
-        R = res_of(a0_of([z] + [z + np.eye(z.size)[i] * steps[i] for i in range(z.size)]))
-        return ((R[1:] - R[0]) / steps[:, None]).T
-
-    z0 = np.array([fp.to_z(fp.initial) for fp in free], float)
-    # a parameter a0(T) does not depend on at all is held at its start value (calibrate's policy)
-    zb = np.clip(z0[None, :] + 0.1 * (hi - lo) * np.eye(z0.size), lo, hi)   # 10 % of each range
-    R0 = res_of(a0_of(np.vstack([z0, zb])))
-    live = np.abs(R0[1:] - R0[0]).max(axis=1) > 1e-6                      # in units of σ
-    zs = np.vstack([z0, lo + qmc.LatinHypercube(d=z0.size, seed=seed).random(max(starts - 1, 0)) * (hi - lo)])
-    zs[:, ~live] = z0[~live]
-    fits, records = [], []
-    for i, zi in enumerate(zs):
-        def fun(z, zi=zi):
-            return res_of(a0_of([np.where(live, z, zi)]))[0]
-
-        sol = least_squares(fun, zi, jac=lambda z: jac(z) * live[None, :], bounds=(lo, hi), method="trf",
-                            xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=max_nfev)
-        fits.append(sol)
-        records.append(StartRecord(i, vals(zi), vals(sol.x), float(sol.cost), int(sol.nfev), int(sol.status),
-                                   sol.message))
-    best = min(range(len(fits)), key=lambda k: fits[k].cost)
-    sol = fits[best]
-    a0 = a0_of([sol.x])[0]
-    r = res_of(a0[None])[0]
-    J = jac(sol.x)
-    Jl = J[:, live]
-    U, sv, Vt = np.linalg.svd(Jl, full_matrices=False)
-    cov = np.full((z0.size, z0.size), np.nan)
-    cov[np.ix_(live, live)] = (Vt.T / np.maximum(sv, sv.max() * 1e-14 if sv.max() > 0 else 1e-300) ** 2) @ Vt
-    se = np.sqrt(np.maximum(np.nan_to_num(np.diag(cov), nan=np.inf), 0.0))
-    dd = np.sqrt(np.maximum(np.diag(cov), 1e-300))
-    corr = cov / np.outer(dd, dd)
-    v = vals(sol.x)
-    ident, ci_l, ci_u, stderr = {}, {}, {}, {}
-    for j, fp in enumerate(free):
-        a, b = fp.from_z(sol.x[j] - Z95 * se[j]), fp.from_z(sol.x[j] + Z95 * se[j])
-        ci_l[fp.name], ci_u[fp.name] = float(min(a, b)), float(max(a, b))
-        stderr[fp.name] = float(se[j] * (fp.upper - fp.lower))
-        ratio = 2 * Z95 * se[j] / (hi[j] - lo[j])
-        pinned = ("lower" if sol.x[j] - lo[j] <= BOUND_TOL * (hi[j] - lo[j]) else
-                  "upper" if hi[j] - sol.x[j] <= BOUND_TOL * (hi[j] - lo[j]) else None)
-        others = [(abs(corr[j, k]), free[k].name) for k in range(len(free)) if k != j and np.isfinite(corr[j, k])]
-        conf = max(others) if others else (0.0, "")
-        if not live[j]:
-            ci_l[fp.name] = ci_u[fp.name] = stderr[fp.name] = math.nan
-            ident[fp.name] = Identifiability(False, "a0(T) does not depend on it (zero sensitivity): held at its "
-                                             "start value, the data carry no information on it")
-        elif pinned:
-            ident[fp.name] = Identifiability(False, f"ended at its {pinned} bound ({getattr(fp, pinned):.4g}): the "
-                                             "data do not determine it inside its bounds")
-        elif not math.isfinite(ratio) or ratio > 1.0:
-            ident[fp.name] = Identifiability(False, f"its 95 % interval would be {ratio:.3g} times as wide as its "
-                                             "bounds" + (f"; confounded with {conf[1]} (correlation {conf[0]:.3f})"
-                                                         if conf[0] > 0.95 else ""))
-        else:
-            ident[fp.name] = Identifiability(True, "determined by the data")
-    n = data.a0.size
-    cost = float(0.5 * r @ r)
-    gof = goodness_of_fit(cost, n, int(live.sum()), False)
-    res = CalibrationResult(
-        names=names, values=v, parameters=None, stderr=stderr, ci_lower=ci_l, ci_upper=ci_u, correlation=corr,
-        cost=cost, expected_cost=0.5 * (n - live.sum()), cost_std=math.sqrt(max(0.5 * (n - live.sum()), 0.0)),
-        n_lines=n, n_evaluations=count[1], n_model_calls=count[0], converged=bool(sol.status > 0),
-        message=f"best of {len(fits)} start(s) is start {best}: {sol.message}", starts=records,
-        identifiability=ident, noise_estimated=False, noise_scale=1.0,
-        held=[fp.name for fp, ok in zip(free, live) if not ok], free=list(free),
-        band_hz=(float(frequency_hz[0]), float(frequency_hz[-1])), temperatures_c=data.temperatures_c.tolist(),
-        elapsed_s=0.0, goodness_of_fit=gof)
-    if not gof.adequate:
+    res = fit_parameters(obs, None, free, starts=starts, seed=seed, predict_many=a0_many, max_nfev=max_nfev,
+                         hold_undetermined="insensitive")
+    res.band_hz = (float(frequency_hz[0]), float(frequency_hz[-1]))
+    if not res.adequate:
         apply_misfit_policy(res, widen=True)
-    return LawCalibration(res, a0, r, dict(v))
+    a0 = a0_many([res.values])[0]
+    return LawCalibration(res, a0, np.log(np.abs(a0 / data.a0)) / data.sigma_ln, dict(res.values))
 
 
 # ----------------------------------------------------------------------------- the step's part

@@ -6,7 +6,7 @@ parameters) to measured sweeps: the physics binding of the least-squares engine 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -50,7 +50,8 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
 
 def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "actuator",
                       quantity: str | None = None, kernel: str = "boundary_charge",
-                      free: Sequence[FreeParameter] | None = None):
+                      free: Sequence[FreeParameter] | None = None,
+                      effects: Mapping[str, Mapping[str, float]] | None = None):
     """``predict_many(list of values) -> (n_sets, N)`` in the sweep's units, plus a wide-band
     :class:`SensitivityProbe` at the median data temperature.  One model call per batch
     (sets × temperatures × union of frequencies).
@@ -59,8 +60,11 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
     ``predict_many.array(X) -> (n_sets, N)`` for rows of physical values of ``free`` (and the probe
     a ``predict_array``): states built as arrays by a :class:`~physmodel.parameter_paths.StateMap`,
     no parameter set per row; None when the state is not log-affine in those parameters.
+
+    With ``effects`` ({effect: {parameter: value}}, see :mod:`physmodel.effects`) the predictions
+    are those of ``EffectModel(sets, kind, effects)`` (the measurement chain fixed at those values;
+    no array path).
     """
-    from ..model import evaluate_grid
     from ..params import STATE_FIELDS, State
     from ..protocol import physics_model
 
@@ -70,6 +74,10 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
 
     def model_of(values_list):
         plist = [apply_values(base, v) for v in values_list]
+        if effects:
+            from ..effects import EffectModel
+
+            return EffectModel(plist, kind, effects, kernel=kernel)
         return physics_model(kind, plist, kernel=kernel)
 
     def predict_many(values_list):
@@ -84,25 +92,32 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
         return model_of(values_list).frequency_response(f_probe, [t_probe], quantities=(q,))[q][:, 0, :] * factor
 
     predict_many.array = probe_array = None
-    smap = None if not free else StateMap.build(base, [fp.name for fp in free], [fp.lower for fp in free],
+    smap = None if not free or effects else StateMap.build(base, [fp.name for fp in free], [fp.lower for fp in free],
                                                 [fp.upper for fp in free],
                                                 [base_value(base, fp.name) if fp.initial is None else fp.initial
                                                  for fp in free], Tu)
     if smap is not None:
-        # the kernel of the same model class, evaluated on states built as arrays (model.evaluate_grid)
-        kern = physics_model(kind, base, kernel=kernel)._kernel
+        # the same model class, evaluated on states built as arrays
+        model = physics_model(kind, base, kernel=kernel)
         s_data, s_probe = 2j * np.pi * fu, 2j * np.pi * f_probe
+
+        # lines laid out as the (temperature × frequency) grid, row-major: a reshape, not a gather
+        on_grid = inv_T.size == Tu.size * fu.size and np.array_equal(inv_T * fu.size + inv_f, np.arange(inv_T.size))
 
         def predict_array(X):
             with np.errstate(all="ignore"):     # a non-finite response is refused by the residuals
-                R = evaluate_grid(smap(X), s_data, kern, (q,))[q]
+                R = model.evaluate_state(smap(X), s_data, (q,))[q]
+            if on_grid:
+                R = R.reshape(R.shape[0], -1)
+                R *= factor
+                return R
             return R[:, inv_T, inv_f] * factor
 
         def probe_array(X):
             st = smap(X)
             st = State(**{k: getattr(st, k)[:, i_probe:i_probe + 1] for k in STATE_FIELDS})
             with np.errstate(all="ignore"):
-                return evaluate_grid(st, s_probe, kern, (q,))[q][:, 0, :] * factor
+                return model.evaluate_state(st, s_probe, (q,))[q][:, 0, :] * factor
 
         key = (smap, tuple(free), kind, q, kernel, fu.tobytes(), Tu.tobytes(), inv_T.tobytes(), inv_f.tobytes())
         if key not in _PLANS:
@@ -140,18 +155,22 @@ def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
     x0 = np.array([fp.initial if fp.initial is not None else fp.midpoint() for fp in free])
     X1 = np.vstack([x0, [float(fp.from_z(0.3 * fp.z_bounds[0] + 0.7 * fp.z_bounds[1])) for fp in free]])
     single = []
+    # every pair (k, j) at once: c_kj(T) = <A_k, A_j>/<A_j, A_j> per temperature, and whether
+    # A_k = c_kj A_j to 1e-12 of max|A_k| (the loop below only picks the first match)
+    gram = np.einsum("vtk,vtj->tkj", A, A)                                            # (n_T, n, n)
+    nj = np.diagonal(gram, axis1=1, axis2=2)                                          # (n_T, n)
+    cs = np.divide(gram, nj[:, None, :], out=np.zeros_like(gram), where=nj[:, None, :] > 0)
+    atol = 1e-12 * np.abs(A).max(axis=(0, 1))                                         # (n,)
+    match = np.all(np.abs(A[:, :, :, None] - cs[None] * A[:, :, None, :]) <= atol[None, None, :, None], axis=(0, 1))
+    moves = np.count_nonzero(np.abs(A).max(axis=1), axis=0)                          # fields moved per parameter
     for k in range(len(free)):
         if dudz[k] is None:
             continue
         for j in range(k):
-            if dudz[j] is None or j in plan:
-                continue
-            nj = np.einsum("vt,vt->t", A[:, :, j], A[:, :, j])
-            c = np.divide(np.einsum("vt,vt->t", A[:, :, k], A[:, :, j]), nj, out=np.zeros(nj.size), where=nj > 0)
-            if np.allclose(A[:, :, k], c * A[:, :, j], rtol=0, atol=1e-12 * np.abs(A[:, :, k]).max()):
-                plan[k] = ("scaled", j, c[inv_T])
+            if dudz[j] is not None and j not in plan and match[k, j]:
+                plan[k] = ("scaled", j, cs[:, k, j][inv_T])
                 break
-        if k not in plan and np.count_nonzero(np.abs(A[:, :, k]).max(axis=1)) == 1:
+        if k not in plan and moves[k] == 1:
             single.append(k)        # the affine test below only for a parameter moving one field
     if not single:
         return plan
@@ -166,7 +185,8 @@ def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
                 du.append(h * step)
     G = predict_array(np.array(rows))
     base_rows = np.tile([0, 0, 1, 1], len(single))
-    rates = (np.log(G[2:] / G[base_rows]) / np.array(du)[:, None]).reshape(len(single), 4, -1)   # ∂ln G/∂u
+    q = G[2:] / G[base_rows]            # ln q = ln|q| + i arg q, without the slower complex logarithm
+    rates = ((np.log(np.abs(q)) + 1j * np.angle(q)) / np.array(du)[:, None]).reshape(len(single), 4, -1)  # ∂lnG/∂u
     for k, rk in zip(single, rates):
         if np.all(np.isfinite(rk)) and np.ptp(rk.real) <= AFFINE_TOL and np.ptp(rk.imag) <= AFFINE_TOL:
             plan[k] = ("constant", complex(rk.mean()) * dudz[k])
@@ -178,31 +198,64 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
               starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
               identify: bool = True, hold_undetermined: bool = True, name: str | None = None,
               progress: Callable[[int], None] | None = None, misfit: str = "widen",
-              **kwargs) -> CalibrationResult:
+              effects: Mapping[str, Mapping[str, float]] | None = None, **kwargs) -> CalibrationResult:
     """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
 
-    ``free``: :class:`FreeParameter` records or bare names (default bounds: see
-    :func:`default_free_parameter`); names are IPMCParameters fields, ``"omega_n"`` or
-    ``"laws.<quantity>.<attribute>"`` (temperature-law parameters, fitted jointly across
-    temperatures).  Start 0 is the base value (or ``initial``); ``starts − 1`` more are seeded
-    Latin-hypercube points.  ``kind``/``quantity``: ``"actuator"`` (``"M"`` tip displacement per
-    volt by default, also ``H``, ``Z``, ``I``) or ``"sensor"`` (``"S"``, ``"Z"``); the data's units must
-    be of the matching kinds (mm/V, µA/mm, Ω, ...).  Returns a :class:`CalibrationResult` whose
-    ``parameters`` is ``base`` with the determined values (held ones at their base value), named
-    ``name`` (default ``"<base.name>_calibrated"``).
+    Start 0 is the base value (or ``initial``); ``starts − 1`` more are seeded Latin-hypercube
+    points.  Goodness of fit (``result.goodness_of_fit``,
+    :func:`~physmodel.estimation.residuals.goodness_of_fit`): when the cost is inconsistent with
+    its χ² expectation (declared noise) or implies implausible noise (estimated noise), the result
+    says so (``adequate`` False, message), no parameter is reported as identifiable, and its
+    intervals are widened by the Birge ratio sqrt(χ²/dof) or withheld (``misfit``).
 
-    Goodness of fit (``result.goodness_of_fit``, :func:`~physmodel.estimation.residuals.goodness_of_fit`):
-    when the cost is inconsistent with its χ² expectation (declared noise) or implies implausible
-    noise (estimated noise), the result says so (``adequate`` False, message), no parameter is
-    reported as identifiable, and its intervals are widened by the Birge ratio sqrt(χ²/dof)
-    (``misfit="widen"``, the default) or withheld as NaN (``misfit="withhold"``, what ``ipmc
-    calibrate`` does unless ``--accept-misfit``).
+    Parameters
+    ----------
+    data : FrequencySweep or sequence of FrequencySweep
+        The measured lines, in units of the matching kind (mm/V, µA/mm, Ω, ...).
+    base : IPMCParameters
+        The parameter set whose other parameters are kept.
+    free : sequence of FreeParameter or str
+        Records or bare names (default bounds: :func:`default_free_parameter`): IPMCParameters
+        fields, ``"omega_n"`` or ``"laws.<quantity>.<attribute>"`` (temperature-law parameters,
+        fitted jointly across temperatures).
+    kind, quantity, kernel : str, str or None, str
+        ``"actuator"`` (``"M"`` tip displacement per volt by default, also ``H``, ``Z``, ``I``) or
+        ``"sensor"`` (``"S"``, ``"Z"``); the sensor's collection kernel.
+    starts, seed, max_nfev : int, int, int or None
+        Starts of the multi-start search, their seed, residual evaluations per start.
+    identify, hold_undetermined : bool, bool or str
+        Flag undetermined parameters; hold them at their base value (see
+        :func:`~physmodel.estimation.lsq.fit_parameters`).
+    name : str or None
+        Name of the calibrated set (default ``"<base.name>_calibrated"``).
+    progress : callable or None
+        ``progress(1)`` after each start.
+    misfit : {"widen", "withhold"}
+        On a misfit widen the intervals by the Birge ratio (default) or withhold them as NaN
+        (what ``ipmc calibrate`` does unless ``--accept-misfit``).
+    effects : mapping or None
+        A measurement chain or other effects ({effect: {parameter: value}}, SI,
+        :mod:`physmodel.effects`) held fixed while the physical parameters are fitted: the model
+        is ``EffectModel(base, kind, effects)``.
+    **kwargs
+        Passed to :func:`~physmodel.estimation.lsq.fit_parameters` (``fixed``, ``ftol``, ``fd_step``).
+
+    Returns
+    -------
+    CalibrationResult
+        ``parameters`` is ``base`` with the determined values (held ones at their base value).
     """
     if misfit not in ("widen", "withhold"):
         raise ParameterError(f"misfit must be 'widen' or 'withhold', got {misfit!r}")
     if not isinstance(base, IPMCParameters):
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
     data = as_sweep(data)
+    if effects is not None:
+        if not isinstance(effects, Mapping):
+            raise ParameterError(f"effects must map effect names to {{parameter: value}}, got {effects!r}")
+        from ..effects import normalize_effects
+
+        effects = normalize_effects(effects)
     fps = []
     for item in free:
         if isinstance(item, str):
@@ -220,7 +273,7 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
             raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
     fixed = kwargs.get("fixed") or {}
     predict_many, probe, q = physics_predictor(data, apply_values(base, fixed) if fixed else base, kind, quantity,
-                                               kernel, free=fps)
+                                               kernel, free=fps, effects=effects)
     res = fit_parameters(data, None, fps, starts=starts, seed=seed, predict_many=predict_many,
                          predict_array=predict_many.array, max_nfev=max_nfev, identify=identify,
                          hold_undetermined=hold_undetermined, probe=probe, progress=progress, **kwargs)
@@ -232,6 +285,8 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
     res.parameters = replace(apply_values(base, res.values), name=label, source=src)
     res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
                          "data_fingerprint": data.fingerprint(), "seed": seed})
+    if effects:
+        res.metadata["effects"] = {k: dict(v) for k, v in effects.items()}
     if not res.adequate:
         apply_misfit_policy(res, widen=misfit == "widen")
     return res
@@ -270,7 +325,8 @@ def model_sweep(result: CalibrationResult, data: FrequencySweep, kind: str | Non
     kind = kind or result.metadata.get("kind", "actuator")
     predict_many, _, _ = physics_predictor(data, result.parameters, kind,
                                            quantity or result.metadata.get("quantity"),
-                                           kernel or result.metadata.get("kernel", "boundary_charge"))
+                                           kernel or result.metadata.get("kernel", "boundary_charge"),
+                                           effects=result.metadata.get("effects"))
     G = predict_many([{}])[0]
     return replace(data, response=G, magnitude_std_db=None, phase_std_deg=None,
                    metadata={"source": "calibrated model", "parameter_set": result.parameters.name})

@@ -6,7 +6,7 @@ one or many :class:`~physmodel.data.sweep.FrequencySweep` by weighted nonlinear 
 returned as a :class:`CalibrationResult` with 95 % confidence intervals, the correlation matrix
 and an identifiability report.
 
-Residuals (discrepancy.md §1)
+Residuals (discrepancy.md §1; :class:`~physmodel.estimation.residuals.SweepResiduals`)
     For each line the relative error ln(G_data/G_model) is split into log-magnitude and phase:
     ``r = [ln|G_d/G_m| / σ_ln, wrap(∠G_d − ∠G_m) / σ_φ]`` with σ_ln = magnitude_std_db·ln10/20 and
     σ_φ = phase_std_deg·π/180 from the sweep.  The cost ½Σr² of a correct model averages
@@ -15,7 +15,8 @@ Residuals (discrepancy.md §1)
     Fallback when the sweep carries no per-line standard deviations: every line gets
     σ_ln = σ_φ = :data:`FALLBACK_RELATIVE_STD` (1 % relative error), the result says
     ``noise_estimated=True``, and the covariance is rescaled by the residual variance
-    2·cost/(2F − nθ) (the usual estimated-σ² least-squares covariance).
+    2·cost/(2F − nθ) (the usual estimated-σ² least-squares covariance).  Scalar observations
+    (:class:`ScalarObservations`, e.g. a0(T)) give one residual each, ln|y_model/y|/σ_ln.
 
 Scaled space
     A ``"log"`` parameter is fitted as z = log10(|x|) (both bounds of one sign; its sign is kept),
@@ -68,12 +69,22 @@ from .records import (
     FreeParameter,
     Identifiability,
     ModelBatch,
+    ScalarObservations,
     ScaledRows,
     SensitivityProbe,
     StartRecord,
     Values,
+    lhs_starts,
 )
-from .residuals import gauss_newton_covariance, goodness_of_fit, noise_std, standardised_residuals
+from .residuals import (
+    ZERO_REASON,
+    ZERO_SENSITIVITY,
+    gauss_newton_covariance,
+    goodness_of_fit,
+    insensitive,
+    residual_model,
+    tenth_moves,
+)
 
 #: Two-sided 95 % normal quantile.
 Z95 = 1.959963984540054
@@ -94,20 +105,6 @@ JOIN_DISTANCE = 0.1
 
 
 # =============================================================================== the engine
-def _lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
-    """``n`` Latin-hypercube points in the scaled boxes (n, n_free), seeded."""
-    from scipy.stats import qmc
-
-    if n <= 0:
-        return np.empty((0, len(free)))
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ParameterError(f"seed must be a non-negative integer, got {seed!r}")
-    u = qmc.LatinHypercube(d=len(free), seed=seed).random(n)
-    lo = np.array([fp.z_bounds[0] for fp in free])
-    hi = np.array([fp.z_bounds[1] for fp in free])
-    return lo + u * (hi - lo)
-
-
 @dataclass
 class _Fit:
     index: int
@@ -120,7 +117,7 @@ class _Fit:
     message: str
 
 
-def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step, data, s_ln, s_ph):
+def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step, res):
     """Standardised residuals (2N,) at scaled ``z`` and their Jacobian (2N, n) in one batched model
     call: forward differences (step ``fd_step``, backwards at the upper bound ``hi``) except for
     the columns the predictor knows by the chain rule (:meth:`ModelBatch.jacobian_plan`)."""
@@ -128,16 +125,15 @@ def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step,
     fd = [i for i in range(z.size) if i not in plan]
     steps = np.where(z + fd_step <= hi, fd_step, -fd_step)[fd]
     Z = z[None, :] + np.vstack([np.zeros_like(z), np.eye(z.size)[fd] * steps[:, None]])
-    R = standardised_residuals(batch(rows(Z)), data, s_ln, s_ph)
+    R = res(batch(rows(Z)))
     J = np.empty((R.shape[1], z.size))
     J[:, fd] = ((R[1:] - R[0][None, :]) / steps[:, None]).T
-    for i, p in plan.items():     # r = [ln|G_d/G_m|/σ_ln, arg(G_d/G_m)/σ_φ]
-        J[:, i] = J[:, p[1]] * np.tile(p[2], 2) if p[0] == "scaled" else np.concatenate(
-            [np.full(s_ln.size, -p[1].real) / s_ln, np.full(s_ph.size, -p[1].imag) / s_ph])
+    for i, p in plan.items():
+        J[:, i] = res.scaled_column(J[:, p[1]], p[2]) if p[0] == "scaled" else res.constant_column(p[1])
     return R[0], J
 
 
-def residual_jacobian(data: FrequencySweep, free: Sequence[FreeParameter], values: Values, *,
+def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[FreeParameter], values: Values, *,
                       predict: Callable[[Values], np.ndarray] | None = None,
                       predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
                       predict_array: Callable[[np.ndarray], np.ndarray] | None = None,
@@ -154,19 +150,19 @@ def residual_jacobian(data: FrequencySweep, free: Sequence[FreeParameter], value
         (2N, len(free)) forward differences ∂r/∂z. [-]
     """
     free = list(free)
-    s_ln, s_ph, _ = noise_std(data)
-    batch = ModelBatch(free, dict(fixed or {}), predict, predict_many, predict_array, None, data.frequency_hz.size)
+    res = residual_model(data)
+    batch = ModelBatch(free, dict(fixed or {}), predict, predict_many, predict_array, None, res.n_values)
     x = np.array([float(values[fp.name]) for fp in free])
     z = np.array([float(fp.to_z(v)) for fp, v in zip(free, x)])
     hi = np.array([fp.z_bounds[1] for fp in free])
-    return _residuals_and_jacobian(batch, ScaledRows(free, x, range(len(free))), z, hi, fd_step, data, s_ln, s_ph)
+    return _residuals_and_jacobian(batch, ScaledRows(free, x, range(len(free))), z, hi, fd_step, res)
 
 
 class _Stop(Exception):
     """Ends scipy's search from inside the residual function."""
 
 
-def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatch, data, s_ln, s_ph, max_nfev, ftol,
+def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatch, res, max_nfev, ftol,
            fd_step, optima: Sequence[_Fit] = ()) -> _Fit:
     """Least squares over the ``active`` parameters of ``free`` in their scaled space (the others
     at ``x_full``); search and stopping in the module doc.  A point costs one batched model call,
@@ -178,7 +174,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     lo = np.array([fp.z_bounds[0] for fp in act])
     hi = np.array([fp.z_bounds[1] for fp in act])
     rows = ScaledRows(free, x_full, active)
-    dof = 2 * data.frequency_hz.size - len(act)
+    dof = res.size - len(act)
     cache: dict = {}
     count, last = [0], [None]
 
@@ -189,8 +185,8 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         g = J.T @ r
         try:
             step = np.linalg.solve(J.T @ J, -g)
-        except np.linalg.LinAlgError:
-            return None, "", None, c
+        except np.linalg.LinAlgError:       # e.g. a zero column: the minimum-norm step
+            step = np.linalg.lstsq(J, -r, rcond=None)[0]
         decrement = -0.5 * float(g @ step)
         if 0 <= decrement < GN_DECREMENT * s2:
             return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c
@@ -208,7 +204,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         if key not in cache:
             if len(cache) > 1:
                 cache.pop(next(iter(cache)))
-            r, J = _residuals_and_jacobian(batch, rows, z, hi, fd_step, data, s_ln, s_ph)
+            r, J = _residuals_and_jacobian(batch, rows, z, hi, fd_step, res)
             cache[key] = (z.copy(), r, J, *assess(z, r, J))
         last[0] = cache[key]
         return cache[key]
@@ -252,18 +248,17 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     return _Fit(index=-1, z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=count[0], status=status, message=msg)
 
 
-def _sensitivity_peaks(free, active, x_full: np.ndarray, J: np.ndarray, data: FrequencySweep,
+def _sensitivity_peaks(free, active, x_full: np.ndarray, J: np.ndarray, res,
                        probe: SensitivityProbe | None, batch: ModelBatch, fd_step: float):
-    """Per free parameter: (frequency of peak |∂lnG/∂z| [Hz], in-band max / overall max)."""
-    n = data.frequency_hz.size
+    """Per free parameter: (frequency of peak |∂lnG/∂z| [Hz] (NaN without frequencies), in-band
+    max / overall max)."""
     out = {}
-    # in-band sensitivity from the weighted Jacobian converted back to |∂ ln G/∂z| per line
-    s_ln, s_ph, _ = noise_std(data)
-    in_band = np.sqrt((J[:n] * s_ln[:, None]) ** 2 + (J[n:] * s_ph[:, None]) ** 2)   # (N, n_free)
+    in_band = res.ln_sensitivity(J)        # |∂ ln G/∂z| per line from the weighted Jacobian (N, n_free)
     band_max = in_band.max(axis=0)
-    if probe is None:
+    if probe is None or res.frequency_hz is None:
         for j, k in enumerate(active):
-            out[free[k].name] = (float(data.frequency_hz[np.argmax(in_band[:, j])]), 1.0)
+            out[free[k].name] = (float("nan") if res.frequency_hz is None else
+                                 float(res.frequency_hz[np.argmax(in_band[:, j])]), 1.0)
         return out
     f = np.asarray(probe.frequency_hz, dtype=float)
     X = np.repeat(x_full[None, :], len(active) + 1, axis=0)
@@ -276,7 +271,7 @@ def _sensitivity_peaks(free, active, x_full: np.ndarray, J: np.ndarray, data: Fr
         steps.append(step)
     G = batch.probe(X)
     base = np.log(G[0])
-    fmin, fmax = data.frequency_hz.min(), data.frequency_hz.max()
+    fmin, fmax = res.band_hz
     inside = (f >= fmin) & (f <= fmax)
     for j, k in enumerate(active):
         fp = free[k]
@@ -288,15 +283,15 @@ def _sensitivity_peaks(free, active, x_full: np.ndarray, J: np.ndarray, data: Fr
     return out
 
 
-def _identifiability(free_all, active, z, J, cov, x_full, data, probe, batch, fd_step):
+def _identifiability(free_all, active, z, J, cov, x_full, res, probe, batch, fd_step):
     """Flags and reasons for every active free parameter of one fit (no holding here)."""
     free = [free_all[k] for k in active]
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
     corr = cov / np.outer(d, d)
-    peaks = _sensitivity_peaks(free_all, active, x_full, J, data, probe, batch, fd_step)
-    fmin, fmax = float(data.frequency_hz.min()), float(data.frequency_hz.max())
-    report, badness = {}, {}
+    peaks = _sensitivity_peaks(free_all, active, x_full, J, res, probe, batch, fd_step)
+    fmin, fmax = res.band_hz
+    report, badness, dead = {}, {}, []
     for j, fp in enumerate(free):
         lo, hi = fp.z_bounds
         width = 2 * Z95 * se[j]
@@ -312,6 +307,11 @@ def _identifiability(free_all, active, z, J, cov, x_full, data, probe, batch, fd
         elif hi - z[j] <= BOUND_TOL * (hi - lo):
             pinned = "upper" if fp.scale == "linear" or fp.sign > 0 else "lower"
         peak_hz, frac = peaks[fp.name]
+        if np.abs(J[:, j]).max() * 0.1 * (hi - lo) <= ZERO_SENSITIVITY:
+            report[fp.name] = Identifiability(False, ZERO_REASON, peak_hz, frac)
+            badness[fp.name] = np.inf
+            dead.append(fp.name)
+            continue
         where = ""
         if frac < 0.5:
             side = "above" if peak_hz > fmax else "below" if peak_hz < fmin else "inside"
@@ -338,7 +338,7 @@ def _identifiability(free_all, active, z, J, cov, x_full, data, probe, batch, fd
         else:
             report[fp.name] = Identifiability(True, "determined by the data" + (f" ({where})" if where else ""),
                                               peak_hz, frac)
-    return report, badness, se, corr
+    return report, badness, se, corr, dead
 
 
 def _fmt_hz(f: float) -> str:
@@ -347,11 +347,11 @@ def _fmt_hz(f: float) -> str:
     return f"{f:.3g} Hz"
 
 
-def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray] | None,
+def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[[Values], np.ndarray] | None,
                    free: Sequence[FreeParameter], *, starts: int = 1, seed: int = 0,
                    predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
                    fixed: Values | None = None, max_nfev: int | None = None, ftol: float = 1e-10,
-                   identify: bool = True, hold_undetermined: bool = True,
+                   identify: bool = True, hold_undetermined: bool | str = True,
                    probe: SensitivityProbe | None = None, fd_step: float = FD_STEP,
                    progress: Callable[[int], None] | None = None,
                    predict_array: Callable[[np.ndarray], np.ndarray] | None = None) -> CalibrationResult:
@@ -359,8 +359,10 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
 
     Parameters
     ----------
-    data : FrequencySweep
+    data : FrequencySweep or ScalarObservations
         The measured lines; their per-line σ weight the residuals (without them: module doc).
+        Or scalar observations y with σ of ln y: residuals ln|y_model/y|/σ_ln, predictions real
+        (n_sets, N) (no probe; the sensitivity peaks are NaN).
     predict, predict_many, predict_array : callable or None
         The model at every line of ``data`` (same order and units), the first given of:
         ``predict_array(X) -> (n_sets, N)`` with ``X`` the physical values (n_sets, len(free)) in
@@ -375,8 +377,12 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     max_nfev, ftol, fd_step : int or None, float, float
         Residual evaluations per start and relative cost tolerance (scipy's meaning); the
         forward-difference step in the scaled coordinates. [-]
-    identify, hold_undetermined : bool
-        Flag undetermined parameters (module doc); hold them at their start-0 value and refit.
+    identify : bool
+        Flag undetermined parameters (module doc).
+    hold_undetermined : bool or "insensitive"
+        Hold undetermined parameters at their start-0 value and refit (one at a time, the worst
+        first; those at a bound or with zero sensitivity at once); ``"insensitive"``: only those
+        the data do not depend on (the others keep their fitted value and interval).
     probe : SensitivityProbe or None
         Wide-band evaluation locating where each parameter acts.
     progress : callable or None
@@ -388,8 +394,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
         ``parameters`` is None (see :func:`calibrate` for the physics wrapper).
     """
     t0 = time.perf_counter()
-    if not isinstance(data, FrequencySweep):
-        raise IPMCError(f"data must be a FrequencySweep, got {type(data).__name__}")
+    res = residual_model(data)
     free = [fp if isinstance(fp, FreeParameter) else None for fp in free]
     if not free or any(fp is None for fp in free):
         raise ParameterError("free must be a non-empty sequence of FreeParameter")
@@ -401,27 +406,38 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
         raise IPMCError("give predict, predict_many or predict_array")
     if int(starts) < 1:
         raise IPMCError(f"starts must be >= 1, got {starts}")
+    if hold_undetermined not in (True, False, "insensitive"):
+        raise IPMCError(f"hold_undetermined must be True, False or 'insensitive', got {hold_undetermined!r}")
     if max_nfev is not None and int(max_nfev) < 1:
         raise IPMCError(f"max_nfev must be >= 1, got {max_nfev}")
     fixed = dict(fixed or {})
-    s_ln, s_ph, estimated = noise_std(data)
-    n_lines = data.frequency_hz.size
-    if 2 * n_lines <= len(free):
-        raise IPMCError(f"{n_lines} lines (2 residuals each) cannot determine {len(free)} parameters")
+    estimated, n_lines = res.estimated, res.n_values
+    if res.size <= len(free):
+        raise IPMCError(f"{res.what} cannot determine {len(free)} parameters")
     batch = ModelBatch(free, fixed, predict, predict_many, predict_array, probe, n_lines)
 
     x_init = [fp.initial if fp.initial is not None else fp.midpoint() for fp in free]
     x_full = np.array(x_init, dtype=float)
     z_init = np.array([fp.to_z(x) for fp, x in zip(free, x_init)], float)
-    z_starts = np.vstack([z_init[None, :], _lhs_starts(free, int(starts) - 1, seed)])
-    records, fits = [], []
+    held: dict[str, Identifiability] = {}
+    if hold_undetermined == "insensitive":
+        R = res(batch(ScaledRows(free, x_full, range(len(free)))(tenth_moves(free, z_init))))
+        held = {free[k].name: Identifiability(False, ZERO_REASON + "; held at its start value") for k in insensitive(R)}
+        if len(held) == len(free):
+            raise IPMCError(f"the data depend on none of the free parameters {list(held)} (zero sensitivity)")
+    active = [k for k, fp in enumerate(free) if fp.name not in held]
+    z_starts = np.vstack([z_init[None, :], lhs_starts(free, int(starts) - 1, seed)])
+    z_starts[:, [k for k in range(len(free)) if k not in active]] = z_init[[k for k in range(len(free)) if k not in active]]
+    records, fits, ends = [], [], []
     for i, z0 in enumerate(z_starts):
-        fit = _solve(free, range(len(free)), x_full, z0, batch, data, s_ln, s_ph, max_nfev, ftol, fd_step, fits)
+        fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits)
         fit.index = i
         fits.append(fit)
+        ends.append(z0.copy())
+        ends[-1][active] = fit.z
         initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
         records.append(StartRecord(i, initial,
-                                   {fp.name: float(fp.from_z(v)) for fp, v in zip(free, fit.z)},
+                                   {fp.name: float(fp.from_z(v)) for fp, v in zip(free, ends[-1])},
                                    fit.cost, fit.nfev, fit.status, fit.message))
         if progress:
             progress(1)
@@ -431,9 +447,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
     message = f"best of {len(fits)} start(s) is start {best}: {fit.message}"
 
     # identifiability: flag, hold the worst, refit the rest; repeat
-    active = list(range(len(free)))
-    z_full = fit.z.copy()
-    held: dict[str, Identifiability] = {}
+    z_full = ends[best].copy()
     report: dict = {}
     while True:
         act = [free[k] for k in active]
@@ -441,7 +455,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
                            for k, fp in enumerate(free)])
         cov, _ = gauss_newton_covariance(fit.J)
         noise_scale = 1.0
-        dof = 2 * n_lines - len(act)
+        dof = res.size - len(act)
         if estimated:
             noise_scale = math.sqrt(2.0 * fit.cost / dof) if dof > 0 else float("nan")
             cov = cov * noise_scale**2
@@ -452,12 +466,12 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
             d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
             corr = cov / np.outer(d, d)
             break
-        report, badness, se, corr = _identifiability(free, active, fit.z, fit.J, cov, x_full, data, probe, batch,
-                                                     fd_step)
-        if not badness or not hold_undetermined:
+        report, badness, se, corr, dead = _identifiability(free, active, fit.z, fit.J, cov, x_full, res, probe,
+                                                           batch, fd_step)
+        if not badness or not hold_undetermined or (hold_undetermined == "insensitive" and not dead):
             break
         pinned = [n for n, b in badness.items() if b == np.inf]
-        to_hold = pinned or [max(badness, key=badness.get)]
+        to_hold = dead if hold_undetermined == "insensitive" else pinned or [max(badness, key=badness.get)]
         for n in to_hold:
             held[n] = report[n]
         active = [k for k in active if free[k].name not in held]
@@ -468,7 +482,7 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
             break
         x_full = np.array([x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))
                            for k, fp in enumerate(free)])
-        fit = _solve(free, active, x_full, z_full[active], batch, data, s_ln, s_ph, max_nfev, ftol, fd_step)
+        fit = _solve(free, active, x_full, z_full[active], batch, res, max_nfev, ftol, fd_step)
         z_full[active] = fit.z
         converged = fit.status > 0
         message += f"; refit without {', '.join(to_hold)}: {fit.message}"
@@ -495,19 +509,18 @@ def fit_parameters(data: FrequencySweep, predict: Callable[[Values], np.ndarray]
             C[k, k2] = corr[i, pos[k2]]
     if not active:
         G = batch(np.array([[values[n] for n in names]]))[0]
-        cost = float(0.5 * np.sum(standardised_residuals(G, data, s_ln, s_ph) ** 2))
+        cost = float(0.5 * np.sum(res(G) ** 2))
     else:
         cost = fit.cost
-    expected = n_lines - n_act / 2.0
+    expected = res.size / 2.0 - n_act / 2.0
     if held:
         message += f"; undetermined and held at their start value: {', '.join(held)}"
-    gof = goodness_of_fit(cost, 2 * n_lines, n_act, estimated)
+    gof = goodness_of_fit(cost, res.size, n_act, estimated)
     return CalibrationResult(
         names=names, values=values, parameters=None, stderr=stderr, ci_lower=lo_ci, ci_upper=hi_ci,
         correlation=C, cost=cost, expected_cost=expected, cost_std=math.sqrt(max(expected, 0.0)),
         n_lines=n_lines, n_evaluations=batch.evaluations, n_model_calls=batch.calls,
         converged=bool(converged), message=message, starts=records, identifiability=ident,
         noise_estimated=estimated, noise_scale=float(noise_scale), held=list(held), free=list(free),
-        band_hz=(float(data.frequency_hz.min()), float(data.frequency_hz.max())),
-        temperatures_c=data.temperatures().tolist(), elapsed_s=time.perf_counter() - t0, goodness_of_fit=gof,
+        band_hz=res.band_hz, temperatures_c=res.temperatures_c, elapsed_s=time.perf_counter() - t0, goodness_of_fit=gof,
     )

@@ -139,6 +139,21 @@ class FreeParameter:
         """
         return replace(self, initial=float(value))
 
+
+def lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
+    """``n`` Latin-hypercube points in the scaled boxes (n, n_free), seeded."""
+    from scipy.stats import qmc
+
+    if n <= 0:
+        return np.empty((0, len(free)))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be a non-negative integer, got {seed!r}")
+    u = qmc.LatinHypercube(d=len(free), seed=seed).random(n)
+    lo = np.array([fp.z_bounds[0] for fp in free])
+    hi = np.array([fp.z_bounds[1] for fp in free])
+    return lo + u * (hi - lo)
+
+
 class ScaledRows:
     """Physical rows (n_sets, n_free) of parameter values: ``x_full`` [each parameter's SI unit]
     with the ``active`` columns of ``free`` at scaled coordinates ``Z`` (n_sets, n_active) [-];
@@ -205,6 +220,59 @@ class ModelBatch:
         if self.probe_.predict_array is not None:
             return np.asarray(self.probe_.predict_array(X), dtype=complex)
         return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
+
+
+# =============================================================================== scalar data
+@dataclass(frozen=True)
+class ScalarObservations:
+    """Scalar observations fitted on a log scale: what :func:`~physmodel.estimation.lsq.fit_parameters`
+    takes besides a frequency sweep (e.g. a printed a0(T), one value per temperature).
+
+    The residual of observation i is ln|y_model,i / y_i| / σ_ln,i (a sign flip of the model is a
+    misfit of the magnitude only); for a correct model the cost ½Σr² averages (N − nθ)/2.
+
+    Parameters
+    ----------
+    values : array_like
+        The observed values y, finite and nonzero. [their own unit, the predictor's]
+    sigma_ln : array_like
+        Standard deviation of ln y per observation, > 0. [-]
+    labels : sequence of str
+        One name per observation (e.g. ``"a0(23 °C)"``), for messages.
+    temperatures_c : array_like or None
+        The temperature of each observation, when it has one. [°C]
+    source : str
+        Where the numbers come from.
+    """
+
+    values: np.ndarray
+    sigma_ln: np.ndarray
+    labels: tuple = ()
+    temperatures_c: np.ndarray | None = None
+    source: str = ""
+
+    def __post_init__(self):
+        y = np.atleast_1d(np.asarray(self.values, dtype=float))
+        s = np.atleast_1d(np.asarray(self.sigma_ln, dtype=float))
+        labels = tuple(str(x) for x in self.labels) or tuple(f"y[{i}]" for i in range(y.size))
+        if y.ndim != 1 or y.size == 0:
+            raise ParameterError(f"ScalarObservations.values must be a non-empty 1-D array, got shape {y.shape}")
+        if s.shape != y.shape or len(labels) != y.size:
+            raise ParameterError(f"ScalarObservations: {y.size} values need as many sigma_ln and labels, got "
+                                 f"{s.size} sigma_ln and {len(labels)} labels")
+        bad = [labels[i] for i in np.flatnonzero(~np.isfinite(y) | (y == 0))]
+        if bad:
+            raise ParameterError(f"ScalarObservations.values must be finite and nonzero; not so at {bad[:5]}")
+        bad = [labels[i] for i in np.flatnonzero(~(np.isfinite(s) & (s > 0)))]
+        if bad:
+            raise ParameterError(f"ScalarObservations.sigma_ln must be finite and > 0; not so at {bad[:5]}")
+        T = None if self.temperatures_c is None else np.atleast_1d(np.asarray(self.temperatures_c, dtype=float))
+        if T is not None and T.shape != y.shape:
+            raise ParameterError(f"ScalarObservations.temperatures_c: {T.size} values for {y.size} observations")
+        object.__setattr__(self, "values", y)
+        object.__setattr__(self, "sigma_ln", s)
+        object.__setattr__(self, "labels", labels)
+        object.__setattr__(self, "temperatures_c", T)
 
 
 # =============================================================================== results

@@ -1,4 +1,5 @@
-"""Standardised residuals of a model against a :class:`~physmodel.data.sweep.FrequencySweep`.
+"""Standardised residuals of a model against a :class:`~physmodel.data.sweep.FrequencySweep`
+(or scalar observations, :class:`SweepResiduals` / :class:`ObservationResiduals`).
 
 For each line the relative error ln(G_data/G_model) is split into log-magnitude and phase:
 ``r = [ln|G_d/G_m| / σ_ln, wrap(∠G_d − ∠G_m) / σ_φ]`` with σ_ln = magnitude_std_db·ln10/20 [Np] and
@@ -138,3 +139,110 @@ def goodness_of_fit(cost: float, n_residuals: int, n_parameters: int, noise_esti
                          f"no per-line standard deviations: the residuals imply {rel:.3g} relative noise per line "
                          f"(ln-magnitude, phase in rad); " + ("plausible as measurement noise" if ok else
                          f"above {MAX_ESTIMATED_RELATIVE_NOISE:g} this is a misfit, not noise: the model does not fit the data"))
+
+
+class SweepResiduals:
+    """The least-squares engine's view of a :class:`~physmodel.data.sweep.FrequencySweep`: 2N
+    residuals ``[ln|G_d/G_m|/σ_ln, arg(G_d/G_m)/σ_φ]`` of N complex predictions per set, and the
+    columns of their Jacobian that a predictor knows by the chain rule."""
+
+    def __init__(self, data: FrequencySweep):
+        self.data = data
+        self.s_ln, self.s_ph, self.estimated = noise_std(data)
+        self.n_values = data.frequency_hz.size
+        self.size = 2 * self.n_values
+        self.frequency_hz = data.frequency_hz
+        self.band_hz = (float(data.frequency_hz.min()), float(data.frequency_hz.max()))
+        self.temperatures_c = data.temperatures().tolist()
+        self.what = f"{self.n_values} lines (2 residuals each)"
+
+    def __call__(self, G) -> np.ndarray:
+        """(n_sets, 2N) standardised residuals of predictions ``G`` (n_sets, N)."""
+        return standardised_residuals(G, self.data, self.s_ln, self.s_ph)
+
+    def scaled_column(self, column: np.ndarray, c: np.ndarray) -> np.ndarray:
+        """∂r/∂z_k for a parameter acting as c(line) times another (``column`` its ∂r/∂z)."""
+        return column * np.tile(c, 2)
+
+    def constant_column(self, dlnG: complex) -> np.ndarray:
+        """∂r/∂z_k for ∂ln G/∂z_k = ``dlnG`` at every line."""
+        return np.concatenate([np.full(self.s_ln.size, -dlnG.real) / self.s_ln,
+                               np.full(self.s_ph.size, -dlnG.imag) / self.s_ph])
+
+    def ln_sensitivity(self, J: np.ndarray) -> np.ndarray:
+        """|∂ln G/∂z| per line (N, n) from the standardised Jacobian (2N, n)."""
+        n = self.n_values
+        return np.sqrt((J[:n] * self.s_ln[:, None]) ** 2 + (J[n:] * self.s_ph[:, None]) ** 2)
+
+
+class ObservationResiduals:
+    """The engine's view of :class:`~physmodel.estimation.records.ScalarObservations`: N residuals
+    ln|y_model/y|/σ_ln of N predictions per set (the real part of a complex prediction)."""
+
+    def __init__(self, data):
+        self.data = data
+        self.s_ln, self.estimated = data.sigma_ln, False
+        self.n_values = self.size = data.values.size
+        self.frequency_hz = None
+        self.band_hz = (float("nan"), float("nan"))
+        self.temperatures_c = [] if data.temperatures_c is None else data.temperatures_c.tolist()
+        self.what = f"{self.n_values} scalar observations"
+
+    def __call__(self, y) -> np.ndarray:
+        y = np.asarray(y)
+        y = y.real if np.iscomplexobj(y) else y
+        if y.shape[-1] != self.n_values:
+            raise IPMCError(f"model returned {y.shape[-1]} values per set for {self.n_values} observations")
+        with np.errstate(all="ignore"):
+            out = np.log(np.abs(y / self.data.values)) / self.s_ln
+        if not np.all(np.isfinite(out)):
+            bad = np.flatnonzero((~np.isfinite(out)).reshape(-1, self.n_values).any(0))
+            raise IPMCError(f"model value is zero or not finite at observation(s) "
+                            f"{[self.data.labels[i] for i in bad[:5]]}")
+        return out
+
+    def scaled_column(self, column: np.ndarray, c: np.ndarray) -> np.ndarray:
+        """As :meth:`SweepResiduals.scaled_column`."""
+        return column * c
+
+    def constant_column(self, dlnG: complex) -> np.ndarray:
+        """As :meth:`SweepResiduals.constant_column` (the real part acts)."""
+        return np.full(self.n_values, dlnG.real) / self.s_ln
+
+    def ln_sensitivity(self, J: np.ndarray) -> np.ndarray:
+        """|∂ln y/∂z| per observation (N, n)."""
+        return np.abs(J * self.s_ln[:, None])
+
+
+#: A parameter whose move across a tenth of its scaled range changes no standardised residual by
+#: more than this has zero sensitivity: the data do not depend on it (held, not fitted).
+ZERO_SENSITIVITY = 1e-6
+ZERO_REASON = (f"the data do not depend on it (zero sensitivity: a move across a tenth of its bounds changes no "
+               f"residual by more than {ZERO_SENSITIVITY:g} σ)")
+
+
+def tenth_moves(free, z) -> np.ndarray:
+    """Rows (1 + n, n) of scaled coordinates: ``z``, then each parameter moved by a tenth of its
+    scaled range (away from its nearer bound) [-]."""
+    lo = np.array([fp.z_bounds[0] for fp in free])
+    hi = np.array([fp.z_bounds[1] for fp in free])
+    step = np.where(z + 0.1 * (hi - lo) <= hi, 0.1, -0.1) * (hi - lo)
+    return np.vstack([z, z + np.diag(step)])
+
+
+def insensitive(R: np.ndarray) -> list[int]:
+    """Indices of the parameters whose move (rows 1.. of ``R``, the residuals at
+    :func:`tenth_moves`) changes no residual by more than :data:`ZERO_SENSITIVITY`."""
+    return np.flatnonzero(np.abs(R[1:] - R[0]).max(axis=1) <= ZERO_SENSITIVITY).tolist()
+
+
+def residual_model(data):
+    """:class:`SweepResiduals` or :class:`ObservationResiduals` for ``data``; anything else is an
+    IPMCError."""
+    from .records import ScalarObservations
+
+    if isinstance(data, FrequencySweep):
+        return SweepResiduals(data)
+    if isinstance(data, ScalarObservations):
+        return ObservationResiduals(data)
+    raise IPMCError(f"data must be a FrequencySweep or ScalarObservations, got {type(data).__name__}")

@@ -16,16 +16,19 @@
     python3 tests/benchmarks/bench_calibration.py --speed 7 --root /path/to/baseline/checkout
 
 Measured (2 shared cores, 2026-11-23, issue 17), against a06d884 (the engine before the issue-17
-work; main at df39d69 timed the same), ``--speed 7 --reps 3 --speed-draws 10``, ratio
-baseline/this, median [min, max] over the 7 pairs:
+work; main at df39d69 timed the same), ``--speed 11 --reps 3 --speed-draws 10``, ratio
+baseline/this, median [min, max] over the 11 pairs:
 
-* 4 starts: 24.4 ms vs 128.2 ms, 5.26x [5.17, 5.76]; the first calibration of a problem (state
-  map and Jacobian plan built): 28.5 ms, 4.46x [4.37, 4.65];
-* 1 start (the Monte Carlo calibrations): 5.0 ms vs 24.6 ms, 4.91x [4.85, 5.12];
+* 4 starts: 24.6 ms vs 138.2 ms, 5.61x [5.27, 6.15]; the first calibration of a problem (state
+  map and Jacobian plan built): 26.8 ms, 5.12x [4.85, 5.22];
+* 1 start (the Monte Carlo calibrations): 5.2 ms vs 26.8 ms, 5.11x [4.81, 5.34];
+  (before the shared strip terms, the first-of-problem plan work and the reshape of grid-ordered
+  data, at 9715fa4: 5.26x [5.17, 5.76], 4.46x [4.37, 4.65], 4.91x [4.85, 5.12] with 7 pairs);
 * model evaluations 240 vs 492 (4 starts), 62 vs 102 per 1-start calibration;
 * estimates: the same to 1.2e-6 (4 starts) and 1.3e-5 (40 one-start draws) relative; the
   difference is the baseline's own stopping error (its Gauss–Newton step from its estimate is
-  up to 6e-5 standard errors, ours below 3e-6);
+  up to 6e-5 standard errors, ours below 3e-6); bit for bit those of 9715fa4 (values and
+  intervals of 12 one-start draws), so the coverage below is unchanged;
 * coverage over 200 draws, identical hit for hit: 0.950/0.945/0.945/0.955/0.950/0.950/0.970/0.945
   (mean 0.951); with estimated noise mean 0.953 (0.925 for laws.E.slope, in both).
 """
