@@ -28,7 +28,7 @@ Data (physmodel.data)
     write_sweep; time-domain experiments in physmodel.data.timesim (simulate, sine, step,
     free_release, TimeSeries)
 Calibration (physmodel.estimation)
-    calibrate, fit_parameters, FreeParameter, CalibrationResult — weighted multi-start least squares
+    calibrate, fit_parameters, FreeParameter, CalibrationResult, ScalarObservations — weighted multi-start least squares
     with confidence intervals, correlations and an identifiability report; ``ipmc calibrate``
 Discrepancy workflow (physmodel.effects, physmodel.estimation.discrepancy)
     EffectModel, LIBRARY — named candidate effects composable with any model;
@@ -48,7 +48,7 @@ from .errors import DataFormatError, IPMCError, ParameterError, TemperatureRange
 from .estimation.calibration import calibrate
 from .estimation.discrepancy import Diagnosis, diagnose
 from .estimation.lsq import fit_parameters
-from .estimation.records import CalibrationResult, FreeParameter
+from .estimation.records import CalibrationResult, FreeParameter, ScalarObservations
 from .model import FrequencyResponse
 from .parameter_sets import (
                              available_parameter_sets,
@@ -80,7 +80,7 @@ __all__ = [
     "FrequencyModel", "physics_model", "FrequencyResponse", "ActuatorModel", "SensorModel", "TransimpedanceChain",
     "FrequencySweep", "synthesize_sweep", "MagnitudePhaseNoise", "ComplexGaussianNoise", "read_sweep",
     "write_sweep",
-    "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult",
+    "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult", "ScalarObservations",
     "EffectModel", "LIBRARY", "diagnose", "Diagnosis",
     "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
 ]
