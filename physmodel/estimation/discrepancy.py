@@ -84,7 +84,9 @@ from .priors import (
 from .records import CalibrationResult, FreeParameter
 from .residuals import standardised_residuals
 from .signatures import (
+    _confusability,
     _constrained_lr,
+    _cosine,
     _gap,
     _localise,
     _orth,
@@ -93,6 +95,7 @@ from .signatures import (
     _signature,
     _simulated,
     _z_jacobian,
+    vuong_critical,
 )
 
 #: Pairs of two effects: every pair among this many most significant candidates, and each of the
@@ -193,17 +196,20 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     sigs, sided, skipped, first_order, raw_sigs = {}, {}, {}, {}, {}
     for c in cand:
         S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
-        Sp = _project_out(Q0, S)
         reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in cpars[c]])
+        if np.all(np.isfinite(S)) and np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
+            S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c], h=1.0)   # no first-order signature
+            first_order[c] = "no first-order signature at off (secant signature to the typical size; refitted)"
+        Sp = _project_out(Q0, S)
         max_lr = float(np.sum((np.linalg.norm(Sp, axis=0) * reach) ** 2))
         if not np.all(np.isfinite(S)) or np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
             skipped[c] = "no signature on these data (cannot change the cost by the noise level)"
             continue
         sigs[c], sided[c], raw_sigs[c] = Sp, one, S
-        if max_lr < MIN_SIGNATURE_LR:
+        if max_lr < MIN_SIGNATURE_LR and c not in first_order:
             first_order[c] = "confounded with the free parameters to first order (refitted; only nonlinear terms can show it)"
     confusable = []
-    orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order}
+    orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order or first_order[c].startswith("no first")}
     for a, b in combinations(orth, 2):
         if orth[a].shape[1] == 0 or orth[b].shape[1] == 0:
             continue
@@ -233,18 +239,31 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             out.append(FreeParameter(f"{c}.{p.name}", p.lower, p.upper, "linear", v))
         return out
 
-    def refit(effects_on: Sequence[str], start_vals: dict, eff_starts: list, sim=None, identify=True):
-        best = None
-        for starts in eff_starts:
-            fr = [fp.with_initial(min(max(start_vals[fp.name], fp.lower), fp.upper)) for fp in free0]
-            for c in effects_on:
-                st = None if starts is None else starts.get(c)
-                if st is None and any(k.startswith(c + ".") for k in start_vals):
-                    st = {k.split(".", 1)[1]: v for k, v in start_vals.items() if k.startswith(c + ".")}
-                fr += eff_free(c, st)
-            res = fit(fr, sim=sim, identify=identify)
-            if best is None or res.cost < best.cost:
-                best = res
+    user0 = {fp.name: fp.initial for fp in free0}
+
+    def refit(effects_on: Sequence[str], start_vals: dict, eff_starts: list, sim=None, identify=True,
+              from_user=False):
+        """Best of the refits from ``start_vals`` (and, ``from_user``, the user's start) × ``eff_starts``."""
+        best, runs = None, []
+        for origin, sv in [("baseline optimum", start_vals)] + ([("user start", user0)] if from_user else []):
+            for starts in eff_starts:
+                fr = [fp.with_initial(min(max(sv[fp.name], fp.lower), fp.upper)) for fp in free0]
+                for c in effects_on:
+                    st = None if starts is None else starts.get(c)
+                    if st is None and any(k.startswith(c + ".") for k in sv):
+                        st = {k.split(".", 1)[1]: v for k, v in sv.items() if k.startswith(c + ".")}
+                    fr += eff_free(c, st)
+                res = fit(fr, sim=sim, identify=identify)
+                runs.append((origin, res))
+                if best is None or res.cost < best.cost:
+                    best, best_origin = res, origin
+        costs = [float(r.cost) for _, r in runs]
+        near = [r for _, r in runs if r.cost <= best.cost + 1.0]
+        best.metadata["refit_multistart"] = {
+            "n_starts": len(runs), "costs": costs, "origins": [o for o, _ in runs], "best_origin": best_origin,
+            "n_at_best": len(near), "cost_spread": max(costs) - min(costs),
+            "ranges": {n: [float(min(r.values[n] for r in near)), float(max(r.values[n] for r in near))]
+                       for n in best.names}}
         return best
 
     def lin_start(c, r_now, Qb):
@@ -268,7 +287,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     k0 = len(free0)
     n_res = 2 * N
     for c in sigs:
-        res = refit([c], v0, starts_for(c, r0, Q0))
+        res = refit([c], v0, starts_for(c, r0, Q0), from_user=True)
         fits[c] = res
         k = len(cpars[c])
         lr = max(0.0, 2 * (res0.cost - res.cost))
@@ -281,7 +300,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             False, False, res.converged, float(np.linalg.norm(sigs[c])),
             float(_constrained_lr(sigs[c], sided[c], -_project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""),
             bounds={p.name: [p.lower, p.upper] for p in cpars[c]}, at_bound=ab, implausible=imp,
-            penalty=res.metadata["penalty"])
+            penalty=res.metadata["penalty"], multistart=res.metadata["refit_multistart"])
     say(f"{len(cres)} candidates refitted")
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
     full_max, lin_used = [], []
@@ -321,6 +340,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         cr.significant = cr.lr > T
         cr.closes_gap = closes_gap(cr.cost, [c])
     gap0_sig = 2 * cost0 > gap_thr0
+    z_crit = vuong_critical(alpha)
+    confusability: dict = {"z_critical": z_crit, "data": [], "in_band": []}
     sig = sorted((c for c in cres if cres[c].significant), key=lambda c: -cres[c].lr)
     final_effects: list[str] = []
     final_fit: CalibrationResult | None = None
@@ -379,15 +400,15 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            amb = [c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC
-                   or frozenset((top, c)) in conf_set]          # declared confusable and also closing
+            confusability = _confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit, refit)
+            amb = [top] + [x["other"] for x in confusability["data"] if not x["separated"]]
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
                 verdict = "ambiguous"
-                pairs = [f"{a}~{b}" + ("" if frozenset((a, b)) in conf_set else " (not declared confusable)")
-                         for a, b in combinations(amb, 2)]
-                message = (f"Ambiguous between {', '.join(amb)} (each closes the gap; AIC within {AMBIGUITY_AIC:g} or "
-                           f"declared confusable; {'; '.join(pairs)}; lowest AIC: {top}). "
+                zs = "; ".join(f"{x['other']} z = {x['z']:.3g}" for x in confusability["data"] if not x["separated"])
+                message = (f"Ambiguous between {', '.join(amb)}: the data do not separate them from the best "
+                           f"closer {top} (Vuong's test of non-nested fits, z < {z_crit:.3g} at "
+                           f"α = {alpha:g}: {zs}). "
                            "Separate them with a wider band, more temperatures, or magnitude vs phase.")
             else:
                 verdict, message = "named", _named_msg(top, cres[top])
@@ -487,6 +508,17 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
     if warn:
         message += f" Cost vs declared noise: {warn}."
+    declared = {frozenset(x[:2]) for x in confusable}
+    for x, why in [(x, f"not separated by the data (Vuong z = {x['z']:.3g})") for x in confusability["data"]
+                   if not x["separated"]] + [(x, f"confusable in this band at the fitted sizes (noiseless cross-fit "
+                                                 f"λ = {min(x['lambda_other_to_top'], x['lambda_top_to_other']):.3g})")
+                                             for x in confusability["in_band"] if x["confusable"]]:
+        key = f"{x['top']}~{x['other']}"
+        if frozenset((x["top"], x["other"])) not in declared:
+            declared.add(frozenset((x["top"], x["other"])))
+            confusable.append((x["top"], x["other"], _cosine(sigs[x["top"]], sigs[x["other"]])))
+            separation[key] = _separation(x["top"], x["other"], raw_sigs, data)
+        separation[key] = separation.get(key, "") + f" Declared: {why}."
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
@@ -507,7 +539,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                   "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
-        cost_warning=warn,
+        cost_warning=warn, confusability=confusability,
     )
 
 
