@@ -455,8 +455,10 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
              and a["name"].split(".", 1)[0] in final_effects]
     # a significant candidate confusable with a named effect that stopped at a widenable bound: its
     # LR there is only a lower bound, so it might beat the named effect once the bound is widened
+    # (unless that bound is the effect's absolute bound, which no user may widen)
     widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
-              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")]
+              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
+              and a["bound"] != getattr(LIBRARY[c].parameter(a["name"].split(".", 1)[1]), a["side"])]
     if verdict in ("named", "ambiguous") and widen:
         verdict = "at_bound"
         message = ("At bound — widen or the effect is larger than allowed: " + "; ".join(
