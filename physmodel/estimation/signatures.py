@@ -199,7 +199,8 @@ def vuong_z(r_a, r_b, cost_a: float, cost_b: float) -> float:
     z = (cost_b − cost_a) / ω with ω² = Σ_i (ℓ_i − ℓ̄)², ℓ_i = (r_b,i² − r_a,i²)/2 the per-residual
     log-likelihood ratio (Vuong 1989, Econometrica 57:307, Theorem 5.1).  Under "equally close to
     the truth" z is asymptotically N(0, 1); for two exactly specified candidates whose fits differ by
-    a deterministic signature δ (noiseless λ_ab = ‖δ‖²) z ≈ N(√λ_ab / 2, 1).  No Akaike/Schwarz
+    a deterministic signature δ (noiseless λ_ab = ‖δ‖²) z has mean ≈ √λ_ab / 2 and a spread of at
+    most 1 (ω also carries the fits' own noise; ≈ 0.8 in tests/estimation/test_vuong.py).  No Akaike/Schwarz
     correction: divided by a small ω it would turn a difference of parameter counts between two
     fits that coincide into a "significant" one.  Identical fits (ω = 0) give 0."""
     ra, rb = np.asarray(r_a, float), np.asarray(r_b, float)
@@ -221,7 +222,8 @@ def vuong_critical(alpha: float) -> float:
 
 def vuong_power(lam: float, z_crit: float) -> float:
     """Probability that :func:`vuong_z` exceeds ``z_crit`` when the noiseless fits differ by
-    λ = 2·Δcost (z ≈ N(√λ/2, 1))."""
+    λ = 2·Δcost, in the normal approximation z ~ N(√λ/2, 1): exact at ½ (λ = 4·z_crit²); with the
+    smaller real spread it understates the power above ½ and overstates it below."""
     from scipy.stats import norm
 
     return float(norm.cdf(math.sqrt(max(lam, 0.0)) / 2.0 - z_crit))
