@@ -11,7 +11,9 @@ user's free parameters, and:
    multi-start spread; it tabulates where the standardised residuals exceed their band;
 2. refits the full model with each candidate effect of :data:`physmodel.effects.LIBRARY` switched
    on (nested, full nonlinear refits, starting from off, from a linearised estimate, from a
-   typical size and from any user start), within *candidate bounds* scaled to the strip
+   typical size and from any user start — each from the baseline optimum and from the user's start
+   values (a baseline that absorbed the effect can hold a refit in its basin); the best is kept and
+   the spread reported), within *candidate bounds* scaled to the strip
    (:meth:`physmodel.effects.Effect.candidate_parameters`; user-adjustable) and scores it by
    LR = 2 (cost_baseline − cost_candidate) of the penalised costs, with AIC/BIC alongside;
 3. sets the acceptance threshold by Monte Carlo under the null (no effect), so that the
@@ -20,14 +22,23 @@ user's free parameters, and:
    value is a bound), ``null_draws`` draws, scaled by the ratio of full-refit to linearised LR
    on ``null_refits`` parametric-bootstrap draws (clipped to [1, 3]);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
-   baseline Jacobian projected out) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`;
+   baseline Jacobian projected out; the secant to the typical size where the tangent at off carries
+   < :data:`SECANT_RATIO` of it) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`,
+   and, after the refits, the pairs the data cannot separate (below) or that are *confusable in this
+   band at the fitted sizes*: each fitted noiselessly to the other's fitted prediction leaves
+   λ = 2·cost < 4·z_crit², where Vuong's test has less than even odds;
 5. decides: ``none``, ``named`` (one significant candidate that closes the gap, plus a second one
    significant on top of it if any — a forward step; else the best pair among the
    :data:`PAIR_POOL` most significant candidates whose members are each significant on top of the
    other and that closes the gap; pairs are drawn from the most significant candidates and from
    those that best explain what the best one leaves, never a declared-confusable pair; each
    member must carry more than :data:`CLOSE_FRACTION` of the baseline's excess), ``ambiguous``
-   (several closers within :data:`AMBIGUITY_AIC` or declared confusable), ``at_bound`` (the named
+   (``named`` lists the candidates: the closer of lowest AIC and every significant candidate that
+   Vuong's test of non-nested models (1989; :func:`~physmodel.estimation.signatures.vuong_z`,
+   per-residual log-likelihood ratios of the two refits) does not reject against it, two-sided at
+   the user's α: z < Φ⁻¹(1 − α/2).  For exactly specified candidates whose noiseless fits differ by
+   λ, z has mean ≈ √λ/2, so a wrong confident name has chance ≤ α/2 and a pair with λ ≥ 25 is
+   told apart in about 70 % of draws; pairs use an AIC window of :data:`AMBIGUITY_AIC`), ``at_bound`` (the named
    effect closes the gap only with a parameter at its candidate bound: "widen the bound, or the
    effect is larger than allowed" — never a confident name), ``unexplained`` (a significant gap
    nothing closes).  The gap test
@@ -86,7 +97,7 @@ from .residuals import standardised_residuals
 from .signatures import (
     _confusability,
     _constrained_lr,
-    _cosine,
+    _declare,
     _gap,
     _localise,
     _orth,
@@ -94,6 +105,7 @@ from .signatures import (
     _separation,
     _signature,
     _simulated,
+    _spread,
     _z_jacobian,
     vuong_critical,
 )
@@ -264,13 +276,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                 runs.append((origin, res))
                 if best is None or res.cost < best.cost:
                     best, best_origin = res, origin
-        costs = [float(r.cost) for _, r in runs]
-        near = [r for _, r in runs if r.cost <= best.cost + 1.0]
-        best.metadata["refit_multistart"] = {
-            "n_starts": len(runs), "costs": costs, "origins": [o for o, _ in runs], "best_origin": best_origin,
-            "n_at_best": len(near), "cost_spread": max(costs) - min(costs),
-            "ranges": {n: [float(min(r.values[n] for r in near)), float(max(r.values[n] for r in near))]
-                       for n in best.names}}
+        best.metadata["refit_multistart"] = _spread(runs, best, best_origin)
         return best
 
     def lin_start(c, r_now, Qb):
@@ -517,17 +523,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
     if warn:
         message += f" Cost vs declared noise: {warn}."
-    declared = {frozenset(x[:2]) for x in confusable}
-    for x, why in [(x, f"not separated by the data (Vuong z = {x['z']:.3g})") for x in confusability["data"]
-                   if not x["separated"]] + [(x, f"confusable in this band at the fitted sizes (noiseless cross-fit "
-                                                 f"λ = {min(x['lambda_other_to_top'], x['lambda_top_to_other']):.3g})")
-                                             for x in confusability["in_band"] if x["confusable"]]:
-        key = f"{x['top']}~{x['other']}"
-        if frozenset((x["top"], x["other"])) not in declared:
-            declared.add(frozenset((x["top"], x["other"])))
-            confusable.append((x["top"], x["other"], _cosine(sigs[x["top"]], sigs[x["other"]])))
-            separation[key] = _separation(x["top"], x["other"], raw_sigs, data)
-        separation[key] = separation.get(key, "") + f" Declared: {why}."
+    _declare(confusable, separation, confusability, sigs, raw_sigs, data)
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(

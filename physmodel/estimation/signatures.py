@@ -270,3 +270,34 @@ def _cosine(Sa, Sb) -> float:
     if Qa.shape[1] == 0 or Qb.shape[1] == 0:
         return float("nan")
     return float(min(np.linalg.svd(Qa.T @ Qb, compute_uv=False).max(), 1.0))
+
+
+def _declare(confusable: list, separation: dict, confusability: dict, sigs: dict, raw_sigs: dict, data) -> None:
+    """Add to ``confusable``/``separation`` (in place) the pairs the data do not separate and those
+    confusable in this band (from :func:`_confusability`), each with its reason."""
+    declared = {frozenset(x[:2]) for x in confusable}
+    rows = [(x, f"not separated by the data (Vuong z = {x['z']:.3g})") for x in confusability["data"]
+            if not x["separated"]]
+    rows += [(x, "confusable in this band at the fitted sizes (noiseless cross-fit λ = "
+                 f"{min(x['lambda_other_to_top'], x['lambda_top_to_other']):.3g})")
+             for x in confusability["in_band"] if x["confusable"]]
+    for x, why in rows:
+        a, b = x["top"], x["other"]
+        key = f"{a}~{b}" if f"{b}~{a}" not in separation else f"{b}~{a}"
+        if frozenset((a, b)) not in declared:
+            declared.add(frozenset((a, b)))
+            confusable.append((a, b, _cosine(sigs[a], sigs[b])))
+            separation[key] = _separation(a, b, raw_sigs, data)
+        separation[key] = separation.get(key, "") + f" Declared: {why}."
+
+
+def _spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:
+    """Multi-start record of a candidate refit: ``runs`` = [(origin, CalibrationResult)]; the costs,
+    origins, the best's origin, how many reach the best cost within ``tol`` (½Δχ²), the cost spread
+    and each parameter's range over the starts that reach it."""
+    costs = [float(r.cost) for _, r in runs]
+    near = [r for _, r in runs if r.cost <= best.cost + tol]
+    return {"n_starts": len(runs), "costs": costs, "origins": [o for o, _ in runs], "best_origin": best_origin,
+            "n_at_best": len(near), "cost_spread": max(costs) - min(costs),
+            "ranges": {n: [float(min(r.values[n] for r in near)), float(max(r.values[n] for r in near))]
+                       for n in best.names}}
