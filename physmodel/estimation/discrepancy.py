@@ -110,9 +110,9 @@ from .signatures import (
     vuong_critical,
 )
 
-#: A candidate whose tangent signature at off is below this fraction of its secant to the typical
-#: size (the first-order term carries < 10 % of the change, e.g. a resonance 1/(1 + 2ζτs + τ²s²)
-#: in τ) is described by the secant instead (fixed a priori, not tuned on results).
+#: A candidate parameter whose tangent signature at off is below this fraction of its secant to the
+#: typical size (the first-order term carries < 10 % of the change, e.g. a resonance
+#: 1/(1 + 2ζτs + τ²s²) in τ) is described by the secant instead (fixed a priori, not tuned).
 SECANT_RATIO = 0.1
 #: Pairs of two effects: every pair among this many most significant candidates, and each of the
 #: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
@@ -214,11 +214,11 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
         reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in cpars[c]])
         Ssec, _ = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c], h=1.0)    # secant to the typical size
-        if np.all(np.isfinite(S)) and np.all(np.isfinite(Ssec)) and (
-                np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR
-                or np.linalg.norm(S) < SECANT_RATIO * np.linalg.norm(Ssec)):
-            S = Ssec
-            first_order[c] = "no first-order signature at off (secant signature to the typical size; refitted)"
+        sec = np.linalg.norm(S, axis=0) < SECANT_RATIO * np.linalg.norm(Ssec, axis=0)
+        if np.all(np.isfinite(S)) and np.all(np.isfinite(Ssec)) and sec.any():
+            S = np.where(sec[None, :], Ssec, S)
+            first_order[c] = ("no first-order signature at off in " + ", ".join(
+                p.name for p, x in zip(cpars[c], sec) if x) + " (secant to the typical size there; refitted)")
         Sp = _project_out(Q0, S)
         max_lr = float(np.sum((np.linalg.norm(Sp, axis=0) * reach) ** 2))
         if not np.all(np.isfinite(S)) or np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
@@ -322,11 +322,14 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         sim = FrequencySweep(data.temperature_c, data.frequency_hz, _simulated(G0, e, s_ln, s_ph),
                              np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
                              data.input_unit, data.output_name, data.output_unit)
-        rb = fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
-                 identify=False)
+        # the same search as on the data (baseline multi-start; candidates from both base starts)
+        rb = min((fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
+                      identify=False), fit(free0, sim=sim, starts=int(baseline_starts), identify=False)),
+                 key=lambda x: x.cost)
+        r_b = standardised_residuals(pm([rb.values])[0], sim, s_ln, s_ph)
         m = 0.0
         for c in sigs:
-            rc = refit([c], rb.values, [None], sim=sim, identify=False)
+            rc = refit([c], rb.values, starts_for(c, r_b, Q0), sim=sim, identify=False, from_user=True)
             m = max(m, 2 * (rb.cost - rc.cost))
         full_max.append(m)
         lin_used.append(float(lin_max[b]))
