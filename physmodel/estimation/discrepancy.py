@@ -322,10 +322,9 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         sim = FrequencySweep(data.temperature_c, data.frequency_hz, _simulated(G0, e, s_ln, s_ph),
                              np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
                              data.input_unit, data.output_name, data.output_unit)
-        # the same search as on the data (baseline multi-start; candidates from both base starts)
         rb = min((fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
                       identify=False), fit(free0, sim=sim, starts=int(baseline_starts), identify=False)),
-                 key=lambda x: x.cost)
+                 key=lambda x: x.cost)      # the same search as on the data (both base starts, below too)
         r_b = standardised_residuals(pm([rb.values])[0], sim, s_ln, s_ph)
         m = 0.0
         for c in sigs:
@@ -470,8 +469,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     widen = [a for a in at_bound if not a["hard"] and "." in a["name"] and not a["name"].startswith("laws.")
              and a["name"].split(".", 1)[0] in final_effects]
     # a significant candidate confusable with a named effect that stopped at a widenable bound: its
-    # LR there is only a lower bound, so it might beat the named effect once the bound is widened
-    # (unless that bound is the effect's absolute bound, which no user may widen)
+    # LR there is only a lower bound, so it might beat the named effect once the bound is widened (not an absolute one)
     widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
               for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
               and a["bound"] != getattr(LIBRARY[c].parameter(a["name"].split(".", 1)[1]), a["side"])]
