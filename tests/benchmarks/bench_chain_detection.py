@@ -60,6 +60,12 @@ window of 6 plus first-order signature cosine ≥ 0.9, fixture_joint skipped whe
 signature vanished) run with this script; "after" = this branch.  The docstring's earlier table
 (commit b6611f9, older reporting) had library 8/15, independent 5/11 named exactly.
 
+Paired timing (same loaded machine, 3 interleaved runs of 4 fixed independent cases — opamp 6,
+laser 7, joint 13, none 21 — with the bench's diagnose settings, whole process): after 12.0 s vs
+before 3.3 s per diagnosis, ratio 3.56 (3.45-3.64).  The cost is the null bootstrap refits, which
+now repeat the data's full multi-start search (≈ 5.5 of ≈ 9 s on an idle core), then the second
+base start of the candidate refits and the cross-fits.  Within the issue's 60 s per diagnosis.
+
 What the figures say: 9 of the 15 (library) and 6 of the 11 (independent) detectable cases are not
 distinguishable in 10-100 Hz at all — a laser lag and a strip resonance above the band differ by
 Δλ < 0.02 noiselessly, one amplifier pole reproduces the transimpedance circuit to Δλ < 3e-4, the
