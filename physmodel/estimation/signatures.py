@@ -240,13 +240,14 @@ def _confusability(top: str, sig: Sequence[str], fits: dict, cres: dict, pm, dat
     """Is the best closer ``top`` separated from each other significant candidate?
 
     ``data``: Vuong's test (:func:`vuong_z`) of ``top`` against it on the measured data — not
-    separated when z < ``z_crit``.  ``in_band``: each fitted to the other's noiseless prediction at
+    separated when z < ``z_crit``; ``pairs``: the same, two-sided, between the others not separated
+    from ``top`` (so an ambiguous set declares which of its pairs the data cannot split).  ``in_band``: each fitted to the other's noiseless prediction at
     its fitted size (``refit(effects, start_values, [None], sim=...)``), λ = 2·data cost; the pair is
     *confusable in this band* when the smaller λ gives Vuong's test less than even odds
     (:func:`vuong_power` < ½, i.e. λ < 4·z_crit²)."""
     pred = {c: pm([fits[c].values])[0] for c in sig}
     r = {c: standardised_residuals(pred[c], data, s_ln, s_ph) for c in sig}
-    out: dict = {"top": top, "z_critical": z_crit, "data": [], "in_band": [],
+    out: dict = {"top": top, "z_critical": z_crit, "data": [], "in_band": [], "pairs": [],
                  "rule": "Vuong's test of the best closer against each significant candidate, "
                          "two-sided at α; confusable in the band when the noiseless cross-fit λ < 4·z_crit²"}
     for c in sig:
@@ -261,6 +262,10 @@ def _confusability(top: str, sig: Sequence[str], fits: dict, cres: dict, pm, dat
         power = vuong_power(min(lam_ct, lam_tc), z_crit)
         out["in_band"].append({"top": top, "other": c, "lambda_other_to_top": lam_ct, "lambda_top_to_other": lam_tc,
                                "power": power, "confusable": bool(power < 0.5)})
+    rest = [x["other"] for x in out["data"] if not x["separated"]]
+    for a, b in combinations(rest, 2):     # within an ambiguous set: the other pairs, two-sided
+        z = vuong_z(r[a], r[b], fits[a].cost, fits[b].cost)
+        out["pairs"].append({"top": a, "other": b, "z": z, "separated": bool(abs(z) >= z_crit)})
     return out
 
 
@@ -276,8 +281,8 @@ def _declare(confusable: list, separation: dict, confusability: dict, sigs: dict
     """Add to ``confusable``/``separation`` (in place) the pairs the data do not separate and those
     confusable in this band (from :func:`_confusability`), each with its reason."""
     declared = {frozenset(x[:2]) for x in confusable}
-    rows = [(x, f"not separated by the data (Vuong z = {x['z']:.3g})") for x in confusability["data"]
-            if not x["separated"]]
+    rows = [(x, f"not separated by the data (Vuong z = {x['z']:.3g})")
+            for x in confusability["data"] + confusability.get("pairs", []) if not x["separated"]]
     rows += [(x, "confusable in this band at the fitted sizes (noiseless cross-fit λ = "
                  f"{min(x['lambda_other_to_top'], x['lambda_top_to_other']):.3g})")
              for x in confusability["in_band"] if x["confusable"]]
