@@ -46,18 +46,18 @@ named exactly                          7/15                 7/15                
 ambiguous listing the truth            3/15                 8/15                 2/11                 6/11
 at_bound naming the truth / other      1/15, 4/15           0/15, 0/15           2/11, 2/11           0/11, 0/11
 wrong confident name                   0/15                 0/15                 0/11                 0/11
-exact or ambiguous among declared      10/15 = 67 %         14/15 = 93 %         7/11 = 64 %          10/11 = 91 %
-  (95 % Wilson)                        (42-85 %)            (70-99 %)            (35-85 %)            (62-98 %)
+exact or ambiguous among declared      10/15 = 67 %         15/15 = 100 %        7/11 = 64 %          11/11 = 100 %
+  (95 % Wilson)                        (42-85 %)            (80-100 %)           (35-85 %)            (74-100 %)
 distinguishable cases / named exactly  6 / 6                6 / 6                5 / 4                5 / 5
 FPR on null data (anything named)      0/8                  1/8                  0/8                  0/8
 out of library -> unexplained          3/3                  3/3                  4/4                  4/4
 wrong confident names, all cases       1/32                 2/32                 1/33                 1/33
-median / max s per diagnosis (loaded)  12.2 / 29.8          12.6 / 41.4          6.3 / 16.0           11.4 / 18.8
+median / max s per diagnosis (loaded)  12.2 / 29.8          11.1 / 22.9          6.3 / 16.0           10.9 / 18.3
 =====================================  ===================  ===================  ===================  ===================
 
 "before" = commit df39d69 (candidate refits from the baseline optimum only, ambiguity by an AIC
 window of 6 plus first-order signature cosine ≥ 0.9, fixture_joint skipped when its tangent
-signature vanished) run with this script; "after" = this branch.  The docstring's earlier table
+signature vanished) run with this script; "after" = this branch at its last commit (985 s).  The docstring's earlier table
 (commit b6611f9, older reporting) had library 8/15, independent 5/11 named exactly.
 
 Paired timing (same loaded machine, 3 interleaved runs of 4 fixed independent cases — opamp 6,
