@@ -20,7 +20,8 @@ from .records import CalibrationResult
 VERDICTS = ("none", "named", "ambiguous", "at_bound", "unexplained")
 #: Candidates whose signatures have a canonical correlation at least this high are confusable.
 CONFUSABLE_COSINE = 0.9
-#: Significant candidates within this AIC difference of the best are reported as ambiguous.
+#: Pairs of effects within this AIC difference of the best pair are reported as ambiguous (single
+#: candidates are compared by Vuong's test instead, see :mod:`physmodel.estimation.discrepancy`).
 AMBIGUITY_AIC = 6.0
 #: The gap test runs at α / GAP_ALPHA_DIVISOR.
 GAP_ALPHA_DIVISOR = 5.0
@@ -58,6 +59,7 @@ class CandidateResult:
     at_bound: list = field(default_factory=list)
     implausible: list = field(default_factory=list)
     penalty: float = 0.0
+    multistart: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         return {"name": self.name, "values": self.values, "ci95_lower": self.ci_lower,
@@ -66,7 +68,8 @@ class CandidateResult:
                 "closes_gap": self.closes_gap, "converged": self.converged,
                 "signature_norm": self.signature_norm, "lr_linearised": self.lr_linearised, "note": self.note,
                 "candidate_bounds": self.bounds, "at_or_near_bound": self.at_bound,
-                "outside_plausible_range": self.implausible, "penalty": self.penalty}
+                "outside_plausible_range": self.implausible, "penalty": self.penalty,
+                "multistart": self.multistart}
 
 
 @dataclass
@@ -109,6 +112,7 @@ class Diagnosis:
     final_at_bound: list = field(default_factory=list)
     final_implausible: list = field(default_factory=list)
     cost_warning: str = ""
+    confusability: dict = field(default_factory=dict)
 
     # ---------------------------------------------------------------- views
     def named_effect(self) -> dict | None:
@@ -157,6 +161,7 @@ class Diagnosis:
             "temperature_laws": self.laws, "baseline_audit": self.baseline_audit,
             "baseline_parameters": self._baseline_rows(), "final_at_bound": self.final_at_bound,
             "final_outside_plausible_range": self.final_implausible, "cost_warning": self.cost_warning,
+            "confusability": self.confusability,
         })
 
     def _baseline_rows(self) -> list:
@@ -232,8 +237,28 @@ class Diagnosis:
                 + (", physical limit)" if a["hard"] else ")") for a in self.final_at_bound)]
         if self.skipped:
             L += ["", "Not testable on these data: " + "; ".join(f"{k} ({v})" for k, v in self.skipped.items())]
-        L += ["", "## Confusable pairs (signature cosine ≥ %.2g)" % CONFUSABLE_COSINE, ""]
-        L += [f"- {a} ~ {b}: {c:.3f}. {self.separation.get(f'{a}~{b}', '')}" for a, b, c in self.confusable] or ["- none"]
+        L += ["", "## Confusable pairs", "", f"Declared confusable: first-order signature cosine ≥ {CONFUSABLE_COSINE:.2g}, "
+              "confusable in this band at the fitted sizes (noiseless cross-fit), or not separated by the data "
+              "(Vuong's test).", ""]
+        L += [f"- {a} ~ {b}: cosine {c:.3f}. {self.separation.get(f'{a}~{b}', '')}" for a, b, c in self.confusable] or ["- none"]
+        cf = self.confusability
+        if cf.get("in_band") or cf.get("data"):
+            L += ["", f"Vuong's test at α = {self.alpha:g} (critical |z| {cf.get('z_critical', float('nan')):.3g}) "
+                      f"against the best closer {cf.get('top', '–')}:", "",
+                  "| candidate | z (data) | separated by the data | λ(it → best) | λ(best → it) | power | "
+                  "confusable in this band |", "|---|---|---|---|---|---|---|"]
+            ib = {x["other"]: x for x in cf.get("in_band", [])}
+            for x in cf.get("data", []):
+                y = ib.get(x["other"], {})
+                L.append(f"| {x['other']} | {x['z']:.3g} | {'yes' if x['separated'] else 'no'} | "
+                         f"{_g(y.get('lambda_other_to_top'))} | {_g(y.get('lambda_top_to_other'))} | "
+                         f"{_g(y.get('power'))} | {'yes' if y.get('confusable') else ('no' if y else '–')} |")
+        ms = [c for c in self.candidates.values() if c.multistart.get("n_starts")]
+        if ms:
+            L += ["", "Candidate refit multi-start (best origin; starts reaching the best cost within 1; "
+                      "cost spread over starts): " + "; ".join(
+                          f"{c.name}: {c.multistart['best_origin']}, {c.multistart['n_at_best']}/"
+                          f"{c.multistart['n_starts']}, {c.multistart['cost_spread']:.3g}" for c in ms)]
         L += ["", "## Where the baseline misfits (flagged cells)", ""]
         L += _loc_lines(self.localisation_before)
         L += ["", "## After", ""]

@@ -11,7 +11,9 @@ user's free parameters, and:
    multi-start spread; it tabulates where the standardised residuals exceed their band;
 2. refits the full model with each candidate effect of :data:`physmodel.effects.LIBRARY` switched
    on (nested, full nonlinear refits, starting from off, from a linearised estimate, from a
-   typical size and from any user start), within *candidate bounds* scaled to the strip
+   typical size and from any user start — each from the baseline optimum and from the user's start
+   values (a baseline that absorbed the effect can hold a refit in its basin); the best is kept and
+   the spread reported), within *candidate bounds* scaled to the strip
    (:meth:`physmodel.effects.Effect.candidate_parameters`; user-adjustable) and scores it by
    LR = 2 (cost_baseline − cost_candidate) of the penalised costs, with AIC/BIC alongside;
 3. sets the acceptance threshold by Monte Carlo under the null (no effect), so that the
@@ -20,14 +22,23 @@ user's free parameters, and:
    value is a bound), ``null_draws`` draws, scaled by the ratio of full-refit to linearised LR
    on ``null_refits`` parametric-bootstrap draws (clipped to [1, 3]);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
-   baseline Jacobian projected out) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`;
+   baseline Jacobian projected out; the secant to the typical size where the tangent at off carries
+   < :data:`SECANT_RATIO` of it) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`,
+   and, after the refits, the pairs the data cannot separate (below) or that are *confusable in this
+   band at the fitted sizes*: each fitted noiselessly to the other's fitted prediction leaves
+   λ = 2·cost < 4·z_crit², where Vuong's test has less than even odds;
 5. decides: ``none``, ``named`` (one significant candidate that closes the gap, plus a second one
    significant on top of it if any — a forward step; else the best pair among the
    :data:`PAIR_POOL` most significant candidates whose members are each significant on top of the
    other and that closes the gap; pairs are drawn from the most significant candidates and from
    those that best explain what the best one leaves, never a declared-confusable pair; each
    member must carry more than :data:`CLOSE_FRACTION` of the baseline's excess), ``ambiguous``
-   (several closers within :data:`AMBIGUITY_AIC` or declared confusable), ``at_bound`` (the named
+   (``named`` lists the candidates: the closer of lowest AIC and every significant candidate that
+   Vuong's test of non-nested models (1989; :func:`~physmodel.estimation.signatures.vuong_z`,
+   per-residual log-likelihood ratios of the two refits) does not reject against it, two-sided at
+   the user's α: z < Φ⁻¹(1 − α/2).  For exactly specified candidates whose noiseless fits differ by
+   λ, z has mean ≈ √λ/2, so a wrong confident name has chance ≤ α/2 and a pair with λ ≥ 25 is
+   told apart in about 70 % of draws; pairs use an AIC window of :data:`AMBIGUITY_AIC`), ``at_bound`` (the named
    effect closes the gap only with a parameter at its candidate bound: "widen the bound, or the
    effect is larger than allowed" — never a confident name), ``unexplained`` (a significant gap
    nothing closes).  The gap test
@@ -84,7 +95,9 @@ from .priors import (
 from .records import CalibrationResult, FreeParameter
 from .residuals import standardised_residuals
 from .signatures import (
+    _confusability,
     _constrained_lr,
+    _declare,
     _gap,
     _localise,
     _orth,
@@ -92,9 +105,15 @@ from .signatures import (
     _separation,
     _signature,
     _simulated,
+    _spread,
     _z_jacobian,
+    vuong_critical,
 )
 
+#: A candidate parameter whose tangent signature at off is below this fraction of its secant to the
+#: typical size (the first-order term carries < 10 % of the change, e.g. a resonance
+#: 1/(1 + 2ζτs + τ²s²) in τ) is described by the secant instead (fixed a priori, not tuned).
+SECANT_RATIO = 0.1
 #: Pairs of two effects: every pair among this many most significant candidates, and each of the
 #: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
 PAIR_POOL = 4
@@ -193,17 +212,23 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     sigs, sided, skipped, first_order, raw_sigs = {}, {}, {}, {}, {}
     for c in cand:
         S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
-        Sp = _project_out(Q0, S)
         reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in cpars[c]])
+        Ssec, _ = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c], h=1.0)    # secant to the typical size
+        sec = np.linalg.norm(S, axis=0) < SECANT_RATIO * np.linalg.norm(Ssec, axis=0)
+        if np.all(np.isfinite(S)) and np.all(np.isfinite(Ssec)) and sec.any():
+            S = np.where(sec[None, :], Ssec, S)
+            first_order[c] = ("no first-order signature at off in " + ", ".join(
+                p.name for p, x in zip(cpars[c], sec) if x) + " (secant to the typical size there; refitted)")
+        Sp = _project_out(Q0, S)
         max_lr = float(np.sum((np.linalg.norm(Sp, axis=0) * reach) ** 2))
         if not np.all(np.isfinite(S)) or np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
             skipped[c] = "no signature on these data (cannot change the cost by the noise level)"
             continue
         sigs[c], sided[c], raw_sigs[c] = Sp, one, S
-        if max_lr < MIN_SIGNATURE_LR:
+        if max_lr < MIN_SIGNATURE_LR and c not in first_order:
             first_order[c] = "confounded with the free parameters to first order (refitted; only nonlinear terms can show it)"
     confusable = []
-    orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order}
+    orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order or first_order[c].startswith("no first")}
     for a, b in combinations(orth, 2):
         if orth[a].shape[1] == 0 or orth[b].shape[1] == 0:
             continue
@@ -233,18 +258,25 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             out.append(FreeParameter(f"{c}.{p.name}", p.lower, p.upper, "linear", v))
         return out
 
-    def refit(effects_on: Sequence[str], start_vals: dict, eff_starts: list, sim=None, identify=True):
-        best = None
-        for starts in eff_starts:
-            fr = [fp.with_initial(min(max(start_vals[fp.name], fp.lower), fp.upper)) for fp in free0]
-            for c in effects_on:
-                st = None if starts is None else starts.get(c)
-                if st is None and any(k.startswith(c + ".") for k in start_vals):
-                    st = {k.split(".", 1)[1]: v for k, v in start_vals.items() if k.startswith(c + ".")}
-                fr += eff_free(c, st)
-            res = fit(fr, sim=sim, identify=identify)
-            if best is None or res.cost < best.cost:
-                best = res
+    user0 = {fp.name: fp.initial for fp in free0}
+
+    def refit(effects_on: Sequence[str], start_vals: dict, eff_starts: list, sim=None, identify=True,
+              from_user=False):
+        """Best of the refits from ``start_vals`` (and, ``from_user``, the user's start) × ``eff_starts``."""
+        best, runs = None, []
+        for origin, sv in [("baseline optimum", start_vals)] + ([("user start", user0)] if from_user else []):
+            for starts in eff_starts:
+                fr = [fp.with_initial(min(max(sv[fp.name], fp.lower), fp.upper)) for fp in free0]
+                for c in effects_on:
+                    st = None if starts is None else starts.get(c)
+                    if st is None and any(k.startswith(c + ".") for k in sv):
+                        st = {k.split(".", 1)[1]: v for k, v in sv.items() if k.startswith(c + ".")}
+                    fr += eff_free(c, st)
+                res = fit(fr, sim=sim, identify=identify)
+                runs.append((origin, res))
+                if best is None or res.cost < best.cost:
+                    best, best_origin = res, origin
+        best.metadata["refit_multistart"] = _spread(runs, best, best_origin)
         return best
 
     def lin_start(c, r_now, Qb):
@@ -268,7 +300,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     k0 = len(free0)
     n_res = 2 * N
     for c in sigs:
-        res = refit([c], v0, starts_for(c, r0, Q0))
+        res = refit([c], v0, starts_for(c, r0, Q0), from_user=True)
         fits[c] = res
         k = len(cpars[c])
         lr = max(0.0, 2 * (res0.cost - res.cost))
@@ -281,7 +313,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             False, False, res.converged, float(np.linalg.norm(sigs[c])),
             float(_constrained_lr(sigs[c], sided[c], -_project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""),
             bounds={p.name: [p.lower, p.upper] for p in cpars[c]}, at_bound=ab, implausible=imp,
-            penalty=res.metadata["penalty"])
+            penalty=res.metadata["penalty"], multistart=res.metadata["refit_multistart"])
     say(f"{len(cres)} candidates refitted")
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
     full_max, lin_used = [], []
@@ -290,11 +322,13 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         sim = FrequencySweep(data.temperature_c, data.frequency_hz, _simulated(G0, e, s_ln, s_ph),
                              np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
                              data.input_unit, data.output_name, data.output_unit)
-        rb = fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
-                 identify=False)
+        rb = min((fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
+                      identify=False), fit(free0, sim=sim, starts=int(baseline_starts), identify=False)),
+                 key=lambda x: x.cost)      # the same search as on the data (both base starts, below too)
+        r_b = standardised_residuals(pm([rb.values])[0], sim, s_ln, s_ph)
         m = 0.0
         for c in sigs:
-            rc = refit([c], rb.values, [None], sim=sim, identify=False)
+            rc = refit([c], rb.values, starts_for(c, r_b, Q0), sim=sim, identify=False, from_user=True)
             m = max(m, 2 * (rb.cost - rc.cost))
         full_max.append(m)
         lin_used.append(float(lin_max[b]))
@@ -321,6 +355,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         cr.significant = cr.lr > T
         cr.closes_gap = closes_gap(cr.cost, [c])
     gap0_sig = 2 * cost0 > gap_thr0
+    z_crit = vuong_critical(alpha)
+    confusability: dict = {"z_critical": z_crit, "data": [], "in_band": []}
     sig = sorted((c for c in cres if cres[c].significant), key=lambda c: -cres[c].lr)
     final_effects: list[str] = []
     final_fit: CalibrationResult | None = None
@@ -379,15 +415,15 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            amb = [c for c in closers if cres[c].aic - cres[top].aic < AMBIGUITY_AIC
-                   or frozenset((top, c)) in conf_set]          # declared confusable and also closing
+            confusability = _confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit, refit)
+            amb = [top] + [x["other"] for x in confusability["data"] if not x["separated"]]
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
                 verdict = "ambiguous"
-                pairs = [f"{a}~{b}" + ("" if frozenset((a, b)) in conf_set else " (not declared confusable)")
-                         for a, b in combinations(amb, 2)]
-                message = (f"Ambiguous between {', '.join(amb)} (each closes the gap; AIC within {AMBIGUITY_AIC:g} or "
-                           f"declared confusable; {'; '.join(pairs)}; lowest AIC: {top}). "
+                zs = "; ".join(f"{x['other']} z = {x['z']:.3g}" for x in confusability["data"] if not x["separated"])
+                message = (f"Ambiguous between {', '.join(amb)}: the data do not separate them from the best "
+                           f"closer {top} (Vuong's test of non-nested fits, z < {z_crit:.3g} at "
+                           f"α = {alpha:g}: {zs}). "
                            "Separate them with a wider band, more temperatures, or magnitude vs phase.")
             else:
                 verdict, message = "named", _named_msg(top, cres[top])
@@ -433,9 +469,10 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     widen = [a for a in at_bound if not a["hard"] and "." in a["name"] and not a["name"].startswith("laws.")
              and a["name"].split(".", 1)[0] in final_effects]
     # a significant candidate confusable with a named effect that stopped at a widenable bound: its
-    # LR there is only a lower bound, so it might beat the named effect once the bound is widened
+    # LR there is only a lower bound, so it might beat the named effect once the bound is widened (not an absolute one)
     widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
-              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")]
+              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
+              and a["bound"] != getattr(LIBRARY[c].parameter(a["name"].split(".", 1)[1]), a["side"])]
     if verdict in ("named", "ambiguous") and widen:
         verdict = "at_bound"
         message = ("At bound — widen or the effect is larger than allowed: " + "; ".join(
@@ -487,6 +524,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
     if warn:
         message += f" Cost vs declared noise: {warn}."
+    _declare(confusable, separation, confusability, sigs, raw_sigs, data)
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
@@ -507,7 +545,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                   "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
-        cost_warning=warn,
+        cost_warning=warn, confusability=confusability,
     )
 
 

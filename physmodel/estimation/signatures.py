@@ -32,14 +32,15 @@ def _z_jacobian(predict_many, values: dict, params: Sequence[FreeParameter], r0,
     return ((R - r0[None, :]) / np.array(steps)[:, None]).T
 
 
-def _signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph, params=None):
+def _signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph, params=None, h=1e-3):
     """Columns d r/d δ at "off" for each effect parameter, δ in units of (typical − off);
     and which are one-sided (off at a bound).  ``params``: the effect's parameters with their
-    candidate bounds (default: the library's)."""
+    candidate bounds (default: the library's).  ``h``: the step in δ (1: the secant to the typical
+    size, for effects whose first-order signature vanishes at off, e.g. a resonance (1 + 2ζτs)/
+    (1 + 2ζτs + τ²s²) whose derivative in τ is 0 at τ = 0)."""
     pts, steps, one_sided = [], [], []
     for p in (params if params is not None else LIBRARY[effect].parameters):
         span = p.typical - p.off
-        h = 1e-3
         v = dict(values)
         v[f"{effect}.{p.name}"] = p.off + h * span
         pts.append(v)
@@ -187,3 +188,121 @@ def _simulated(G, e, s_ln, s_ph):
     """``G`` with standardised log-magnitude/phase noise ``e`` (2N,) applied at σ ``s_ln`` [Np], ``s_ph`` [rad]."""
     N = G.size
     return G * np.exp(e[:N] * s_ln + 1j * e[N:] * s_ph)
+
+
+def vuong_z(r_a, r_b, cost_a: float, cost_b: float) -> float:
+    """Vuong's statistic for two non-nested models fitted to the same data, > 0 when ``a`` fits better.
+
+    ``r_a``, ``r_b``: standardised residuals of the data lines (log-magnitude and phase, each an
+    independent unit-variance Gaussian term of the log-likelihood); ``cost_*``: the minimised
+    costs (½Σr² plus any range penalty, i.e. minus the log-likelihood).
+    z = (cost_b − cost_a) / ω with ω² = Σ_i (ℓ_i − ℓ̄)², ℓ_i = (r_b,i² − r_a,i²)/2 the per-residual
+    log-likelihood ratio (Vuong 1989, Econometrica 57:307, Theorem 5.1).  Under "equally close to
+    the truth" z is asymptotically N(0, 1); for two exactly specified candidates whose fits differ by
+    a deterministic signature δ (noiseless λ_ab = ‖δ‖²) z has mean ≈ √λ_ab / 2 and a spread of at
+    most 1 (ω also carries the fits' own noise; ≈ 0.8 in tests/estimation/test_vuong.py).  No Akaike/Schwarz
+    correction: divided by a small ω it would turn a difference of parameter counts between two
+    fits that coincide into a "significant" one.  Identical fits (ω = 0) give 0."""
+    ra, rb = np.asarray(r_a, float), np.asarray(r_b, float)
+    ell = 0.5 * (rb * rb - ra * ra)
+    omega = float(np.sqrt(np.sum((ell - ell.mean()) ** 2)))
+    num = cost_b - cost_a
+    if omega <= 1e-12 * (1.0 + abs(num)) or not math.isfinite(omega):
+        return 0.0
+    return float(num / omega)
+
+
+def vuong_critical(alpha: float) -> float:
+    """Two-sided critical value Φ⁻¹(1 − α/2) of :func:`vuong_z` (the better model is chosen by the
+    data, so a one-sided test of the chosen one is a two-sided test)."""
+    from scipy.stats import norm
+
+    return float(norm.ppf(1.0 - alpha / 2.0))
+
+
+def vuong_power(lam: float, z_crit: float) -> float:
+    """Probability that :func:`vuong_z` exceeds ``z_crit`` when the noiseless fits differ by
+    λ = 2·Δcost, in the normal approximation z ~ N(√λ/2, 1): exact at ½ (λ = 4·z_crit²); with the
+    smaller real spread it understates the power above ½ and overstates it below."""
+    from scipy.stats import norm
+
+    return float(norm.cdf(math.sqrt(max(lam, 0.0)) / 2.0 - z_crit))
+
+
+def _noiseless(data: FrequencySweep, G, s_ln, s_ph) -> FrequencySweep:
+    """``data`` with response ``G`` and the same per-line σ."""
+    return FrequencySweep(data.temperature_c, data.frequency_hz, G, np.asarray(s_ln) * 20 / math.log(10),
+                          np.degrees(s_ph), data.input_name, data.input_unit, data.output_name, data.output_unit)
+
+
+def _confusability(top: str, sig: Sequence[str], fits: dict, cres: dict, pm, data: FrequencySweep, s_ln, s_ph,
+                   z_crit: float, refit) -> dict:
+    """Is the best closer ``top`` separated from each other significant candidate?
+
+    ``data``: Vuong's test (:func:`vuong_z`) of ``top`` against it on the measured data — not
+    separated when z < ``z_crit``; ``pairs``: the same, two-sided, between the others not separated
+    from ``top`` (so an ambiguous set declares which of its pairs the data cannot split).  ``in_band``: each fitted to the other's noiseless prediction at
+    its fitted size (``refit(effects, start_values, [None], sim=...)``), λ = 2·data cost; the pair is
+    *confusable in this band* when the smaller λ gives Vuong's test less than even odds
+    (:func:`vuong_power` < ½, i.e. λ < 4·z_crit²)."""
+    pred = {c: pm([fits[c].values])[0] for c in sig}
+    r = {c: standardised_residuals(pred[c], data, s_ln, s_ph) for c in sig}
+    out: dict = {"top": top, "z_critical": z_crit, "data": [], "in_band": [], "pairs": [],
+                 "rule": "Vuong's test of the best closer against each significant candidate, "
+                         "two-sided at α; confusable in the band when the noiseless cross-fit λ < 4·z_crit²"}
+    for c in sig:
+        if c == top:
+            continue
+        z = vuong_z(r[top], r[c], fits[top].cost, fits[c].cost)
+        out["data"].append({"top": top, "other": c, "z": z, "separated": bool(z >= z_crit)})
+        lam_ct = 2 * refit([c], fits[c].values, [None], sim=_noiseless(data, pred[top], s_ln, s_ph),
+                           identify=False).metadata["data_cost"]
+        lam_tc = 2 * refit([top], fits[top].values, [None], sim=_noiseless(data, pred[c], s_ln, s_ph),
+                           identify=False).metadata["data_cost"]
+        power = vuong_power(min(lam_ct, lam_tc), z_crit)
+        out["in_band"].append({"top": top, "other": c, "lambda_other_to_top": lam_ct, "lambda_top_to_other": lam_tc,
+                               "power": power, "confusable": bool(power < 0.5)})
+    rest = [x["other"] for x in out["data"] if not x["separated"]]
+    for a, b in combinations(rest, 2):     # within an ambiguous set: the other pairs, two-sided
+        z = vuong_z(r[a], r[b], fits[a].cost, fits[b].cost)
+        out["pairs"].append({"top": a, "other": b, "z": z, "separated": bool(abs(z) >= z_crit)})
+    return out
+
+
+def _cosine(Sa, Sb) -> float:
+    """Largest canonical correlation between two signature blocks (nan if either is empty)."""
+    Qa, Qb = _orth(Sa), _orth(Sb)
+    if Qa.shape[1] == 0 or Qb.shape[1] == 0:
+        return float("nan")
+    return float(min(np.linalg.svd(Qa.T @ Qb, compute_uv=False).max(), 1.0))
+
+
+def _declare(confusable: list, separation: dict, confusability: dict, sigs: dict, raw_sigs: dict, data) -> None:
+    """Add to ``confusable``/``separation`` (in place) the pairs the data do not separate and those
+    confusable in this band (from :func:`_confusability`), each with its reason."""
+    declared = {frozenset(x[:2]) for x in confusable}
+    rows = [(x, f"not separated by the data (Vuong z = {x['z']:.3g})")
+            for x in confusability["data"] + confusability.get("pairs", []) if not x["separated"]]
+    rows += [(x, "confusable in this band at the fitted sizes (noiseless cross-fit λ = "
+                 f"{min(x['lambda_other_to_top'], x['lambda_top_to_other']):.3g})")
+             for x in confusability["in_band"] if x["confusable"]]
+    for x, why in rows:
+        a, b = x["top"], x["other"]
+        key = f"{a}~{b}" if f"{b}~{a}" not in separation else f"{b}~{a}"
+        if frozenset((a, b)) not in declared:
+            declared.add(frozenset((a, b)))
+            confusable.append((a, b, _cosine(sigs[a], sigs[b])))
+            separation[key] = _separation(a, b, raw_sigs, data)
+        separation[key] = separation.get(key, "") + f" Declared: {why}."
+
+
+def _spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:
+    """Multi-start record of a candidate refit: ``runs`` = [(origin, CalibrationResult)]; the costs,
+    origins, the best's origin, how many reach the best cost within ``tol`` (½Δχ²), the cost spread
+    and each parameter's range over the starts that reach it."""
+    costs = [float(r.cost) for _, r in runs]
+    near = [r for _, r in runs if r.cost <= best.cost + tol]
+    return {"n_starts": len(runs), "costs": costs, "origins": [o for o, _ in runs], "best_origin": best_origin,
+            "n_at_best": len(near), "cost_spread": max(costs) - min(costs),
+            "ranges": {n: [float(min(r.values[n] for r in near)), float(max(r.values[n] for r in near))]
+                       for n in best.names}}
