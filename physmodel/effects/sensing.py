@@ -39,7 +39,7 @@ two inverting stages (hence v2 = +R3 R1/R2 · i).  Each op-amp is a single-pole 
 The first stage's noise gain 1 + R1/Z is what matters: the strip's Z is tens of ohms at
 10-100 Hz for literature diffusivities, so 1 + R1/Z ≈ 2e4 and a 1 MHz op-amp closes the loop
 near 50 Hz, in the band (the "virtual ground" fails); ``TransimpedanceChain`` in
-:mod:`physmodel.sensor` ignores this.
+:mod:`physmodel.sensor` models this when given ``gbw_hz``/``dc_gain`` (and ``simulate`` honours it).
 
 Every element is a pure, vectorised function of s [rad/s] (parameters broadcast against s) with an
 "off" value at which it is exactly 1.  Resonances and filters are parametrised by time constants
