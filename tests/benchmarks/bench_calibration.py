@@ -52,10 +52,12 @@ sys.path.insert(0, str(_ROOT))
 from physmodel import ActuatorModel, get_parameter_set  # noqa: E402
 from physmodel.temperature import Arrhenius, LogLinear  # noqa: E402
 
-try:
+# The layout is decided by the files under _ROOT, not by what imports: with another checkout installed
+# editable, ``physmodel.data`` would be found there and mixed with _ROOT's package.
+if (Path(_ROOT) / "physmodel" / "data" / "sweep.py").exists():
     from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise, synthesize_sweep
     from physmodel.estimation.calibration import calibrate
-except ImportError:  # the layout before issue 19 (for --root at an older commit)
+else:  # the layout before issue 19 (for --root at an older commit)
     from physmodel.calibration import calibrate  # type: ignore[no-redef]
     from physmodel.sweep import (  # type: ignore[no-redef]
         ComplexGaussianNoise,
