@@ -65,9 +65,11 @@ for ambiguity, null refits with the same multi-start search), on fresh seeds nob
 at 4ad8685, three jobs sharing 2 cores): detectable single effects named 35/38 = 92 % (Wilson 79-97 %),
 0 wrong confident names, 0 confusions outside declared pairs, out of library 7/7 of those not 'none',
 0 unreported bounds; but FPR 3/24 = 12.5 % (4-31 %) and two effects both named 6/12; mean 28 s per
-diagnosis under that load.  Suspected (unverified): a candidate refit from the user's start reaches a
-better basin of the base parameters than the baseline's own search, so the ratio measures the
-baseline's local minimum; refitting the baseline from the best candidate's base values is the next step.
+diagnosis under that load.  Checked on two of the three false positives (null seeds 9071 and 9081:
+``diffusivity_temperature`` LR 15.4, ``second_mode`` LR 10.7): both winning refits started at the
+baseline optimum, not at the user's start, so the multi-start is not their cause; what remains is the
+threshold (linearised null with a 2-draw bootstrap correction) or chance (3 of 24 at α = 5 %: binomial
+p ≈ 0.12).
 """
 
 from __future__ import annotations
