@@ -69,7 +69,9 @@ diagnosis under that load.  Checked on two of the three false positives (null se
 ``diffusivity_temperature`` LR 15.4, ``second_mode`` LR 10.7): both winning refits started at the
 baseline optimum, not at the user's start, so the multi-start is not their cause; what remains is the
 threshold (linearised null with a 2-draw bootstrap correction) or chance (3 of 24 at α = 5 %: binomial
-p ≈ 0.12).
+p ≈ 0.12).  A null-only run on fresh seeds (``--first-seed 20000 --n-per-label 0 --null 48 --workers 2
+--no-real``, idle machine): 3/48 = 6 % named (Wilson 2-17 %; two of them the new three-parameter
+``viscous_fluid``, one ``modulus_temperature``), 1 ``unexplained``; 13.9 s mean per diagnosis.
 """
 
 from __future__ import annotations
