@@ -22,7 +22,6 @@ Not collected by pytest (the file name does not start with ``test_``).
 from __future__ import annotations
 
 import argparse
-import gc
 import os
 import resource
 import sys
@@ -35,6 +34,8 @@ import numpy as np
 import scipy.signal as ss
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from _timing import interleaved  # noqa: E402
 
 from inversion import (  # noqa: E402
     StreamingInverter,
@@ -53,14 +54,7 @@ G35 = seed000_sensor_35c("coefficients")
 
 
 def _best(fns: dict, reps: int) -> dict:
-    times = {k: [] for k in fns}
-    for _ in range(reps):
-        for k, f in fns.items():
-            gc.collect()
-            t0 = time.perf_counter()
-            f()
-            times[k].append(time.perf_counter() - t0)
-    return {k: min(v) for k, v in times.items()}
+    return interleaved(fns, reps, reduce=np.min)
 
 
 def bench_batch(n: int, reps: int) -> None:

@@ -14,17 +14,9 @@ import time
 import tracemalloc
 
 import numpy as np
+from _timing import best_of
 
 from physmodel import ActuatorModel, get_parameter_set
-
-
-def best_of(fn, repeat=5):
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def main(argv=None):

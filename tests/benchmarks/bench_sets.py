@@ -12,23 +12,15 @@ ratio is the goal's, the "one-shot" ratio also counts building the 10k-set model
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))   # this checkout's packages
 
-from physmodel import ActuatorModel, get_parameter_set, state_at
+from _timing import best_of  # noqa: E402
 
-
-def best_of(fn, repeat=5):
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
+from physmodel import ActuatorModel, get_parameter_set, state_at  # noqa: E402
 
 
 def main() -> None:

@@ -397,14 +397,9 @@ def build_section(args):
 
 # ============================================================================ stream
 def _median_interleaved(fns: dict, reps: int) -> dict:
-    times = {k: [] for k in fns}
-    for _ in range(reps):
-        for k, f in fns.items():
-            gc.collect()
-            t0 = time.perf_counter()
-            f()
-            times[k].append(time.perf_counter() - t0)
-    return {k: float(np.median(v)) for k, v in times.items()}
+    from _timing import interleaved
+
+    return interleaved(fns, reps)
 
 
 def stream_section(args):
