@@ -23,7 +23,7 @@ user's free parameters, and:
    on ``null_refits`` parametric-bootstrap draws (clipped to [1, 3]);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
    baseline Jacobian projected out; the secant to the typical size where the tangent at off carries
-   < :data:`SECANT_RATIO` of it) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`,
+   < :data:`~physmodel.estimation.nullstats.SECANT_RATIO` of it) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`,
    and, after the refits, the pairs the data cannot separate (below) or that are *confusable in this
    band at the fitted sizes*: each fitted noiselessly to the other's fitted prediction leaves
    λ = 2·cost < 4·z_crit², where Vuong's test has less than even odds;
@@ -71,7 +71,6 @@ from .diagnosis import (
     CLOSE_FRACTION,
     CONFUSABLE_COSINE,
     GAP_ALPHA_DIVISOR,
-    MIN_SIGNATURE_LR,
     VERDICTS,
     CandidateResult,
     Diagnosis,
@@ -82,6 +81,7 @@ from .diagnosis import (
     gap_shrink,
     resolve_laws,
 )
+from .nullstats import _constrained_lr, _scan_lr, signature_stage
 from .priors import (
     WALL_DECADES,
     PenalisedProblem,
@@ -96,24 +96,18 @@ from .records import CalibrationResult, FreeParameter
 from .residuals import standardised_residuals
 from .signatures import (
     _confusability,
-    _constrained_lr,
     _declare,
     _gap,
     _localise,
     _orth,
+    _pair_members,
     _project_out,
-    _separation,
-    _signature,
     _simulated,
     _spread,
-    _z_jacobian,
     vuong_critical,
+    vuong_z,
 )
 
-#: A candidate parameter whose tangent signature at off is below this fraction of its secant to the
-#: typical size (the first-order term carries < 10 % of the change, e.g. a resonance
-#: 1/(1 + 2ζτs + τ²s²) in τ) is described by the secant instead (fixed a priori, not tuned).
-SECANT_RATIO = 0.1
 #: Pairs of two effects: every pair among this many most significant candidates, and each of the
 #: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
 PAIR_POOL = 4
@@ -207,35 +201,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         raise ParameterError(f"candidate bounds/starts given for {bad}, which are not candidates here ({cand})")
     cpars = {c: LIBRARY[c].candidate_parameters(base, cbounds.get(c)) for c in cand}
     hard = _hard_sides(cpars)
-    J0 = _z_jacobian(pm, v0, free0, r0, data, s_ln, s_ph)
-    Q0 = _orth(J0)
-    sigs, sided, skipped, first_order, raw_sigs = {}, {}, {}, {}, {}
-    for c in cand:
-        S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
-        reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in cpars[c]])
-        Ssec, _ = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c], h=1.0)    # secant to the typical size
-        sec = np.linalg.norm(S, axis=0) < SECANT_RATIO * np.linalg.norm(Ssec, axis=0)
-        if np.all(np.isfinite(S)) and np.all(np.isfinite(Ssec)) and sec.any():
-            S = np.where(sec[None, :], Ssec, S)
-            first_order[c] = ("no first-order signature at off in " + ", ".join(
-                p.name for p, x in zip(cpars[c], sec) if x) + " (secant to the typical size there; refitted)")
-        Sp = _project_out(Q0, S)
-        max_lr = float(np.sum((np.linalg.norm(Sp, axis=0) * reach) ** 2))
-        if not np.all(np.isfinite(S)) or np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
-            skipped[c] = "no signature on these data (cannot change the cost by the noise level)"
-            continue
-        sigs[c], sided[c], raw_sigs[c] = Sp, one, S
-        if max_lr < MIN_SIGNATURE_LR and c not in first_order:
-            first_order[c] = "confounded with the free parameters to first order (refitted; only nonlinear terms can show it)"
-    confusable = []
-    orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order or first_order[c].startswith("no first")}
-    for a, b in combinations(orth, 2):
-        if orth[a].shape[1] == 0 or orth[b].shape[1] == 0:
-            continue
-        cos = float(np.linalg.svd(orth[a].T @ orth[b], compute_uv=False).max())
-        if cos >= CONFUSABLE_COSINE:
-            confusable.append((a, b, min(cos, 1.0)))
-    separation = {f"{a}~{b}": _separation(a, b, raw_sigs, data) for a, b, _ in confusable}
+    J0, Q0, sigs, sided, skipped, first_order, raw_sigs, degenerate, confusable, separation = signature_stage(
+        pm, v0, free0, cand, cpars, r0, data, s_ln, s_ph)
     conf_set = {frozenset((a, b)) for a, b, _ in confusable}
 
     # ---- 3. linearised null Monte Carlo
@@ -243,6 +210,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     E = rng.standard_normal((2 * N, int(null_draws)))
     Ep = _project_out(Q0, E)
     lin = {c: _constrained_lr(S, sided[c], Ep) for c, S in sigs.items()}
+    for c in [c for c in sigs if c in degenerate]:      # look-elsewhere over parameters without a first-order signature
+        lin[c] = np.maximum(lin[c], _scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep))
     lin_max = np.max(np.vstack(list(lin.values())), axis=0) if lin else np.zeros(E.shape[1])
     cost2_null = np.sum(Ep * Ep, axis=0)
     T_lin = float(np.quantile(lin_max, 1 - alpha))
@@ -382,6 +351,10 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                   for b in pool if b != a}
             return [b for b in sorted(sc, key=lambda k: -sc[k])[:PAIR_POOL - 1]], r_a, Qa
 
+        def strict(res, effs) -> bool:
+            """2·cost within its null band (no tolerance for a parametrisation mismatch)."""
+            return 2 * res.metadata["data_cost"] <= gap_thr(effs)
+
         def pair_fits(pairs):
             out = []
             for a, b in pairs:
@@ -390,23 +363,41 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                 res2 = refit([a, b], va, [{b: {p.name: p.off for p in cpars[b]}}, {b: lin_start(b, r_a, Qa)}])
                 lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)   # each on top
                 closes = closes_gap(res2.metadata["data_cost"], [a, b])
+                # each member significant on top of the other, and either carrying more than the
+                # share of the excess a closing effect may leave, or the pair closes the gap strictly
+                # (within the noise band) where neither member alone does
+                rescue = strict(res2, [a, b]) and not strict(fits[a], [a]) and not strict(fits[b], [b])
+                accepted = min(lr_a, lr_b) > T and (min(lr_a, lr_b) > T2 or rescue)
                 pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
-                                   "lr_second_on_top": lr_b, "closes_gap": closes})
-                if min(lr_a, lr_b) > T2:
+                                   "lr_second_on_top": lr_b, "closes_gap": closes, "closes_strictly": rescue,
+                                   "accepted": accepted})
+                if accepted:
                     out.append(((a, b), res2, lr_a, lr_b, closes))
             return sorted(out, key=lambda x: x[1].cost)
 
         def name_pair(ok):
+            """The best pair, ambiguous with every closing pair Vuong's test does not separate from it
+            (two-sided at α, as for single effects); their differing members are declared confusable."""
             best2 = ok[0]
             a, b = best2[0]
-            alt = [x[0] for x in ok[1:] if x[4] and 2 * (x[1].cost - best2[1].cost) < AMBIGUITY_AIC]
+            r_best = standardised_residuals(pm([best2[1].values])[0], data, s_ln, s_ph)
+            alt = []
+            for x in ok[1:]:
+                if not x[4]:
+                    continue
+                z = vuong_z(r_best, standardised_residuals(pm([x[1].values])[0], data, s_ln, s_ph),
+                            best2[1].cost, x[1].cost)
+                if z < z_crit:
+                    alt.append((x[0], z))
+                    for m, o in _pair_members(best2[0], x[0], sigs):
+                        confusability.setdefault("pairs", []).append({"top": m, "other": o, "z": z, "separated": False})
             msg = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
-                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T2:.3g}); the gap closes.")
+                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T:.3g}); the gap closes.")
             if alt:
-                return ("ambiguous", sorted({a, b} | {c for x in alt for c in x}), list(best2[0]), best2[1],
+                return ("ambiguous", sorted({a, b} | {c for x, _ in alt for c in x}), list(best2[0]), best2[1],
                         msg.replace("Named two effects", "Ambiguous: best pair")
-                        + " Other pairs fit as well (AIC within %g): " % AMBIGUITY_AIC
-                        + "; ".join(f"{x[0]} + {x[1]}" for x in alt) + ".")
+                        + f" Other pairs the data do not separate from it (Vuong z < {z_crit:.3g}): "
+                        + "; ".join(f"{x[0]} + {x[1]} (z = {z:.3g})" for x, z in alt) + ".")
             return "named", [a, b], list(best2[0]), best2[1], msg
 
         # a second effect must be significant and carry more than the share of the excess that a

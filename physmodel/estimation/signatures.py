@@ -63,31 +63,6 @@ def _project_out(Q, A):
     return A - Q @ (Q.T @ A) if Q.shape[1] else A
 
 
-def _constrained_lr(S, one_sided, E):
-    """Max over δ (one-sided components ≥ 0) of 2δᵀSᵀe − δᵀSᵀSδ for every column e of E.
-
-    Exact for ≤ 3 parameters by enumerating active sets (concave quadratic)."""
-    k = S.shape[1]
-    best = np.zeros(E.shape[1])
-    for m in range(1, k + 1):
-        for sub in combinations(range(k), m):
-            Ss = S[:, sub]
-            G = Ss.T @ Ss
-            try:
-                Ginv = np.linalg.pinv(G)
-            except np.linalg.LinAlgError:  # pragma: no cover
-                continue
-            b = Ss.T @ E                        # (m, n)
-            d = Ginv @ b
-            lr = np.sum(b * d, axis=0)
-            ok = np.ones(E.shape[1], bool)
-            for j, c in enumerate(sub):
-                if one_sided[c]:
-                    ok &= d[j] >= 0
-            best = np.where(ok & (lr > best), lr, best)
-    return best
-
-
 def _localise(data: FrequencySweep, r: np.ndarray, alpha: float, n_bands: int = 4) -> list:
     """Standardised residuals by band × temperature × part, flagged at Bonferroni level α."""
     from scipy.stats import chi2
@@ -306,3 +281,16 @@ def _spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:
             "n_at_best": len(near), "cost_spread": max(costs) - min(costs),
             "ranges": {n: [float(min(r.values[n] for r in near)), float(max(r.values[n] for r in near))]
                        for n in best.names}}
+
+
+def _pair_members(best: Sequence[str], other: Sequence[str], sigs: dict) -> list:
+    """The members in which two pairs differ, matched one to one (by the larger signature cosine
+    when both differ)."""
+    db, do = [m for m in best if m not in other], [m for m in other if m not in best]
+    if len(db) != len(do) or not db:
+        return []
+    if len(db) == 1:
+        return [(db[0], do[0])]
+    straight = _cosine(sigs[db[0]], sigs[do[0]]) + _cosine(sigs[db[1]], sigs[do[1]])
+    crossed = _cosine(sigs[db[0]], sigs[do[1]]) + _cosine(sigs[db[1]], sigs[do[0]])
+    return list(zip(db, do if not crossed > straight else do[::-1]))

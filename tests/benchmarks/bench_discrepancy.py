@@ -342,8 +342,12 @@ def report(rows, title):
             print(f"    missed (detectable) {r['label']:28s} λ={r['lam']:.0f} -> {outcome(r)}")
     if pairs:
         dp = [r for r in pairs if r["detectable"]]
+        dpw = [r for r in pairs if r.get("detectable_workflow", r["detectable"])]
         print(f"\n=== Two hidden effects ===\n  both named (all): {_rate(sum(correct(r) for r in pairs), len(pairs))}"
-              f"\n  both named (each detectable on top of the other): {_rate(sum(correct(r) for r in dp), len(dp))}")
+              f"\n  both named (each detectable on top of the other): {_rate(sum(correct(r) for r in dp), len(dp))}"
+              f"\n  the same, detectable after refitting the workflow's own free set (κe too): "
+              f"{_rate(sum(correct(r) for r in dpw), len(dpw))}"
+              f"\n  of those, named exactly (verdict 'named'): {_rate(sum(r['verdict'] == 'named' and correct(r) for r in dpw), len(dpw))}")
         for r in pairs:
             if not correct(r):
                 print(f"    {r['label']:45s} -> {outcome(r)}" + ("" if r["detectable"] else " (not detectable)"))

@@ -1,0 +1,184 @@
+"""Null statistics of the discrepancy workflow: each candidate's residual signature at the fitted
+baseline (tangent, or secant where the tangent vanishes), which parameters only act once the others
+are on, the constrained likelihood ratio of the linearised Gaussian null, and its look-elsewhere
+scan over parameters that are not identified under the null (Davies 1987)."""
+
+from __future__ import annotations
+
+import math
+from itertools import combinations
+
+import numpy as np
+
+from .diagnosis import CONFUSABLE_COSINE, MIN_SIGNATURE_LR
+from .residuals import standardised_residuals
+from .signatures import _orth, _project_out, _separation, _signature, _z_jacobian
+
+#: A candidate parameter whose tangent signature at off is below this fraction of its secant to the
+#: typical size (the first-order term carries < 10 % of the change, e.g. a resonance
+#: 1/(1 + 2ζτs + τ²s²) in τ) is described by the secant instead (fixed a priori, not tuned).
+SECANT_RATIO = 0.1
+
+def signature_stage(pm, v0: dict, free0, cand, cpars: dict, r0, data, s_ln, s_ph):
+    """Signatures of every candidate at the fitted baseline ``v0`` (columns d r/d δ, the baseline
+    Jacobian projected out), which are one-sided, skipped (no signature on these data), described by
+    the secant, *degenerate* (parameters with no first-order signature at off, scanned by
+    :func:`_scan_lr`), and the pairs whose signatures are confusable (canonical correlation
+    ≥ ``CONFUSABLE_COSINE``) with what separates them.
+
+    Returns ``(J0, Q0, sigs, sided, skipped, first_order, raw_sigs, degenerate, confusable, separation)``."""
+    J0 = _z_jacobian(pm, v0, free0, r0, data, s_ln, s_ph)
+    Q0 = _orth(J0)
+    sigs, sided, skipped, first_order, raw_sigs, degenerate = {}, {}, {}, {}, {}, {}
+    for c in cand:
+        S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
+        reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in cpars[c]])
+        Ssec, _ = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c], h=1.0)    # secant to the typical size
+        sec = np.linalg.norm(S, axis=0) < SECANT_RATIO * np.linalg.norm(Ssec, axis=0)
+        if len(cpars[c]) > 1 and np.all(np.isfinite(S)):
+            dead = _needs_others(pm, v0, c, cpars[c], np.where(sec[None, :], Ssec, S), r0, data, s_ln, s_ph,
+                                 SECANT_RATIO)
+            if (dead | sec).any():
+                degenerate[c] = dead | sec
+        elif sec.any():
+            degenerate[c] = sec
+        if np.all(np.isfinite(S)) and np.all(np.isfinite(Ssec)) and sec.any():
+            S = np.where(sec[None, :], Ssec, S)
+            first_order[c] = ("no first-order signature at off in " + ", ".join(
+                p.name for p, x in zip(cpars[c], sec) if x) + " (secant to the typical size there; refitted)")
+        Sp = _project_out(Q0, S)
+        max_lr = float(np.sum((np.linalg.norm(Sp, axis=0) * reach) ** 2))
+        if not np.all(np.isfinite(S)) or np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
+            skipped[c] = "no signature on these data (cannot change the cost by the noise level)"
+            continue
+        sigs[c], sided[c], raw_sigs[c] = Sp, one, S
+        if max_lr < MIN_SIGNATURE_LR and c not in first_order:
+            first_order[c] = "confounded with the free parameters to first order (refitted; only nonlinear terms can show it)"
+    confusable = []
+    orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order or first_order[c].startswith("no first")}
+    for a, b in combinations(orth, 2):
+        if orth[a].shape[1] == 0 or orth[b].shape[1] == 0:
+            continue
+        cos = float(np.linalg.svd(orth[a].T @ orth[b], compute_uv=False).max())
+        if cos >= CONFUSABLE_COSINE:
+            confusable.append((a, b, min(cos, 1.0)))
+    separation = {f"{a}~{b}": _separation(a, b, raw_sigs, data) for a, b, _ in confusable}
+    return J0, Q0, sigs, sided, skipped, first_order, raw_sigs, degenerate, confusable, separation
+
+
+def _constrained_lr(S, one_sided, E):
+    """Max over δ (one-sided components ≥ 0) of 2δᵀSᵀe − δᵀSᵀSδ for every column e of E.
+
+    Exact for ≤ 3 parameters by enumerating active sets (concave quadratic)."""
+    return _constrained_lr_gram(S.T @ S, S.T @ E, one_sided)
+
+
+def _constrained_lr_gram(G, B, one_sided):
+    """:func:`_constrained_lr` from the Gram matrix ``G`` = SᵀS (k, k) and ``B`` = SᵀE (k, n)."""
+    k = G.shape[0]
+    best = np.zeros(B.shape[1])
+    for m in range(1, k + 1):
+        for sub in combinations(range(k), m):
+            idx = np.array(sub)
+            Ginv = np.linalg.pinv(G[np.ix_(idx, idx)])
+            b = B[idx]                          # (m, n)
+            d = Ginv @ b
+            lr = np.sum(b * d, axis=0)
+            ok = np.ones(B.shape[1], bool)
+            for j, c in enumerate(sub):
+                if one_sided[c]:
+                    ok &= d[j] >= 0
+            best = np.where(ok & (lr > best), lr, best)
+    return best
+
+
+#: Largest number of grid points of :func:`_scan_lr` per candidate (a few model evaluations each).
+SCAN_POINTS = 256
+
+
+def _scan_axis(p, n: int) -> np.ndarray:
+    """Values of one parameter for the look-elsewhere scan: geometric steps away from an off value at
+    a bound (10⁻³ … 1 of the span, where small values give small, differently shaped effects, e.g. a
+    time constant), else the range (geometric when it spans a decade or more of positive values)."""
+    if p.off in (p.lower, p.upper):
+        other = p.upper if p.off == p.lower else p.lower
+        return p.off + (other - p.off) * np.logspace(-3.0, 0.0, n)
+    if p.lower > 0 and p.upper / p.lower >= 10.0:
+        return np.geomspace(p.lower, p.upper, n)
+    return np.linspace(p.lower, p.upper, n)
+
+
+def _scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, data, s_ln, s_ph, Q0, E,
+             h: float = 1e-3, max_points: int = SCAN_POINTS) -> np.ndarray:
+    """Linearised null LR of a candidate whose parameters include *degenerate* ones (no first-order
+    signature at off: a shape that only exists once the effect is on, e.g. the frequency and damping
+    of a resonance, the viscosity of a fluid load), with the look-elsewhere effect over them.
+
+    Davies (1987, Biometrika 74:33): when a parameter is not identified under the null, the LR is
+    the supremum over it of the LR with it fixed.  The degenerate parameters run over a grid
+    (:func:`_scan_axis`, at most ``max_points`` points); at each point the other parameters enter by
+    their tangent signatures at off (one-sided where off is a bound), plus the secant from the
+    baseline to that point when it moves the prediction by itself (a one-sided ray: for a resonance
+    whose time constant and damping are both degenerate, the sizes between grid points are covered
+    by the ray, a slight over-cover, i.e. conservative).  Columns are projected off the baseline
+    Jacobian (``Q0``); returns the max over the grid of the constrained LR for every column of ``E``
+    (the null draws, already projected)."""
+    from itertools import product
+
+    deg = [i for i, x in enumerate(degenerate) if x]
+    amp = [i for i in range(len(params)) if i not in deg]
+    n_per = max(4, int(math.floor(max_points ** (1.0 / len(deg)) + 1e-9)))
+    grid = list(product(*[_scan_axis(params[i], n_per) for i in deg]))
+    pts = []
+    for g in grid:
+        v = dict(values)
+        for j, i in enumerate(deg):
+            v[f"{effect}.{params[i].name}"] = float(g[j])
+        for i in amp:
+            v[f"{effect}.{params[i].name}"] = params[i].off
+        pts.append(v)
+        for i in amp:
+            w = dict(v)
+            w[f"{effect}.{params[i].name}"] = params[i].off + h * (params[i].typical - params[i].off)
+            pts.append(w)
+    R = standardised_residuals(predict_many(pts), data, s_ln, s_ph)        # (points, 2N)
+    stride = 1 + len(amp)
+    base = R[0::stride]                                                    # each grid point, amplitudes off
+    tang = [(R[1 + j::stride] - base) / h for j in range(len(amp))]       # (G, 2N) each
+    ray = base - r0[None, :]
+    scale = np.sqrt(np.mean(r0 * r0)) + 1.0
+    use_ray = np.linalg.norm(ray, axis=1) > 1e-6 * scale * math.sqrt(r0.size)
+    cols = np.stack(tang + [ray], axis=1)                                  # (G, k + 1, 2N)
+    cols = cols - (cols @ Q0) @ Q0.T if Q0.shape[1] else cols
+    one = [params[i].off in (params[i].lower, params[i].upper) for i in amp] + [True]
+    B = np.einsum("gkn,nd->gkd", cols, E)                                  # (G, k + 1, draws)
+    best = np.zeros(E.shape[1])
+    finite = np.all(np.isfinite(cols), axis=(1, 2))
+    for gi in np.flatnonzero(finite):
+        keep = list(range(len(amp))) + ([len(amp)] if use_ray[gi] else [])
+        if not keep:
+            continue
+        C = cols[gi, keep]
+        lr = _constrained_lr_gram(C @ C.T, B[gi, keep], [one[j] for j in keep])
+        np.maximum(best, lr, out=best)
+    return best
+
+
+def _needs_others(predict_many, values: dict, effect: str, params, S, r0, data, s_ln, s_ph, ratio: float,
+                  h: float = 1e-3) -> np.ndarray:
+    """Which parameters act only once the effect's other parameters are on (a shape parameter: the
+    damping of a resonance, the viscosity of a fluid load, the share of a second mode): their tangent
+    at off (``S``, others off) is below ``ratio`` of their tangent with the others at their typical
+    sizes."""
+    pts = []
+    for i, p in enumerate(params):
+        v = dict(values)
+        for j, q in enumerate(params):
+            v[f"{effect}.{q.name}"] = q.typical if j != i else q.off
+        w = dict(v)
+        w[f"{effect}.{p.name}"] = p.off + h * (p.typical - p.off)
+        pts += [v, w]
+    R = standardised_residuals(predict_many(pts), data, s_ln, s_ph)
+    T = (R[1::2] - R[0::2]) / h                                            # (k, 2N)
+    with np.errstate(invalid="ignore"):
+        return np.linalg.norm(S, axis=0) < ratio * np.linalg.norm(T, axis=1)
