@@ -20,9 +20,6 @@ from .records import CalibrationResult
 VERDICTS = ("none", "named", "ambiguous", "at_bound", "unexplained")
 #: Candidates whose signatures have a canonical correlation at least this high are confusable.
 CONFUSABLE_COSINE = 0.9
-#: Pairs of effects within this AIC difference of the best pair are reported as ambiguous (single
-#: candidates are compared by Vuong's test instead, see :mod:`physmodel.estimation.discrepancy`).
-AMBIGUITY_AIC = 6.0
 #: The gap test runs at α / GAP_ALPHA_DIVISOR.
 GAP_ALPHA_DIVISOR = 5.0
 #: An effect also "closes the gap" when what it leaves above the gap threshold is at most this

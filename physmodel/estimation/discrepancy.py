@@ -19,8 +19,11 @@ user's free parameters, and:
 3. sets the acceptance threshold by Monte Carlo under the null (no effect), so that the
    *family-wise* false-positive rate of "max over candidates of LR" is α: a linearised Gaussian
    null at the fitted baseline (constrained LR per candidate: χ̄² mixtures for effects whose off
-   value is a bound), ``null_draws`` draws, scaled by the ratio of full-refit to linearised LR
-   on ``null_refits`` parametric-bootstrap draws (clipped to [1, 3]);
+   value is a bound; for a candidate with parameters that act only once it is on — the damping
+   of a resonance, a fluid's viscosity — the supremum over a grid of them, Davies' look-elsewhere
+   correction, :func:`~physmodel.estimation.nullstats._scan_lr`), ``null_draws`` draws, scaled by
+   the ratio of full-refit to linearised LR on ``null_refits`` parametric-bootstrap draws
+   (clipped to [1, 3]);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
    baseline Jacobian projected out; the secant to the typical size where the tangent at off carries
    < :data:`~physmodel.estimation.nullstats.SECANT_RATIO` of it) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`,
@@ -32,13 +35,15 @@ user's free parameters, and:
    :data:`PAIR_POOL` most significant candidates whose members are each significant on top of the
    other and that closes the gap; pairs are drawn from the most significant candidates and from
    those that best explain what the best one leaves, never a declared-confusable pair; each
-   member must carry more than :data:`CLOSE_FRACTION` of the baseline's excess), ``ambiguous``
+   member must carry more than :data:`CLOSE_FRACTION` of the baseline's excess, unless the pair
+   closes the gap strictly — within the noise band — where neither member alone does), ``ambiguous``
    (``named`` lists the candidates: the closer of lowest AIC and every significant candidate that
    Vuong's test of non-nested models (1989; :func:`~physmodel.estimation.signatures.vuong_z`,
    per-residual log-likelihood ratios of the two refits) does not reject against it, two-sided at
    the user's α: z < Φ⁻¹(1 − α/2).  For exactly specified candidates whose noiseless fits differ by
    λ, z has mean ≈ √λ/2, so a wrong confident name has chance ≤ α/2 and a pair with λ ≥ 25 is
-   told apart in about 70 % of draws; pairs use an AIC window of :data:`AMBIGUITY_AIC`), ``at_bound`` (the named
+   told apart in about 70 % of draws; the best pair likewise against every other closing pair,
+   the members in which two unseparated pairs differ being declared confusable), ``at_bound`` (the named
    effect closes the gap only with a parameter at its candidate bound: "widen the bound, or the
    effect is larger than allowed" — never a confident name), ``unexplained`` (a significant gap
    nothing closes).  The gap test
@@ -67,7 +72,6 @@ from ..errors import IPMCError, ParameterError
 from ..params import IPMCParameters
 from ..plausible import plausible_ranges
 from .diagnosis import (
-    AMBIGUITY_AIC,
     CLOSE_FRACTION,
     CONFUSABLE_COSINE,
     GAP_ALPHA_DIVISOR,
@@ -541,4 +545,4 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
 
 
 __all__ = ["diagnose", "Diagnosis", "CandidateResult", "VERDICTS", "gap_shrink", "CONFUSABLE_COSINE",
-           "AMBIGUITY_AIC", "PAIR_POOL"]
+           "PAIR_POOL"]
