@@ -421,3 +421,32 @@ def _worst_cells(rows) -> str:
     parts = [f"{r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} Hz at {r['temperature_c']:g} °C ({r['part']})"
              for r in flagged[:3]]
     return ", ".join(parts)
+
+
+def _audit_notes(verdict: str, at_bound: list, widen: list, audit0: dict, final_implausible: list, res0, cres: dict) -> str:
+    """The sentences a diagnosis message ends with: parameters at a bound (final fit, and the baseline's
+    when nothing was named), plausible-range violations, and fits that did not converge."""
+    out = ""
+    other_bounds = [a for a in at_bound if a not in widen and not a["hard"]]
+    if other_bounds:
+        out += (" Parameters at a bound in the final fit: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in other_bounds) + ".")
+    b0 = [a for a in audit0["at_bound"] if a["status"] == "at"]
+    if b0 and verdict in ("none", "unexplained"):
+        out += " Baseline parameters at a fit bound: " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} ({a['side']} bound {a['bound']:.4g})" for a in b0) + "."
+    if audit0["implausible"]:
+        bad0 = ", ".join(f"{x['name']} = {x['value']:.3g} {x['unit']} (plausible [{x['lower']:.3g}, {x['upper']:.3g}])"
+                         for x in audit0["implausible"])
+        out += (f" The baseline fits only by leaving the plausible range of {bad0}: that is itself evidence of a "
+                "missing effect" + ("." if verdict != "none" else "; consider the candidates above or "
+                                    "revise the plausible range if it does not apply to this strip."))
+    if final_implausible:
+        out += " In the final fit outside the plausible range: " + ", ".join(
+            f"{x['name']} = {x['value']:.3g} {x['unit']}" for x in final_implausible) + "."
+    if not res0.converged:
+        out += f" WARNING: the baseline calibration did not converge ({res0.message})."
+    bad = [c for c, cr in cres.items() if not cr.converged]
+    if bad:
+        out += f" Candidate refits that did not converge: {', '.join(bad)}."
+    return out

@@ -10,9 +10,10 @@ from itertools import combinations
 
 import numpy as np
 
+from ..data.sweep import FrequencySweep
 from .diagnosis import CONFUSABLE_COSINE, MIN_SIGNATURE_LR
 from .residuals import standardised_residuals
-from .signatures import _orth, _project_out, _separation, _signature, _z_jacobian
+from .signatures import _orth, _project_out, _separation, _signature, _simulated, _z_jacobian
 
 #: A candidate parameter whose tangent signature at off is below this fraction of its secant to the
 #: typical size (the first-order term carries < 10 % of the change, e.g. a resonance
@@ -182,3 +183,22 @@ def _needs_others(predict_many, values: dict, effect: str, params, S, r0, data, 
     T = (R[1::2] - R[0::2]) / h                                            # (k, 2N)
     with np.errstate(invalid="ignore"):
         return np.linalg.norm(S, axis=0) < ratio * np.linalg.norm(T, axis=1)
+
+
+def bootstrap_ratio(E, lin_max, G0, data, s_ln, s_ph, n_refits: int, fit_null, refit_max):
+    """Nonlinearity correction of the linearised threshold: on the first ``n_refits`` null draws
+    (columns of ``E``, applied to the baseline prediction ``G0``), ``fit_null(sim)`` refits the
+    baseline and ``refit_max(sim, baseline_fit)`` returns the largest full-refit LR over the
+    candidates; the ratio of their sum to the linearised one (``lin_max``), clipped to [1, 3].
+    Returns ``(ratio, full_max, lin_used)``."""
+    full_max, lin_used = [], []
+    for b in range(n_refits):
+        sim = FrequencySweep(data.temperature_c, data.frequency_hz, _simulated(G0, E[:, b], s_ln, s_ph),
+                             np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
+                             data.input_unit, data.output_name, data.output_unit)
+        full_max.append(float(refit_max(sim, fit_null(sim))))
+        lin_used.append(float(lin_max[b]))
+    ratio = 1.0
+    if full_max and sum(lin_used) > 0:
+        ratio = float(np.clip(sum(full_max) / sum(lin_used), 1.0, 3.0))
+    return ratio, full_max, lin_used

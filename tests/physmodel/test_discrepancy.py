@@ -261,3 +261,34 @@ def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
     bad = parser.parse_args(["diagnose", str(tmp_path / "bad.toml"), "--quiet"])
     with pytest.raises(IPMCError, match="bogus"):
         bad.func(bad)
+
+
+def test_a_baseline_stuck_short_of_its_optimum_is_refitted_not_taken_for_an_effect(monkeypatch):
+    """The first baseline fit is held away from its optimum (d confined to 1.6× the start, as a
+    multi-start that missed the best basin would leave it); every candidate refit from there then
+    "explains" the difference.  The workflow must notice that the baseline alone, refitted from a
+    candidate's base values, does as well, and restart with it: on null data the verdict is 'none'
+    and the baseline cost is the one of an unhindered fit."""
+    import dataclasses
+
+    import physmodel.estimation.discrepancy as disc
+
+    data, _ = _hidden(0, lambda r: {})
+    original = disc.PenalisedProblem.fit
+    calls = {"n": 0}
+
+    def first_fit_held_away(self, free, **kw):
+        calls["n"] += 1
+        if calls["n"] == 1:
+            free = [dataclasses.replace(fp, lower=1.6 * fp.initial, upper=1.601 * fp.initial, initial=1.6005 * fp.initial)
+                    if fp.name == "d" else fp for fp in free]
+        return original(self, free, **kw)
+
+    monkeypatch.setattr(disc.PenalisedProblem, "fit", first_fit_held_away)
+    d = diagnose(data, P, kind="actuator", free=FREE, seed=0, null_refits=0)
+    restart = d.metadata["baseline_restart"]
+    assert restart["cost_before"] > restart["cost_after"] + 10
+    assert d.verdict == "none", d.message
+    monkeypatch.setattr(disc.PenalisedProblem, "fit", original)
+    assert d.baseline.cost == pytest.approx(diagnose(data, P, kind="actuator", free=FREE, seed=0,
+                                                     null_refits=0).baseline.cost, abs=1e-3)
