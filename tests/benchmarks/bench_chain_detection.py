@@ -85,12 +85,16 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 from collections import Counter
 from pathlib import Path
 
-import numpy as np
+for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):     # one thread per diagnosis
+    os.environ.setdefault(_v, "1")
+
+import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "discrepancy")]
@@ -328,12 +332,37 @@ def validate_generator():
         raise SystemExit("the independent generator disagrees with physmodel: fix it before benchmarking")
 
 
+def _one(item):
+    """One case (a worker's unit): ``(generator, seed, label, args)`` -> the row of :func:`run_case`."""
+    gen, seed, lab, args = item
+    if gen == "library":
+        sw, tr = library_case(seed, lab)
+    else:
+        sw, tr = isn.make_case(seed, lab)
+        tr = independent_oracle_inputs(sw, tr)
+    if set(tr["expected"]) & set(args.exclude):
+        tr = dict(tr, expected=[], out_of_library=True)
+    return run_case(sw, tr, args)
+
+
+def _report_rows(results, items):
+    rows = []
+    for (gen, seed, lab, _), row in zip(items, results):
+        rows.append(row)
+        o = row["oracle"]
+        print(f"  [{gen} {len(rows)}/{len(items)} seed {seed}] {lab:12s} λ = {row['lam']:8.1f} -> {row['verdict']} "
+              f"{row['named']} ({row['dt']:.1f} s)" + (f" oracle margin {o['margin']:.3g}" if o else ""), flush=True)
+    return rows
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--generator", choices=("both", "library", "independent"), default="both")
     ap.add_argument("--n-per-label", type=int, default=3)
     ap.add_argument("--null", type=int, default=8)
     ap.add_argument("--null-draws", type=int, default=1000)
+    ap.add_argument("--first-seed", type=int, default=0, help="seed of the first case (cases use consecutive seeds)")
+    ap.add_argument("--workers", type=int, default=1, help="processes (each diagnosis is single-threaded)")
     ap.add_argument("--null-refits", type=int, default=2)
     ap.add_argument("--no-oracle", action="store_true", help="skip the noiseless distinguishability oracle")
     ap.add_argument("--exclude", nargs="*", default=[], help="candidates left out (a diagnostic variant; cases "
@@ -347,20 +376,14 @@ def main(argv=None):
         oo = ["notch"] * 3 if gen == "library" else ["gain_ripple", "notch"] * 2
         cases = labels + ["none"] * args.null + oo
         print(f"\n{gen}: candidates {[c for c in CANDIDATES if c not in args.exclude]}")
-        rows = []
-        for i, lab in enumerate(cases):
-            if gen == "library":
-                sw, tr = library_case(i, lab)
-            else:
-                sw, tr = isn.make_case(i, lab)
-                tr = independent_oracle_inputs(sw, tr)
-            if set(tr["expected"]) & set(args.exclude):
-                tr = dict(tr, expected=[], out_of_library=True)
-            rows.append(run_case(sw, tr, args))
-            o = rows[-1]["oracle"]
-            print(f"  [{gen} {i + 1}/{len(cases)}] {lab:12s} λ = {tr['lam_baseline']:8.1f} -> {rows[-1]['verdict']} "
-                  f"{rows[-1]['named']} ({rows[-1]['dt']:.1f} s)"
-                  + (f" oracle margin {o['margin']:.3g}" if o else ""), flush=True)
+        items = [(gen, args.first_seed + i, lab, args) for i, lab in enumerate(cases)]
+        if args.workers > 1:
+            from multiprocessing import get_context
+
+            with get_context("spawn").Pool(args.workers) as pool:
+                rows = _report_rows(pool.imap(_one, items), items)
+        else:
+            rows = _report_rows(map(_one, items), items)
         out[gen] = report(rows, gen)
     print(f"\nelapsed {time.perf_counter() - t0:.0f} s")
     return out
