@@ -2,11 +2,14 @@
 
     ipmc calibrate SWEEP_FILE --set NAME_OR_JSON --kind actuator|sensor [--quantity M]
                    --free d --free "kappa_e:1e-7:1e-5" --free laws.d.activation_energy ...
-                   [--starts N] [--seed S] --out FOLDER [--name NAME] [--quiet]
+                   [--effect "time_delay:delay=1e-3" ...] [--starts N] [--seed S] --out FOLDER [--name NAME] [--quiet]
 
 ``--free`` (repeatable): ``NAME`` (default bounds, see physmodel.estimation.calibration.default_free_parameter),
 ``NAME:LOWER:UPPER``, ``NAME:LOWER:UPPER:log|linear`` or ``NAME:LOWER:UPPER:SCALE:INITIAL``, in SI
 units; NAME is an IPMCParameters field, ``omega_n`` or ``laws.<quantity>.<attribute>``.
+``--effect`` (repeatable): ``NAME:PARAM=VALUE,...`` — a measurement-chain element or other library effect
+(a name of ``physmodel.effects.LIBRARY``; values SI) held fixed while the physical parameters are fitted, e.g. the
+chain a previous ``ipmc diagnose`` named; parameters not given stay at their "off" values.
 
 Writes into FOLDER: ``parameters.json`` (a parameter set: ``get_parameter_set("FOLDER/parameters.json")``
 loads it; calibration metadata inside), ``calibration.json`` (estimates, 95 % intervals, correlation,
@@ -72,6 +75,8 @@ def add_parser(subparsers):
                    help="sensing kernel (sensor only)")
     p.add_argument("--free", action="append", required=True, metavar="SPEC",
                    help="a parameter to fit: NAME[:LOWER:UPPER[:log|linear[:INITIAL]]] (repeatable)")
+    p.add_argument("--effect", action="append", metavar="NAME:P=V,...",
+                   help="a library effect held fixed at these SI values while fitting (repeatable)")
     p.add_argument("--starts", type=int, default=4, help="number of starts (base value + seeded Latin hypercube; default 4)")
     p.add_argument("--seed", type=int, default=0, help="seed of the extra starts (default 0)")
     p.add_argument("--max-nfev", type=int, help="residual evaluations allowed per start (default: scipy's)")
@@ -100,6 +105,13 @@ def run(args) -> int:
     over = parse_assignments(args.param)
     base = get_parameter_set(args.base_set, **over)
     free = [parse_free(s, base) for s in args.free]
+    effects = None
+    if args.effect:
+        from physmodel.effects import normalize_effects
+
+        from .diagnose import _parse_effect
+
+        effects = normalize_effects(dict(_parse_effect(e) for e in args.effect))
     from physmodel.data.files import check_output_folder, output_folder
     from physmodel.estimation.calibration import calibrate
 
@@ -113,7 +125,7 @@ def run(args) -> int:
         res = calibrate(data, base, free, kind=args.kind, quantity=args.quantity, kernel=args.kernel,
                         starts=args.starts, seed=args.seed, max_nfev=args.max_nfev,
                         hold_undetermined=not args.no_hold, name=args.name,
-                        misfit="widen" if args.accept_misfit else "withhold",
+                        misfit="widen" if args.accept_misfit else "withhold", effects=effects,
                         progress=bar.update if bar is not None else None)
     finally:
         if bar is not None:
@@ -163,7 +175,9 @@ def render_report(res, data, args) -> str:
         f"- data: `{args.sweep}` — {res.n_lines} lines, temperatures {', '.join(f'{t:g}' for t in res.temperatures_c)} °C, "
         f"band {res.band_hz[0]:.4g}–{res.band_hz[1]:.4g} Hz, {data.output_name} [{data.output_unit}] per "
         f"{data.input_name} [{data.input_unit}]",
-        f"- model: {res.metadata.get('kind')} quantity {res.metadata.get('quantity')}, base set `{args.base_set}`",
+        f"- model: {res.metadata.get('kind')} quantity {res.metadata.get('quantity')}, base set `{args.base_set}`"
+        + ("" if not res.metadata.get("effects") else "; fixed effects: " + "; ".join(
+            f"{k} ({', '.join(f'{p} = {v:.4g}' for p, v in e.items())})" for k, e in res.metadata["effects"].items())),
         f"- status: {'converged' if res.converged else '**NOT CONVERGED**'} — {res.message}",
         f"- weighted cost {res.cost:.5g}; expected for a correct model {res.expected_cost:.5g} ± {res.cost_std:.3g}",
         "- goodness of fit: " + ("n/a" if res.goodness_of_fit is None else
