@@ -103,7 +103,7 @@ median / max s per diagnosis           12.5 / 23.3                11.5 / 19.7
 =====================================  =========================  =========================
 
 Every detectable case the workflow did not name exactly is one the oracle finds indistinguishable
-in 10-100 Hz (margins 9e-6 to 9.2 noiseless λ against the runner-up, a strip resonance above the
+in 10-100 Hz (margins 9e-6 to 4.8 noiseless λ against the runner-up, a strip resonance above the
 band or one amplifier pole), and the report lists the truth with the pair declared confusable.
 """
 
