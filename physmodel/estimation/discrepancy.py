@@ -381,8 +381,11 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                 closes = closes_gap(res2.metadata["data_cost"], [a, b])
                 # each member significant on top of the other, and either carrying more than the
                 # share of the excess a closing effect may leave, or the pair closes the gap strictly
-                # (within the noise band) where neither member alone does
-                rescue = strict(res2, [a, b]) and not strict(fits[a], [a]) and not strict(fits[b], [b])
+                # (within the noise band) where neither member alone does and each explains the
+                # majority of what the other leaves above its χ² expectation (not a share of noise)
+                left = {c: 2 * fits[c].metadata["data_cost"] - (n_res - len(fits[c].names)) for c in (a, b)}
+                rescue = (strict(res2, [a, b]) and not strict(fits[a], [a]) and not strict(fits[b], [b])
+                          and lr_b >= 0.5 * left[a] and lr_a >= 0.5 * left[b])
                 accepted = min(lr_a, lr_b) > T and (min(lr_a, lr_b) > T2 or rescue)
                 pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
                                    "lr_second_on_top": lr_b, "closes_gap": closes, "closes_strictly": rescue,
