@@ -144,7 +144,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     multi-start count of the baseline fit.  ``progress(message)`` is called after each stage.
     A candidate refit that beats the baseline may have found a better basin of the baseline itself:
     for the three best candidates above the linearised threshold, the baseline is refitted from
-    their base values and, if lower by more than ½ in cost, the diagnosis restarts once with it (``metadata["baseline_restart"]``; ``_restart`` is that internal start).
+    their base values and, if lower by more than ½ in cost, the diagnosis restarts once with it
+    (``metadata["baseline_restart"]``; ``_restart`` is that internal start).
     """
     args = dict(kind=kind, quantity=quantity, free=free, baseline_effects=baseline_effects, candidates=candidates,
                 alpha=alpha, null_draws=null_draws, null_refits=null_refits, seed=seed, kernel=kernel,
@@ -184,6 +185,10 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     N = data.frequency_hz.size
     n_temps = data.temperatures().size
 
+    def from_(values):
+        """The base free parameters started at ``values`` (clipped to their bounds)."""
+        return [fp.with_initial(min(max(values[fp.name], fp.lower), fp.upper)) for fp in free0]
+
     def fit(free_list, sim=None, starts=1, identify=True):
         pr = prob if sim is None else PenalisedProblem(sim, pm, prob.penalties)
         return pr.fit(free_list, starts=starts, seed=seed, max_nfev=max_nfev, identify=identify,
@@ -192,8 +197,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     # ---- 1. baseline
     res0 = fit(free0, starts=int(baseline_starts))
     if _restart is not None:
-        res0 = min(res0, fit([fp.with_initial(min(max(_restart[fp.name], fp.lower), fp.upper)) for fp in free0]),
-                   key=lambda x: x.cost)
+        res0 = min(res0, fit(from_(_restart)), key=lambda x: x.cost)
     v0 = dict(res0.values)
     G0 = pm([v0])[0]
     r0 = standardised_residuals(G0, data, s_ln, s_ph)
@@ -250,7 +254,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         best, runs = None, []
         for origin, sv in [("baseline optimum", start_vals)] + ([("user start", user0)] if from_user else []):
             for starts in eff_starts:
-                fr = [fp.with_initial(min(max(sv[fp.name], fp.lower), fp.upper)) for fp in free0]
+                fr = from_(sv)
                 for c in effects_on:
                     st = None if starts is None else starts.get(c)
                     if st is None and any(k.startswith(c + ".") for k in sv):
@@ -302,7 +306,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     for c in sorted(cres, key=lambda c: -cres[c].lr)[:3] if _restart is None else []:
         if cres[c].lr <= T_lin:
             break
-        rb = fit([fp.with_initial(min(max(fits[c].values[fp.name], fp.lower), fp.upper)) for fp in free0])
+        rb = fit(from_(fits[c].values))
         if rb.cost < res0.cost - 0.5:       # ½Δχ² > ½: a better baseline basin, not the effect
             say(f"baseline basin from the {c} refit: cost {rb.cost:.4g} < {res0.cost:.4g}; restarting")
             out = diagnose(data, base_in, **args, _restart=rb.values)
@@ -310,9 +314,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             return out
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
     def fit_null(sim):       # the same search as on the data (both base starts, candidates from the user's too)
-        return min((fit([fp.with_initial(min(max(v0[fp.name], fp.lower), fp.upper)) for fp in free0], sim=sim,
-                        identify=False), fit(free0, sim=sim, starts=int(baseline_starts), identify=False)),
-                   key=lambda x: x.cost)
+        return min((fit(from_(v0), sim=sim, identify=False),
+                    fit(free0, sim=sim, starts=int(baseline_starts), identify=False)), key=lambda x: x.cost)
 
     def refit_max(sim, rb):
         r_b = standardised_residuals(pm([rb.values])[0], sim, s_ln, s_ph)

@@ -20,6 +20,7 @@ from .signatures import _orth, _project_out, _separation, _signature, _simulated
 #: 1/(1 + 2ζτs + τ²s²) in τ) is described by the secant instead (fixed a priori, not tuned).
 SECANT_RATIO = 0.1
 
+
 def signature_stage(pm, v0: dict, free0, cand, cpars: dict, r0, data, s_ln, s_ph):
     """Signatures of every candidate at the fitted baseline ``v0`` (columns d r/d δ, the baseline
     Jacobian projected out), which are one-sided, skipped (no signature on these data), described by
@@ -75,20 +76,21 @@ def _constrained_lr(S, one_sided, E):
 
 
 def _constrained_lr_gram(G, B, one_sided):
-    """:func:`_constrained_lr` from the Gram matrix ``G`` = SᵀS (k, k) and ``B`` = SᵀE (k, n)."""
-    k = G.shape[0]
-    best = np.zeros(B.shape[1])
+    """:func:`_constrained_lr` from the Gram matrix ``G`` = SᵀS (..., k, k) and ``B`` = SᵀE (..., k, n),
+    batched over any leading axes (a zero column is a parameter left out); returns (..., n)."""
+    k = G.shape[-1]
+    best = np.zeros(B.shape[:-2] + B.shape[-1:])
     for m in range(1, k + 1):
         for sub in combinations(range(k), m):
             idx = np.array(sub)
-            Ginv = np.linalg.pinv(G[np.ix_(idx, idx)])
-            b = B[idx]                          # (m, n)
+            Ginv = np.linalg.pinv(G[..., idx[:, None], idx[None, :]])
+            b = B[..., idx, :]                  # (..., m, n)
             d = Ginv @ b
-            lr = np.sum(b * d, axis=0)
-            ok = np.ones(B.shape[1], bool)
+            lr = np.sum(b * d, axis=-2)
+            ok = np.ones(lr.shape, bool)
             for j, c in enumerate(sub):
                 if one_sided[c]:
-                    ok &= d[j] >= 0
+                    ok &= d[..., j, :] >= 0
             best = np.where(ok & (lr > best), lr, best)
     return best
 
@@ -152,17 +154,10 @@ def _scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, da
     cols = np.stack(tang + [ray], axis=1)                                  # (G, k + 1, 2N)
     cols = cols - (cols @ Q0) @ Q0.T if Q0.shape[1] else cols
     one = [params[i].off in (params[i].lower, params[i].upper) for i in amp] + [True]
+    cols[~use_ray, len(amp)] = 0.0                                         # no ray where the point alone is off
+    cols[~np.all(np.isfinite(cols), axis=(1, 2))] = 0.0                    # a grid point the model cannot evaluate
     B = np.einsum("gkn,nd->gkd", cols, E)                                  # (G, k + 1, draws)
-    best = np.zeros(E.shape[1])
-    finite = np.all(np.isfinite(cols), axis=(1, 2))
-    for gi in np.flatnonzero(finite):
-        keep = list(range(len(amp))) + ([len(amp)] if use_ray[gi] else [])
-        if not keep:
-            continue
-        C = cols[gi, keep]
-        lr = _constrained_lr_gram(C @ C.T, B[gi, keep], [one[j] for j in keep])
-        np.maximum(best, lr, out=best)
-    return best
+    return _constrained_lr_gram(cols @ cols.transpose(0, 2, 1), B, one).max(axis=0)
 
 
 def _needs_others(predict_many, values: dict, effect: str, params, S, r0, data, s_ln, s_ph, ratio: float,
