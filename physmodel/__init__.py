@@ -7,6 +7,7 @@ Layers (each imports only those above it in this list)
     sets           parameter_sets (one module per source; the seeds' printed numbers)
     data           data.units, data.sweep (the one FrequencySweep record), data.files, data.timesim
     effects        effects (candidate physical and measurement-chain effects, composable with any model)
+    model file     model_file (a model with its effects, the data's verdict and provenance: ModelFile)
     estimation     estimation.residuals, .records, .lsq, .calibration, .discrepancy
 
 Public API
@@ -33,6 +34,9 @@ Calibration (physmodel.estimation)
 Discrepancy workflow (physmodel.effects, physmodel.estimation.discrepancy)
     EffectModel, LIBRARY — named candidate effects composable with any model;
     diagnose, Diagnosis — locate, name, add and refit; ``ipmc diagnose``
+The model file (physmodel.model_file)
+    ModelFile, load_model, FitVerdict, Provenance — what ``ipmc calibrate``/``ipmc diagnose`` write and
+    every command that takes physics reads: parameters, laws, effects, the data's verdict, provenance
 Errors (physmodel.errors) — the library's one error root
     IPMCError (a ValueError), ParameterError, TemperatureRangeError, DataFormatError
 
@@ -48,8 +52,10 @@ from .errors import DataFormatError, IPMCError, ParameterError, TemperatureRange
 from .estimation.calibration import calibrate
 from .estimation.discrepancy import Diagnosis, diagnose
 from .estimation.lsq import fit_parameters
-from .estimation.records import CalibrationResult, FreeParameter, ScalarObservations
+from .estimation.observations import ScalarObservations
+from .estimation.records import CalibrationResult, FreeParameter
 from .model import FrequencyResponse
+from .model_file import FitVerdict, ModelFile, Provenance, load_model
 from .parameter_sets import (
                              available_parameter_sets,
                              get_parameter_set,
@@ -82,5 +88,6 @@ __all__ = [
     "write_sweep",
     "calibrate", "fit_parameters", "FreeParameter", "CalibrationResult", "ScalarObservations",
     "EffectModel", "LIBRARY", "diagnose", "Diagnosis",
+    "ModelFile", "load_model", "FitVerdict", "Provenance",
     "IPMCError", "ParameterError", "TemperatureRangeError", "DataFormatError",
 ]

@@ -216,7 +216,7 @@ def calibrate_laws(data: A0Series, respond, frequency_hz, free, starts: int = 3,
     no identifiability verdict)."""
     from physmodel.estimation.calibration import apply_misfit_policy
     from physmodel.estimation.lsq import fit_parameters
-    from physmodel.estimation.records import ScalarObservations
+    from physmodel.estimation.observations import ScalarObservations
 
     obs = ScalarObservations(data.a0, data.sigma_ln, tuple(f"a0({t:g} °C)" for t in data.temperatures_c),
                              data.temperatures_c, data.source)

@@ -336,7 +336,9 @@ def model_realization(model, temperature_c: float, fs: float, duration: float, o
     f_lo = min(1e-3, 0.01 / duration)
     f_hi = min(20.0 * fs, max(5.0 * fs, 1e5))   # beyond 100 kHz, 5 fs suffices for FOH input spectra
     if is_act and output == "displacement":
-        q, deriv, dc = "M", False, float(model.dc_gain([temperature_c])["M0"][set_index, 0])
+        # a model with effects has no closed-form DC limit: the fit then anchors on the lowest grid frequency
+        dc = None if getattr(model, "effects", None) else float(model.dc_gain([temperature_c])["M0"][set_index, 0])
+        q, deriv = "M", False
     elif output == "current":
         q, deriv, dc = ("I" if is_act else "S"), True, None
     else:

@@ -110,6 +110,7 @@ class Diagnosis:
     final_implausible: list = field(default_factory=list)
     cost_warning: str = ""
     confusability: dict = field(default_factory=dict)
+    base_parameters: object = field(default=None, repr=False)    # the base set with the laws used (IPMCParameters)
 
     # ---------------------------------------------------------------- views
     def named_effect(self) -> dict | None:
@@ -122,6 +123,53 @@ class Diagnosis:
                                             "unit": get_effect(n).parameter(k.split(".", 1)[1]).unit}
                       for k in self.final.names if k.startswith(n + ".")}
         return out
+
+    def to_model_file(self, provenance=None):
+        """The model this diagnosis ends with, as a :class:`physmodel.ModelFile`: the base
+        parameters (laws included) refitted, the baseline's effects plus the named ones with their
+        fitted values — the final fit when the verdict is named, ambiguous or at_bound (the verdict
+        and the names travel in the file's :class:`~physmodel.model_file.FitVerdict`), the baseline
+        otherwise — and the goodness of fit of that model to the data (data cost against its χ²
+        expectation, prior penalties excluded).
+
+        Parameters
+        ----------
+        provenance : physmodel.model_file.Provenance or None
+            Where the data came from (the caller knows the file and the command).
+        """
+        from ..model_file import FitVerdict, ModelFile, Provenance
+        from ..parameter_paths import apply_values
+        from .residuals import goodness_of_fit
+
+        if self.base_parameters is None:
+            raise ParameterError("this diagnosis does not carry its base parameters; rerun diagnose")
+        use_final = self.final is not None and self.verdict in ("named", "ambiguous", "at_bound")
+        fit = self.final if use_final else self.baseline
+        gap = self.gap_after if use_final else self.gap_before
+        effects = {k: dict(v) for k, v in (self.metadata.get("baseline_effects") or {}).items()}
+        base_vals = {}
+        for n, v in fit.values.items():
+            if "." in n and not n.startswith("laws."):
+                e, p = n.split(".", 1)
+                effects.setdefault(e, {})[p] = float(v)
+            else:
+                base_vals[n] = float(v)
+        params = apply_values(self.base_parameters, base_vals)
+        name = f"{self.base_parameters.name}_diagnosed"
+        src = (f"ipmc diagnose ({self.verdict}" + (f": {', '.join(self.named)}" if self.named else "")
+               + f") on sweep {self.metadata.get('data_fingerprint', '')[:12]}; base {self.base_parameters.name}")
+        from dataclasses import replace as _replace
+
+        params = _replace(params, name=name, source=src)
+        N = self.data.frequency_hz.size
+        gof = goodness_of_fit(gap["cost"], 2 * N, int(gap["n_free"]), self.noise_estimated)
+        verdict = FitVerdict.from_goodness(gof, self.verdict, self.named)
+        if provenance is None:
+            provenance = Provenance("physmodel.diagnose", data_fingerprint=self.metadata.get("data_fingerprint"),
+                                    temperatures_c=tuple(self.data.temperatures().tolist()),
+                                    band_hz=(float(self.data.frequency_hz.min()), float(self.data.frequency_hz.max())))
+        return ModelFile(self.kind, params, effects, self.quantity, self.metadata.get("kernel", "boundary_charge"),
+                         verdict, tuple(fit.estimates()), provenance)
 
     def to_dict(self) -> dict:
         def clean(o):

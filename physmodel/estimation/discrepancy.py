@@ -532,12 +532,12 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
               "alpha_gap": alpha_gap, "seed": seed},
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
-        metadata={"base": base.name, "free": names0, "baseline_effects": beff, "candidates": cand,
+        metadata={"base": base.name, "kernel": kernel, "free": names0, "baseline_effects": beff, "candidates": cand,
                   "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried,
                   "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
-        cost_warning=warn, confusability=confusability,
+        cost_warning=warn, confusability=confusability, base_parameters=base,
     )
 
 

@@ -64,12 +64,12 @@ from scipy.optimize import least_squares
 
 from ..data.sweep import FrequencySweep
 from ..errors import IPMCError, ParameterError
+from .observations import ScalarObservations
 from .records import (
     CalibrationResult,
     FreeParameter,
     Identifiability,
     ModelBatch,
-    ScalarObservations,
     ScaledRows,
     SensitivityProbe,
     StartRecord,

@@ -222,59 +222,6 @@ class ModelBatch:
         return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
 
 
-# =============================================================================== scalar data
-@dataclass(frozen=True)
-class ScalarObservations:
-    """Scalar observations fitted on a log scale: what :func:`~physmodel.estimation.lsq.fit_parameters`
-    takes besides a frequency sweep (e.g. a printed a0(T), one value per temperature).
-
-    The residual of observation i is ln|y_model,i / y_i| / σ_ln,i (a sign flip of the model is a
-    misfit of the magnitude only); for a correct model the cost ½Σr² averages (N − nθ)/2.
-
-    Parameters
-    ----------
-    values : array_like
-        The observed values y, finite and nonzero. [their own unit, the predictor's]
-    sigma_ln : array_like
-        Standard deviation of ln y per observation, > 0. [-]
-    labels : sequence of str
-        One name per observation (e.g. ``"a0(23 °C)"``), for messages.
-    temperatures_c : array_like or None
-        The temperature of each observation, when it has one. [°C]
-    source : str
-        Where the numbers come from.
-    """
-
-    values: np.ndarray
-    sigma_ln: np.ndarray
-    labels: tuple = ()
-    temperatures_c: np.ndarray | None = None
-    source: str = ""
-
-    def __post_init__(self):
-        y = np.atleast_1d(np.asarray(self.values, dtype=float))
-        s = np.atleast_1d(np.asarray(self.sigma_ln, dtype=float))
-        labels = tuple(str(x) for x in self.labels) or tuple(f"y[{i}]" for i in range(y.size))
-        if y.ndim != 1 or y.size == 0:
-            raise ParameterError(f"ScalarObservations.values must be a non-empty 1-D array, got shape {y.shape}")
-        if s.shape != y.shape or len(labels) != y.size:
-            raise ParameterError(f"ScalarObservations: {y.size} values need as many sigma_ln and labels, got "
-                                 f"{s.size} sigma_ln and {len(labels)} labels")
-        bad = [labels[i] for i in np.flatnonzero(~np.isfinite(y) | (y == 0))]
-        if bad:
-            raise ParameterError(f"ScalarObservations.values must be finite and nonzero; not so at {bad[:5]}")
-        bad = [labels[i] for i in np.flatnonzero(~(np.isfinite(s) & (s > 0)))]
-        if bad:
-            raise ParameterError(f"ScalarObservations.sigma_ln must be finite and > 0; not so at {bad[:5]}")
-        T = None if self.temperatures_c is None else np.atleast_1d(np.asarray(self.temperatures_c, dtype=float))
-        if T is not None and T.shape != y.shape:
-            raise ParameterError(f"ScalarObservations.temperatures_c: {T.size} values for {y.size} observations")
-        object.__setattr__(self, "values", y)
-        object.__setattr__(self, "sigma_ln", s)
-        object.__setattr__(self, "labels", labels)
-        object.__setattr__(self, "temperatures_c", T)
-
-
 # =============================================================================== results
 @dataclass(frozen=True)
 class StartRecord:
@@ -472,6 +419,55 @@ class CalibrationResult:
             "metadata": {k: str(v) for k, v in self.metadata.items()},
         }
 
+    def estimates(self) -> list:
+        """The fitted parameters as records: name, value, ci95 [lower, upper], status. [SI]"""
+        def num(v):
+            v = float(v)
+            return v if math.isfinite(v) else None
+
+        out = []
+        for n in self.names:
+            held = n in self.held
+            status = "held at base (undetermined)" if held else (
+                "determined" if n not in self.identifiability or self.identifiability[n].identifiable
+                else "not assessed")
+            out.append({"name": n, "value": num(self.values[n]), "ci95": [num(self.ci_lower[n]), num(self.ci_upper[n])],
+                        "status": status})
+        return out
+
+    def to_model_file(self, provenance=None, *, diagnosis: str | None = None, named=(), effects=None):
+        """The :class:`physmodel.ModelFile` of this result: the calibrated parameters, the effects
+        held or fitted in the model, this fit's goodness-of-fit verdict and ``provenance``.
+
+        Parameters
+        ----------
+        provenance : physmodel.model_file.Provenance or None
+            Where the data came from (the caller knows the file and the command).
+        diagnosis : str or None
+            The verdict of a diagnosis that chose this fit.
+        named : sequence of str
+            Effects the diagnosis named.
+        effects : dict or None
+            Effects in the model ``{name: {parameter: value}}`` (SI); default those of the
+            metadata (``calibrate(effects=...)``) with any fitted ``effect.parameter`` values.
+        """
+        from ..model_file import FitVerdict, ModelFile, Provenance
+
+        if self.parameters is None:
+            raise IPMCError("this calibration produced no parameter set; there is no model to write")
+        eff = {k: dict(v) for k, v in (effects if effects is not None else self.metadata.get("effects") or {}).items()}
+        for n in self.names:
+            if "." in n and not n.startswith("laws."):
+                e, p = n.split(".", 1)
+                eff.setdefault(e, {})[p] = float(self.values[n])
+        verdict = None if self.goodness_of_fit is None else FitVerdict.from_goodness(
+            self.goodness_of_fit, diagnosis, named)
+        if provenance is None:
+            provenance = Provenance("physmodel.calibrate", data_fingerprint=self.metadata.get("data_fingerprint"),
+                                    temperatures_c=tuple(self.temperatures_c), band_hz=tuple(self.band_hz))
+        return ModelFile(self.metadata.get("kind", "actuator"), self.parameters, eff, self.metadata.get("quantity"),
+                         self.metadata.get("kernel", "boundary_charge"), verdict, tuple(self.estimates()), provenance)
+
     def save(self, path) -> Path:
         """Atomic JSON: a parameter-set payload (readable by :func:`physmodel.load_parameter_set`)
         when ``parameters`` is known, plus the calibration record under ``"calibration"``.
@@ -486,11 +482,12 @@ class CalibrationResult:
         Path
             The file written.
         """
-        from ..parameter_sets import _FORMAT, _VERSION, _finite_json
+        from ..model_file import PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
 
         payload: dict = {}
         if self.parameters is not None:
-            payload = {"format": _FORMAT, "version": _VERSION, "parameters": _finite_json(self.parameters.to_dict())}
+            payload = {"format": PARAMETER_SET_FORMAT, "version": PARAMETER_SET_VERSION,
+                       "parameters": finite_json(self.parameters.to_dict())}
         payload["calibration"] = self.to_dict()
         text = json.dumps(payload, indent=2, allow_nan=False)
         return atomic_write(Path(path), lambda fh: fh.write(text + "\n"))

@@ -239,7 +239,7 @@ def insensitive(R: np.ndarray) -> list[int]:
 def residual_model(data):
     """:class:`SweepResiduals` or :class:`ObservationResiduals` for ``data``; anything else is an
     IPMCError."""
-    from .records import ScalarObservations
+    from .observations import ScalarObservations
 
     if isinstance(data, FrequencySweep):
         return SweepResiduals(data)

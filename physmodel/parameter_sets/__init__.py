@@ -24,11 +24,6 @@ from typing import Any
 from ..errors import ParameterError
 from ..params import IPMCParameters
 
-_FORMAT = "ipmc-parameter-set"
-_VERSION = 1
-
-
-
 #: Modules of this package that are not parameter-set sources.
 _NOT_SOURCES = ("derivation", "published")
 
@@ -76,59 +71,30 @@ def get_parameter_set(name: str | os.PathLike, **overrides: Any) -> IPMCParamete
 
 
 def save_parameter_set(params: IPMCParameters, path: str | os.PathLike) -> Path:
-    """Write ``params`` as a versioned JSON parameter file (atomically) and return its path."""
+    """Write ``params`` as a versioned JSON parameter file (atomically) and return its path (no
+    verdict, no effects: :class:`physmodel.ModelFile` writes a whole model)."""
     from ..data.files import atomic_write
+    from ..model_file import PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
 
     path = Path(path)
-    payload = {"format": _FORMAT, "version": _VERSION, "parameters": _finite_json(params.to_dict())}
+    payload = {"format": PARAMETER_SET_FORMAT, "version": PARAMETER_SET_VERSION,
+               "parameters": finite_json(params.to_dict())}
     text = json.dumps(payload, indent=2, allow_nan=False)
     atomic_write(path, lambda fh: fh.write(text + "\n"))
     return path
 
 
 def load_parameter_set(path: str | os.PathLike) -> IPMCParameters:
-    """Read a JSON parameter file written by :func:`save_parameter_set` (or a bare parameter record)."""
-    from ..data.files import read_text
-    from ..errors import DataFormatError
+    """The parameters of a JSON model file (``ipmc calibrate``/``ipmc diagnose``'s ``model.json``), of
+    a parameter file written by :func:`save_parameter_set` or an older ``ipmc calibrate``, or of a
+    bare parameter record.  Effects and the data's verdict are not parameters: read the whole model
+    with :func:`physmodel.load_model`."""
+    from ..model_file import load_model
 
     path = Path(path)
     if not path.is_file():
         raise ParameterError(f"parameter file {str(path)!r} does not exist")
-    try:
-        data = json.loads(read_text(path, "parameter file"))
-    except DataFormatError as exc:
-        raise ParameterError(str(exc)) from None
-    except json.JSONDecodeError as exc:
-        raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from None
-    if isinstance(data, dict) and "parameters" in data:
-        if data.get("format") != _FORMAT:
-            raise ParameterError(f"parameter file {str(path)!r} has format {data.get('format')!r}, "
-                                 f"expected {_FORMAT!r}")
-        version = data.get("version", 0)
-        if isinstance(version, bool) or not isinstance(version, int) or version < 0:
-            raise ParameterError(f"parameter file {str(path)!r}: version must be a non-negative integer, "
-                                 f"got {version!r}")
-        if version > _VERSION:
-            raise ParameterError(f"parameter file {str(path)!r} has version {version}, "
-                                 f"this library reads up to {_VERSION}")
-        data = data["parameters"]
-    if not isinstance(data, dict):
-        raise ParameterError(f"parameter file {str(path)!r} holds {type(data).__name__}, expected an object")
-    try:
-        return IPMCParameters.from_dict(data)
-    except ParameterError as exc:
-        raise ParameterError(f"parameter file {str(path)!r}: {exc}") from None
-
-
-def _finite_json(obj):
-    """Infinite values (Rp' = inf, validity ranges) as the strings "inf"/"-inf", which float() reads back."""
-    if isinstance(obj, dict):
-        return {k: _finite_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite_json(v) for v in obj]
-    if isinstance(obj, float) and obj in (float("inf"), float("-inf")):
-        return "inf" if obj > 0 else "-inf"
-    return obj
+    return load_model(path).parameters
 
 
 def register_parameter_set(name: str, factory: Callable[[], IPMCParameters], *, overwrite: bool = False) -> None:

@@ -71,32 +71,103 @@ def check_out_file(path, suffixes, option: str = "--out") -> Path:
     return p
 
 
-def _load_params(args):
-    from physmodel import get_parameter_set
-    if getattr(args, "params_json", None):
-        from physmodel.parameter_sets import load_parameter_set
-
-        path = Path(args.params_json)
-        if not path.is_file():
-            raise CLIError(f"--params-json {path}: no such file")
-        # the same reader as --set FILE.json: the versioned file ipmc calibrate writes, or a bare record
-        p = load_parameter_set(path)
-        over = parse_assignments(args.param)
-        return p.replace(**over) if over else p
-    return get_parameter_set(args.set, **parse_assignments(args.param))
+#: The named set the model options fall back to when no model is given (sweep, simulate).
+DEFAULT_SET = "seed002_table3"
 
 
-def _model(args, params):
-    from physmodel import physics_model
+def load_physics(args, command: str, *, default_set: str | None = DEFAULT_SET):
+    """The physics the model options name, as a :class:`physmodel.ModelFile`: ``--model FILE``,
+    ``--params-json FILE`` or ``--set NAME_OR_FILE`` (one of them), with ``--param`` overrides; the
+    file's own kind wins over a ``--kind`` left at its default.  Returns ``(model file, whether
+    --param overrode parameters)``; ``(None, False)`` when nothing is given and ``default_set`` is
+    None."""
+    from physmodel.model_file import load_model
 
-    return physics_model(args.kind, params, kernel=args.kernel)
+    given = [(o, v) for o, v in (("--model", getattr(args, "model", None)), ("--params-json", getattr(args, "params_json", None)),
+                                 ("--set", getattr(args, "set", None))) if v]
+    if len(given) > 1:
+        raise CLIError(f"{command}: give one of --model, --params-json, --set (got {', '.join(o for o, _ in given)})")
+    if not given:
+        if default_set is None:
+            return None, False
+        given = [("--set", default_set)]
+    option, source = given[0]
+    if option != "--set" and not Path(source).is_file():
+        raise CLIError(f"{option} {source}: no such file")
+    kind = getattr(args, "kind", None)
+    try:
+        mf = load_model(source, kind=kind)
+    except IPMCError as exc:
+        raise CLIError(f"{option} {source}: {exc}") from None
+    over = parse_assignments(getattr(args, "param", None))
+    if over:
+        mf = mf.with_parameters(mf.parameters.replace(**over))
+    if mf.path is None and getattr(args, "kernel", None):       # a named set: the kernel is the command's
+        from dataclasses import replace
+
+        mf = replace(mf, kernel=args.kernel)
+    if hasattr(args, "kind") and args.kind is None:
+        args.kind = mf.kind
+    return mf, bool(over)
 
 
-def _add_model_args(p):
-    p.add_argument("--kind", choices=("actuator", "sensor"), default="actuator",
-                   help="actuator (voltage in) or sensor (tip displacement in, short-circuit current out)")
-    p.add_argument("--set", default="seed002_table3", help="named parameter set (see 'ipmc sets'); default seed002_table3")
-    p.add_argument("--params-json", help="a parameter-set JSON file (IPMCParameters.to_dict) instead of --set")
+def verdict_lines(mf, overridden: bool = False) -> list[str]:
+    """Report lines (Markdown) saying what the physics is and whether it fits its data."""
+    lines = [f"- physics: {mf.describe()}" + (f" — file `{mf.path}`, sha256 `{mf.fingerprint()[:16]}`" if mf.path else "")]
+    if mf.verdict is not None and not mf.verdict.adequate:
+        lines.append(f"- **the physics DOES NOT FIT the data it was fitted to**: {mf.verdict.reason}; every number "
+                     "computed from it inherits that misfit")
+    elif mf.verdict is None:
+        lines.append("- the physics was never compared with measured data (a named set or a bare parameter file)")
+    if mf.provenance is not None and mf.provenance.temperatures_c:
+        band = mf.provenance.band_hz
+        lines.append(f"- fitted on {', '.join(f'{t:g}' for t in mf.provenance.temperatures_c)} °C"
+                     + (f", {band[0]:.4g}–{band[1]:.4g} Hz" if band else "")
+                     + (f" (`{mf.provenance.data_file}`)" if mf.provenance.data_file else ""))
+    if overridden:
+        lines.append("- **parameters overridden with --param**: the verdict above describes the file's parameters, "
+                     "not these")
+    return lines
+
+
+def warn_verdict(mf, command: str) -> None:
+    """Say on stderr when the physics does not fit its data (the verdict travels)."""
+    if mf.verdict is not None and not mf.verdict.adequate:
+        print(f"{command}: warning: the model {mf.path or mf.name} does not fit the data it was fitted to "
+              f"({mf.verdict.reason}); results computed from it inherit the misfit", file=sys.stderr)
+
+
+def model_metadata(mf) -> dict[str, str]:
+    """What a sweep written from ``mf`` records of it (``model_*`` keys, read back by ``ipmc fit``)."""
+    meta = {"model_file": str(mf.path or mf.name), "model_sha256": mf.fingerprint(), "model_kind": mf.kind,
+            "model_effects": ", ".join(mf.effects) or "none",
+            "model_verdict": ("unchecked" if mf.verdict is None else ("adequate" if mf.verdict.adequate else "MISFIT")),
+            "model_verdict_reason": "" if mf.verdict is None else mf.verdict.reason}
+    prov = mf.provenance
+    if prov is not None:
+        if prov.temperatures_c:
+            meta["model_fitted_temperatures_c"] = ",".join(f"{t:g}" for t in prov.temperatures_c)
+        if prov.band_hz:
+            meta["model_fitted_band_hz"] = f"{prov.band_hz[0]:.6g},{prov.band_hz[1]:.6g}"
+        if prov.data_file:
+            data = prov.data_path(mf.path)
+            meta["model_data_file"] = str(Path(data).resolve()) if data is not None and Path(data).exists() else prov.data_file
+    return meta
+
+
+def _model(args, mf):
+    return mf.model()
+
+
+def _add_model_args(p, default_set: str | None = DEFAULT_SET):
+    p.add_argument("--kind", choices=("actuator", "sensor"), default=None,
+                   help="actuator (voltage in) or sensor (tip displacement in, short-circuit current out); "
+                        "default: the model file's kind, else actuator")
+    p.add_argument("--model", help="a model file (model.json of 'ipmc calibrate' or 'ipmc diagnose': parameters, "
+                                   "laws, effects and the data's verdict)")
+    p.add_argument("--set", default=None, help="named parameter set (see 'ipmc sets') or a JSON model/parameter file"
+                   + (f"; default {default_set}" if default_set else ""))
+    p.add_argument("--params-json", help="a JSON parameter or model file (same as --model)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="override a parameter in SI units, e.g. --param W=2e-3 (repeatable)")
     p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), default="boundary_charge",

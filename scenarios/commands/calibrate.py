@@ -11,10 +11,12 @@ units; NAME is an IPMCParameters field, ``omega_n`` or ``laws.<quantity>.<attrib
 (a name of ``physmodel.effects.LIBRARY``; values SI) held fixed while the physical parameters are fitted, e.g. the
 chain a previous ``ipmc diagnose`` named; parameters not given stay at their "off" values.
 
-Writes into FOLDER: ``parameters.json`` (a parameter set: ``get_parameter_set("FOLDER/parameters.json")``
-loads it; calibration metadata inside), ``calibration.json`` (estimates, 95 % intervals, correlation,
+Writes into FOLDER: ``model.json`` (the model file every later command takes with ``--model``:
+parameters, laws, the fixed effects, the goodness-of-fit verdict and the data's provenance;
+``physmodel.load_model`` reads it), ``parameters.json`` (the parameters alone, as before), ``calibration.json`` (estimates, 95 % intervals, correlation,
 identifiability, starts), ``report.md`` and ``bode.png`` (data/model overlay and standardised residuals).
-Exit codes: 0 converged, 2 bad input, 3 the fit did not converge, 130 interrupted.
+Exit codes: 0 converged, 2 bad input, 3 the fit did not converge or the model does not fit the data
+(``--accept-misfit``: exit 0; the verdict still travels in model.json), 130 interrupted.
 """
 
 from __future__ import annotations
@@ -59,17 +61,47 @@ def parse_free(spec: str, base):
     return FreeParameter(name, lo, hi, scale, initial)
 
 
+def start_model(source: str, kind: str | None, overrides: dict):
+    """The start of a calibration or diagnosis: a named set or a model/parameter file (its effects
+    come along), with ``overrides`` (SI) applied."""
+    from physmodel.model_file import load_model
+
+    return load_model(source, kind=kind, **overrides)
+
+
+def parse_effect(item: str, option: str = "--effect") -> tuple[str, dict]:
+    """``NAME:P=V,...`` → ``(NAME, {P: V})`` (SI values; none = the effect's parameters left to the caller)."""
+    name, _, rest = item.partition(":")
+    items = [s.strip() for s in rest.split(",") if s.strip()]
+    return name.strip(), parse_assignments(items, option=f"{option} {item!r}:")
+
+
+def provenance_of(data_file, data, creator: str):
+    """The :class:`physmodel.model_file.Provenance` of a model fitted to ``data`` read from ``data_file``."""
+    import shlex
+
+    import physmodel
+    from physmodel.model_file import Provenance, file_sha256
+
+    return Provenance(creator, str(data_file), file_sha256(data_file), data.fingerprint(),
+                      tuple(float(t) for t in data.temperatures()),
+                      (float(np.min(data.frequency_hz)), float(np.max(data.frequency_hz))),
+                      " ".join(shlex.quote(a) for a in ["ipmc", *sys.argv[1:]]), physmodel.__version__)
+
+
 def add_parser(subparsers):
     """Add the ``calibrate`` subcommand."""
     p = subparsers.add_parser(
         "calibrate", help="calibrate physical parameters to a measured sweep (estimates, intervals, identifiability)",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("sweep", metavar="SWEEP_FILE", help="frequency sweep (.csv, .npz or .mat; physmodel format)")
-    p.add_argument("--set", required=True, dest="base_set",
-                   help="base parameter set: a name (see 'ipmc sets') or a JSON parameter file")
+    p.add_argument("--set", "--model", required=True, dest="base_set",
+                   help="start: a named parameter set (see 'ipmc sets') or a model file (model.json of an earlier "
+                        "calibrate/diagnose: its effects are kept, fixed)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="override a base parameter in SI units before fitting (repeatable)")
-    p.add_argument("--kind", choices=("actuator", "sensor"), default="actuator", help="model kind (default actuator)")
+    p.add_argument("--kind", choices=("actuator", "sensor"), default=None,
+                   help="model kind (default: the model file's, else actuator)")
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
     p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), default="boundary_charge",
                    help="sensing kernel (sensor only)")
@@ -96,22 +128,21 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     """Execute ``ipmc calibrate``; returns 0, or 3 when the fit did not converge (bad input raises)."""
-    from physmodel import get_parameter_set
     from physmodel.data.files import read_sweep
 
     if args.starts < 1:
         raise ParameterError(f"--starts must be >= 1, got {args.starts}")
     data = read_sweep(args.sweep)
     over = parse_assignments(args.param)
-    base = get_parameter_set(args.base_set, **over)
+    start = start_model(args.base_set, args.kind, over)
+    args.kind = start.kind
+    base = start.parameters
     free = [parse_free(s, base) for s in args.free]
-    effects = None
+    effects = dict(start.effects) or None
     if args.effect:
         from physmodel.effects import normalize_effects
 
-        from .diagnose import _parse_effect
-
-        effects = normalize_effects(dict(_parse_effect(e) for e in args.effect))
+        effects = normalize_effects({**(effects or {}), **dict(parse_effect(e, "--effect") for e in args.effect)})
     from physmodel.data.files import check_output_folder, output_folder
     from physmodel.estimation.calibration import calibrate
 
@@ -131,6 +162,9 @@ def run(args) -> int:
         if bar is not None:
             bar.close()
     res.metadata["sweep_file"] = str(args.sweep)
+    if start.verdict is not None and not start.verdict.adequate and not args.quiet:
+        print(f"ipmc calibrate: note: the start model {args.base_set} did not fit its own data "
+              f"({start.verdict.reason}); this calibration is judged afresh on {args.sweep}", file=sys.stderr)
     with output_folder(out, "ipmc calibrate", force=args.force):
         _write(res, data, args, out)
     if not res.converged:
@@ -148,6 +182,8 @@ def _write(res, data, args, out):
     from physmodel.data.files import atomic_write
     from physmodel.estimation.calibration import model_sweep
 
+    if res.parameters is not None:
+        res.to_model_file(provenance_of(args.sweep, data, "ipmc calibrate")).save(out / "model.json")
     res.save(out / "parameters.json")
     record = res.to_dict()
     record["sweep_file"] = str(args.sweep)
@@ -160,7 +196,8 @@ def _write(res, data, args, out):
     atomic_write(out / "report.md", lambda fh: fh.write(report))
     if not args.quiet:
         print(res.summary())
-        print(f"wrote {out}/parameters.json, calibration.json, report.md, bode.png")
+        print(f"wrote {out}/model.json (the model for every later command: --model {out}/model.json), "
+              "parameters.json, calibration.json, report.md, bode.png")
 
 
 def _g(v) -> str:

@@ -37,7 +37,9 @@ EXPERIMENT.toml (paths relative to the TOML file; SI units for parameters)::
     prior = true                       # hold the free base parameters to their plausible ranges
     baseline_starts = 3                # multi-start count of the baseline fit
 
-Writes report.json (verdict none / named / ambiguous / unexplained, the named effect with its fitted
+Writes model.json (the model it ends with — the baseline plus the named effect(s), refitted, with the
+goodness-of-fit verdict and the data's provenance: what ``--model`` takes in every later command),
+report.json (verdict none / named / ambiguous / unexplained, the named effect with its fitted
 value and interval, every candidate's statistics, localisation tables, gap before/after, confusable
 pairs, null calibration), summary.md, bode_before.png and bode_after.png.
 
@@ -57,6 +59,7 @@ from physmodel.errors import IPMCError, ParameterError
 
 from .. import plots
 from ._common import EXIT_OK, parse_assignments
+from .calibrate import parse_effect, provenance_of, start_model
 
 _GEOMETRY = ("L", "W", "h")
 
@@ -71,7 +74,9 @@ def add_parser(subparsers):
     p.add_argument("--kind", choices=("actuator", "sensor"), help="model kind (default actuator)")
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
     p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), help="sensing kernel")
-    p.add_argument("--set", dest="base_set", help="starting parameter set: a name or a JSON file")
+    p.add_argument("--set", "--model", dest="base_set",
+                   help="start: a named parameter set or a JSON model/parameter file (a model file's effects are "
+                        "kept as baseline effects)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="override a base parameter (SI), e.g. W=2e-3 (repeatable)")
     p.add_argument("--free", action="append", metavar="SPEC",
@@ -204,7 +209,10 @@ def _laws(spec: dict, args, set_name) -> object:
         raise IPMCError(f"laws = {laws!r}: expected a name (set, isothermal, default) or a table")
     if str(set_name).lower().endswith(".json") and Path(set_name).is_file():
         try:
-            has_laws = "laws" in json.loads(Path(set_name).read_text())
+            record = json.loads(Path(set_name).read_text(encoding="utf-8-sig"))
+            # a bare record holds its laws at the top; a parameter or model file under "parameters"
+            has_laws = isinstance(record, dict) and ("laws" in record or isinstance(record.get("parameters"), dict)
+                                                     and "laws" in record["parameters"])
         except (OSError, ValueError) as exc:
             raise IPMCError(f"parameter file {set_name!r} cannot be read: {exc}") from None
         base_choice = laws.get("base", "set") if isinstance(laws, dict) else laws
@@ -213,12 +221,6 @@ def _laws(spec: dict, args, set_name) -> object:
                             "with laws = \"isothermal\" | \"default\" (physics.md §7) or a [laws] table "
                             "(--laws / --law); they are stated in the report")
     return laws
-
-
-def _parse_effect(item: str) -> tuple[str, dict]:
-    name, _, rest = item.partition(":")
-    items = [s.strip() for s in rest.split(",") if s.strip()]
-    return name.strip(), parse_assignments(items, option=f"--baseline-effect {item!r}:")
 
 
 def _free(spec: str, base, effects: dict):
@@ -241,7 +243,6 @@ def _free(spec: str, base, effects: dict):
 
 def build(args):
     """Resolve TOML + flags into ``(data, base, kwargs for diagnose, out folder, spec)``."""
-    from physmodel import get_parameter_set
     from physmodel.data.files import read_sweep
     from physmodel.effects import normalize_effects
 
@@ -262,11 +263,13 @@ def build(args):
             raise IPMCError(f"[geometry] accepts {_GEOMETRY} [m]; got {sorted(sec)}")
         over.update({k: float(v) for k, v in sec.items()})
     over.update(parse_assignments(args.param))
-    base = get_parameter_set(set_name, **over)
+    start = start_model(set_name, pick(args.kind, "kind"), over)
+    base = start.parameters
     data = read_sweep(data_path)
-    effects_spec = dict(spec.get("baseline_effects", {}))
+    # the start model's effects are in the model (fixed at their values) unless the TOML/flags say otherwise
+    effects_spec = {**start.effects, **dict(spec.get("baseline_effects", {}))}
     for item in args.baseline_effect or []:
-        n, v = _parse_effect(item)
+        n, v = parse_effect(item, "--baseline-effect")
         effects_spec[n] = v
     fitted_effects = [n for n, v in effects_spec.items() if not v]
     effects = normalize_effects(effects_spec)
@@ -300,7 +303,7 @@ def build(args):
     prior = False if args.no_prior else spec.get("prior", True)
     if not isinstance(prior, bool):
         raise IPMCError(f"prior = {prior!r}: expected true or false")
-    kw = dict(kind=pick(args.kind, "kind", "actuator"), quantity=pick(args.quantity, "quantity"),
+    kw = dict(kind=pick(args.kind, "kind", start.kind), quantity=pick(args.quantity, "quantity"),
               laws=_laws(spec, args, set_name), candidate_bounds=cb or None, candidate_starts=cs or None,
               plausible=pl or None, prior=prior, baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
               free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
@@ -309,6 +312,7 @@ def build(args):
               kernel=pick(args.kernel, "kernel", "boundary_charge"))
     if kw["kind"] not in ("actuator", "sensor"):
         raise IPMCError(f"kind = {kw['kind']!r}; expected 'actuator' or 'sensor'")
+    args.data_path = data_path
     return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
 
 
@@ -335,8 +339,10 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
+    mf = d.to_model_file(provenance_of(args.data_path, data, "ipmc diagnose"))
     with output_folder(out, "ipmc diagnose", force=args.force):
         d.write_report(out)
+        mf.save(out / "model.json")
         plots.diagnosis_figures(d, out)
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
@@ -345,6 +351,10 @@ def run(args) -> int:
               f"(expected {d.gap_after['expected_cost']:.4g}); gap shrink {gap_shrink(d):.3g}x; "
               f"{d.elapsed_s:.1f} s")
         print(f"report: {out}/report.json, summary.md, bode_before.png, bode_after.png")
+        print(f"model: {out}/model.json — {mf.describe()}; use it downstream with --model {out}/model.json")
+    if not mf.adequate:
+        print(f"ipmc diagnose: the diagnosed model does not fit the data ({mf.verdict.reason}); model.json says so "
+              "and every command that reads it will too", file=sys.stderr)
     return EXIT_OK
 
 

@@ -1,7 +1,7 @@
-"""``ipmc feedforward``: a surrogate's feedforward voltage, checked on the calibrated physics.
+"""``ipmc feedforward``: a surrogate's feedforward voltage, with its error predicted on *your strip*.
 
-    ipmc feedforward model.json --temperature 35 --reference sine --amplitude 0.3 --frequency 1 \\
-        --set seed001_actuator --out ff-out
+    ipmc feedforward fit/model.json --temperature 35 --reference sine --amplitude 0.3 --frequency 1 \\
+        --model diag/model.json --data sweep.csv --out ff-out
 
 1. builds the reference (sine, multitone or smoothed steps from options, or ``--reference-file``)
    with C2 fade-in/fade-out windows and rest at both ends (:mod:`inversion.references`), in the
@@ -10,13 +10,25 @@
    ``auto``: truncation error below ``--preview-tol`` of the full inverse) and checks the voltage
    against ``--max-voltage`` (default 3 V) and ``--max-rate``: a violation is refused (exit 3,
    nothing written) unless ``--on-limit warn``;
-3. runs V(t) through the physics (``--set``/``--params-json``, ``physmodel.data.timesim.simulate``)
-   and reports the tracking error and peak voltage (and, for a sine, the steady-state prediction
-   ``A |P/G - 1|`` from the physics frequency response P and the surrogate G).
+3. **predicts the tracking error on the strip** from the measured sweep (``--data``, or the data
+   file named in the physics model's or the surrogate's provenance): the surrogate's misfit to
+   the measured lines, carried to ``--temperature`` between the measured temperatures with a
+   stated bound (:mod:`surrogate.strip_check`); without measured data the report says the
+   prediction is unchecked against measurement;
+4. runs V(t) through the physics model (``--model`` — the ``model.json`` of ``ipmc calibrate`` or
+   ``ipmc diagnose``, effects included — or ``--set``/``--params-json``; by default the model the
+   surrogate's sweep was made from, never an unrelated named set) with an exact frequency-domain
+   simulation (:mod:`physmodel.data.fftsim`) and reports the error against that physics beside
+   the prediction on the strip.
+
+Verdicts travel: when the physics model or the model behind the surrogate's sweep does not fit the
+data it was fitted to, the report and stderr say so and the exit code is 3 unless
+``--accept-misfit``.
 
 Writes into ``--out``: ``voltage.csv`` (``time_s, voltage_V, reference_<u>, predicted_tip_<u>``; the
-``voltage_V`` column is what ``ipmc simulate --input`` reads), ``report.md`` and ``feedforward.png``.
-Exit codes: 0 ok, 2 bad input, 3 a limit was violated (refused) or ``--max-error`` exceeded.
+``voltage_V`` column is what ``ipmc simulate --input`` reads), ``report.md``, ``report.json`` and
+``feedforward.png``.  Exit codes: 0 ok, 2 bad input, 3 a limit was violated (refused), an
+upstream model does not fit its data, or ``--max-error`` exceeded.
 """
 
 from __future__ import annotations
@@ -28,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import EXIT_FAILED, EXIT_OK, CLIError, _floats, _load_params
+from ._common import EXIT_FAILED, EXIT_OK, CLIError, _floats, load_physics, verdict_lines
 
 __all__ = ["add_parser", "run", "build_reference"]
 
@@ -61,10 +73,16 @@ def add_parser(sub):
     c.add_argument("--on-limit", choices=("error", "warn"), default="error",
                    help="refuse (exit 3, nothing written) or warn and continue")
     c.add_argument("--max-error", type=float, help="fail (exit 3) if the predicted tracking error exceeds this [unit]")
-    m = p.add_argument_group("physics check")
-    m.add_argument("--set", default="seed001_actuator", help="parameter set of the physics (default seed001_actuator)")
-    m.add_argument("--params-json", help="calibrated parameter-set JSON (what 'ipmc calibrate' writes)")
+    m = p.add_argument_group("checks: your measured data and the physics")
+    m.add_argument("--data", help="the measured sweep of the strip (.csv/.npz/.mat); default: the data file named "
+                                  "in the physics model's provenance, else in the surrogate's")
+    m.add_argument("--model", help="physics model file (model.json of 'ipmc calibrate' or 'ipmc diagnose'); default: "
+                                   "the model the surrogate's sweep was made from")
+    m.add_argument("--set", default=None, help="a named parameter set or JSON file for the physics (instead of --model)")
+    m.add_argument("--params-json", help="a JSON parameter or model file (same as --model)")
     m.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (SI)")
+    m.add_argument("--accept-misfit", action="store_true",
+                   help="exit 0 even when the physics model (or the one behind the surrogate) does not fit its data")
     m.add_argument("--no-check", action="store_true", help="only write V(t); skip the physics simulation")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--quiet", action="store_true")
@@ -114,7 +132,74 @@ def _surrogate(path, temperature_c):
     return model
 
 
+def physics_for(args, model, command: str):
+    """The physics model file of the check: the options' (--model/--set/--params-json), else the model
+    the surrogate's sweep was made from (when its file still exists and its sha256 matches), else
+    None.  Returns ``(ModelFile or None, overridden, note)``."""
+    from physmodel.model_file import load_model
+
+    mf, over = load_physics(args, command, default_set=None)
+    if mf is not None:
+        return mf, over, ""
+    src = model.info.get("source_model") or {}
+    path = src.get("file")
+    if not path:
+        return None, False, ("no physics model given and the surrogate names none (it was fitted to measured data): "
+                             "the error against the physics is not computed")
+    if not Path(path).is_file():
+        return None, False, f"the surrogate's physics model {path} is not found: pass --model"
+    mf = load_model(path)
+    if src.get("sha256") and mf.fingerprint() != src["sha256"]:
+        return None, False, (f"{path} has changed since the surrogate's sweep was made from it (sha256 differs): "
+                             "pass --model explicitly")
+    return mf, False, f"physics: the model the surrogate's sweep was made from ({path})"
+
+
+def measured_data(args, mf, model):
+    """The measured sweep to check against: ``--data``, else the data file in the physics model's
+    provenance, else in the surrogate's source model, else — for a surrogate fitted straight to a
+    measured sweep (no source model) — that sweep.  Returns ``(path or None, how found)``."""
+    if args.data:
+        if not Path(args.data).is_file():
+            raise CLIError(f"--data {args.data}: no such file")
+        return Path(args.data), "--data"
+    if mf is not None and mf.provenance is not None:
+        p = mf.provenance.data_path(mf.path)
+        if p is not None and p.is_file():
+            return p, f"the physics model's provenance ({mf.path})"
+    src_model = model.info.get("source_model") or {}
+    src = src_model.get("data_file")
+    if src and Path(src).is_file():
+        return Path(src), "the surrogate's source model"
+    own = (model.info.get("data") or {}).get("file")
+    if not src_model and own and Path(own).is_file():    # fitted straight to a measured sweep: that sweep
+        return Path(own), "the surrogate's own data (it was fitted to a measured sweep)"
+    return None, ""
+
+
+def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_unit):
+    """(DataMisfit, PredictedError) of the surrogate against the measured sweep at ``data_path``."""
+    from physmodel.data.files import read_sweep
+    from physmodel.errors import IPMCError
+    from surrogate.strip_check import misfit_to_data, predicted_error
+
+    sweep = read_sweep(data_path)
+    try:
+        sweep = sweep.in_units(in_unit, out_unit)
+    except IPMCError as exc:
+        raise CLIError(f"--data {data_path}: its units {sweep.output_unit}/{sweep.input_unit} do not match the "
+                       f"surrogate's {out_unit}/{in_unit}: {exc}") from None
+    mis = misfit_to_data(model, sweep, source=f"{data_path} (fingerprint {sweep.fingerprint()[:12]})")
+    return mis, predicted_error(mis, temperature_c, t, signal)
+
+
+def _rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
 def run(args) -> int:
+    import json
+
     from inversion import feedforward
     from inversion.limits import LimitError, Limits
     from physmodel.data.files import atomic_write
@@ -130,6 +215,11 @@ def run(args) -> int:
     if UNITS[in_unit][0] != "voltage" or UNITS[out_unit][0] != "length":
         raise CLIError(f"{args.surrogate}: expected an actuator surrogate (length per voltage), got "
                        f"{out_unit}/{in_unit}")
+    mf, overridden, phys_note = (None, False, "physics check skipped (--no-check)") if args.no_check else \
+        physics_for(args, model, "ipmc feedforward")
+    if mf is not None and mf.kind != "actuator":
+        raise CLIError(f"{mf.path or mf.name}: a {mf.kind} model cannot check an actuator's feedforward")
+    data_path, data_how = measured_data(args, mf, model)
     ref = build_reference(args, out_unit)
     from inversion.references import edge_jump
 
@@ -148,18 +238,77 @@ def run(args) -> int:
         return EXIT_FAILED
     volts = ff.output * v_scale
     out = Path(args.out)
+    r_rms = _rms(ref.y)
     cols = {"time_s": ref.t, "voltage_V": volts, f"reference_{out_unit}": ref.y}
-    lines = [f"# Feedforward at {args.temperature:g} °C", "",
-             f"- surrogate: `{args.surrogate}` ({model!r})",
-             f"- reference: {ref.description}; fades {ref.fade_in_s:g}/{ref.fade_out_s:g} s, rest "
-             f"{ref.lead_s:g}/{ref.tail_s:g} s, {ref.t.size} samples at {1 / ref.dt:g} Hz",
-             f"- preview: {ff.preview_rule} -> {ff.preview_s:.4g} s"
-             + (f" (truncation error {ff.preview_choice.relative_error:.2g} of the inverse, tolerance "
-                f"{ff.preview_choice.tolerance:g}; the 4/r0 rule would give {ff.auto_preview_s:.4g} s)"
-                if ff.preview_choice is not None else "")
-             + f"; truncation error {ff.truncation_error * v_scale:.3g} V (bound {ff.truncation_bound * v_scale:.3g} V)",
-             f"- peak voltage {ff.limit_report.peak * v_scale:.4g} V, peak rate {ff.limit_report.peak_rate * v_scale:.4g} V/s "
-             f"(limits: max_voltage {args.max_voltage}, max_rate {args.max_rate})"]
+    summary: dict = {"surrogate": str(args.surrogate), "temperature_c": args.temperature, "unit": out_unit,
+                     "reference": ref.description, "reference_rms": r_rms,
+                     "peak_voltage_V": float(ff.limit_report.peak * v_scale)}
+
+    # ---- upstream verdicts
+    upstream = []
+    src = model.info.get("source_model") or {}
+    if src.get("verdict") == "MISFIT":
+        upstream.append(f"the physics the surrogate's sweep was made from ({src.get('file')}) does not fit its data: "
+                        f"{src.get('verdict_reason', '')}")
+    if mf is not None and mf.verdict is not None and not mf.verdict.adequate and \
+            not (src.get("sha256") and src.get("sha256") == mf.fingerprint()):
+        upstream.append(f"the physics model {mf.path or mf.name} does not fit its data: {mf.verdict.reason}")
+    summary["upstream_misfit"] = upstream
+    lo_hi = model.temperature_range_c
+    range_notes = []
+    fitted_t = src.get("fitted_temperatures_c") or (",".join(f"{t:g}" for t in mf.provenance.temperatures_c)
+                                                    if mf is not None and mf.provenance is not None else "")
+    if fitted_t:
+        ts_ = [float(x) for x in str(fitted_t).split(",") if x.strip()]
+        if ts_ and not (min(ts_) <= args.temperature <= max(ts_)):
+            range_notes.append(f"{args.temperature:g} °C is outside the temperatures the physics was fitted at "
+                               f"({min(ts_):g}–{max(ts_):g} °C): extrapolated physics")
+
+    # ---- prediction on the strip
+    lines = [f"# Feedforward at {args.temperature:g} °C", ""]
+    strip = None
+    if data_path is not None:
+        mis, strip = strip_prediction(data_path, model, args.temperature, ref.t, ref.y, in_unit, out_unit)
+        summary["predicted_error_on_strip_rms"] = strip.rms
+        summary["predicted_error_on_strip_bound"] = strip.bound
+        summary["strip_check"] = {**strip.to_dict(), "data": str(data_path), "found_by": data_how,
+                                  "misfit_per_temperature": mis.table()}
+        lines += ["## Predicted error on your strip", "",
+                  f"- **{100 * strip.rms:.3g} % RMS of the reference** ({strip.rms * r_rms:.4g} {out_unit} RMS), "
+                  f"stated bound {100 * strip.bound:.3g} % — the surrogate's misfit to the measured sweep "
+                  f"`{data_path}` (found by {data_how}) carried to {args.temperature:g} °C",
+                  f"- {strip.sentence()}",
+                  "- measured misfit |H/G − 1| per temperature: " + ", ".join(
+                      f"{r['temperature_c']:g} °C {100 * r['rms_misfit']:.3g} % (noise {100 * r['rms_sigma']:.2g} %)"
+                      for r in mis.table())]
+        if not strip.checked:
+            print(f"ipmc feedforward: warning: the prediction on the strip is not covered by the data: {strip.sentence()}",
+                  file=sys.stderr)
+    else:
+        summary["predicted_error_on_strip_rms"] = None
+        lines += ["## Predicted error on your strip", "",
+                  "- **UNCHECKED against measurement**: no measured sweep (give --data, or use a model whose provenance "
+                  "names its data); the numbers below are against a model, not the strip"]
+        print("ipmc feedforward: warning: the predicted error is unchecked against measurement (no --data)",
+              file=sys.stderr)
+    for u in upstream:
+        lines.append(f"- **UPSTREAM MISFIT**: {u}")
+        print(f"ipmc feedforward: {u}", file=sys.stderr)
+    for n in range_notes:
+        lines.append(f"- **{n}**")
+        print(f"ipmc feedforward: warning: {n}", file=sys.stderr)
+    lines += ["", "## Voltage", "",
+              f"- surrogate: `{args.surrogate}` ({model!r})"
+              + (f"; fitted over {lo_hi[0]:g}–{lo_hi[1]:g} °C" if lo_hi else ""),
+              f"- reference: {ref.description}; fades {ref.fade_in_s:g}/{ref.fade_out_s:g} s, rest "
+              f"{ref.lead_s:g}/{ref.tail_s:g} s, {ref.t.size} samples at {1 / ref.dt:g} Hz",
+              f"- preview: {ff.preview_rule} -> {ff.preview_s:.4g} s"
+              + (f" (truncation error {ff.preview_choice.relative_error:.2g} of the inverse, tolerance "
+                 f"{ff.preview_choice.tolerance:g}; the 4/r0 rule would give {ff.auto_preview_s:.4g} s)"
+                 if ff.preview_choice is not None else "")
+              + f"; truncation error {ff.truncation_error * v_scale:.3g} V (bound {ff.truncation_bound * v_scale:.3g} V)",
+              f"- peak voltage {ff.limit_report.peak * v_scale:.4g} V, peak rate {ff.limit_report.peak_rate * v_scale:.4g} V/s "
+              f"(limits: max_voltage {args.max_voltage}, max_rate {args.max_rate})"]
     trunc_rel = ff.truncation_error / max(ff.limit_report.peak, 1e-300)
     if trunc_rel > 0.01:
         lines.append(f"- **preview too short: it changes the voltage by {100 * trunc_rel:.0f} % of its peak "
@@ -175,30 +324,39 @@ def run(args) -> int:
     if not ff.limit_report.ok:
         lines.append(f"- **LIMIT VIOLATED**: {ff.limit_report.message}")
     status = EXIT_OK
-    if not args.no_check:
-        from physmodel import ActuatorModel
-        from physmodel.data.timesim import simulate
+
+    # ---- error against the physics model
+    lines += ["", "## Error against the physics model", ""]
+    if mf is None:
+        lines.append(f"- not computed: {phys_note}")
+        summary["physics_error_rms"] = None
+    else:
+        from physmodel.data.fftsim import simulate_at_rest
 
         from ..plots_control import feedforward_check
 
-        params = _load_params(args)
-        plant = ActuatorModel(params)
-        ts = simulate(plant, args.temperature, ref.t, volts)
-        y = ts.output / unit_scale(out_unit)
+        if phys_note:
+            lines.append(f"- {phys_note}")
+        lines += verdict_lines(mf, overridden)
+        sim = simulate_at_rest(mf.model(), args.temperature, ref.t, volts)
+        y = sim.y / unit_scale(out_unit)
         err = y - ref.y
         e_max = float(np.max(np.abs(err)))
         e_body = float(np.max(np.abs(err[ref.body]))) if np.any(ref.body) else e_max
         cols[f"predicted_tip_{out_unit}"] = y
-        lines += [f"- physics: `{params.name}`, {ts.metadata['realization']}",
-                  f"- tracking error: max {e_max:.4g} {out_unit} over the record, {e_body:.4g} {out_unit} "
-                  f"between the fades (reference peak {float(np.max(np.abs(ref.y))):.4g} {out_unit})"]
+        summary.update(physics_error_rms=_rms(err) / r_rms, physics_error_max=e_max, physics_error_max_body=e_body,
+                       physics_model=str(mf.path or mf.name), physics_model_sha256=mf.fingerprint())
+        lines += [f"- {sim.describe()}",
+                  f"- tracking error against this physics: {100 * _rms(err) / r_rms:.3g} % RMS of the reference; max "
+                  f"{e_max:.4g} {out_unit} over the record, {e_body:.4g} {out_unit} between the fades (reference peak "
+                  f"{float(np.max(np.abs(ref.y))):.4g} {out_unit})"]
         if not args.reference_file and args.reference == "sine":
             f = _floats(args.frequency, "--frequency")[0]
             A = _floats(args.amplitude, "--amplitude")[0]
-            P = plant.frequency_response(np.array([f]), [args.temperature])["M"][0, 0, 0] / unit_scale(out_unit) * v_scale
+            P = complex(mf.model().response(np.array([f]), [args.temperature])[0, 0]) / unit_scale(out_unit) * v_scale
             Gj = complex(G(2j * math.pi * f))
             lines.append(f"- steady-state prediction A |P/G - 1| = {A * abs(P / Gj - 1):.4g} {out_unit} "
-                         f"(P: physics, G: surrogate at {f:g} Hz)")
+                         f"(P: this physics, G: surrogate at {f:g} Hz)")
         fig = feedforward_check(ref.t, ref.y, y, volts, out / "feedforward.png", unit=out_unit,
                                 max_voltage=args.max_voltage, body=ref.body,
                                 title=f"{ref.description}, {args.temperature:g} °C, preview {ff.preview_s:.3g} s")
@@ -206,21 +364,33 @@ def run(args) -> int:
         if args.max_error is not None and e_body > args.max_error:
             lines.append(f"- **tracking error {e_body:.4g} {out_unit} exceeds --max-error {args.max_error:g}**")
             status = EXIT_FAILED
+    if upstream and not args.accept_misfit:
+        status = EXIT_FAILED
+    summary["exit_code"] = status
     arr = np.column_stack(list(cols.values()))
 
     def write_csv(fh):
         fh.write("# ipmc-timeseries 1\n")
         fh.write(f"# surrogate: {args.surrogate}\n# temperature_c: {args.temperature:g}\n")
         fh.write(f"# preview_s: {ff.preview_s:.6g}\n")
+        fh.write("# predicted_error_on_strip: " + (f"{strip.rms:.6g} (bound {strip.bound:.6g})" if strip is not None
+                                                   else "unchecked against measurement") + "\n")
+        if upstream:
+            fh.write(f"# upstream_misfit: {'; '.join(upstream)}\n")
         fh.write(",".join(cols) + "\n")
         np.savetxt(fh, arr, delimiter=",", fmt="%.12g")
 
     out.mkdir(parents=True, exist_ok=True)
+    text = json.dumps(summary, indent=2, allow_nan=False, default=float)
     atomic_write(out / "voltage.csv", write_csv)
+    atomic_write(out / "report.json", lambda fh: fh.write(text + "\n"))
     atomic_write(out / "report.md", lambda fh: fh.write("\n".join(lines) + "\n"))
     if not args.quiet:
         print("\n".join(lines[2:]).replace("**", ""))
-        print(f"ipmc feedforward: wrote {out / 'voltage.csv'} and {out / 'report.md'}")
-    if status != EXIT_OK:
+        print(f"ipmc feedforward: wrote {out / 'voltage.csv'}, report.md and report.json")
+    if upstream and not args.accept_misfit:
+        print("ipmc feedforward: an upstream model does not fit its data (exit 3; --accept-misfit to accept it)",
+              file=sys.stderr)
+    elif status != EXIT_OK:
         print(f"ipmc feedforward: tracking error above --max-error {args.max_error:g}", file=sys.stderr)
     return status

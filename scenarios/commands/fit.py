@@ -113,6 +113,39 @@ def _report(args, data, fit_data, res, held_out, figures, verdict=None) -> str:
     return "\n".join(lines) + "\n"
 
 
+def provenance(args, data, fit_data) -> dict:
+    """What the surrogate records of its data: the sweep file, its fingerprint, the temperatures and
+    band fitted and, when the sweep was made from a physics model (``ipmc sweep --model``), that
+    model (file, sha256, effects, its data's verdict) — read by ``ipmc feedforward``/``ipmc invert``."""
+    from pathlib import Path
+
+    info = {"data": {"file": str(Path(args.csv).resolve()), "fingerprint": data.fingerprint(),
+                     "temperatures_c": [float(t) for t in fit_data.temperatures()],
+                     "band_hz": [float(np.min(fit_data.frequency_hz)), float(np.max(fit_data.frequency_hz))]}}
+    src = {k[len("model_"):]: v for k, v in (data.metadata or {}).items() if k.startswith("model_")}
+    if src:
+        info["source_model"] = src
+    return info
+
+
+def upstream_lines(info: dict) -> str:
+    """The report section on the physics this surrogate was fitted to (empty when it was measured data)."""
+    src = info.get("source_model")
+    if not src:
+        return ""
+    v = src.get("verdict", "unchecked")
+    text = ["", "## Upstream physics", "",
+            f"- the sweep was made from `{src.get('file')}` (sha256 `{str(src.get('sha256', ''))[:16]}`; effects: "
+            f"{src.get('effects', 'none')})",
+            "- its verdict on its own data: " + {"adequate": "fits its data", "MISFIT": "**DOES NOT FIT its data**",
+                                                 "unchecked": "never compared with measured data"}.get(v, v)
+            + (f" — {src['verdict_reason']}" if src.get("verdict_reason") else "")]
+    if src.get("fitted_temperatures_c"):
+        text.append(f"- that model was fitted at {src['fitted_temperatures_c']} °C"
+                    + (f", {src['fitted_band_hz'].replace(',', '–')} Hz" if src.get("fitted_band_hz") else ""))
+    return "\n".join(text) + "\n"
+
+
 def run(args) -> int:
     """Execute ``fit``; returns the exit code (0 ok, 2 bad input, 3 not converged)."""
     from physmodel.data.files import check_output_folder
@@ -146,6 +179,11 @@ def run(args) -> int:
         return EXIT_BAD_INPUT
     from physmodel.data.files import output_folder
     from surrogate.adequacy import assess
+
+    if (data.metadata or {}).get("model_verdict") == "MISFIT":
+        print(f"ipmc fit: warning: {args.csv} was made from {data.metadata.get('model_file')}, which does not fit "
+              f"its own data ({data.metadata.get('model_verdict_reason', '')}); the surrogate inherits that misfit "
+              "and ipmc feedforward/invert will refuse it without --accept-misfit", file=sys.stderr)
 
     verdict = assess(res)
     schedule = None
@@ -188,8 +226,10 @@ def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, sche
         plots.save_poles_zeros_vs_temperature(model, out / "poles_zeros_vs_temperature.png",
                                         res.per_temperature_models)
         figures.append("poles_zeros_vs_temperature.png")
+    model.info.update(provenance(args, data, fit_data))
     model.to_json(out / "model.json")
     report = _report(args, data, fit_data, res, held, figures, verdict)
+    report += upstream_lines(model.info)
     if schedule is not None:
         report += ("\n## Between the fit temperatures (leave-one-temperature-out)\n\n" + schedule.cv.to_markdown()
                    + "\n" + ("OK: " if schedule.ok else "**WARNING**: ") + schedule.message

@@ -87,6 +87,11 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("--filter-bandwidth", type=float, default=None,
                    help="low-pass bandwidth [rad/s] for --improper filter")
     p.add_argument("--plot", default=None, help="write a PNG with input, reconstruction and error")
+    p.add_argument("--data", default=None,
+                   help="with --surrogate: the measured sweep of the strip; the decoding error predicted from the "
+                        "surrogate's misfit to it is reported (default: the data file in the surrogate's provenance)")
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="exit 0 even when the physics behind the surrogate does not fit its data")
     p.set_defaults(func=run)
     return p
 
@@ -149,6 +154,9 @@ def run(args: argparse.Namespace) -> int:
         if args.temperature is None:
             raise InversionError("--surrogate needs --temperature (degC)")
         model: Any = model_from_surrogate(args.surrogate, args.temperature)
+        import surrogate as _surrogate_pkg
+
+        smodel = _surrogate_pkg.load(args.surrogate)
     else:
         if args.num is None or args.den is None:
             raise InversionError("the model is missing: give --num and --den (or --surrogate)")
@@ -190,7 +198,16 @@ def run(args: argparse.Namespace) -> int:
         table += [ref, y - ref]
     arr = np.column_stack(table)
 
+    status = EXIT_OK
+    notes: list[str] = []
+    if args.surrogate is not None:
+        notes, status = _verdicts(args, smodel, t, y)
+    elif args.data is not None:
+        raise InversionError("--data needs --surrogate and --temperature (a coefficient model has no temperature)")
+
     def write_csv(fh: Any) -> None:
+        for n in notes:
+            fh.write(f"# {n}\n")
         fh.write(",".join(cols) + "\n")
         np.savetxt(fh, arr, delimiter=",", fmt="%.12g")
 
@@ -200,4 +217,45 @@ def run(args: argparse.Namespace) -> int:
         plots.inversion_traces(args.plot, t, u, y, ucol, ref, args.reference, f"stable inversion, preview {prev}")
     if not args.quiet:
         print(f"ipmc invert: wrote {args.out} ({t.size} samples, preview {prev})")
-    return EXIT_OK
+    return status
+
+
+def _verdicts(args: argparse.Namespace, smodel: Any, t: np.ndarray, y: np.ndarray) -> tuple[list[str], int]:
+    """The upstream verdict of the surrogate's physics and the decoding error predicted from its
+    misfit to the measured sweep (said on stderr and as ``# key: value`` lines of the output);
+    exit 3 on an upstream misfit unless ``--accept-misfit``."""
+    import sys
+    from pathlib import Path
+
+    from physmodel.data.files import read_sweep
+    from surrogate.strip_check import misfit_to_data, predicted_error
+
+    notes, status = [], EXIT_OK
+    src = smodel.info.get("source_model") or {}
+    if src.get("verdict") == "MISFIT":
+        msg = (f"upstream_misfit: the physics the surrogate's sweep was made from ({src.get('file')}) does not fit "
+               f"its data: {src.get('verdict_reason', '')}")
+        notes.append(msg)
+        print(f"ipmc invert: {msg}" + ("" if args.accept_misfit else " (exit 3; --accept-misfit to accept)"),
+              file=sys.stderr)
+        status = EXIT_OK if args.accept_misfit else 3
+    data = args.data or src.get("data_file") or (None if src else (smodel.info.get("data") or {}).get("file"))
+    if data is None or not Path(data).is_file():
+        if args.data is not None:
+            raise InversionError(f"--data {args.data}: no such file")
+        notes.append("predicted_error_on_strip: unchecked against measurement (no --data)")
+        print("ipmc invert: warning: the decoding error is unchecked against measurement (give --data)", file=sys.stderr)
+        return notes, status
+    sweep = read_sweep(data)
+    lab = smodel.labels
+    try:
+        sweep = sweep.in_units(lab.get("input_unit") or sweep.input_unit, lab.get("output_unit") or sweep.output_unit)
+    except ValueError as exc:
+        raise InversionError(f"--data {data}: its units do not match the surrogate's: {exc}") from None
+    pe = predicted_error(misfit_to_data(smodel, sweep), float(args.temperature), t, y)
+    notes.append(f"predicted_error_on_strip: {pe.rms:.6g} (bound {pe.bound:.6g}; {pe.sentence()}; data {data})")
+    if not args.quiet:
+        print(f"ipmc invert: predicted decoding error on the strip: {pe.sentence()}")
+    if not pe.checked:
+        print(f"ipmc invert: warning: {pe.sentence()}", file=sys.stderr)
+    return notes, status

@@ -13,7 +13,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import EXIT_OK, CLIError, _add_model_args, _floats, _load_params, _model, check_plot_path
+from ._common import (
+    EXIT_OK,
+    CLIError,
+    _add_model_args,
+    _floats,
+    check_plot_path,
+    load_physics,
+    model_metadata,
+    warn_verdict,
+)
 
 
 def add_parser(sub):
@@ -51,7 +60,10 @@ def run(args) -> int:
         raise CLIError(f"--out {out}: use a .csv, .npz or .mat file name")
     if args.plot:
         check_plot_path(args.plot)
-    model = _model(args, _load_params(args))
+    mf, overridden = load_physics(args, "ipmc simulate")
+    warn_verdict(mf, "ipmc simulate")
+    model = mf.model()
+    args.model_metadata = model_metadata(mf)
     kw = dict(output_noise_rms=args.noise_rms, input_noise_rms=args.input_noise_rms, seed=args.seed)
     if args.chain:
         if args.kind != "sensor":
@@ -84,6 +96,7 @@ def run(args) -> int:
 
 
 def _finish(args, ts, model, what: str, out: Path) -> int:
+    ts.metadata.update(getattr(args, "model_metadata", {}))
     ts.save(out)
     if args.plot:
         from ..plots import traces

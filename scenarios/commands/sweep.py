@@ -9,11 +9,12 @@ from ._common import (
     CLIError,
     _add_model_args,
     _floats,
-    _load_params,
-    _model,
     _Progress,
     check_out_file,
     check_plot_path,
+    load_physics,
+    model_metadata,
+    warn_verdict,
 )
 
 
@@ -59,7 +60,9 @@ def run(args) -> int:
     out = check_out_file(args.out, (".csv", ".npz", ".mat"))
     if args.plot:
         check_plot_path(args.plot)
-    model = _model(args, _load_params(args))
+    mf, overridden = load_physics(args, "ipmc sweep")
+    warn_verdict(mf, "ipmc sweep")
+    model = mf.model()
     quantity = args.quantity or ("M" if args.kind == "actuator" else "S")
     noise = None
     if args.noise == "magphase":
@@ -72,6 +75,12 @@ def run(args) -> int:
         sw = synthesize_sweep(model, quantity, f, temps, noise=noise, seed=args.seed, progress=bar)
     finally:
         bar.close()
+    meta = model_metadata(mf)
+    if overridden:
+        meta["model_overridden"] = "parameters overridden with --param: the verdict describes the file's parameters"
+    from dataclasses import replace
+
+    sw = replace(sw, metadata={**sw.metadata, **meta})
     write_sweep(sw, out)
     if args.plot:
         from ..plots import bode
@@ -79,5 +88,5 @@ def run(args) -> int:
         bode(sw, args.plot, title=f"{model.params[0].name}: {sw.metadata['description']}")
     if not args.quiet:
         print(f"wrote {out} ({sw.frequency_hz.size} lines, {len(temps)} temperatures, "
-              f"{sw.output_unit}/{sw.input_unit})" + (f" and {args.plot}" if args.plot else ""))
+              f"{sw.output_unit}/{sw.input_unit}) from {mf.describe()}" + (f" and {args.plot}" if args.plot else ""))
     return EXIT_OK

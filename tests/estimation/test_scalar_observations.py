@@ -14,7 +14,8 @@ import pytest
 
 from physmodel.errors import IPMCError
 from physmodel.estimation.lsq import Z95, fit_parameters
-from physmodel.estimation.records import FreeParameter, ScalarObservations
+from physmodel.estimation.observations import ScalarObservations
+from physmodel.estimation.records import FreeParameter
 
 R = 8.314462618
 T = np.array([283.15, 293.15, 303.15, 313.15, 323.15, 333.15, 343.15])

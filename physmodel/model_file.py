@@ -1,0 +1,449 @@
+"""The one model file: a physics model (parameters, temperature laws, effects) with the verdict of
+the data it was fitted to and where it came from.
+
+``ipmc calibrate`` and ``ipmc diagnose`` write it (``FOLDER/model.json``); every command that takes
+physics reads it (``--model FILE``, or ``--set FILE``), and :func:`load_model` reads it in Python:
+
+>>> mf = load_model("diag/model.json")          # doctest: +SKIP
+>>> mf.model().response([1.0], [35.0])           # the physics with its effects  # doctest: +SKIP
+>>> mf.adequate, mf.verdict.reason               # did it fit its data?           # doctest: +SKIP
+
+A model file holds
+
+- ``kind`` (actuator | sensor), the fitted ``quantity`` and the sensing ``kernel``;
+- ``parameters``: an :class:`~physmodel.IPMCParameters` with its temperature laws (SI);
+- ``effects``: ``{effect name: {parameter: value}}`` switched on in the model (SI; see
+  :mod:`physmodel.effects`) — for a diagnosis the baseline's effects plus the named ones, refitted;
+- ``verdict``: a :class:`FitVerdict` — the goodness-of-fit test of the model against the data it
+  was fitted to (χ², dof, p, adequate or not, and the diagnosis verdict when there was one); None
+  when the model was never compared with data (a named set);
+- ``estimates``: the fitted parameters with their 95 % intervals (as the fit reported them);
+- ``provenance``: a :class:`Provenance` — the data file and its SHA-256, the temperatures and band
+  fitted, the command line, the library version.
+
+Files written by older versions load too: a ``parameters.json`` of ``ipmc calibrate`` (format
+``ipmc-parameter-set`` with the calibration record inside: its goodness of fit becomes the
+verdict, its fixed effects the effects) and a bare parameter record (no verdict).
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import json
+import math
+import os
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from .errors import ParameterError
+from .params import IPMCParameters
+
+#: Format name and version of the model file.
+MODEL_FORMAT = "ipmc-model"
+MODEL_VERSION = 1
+
+#: Format name and version of a bare parameter-set file (:func:`physmodel.save_parameter_set`).
+PARAMETER_SET_FORMAT = "ipmc-parameter-set"
+PARAMETER_SET_VERSION = 1
+
+
+def finite_json(obj):
+    """``obj`` with infinite floats as the strings "inf"/"-inf" (which ``float()`` reads back), so
+    that it is strict JSON (NaN is left to fail there: a parameter is never NaN)."""
+    if isinstance(obj, dict):
+        return {str(k): finite_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [finite_json(v) for v in obj]
+    if isinstance(obj, float) and math.isinf(obj):
+        return "inf" if obj > 0 else "-inf"
+    return obj
+
+
+def _num(v) -> float | None:
+    if v is None:
+        return None
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return None
+    return x if math.isfinite(x) else None
+
+
+def file_sha256(path) -> str:
+    """SHA-256 of a file's bytes (hex), read in blocks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+# =============================================================================== records
+@dataclass(frozen=True)
+class FitVerdict:
+    """Whether a model fits the data it was fitted to.
+
+    Parameters
+    ----------
+    adequate : bool
+        The goodness-of-fit test passed (χ² consistent with the declared noise).
+    chi2 : float or None
+        Σ r² of the standardised residuals at the optimum. [-]
+    dof : int or None
+        Residual degrees of freedom.
+    p_value : float or None
+        P(χ²_dof ≥ chi2); None when the noise was estimated from the residuals.
+    reason : str
+        The test's sentence.
+    diagnosis : str or None
+        The verdict of ``ipmc diagnose`` (none, named, ambiguous, at_bound, unexplained) when the
+        model came from a diagnosis, with ``named`` the effects it named.
+    named : tuple of str
+        Effects the diagnosis named.
+    """
+
+    adequate: bool
+    chi2: float | None
+    dof: int | None
+    p_value: float | None
+    reason: str
+    diagnosis: str | None = None
+    named: tuple = ()
+
+    @classmethod
+    def from_goodness(cls, gof, diagnosis: str | None = None, named=()) -> FitVerdict:
+        """From a :class:`physmodel.estimation.residuals.GoodnessOfFit` (or its ``to_dict()``)."""
+        d = gof.to_dict() if hasattr(gof, "to_dict") else dict(gof)
+        dof = d.get("dof")
+        return cls(bool(d.get("adequate")), _num(d.get("chi2")), None if dof is None else int(dof),
+                   _num(d.get("p_value")), str(d.get("reason", "")), diagnosis, tuple(named))
+
+    def to_dict(self) -> dict:
+        return {"adequate": bool(self.adequate), "chi2": _num(self.chi2), "dof": self.dof,
+                "p_value": _num(self.p_value), "reason": self.reason, "diagnosis": self.diagnosis,
+                "named": list(self.named)}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "model file") -> FitVerdict:
+        if not isinstance(d, dict) or "adequate" not in d:
+            raise ParameterError(f"{where}: 'verdict' must be an object with 'adequate', got {d!r}")
+        dof = d.get("dof")
+        return cls(bool(d["adequate"]), _num(d.get("chi2")), None if dof is None else int(dof),
+                   _num(d.get("p_value")), str(d.get("reason", "")), d.get("diagnosis"), tuple(d.get("named") or ()))
+
+    def line(self) -> str:
+        """One sentence: adequate or not, with χ²/dof and p."""
+        stat = (f"chi2 {self.chi2:.4g} on {self.dof} dof" if self.chi2 is not None and self.dof else "chi2 n/a") + (
+            f", p = {self.p_value:.2g}" if self.p_value is not None else "")
+        diag = f"; diagnosis: {self.diagnosis}" + (f" ({', '.join(self.named)})" if self.named else "") \
+            if self.diagnosis else ""
+        return ("fits its data" if self.adequate else "DOES NOT FIT its data") + f" ({stat}{diag})"
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """Where a model came from.
+
+    Parameters
+    ----------
+    creator : str
+        The command or function that made it (``"ipmc calibrate"``, ``"ipmc diagnose"``, ...).
+    data_file : str or None
+        The data file it was fitted to, as given.
+    data_sha256 : str or None
+        SHA-256 of that file's bytes.
+    data_fingerprint : str or None
+        SHA-256 of the sweep's numerical content (:meth:`FrequencySweep.fingerprint`).
+    temperatures_c : tuple of float
+        Temperatures of the data. [°C]
+    band_hz : tuple of float or None
+        (lowest, highest) frequency of the data. [Hz]
+    command : str
+        The command line.
+    library_version : str
+        ``physmodel.__version__`` of the writer.
+    """
+
+    creator: str
+    data_file: str | None = None
+    data_sha256: str | None = None
+    data_fingerprint: str | None = None
+    temperatures_c: tuple = ()
+    band_hz: tuple | None = None
+    command: str = ""
+    library_version: str = ""
+
+    def to_dict(self) -> dict:
+        return {"creator": self.creator, "data_file": self.data_file, "data_sha256": self.data_sha256,
+                "data_fingerprint": self.data_fingerprint, "temperatures_c": [float(t) for t in self.temperatures_c],
+                "band_hz": None if self.band_hz is None else [float(b) for b in self.band_hz],
+                "command": self.command, "library_version": self.library_version}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "model file") -> Provenance:
+        if not isinstance(d, dict):
+            raise ParameterError(f"{where}: 'provenance' must be an object, got {d!r}")
+        band = d.get("band_hz")
+        return cls(str(d.get("creator", "")), d.get("data_file"), d.get("data_sha256"), d.get("data_fingerprint"),
+                   tuple(float(t) for t in d.get("temperatures_c") or ()),
+                   None if band is None else (float(band[0]), float(band[1])),
+                   str(d.get("command", "")), str(d.get("library_version", "")))
+
+    def data_path(self, relative_to=None) -> Path | None:
+        """The data file, resolved against the model file's folder when relative and not found
+        from the working directory; None when unknown."""
+        if not self.data_file:
+            return None
+        p = Path(self.data_file)
+        if p.is_absolute() or p.exists() or relative_to is None:
+            return p
+        return Path(relative_to).parent / p
+
+
+@dataclass(frozen=True)
+class ModelFile:
+    """A physics model with its data's verdict and provenance (see the module doc).
+
+    Parameters
+    ----------
+    kind : str
+        ``"actuator"`` or ``"sensor"``.
+    parameters : IPMCParameters
+        Parameters and temperature laws (SI).
+    effects : dict
+        ``{effect name: {parameter: value}}`` switched on (SI).
+    quantity : str or None
+        The quantity fitted (actuator M/H/Z/I, sensor S/Z); None for the kind's primary one.
+    kernel : str
+        Sensing kernel (sensors).
+    verdict : FitVerdict or None
+        The data's verdict; None when the model was never compared with data.
+    estimates : tuple of dict
+        Fitted parameters: name, value, ci95 [lower, upper], status. [SI]
+    provenance : Provenance or None
+        Where it came from.
+    path : str or None
+        The file it was read from (not written).
+    """
+
+    kind: str
+    parameters: IPMCParameters
+    effects: dict = field(default_factory=dict)
+    quantity: str | None = None
+    kernel: str = "boundary_charge"
+    verdict: FitVerdict | None = None
+    estimates: tuple = ()
+    provenance: Provenance | None = None
+    path: str | None = None
+
+    def __post_init__(self):
+        if self.kind not in ("actuator", "sensor"):
+            raise ParameterError(f"model kind must be 'actuator' or 'sensor', got {self.kind!r}")
+        if not isinstance(self.parameters, IPMCParameters):
+            raise ParameterError(f"model parameters must be IPMCParameters, got {type(self.parameters).__name__}")
+        from .effects import normalize_effects
+
+        object.__setattr__(self, "effects", {k: dict(v) for k, v in normalize_effects(self.effects or {}).items()})
+
+    # -------------------------------------------------------------- views
+    @property
+    def name(self) -> str:
+        """The parameter set's name."""
+        return self.parameters.name
+
+    @property
+    def checked(self) -> bool:
+        """Whether the model was compared with data (it carries a verdict)."""
+        return self.verdict is not None
+
+    @property
+    def adequate(self) -> bool | None:
+        """True/False: the model fits / does not fit its data; None: never compared with data."""
+        return None if self.verdict is None else bool(self.verdict.adequate)
+
+    def model(self, params: IPMCParameters | None = None):
+        """The model (the one interface, :mod:`physmodel.protocol`): the physics of ``kind`` with
+        the effects switched on (:func:`physmodel.effects.EffectModel`), or the plain physics when
+        there are none.
+
+        Parameters
+        ----------
+        params : IPMCParameters or None
+            Parameters replacing the file's (e.g. with overrides); default the file's.
+        """
+        p = self.parameters if params is None else params
+        if self.effects:
+            from .effects import EffectModel
+
+            return EffectModel(p, self.kind, self.effects, kernel=self.kernel)
+        from .protocol import physics_model
+
+        return physics_model(self.kind, p, kernel=self.kernel)
+
+    def describe(self) -> str:
+        """One line: name, kind, effects, verdict."""
+        eff = "; ".join(f"{k} ({', '.join(f'{p} = {v:.4g}' for p, v in e.items())})" for k, e in self.effects.items())
+        ver = "not compared with data" if self.verdict is None else self.verdict.line()
+        return f"`{self.name}` ({self.kind}" + (f", effects: {eff}" if eff else ", no effects") + f"): {ver}"
+
+    def with_parameters(self, params: IPMCParameters) -> ModelFile:
+        """A copy with other parameters (the verdict and provenance are kept: say so where it matters)."""
+        return replace(self, parameters=params)
+
+    # -------------------------------------------------------------- files
+    def to_dict(self) -> dict:
+        """JSON-ready data (format ``ipmc-model`` 1; infinities as "inf")."""
+        return finite_json({
+            "format": MODEL_FORMAT, "version": MODEL_VERSION, "kind": self.kind, "quantity": self.quantity,
+            "kernel": self.kernel, "parameters": self.parameters.to_dict(),
+            "effects": {k: {p: float(v) for p, v in e.items()} for k, e in self.effects.items()},
+            "verdict": None if self.verdict is None else self.verdict.to_dict(),
+            "estimates": [dict(e) for e in self.estimates],
+            "provenance": None if self.provenance is None else self.provenance.to_dict()})
+
+    def fingerprint(self) -> str:
+        """SHA-256 of the model's content (parameters, laws, effects, verdict, provenance), independent
+        of formatting: what a sweep, a surrogate and a feedforward report cite."""
+        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"), allow_nan=False)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def save(self, path) -> Path:
+        """Write the model file atomically and return its path."""
+        from .data.files import atomic_write
+
+        text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
+        return atomic_write(Path(path), lambda fh: fh.write(text + "\n"))
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "model file", path: str | None = None) -> ModelFile:
+        """Read the ``ipmc-model`` format (see :func:`load_model` for older formats)."""
+        if d.get("format") != MODEL_FORMAT:
+            raise ParameterError(f"{where} has format {d.get('format')!r}, expected {MODEL_FORMAT!r}")
+        version = d.get("version")
+        if isinstance(version, bool) or not isinstance(version, int) or not 1 <= version <= MODEL_VERSION:
+            raise ParameterError(f"{where}: version {version!r}; this library reads {MODEL_FORMAT} versions 1 to "
+                                 f"{MODEL_VERSION}")
+        missing = [k for k in ("kind", "parameters") if k not in d]
+        if missing:
+            raise ParameterError(f"{where}: missing key(s) {missing}")
+        try:
+            params = IPMCParameters.from_dict(dict(d["parameters"]))
+        except (ParameterError, TypeError, ValueError) as exc:
+            raise ParameterError(f"{where}: parameters: {exc}") from None
+        effects = d.get("effects") or {}
+        if not isinstance(effects, dict) or not all(isinstance(v, dict) for v in effects.values()):
+            raise ParameterError(f"{where}: 'effects' must be an object of {{effect: {{parameter: value}}}}, got {effects!r}")
+        verdict = None if d.get("verdict") is None else FitVerdict.from_dict(d["verdict"], where)
+        prov = None if d.get("provenance") is None else Provenance.from_dict(d["provenance"], where)
+        try:
+            return cls(str(d["kind"]), params, {k: {p: float(v) for p, v in e.items()} for k, e in effects.items()},
+                       d.get("quantity"), str(d.get("kernel") or "boundary_charge"), verdict,
+                       tuple(d.get("estimates") or ()), prov, path)
+        except (ParameterError, TypeError, ValueError) as exc:
+            raise ParameterError(f"{where}: {exc}") from None
+
+
+def _legacy(data: dict, where: str, kind: str | None, path: str) -> ModelFile:
+    """A model from an ``ipmc-parameter-set`` file (what ``ipmc calibrate`` wrote before the model
+    file) or a bare parameter record."""
+    record = data
+    cal = None
+    if "parameters" in data:
+        if data.get("format") != PARAMETER_SET_FORMAT:
+            raise ParameterError(f"{where} has format {data.get('format')!r}, expected {MODEL_FORMAT!r} (or the older "
+                                 f"{PARAMETER_SET_FORMAT!r})")
+        version = data.get("version", 0)
+        if isinstance(version, bool) or not isinstance(version, int) or version < 0:
+            raise ParameterError(f"{where}: version must be a non-negative integer, got {version!r}")
+        if version > PARAMETER_SET_VERSION:
+            raise ParameterError(f"{where} has version {version}, this library reads up to {PARAMETER_SET_VERSION}")
+        record = data["parameters"]
+        cal = data.get("calibration")
+    elif "calibration" in data and "parameters" not in data:
+        raise ParameterError(f"{where} holds a calibration record without parameters (the calibration did not "
+                             "produce a parameter set); use the folder's model.json")
+    if not isinstance(record, dict):
+        raise ParameterError(f"{where} holds {type(record).__name__}, expected an object")
+    try:
+        params = IPMCParameters.from_dict(dict(record))
+    except ParameterError as exc:
+        raise ParameterError(f"{where}: {exc}") from None
+    verdict, effects, quantity, kernel, prov = None, {}, None, "boundary_charge", None
+    if isinstance(cal, dict):
+        meta = cal.get("metadata") or {}
+        if cal.get("goodness_of_fit"):
+            verdict = FitVerdict.from_goodness(cal["goodness_of_fit"])
+        kind = kind or meta.get("kind")
+        quantity = meta.get("quantity") or None
+        kernel = meta.get("kernel") or "boundary_charge"
+        if meta.get("effects"):
+            # the old writer stored metadata values with str(): a dict literal
+            try:
+                effects = ast.literal_eval(meta["effects"]) if isinstance(meta["effects"], str) else meta["effects"]
+            except (ValueError, SyntaxError):
+                raise ParameterError(f"{where}: calibration metadata 'effects' = {meta['effects']!r} cannot be read; "
+                                     "recalibrate with this version to get a model.json") from None
+        band = cal.get("band_hz")
+        prov = Provenance("ipmc calibrate (older parameters.json)", meta.get("sweep_file"), None, None,
+                          tuple(cal.get("temperatures_c") or ()), None if band is None else tuple(band))
+    return ModelFile(kind or "actuator", params, effects, quantity, kernel, verdict, (), prov, path)
+
+
+def load_model(source: str | os.PathLike, *, kind: str | None = None, **overrides: Any) -> ModelFile:
+    """A model file, an older parameter file, or a named parameter set, as a :class:`ModelFile`.
+
+    Parameters
+    ----------
+    source : str or path
+        A model file (``ipmc-model``), a parameter file (``ipmc-parameter-set``, e.g. an older
+        ``ipmc calibrate`` output, or a bare record), or a name from
+        :func:`~physmodel.available_parameter_sets` (no verdict: never compared with data).
+    kind : str or None
+        ``"actuator"`` or ``"sensor"``: required for a named set or a bare record (default
+        actuator); for a file that states its kind, a different one is an error.
+    **overrides
+        Parameter fields to override (SI). The verdict then describes the file's parameters, not
+        the overridden ones: the caller must say so.
+
+    Returns
+    -------
+    ModelFile
+    """
+    from .data.files import read_text
+    from .errors import DataFormatError
+    from .parameter_sets import available_parameter_sets, get_parameter_set
+
+    text = os.fspath(source)
+    if text in available_parameter_sets():
+        mf = ModelFile(kind or "actuator", get_parameter_set(text))
+    else:
+        path = Path(text)
+        if not (text.lower().endswith(".json") or path.is_file()):
+            raise ParameterError(f"unknown parameter set or model file {text!r}; expected one of "
+                                 f"{available_parameter_sets()} or the path of a JSON model/parameter file")
+        if not path.is_file():
+            raise ParameterError(f"model file {text!r} does not exist")
+        where = f"model file {text!r}"
+        try:
+            data = json.loads(read_text(path, "model file"))
+        except DataFormatError as exc:
+            raise ParameterError(str(exc)) from None
+        except json.JSONDecodeError as exc:
+            raise ParameterError(f"{where} is not valid JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise ParameterError(f"{where} holds {type(data).__name__}, expected an object")
+        if data.get("format") == MODEL_FORMAT:
+            mf = ModelFile.from_dict(data, where, path=text)
+        else:
+            mf = _legacy(data, where, kind, text)
+        if kind is not None and mf.kind != kind:
+            raise ParameterError(f"{where} is a {mf.kind} model; this command needs a {kind} model (--kind)")
+    if overrides:
+        mf = mf.with_parameters(mf.parameters.replace(**overrides))
+    return mf
+
+
+__all__ = ["ModelFile", "FitVerdict", "Provenance", "load_model", "file_sha256", "finite_json",
+           "MODEL_FORMAT", "MODEL_VERSION", "PARAMETER_SET_FORMAT", "PARAMETER_SET_VERSION"]

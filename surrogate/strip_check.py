@@ -1,0 +1,242 @@
+"""A surrogate checked against the user's own measured sweep, and the tracking (or decoding) error
+that follows for a given signal: the prediction of what happens on *the strip*, not on the model
+that produced the surrogate.
+
+Inverting a model G on a plant P gives y = (P/G)·r, so the error is e = (P/G − 1)·r.  The measured
+sweep H (with per-line σ) stands for P where it was measured:
+
+1. :func:`misfit_to_data` — m = H/G − 1 at every measured line and temperature, with its standard
+   deviation σ_m = |H/G|·σ_rel (σ_rel² = (σ_dB·ln10/20)² + σ_rad², the relative complex std of the
+   measured line);
+2. :func:`predicted_error` — for a signal r at a target temperature T: at each of the two measured
+   temperatures around T (the nearest one beyond the range, *extrapolated*), m is interpolated
+   over log-frequency onto the signal's spectrum (flat beyond the measured band, and the share of
+   the signal's power outside the band reported), and
+
+   * the central prediction is RMS(e)/RMS(r) with |m|² debiased for the measurement noise
+     (max(|m|² − σ_m², 0)), interpolated linearly in T between the two temperatures;
+   * the stated upper bound takes, at each of the two temperatures, |m| + 2σ_m per line, and the
+     larger of the two (a misfit that changes monotonically between the measured temperatures
+     stays below it; beyond the measured band or range nothing bounds it and the result says so).
+
+What is not in it: the error of the inversion itself (preview truncation, sampling, transients at
+the fades) — the feedforward report states those separately — and effects that the measured band
+did not excite.  Frequencies in Hz, temperatures in °C, signals in any one unit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class DataMisfit:
+    """m = H/G − 1 per measured line (see the module doc).
+
+    Parameters
+    ----------
+    temperatures_c : ndarray
+        The measured temperatures, ascending. [°C]
+    frequency_hz : tuple of ndarray
+        Per temperature, the measured frequencies, ascending. [Hz]
+    misfit : tuple of ndarray
+        Per temperature, complex m at those frequencies. [-]
+    sigma : tuple of ndarray
+        Per temperature, the standard deviation of m from the measurement noise. [-]
+    rms : ndarray
+        Per temperature, sqrt(mean |m|²) over the measured lines. [-]
+    source : str
+        What was compared (file names, fingerprints).
+    """
+
+    temperatures_c: np.ndarray
+    frequency_hz: tuple
+    misfit: tuple
+    sigma: tuple
+    rms: np.ndarray
+    source: str = ""
+
+    @property
+    def band_hz(self) -> tuple[float, float]:
+        """(lowest, highest) measured frequency. [Hz]"""
+        return (float(min(f[0] for f in self.frequency_hz)), float(max(f[-1] for f in self.frequency_hz)))
+
+    def table(self) -> list[dict]:
+        """Per temperature: T [°C], lines, RMS |m| and RMS σ_m [-]."""
+        return [{"temperature_c": float(t), "lines": int(f.size), "rms_misfit": float(r),
+                 "rms_sigma": float(np.sqrt(np.mean(s ** 2)))}
+                for t, f, r, s in zip(self.temperatures_c, self.frequency_hz, self.rms, self.sigma)]
+
+
+def misfit_to_data(model, sweep, *, source: str = "") -> DataMisfit:
+    """Compare ``model`` (anything with ``frequency_response(f_hz, T_c, extrapolate=True)``, e.g. a
+    :class:`~surrogate.RationalModel`, in the units of ``sweep``) with a measured sweep.
+
+    Parameters
+    ----------
+    model : RationalModel
+        The surrogate, in the sweep's units (convert the sweep first:
+        ``FrequencySweep.in_units``).
+    sweep : physmodel.FrequencySweep
+        The measured sweep; lines without σ count as noise-free (σ_m = 0).
+    source : str
+        Recorded in the result.
+
+    Returns
+    -------
+    DataMisfit
+    """
+    temps = np.unique(np.asarray(sweep.temperature_c, float))
+    sdb = getattr(sweep, "magnitude_std_db", None)
+    sdeg = getattr(sweep, "phase_std_deg", None)
+    fs, ms, ss, rms = [], [], [], []
+    for t in temps:
+        sel = np.asarray(sweep.temperature_c) == t
+        f = np.asarray(sweep.frequency_hz, float)[sel]
+        order = np.argsort(f)
+        f = f[order]
+        H = np.asarray(sweep.response)[sel][order]
+        G = np.asarray(model.frequency_response(f, float(t), extrapolate=True)).reshape(-1)
+        ratio = H / G
+        rel = np.zeros(f.size)
+        if sdb is not None:
+            rel = rel + (np.asarray(sdb, float)[sel][order] * math.log(10) / 20) ** 2
+        if sdeg is not None:
+            rel = rel + np.radians(np.asarray(sdeg, float)[sel][order]) ** 2
+        m = ratio - 1.0
+        fs.append(f)
+        ms.append(m)
+        ss.append(np.abs(ratio) * np.sqrt(rel))
+        rms.append(float(np.sqrt(np.mean(np.abs(m) ** 2))))
+    return DataMisfit(temps, tuple(fs), tuple(ms), tuple(ss), np.array(rms), source)
+
+
+@dataclass(frozen=True)
+class PredictedError:
+    """The error a signal will see on the strip (see the module doc).
+
+    Parameters
+    ----------
+    rms : float
+        Central prediction, RMS(e)/RMS(r). [-]
+    bound : float
+        Stated upper bound of the same ratio. [-]
+    temperature_c : float
+        Target temperature. [°C]
+    neighbours_c : tuple of float
+        The measured temperatures used (one when extrapolated or exactly at one). [°C]
+    extrapolated : bool
+        The target lies outside the measured temperatures (the bound is then not a bound).
+    out_of_band_power : float
+        Share of the signal's power (rest excluded) outside the measured band. [-]
+    per_temperature : dict
+        {T: (central, bound)} at each neighbour. [-]
+    """
+
+    rms: float
+    bound: float
+    temperature_c: float
+    neighbours_c: tuple
+    extrapolated: bool
+    out_of_band_power: float
+    per_temperature: dict
+
+    @property
+    def checked(self) -> bool:
+        """Whether the data cover the target (temperature inside the measured ones, ≥ 99 % of the
+        signal's power inside the measured band)."""
+        return not self.extrapolated and self.out_of_band_power <= 0.01
+
+    def sentence(self) -> str:
+        """One line for reports."""
+        s = (f"{100 * self.rms:.3g} % RMS of the signal (bound {100 * self.bound:.3g} %), from the measured misfit at "
+             + " and ".join(f"{t:g} °C" for t in self.neighbours_c))
+        if self.extrapolated:
+            s += f"; {self.temperature_c:g} °C is OUTSIDE the measured temperatures: extrapolated, not bounded"
+        if self.out_of_band_power > 0.01:
+            s += (f"; {100 * self.out_of_band_power:.2g} % of the signal's power lies outside the measured band: "
+                  "unchecked there")
+        return s
+
+    def to_dict(self) -> dict:
+        return {"rms": self.rms, "bound": self.bound, "temperature_c": self.temperature_c,
+                "neighbours_c": list(self.neighbours_c), "extrapolated": self.extrapolated,
+                "out_of_band_power": self.out_of_band_power, "checked": self.checked,
+                "per_temperature": {f"{k:g}": list(v) for k, v in self.per_temperature.items()}}
+
+
+def _interp_log(f_new, f, values):
+    """Interpolate real or complex values over log10 f (flat beyond the ends)."""
+    x, xn = np.log10(f), np.log10(f_new)
+    if np.iscomplexobj(values):
+        return np.interp(xn, x, values.real) + 1j * np.interp(xn, x, values.imag)
+    return np.interp(xn, x, values)
+
+
+def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal) -> PredictedError:
+    """The RMS error, relative to the signal's RMS, of inverting the surrogate on the measured strip
+    for ``signal`` at ``temperature_c`` (see the module doc).
+
+    Parameters
+    ----------
+    misfit : DataMisfit
+        From :func:`misfit_to_data`.
+    temperature_c : float
+        Target temperature. [°C]
+    t : array_like
+        Uniform sample times of the signal. [s]
+    signal : array_like
+        The reference (feedforward) or the decoded input (sensor decoding). [any unit]
+
+    Returns
+    -------
+    PredictedError
+    """
+    t = np.asarray(t, float)
+    r = np.asarray(signal, float)
+    if r.size < 4 or t.shape != r.shape:
+        raise ValueError(f"signal and t must be equal-length arrays of >= 4 samples, got {r.shape} and {t.shape}")
+    dt = float(t[1] - t[0])
+    R = np.fft.rfft(r)
+    f = np.fft.rfftfreq(r.size, dt)
+    w = np.abs(R) ** 2
+    w[1:] *= 2.0                      # one-sided power (the Nyquist bin counted twice is negligible here)
+    w[0] = 0.0                        # a constant offset: the DC misfit is not measured; counted as out of band
+    total = float(np.sum(np.abs(R) ** 2 * np.where(np.arange(f.size) == 0, 1.0, 2.0)))
+    if total <= 0:
+        raise ValueError("the signal is identically zero")
+    lo, hi = misfit.band_hz
+    inside = (f >= lo * (1 - 1e-9)) & (f <= hi * (1 + 1e-9))
+    out_share = 1.0 - float(np.sum(w[inside])) / total
+    fpos = np.where(f > 0, f, f[1] if f.size > 1 else 1.0)
+    T = np.asarray(misfit.temperatures_c, float)
+    Tc = float(temperature_c)
+    if Tc <= T[0]:
+        idx, wts, extrap = [0], [1.0], Tc < T[0] - 1e-9
+    elif Tc >= T[-1]:
+        idx, wts, extrap = [T.size - 1], [1.0], Tc > T[-1] + 1e-9
+    else:
+        j = int(np.searchsorted(T, Tc))
+        if abs(T[j] - Tc) <= 1e-9:
+            idx, wts = [j], [1.0]
+        else:
+            a = (T[j] - Tc) / (T[j] - T[j - 1])
+            idx, wts = [j - 1, j], [a, 1.0 - a]
+        extrap = False
+    per, c2, bounds = {}, 0.0, []
+    for i, wt in zip(idx, wts):
+        m = _interp_log(fpos, misfit.frequency_hz[i], misfit.misfit[i])
+        s = _interp_log(fpos, misfit.frequency_hz[i], misfit.sigma[i])
+        central2 = float(np.sum(w * np.maximum(np.abs(m) ** 2 - s ** 2, 0.0)) / total)
+        upper = float(math.sqrt(np.sum(w * (np.abs(m) + 2.0 * s) ** 2) / total))
+        per[float(T[i])] = (math.sqrt(central2), upper)
+        c2 += wt * central2
+        bounds.append(upper)
+    return PredictedError(math.sqrt(c2), max(bounds), Tc, tuple(float(T[i]) for i in idx), bool(extrap),
+                          out_share, per)
+
+
+__all__ = ["DataMisfit", "PredictedError", "misfit_to_data", "predicted_error"]
