@@ -237,11 +237,13 @@ def _printed(value) -> str:
 class Context:
     """The printed data, the parameter sets and a memo for evaluations shared by several checks."""
 
-    def __init__(self, quick: bool, published: dict, path: Path = DEFAULT_PUBLISHED):
+    def __init__(self, quick: bool, published: dict, path: Path = DEFAULT_PUBLISHED, sets: dict | None = None):
         self.quick = quick
         self.pub = published
         self.path = Path(path)
         self._memo: dict = {}
+        #: parameter sets used in place of the named ones (what-if runs: what does a check depend on?)
+        self.sets = dict(sets or {})
 
     def memo(self, key: str, compute: Callable):
         """``compute(self)`` once per report."""
@@ -252,7 +254,7 @@ class Context:
     def parameter_set(self, name: str):
         from physmodel import get_parameter_set
 
-        return self.memo(f"set:{name}", lambda ctx: get_parameter_set(name))
+        return self.memo(f"set:{name}", lambda ctx: ctx.sets[name] if name in ctx.sets else get_parameter_set(name))
 
     @cached_property
     def calibration(self) -> dict:
@@ -309,18 +311,20 @@ def _rows(ctx, claim_id, section, key, value) -> list[ClaimRow]:
     return rows
 
 
-def validate(*, quick: bool = False, progress=None, published=None) -> ValidationReport:
+def validate(*, quick: bool = False, progress=None, published=None, sets: dict | None = None) -> ValidationReport:
     """Check every claim of the published numbers; ``quick`` fits fewer temperatures.
 
     ``progress(n)`` is called with 1 after each claim.  ``published``: path of a TOML file of the
-    same layout (default: the file shipped in :mod:`physmodel.parameter_sets`).
+    same layout (default: the file shipped in :mod:`physmodel.parameter_sets`).  ``sets``: ``{set name:
+    IPMCParameters}`` used in place of the named sets (a what-if run; the bases still come from the
+    named sets' ``CALIBRATION``).
     """
     from . import seed000, seed001, seed002  # noqa: F401  (they register their checks)
 
     t0 = time.perf_counter()
     path = Path(published) if published is not None else DEFAULT_PUBLISHED
     data = load_published(path)
-    ctx = Context(bool(quick), data, path)
+    ctx = Context(bool(quick), data, path, sets)
     rows = []
     for claim in published_claims(data):
         rows.extend(_rows(ctx, *claim))

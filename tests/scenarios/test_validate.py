@@ -9,11 +9,15 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
+from physmodel import get_parameter_set
 from physmodel.parameter_sets import derivation, seed000, seed001
 from scenarios import validation as V
 from scenarios.cli import main
+from scenarios.validation import seed001 as checks001
+from scenarios.validation.shared import ZERO_REACH, rhp
 
 
 @pytest.fixture(scope="module")
@@ -139,6 +143,56 @@ def test_headline_counts_only_independent_reproductions(report):
     d = json.loads(report.to_json())
     assert d["independent_reproductions"] == n and d["counts_by_basis"] == cb and len(d["rows"]) == len(report.rows)
     assert all(row["basis"] in V.BASES for row in d["rows"])
+
+
+# ---------------------------------------------------------------------------- the right-half-plane zero check can fail
+TOP_001 = 2 * np.pi * float(derivation.seed001_frequencies_hz()[-1])     # 9 Hz in rad/s
+
+
+def _seed001_at_19c(params):
+    from physmodel import ActuatorModel
+
+    f = derivation.seed001_frequencies_hz()
+    return f, ActuatorModel(params).frequency_response(f, [19.0])["M"][0, 0]
+
+
+@pytest.mark.parametrize("r1", [0.0, 1e-3])
+def test_rhp_zero_check_fails_when_the_physics_has_no_zeros_in_reach(r1):
+    """r1 -> 0: the actuator physics is 3 poles and no zeros over 0.1-9 Hz (at r1 = 0 a 0/3 fit reproduces
+    it to about 1e-6 relative RMS; a zero within the reach would change the response by about 0.1 at
+    the band top), so a 3/3 fit's zeros go numerically to infinity or far beyond the band.  The old
+    rule (real part > 1e-6 max|pole|) counted them as a right-half-plane pair; the check must fail."""
+    from surrogate import RationalFit
+
+    p = get_parameter_set("seed001_actuator").replace(r1_sheet=r1)
+    f, H = _seed001_at_19c(p)
+    if r1 == 0.0:
+        assert RationalFit(0, 3).fit(f, 19.0, H).per_temperature[0].relative_rms_error < 1e-4
+    z = RationalFit(3, 3).fit(f, 19.0, H).model.zeros()
+    assert np.min(np.abs(z)) > 100 * TOP_001                                   # all far beyond the data
+    assert rhp(z, TOP_001).size == 0
+    ctx = V.Context(True, V.load_published(), sets={"seed001_actuator": p})
+    out = checks001.c_nmp(ctx, None)
+    assert not out.ok and " in 0 of " in out.ours, out.ours
+
+
+def test_rhp_zero_check_passes_where_a_genuine_pair_exists(by):
+    from surrogate import RationalFit
+
+    # the calibrated physics
+    assert by["actuator_seed001.nonminimum_phase"].status == "reproduced"
+    # a plant built with a known pair at 40 +/- 70j rad/s (|z| = 1.4x the band top), fitted like the physics
+    zeros, poles = np.array([40 + 70j, 40 - 70j, -40.0]), np.array([-1.4 + 17.9j, -1.4 - 17.9j, -4.0])
+    f = derivation.seed001_frequencies_hz()
+    s = 2j * np.pi * f
+    H = 0.05 * np.prod(s[:, None] - zeros, axis=1) / np.prod(s[:, None] - poles, axis=1)
+    found = np.sort_complex(rhp(RationalFit(3, 3).fit(f, 19.0, H).model.zeros(), TOP_001))
+    np.testing.assert_allclose(found, np.sort_complex(zeros[:2]), rtol=1e-6)
+    # the printed seed 000 35 °C model, fitted over 10-100 Hz: its three printed RHP zeros are within reach
+    assert rhp(np.roots(derivation.SEED000_NUM_35C), 2 * np.pi * 100.0).size == 3
+    # numerically infinite, out-of-reach and left-half-plane zeros are not counted
+    assert rhp([np.inf, 1e9 + 1j, 1.01 * ZERO_REACH * TOP_001, -5 + 3j], TOP_001).size == 0
+    assert rhp([0.99 * ZERO_REACH * TOP_001], TOP_001).size == 1
 
 
 def test_35c_misfit_in_table_matches_the_calibration_module(by, report):
