@@ -195,6 +195,15 @@ def test_rhp_zero_check_passes_where_a_genuine_pair_exists(by):
     assert rhp([0.99 * ZERO_REACH * TOP_001], TOP_001).size == 1
 
 
+def test_table_rows_name_the_unit_conventions_they_applied(by):
+    t2, t3 = by["actuator_seed002.table2_initial"].ours, by["actuator_seed002.table3_fitted"].ours
+    for ours in (t2, t3):
+        assert "alpha0 stored as printed/omega_n" in ours
+        assert "r2' printed in Ohm m read as r2_specific [Ohm m^2]" in ours
+    assert "r1' printed in Ohm m read as the sheet resistance r1_sheet [Ohm]" in t2
+    assert "r1' [Ohm] is the sheet resistance r1_sheet" in t3
+
+
 def test_35c_misfit_in_table_matches_the_calibration_module(by, report):
     from physmodel import get_parameter_set
 
