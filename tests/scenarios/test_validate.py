@@ -1,8 +1,10 @@
 """``ipmc validate``: every published claim covered, each row's status and basis, files and exit codes.
 
-The basis assertions are the issue-12 audit written down: rows that re-read inputs, compare the
-paper with itself, or check a set against the claim it was calibrated on must not be counted as
-independent reproductions.
+The basis assertions are the issue-12 and issue-25 audits written down: rows that re-read inputs,
+compare the paper with itself, check a set against the claim it was calibrated on (or a claim that
+calibration implies), or compare a surrogate of the model with the model must not be counted as
+independent reproductions.  The what-if tests below are the evidence for each relabelling: the row
+passes with an input that is wrong for the claim.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import pytest
 
 from physmodel import get_parameter_set
 from physmodel.parameter_sets import derivation, seed000, seed001
+from physmodel.temperature import LogLinear
 from scenarios import validation as V
 from scenarios.cli import main
 from scenarios.validation import seed001 as checks001
@@ -78,6 +81,12 @@ EXPECTED = {
     "sensor_seed000.model_35c_den": ("calibrated", "not-reproduced"),
     "sensor_seed000.model_order": ("calibrated", "not-reproduced"),
     "sensor_seed000.model_order+nonminimum_phase": ("calibrated", "not-reproduced"),
+    # implied by a calibrated claim on the grid the calibration searched (issue 25)
+    "sensor_seed000.trends_with_rising_temperature[2]": ("calibrated", "reproduced"),
+    # a surrogate of the model against the model (issue 25)
+    "actuator_seed001.validation_temperatures_c": ("round-trip", "reproduced"),
+    "actuator_seed001.tracking_claims[1]": ("round-trip", "reproduced"),
+    "actuator_seed001.tracking_claims[1]+half_hz": ("round-trip", "not-reproduced"),
     # model inputs
     "actuator_seed001.trends[0]": ("input", "reproduced"),
     "actuator_seed002.claims[0]": ("input", "reproduced"),
@@ -96,15 +105,11 @@ EXPECTED = {
     "sensor_seed000.circuit": ("metadata", "reproduced"),
     "actuator_seed001.model": ("metadata", "reproduced"),
     # independent comparisons
-    "sensor_seed000.trends_with_rising_temperature[2]": ("independent", "reproduced"),   # held out
     "sensor_seed000.preview_claims[0]": ("independent", "not-reproduced"),
     "sensor_seed000.preview_claims[1]": ("independent", "not-reproduced"),
-    "actuator_seed001.validation_temperatures_c": ("independent", "reproduced"),
     "actuator_seed001.order_claims[0]": ("independent", "reproduced"),
     "actuator_seed001.order_claims[1]": ("independent", "not-reproduced"),
     "actuator_seed001.nonminimum_phase": ("independent", "reproduced"),
-    "actuator_seed001.tracking_claims[1]": ("independent", "reproduced"),
-    "actuator_seed001.tracking_claims[1]+half_hz": ("independent", "not-reproduced"),
     "actuator_seed002.claims[1]": ("independent", "reproduced"),
     "actuator_seed002.claims[3]": ("independent", "reproduced"),
     "actuator_seed002.claims[4]": ("independent", "not-reproduced"),
@@ -117,12 +122,15 @@ def test_basis_and_status_of_the_audited_rows(by, cid):
 
 
 def test_calibrated_basis_is_what_the_derivation_used(report):
-    """A row is 'calibrated' exactly when its claim is in a set's CALIBRATION table, and the tables say
-    what the derivation actually used (the sensor laws: two of the three printed directions)."""
+    """A row is 'calibrated' exactly when its claim, or the claim it is implied by, is in a set's
+    CALIBRATION table, and the tables say what the derivation actually used (the sensor laws: two of
+    the three printed directions; the third is implied, see the next test)."""
     table = {**seed000.CALIBRATION, **seed001.CALIBRATION}
     used = {cid for t in table.values() for cid in t}
+    implied = {cid for cid, c in V.CHECKS.items() if c.implied_by in used}
+    assert implied == {"sensor_seed000.trends_with_rising_temperature[2]"}
     calibrated = {r.claim_id.split("+")[0] for r in report.rows if r.basis == "calibrated"}
-    assert calibrated == used
+    assert calibrated == used | implied
     assert derivation.SENSOR_CALIBRATION_TRENDS == ("cutoff_decreases", "hf_gain_decreases")
     trends = {k for k in table["seed000_sensor"] if "trends" in k}
     assert trends == {"sensor_seed000.trends_with_rising_temperature[0]", "sensor_seed000.trends_with_rising_temperature[1]"}
@@ -133,6 +141,11 @@ def test_headline_counts_only_independent_reproductions(report):
     n = sum(r.status == "reproduced" and r.basis == "independent" for r in report.rows)
     assert report.independent_reproductions == n
     assert n < report.counts["reproduced"]                    # calibrated/input/paper/metadata rows do not count
+    # the denominator: independent rows where something was compared (a not-checkable row compares nothing)
+    m = sum(r.basis == "independent" and r.status != "not-checkable" for r in report.rows)
+    assert report.independent_comparisons == m
+    assert m < sum(r.basis == "independent" for r in report.rows)
+    assert f"(of {m} independent comparisons made;" in report.headline()
     cb = report.counts_by_basis
     assert sum(sum(v.values()) for v in cb.values()) == len(report.rows)
     assert {s: sum(cb[s].values()) for s in V.STATUSES} == report.counts
@@ -141,11 +154,45 @@ def test_headline_counts_only_independent_reproductions(report):
     assert report.headline() in md and "| status \\ basis |" in md
     assert md.count("\n| `") == len(report.rows)
     d = json.loads(report.to_json())
-    assert d["independent_reproductions"] == n and d["counts_by_basis"] == cb and len(d["rows"]) == len(report.rows)
+    assert d["independent_reproductions"] == n and d["independent_comparisons"] == m and d["counts_by_basis"] == cb and len(d["rows"]) == len(report.rows)
     assert all(row["basis"] in V.BASES for row in d["rows"])
 
 
-# ---------------------------------------------------------------------------- the right-half-plane zero check can fail
+# ---------------------------------------------------------------------------- evidence for the issue-25 relabelling
+def test_phase_lag_trend_is_implied_by_the_cutoff_trend_on_the_calibration_grid():
+    """On every (C- slope, E slope) the sensor law search could pick, the band-mean lag rises exactly
+    where the cut-off falls, and both outcomes occur on the grid: once the search made the cut-off
+    fall, the 'held-out' lag direction could not fail, so its row is not an independent pass."""
+    sen = get_parameter_set("seed000_sensor")
+    pairs = [(m["cutoff_decreases"], m["phase_lag_increases"])
+             for c in derivation.C_SLOPES for e in derivation.E_SLOPES
+             for m in [derivation.sensor_trends(derivation.with_slopes(sen, c, e)).monotone()]]
+    assert len(pairs) == len(derivation.C_SLOPES) * len(derivation.E_SLOPES)
+    assert all(cut == lag for cut, lag in pairs)
+    assert {cut for cut, _ in pairs} == {True, False}
+
+
+def _wrong_actuators():
+    """Seed 001 plants whose 19-vs-55 °C difference has the wrong sign (19 °C smaller)."""
+    cal = get_parameter_set("seed001_actuator")
+    flipped = cal.replace(laws=cal.laws.with_(C_minus=LogLinear(slope=-cal.laws.C_minus.slope)))
+    return {"uncalibrated seed001_actuator_dev": get_parameter_set("seed001_actuator_dev"), "C- slope flipped": flipped}
+
+
+@pytest.mark.parametrize("which", sorted(_wrong_actuators()))
+def test_round_trip_rows_pass_with_a_plant_whose_trend_has_the_wrong_sign(which):
+    """The scheduled-model hold-out and the tracking comparison pass whatever the plant's temperature
+    dependence: with the uncalibrated set or with the C- slope's sign flipped (both make 19 °C the
+    *smaller* response), while the calibrated trend row notices.  So they are round trips of our
+    fitting and inversion code, not reproductions of the paper."""
+    plant = _wrong_actuators()[which]
+    assert derivation.actuator_trends(plant).max_difference_db < -3.0          # printed: about +7 dB
+    rows = {r.claim_id: r for r in V.validate(quick=True, sets={"seed001_actuator": plant}).rows}
+    assert rows["actuator_seed001.trends[1]"].status == "fail"
+    for cid in ("actuator_seed001.validation_temperatures_c", "actuator_seed001.tracking_claims[1]"):
+        assert (rows[cid].basis, rows[cid].status) == ("round-trip", "reproduced"), (cid, rows[cid].ours)
+
+
 TOP_001 = 2 * np.pi * float(derivation.seed001_frequencies_hz()[-1])     # 9 Hz in rad/s
 
 
@@ -253,7 +300,7 @@ def test_cli_runs_from_any_directory_with_the_shipped_claims(tmp_path, monkeypat
     assert main(["validate", "--out", "val", "--quick"]) == 0
     md = (tmp_path / "val" / "validation.md").read_text(encoding="utf-8")
     d = json.loads((tmp_path / "val" / "validation.json").read_text(encoding="utf-8"))
-    assert md.startswith("# Validation") and d["format"] == "ipmc-validation" and d["version"] == 2
+    assert md.startswith("# Validation") and d["format"] == "ipmc-validation" and d["version"] == 3
     assert d["counts"]["fail"] == 0 and len(d["rows"]) == sum(d["counts"].values())
     assert d["published"].endswith("physmodel/parameter_sets/published.toml")
     assert "independently reproduced" in capsys.readouterr().out
