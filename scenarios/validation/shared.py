@@ -13,6 +13,9 @@ from .framework import Outcome
 #: phase (atan 0.1) and 0.04 dB of magnitude per zero, so a fit to measured data cannot place it, nor
 #: tell which half-plane it is in.  Fixed from that argument, not from the rows it decides.
 ZERO_REACH = 10.0
+#: A fit misfit below this relative RMS error (5 %, about 0.4 dB) is not visible on a Bode plot of measured
+#: data (the bound the seed 000 order row uses too): a fit 'clearly worse' than another must exceed it.
+VISIBLE_MISFIT = 0.05
 
 
 def rhp(z, band_top_rad_s: float) -> np.ndarray:

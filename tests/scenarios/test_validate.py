@@ -242,6 +242,16 @@ def test_rhp_zero_check_passes_where_a_genuine_pair_exists(by):
     assert rhp([0.99 * ZERO_REACH * TOP_001], TOP_001).size == 1
 
 
+def test_second_order_check_fails_for_a_plant_a_second_order_model_fits():
+    """'Second order fits clearly worse' must be able to fail: with r1 = 0 and a 1000x faster charge
+    relaxation the plant is the first mode alone (2/2 relative RMS error about 1e-5); the old criterion
+    (2/2 error >= 2x the 3/3 error, here about 1e-16) still called that 'clearly worse'."""
+    cal = get_parameter_set("seed001_actuator")
+    ctx = V.Context(True, V.load_published(), sets={"seed001_actuator": cal.replace(r1_sheet=0.0, d=cal.d * 1e3)})
+    assert not checks001.c_order_2(ctx, None).ok
+    assert checks001.c_order_2(V.Context(True, V.load_published()), None).ok
+
+
 def test_table_rows_name_the_unit_conventions_they_applied(by):
     t2, t3 = by["actuator_seed002.table2_initial"].ours, by["actuator_seed002.table3_fitted"].ours
     for ours in (t2, t3):
