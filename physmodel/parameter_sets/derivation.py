@@ -20,7 +20,8 @@ Seed 000 sensor (18 × 6.5 × 0.21 mm Nafion-117)
     are used, each on the knob that mainly controls it: :func:`choose_sensor_laws` takes the smallest
     departure from the physics.md defaults on a grid of (C⁻ slope, E slope) that makes the cut-off
     and the 100 Hz gain fall strictly over the seven fit temperatures (:data:`SENSOR_CALIBRATION_TRENDS`).
-    The phase-lag direction is held out (a prediction; it and the cut-off both follow K(T)).
+    The phase-lag direction is not used, but it is no prediction: it and the cut-off both follow K(T),
+    and on every slope pair of the grid the lag rises exactly when the cut-off falls.
 
 Seed 001 actuator (45 mm free length × 11 × 0.3 mm, in water)
     *Data.*  The zpk schedules' numbers are not in the text; what is printed is the trend: the
@@ -32,12 +33,14 @@ Seed 001 actuator (45 mm free length × 11 × 0.3 mm, in water)
     2 Hz rises with T because E falls and d rises).  The modulus keeps the physics.md default slope
     −0.75 %/K (DuPont), which moves the resonance down.  These are feature targets, not a response,
     so they are solved with ``scipy.optimize.least_squares`` directly (:func:`solve_actuator_trend`).
-    The resonance shift (from the modulus-law input), the order claims, the right-half-plane zero
-    pair, the 35/45 °C hold-out and the 45 °C tracking comparison are predictions.
+    The resonance shift follows from the modulus-law input; the order claims and the right-half-plane
+    zero pair are predictions; the 35/45 °C hold-out and the 45 °C tracking comparison are round trips
+    (a surrogate of the physics against the physics), not predictions.
 
 Which claims each set was calibrated on is recorded in the ``CALIBRATION`` table of its module
 (:mod:`~physmodel.parameter_sets.seed000`, :mod:`~physmodel.parameter_sets.seed001`); ``ipmc validate``
-gives every other row that uses the set the basis "independent" and these the basis "calibrated".
+gives these rows, and rows a test shows they imply, the basis "calibrated"; a model row that uses the set is
+otherwise "independent", unless it compares a surrogate of the set with the set ("round-trip").
 """
 
 from __future__ import annotations
@@ -182,7 +185,8 @@ def sensor_trends(params, temperatures_c=SENSOR_FIT_TEMPERATURES_C, n_points: in
                         tuple((-ph.mean(axis=1)).tolist()))
 
 
-#: The published directions the sensor laws are chosen on (the third, ``phase_lag_increases``, is held out).
+#: The published directions the sensor laws are chosen on (the third, ``phase_lag_increases``, is not used;
+#: on the grid it holds exactly when ``cutoff_decreases`` does).
 SENSOR_CALIBRATION_TRENDS = ("cutoff_decreases", "hf_gain_decreases")
 #: Grids searched by :func:`choose_sensor_laws` [1/K]; defaults first.
 C_SLOPES = (0.0, -0.005, -0.01, -0.015, -0.02, -0.025, -0.03, -0.035, -0.04)
@@ -198,7 +202,7 @@ def choose_sensor_laws(params, trends=SENSOR_CALIBRATION_TRENDS) -> tuple[float,
     """Smallest departure |c_slope| + |e_slope + 0.0075| on the grid making the named ``trends`` hold.
 
     Only the directions in ``trends`` (keys of :meth:`SensorTrends.monotone`) are used; the others
-    in the returned :class:`SensorTrends` are predictions.
+    in the returned :class:`SensorTrends` were not used (not necessarily independent of them).
     """
     unknown = set(trends) - {"cutoff_decreases", "hf_gain_decreases", "phase_lag_increases"}
     if unknown or not trends:
@@ -287,7 +291,7 @@ def main() -> int:  # pragma: no cover - a derivation script
     print("sensor values (store in parameter_sets.py):", {k: float(f"{v:.6g}") for k, v in out["sensor_values"].items()})
     print("sensor laws: C_minus slope", out["sensor_c_slope"], "E slope", out["sensor_e_slope"])
     print("sensor trends (chosen on", SENSOR_CALIBRATION_TRENDS, "):", out["sensor_trends"])
-    print("held-out phase lag rises:", out["sensor_trends"].monotone()["phase_lag_increases"])
+    print("unused phase-lag direction holds:", out["sensor_trends"].monotone()["phase_lag_increases"])
     print("35 C misfit:", out["sensor_misfit"])
     print(f"actuator: E = {out['actuator_E']:.6g} Pa, C_minus slope = {out['actuator_c_slope']:.6g} /K")
     print("actuator trends:", out["actuator_trends"])

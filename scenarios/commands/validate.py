@@ -17,8 +17,9 @@ def add_parser(subparsers) -> None:
         description="Evaluate every claim printed by the seed papers (the published.toml shipped in "
                     "physmodel.parameter_sets: sensor study, actuator study, seed 002) with the seed parameter sets "
                     "and write validation.md and validation.json.  Each row has a status (reproduced, "
-                    "not-reproduced, not-checkable, fail) and a basis (independent, calibrated, input, paper, "
-                    "metadata); the headline counts only independent reproductions.  Exit 0 when every claim is "
+                    "not-reproduced, not-checkable, fail) and a basis (independent, calibrated, round-trip, input, "
+                    "paper, metadata); the headline counts only independent reproductions, out of the independent "
+                    "rows where something was compared.  Exit 0 when every claim is "
                     "reproduced or explained (not-reproduced / not-checkable rows are findings), 3 when a claim "
                     "the project reproduces fails (regression).")
     p.add_argument("--out", default="ipmc-validation", help="output folder (default ./ipmc-validation)")

@@ -18,19 +18,29 @@ Status (what happened)
                         or a claim has no check: a regression (``ipmc validate`` exits 3).
 
 Basis (how independent the comparison is)
-    ``independent``  nothing in the model or its parameters was chosen using this claim.
-    ``calibrated``   the parameter set was fitted or solved to this claim or to data from it; the
-                     row is a consistency check and never counts as a reproduction.
+    ``independent``  nothing in the model or its parameters was chosen using this claim, and the
+                     comparison sets the physics against what the paper printed.
+    ``calibrated``   the parameter set was fitted or solved to this claim or to data from it, or to a
+                     claim that implies it on the grid the calibration searched (``Claim.implied_by``);
+                     the row is a consistency check and never counts as a reproduction.
+    ``round-trip``   a surrogate or an inverse fitted to the model is compared with the same model (or
+                     with another fit to it): the row checks our fitting or inversion code, not the
+                     physics against the paper; it passes whatever the model's temperature dependence
+                     (an uncalibrated set, a trend of the wrong sign), so it never counts either.
     ``input``        the number is a model input (geometry, a printed parameter, a material law).
     ``paper``        the paper's own internal consistency (printed numbers against each other, or a
                      statement true by construction of the paper's model classes).
     ``metadata``     bookkeeping: units, bands, temperature lists, the paper's name.
 
-A check declares its kind as one of ``model`` (a prediction of the physics), ``input``, ``paper``,
-``metadata``.  ``model`` resolves to ``calibrated`` when the claim is listed in the ``CALIBRATION``
-table of the parameter-set module that the check uses, else to ``independent``: the calibrated
-basis comes from what the derivation actually used, not from a label written beside the check.
-The headline counts only ``reproduced`` × ``independent`` rows.
+A check declares its kind as one of ``model`` (a prediction of the physics), ``round-trip``,
+``input``, ``paper``, ``metadata``.  ``model`` resolves to ``calibrated`` when the claim (or the claim
+named by ``implied_by``) is listed in the ``CALIBRATION`` table of the parameter-set module that the
+check uses, else to ``independent``: the calibrated basis comes from what the derivation actually
+used, not from a label written beside the check.
+
+The headline counts only ``reproduced`` × ``independent`` rows, out of the independent rows where
+something was compared (``reproduced``, ``not-reproduced`` or ``fail``; a ``not-checkable`` row
+compares nothing).
 """
 
 from __future__ import annotations
@@ -45,8 +55,10 @@ from pathlib import Path
 from physmodel.parameter_sets import published as _published_module
 
 STATUSES = ("reproduced", "not-reproduced", "not-checkable", "fail")
-BASES = ("independent", "calibrated", "input", "paper", "metadata")
-KINDS = ("model", "input", "paper", "metadata")
+BASES = ("independent", "calibrated", "round-trip", "input", "paper", "metadata")
+KINDS = ("model", "round-trip", "input", "paper", "metadata")
+#: Statuses of a row where something was compared (``not-checkable`` compares nothing).
+COMPARED = ("reproduced", "not-reproduced", "fail")
 #: Keys of a section that describe the paper, not claims.
 META_KEYS = ("citation", "cite_as", "location")
 #: Default published numbers: the file shipped inside the package.
@@ -102,8 +114,9 @@ class ValidationReport:
         return self.counts_by_basis["reproduced"]["independent"]
 
     @property
-    def independent_rows(self) -> int:
-        return sum(r.basis == "independent" for r in self.rows)
+    def independent_comparisons(self) -> int:
+        """The headline's denominator: independent rows where something was compared (not ``not-checkable``)."""
+        return sum(r.basis == "independent" and r.status in COMPARED for r in self.rows)
 
     @property
     def regressions(self) -> list:
@@ -116,13 +129,14 @@ class ValidationReport:
     def headline(self) -> str:
         c = self.counts
         return (f"{self.independent_reproductions} claims independently reproduced "
-                f"(of {self.independent_rows} independent comparisons; {len(self.rows)} rows: "
+                f"(of {self.independent_comparisons} independent comparisons made; {len(self.rows)} rows: "
                 + ", ".join(f"{c[s]} {s}" for s in STATUSES) + ")")
 
     def to_dict(self) -> dict:
-        return {"format": "ipmc-validation", "version": 2, "published": self.published, "quick": self.quick,
+        return {"format": "ipmc-validation", "version": 3, "published": self.published, "quick": self.quick,
                 "elapsed_s": round(self.elapsed_s, 3), "headline": self.headline(),
                 "independent_reproductions": self.independent_reproductions,
+                "independent_comparisons": self.independent_comparisons,
                 "counts": self.counts, "counts_by_basis": self.counts_by_basis,
                 "calibration": self.calibration, "papers": self.papers, "metadata": self.metadata,
                 "rows": [asdict(r) for r in self.rows]}
@@ -137,8 +151,10 @@ class ValidationReport:
                  f"**{self.headline()}**" + (" (quick mode: fewer temperatures)" if self.quick else "") + ".",
                  f"Claims from `{self.published}`, {self.elapsed_s:.1f} s.", "",
                  ("Only `reproduced` rows of basis `independent` are evidence that the physics reproduces a paper: "
-                  "`calibrated` rows check that a fit hit its target, `input` rows re-read model inputs, `paper` rows "
-                  "check the paper against itself, `metadata` rows are bookkeeping.  `not-reproduced` is a finding "
+                  "`calibrated` rows check that a fit hit its target (or a claim it implies), `round-trip` rows check "
+                  "a surrogate or inverse of the model against the model, `input` rows re-read model inputs, `paper` "
+                  "rows check the paper against itself, `metadata` rows are bookkeeping.  `not-checkable` rows compare "
+                  "nothing and are not in the headline's count of comparisons.  `not-reproduced` is a finding "
                   "about the physics (the reason says why); `fail` is a regression."), "",
                  "| status \\ basis | " + " | ".join(BASES) + " | total |", "|---|" + "---|" * (len(BASES) + 1)]
         for s in STATUSES:
@@ -176,7 +192,9 @@ class Claim:
     ``expect``: ``"reproduce"``, ``"finding: <why the physics does not reproduce it>"`` or
     ``"not-checkable: <why>"``; ``kind``: one of :data:`KINDS`; ``uses``: the parameter set whose
     ``CALIBRATION`` decides between ``calibrated`` and ``independent`` (kind ``model``);
-    ``note``: why the row has its basis (optional for ``model``).
+    ``note``: why the row has its basis (optional for ``model``); ``implied_by``: the id of a claim
+    that implies this one on the grid the calibration of ``uses`` searched (a test shows it): when
+    that claim is calibrated, so is this row.
     """
 
     check: Callable | None
@@ -184,6 +202,7 @@ class Claim:
     kind: str
     uses: str | None = None
     note: str = ""
+    implied_by: str | None = None
 
 
 #: claim id -> Claim; filled by the per-seed modules.
@@ -237,11 +256,13 @@ def _printed(value) -> str:
 class Context:
     """The printed data, the parameter sets and a memo for evaluations shared by several checks."""
 
-    def __init__(self, quick: bool, published: dict, path: Path = DEFAULT_PUBLISHED):
+    def __init__(self, quick: bool, published: dict, path: Path = DEFAULT_PUBLISHED, sets: dict | None = None):
         self.quick = quick
         self.pub = published
         self.path = Path(path)
         self._memo: dict = {}
+        #: parameter sets used in place of the named ones (what-if runs: what does a check depend on?)
+        self.sets = dict(sets or {})
 
     def memo(self, key: str, compute: Callable):
         """``compute(self)`` once per report."""
@@ -252,7 +273,7 @@ class Context:
     def parameter_set(self, name: str):
         from physmodel import get_parameter_set
 
-        return self.memo(f"set:{name}", lambda ctx: get_parameter_set(name))
+        return self.memo(f"set:{name}", lambda ctx: ctx.sets[name] if name in ctx.sets else get_parameter_set(name))
 
     @cached_property
     def calibration(self) -> dict:
@@ -271,6 +292,9 @@ def _basis(ctx, claim_id: str, claim: Claim) -> tuple[str, str]:
     used = ctx.calibration.get(claim.uses or "", {})
     if base in used:
         return "calibrated", f"{claim.uses}: {used[base]}" + (f"; {claim.note}" if claim.note else "")
+    if claim.implied_by in used:
+        return "calibrated", (f"{claim.uses}: implied by the calibrated claim {claim.implied_by} "
+                              f"({used[claim.implied_by]})" + (f"; {claim.note}" if claim.note else ""))
     return "independent", claim.note or (f"{claim.uses} was not calibrated on this claim" if claim.uses else "")
 
 
@@ -309,18 +333,20 @@ def _rows(ctx, claim_id, section, key, value) -> list[ClaimRow]:
     return rows
 
 
-def validate(*, quick: bool = False, progress=None, published=None) -> ValidationReport:
+def validate(*, quick: bool = False, progress=None, published=None, sets: dict | None = None) -> ValidationReport:
     """Check every claim of the published numbers; ``quick`` fits fewer temperatures.
 
     ``progress(n)`` is called with 1 after each claim.  ``published``: path of a TOML file of the
-    same layout (default: the file shipped in :mod:`physmodel.parameter_sets`).
+    same layout (default: the file shipped in :mod:`physmodel.parameter_sets`).  ``sets``: ``{set name:
+    IPMCParameters}`` used in place of the named sets (a what-if run; the bases still come from the
+    named sets' ``CALIBRATION``).
     """
     from . import seed000, seed001, seed002  # noqa: F401  (they register their checks)
 
     t0 = time.perf_counter()
     path = Path(published) if published is not None else DEFAULT_PUBLISHED
     data = load_published(path)
-    ctx = Context(bool(quick), data, path)
+    ctx = Context(bool(quick), data, path, sets)
     rows = []
     for claim in published_claims(data):
         rows.extend(_rows(ctx, *claim))

@@ -1,8 +1,13 @@
 """Claim checks of seed 001 (Dong and Tan 2012, the IPMC actuator temperature study).
 
 Parameter set ``seed001_actuator``: E at T_ref and a C⁻ law solved from the 19-vs-55 °C trend only
-(``trends[1]``: 7 dB at about 3 Hz, 19 °C larger).  The order claims, the right-half-plane zero
-pair, the 35/45 °C hold-out prediction and the 45 °C tracking comparison are predictions.
+(``trends[1]``: 7 dB at about 3 Hz, 19 °C larger).  The order claims and the right-half-plane zero
+pair are predictions of the physics.  The 35/45 °C hold-out of the scheduled model and the 45 °C
+tracking comparison are round trips: a surrogate fitted to the noise-free physics is compared with
+another fit to it, or inverted to drive the very plant it was fitted to.  They pass with the
+uncalibrated ``seed001_actuator_dev`` (whose 19-vs-55 °C difference has the wrong sign) and with the
+C⁻ slope's sign flipped (tests/scenarios/test_validate.py), so they test our fitting and inversion
+code, not the physics against the paper.
 """
 
 from __future__ import annotations
@@ -14,7 +19,7 @@ import numpy as np
 from physmodel.parameter_sets import derivation as sc
 
 from .framework import CHECKS, EXTRA_ROWS, Claim, Outcome
-from .shared import geometry_check, io_check, paper_check, rhp
+from .shared import VISIBLE_MISFIT, ZERO_REACH, geometry_check, io_check, paper_check, rhp
 
 SET = "seed001_actuator"
 S = "actuator_seed001"
@@ -140,7 +145,8 @@ def c_model(ctx, value):
 def c_order_2(ctx, value):
     e2, e3 = _err(ctx, (2, 2)), _err(ctx, (3, 3))
     return Outcome(f"relative RMS error 2/2: {e2.min():.3f}-{e2.max():.3f}, 3/3: {e3.min():.3f}-{e3.max():.3f}",
-                   "'clearly worse': 2/2 error >= 2x the 3/3 error at every temperature", bool(np.all(e2 >= 2 * e3)))
+                   f"'clearly worse': 2/2 error >= 2x the 3/3 error and >= {VISIBLE_MISFIT:g} (visible) at every "
+                   "temperature", bool(np.all(e2 >= 2 * e3) and np.all(e2 >= VISIBLE_MISFIT)))
 
 
 def c_order_4(ctx, value):
@@ -162,14 +168,17 @@ def c_order_strict(ctx, value):
 
 
 def c_nmp(ctx, value):
+    top = 2 * np.pi * float(sc.seed001_frequencies_hz()[-1])
     n = []
     for r in _orders(ctx)[(3, 3)].values():
-        z = rhp(r.model.zeros(), float(np.max(np.abs(r.model.poles()))))
+        z = rhp(r.model.zeros(), top)
         n.append(z.size == 2 and bool(np.all(np.abs(z.imag) > 0)))
-    z19 = next(iter(_orders(ctx)[(3, 3)].values())).model.zeros()
-    pair = [v for v in z19 if v.real > 0]
-    return Outcome(f"complex RHP zero pair in {sum(n)} of {len(n)} 3/3 fits (e.g. {_temps(ctx)[0]:g} °C: "
-                   f"{', '.join(f'{v:.3g}' for v in pair)} rad/s)", "at every temperature", all(n))
+    pair = rhp(next(iter(_orders(ctx)[(3, 3)].values())).model.zeros(), top)
+    return Outcome(f"complex RHP zero pair within {ZERO_REACH:g}x the band top ({ZERO_REACH * top:.0f} rad/s) in "
+                   f"{sum(n)} of {len(n)} 3/3 fits (e.g. {_temps(ctx)[0]:g} °C: "
+                   f"{', '.join(f'{v:.3g}' for v in pair) or 'none'}{' rad/s' if pair.size else ''})",
+                   "at every temperature; a zero beyond the reach of the 0.1-9 Hz data or numerically infinite "
+                   "is not counted", all(n))
 
 
 def c_resonance(ctx, value):
@@ -203,6 +212,13 @@ def c_tracking_half_hz(ctx, value):
 
 # ============================================================================ mapping
 _NOT_MEASURED = "not-checkable: the measured records are not printed"
+_ROUND_TRIP_SCHEDULE = ("the scheduled and the direct model are both fitted to the same noise-free physics, so the row "
+                        "checks the zpk schedule's interpolation in T, not the physics against the paper; it passes "
+                        "with the uncalibrated seed001_actuator_dev and with the C- slope's sign flipped")
+_ROUND_TRIP_TRACKING = ("virtual experiment: scheme 2 inverts a surrogate of the very plant it drives (the physics), "
+                        "scheme 1 one fitted at 19 °C; scheme 2 wins whenever the plant changes between 19 and 45 °C, "
+                        "in either direction: the 2 Hz/two-tone ratios stay below 0.5 with the uncalibrated "
+                        "seed001_actuator_dev and with the C- slope's sign flipped (19-vs-55 °C trend of the wrong sign)")
 CHECKS.update({
     f"{S}.paper": Claim(paper_check, "reproduce", "metadata"),
     f"{S}.input": Claim(io_check("actuator", "M", "input"), "reproduce", "metadata"),
@@ -211,7 +227,7 @@ CHECKS.update({
                          note="the printed geometry is typed into the set"),
     f"{S}.excitation": Claim(c_excitation, "reproduce", "metadata"),
     f"{S}.temperatures_c": Claim(c_temps, "reproduce", "metadata"),
-    f"{S}.validation_temperatures_c": Claim(c_validation, "reproduce", "model", SET),
+    f"{S}.validation_temperatures_c": Claim(c_validation, "reproduce", "round-trip", SET, _ROUND_TRIP_SCHEDULE),
     f"{S}.model": Claim(c_model, "reproduce", "metadata", note="the paper's procedure runs on the physics"),
     f"{S}.order_claims[0]": Claim(c_order_2, "reproduce", "model", SET),
     f"{S}.order_claims[1]": Claim(
@@ -228,8 +244,7 @@ CHECKS.update({
     f"{S}.tracking_experiments": Claim(None, _NOT_MEASURED + " (hardware tracking, Figs. 6-8)", "model", SET),
     f"{S}.tracking_claims[0]": Claim(None, "not-checkable: describes the experimental schemes (hardware); "
                                      "tracking_claims[1] runs them on the physics", "metadata"),
-    f"{S}.tracking_claims[1]": Claim(c_tracking_halves, "reproduce", "model", SET,
-                                     "virtual experiment: the plant is the physics calibrated on trends[1] only"),
+    f"{S}.tracking_claims[1]": Claim(c_tracking_halves, "reproduce", "round-trip", SET, _ROUND_TRIP_TRACKING),
 })
 
 EXTRA_ROWS[f"{S}.tracking_claims[1]"] = [(
@@ -237,5 +252,5 @@ EXTRA_ROWS[f"{S}.tracking_claims[1]"] = [(
     Claim(c_tracking_half_hz, "finding: in the virtual experiment scheme 2 nearly halves the 0.5 Hz error too: the "
           "physics' 19-to-45 °C change of |M| at 0.5 Hz (about 10 %, half its 2 Hz change) is as large as the 3/3 fits' "
           "structural error there, and the scheduled model removes it; 'only slightly better' implies a 0.5 Hz change "
-          "small next to the hardware's other errors, which the physics (calibrated at 3 Hz only) does not have", "model", SET,
-          "virtual experiment: the plant is the physics calibrated on trends[1] only"))]
+          "small next to the hardware's other errors, which the physics (calibrated at 3 Hz only) does not have",
+          "round-trip", SET, _ROUND_TRIP_TRACKING))]

@@ -73,6 +73,17 @@ def c_geometry(ctx, value):
                    "(other widths in the width check)", "equal to the printed geometry", ok)
 
 
+#: The unit conventions a table row applies (printed key -> how the set stores it); see
+#: :mod:`physmodel.parameter_sets.seed002`.  Keys not listed are stored as printed, in SI.
+UNIT_CONVENTIONS = {
+    "alpha0": "alpha0 stored as printed/omega_n (the paper's mode omega_n/(s^2+...) has DC gain 1/omega_n)",
+    "r1_ohm_m": "r1' printed in Ohm m read as the sheet resistance r1_sheet [Ohm] (r1 = r1'/W, eq. 11)",
+    "r1_ohm": "r1' [Ohm] is the sheet resistance r1_sheet (r1 = r1'/W, eq. 11)",
+    "r2_ohm_m": "r2' printed in Ohm m read as r2_specific [Ohm m^2] (r2 = r2'/W)",
+    "Rp_ohm_m2": "Rp' [Ohm m^2] is Rp_specific (Rp = Rp'/W)",
+}
+
+
 def _table(which):
     def check(ctx, value):
         p = ctx.parameter_set(f"seed002_table{2 if which == 'table2_initial' else 3}")
@@ -83,10 +94,11 @@ def _table(which):
                  "Rp_ohm_m2": p.Rp_specific, "T_K": p.T_ref}
         bad = [k for k, v in value.items() if k in pairs and not math.isclose(pairs[k], v, rel_tol=1e-9)]
         unknown = [k for k in value if k not in pairs]
-        return Outcome(f"{p.name}: {len(value) - len(bad) - len(unknown)}/{len(value)} values equal "
-                       "(alpha0 stored as printed/omega_n)" + (f"; differ: {bad}" if bad else "")
+        conventions = [UNIT_CONVENTIONS[k] for k in value if k in UNIT_CONVENTIONS]
+        return Outcome(f"{p.name}: {len(value) - len(bad) - len(unknown)}/{len(value)} values equal, with the unit "
+                       "conventions: " + "; ".join(conventions) + (f"; differ: {bad}" if bad else "")
                        + (f"; unmapped: {unknown}" if unknown else ""),
-                       "every printed value in the set", not bad and not unknown)
+                       "every printed value in the set, under the named conventions", not bad and not unknown)
     return check
 
 
