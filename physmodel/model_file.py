@@ -94,7 +94,7 @@ class FitVerdict:
     dof : int or None
         Residual degrees of freedom.
     p_value : float or None
-        P(χ²_dof ≥ chi2); None when the noise was estimated from the residuals.
+        P(χ²_dof ≥ chi2); None when the noise was estimated from the residuals. [-]
     reason : str
         The test's sentence.
     diagnosis : str or None
@@ -114,19 +114,39 @@ class FitVerdict:
 
     @classmethod
     def from_goodness(cls, gof, diagnosis: str | None = None, named=()) -> FitVerdict:
-        """From a :class:`physmodel.estimation.residuals.GoodnessOfFit` (or its ``to_dict()``)."""
+        """From a :class:`physmodel.estimation.residuals.GoodnessOfFit` (or its ``to_dict()``).
+
+        Parameters
+        ----------
+        gof : GoodnessOfFit or dict
+            The test.
+        diagnosis : str or None
+            The diagnosis verdict, when there was one.
+        named : sequence of str
+            The effects it named.
+        """
         d = gof.to_dict() if hasattr(gof, "to_dict") else dict(gof)
         dof = d.get("dof")
         return cls(bool(d.get("adequate")), _num(d.get("chi2")), None if dof is None else int(dof),
                    _num(d.get("p_value")), str(d.get("reason", "")), diagnosis, tuple(named))
 
     def to_dict(self) -> dict:
+        """JSON-ready data (non-finite numbers as None)."""
         return {"adequate": bool(self.adequate), "chi2": _num(self.chi2), "dof": self.dof,
                 "p_value": _num(self.p_value), "reason": self.reason, "diagnosis": self.diagnosis,
                 "named": list(self.named)}
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "model file") -> FitVerdict:
+        """Read :meth:`to_dict`'s data.
+
+        Parameters
+        ----------
+        d : dict
+            The record.
+        where : str
+            The file, for messages.
+        """
         if not isinstance(d, dict) or "adequate" not in d:
             raise ParameterError(f"{where}: 'verdict' must be an object with 'adequate', got {d!r}")
         dof = d.get("dof")
@@ -176,6 +196,7 @@ class Provenance:
     library_version: str = ""
 
     def to_dict(self) -> dict:
+        """JSON-ready data."""
         return {"creator": self.creator, "data_file": self.data_file, "data_sha256": self.data_sha256,
                 "data_fingerprint": self.data_fingerprint, "temperatures_c": [float(t) for t in self.temperatures_c],
                 "band_hz": None if self.band_hz is None else [float(b) for b in self.band_hz],
@@ -183,6 +204,15 @@ class Provenance:
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "model file") -> Provenance:
+        """Read :meth:`to_dict`'s data.
+
+        Parameters
+        ----------
+        d : dict
+            The record.
+        where : str
+            The file, for messages.
+        """
         if not isinstance(d, dict):
             raise ParameterError(f"{where}: 'provenance' must be an object, got {d!r}")
         band = d.get("band_hz")
@@ -193,7 +223,13 @@ class Provenance:
 
     def data_path(self, relative_to=None) -> Path | None:
         """The data file, resolved against the model file's folder when relative and not found
-        from the working directory; None when unknown."""
+        from the working directory; None when unknown.
+
+        Parameters
+        ----------
+        relative_to : str or Path or None
+            The model file's path.
+        """
         if not self.data_file:
             return None
         p = Path(self.data_file)
@@ -289,7 +325,13 @@ class ModelFile:
         return f"`{self.name}` ({self.kind}" + (f", effects: {eff}" if eff else ", no effects") + f"): {ver}"
 
     def with_parameters(self, params: IPMCParameters) -> ModelFile:
-        """A copy with other parameters (the verdict and provenance are kept: say so where it matters)."""
+        """A copy with other parameters (the verdict and provenance are kept: say so where it matters).
+
+        Parameters
+        ----------
+        params : IPMCParameters
+            The new parameters.
+        """
         return replace(self, parameters=params)
 
     # -------------------------------------------------------------- files
@@ -310,7 +352,13 @@ class ModelFile:
         return hashlib.sha256(text.encode()).hexdigest()
 
     def save(self, path) -> Path:
-        """Write the model file atomically and return its path."""
+        """Write the model file atomically and return its path.
+
+        Parameters
+        ----------
+        path : str or Path
+            The JSON file to write.
+        """
         from .data.files import atomic_write
 
         text = json.dumps(self.to_dict(), indent=2, allow_nan=False)
@@ -318,7 +366,17 @@ class ModelFile:
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "model file", path: str | None = None) -> ModelFile:
-        """Read the ``ipmc-model`` format (see :func:`load_model` for older formats)."""
+        """Read the ``ipmc-model`` format (see :func:`load_model` for older formats).
+
+        Parameters
+        ----------
+        d : dict
+            The file's data.
+        where : str
+            The file, for messages.
+        path : str or None
+            Recorded as :attr:`path`.
+        """
         if d.get("format") != MODEL_FORMAT:
             raise ParameterError(f"{where} has format {d.get('format')!r}, expected {MODEL_FORMAT!r}")
         version = d.get("version")
@@ -421,7 +479,7 @@ def load_model(source: str | os.PathLike, *, kind: str | None = None, **override
     else:
         path = Path(text)
         if not (text.lower().endswith(".json") or path.is_file()):
-            raise ParameterError(f"unknown parameter set or model file {text!r}; expected one of "
+            raise ParameterError(f"unknown parameter set {text!r} (and no such model file); expected one of "
                                  f"{available_parameter_sets()} or the path of a JSON model/parameter file")
         if not path.is_file():
             raise ParameterError(f"model file {text!r} does not exist")

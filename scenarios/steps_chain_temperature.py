@@ -209,7 +209,7 @@ def calibrate_laws(data: A0Series, respond, frequency_hz, free, starts: int = 3,
                    max_nfev: int = 200) -> LawCalibration:
     """Fit ``free`` law parameters so that a0 of :func:`levy_4_4` of ``respond`` matches ``data``:
     the calibration engine (:func:`~physmodel.estimation.lsq.fit_parameters`) on the a0 values as
-    :class:`~physmodel.estimation.records.ScalarObservations` (residuals ln|a0_model/a0|/σ_ln; a
+    :class:`~physmodel.estimation.observations.ScalarObservations` (residuals ln|a0_model/a0|/σ_ln; a
     sign flip is a misfit of the magnitude only), ``max_nfev`` residual evaluations per start.  Only
     parameters a0(T) does not depend on are held at their start value; other undetermined ones keep
     their fitted value and interval.  On a misfit ``calibrate``'s policy (Birge-widened intervals,

@@ -13,15 +13,20 @@ sweep H (with per-line σ) stands for P where it was measured:
    over log-frequency onto the signal's spectrum (flat beyond the measured band, and the share of
    the signal's power outside the band reported), and
 
-   * the central prediction is RMS(e)/RMS(r) with |m|² debiased for the measurement noise
-     (max(|m|² − σ_m², 0)), interpolated linearly in T between the two temperatures;
-   * the stated upper bound takes, at each of the two temperatures, |m| + 2σ_m per line, and the
-     larger of the two (a misfit that changes monotonically between the measured temperatures
-     stays below it; beyond the measured band or range nothing bounds it and the result says so).
+   * the error spectrum is E = m·Y + E_inv, where Y = G·u is the surrogate's output for the drive
+     and E_inv = Y − R the inversion's own error (preview truncation, sampling of the inverse;
+     known exactly when ``inversion_residual`` is given, else 0 and Y = R), so misfit and
+     inversion errors add with their phases;
+   * the central prediction is RMS(e)/RMS(r) with m interpolated linearly in T between the two
+     temperatures and the measurement noise removed on average (Σ|E|² − Σσ²|Y|², clipped at 0, σ²
+     the variance of the interpolated m: interpolation averages the independent noise of the
+     lines and temperatures it combines);
+   * the stated upper bound takes, at each of the two temperatures, (|m| + 2σ_m)|Y| + |E_inv| per
+     frequency, and the larger of the two (a misfit that changes monotonically between the
+     measured temperatures stays below it; beyond the measured band or range nothing bounds it
+     and the result says so).
 
-What is not in it: the error of the inversion itself (preview truncation, sampling, transients at
-the fades) — the feedforward report states those separately — and effects that the measured band
-did not excite.  Frequencies in Hz, temperatures in °C, signals in any one unit.
+Not in it: effects that the measured band did not excite.  Frequencies in Hz, temperatures in °C, signals in any one unit.
 """
 
 from __future__ import annotations
@@ -134,6 +139,8 @@ class PredictedError:
         Share of the signal's power (rest excluded) outside the measured band. [-]
     per_temperature : dict
         {T: (central, bound)} at each neighbour. [-]
+    inversion : float
+        The inversion's own error, RMS over the signal's RMS (0 when not given). [-]
     """
 
     rms: float
@@ -143,6 +150,7 @@ class PredictedError:
     extrapolated: bool
     out_of_band_power: float
     per_temperature: dict
+    inversion: float = 0.0
 
     @property
     def checked(self) -> bool:
@@ -153,7 +161,8 @@ class PredictedError:
     def sentence(self) -> str:
         """One line for reports."""
         s = (f"{100 * self.rms:.3g} % RMS of the signal (bound {100 * self.bound:.3g} %), from the measured misfit at "
-             + " and ".join(f"{t:g} °C" for t in self.neighbours_c))
+             + " and ".join(f"{t:g} °C" for t in self.neighbours_c)
+             + (f" and the inversion's own error ({100 * self.inversion:.2g} %)" if self.inversion else ""))
         if self.extrapolated:
             s += f"; {self.temperature_c:g} °C is OUTSIDE the measured temperatures: extrapolated, not bounded"
         if self.out_of_band_power > 0.01:
@@ -162,21 +171,27 @@ class PredictedError:
         return s
 
     def to_dict(self) -> dict:
+        """JSON-ready data (temperatures as keys of ``per_temperature``)."""
         return {"rms": self.rms, "bound": self.bound, "temperature_c": self.temperature_c,
                 "neighbours_c": list(self.neighbours_c), "extrapolated": self.extrapolated,
-                "out_of_band_power": self.out_of_band_power, "checked": self.checked,
+                "out_of_band_power": self.out_of_band_power, "checked": self.checked, "inversion": self.inversion,
                 "per_temperature": {f"{k:g}": list(v) for k, v in self.per_temperature.items()}}
 
 
-def _interp_log(f_new, f, values):
-    """Interpolate real or complex values over log10 f (flat beyond the ends)."""
+def _interp_log(f_new, f, values, sigma):
+    """Linear interpolation over log10 f (flat beyond the ends) of complex ``values`` and of the
+    variance of independent per-line noise ``sigma``: (1 − b)²σ_k² + b²σ_{k+1}² between lines k and
+    k+1 (an interpolated value averages two noises)."""
     x, xn = np.log10(f), np.log10(f_new)
-    if np.iscomplexobj(values):
-        return np.interp(xn, x, values.real) + 1j * np.interp(xn, x, values.imag)
-    return np.interp(xn, x, values)
+    m = np.interp(xn, x, values.real) + 1j * np.interp(xn, x, values.imag)
+    if x.size == 1:
+        return m, np.full(xn.shape, float(sigma[0]) ** 2)
+    k = np.clip(np.searchsorted(x, xn) - 1, 0, x.size - 2)
+    b = np.clip((xn - x[k]) / (x[k + 1] - x[k]), 0.0, 1.0)
+    return m, (1 - b) ** 2 * sigma[k] ** 2 + b ** 2 * sigma[k + 1] ** 2
 
 
-def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal) -> PredictedError:
+def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal, inversion_residual=None) -> PredictedError:
     """The RMS error, relative to the signal's RMS, of inverting the surrogate on the measured strip
     for ``signal`` at ``temperature_c`` (see the module doc).
 
@@ -190,6 +205,9 @@ def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal) -> Pred
         Uniform sample times of the signal. [s]
     signal : array_like
         The reference (feedforward) or the decoded input (sensor decoding). [any unit]
+    inversion_residual : array_like or None
+        G·u − signal: the surrogate's own response to the computed drive minus the signal (the
+        inversion's error), same samples. [the signal's unit]
 
     Returns
     -------
@@ -199,18 +217,20 @@ def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal) -> Pred
     r = np.asarray(signal, float)
     if r.size < 4 or t.shape != r.shape:
         raise ValueError(f"signal and t must be equal-length arrays of >= 4 samples, got {r.shape} and {t.shape}")
+    e_inv = np.zeros_like(r) if inversion_residual is None else np.asarray(inversion_residual, float)
+    if e_inv.shape != r.shape:
+        raise ValueError(f"inversion_residual has shape {e_inv.shape}, the signal {r.shape}")
     dt = float(t[1] - t[0])
-    R = np.fft.rfft(r)
     f = np.fft.rfftfreq(r.size, dt)
-    w = np.abs(R) ** 2
-    w[1:] *= 2.0                      # one-sided power (the Nyquist bin counted twice is negligible here)
-    w[0] = 0.0                        # a constant offset: the DC misfit is not measured; counted as out of band
-    total = float(np.sum(np.abs(R) ** 2 * np.where(np.arange(f.size) == 0, 1.0, 2.0)))
+    W = np.where(np.arange(f.size) == 0, 1.0, 2.0)          # one-sided power weights
+    R, Einv = np.fft.rfft(r), np.fft.rfft(e_inv)
+    Y = R + Einv                                             # the surrogate's output for the drive, G·u
+    total = float(np.sum(W * np.abs(R) ** 2))
     if total <= 0:
         raise ValueError("the signal is identically zero")
     lo, hi = misfit.band_hz
     inside = (f >= lo * (1 - 1e-9)) & (f <= hi * (1 + 1e-9))
-    out_share = 1.0 - float(np.sum(w[inside])) / total
+    out_share = 1.0 - float(np.sum((W * np.abs(R) ** 2)[inside])) / total
     fpos = np.where(f > 0, f, f[1] if f.size > 1 else 1.0)
     T = np.asarray(misfit.temperatures_c, float)
     Tc = float(temperature_c)
@@ -226,17 +246,24 @@ def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal) -> Pred
             a = (T[j] - Tc) / (T[j] - T[j - 1])
             idx, wts = [j - 1, j], [a, 1.0 - a]
         extrap = False
-    per, c2, bounds = {}, 0.0, []
+
+    def central2(m, s2):
+        # E|m_meas·Y + E_inv|² = |m·Y + E_inv|² + σ²|Y|²: the measurement noise removed on average
+        return max(float(np.sum(W * (np.abs(m * Y + Einv) ** 2 - s2 * np.abs(Y) ** 2))) / total, 0.0)
+
+    per, bounds = {}, []
+    m_T = np.zeros(f.size, complex)
+    s2_T = np.zeros(f.size)
     for i, wt in zip(idx, wts):
-        m = _interp_log(fpos, misfit.frequency_hz[i], misfit.misfit[i])
-        s = _interp_log(fpos, misfit.frequency_hz[i], misfit.sigma[i])
-        central2 = float(np.sum(w * np.maximum(np.abs(m) ** 2 - s ** 2, 0.0)) / total)
-        upper = float(math.sqrt(np.sum(w * (np.abs(m) + 2.0 * s) ** 2) / total))
-        per[float(T[i])] = (math.sqrt(central2), upper)
-        c2 += wt * central2
+        m, v = _interp_log(fpos, misfit.frequency_hz[i], misfit.misfit[i], misfit.sigma[i])
+        upper = math.sqrt(float(np.sum(W * ((np.abs(m) + 2.0 * np.sqrt(v)) * np.abs(Y) + np.abs(Einv)) ** 2)) / total)
+        per[float(T[i])] = (math.sqrt(central2(m, v)), upper)
         bounds.append(upper)
-    return PredictedError(math.sqrt(c2), max(bounds), Tc, tuple(float(T[i]) for i in idx), bool(extrap),
-                          out_share, per)
+        m_T += wt * m
+        s2_T += wt ** 2 * v                      # independent noise at the two temperatures
+    inv = float(np.sqrt(np.mean(e_inv ** 2) / np.mean(r ** 2)))
+    return PredictedError(math.sqrt(central2(m_T, s2_T)), max(bounds), Tc, tuple(float(T[i]) for i in idx),
+                          bool(extrap), out_share, per, inv)
 
 
 __all__ = ["DataMisfit", "PredictedError", "misfit_to_data", "predicted_error"]

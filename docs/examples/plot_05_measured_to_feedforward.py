@@ -23,8 +23,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from inversion import feedforward
-from physmodel import (ActuatorModel, LogLinear, MagnitudePhaseNoise, calibrate, get_parameter_set,
-                       synthesize_sweep)
+from physmodel import ActuatorModel, LogLinear, MagnitudePhaseNoise, calibrate, get_parameter_set, synthesize_sweep
 from surrogate import ScheduledFit, relative_rms_error
 
 start = get_parameter_set("seed001_actuator")          # what we believe before measuring

@@ -33,6 +33,7 @@ class RestSimulation:
     wraparound: float
 
     def describe(self) -> str:
+        """One line for reports: the padding and the measured wrap-around residue."""
         return (f"frequency-domain simulation ({self.n_fft} points, wrap-around residue "
                 f"{self.wraparound:.1e} of the peak)")
 
@@ -91,4 +92,43 @@ def simulate_at_rest(model, temperature_c: float, t, u, *, pad: int = 4, tol: fl
         n, y = n2, y2
 
 
-__all__ = ["simulate_at_rest", "RestSimulation", "MAX_PAD"]
+class RestRealization:
+    """What :func:`physmodel.data.timesim.simulate` uses for a model with no finite realisation (a
+    model with effects, e.g. a delay): :func:`simulate_at_rest` behind the realisation's
+    ``simulate(t, u, hold, initial)`` call.  Exact for any drive that starts at rest (the model is
+    causal, so what follows the record does not matter beyond the measured wrap-around).
+
+    Parameters
+    ----------
+    model : FrequencyModel
+        The model (its primary ``response``).
+    temperature_c : float
+        Temperature. [°C]
+    """
+
+    def __init__(self, model, temperature_c: float):
+        self.model, self.temperature_c = model, float(temperature_c)
+        self.summary = "frequency-domain simulation (a model with effects has no finite realisation)"
+
+    def simulate(self, t, u, hold: str = "foh", initial: str = "rest") -> np.ndarray:
+        """Output for input samples ``u`` at uniform times ``t`` [s]; ``initial`` must be "rest".
+
+        Parameters
+        ----------
+        t : array_like
+            Uniform sample times. [s]
+        u : array_like
+            Drive samples. [SI input unit]
+        hold : str
+            Ignored: the drive is treated as band-limited.
+        initial : str
+            Only ``"rest"``.
+        """
+        if initial != "rest":
+            raise IPMCError(f"initial={initial!r}: a model with effects is simulated from rest only")
+        sim = simulate_at_rest(self.model, self.temperature_c, t, u)
+        self.summary = sim.describe()
+        return sim.y
+
+
+__all__ = ["simulate_at_rest", "RestSimulation", "RestRealization", "MAX_PAD"]

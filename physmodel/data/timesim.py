@@ -390,6 +390,10 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
         raise IPMCError(f"realization= cannot be combined with a chain of finite op-amps (gbw_hz={chain.gbw_hz}, "
                         f"dc_gain={chain.dc_gain}): the chain is realised together with the strip "
                         "(model_realization(..., chain=chain)); pass one or the other")
+    if realization is None and getattr(model, "effects", None) and output == ("displacement" if is_act else "current"):
+        from .fftsim import RestRealization  # effects (a delay, say) have no finite realisation
+
+        realization = RestRealization(model, temperature_c)
     real = realization or model_realization(model, temperature_c, 1.0 / dt, t[-1] - t[0], output, set_index, tol,
                                             chain=chain if finite_opamps else None)
     y = real.simulate(t, u, hold=hold, initial=initial)
@@ -412,8 +416,8 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
     u_meas = u + input_noise_rms * rng.standard_normal(u.size) if input_noise_rms else u.copy()
     meta = {"model": type(model).__name__ + (f" (kernel={model.kernel})" if hasattr(model, "kernel") else ""),
             "parameter_set": model.params[set_index].name, "temperature_c": f"{temperature_c:g}",
-            "realization": f"order {real.order}, max rel error {real.max_rel_error:.1e} over "
-                           f"{real.band_hz[0]:g}-{real.band_hz[1]:g} Hz",
+            "realization": getattr(real, "summary", None) or f"order {real.order}, max rel error "
+                           f"{real.max_rel_error:.1e} over {real.band_hz[0]:g}-{real.band_hz[1]:g} Hz",
             "hold": hold, "initial": initial, "output_noise_rms": f"{output_noise_rms:g}",
             "input_noise_rms": f"{input_noise_rms:g}", "seed": str(seed)}
     if chain is not None:

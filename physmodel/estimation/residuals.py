@@ -176,7 +176,7 @@ class SweepResiduals:
 
 
 class ObservationResiduals:
-    """The engine's view of :class:`~physmodel.estimation.records.ScalarObservations`: N residuals
+    """The engine's view of :class:`~physmodel.estimation.observations.ScalarObservations`: N residuals
     ln|y_model/y|/σ_ln of N predictions per set (the real part of a complex prediction)."""
 
     def __init__(self, data):

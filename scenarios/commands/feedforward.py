@@ -177,8 +177,9 @@ def measured_data(args, mf, model):
     return None, ""
 
 
-def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_unit):
-    """(DataMisfit, PredictedError) of the surrogate against the measured sweep at ``data_path``."""
+def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_unit, drive=None):
+    """(DataMisfit, PredictedError) of the surrogate against the measured sweep at ``data_path``;
+    with ``drive`` (the computed input, surrogate units) the inversion's own error is included."""
     from physmodel.data.files import read_sweep
     from physmodel.errors import IPMCError
     from surrogate.strip_check import misfit_to_data, predicted_error
@@ -190,7 +191,26 @@ def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_un
         raise CLIError(f"--data {data_path}: its units {sweep.output_unit}/{sweep.input_unit} do not match the "
                        f"surrogate's {out_unit}/{in_unit}: {exc}") from None
     mis = misfit_to_data(model, sweep, source=f"{data_path} (fingerprint {sweep.fingerprint()[:12]})")
-    return mis, predicted_error(mis, temperature_c, t, signal)
+    residual = None
+    if drive is not None:
+        from physmodel.data.fftsim import simulate_at_rest
+
+        residual = simulate_at_rest(_AtTemperature(model), temperature_c, t, drive).y - signal
+    return mis, predicted_error(mis, temperature_c, t, signal, inversion_residual=residual)
+
+
+class _AtTemperature:
+    """A surrogate in the one model interface for the frequency-domain simulation (extrapolation
+    allowed: the range was checked when it was loaded)."""
+
+    kind = "rational"
+
+    def __init__(self, model):
+        self.model = model
+
+    def response(self, frequency_hz, temperature_c):
+        return np.atleast_2d(self.model.frequency_response(np.asarray(frequency_hz), float(np.ravel(temperature_c)[0]),
+                                                           extrapolate=True))
 
 
 def _rms(x) -> float:
@@ -268,7 +288,8 @@ def run(args) -> int:
     lines = [f"# Feedforward at {args.temperature:g} °C", ""]
     strip = None
     if data_path is not None:
-        mis, strip = strip_prediction(data_path, model, args.temperature, ref.t, ref.y, in_unit, out_unit)
+        mis, strip = strip_prediction(data_path, model, args.temperature, ref.t, ref.y, in_unit, out_unit,
+                                      drive=ff.output)
         summary["predicted_error_on_strip_rms"] = strip.rms
         summary["predicted_error_on_strip_bound"] = strip.bound
         summary["strip_check"] = {**strip.to_dict(), "data": str(data_path), "found_by": data_how,

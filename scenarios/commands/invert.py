@@ -253,6 +253,8 @@ def _verdicts(args: argparse.Namespace, smodel: Any, t: np.ndarray, y: np.ndarra
     except ValueError as exc:
         raise InversionError(f"--data {data}: its units do not match the surrogate's: {exc}") from None
     pe = predicted_error(misfit_to_data(smodel, sweep), float(args.temperature), t, y)
+    # (the decoding's own error is not added: a measured signal is not at rest at its ends, so the
+    # frequency-domain check of the inverse would see the record's edges, not the inversion)
     notes.append(f"predicted_error_on_strip: {pe.rms:.6g} (bound {pe.bound:.6g}; {pe.sentence()}; data {data})")
     if not args.quiet:
         print(f"ipmc invert: predicted decoding error on the strip: {pe.sentence()}")

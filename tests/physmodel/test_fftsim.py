@@ -43,3 +43,21 @@ def test_a_first_order_lag_matches_lsim():
     err = np.max(np.abs(res.y - y[::16])) / np.max(np.abs(y))
     assert err < 2e-3                    # the FFT treats u as band-limited, lsim as piecewise linear
     assert res.wraparound < 1e-4
+
+
+def test_simulate_runs_a_model_with_a_delay_as_the_plain_model_shifted():
+    """``timesim.simulate`` takes a model with effects (no finite realisation): a 12 ms delay
+    gives the plain physics' output (through its vector-fitted realisation, another method)
+    shifted by 12 samples."""
+    from physmodel import ActuatorModel, EffectModel, get_parameter_set
+    from physmodel.data.timesim import simulate
+
+    p = get_parameter_set("seed001_actuator")
+    fs, k = 1000.0, 12
+    t = np.arange(8000) / fs
+    u = np.sin(np.pi * t / t[-1]) ** 2 * np.sin(2 * np.pi * 1.5 * t)
+    plain = simulate(ActuatorModel(p), 30.0, t, u).output
+    delayed = simulate(EffectModel(p, "actuator", {"time_delay": {"delay": k / fs}}), 30.0, t, u)
+    assert "frequency-domain" in delayed.metadata["realization"]
+    np.testing.assert_allclose(delayed.output[k:], plain[:-k], atol=2e-3 * np.max(np.abs(plain)))
+    assert np.max(np.abs(delayed.output[:k])) < 1e-3 * np.max(np.abs(plain))

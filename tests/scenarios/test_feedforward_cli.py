@@ -67,7 +67,10 @@ def test_feedforward_writes_voltage_checks_it_and_simulate_reproduces_it(model_j
     assert _run(["simulate", "--set", "seed001_actuator", "--temperature", "37", "--input",
                  str(out / "voltage.csv"), "--out", str(sim), "--quiet"]) == EXIT_OK
     s = _cols(sim)
-    np.testing.assert_allclose(s["tip_displacement_m"] * 1e3, c["predicted_tip_mm"], rtol=0, atol=1e-9)
+    # two methods: feedforward's exact frequency-domain simulation and simulate's vector-fitted realisation
+    # (max relative error 1e-4 by construction): they agree to that tolerance
+    np.testing.assert_allclose(s["tip_displacement_m"] * 1e3, c["predicted_tip_mm"], rtol=0,
+                               atol=1e-4 * np.max(np.abs(c["predicted_tip_mm"])))
     np.testing.assert_allclose(s["voltage_V"], c["voltage_V"], rtol=0, atol=1e-12)
     # the tracking error between the fades equals the steady-state prediction
     body = (c["time_s"] >= 3.0) & (c["time_s"] <= 7.0)

@@ -124,3 +124,22 @@ def test_diagnose_takes_calibrates_output_and_its_model_carries_the_named_effect
     rep = json.loads((chain / "ff4" / "report.json").read_text())
     assert not rep["upstream_misfit"]
     assert rep["predicted_error_on_strip_rms"] < 0.01      # the named delay is in the model now
+
+
+def test_invert_refuses_a_surrogate_of_a_misfit_model_unless_accepted(chain, tmp_path, capsys):
+    if not (chain / "fit" / "model.json").exists():          # run alone: make the misfit surrogate here
+        assert main(["sweep", "--model", str(chain / "cal" / "model.json"), "--temperatures", "20,30,40,50",
+                     "--fmin", "0.1", "--fmax", "9", "--points", "30", "--out", str(chain / "dense.csv"), "--quiet"]) == 0
+        assert main(["fit", str(chain / "dense.csv"), "--zeros", "4", "--poles", "4", "--degree", "2",
+                     "--out", str(chain / "fit"), "--quiet"]) == 0
+    t = np.arange(2000) / 500.0
+    w = np.sin(np.pi * t / t[-1]) ** 2 * 0.1 * np.sin(2 * np.pi * 1.0 * t)
+    np.savetxt(tmp_path / "tip.csv", np.column_stack([t, w]), delimiter=",", header="time_s,tip_mm", comments="")
+    args = ["invert", str(tmp_path / "tip.csv"), "--surrogate", str(chain / "fit" / "model.json"),
+            "--temperature", "35", "--quiet"]
+    capsys.readouterr()
+    assert main([*args, "--out", str(tmp_path / "v.csv")]) == 3
+    assert "does not fit its data" in capsys.readouterr().err
+    head = [ln for ln in (tmp_path / "v.csv").read_text().splitlines() if ln.startswith("#")]
+    assert any("upstream_misfit" in h for h in head) and any("predicted_error_on_strip" in h for h in head)
+    assert main([*args, "--accept-misfit", "--out", str(tmp_path / "v2.csv")]) == 0

@@ -65,11 +65,11 @@ def test_a_sine_sees_the_misfit_at_its_frequency():
     assert pe.rms == pytest.approx(0.01 * math.log10(1.25) + 0.03, rel=1e-3)
 
 
-def test_squared_misfit_interpolates_linearly_between_temperatures():
+def test_the_misfit_interpolates_linearly_between_temperatures():
     mis = misfit_to_data(_Model(), _sweep([20.0, 40.0], F, lambda f, t: 1 + (0.01 if t == 20.0 else 0.03)))
     t, r = _signal()
     pe = predicted_error(mis, 25.0, t, r)            # weights 0.75 / 0.25
-    assert pe.rms == pytest.approx(math.sqrt(0.75 * 1e-4 + 0.25 * 9e-4), rel=1e-9)
+    assert pe.rms == pytest.approx(0.75 * 0.01 + 0.25 * 0.03, rel=1e-9)
     assert pe.bound == pytest.approx(0.03, rel=1e-9)
     out = predicted_error(mis, 50.0, t, r)
     assert out.extrapolated and not out.checked and out.rms == pytest.approx(0.03)
@@ -103,3 +103,15 @@ def test_signal_power_outside_the_measured_band_is_reported():
     pe = predicted_error(mis, 20.0, t, r)
     assert pe.out_of_band_power > 0.9 and not pe.checked
     assert "outside the measured band" in pe.sentence()
+
+
+def test_an_inversion_residual_adds_with_its_phase():
+    # G·u = (1 + ε) r (an inverse that is 1 % off in gain): e = m·(1 + ε) r + ε r exactly
+    m0, eps = 0.02, 0.01
+    mis = misfit_to_data(_Model(), _sweep([20.0], F, lambda f, t: 1 + m0))
+    t, r = _signal()
+    pe = predicted_error(mis, 20.0, t, r, inversion_residual=eps * r)
+    assert pe.rms == pytest.approx(m0 * (1 + eps) + eps, rel=1e-9)
+    assert pe.inversion == pytest.approx(eps, rel=1e-9)
+    pe = predicted_error(mis, 20.0, t, r, inversion_residual=-eps * r)        # opposite sign: they cancel
+    assert pe.rms == pytest.approx(abs(m0 * (1 - eps) - eps), rel=1e-9)
