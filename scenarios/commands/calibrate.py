@@ -258,5 +258,6 @@ def render_report(res, data, args) -> str:
         fin = ", ".join(f"{k}={v:.4g}" for k, v in s.final.items())
         lines.append(f"| {s.index} | {ini} | {fin} | {s.cost:.5g} | {s.nfev} | {s.message} |")
     lines += ["", "## Figure", "", "![Bode overlay and residuals](bode.png)", "",
-              "Load the calibrated set with `physmodel.get_parameter_set(\"<folder>/parameters.json\")`.", ""]
+              "Use the model downstream with `--model <folder>/model.json` (effects and this verdict travel with it), "
+              "or in Python with `physmodel.load_model(\"<folder>/model.json\")`.", ""]
     return "\n".join(lines)
