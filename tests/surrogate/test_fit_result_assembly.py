@@ -12,7 +12,6 @@ import pytest
 
 from surrogate import RationalFit, RationalModel, Scaling, Structure, fit_percent, relative_rms_error
 
-
 # mpmath 1.4 deprecates polyroots' descending coefficient order unless ``asc`` is given;
 # 1.3 has no ``asc`` and takes descending order only. Pass ascending order where the keyword
 # exists (no deprecated call), descending otherwise.
