@@ -5,7 +5,8 @@ zero and pole entry with a polynomial in T.  Joint: one least-squares problem ov
 temperatures whose unknowns are the polynomial coefficients themselves, started from the
 two-stage answer and from a constant schedule and solved by Levenberg–Marquardt (the lower
 converged cost wins, unless an unconverged solve is cheaper: then that one is returned,
-flagged); CasADi/IPOPT re-solves with constraints where a bound or stability needs them.
+flagged); CasADi/IPOPT re-solves with constraints where a bound or stability needs them (form
+'coefficients': only a solve stable on the dense temperature grid can be the answer).
 """
 
 from __future__ import annotations
@@ -41,7 +42,8 @@ class ScheduledFit:
         in T (seed 000); if the unconstrained joint optimum has an unstable pole anywhere on
         a dense temperature grid, the fit is repeated with Liénard–Chipart constraints on
         ``stability_grid`` temperatures (``enforce_stability``), and re-checked on the dense
-        grid (``result.stability``).  'zpk': gain, zero sections (s̃² + c1 s̃ + c0) and log pole-section
+        grid (``result.stability``): the answer is stable there, whatever the solvers' exit
+        status, or flagged not converged with status ``Unstable_Solution``.  'zpk': gain, zero sections (s̃² + c1 s̃ + c0) and log pole-section
         coefficients are polynomials in T (seed 001's gain/zeros/poles, in a form that
         survives real↔complex transitions); stable at every temperature by construction.
         'sections': free numerator coefficients with the 'zpk' denominator.
@@ -198,10 +200,14 @@ class ScheduledFit:
         * a solution whose pole or zero sections leave ``Structure.slot_bounds`` at one of
           the ``stability_grid`` temperatures is re-solved by IPOPT with those bounds as
           constraints (``_nlp.Solver``);
-        * form 'coefficients': a converged solution with a pole at or right of the axis
-          anywhere on the 501-point grid is re-solved by IPOPT with Liénard–Chipart
-          constraints (margin ``stability_margin``) on ``stability_grid`` temperatures,
-          refined where the dense check still fails.
+        * form 'coefficients': a solution with a pole at or right of the axis anywhere on the
+          501-point grid is re-solved by IPOPT with Liénard–Chipart constraints (margin
+          ``stability_margin``) on ``stability_grid`` temperatures, refined where the dense
+          check still fails, whatever the unconstrained solve's exit status (a start stopped
+          on reaching another's unstable optimum, or out of iterations, is a candidate too);
+          only a solution stable on the dense grid can be the answer, and if no solve ended
+          stable the lowest-cost one is returned flagged (status ``Unstable_Solution: …``,
+          not converged).
         """
         st = self.structure
         c, sc = scaling.temperature_center_c, scaling.temperature_scale_c
@@ -216,7 +222,13 @@ class ScheduledFit:
                               pole_margin=self.stability_margin if constrained else 0.0)
 
         def unstable(theta):
-            return RationalModel(st, theta, scaling, t_range).max_pole_real_part(dense_t) >= 0
+            """Per dense-grid temperature: a pole at or right of the axis (or no finite poles)."""
+            with np.errstate(all="ignore"):
+                try:
+                    re = RationalModel(st, theta, scaling, t_range).max_pole_real_part(dense_t)
+                except np.linalg.LinAlgError:          # non-finite coefficients
+                    return np.ones(dense_t.size, bool)
+            return ~(re < 0)
 
         def outside_slot_bounds(theta) -> bool:
             bounds = st.slot_bounds(w_min, w_max)
@@ -260,7 +272,9 @@ class ScheduledFit:
                 out = solver_for(taus, False).solve(problem, out.theta)
                 history.append(F.history_entry(
                     f"joint (section bounds at {taus.size} temperatures)", name, out))
-            if out.converged and hurwitz and unstable(out.theta).any():
+            # whatever the solver's exit status: an unconverged answer (out of iterations, or
+            # stopped on reaching the unstable optimum of another start) is a candidate too
+            if hurwitz and unstable(out.theta).any():
                 start = starts[name]          # a stable start is the better way in
                 grid, th = taus, (start if not unstable(start).any() else out.theta)
                 for _ in range(_MAX_REFINE + 1):
@@ -273,14 +287,36 @@ class ScheduledFit:
                         break
                     grid, th = np.union1d(grid, (dense_t[bad] - c) / sc), out.theta
             final.append((name, out))
-            if out.converged:
+            if out.converged and not (hurwitz and unstable(out.theta).any()):
                 settled = min(settled, out.cost)
+        if hurwitz:
+            # only a model stable on the dense grid can be the answer, whatever its cost or exit
+            # status (an unstable answer is not returned flagged: the form promises stability)
+            stable = [o for o in final if not unstable(o[1].theta).any()]
+            if not stable:
+                return evaluator, self._no_stable_answer(final, dense_t, unstable)
+            final = stable
         # a constrained (IPOPT) solve that ran out of iterations is resumed like the others
         low = min(final, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)[0]
         if low in setups:
+            n_before = len(final)
             F.resume_slowest(final, lambda th: solver_for(*setups[low], F.RESUME_FACTOR).solve(problem, th),
                              history, "joint", self.max_iter)
+            if hurwitz and len(final) > n_before and unstable(final[-1][1].theta).any():
+                final.pop()                            # the resumed solve left the stable set
         return evaluator, F.best_outcome(final)[1]
+
+    @staticmethod
+    def _no_stable_answer(final, dense_t, unstable) -> SolveOutcome:
+        """The lowest-cost outcome, flagged as not converged: no solve (constrained or not)
+        ended with every pole left of the axis on the dense temperature grid."""
+        _, out = min(final, key=lambda o: o[1].cost if np.isfinite(o[1].cost) else np.inf)
+        bad = dense_t[unstable(out.theta)]
+        return SolveOutcome(out.theta, out.cost,
+                            f"Unstable_Solution: no stable solve; the best ({out.status}) has a pole at or "
+                            f"right of the axis at {bad.size} of {dense_t.size} temperatures "
+                            f"({bad.min():g}-{bad.max():g} °C)",
+                            False, out.iterations, out.time_s, out.objective_trace)
 
     def fit_data(self, data: FrequencyData):
         """Fit a ``FrequencyData`` or a ``physmodel.data.sweep.FrequencySweep``."""

@@ -4,11 +4,25 @@ own frequency response, and the poles of the denominator in 50-digit arithmetic 
 
 from __future__ import annotations
 
+import inspect
+
 import mpmath
 import numpy as np
 import pytest
 
 from surrogate import RationalFit, RationalModel, Scaling, Structure, fit_percent, relative_rms_error
+
+# mpmath 1.4 deprecates polyroots' descending coefficient order unless ``asc`` is given;
+# 1.3 has no ``asc`` and takes descending order only. Pass ascending order where the keyword
+# exists (no deprecated call), descending otherwise.
+_POLYROOTS_HAS_ASC = "asc" in inspect.signature(mpmath.polyroots).parameters
+
+
+def _polyroots_descending(coeffs, **kw):
+    """mpmath.polyroots of a polynomial given in descending powers, on mpmath 1.3 and ≥ 1.4."""
+    if _POLYROOTS_HAS_ASC:
+        return mpmath.polyroots(list(coeffs)[::-1], asc=True, **kw)
+    return mpmath.polyroots(list(coeffs), **kw)
 
 
 def _poles_mp(model: RationalModel, temperature_c):
@@ -16,8 +30,14 @@ def _poles_mp(model: RationalModel, temperature_c):
     50-digit arithmetic (roots of the expanded polynomial, not of the sections)."""
     den = model.coefficients(temperature_c, extrapolate=True)[1]
     with mpmath.workdps(50):
-        rts = mpmath.polyroots([mpmath.mpf(float(c)) for c in den], maxsteps=400, extraprec=400)
+        rts = _polyroots_descending([mpmath.mpf(float(c)) for c in den], maxsteps=400, extraprec=400)
         return float(max(mpmath.re(r) for r in rts))
+
+
+def test_polyroots_wrapper_reads_descending_order():
+    """(s + 1)(s + 2)(s - 3) = s³ - 7s - 6 in descending order: roots -2, -1, 3 exactly."""
+    rts = sorted(float(mpmath.re(r)) for r in _polyroots_descending([1, 0, -7, -6]))
+    assert rts == pytest.approx([-2.0, -1.0, 3.0], abs=1e-12)
 
 
 @pytest.mark.parametrize("form,m,n", [("sections", 2, 4), ("sections", 3, 5), ("zpk", 2, 5)])

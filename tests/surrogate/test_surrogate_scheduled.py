@@ -139,3 +139,22 @@ def test_hurwitz_constraints_keep_the_coefficients_form_stable():
     re = [np.max(np.roots(held.model.coefficients(T)[1]).real) for T in np.linspace(19.0, 55.0, 41)]
     assert max(re) <= -margin * (1 - 1e-6)
     assert max(re) == pytest.approx(-margin, rel=0.1)       # active (the truth is unstable)
+
+
+@pytest.mark.parametrize("max_iter", [1, 2, 3])
+def test_coefficients_form_is_stable_whatever_the_solvers_exit_status(max_iter):
+    """The unstable-truth sweep above with an iteration cap below the resume threshold: every
+    solve ends unconverged, and unconverged answers near the unstable truth used to be returned
+    as they were (a pole at +0.9 rad/s, flagged only as out of iterations).  An answer of the
+    coefficients form with enforce_stability is stable on a dense grid (numpy's roots of the
+    returned denominators), or its status says that no stable solve was found."""
+    st = Structure("coefficients", 0, 2, 1)
+    truth = RationalModel(st, np.array([1.0, 0.0, 1.0, 0.0, 0.1, -0.2]), TRUE_SCALING, (19.0, 55.0))
+    f, t, h, sm, sp = noisy_sweep(truth, [19.0, 28.0, 37.0, 46.0, 55.0], np.geomspace(0.5, 10, 30),
+                                  mag_db=0.01, ph_deg=0.06)
+    res = ScheduledFit("coefficients", 0, 2, 1, max_iter=max_iter, raise_on_failure=False,
+                       **SCALES).fit(f, t, h, sm, sp)
+    assert not res.converged
+    worst = max(np.max(np.roots(res.model.coefficients(T)[1]).real) for T in np.linspace(19.0, 55.0, 1001))
+    assert worst < 0 or res.status.startswith("Unstable_Solution"), (res.status, worst)
+    assert res.stability.stable == (worst < 0)
