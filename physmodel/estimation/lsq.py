@@ -47,6 +47,15 @@ Identifiability (see :func:`fit_parameters`)
     is confounded with.  Undetermined parameters are held at their start value (the base value in
     :func:`calibrate`) and the others refitted; they are reported without an interval.
 
+Holding costs said (see :class:`~physmodel.estimation.records.HoldRecord`)
+    Each hold step is tested against the best fit with every parameter free: the hold is taken only
+    when the cost rises by no more than :func:`~physmodel.estimation.residuals.hold_cost_tolerance`
+    (half the 0.95 quantile of χ²(k) for k held parameters: a likelihood-ratio test that the start
+    values are consistent with the data).  A parameter pinned at a bound far from its start value
+    fails it: the hold is undone, the un-held fit kept (the parameter at its bound, reported as not
+    determined, its interval not a valid one) and the message says so.  ``result.holds`` records the
+    cost before and after every step.
+
 Temperature-law parameters are named ``"laws.<quantity>.<attribute>"``, e.g.
 ``"laws.d.activation_energy"`` [J/mol] or ``"laws.E.slope"`` [1/K] (see :mod:`physmodel.temperature`);
 ``"omega_n"`` [rad/s] sets the first bending mode through the density.
@@ -67,6 +76,7 @@ from ..errors import IPMCError, ParameterError
 from .records import (
     CalibrationResult,
     FreeParameter,
+    HoldRecord,
     Identifiability,
     ModelBatch,
     ScalarObservations,
@@ -81,6 +91,7 @@ from .residuals import (
     ZERO_SENSITIVITY,
     gauss_newton_covariance,
     goodness_of_fit,
+    hold_cost_tolerance,
     insensitive,
     residual_model,
     tenth_moves,
@@ -382,7 +393,12 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     hold_undetermined : bool or "insensitive"
         Hold undetermined parameters at their start-0 value and refit (one at a time, the worst
         first; those at a bound or with zero sensitivity at once); ``"insensitive"``: only those
-        the data do not depend on (the others keep their fitted value and interval).
+        the data do not depend on (the others keep their fitted value and interval).  A step whose
+        cost increase over the all-free fit exceeds
+        :func:`~physmodel.estimation.residuals.hold_cost_tolerance` is refused and undone (module
+        doc); ``result.holds`` records every step.  ``"always"``: hold as ``True`` does even when
+        the test fails (the record says so) — for a deliberate modelling choice, e.g. a stored
+        set's derivation.
     probe : SensitivityProbe or None
         Wide-band evaluation locating where each parameter acts.
     progress : callable or None
@@ -406,8 +422,8 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         raise IPMCError("give predict, predict_many or predict_array")
     if int(starts) < 1:
         raise IPMCError(f"starts must be >= 1, got {starts}")
-    if hold_undetermined not in (True, False, "insensitive"):
-        raise IPMCError(f"hold_undetermined must be True, False or 'insensitive', got {hold_undetermined!r}")
+    if hold_undetermined not in (True, False, "insensitive", "always"):
+        raise IPMCError(f"hold_undetermined must be True, False, 'insensitive' or 'always', got {hold_undetermined!r}")
     if max_nfev is not None and int(max_nfev) < 1:
         raise IPMCError(f"max_nfev must be >= 1, got {max_nfev}")
     fixed = dict(fixed or {})
@@ -449,6 +465,10 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     # identifiability: flag, hold the worst, refit the rest; repeat
     z_full = ends[best].copy()
     report: dict = {}
+    holds: list[HoldRecord] = []
+    held_in_loop: list[str] = []
+    free_cost = fit.cost
+    free_gof = goodness_of_fit(free_cost, res.size, len(active), estimated)
     while True:
         act = [free[k] for k in active]
         x_full = np.array([x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))
@@ -472,20 +492,58 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
             break
         pinned = [n for n, b in badness.items() if b == np.inf]
         to_hold = dead if hold_undetermined == "insensitive" else pinned or [max(badness, key=badness.get)]
+        # hold them, refit, and test what the hold cost against the free fit (hold_cost_tolerance)
+        saved = (fit, z_full.copy(), list(active), dict(held), converged)
         for n in to_hold:
             held[n] = report[n]
         active = [k for k in active if free[k].name not in held]
         for k, fp in enumerate(free):
             if fp.name in held:
                 z_full[k] = z_init[k]
-        if not active:
-            break
         x_full = np.array([x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))
                            for k, fp in enumerate(free)])
-        fit = _solve(free, active, x_full, z_full[active], batch, res, max_nfev, ftol, fd_step)
-        z_full[active] = fit.z
+        if active:
+            refit = _solve(free, active, x_full, z_full[active], batch, res, max_nfev, ftol, fd_step)
+            z_full[active] = refit.z
+            cost_held = refit.cost
+        else:
+            refit = None
+            cost_held = float(0.5 * np.sum(res(batch(x_full[None, :]))[0] ** 2))
+        names_held = tuple(held_in_loop) + tuple(to_hold)
+        tol, rule = hold_cost_tolerance(len(names_held), free_gof)
+        rise = cost_held - free_cost
+        accepted = bool(rise <= tol) or hold_undetermined == "always"
+        what = ", ".join(to_hold)
+        holds.append(HoldRecord(names_held, tuple(to_hold), free_cost, cost_held, tol, accepted,
+                                f"holding {', '.join(names_held)} at the start value "
+                                + ("raises" if accepted else "would raise")
+                                + f" the cost from {free_cost:.6g} (all free) to {cost_held:.6g} (+{rise:.3g}); "
+                                + f"allowed +{tol:.3g} ({rule}): "
+                                + ("taken" if rise <= tol else "taken although the data reject the start value "
+                                   "(hold_undetermined='always')" if accepted else
+                                   "refused, the data reject the start value")))
+        if not accepted:
+            fit, z_full, active, held, converged = saved
+            for n in to_hold:
+                st = report[n]
+                z = float(z_full[names.index(n)])
+                lo, hi = free[names.index(n)].z_bounds
+                where = "at its bound, " if min(z - lo, hi - z) <= BOUND_TOL * (hi - lo) else ""
+                report[n] = Identifiability(False, st.reason + f"; {where}not determined and NOT held: holding it at "
+                                            f"its start value would raise the cost by {rise:.3g} (allowed {tol:.3g}), "
+                                            "so its fitted value is kept and its interval is not a valid 95 % interval",
+                                            st.sensitivity_peak_hz, st.in_band_fraction)
+            message += (f"; hold of {what} refused: it would raise the cost from {free_cost:.6g} to {cost_held:.6g} "
+                        f"(allowed +{tol:.3g}); un-held fit kept, {what} not determined")
+            break
+        held_in_loop = list(names_held)
+        if refit is None:
+            break
+        fit = refit
         converged = fit.status > 0
-        message += f"; refit without {', '.join(to_hold)}: {fit.message}"
+        message += (f"; refit without {what}: {fit.message} (cost {free_cost:.6g} -> {cost_held:.6g}, +{rise:.3g} "
+                    + (f"within the {tol:.3g} allowed)" if rise <= tol else
+                       f"above the {tol:.3g} allowed, held anyway: hold_undetermined='always')"))
 
     # assemble in the order of `free`
     n_act = len(active)
@@ -523,4 +581,5 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         converged=bool(converged), message=message, starts=records, identifiability=ident,
         noise_estimated=estimated, noise_scale=float(noise_scale), held=list(held), free=list(free),
         band_hz=res.band_hz, temperatures_c=res.temperatures_c, elapsed_s=time.perf_counter() - t0, goodness_of_fit=gof,
+        holds=holds,
     )

@@ -305,6 +305,61 @@ class Identifiability:
 
 
 @dataclass(frozen=True)
+class HoldRecord:
+    """What holding undetermined parameters at their start values cost the fit.
+
+    One record per hold step of :func:`~physmodel.estimation.lsq.fit_parameters` (one step holds
+    every parameter pinned at a bound at once, else the worst other one), cumulative: ``names``
+    are all the parameters held after the step, ``cost_before`` is the best fit with every
+    parameter free, ``cost_after`` the refit with ``names`` held.  The step is ``accepted`` when
+    cost_after − cost_before <= ``threshold``
+    (:func:`~physmodel.estimation.residuals.hold_cost_tolerance`); a refused step is undone and
+    the un-held fit kept.
+
+    Parameters
+    ----------
+    names : tuple of str
+        The parameters held (cumulatively) in this step.
+    added : tuple of str
+        The ones this step added.
+    cost_before, cost_after : float
+        ½Σr² with every parameter free and with ``names`` held. [-]
+    threshold : float
+        The largest cost increase accepted. [-]
+    accepted : bool
+        Whether the hold was taken.
+    reason : str
+        The test and its outcome, in words.
+    """
+
+    names: tuple
+    added: tuple
+    cost_before: float
+    cost_after: float
+    threshold: float
+    accepted: bool
+    reason: str
+
+    @property
+    def increase(self) -> float:
+        """cost_after − cost_before. [-]"""
+        return self.cost_after - self.cost_before
+
+    @property
+    def within_test(self) -> bool:
+        """The cost increase passes the test (``accepted`` without it: ``hold_undetermined="always"``)."""
+        return self.increase <= self.threshold
+
+    def to_dict(self) -> dict:
+        """The record as JSON-ready data (non-finite numbers as None)."""
+        num = lambda v: float(v) if math.isfinite(v) else None  # noqa: E731
+        return {"names": list(self.names), "added": list(self.added), "cost_before": num(self.cost_before),
+                "cost_after": num(self.cost_after), "increase": num(self.increase),
+                "threshold": num(self.threshold), "accepted": bool(self.accepted),
+                "within_test": bool(self.within_test), "reason": self.reason}
+
+
+@dataclass(frozen=True)
 class SensitivityProbe:
     """A wide-band evaluation used to locate where each parameter acts.
 
@@ -371,6 +426,12 @@ class CalibrationResult:
         Wall time of the calibration. [s]
     metadata : dict
         Provenance (data source, base set, settings).
+    goodness_of_fit : GoodnessOfFit or None
+        The χ² test of the final cost (:func:`~physmodel.estimation.residuals.goodness_of_fit`).
+    holds : list of HoldRecord
+        Every hold step tried, with the cost before (all free) and after; the last one refused
+        (if any) was undone: its ``added`` parameters keep their fitted value (often at a bound)
+        without being determined (:attr:`hold_refused`).
     """
 
     names: list
@@ -399,6 +460,32 @@ class CalibrationResult:
     elapsed_s: float
     metadata: dict = field(default_factory=dict)
     goodness_of_fit: object = None    # physmodel.estimation.residuals.GoodnessOfFit
+    holds: list = field(default_factory=list)
+
+    @property
+    def hold(self) -> HoldRecord | None:
+        """The last hold step (the one that decided), or None when nothing was held."""
+        return self.holds[-1] if self.holds else None
+
+    @property
+    def hold_refused(self) -> list:
+        """Undetermined parameters left free because holding them would worsen the fit beyond the
+        test (their value is the fit's, often at a bound; their interval is not a valid 95 % one)."""
+        last = self.hold
+        return [] if last is None or last.accepted else [n for n in last.added if n not in self.held]
+
+    def hold_line(self) -> str:
+        """One sentence on the hold: what it cost and whether it was taken ("" when none)."""
+        h = self.hold
+        if h is None:
+            return ""
+        if h.accepted:
+            return (f"held {', '.join(h.names)} at the start value: cost {h.cost_before:.5g} -> {h.cost_after:.5g} "
+                    + (f"(+{h.increase:.3g}, within the +{h.threshold:.3g} allowed)" if h.within_test else
+                       f"(+{h.increase:.3g}, ABOVE the +{h.threshold:.3g} allowed: held anyway, hold_undetermined='always')"))
+        return (f"hold of {', '.join(h.added)} REFUSED: holding at the start value would raise the cost "
+                f"{h.cost_before:.5g} -> {h.cost_after:.5g} (+{h.increase:.3g}, above the +{h.threshold:.3g} allowed); "
+                f"the un-held fit is kept and {', '.join(h.added)} reported as not determined")
 
     @property
     def adequate(self) -> bool:
@@ -407,8 +494,8 @@ class CalibrationResult:
 
     @property
     def determined(self) -> list:
-        """The free parameters the data determine (``names`` without ``held``)."""
-        return [n for n in self.names if n not in self.held]
+        """The free parameters the data determine (``names`` without ``held`` and ``hold_refused``)."""
+        return [n for n in self.names if n not in self.held and n not in self.hold_refused]
 
     def summary(self) -> str:
         """A plain-text report: convergence, data, cost against its expectation, and each
@@ -424,6 +511,7 @@ class CalibrationResult:
             f"{self.elapsed_s:.2f} s",
             *([f"  goodness of fit: {'adequate' if self.adequate else 'INADEQUATE'} — {self.goodness_of_fit.reason}"]
               if self.goodness_of_fit is not None else []),
+            *([f"  hold: {self.hold_line()}"] if self.holds else []),
             f"  {'parameter':34s} {'value':>12s} {'95 % interval':>27s}  status",
         ]
         for n in self.names:
@@ -433,6 +521,10 @@ class CalibrationResult:
             else:
                 ci = f"[{self.ci_lower[n]:.5g}, {self.ci_upper[n]:.5g}]"
                 ok = n not in self.identifiability or self.identifiability[n].identifiable
+                if n in self.hold_refused:
+                    lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci + ' (not valid)':>27s}  "
+                                 f"NOT DETERMINED (hold refused): {ident.reason}")
+                    continue
                 lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci:>27s}  {'ok' if ok else 'NOT ASSESSED (model inadequate)'}")
         return "\n".join(lines)
 
@@ -450,7 +542,7 @@ class CalibrationResult:
             "parameters": [
                 {"name": n, "value": num(self.values[n]), "stderr": num(self.stderr[n]),
                  "ci95_lower": num(self.ci_lower[n]), "ci95_upper": num(self.ci_upper[n]),
-                 "held": n in self.held,
+                 "held": n in self.held, "hold_refused": n in self.hold_refused,
                  "identifiable": bool(self.identifiability[n].identifiable) if n in self.identifiability else None,
                  "reason": self.identifiability[n].reason if n in self.identifiability else "",
                  "sensitivity_peak_hz": (num(self.identifiability[n].sensitivity_peak_hz)
@@ -469,6 +561,7 @@ class CalibrationResult:
                         "nfev": s.nfev, "status": s.status, "message": s.message} for s in self.starts],
             "elapsed_s": float(self.elapsed_s),
             "goodness_of_fit": self.goodness_of_fit.to_dict() if self.goodness_of_fit is not None else None,
+            "holds": [h.to_dict() for h in self.holds],
             "metadata": {k: str(v) for k, v in self.metadata.items()},
         }
 
