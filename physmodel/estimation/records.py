@@ -1,7 +1,8 @@
 """Records of the least-squares engine (:mod:`physmodel.estimation.lsq`): what is free
 (:class:`FreeParameter`), how a start went (:class:`StartRecord`), what the data determine
-(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`); with the engine's
-array helpers (:class:`ScaledRows`, :class:`ModelBatch`).  Physical units throughout.
+(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`; what holding cost:
+:class:`~physmodel.estimation.identifiability.HoldRecord`).  The engine's array helpers are in
+:mod:`physmodel.estimation.batching`.  Physical units throughout.
 """
 
 from __future__ import annotations
@@ -11,12 +12,16 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..data.files import atomic_write
-from ..errors import IPMCError, ParameterError
+from ..errors import ParameterError
 from ..params import IPMCParameters
+
+if TYPE_CHECKING:
+    from .identifiability import HoldRecord
 
 Values = Mapping[str, float]
 
@@ -154,74 +159,6 @@ def lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
     return lo + u * (hi - lo)
 
 
-class ScaledRows:
-    """Physical rows (n_sets, n_free) of parameter values: ``x_full`` [each parameter's SI unit]
-    with the ``active`` columns of ``free`` at scaled coordinates ``Z`` (n_sets, n_active) [-];
-    :meth:`FreeParameter.from_z` vectorised over sets and parameters."""
-
-    def __init__(self, free, x_full: np.ndarray, active: Sequence[int]):
-        act = [free[k] for k in active]
-        self.x_full, self.active = np.asarray(x_full, dtype=float), np.asarray(active, dtype=int)
-        self.log = np.array([fp.scale == "log" for fp in act])
-        self.sign = np.array([fp.sign for fp in act])
-        self.lower = np.array([fp.lower for fp in act])
-        self.span = np.array([fp.upper - fp.lower for fp in act])
-
-    def __call__(self, Z: np.ndarray) -> np.ndarray:
-        X = np.repeat(self.x_full[None, :], len(Z), axis=0)
-        # clipped as in FreeParameter.from_z, so that the interval of an undetermined parameter stays finite
-        X[:, self.active] = np.where(self.log, self.sign * 10.0 ** np.clip(Z, -300.0, 300.0), self.lower + Z * self.span)
-        return X
-
-
-class ModelBatch:
-    """A predictor called on rows of physical values of ``free`` (n_sets, n_free) [SI] ->
-    (n_sets, N) complex responses, through ``predict_array`` (one call, no per-set Python) or else
-    ``predict_many``/``predict`` with one values dict per set (``fixed`` added); counts the
-    parameter sets evaluated (``evaluations``) and the calls (``calls``)."""
-
-    def __init__(self, free, fixed: dict, predict, predict_many, predict_array, probe, n_lines: int):
-        self.names = [fp.name for fp in free]
-        self.fixed, self.n_lines, self.probe_ = fixed, n_lines, probe
-        self.predict, self.predict_many, self.predict_array = predict, predict_many, predict_array
-        self.evaluations = 0
-        self.calls = 0
-
-    def jacobian_plan(self, active) -> dict:
-        """The predictor's known Jacobian columns (``predict_array.jacobian_plan``: {k: ("scaled",
-        j, c) | ("constant", dlnG)} over ``free``) re-indexed to the ``active`` columns."""
-        plan = getattr(self.predict_array, "jacobian_plan", None) or {}
-        pos = {int(k): i for i, k in enumerate(active)}
-        return {pos[k]: (p if p[0] == "constant" else ("scaled", pos[p[1]], p[2])) for k, p in plan.items()
-                if k in pos and (p[0] == "constant" or (p[1] in pos and p[1] not in plan))}
-
-    def _dicts(self, X):
-        return [dict(self.fixed, **dict(zip(self.names, map(float, row)))) for row in X]
-
-    def __call__(self, X: np.ndarray) -> np.ndarray:
-        n_sets = len(X)
-        self.evaluations += n_sets
-        self.calls += n_sets if self.predict_array is None and self.predict_many is None else 1
-        if self.predict_array is not None:
-            out = np.asarray(self.predict_array(X), dtype=complex)
-        elif self.predict_many is not None:
-            out = np.asarray(self.predict_many(self._dicts(X)), dtype=complex)
-        else:
-            out = np.stack([np.asarray(self.predict(v), dtype=complex).reshape(-1) for v in self._dicts(X)])
-        if out.shape != (n_sets, self.n_lines):
-            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(n_sets, self.n_lines)} "
-                            "(one complex value per data line and parameter set)")
-        return out
-
-    def probe(self, X: np.ndarray) -> np.ndarray:
-        """The :class:`SensitivityProbe`'s responses (n_sets, n_f) at the rows of ``X``."""
-        self.calls += 1
-        self.evaluations += len(X)
-        if self.probe_.predict_array is not None:
-            return np.asarray(self.probe_.predict_array(X), dtype=complex)
-        return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
-
-
 # =============================================================================== scalar data
 @dataclass(frozen=True)
 class ScalarObservations:
@@ -305,61 +242,6 @@ class Identifiability:
 
 
 @dataclass(frozen=True)
-class HoldRecord:
-    """What holding undetermined parameters at their start values cost the fit.
-
-    One record per hold step of :func:`~physmodel.estimation.lsq.fit_parameters` (one step holds
-    every parameter pinned at a bound at once, else the worst other one), cumulative: ``names``
-    are all the parameters held after the step, ``cost_before`` is the best fit with every
-    parameter free, ``cost_after`` the refit with ``names`` held.  The step is ``accepted`` when
-    cost_after − cost_before <= ``threshold``
-    (:func:`~physmodel.estimation.residuals.hold_cost_tolerance`); a refused step is undone and
-    the un-held fit kept.
-
-    Parameters
-    ----------
-    names : tuple of str
-        The parameters held (cumulatively) in this step.
-    added : tuple of str
-        The ones this step added.
-    cost_before, cost_after : float
-        ½Σr² with every parameter free and with ``names`` held. [-]
-    threshold : float
-        The largest cost increase accepted. [-]
-    accepted : bool
-        Whether the hold was taken.
-    reason : str
-        The test and its outcome, in words.
-    """
-
-    names: tuple
-    added: tuple
-    cost_before: float
-    cost_after: float
-    threshold: float
-    accepted: bool
-    reason: str
-
-    @property
-    def increase(self) -> float:
-        """cost_after − cost_before. [-]"""
-        return self.cost_after - self.cost_before
-
-    @property
-    def within_test(self) -> bool:
-        """The cost increase passes the test (``accepted`` without it: ``hold_undetermined="always"``)."""
-        return self.increase <= self.threshold
-
-    def to_dict(self) -> dict:
-        """The record as JSON-ready data (non-finite numbers as None)."""
-        num = lambda v: float(v) if math.isfinite(v) else None  # noqa: E731
-        return {"names": list(self.names), "added": list(self.added), "cost_before": num(self.cost_before),
-                "cost_after": num(self.cost_after), "increase": num(self.increase),
-                "threshold": num(self.threshold), "accepted": bool(self.accepted),
-                "within_test": bool(self.within_test), "reason": self.reason}
-
-
-@dataclass(frozen=True)
 class SensitivityProbe:
     """A wide-band evaluation used to locate where each parameter acts.
 
@@ -429,7 +311,7 @@ class CalibrationResult:
     goodness_of_fit : GoodnessOfFit or None
         The χ² test of the final cost (:func:`~physmodel.estimation.residuals.goodness_of_fit`).
     holds : list of HoldRecord
-        Every hold step tried, with the cost before (all free) and after; the last one refused
+        (:class:`~physmodel.estimation.identifiability.HoldRecord`) Every hold step tried, with the cost before (all free) and after; the last one refused
         (if any) was undone: its ``added`` parameters keep their fitted value (often at a bound)
         without being determined (:attr:`hold_refused`).
     """
@@ -471,21 +353,13 @@ class CalibrationResult:
     def hold_refused(self) -> list:
         """Undetermined parameters left free because holding them would worsen the fit beyond the
         test (their value is the fit's, often at a bound; their interval is not a valid 95 % one)."""
-        last = self.hold
-        return [] if last is None or last.accepted else [n for n in last.added if n not in self.held]
+        from .identifiability import refused_names
+
+        return refused_names(self.holds, self.held)
 
     def hold_line(self) -> str:
         """One sentence on the hold: what it cost and whether it was taken ("" when none)."""
-        h = self.hold
-        if h is None:
-            return ""
-        if h.accepted:
-            return (f"held {', '.join(h.names)} at the start value: cost {h.cost_before:.5g} -> {h.cost_after:.5g} "
-                    + (f"(+{h.increase:.3g}, within the +{h.threshold:.3g} allowed)" if h.within_test else
-                       f"(+{h.increase:.3g}, ABOVE the +{h.threshold:.3g} allowed: held anyway, hold_undetermined='always')"))
-        return (f"hold of {', '.join(h.added)} REFUSED: holding at the start value would raise the cost "
-                f"{h.cost_before:.5g} -> {h.cost_after:.5g} (+{h.increase:.3g}, above the +{h.threshold:.3g} allowed); "
-                f"the un-held fit is kept and {', '.join(h.added)} reported as not determined")
+        return "" if self.hold is None else self.hold.line()
 
     @property
     def adequate(self) -> bool:

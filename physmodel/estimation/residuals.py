@@ -141,65 +141,6 @@ def goodness_of_fit(cost: float, n_residuals: int, n_parameters: int, noise_esti
                          f"above {MAX_ESTIMATED_RELATIVE_NOISE:g} this is a misfit, not noise: the model does not fit the data"))
 
 
-#: Confidence level of the hold test (:func:`hold_cost_tolerance`).
-HOLD_LEVEL = 0.95
-
-
-def hold_cost_tolerance(k: int, free_fit: GoodnessOfFit, level: float = HOLD_LEVEL) -> tuple[float, str]:
-    """The largest cost increase an identifiability hold may cause: holding ``k`` parameters at
-    their start values is accepted when cost_held − cost_free stays within it.
-
-    Holding k parameters is a restriction of the free fit by k dimensions.  If the start values
-    are consistent with the data, 2·(cost_held − cost_free) is a likelihood-ratio statistic
-    distributed as χ²(k) (Wilks), so the hold is accepted when it stays below the ``level``
-    quantile of χ²(k): the start values lie inside the joint ``level`` likelihood-ratio confidence
-    region of the free fit, i.e. the data do not reject them.  This is the χ² machinery of
-    :func:`goodness_of_fit` applied to the difference of two costs rather than to one cost; the
-    alternative "a few cost_std" would scale with sqrt(number of residuals) and allow a hold that
-    the data reject by dozens of standard errors on a long sweep.
-
-    When the χ² scale is not the declared noise — estimated noise (fallback σ) or a free fit that
-    fails its goodness-of-fit test (the declared σ are too small for this model) — the difference
-    is measured in units of the free fit's residual variance s² = χ²/dof (the Birge ratio
-    squared, as ``physmodel.estimation.calibration.apply_misfit_policy`` widens intervals):
-    the F test, Δcost ≤ ½·s²·k·F_level(k, dof).
-
-    Parameters
-    ----------
-    k : int
-        Number of parameters held (cumulatively, relative to the free fit), >= 1.
-    free_fit : GoodnessOfFit
-        The goodness of fit of the fit with every parameter free.
-    level : float
-        Confidence level of the test. [-]
-
-    Returns
-    -------
-    tolerance : float
-        The largest allowed increase of the cost ½Σr². [-]
-    rule : str
-        How it was obtained, for messages.
-    """
-    from scipy.stats import chi2 as chi2_dist
-    from scipy.stats import f as f_dist
-
-    k = int(k)
-    if k < 1:
-        raise IPMCError(f"a hold test needs k >= 1 held parameters, got {k}")
-    declared = free_fit.p_value is not None
-    s2 = free_fit.reduced_chi2
-    if (declared and free_fit.adequate) or free_fit.dof <= 0 or not (math.isfinite(s2) and s2 > 0):
-        q = float(chi2_dist.ppf(level, k))
-        return 0.5 * q, (f"half the {level:g} quantile of chi2({k}), {q:.3g}: the likelihood-ratio test of the "
-                         "held values against the free fit")
-    if declared:
-        s2 = max(s2, 1.0)
-    q = float(k * f_dist.ppf(level, k, free_fit.dof))
-    why = "estimated noise" if not declared else "the free fit does not fit within the declared noise"
-    return 0.5 * s2 * q, (f"half of s2·k·F_{level:g}({k}, {free_fit.dof}) = {s2:.3g}·{q:.3g} ({why}: the cost "
-                          "difference is scaled by the free fit's residual variance s2)")
-
-
 class SweepResiduals:
     """The least-squares engine's view of a :class:`~physmodel.data.sweep.FrequencySweep`: 2N
     residuals ``[ln|G_d/G_m|/σ_ln, arg(G_d/G_m)/σ_φ]`` of N complex predictions per set, and the
