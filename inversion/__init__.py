@@ -60,7 +60,9 @@ Examples and toy models (:mod:`inversion.examples`)
 Limits (:mod:`inversion.limits`)
     Limits(max_voltage=None, max_rate=None, output_range=None, action="error"|"warn")
     check_limits(signal, t, limits, what=...) -> LimitReport (first violating sample);
-    LimitError, LimitWarning; feedforward(..., limits=Limits(max_voltage=3))
+    LimitError, LimitWarning; DEFAULT_MAX_VOLTAGE (3 V): feedforward(...) refuses a drive beyond it
+    unless told otherwise (limits=Limits(max_voltage=2.5, max_rate=50), or limits="off");
+    input_unit="mV" for a model whose input is in mV.  invert() checks no limit.
 
 References (:mod:`inversion.references`)
     sine, multitone, smoothed_steps, from_file, fade -> Reference (t, y, fade windows)
@@ -89,7 +91,7 @@ from .batch import (
     resolve_preview,
     sampling_interval,
 )
-from .limits import LimitError, Limits, LimitWarning, check_limits
+from .limits import DEFAULT_MAX_VOLTAGE, LimitError, Limits, LimitWarning, check_limits
 from .preview import DEFAULT_PREVIEW_TOL, frequency_preview
 from .scheduled import (
     ScheduledInversionResult,
@@ -102,6 +104,7 @@ from .split import InverseSplit, model_coefficients, split_inverse
 from .streaming import StreamingInverter
 
 __all__ = [
+    "DEFAULT_MAX_VOLTAGE",
     "DEFAULT_PREVIEW_TOL",
     "LimitError",
     "LimitWarning",

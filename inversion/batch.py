@@ -257,6 +257,11 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     record; both parts of the inverse are discretised exactly for that signal (see
     :mod:`inversion._discrete`).  Taper or pad records that do not start and end near zero,
     or discard the first few stable time constants and the last ``T_p*`` seconds.
+
+    ``invert`` checks no limit: it is the generic inverse and does not know whether its output
+    is a voltage (actuator) or a displacement (sensor decoding).  For a drive use
+    :func:`feedforward` (3 V limit by default); for decoding, :func:`decode_sensor` (limits on
+    request); or :func:`inversion.limits.check_limits` on ``result.output``.
     """
     split = _as_split(model, improper, filter_bandwidth)
     ua = _signal(u)
@@ -417,16 +422,51 @@ def decode_sensor(model: Any, t: Any, current: Any, *, limits: Any = None,
     return _with_limits(invert(model, t, current, **kwargs), limits, "decoded signal", "")
 
 
-def feedforward(model: Any, t: Any, desired: Any, *, limits: Any = None,
+def feedforward(model: Any, t: Any, desired: Any, *, limits: Any = "default", input_unit: str = "V",
                 **kwargs: Any) -> InversionResult:
     """Actuator feedforward: the input (e.g. voltage) that makes the output follow ``desired``.
 
     ``model`` maps actuator input -> output (seed 001: voltage [V] -> tip displacement [mm]).
     Same code path and keyword arguments as :func:`invert`; ``result.output`` is the
-    feedforward input.  ``limits`` (:class:`inversion.limits.Limits`, e.g.
-    ``Limits(max_voltage=2.5, max_rate=50)``) refuses (``LimitError``) or warns with the
-    first violating sample; ``result.limit_report`` holds the peak voltage and rate.
-    Build ``desired`` with :mod:`inversion.references` (fade-in and fade-out) so that the
-    noncausal inverse does not see a jump to zero at the record's ends.
+    feedforward input.  Build ``desired`` with :mod:`inversion.references` (fade-in and
+    fade-out) so that the noncausal inverse does not see a jump to zero at the record's ends.
+
+    Safe by default: the drive is checked against limits and a violation refused
+    (:class:`~inversion.limits.LimitError`, naming the first violating sample) or, with
+    ``action="warn"``, warned about; ``result.limit_report`` holds the peak voltage and rate and
+    the limits checked.
+
+    Parameters
+    ----------
+    model : control.TransferFunction, control.StateSpace, (num, den) or InverseSplit
+        The actuator model G(s), input (voltage) -> output (e.g. tip displacement), s in rad/s.
+    t : array_like or float
+        Uniform time stamps [s], or the sampling interval [s] (as :func:`invert`).
+    desired : array_like
+        The output to follow [model output units, e.g. mm].
+    limits : "default", None, "off" or Limits
+        ``"default"`` (or None, or omitted): ``|V| <=``
+        :data:`~inversion.limits.DEFAULT_MAX_VOLTAGE` (3 V, as ``ipmc feedforward``), converted
+        to ``input_unit``.  A :class:`~inversion.limits.Limits` is used as given, in the model's
+        input unit (e.g. ``Limits(max_voltage=2.5, max_rate=50)``; ``Limits()`` checks nothing
+        and only measures the peaks).  ``"off"``: no limit (the peaks are still measured).
+        None meant "no limit" before the 3 V default; it now means "not given".
+    input_unit : str
+        The unit of the model's input, i.e. of ``result.output`` (default ``"V"``).  A transfer
+        function carries no unit, so this cannot be inferred: for a surrogate fitted in mV per
+        mm (``surrogate.labels["input_unit"]``) pass ``input_unit="mV"`` so that the default
+        limit is 3000 mV, not 3 mV.  Only the default limit and the messages use it.
+    **kwargs
+        As :func:`invert` (``preview``, ``improper``, ...).
     """
-    return _with_limits(invert(model, t, desired, **kwargs), limits, "feedforward voltage", "V")
+    from .limits import Limits, default_drive_limits
+
+    if limits is None or (isinstance(limits, str) and limits == "default"):
+        lim: Limits | None = default_drive_limits(input_unit)
+    elif isinstance(limits, str) and limits == "off":
+        lim = None
+    elif isinstance(limits, Limits):
+        lim = limits
+    else:
+        raise InversionError(f"limits={limits!r}: expected 'default' (3 V), 'off' or an inversion.limits.Limits")
+    return _with_limits(invert(model, t, desired, **kwargs), lim, "feedforward voltage", input_unit)

@@ -9,6 +9,10 @@ finds the first sample that violates each one, and either refuses (:class:`Limit
 ``inversion.feedforward(..., limits=Limits(max_voltage=2.5, max_rate=50))`` and
 ``inversion.decode_sensor(..., limits=Limits(output_range=(-2, 2)))`` apply them to
 ``result.output``; the report is ``result.limit_report``.
+
+Safe by default: :func:`inversion.feedforward` without ``limits`` refuses a drive beyond
+:data:`DEFAULT_MAX_VOLTAGE` (3 V, also ``ipmc feedforward --max-voltage``'s default); dropping it
+takes an explicit ``limits="off"`` (or ``Limits()``, which only measures the peaks).
 """
 
 from __future__ import annotations
@@ -22,9 +26,15 @@ import numpy as np
 
 from ._errors import InversionError
 
-__all__ = ["Limits", "LimitReport", "LimitViolation", "LimitError", "LimitWarning", "check_limits"]
+__all__ = ["Limits", "LimitReport", "LimitViolation", "LimitError", "LimitWarning", "check_limits",
+           "DEFAULT_MAX_VOLTAGE", "default_drive_limits"]
 
 _ACTIONS = ("error", "warn")
+
+#: The drive voltage an IPMC strip is assumed to tolerate when nothing else is said: the default
+#: ``max_voltage`` of :func:`inversion.feedforward` and of ``ipmc feedforward --max-voltage``, and
+#: the level above which ``ipmc excite`` warns. [V]
+DEFAULT_MAX_VOLTAGE = 3.0
 
 
 class LimitError(InversionError):
@@ -136,6 +146,8 @@ class LimitReport:
         ``max|d output/dt|`` [output units / s].
     message : str
         Human-readable summary ("" when ok).
+    limits : Limits or None
+        The limits checked (None: none, the peaks were only measured).
     """
 
     ok: bool
@@ -143,6 +155,7 @@ class LimitReport:
     peak: float = 0.0
     peak_rate: float = 0.0
     message: str = ""
+    limits: Limits | None = None
 
 
 def check_limits(y: Any, dt: float, limits: Limits | None, *, t0: float = 0.0,
@@ -177,7 +190,7 @@ def check_limits(y: Any, dt: float, limits: Limits | None, *, t0: float = 0.0,
     peak = float(np.max(np.abs(ya)))
     peak_rate = float(np.max(rate)) if rate.size else 0.0
     if limits is None or limits.empty:
-        return LimitReport(True, [], peak, peak_rate, "")
+        return LimitReport(True, [], peak, peak_rate, "", limits)
     found: list[LimitViolation] = []
 
     def first(mask: np.ndarray, values: np.ndarray, kind: str, bound: Any, offset: int = 0) -> None:
@@ -197,11 +210,36 @@ def check_limits(y: Any, dt: float, limits: Limits | None, *, t0: float = 0.0,
         first((ya < lo) | (ya > hi), ya, "output_range", lambda i: lo if ya[i] < lo else hi)
     found.sort(key=lambda v: v.index)
     if not found:
-        return LimitReport(True, [], peak, peak_rate, "")
+        return LimitReport(True, [], peak, peak_rate, "", limits)
     msg = "; ".join(v.describe(what, unit) for v in found)
     msg += f" (peak {peak:.4g} {unit}, peak rate {peak_rate:.4g} {unit}/s)"
     if limits.action == "error":
         raise LimitError(msg + ": refused. Check the model, use a longer preview or preview='inf', "
                          "lower the reference, or relax the limits (action='warn' to proceed).")
     warnings.warn(LimitWarning(msg), stacklevel=3)
-    return LimitReport(False, found, peak, peak_rate, msg)
+    return LimitReport(False, found, peak, peak_rate, msg, limits)
+
+
+def default_drive_limits(input_unit: str = "V", action: str = "error") -> Limits:
+    """The default drive limit, ``|V| <= DEFAULT_MAX_VOLTAGE``, in a model's input unit.
+
+    Parameters
+    ----------
+    input_unit : str
+        The unit of the drive signal (the actuator model's input), a voltage unit of
+        :data:`physmodel.data.units.UNITS` (``"V"``, ``"mV"``, ...).
+    action : {"error", "warn"}
+        As :class:`Limits`.
+
+    Returns
+    -------
+    Limits
+        ``Limits(max_voltage=DEFAULT_MAX_VOLTAGE / scale)`` with ``scale`` the size of
+        ``input_unit`` in volts (3000 for mV).
+    """
+    from physmodel.data.units import UNITS
+
+    if input_unit not in UNITS or UNITS[input_unit][0] != "voltage":
+        volts = sorted(u for u, (q, _) in UNITS.items() if q == "voltage")
+        raise InversionError(f"input_unit={input_unit!r}: the drive's unit must be a voltage unit, one of {volts}")
+    return Limits(max_voltage=DEFAULT_MAX_VOLTAGE / UNITS[input_unit][1], action=action)

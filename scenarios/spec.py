@@ -146,7 +146,7 @@ SECTIONS = {
     "surrogate": {"form": _choice(*FORMS), "n_zeros": INT, "n_poles": INT,
                   "degree": INT, "method": _choice("joint", "two-stage"), "weighting": STR},
     "inversion": {"preview": NUM_OR_STR, "fs_hz": NUM, "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM,
-                  "lead_s": NUM, "ramp_s": NUM,
+                  "lead_s": NUM, "ramp_s": NUM, "max_voltage_v": NUM_OR_STR,
                   "experiments": _List({"name": STR, "temperature_c": NUM, "stimulus": _choice("sine", "release"),
                                         "amplitude_mm": NUM, "frequencies_hz": NUMS, "model_temperature_c": NUM,
                                         "t_release_s": NUM, "noise_rms": NUM, "seed": INT,
@@ -336,6 +336,11 @@ def _check_values(data: dict, where: str) -> None:
         for key in ("settle_s", "end_margin_s", "lead_s", "ramp_s"):
             if key in inv:
                 need(0 <= inv[key] < dur, "inversion", key, inv[key], f"in [0, duration_s = {dur:g}) s")
+        mv = inv.get("max_voltage_v")             # default inversion.limits.DEFAULT_MAX_VOLTAGE
+        if isinstance(mv, str):
+            need(mv == "off", "inversion", "max_voltage_v", mv, "a voltage > 0 [V] or 'off'")
+        elif mv is not None:
+            need(math.isfinite(mv) and mv > 0, "inversion", "max_voltage_v", mv, "a voltage > 0 [V] or 'off'")
         pv = inv.get("preview", "inf")
         if isinstance(pv, str):
             need(pv in ("inf", "auto", "4/r0"), "inversion", "preview", pv, "'inf', 'auto', '4/r0' or seconds")

@@ -215,7 +215,7 @@ def _stimulus(exp: dict, t: np.ndarray, lead: float = 0.0, ramp: float = 0.0) ->
 
 
 def step_inversion(ctx: _Ctx):
-    from inversion import decode_sensor, feedforward
+    from inversion import Limits, decode_sensor, feedforward
     from physmodel.data.timesim import free_release, simulate, time_grid
 
     from . import plots
@@ -233,8 +233,12 @@ def step_inversion(ctx: _Ctx):
     is_act = ctx.spec.section("model")["kind"] == "actuator"
     if is_act != (_quantity(ctx) == "M") or (not is_act and _quantity(ctx) != "S"):
         raise ScenarioError(f"{ctx.spec.path}: [inversion] needs quantity M (actuator) or S (sensor)")
+    # the drive limit: inversion's default (3 V) unless the scenario states one, or "off" for a
+    # virtual plant that takes any voltage
+    mv = cfg.get("max_voltage_v")
+    limits = "default" if mv is None else "off" if mv == "off" else Limits(max_voltage=float(mv))
     t = time_grid(dur, fs)
-    rows = []
+    rows, peaks = [], []
     for exp in cfg["experiments"]:
         T = exp["temperature_c"]
         Tm = exp.get("model_temperature_c", T)
@@ -244,7 +248,9 @@ def step_inversion(ctx: _Ctx):
             if stim != "sine":
                 raise ScenarioError(f"{ctx.spec.path}: experiment {exp['name']!r}: actuators track sines only")
             ref = _stimulus(exp, t, lead, ramp)                               # mm
-            u = feedforward(G, t, ref, preview=preview).output                # V
+            ff = feedforward(G, t, ref, preview=preview, limits=limits)
+            u = ff.output                                                     # V
+            peaks.append(ctx.metric(f"inversion.{_slug(exp['name'])}.peak_voltage_v", ff.limit_report.peak))
             got = simulate(ctx.model, T, t, u).output * 1e3                    # m -> mm
             labels = ("reference", "tip displacement (physics plant)")
         else:
@@ -288,8 +294,17 @@ def step_inversion(ctx: _Ctx):
         rows.append((exp["name"], f"{T:g}", f"{Tm:g}", f"{emax:.4f}", f"{emax / exp['amplitude_mm']:.3f}", f"![]({png})"))
     what = "feedforward (desired tip displacement → voltage) applied to the physics plant" if is_act else \
         "sensor decoding (short-circuit current → tip displacement) of the physics sensor's output"
+    drive = ""
+    if is_act:
+        from inversion.limits import DEFAULT_MAX_VOLTAGE
+
+        top = max(peaks)
+        drive = (f" Drive limit: {'off (a virtual plant takes any voltage)' if mv == 'off' else f'{mv:g} V' if mv is not None else f'{DEFAULT_MAX_VOLTAGE:g} V (the default)'}; "
+                 f"peak drive {top:.3g} V" + (f" — **above the {DEFAULT_MAX_VOLTAGE:g} V a strip takes: not for a real strip**"
+                                               if top > DEFAULT_MAX_VOLTAGE else "") + ".")
     ctx.section("Stable inversion", f"{what}; preview {preview}; {fs:g} Hz, {dur:g} s records; error bound = "
-                f"max |error| over {settle:g}–{t[-1] - margin:g} s unless the experiment sets its own window (shaded).", "",
+                f"max |error| over {settle:g}–{t[-1] - margin:g} s unless the experiment sets its own window (shaded)."
+                + drive, "",
                 _md_table(["experiment", "plant T [°C]", "model T [°C]", "max |error| [mm]", "relative", "traces"], rows))
 
 

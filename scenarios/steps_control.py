@@ -40,7 +40,7 @@ def step_control_route(ctx) -> None:
     import physmodel
     import surrogate
     from inversion import feedforward
-    from inversion.limits import Limits
+    from inversion.limits import DEFAULT_MAX_VOLTAGE, Limits
     from inversion.references import sine
     from physmodel.data.sweep import synthesize_sweep
     from physmodel.data.timesim import model_realization, simulate
@@ -90,7 +90,7 @@ def step_control_route(ctx) -> None:
     ref = sine(A, fr, cfg.get("duration_s", max(8.0 / fr, 4.0)), fs, unit="mm")
     real = model_realization(truth, T_ff, fs, ref.t[-1])
     P = truth.frequency_response(np.array([fr]), [T_ff])["M"][0, 0, 0] * 1e3      # mm/V
-    lim = Limits(max_voltage=cfg.get("max_voltage_v", 3.0), action="warn")
+    lim = Limits(max_voltage=cfg.get("max_voltage_v", DEFAULT_MAX_VOLTAGE), action="warn")
     rows = []
     for name, res in (("direct", direct), ("route", route)):
         G = res.model.at(T_ff)

@@ -196,7 +196,7 @@ def _jacobian_plan(smap: StateMap, free: list, predict_array, inv_T) -> dict:
 def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParameters,
               free: Sequence[FreeParameter | str], *, kind: str = "actuator", quantity: str | None = None,
               starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
-              identify: bool = True, hold_undetermined: bool = True, name: str | None = None,
+              identify: bool = True, hold_undetermined: bool | str = True, name: str | None = None,
               progress: Callable[[int], None] | None = None, misfit: str = "widen",
               effects: Mapping[str, Mapping[str, float]] | None = None, **kwargs) -> CalibrationResult:
     """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
@@ -281,6 +281,8 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
     src = (f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
            f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"
            + (f"; undetermined (held at base): {', '.join(res.held)}" if res.held else "")
+           + (f"; undetermined, NOT held (holding would worsen the fit beyond its test): {', '.join(res.hold_refused)}"
+              if res.hold_refused else "")
            + f"; base: {base.name}")
     res.parameters = replace(apply_values(base, res.values), name=label, source=src)
     res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
@@ -304,14 +306,20 @@ def apply_misfit_policy(res: CalibrationResult, widen: bool) -> CalibrationResul
         v, lo, hi = res.values[n], res.ci_lower[n], res.ci_upper[n]
         if widen and math.isfinite(R):
             if fp.scale == "log" and v != 0 and lo * v > 0 and hi * v > 0:
-                lo, hi = v * (lo / v) ** R, v * (hi / v) ** R
+                # in log10 and clipped as FreeParameter.from_z does: the interval of an undetermined
+                # parameter (a refused hold) can span hundreds of decades
+                lo, hi = (math.copysign(10.0 ** min(max(math.log10(abs(v)) + R * math.log10(b / v), -300.0), 300.0), v)
+                          for b in (lo, hi))
             else:
                 lo, hi = v - R * (v - lo), v + R * (hi - v)
             res.ci_lower[n], res.ci_upper[n] = min(lo, hi), max(lo, hi)
             res.stderr[n] = res.stderr[n] * R
         else:
             res.ci_lower[n] = res.ci_upper[n] = res.stderr[n] = float("nan")
-        res.identifiability[n] = Identifiability(False, "not assessed: the model does not fit the data (" + gof.reason + ")")
+        was = res.identifiability.get(n)
+        keep = f"{was.reason}; " if n in res.hold_refused and was is not None else ""
+        res.identifiability[n] = Identifiability(False, keep + "not assessed: the model does not fit the data ("
+                                                 + gof.reason + ")")
     res.message += ("; MODEL INADEQUATE: " + gof.reason
                     + ("; intervals widened by the Birge ratio %.3g" % R if widen else "; intervals withheld"))
     return res

@@ -38,14 +38,24 @@ Search and stopping (see ``_solve``)
     :data:`JOIN_COST`·s² of a converged earlier start's and its Gauss–Newton step lands within
     :data:`JOIN_DISTANCE` standard errors of that optimum.
 
-Identifiability (see :func:`fit_parameters`)
+Identifiability (see :func:`fit_parameters`, :mod:`physmodel.estimation.identifiability`)
     From the SVD of the weighted, scaled Jacobian at the optimum a parameter is *undetermined* if
-    its 95 % interval spans more than :data:`MAX_CI_DECADES` decade (log) or more than its bounds
+    its 95 % interval spans more than
+    :data:`~physmodel.estimation.identifiability.MAX_CI_DECADES` decade (log) or more than its bounds
     (linear) — this includes near-null directions of the Jacobian, where se(z) is huge — or if it
     is pinned at a bound.  The reason names where its sensitivity peaks (from an optional
     :class:`SensitivityProbe` over a wide band) relative to the measured band, or the parameter it
     is confounded with.  Undetermined parameters are held at their start value (the base value in
     :func:`calibrate`) and the others refitted; they are reported without an interval.
+
+Holding costs said (see :class:`~physmodel.estimation.identifiability.HoldRecord`)
+    Each hold step is tested against the best fit with every parameter free: the hold is taken only
+    when the cost rises by no more than :func:`~physmodel.estimation.identifiability.hold_cost_tolerance`
+    (half the 0.95 quantile of χ²(k) for k held parameters: a likelihood-ratio test that the start
+    values are consistent with the data).  A parameter pinned at a bound far from its start value
+    fails it: the hold is undone, the un-held fit kept (the parameter at its bound, reported as not
+    determined, its interval not a valid one) and the message says so.  ``result.holds`` records the
+    cost before and after every step.
 
 Temperature-law parameters are named ``"laws.<quantity>.<attribute>"``, e.g.
 ``"laws.d.activation_energy"`` [J/mol] or ``"laws.E.slope"`` [1/K] (see :mod:`physmodel.temperature`);
@@ -64,13 +74,20 @@ from scipy.optimize import least_squares
 
 from ..data.sweep import FrequencySweep
 from ..errors import IPMCError, ParameterError
+from .batching import ModelBatch, ScaledRows
+from .identifiability import (
+    BOUND_TOL,
+    Z95,
+    HoldRecord,
+    flag_parameters,
+    hold_record,
+    refused_identifiability,
+)
 from .observations import ScalarObservations
 from .records import (
     CalibrationResult,
     FreeParameter,
     Identifiability,
-    ModelBatch,
-    ScaledRows,
     SensitivityProbe,
     StartRecord,
     Values,
@@ -78,7 +95,6 @@ from .records import (
 )
 from .residuals import (
     ZERO_REASON,
-    ZERO_SENSITIVITY,
     gauss_newton_covariance,
     goodness_of_fit,
     insensitive,
@@ -86,12 +102,6 @@ from .residuals import (
     tenth_moves,
 )
 
-#: Two-sided 95 % normal quantile.
-Z95 = 1.959963984540054
-#: A log parameter whose 95 % interval spans more decades than this is reported as undetermined.
-MAX_CI_DECADES = 1.0
-#: A parameter closer than this fraction of its scaled range to a bound is "pinned at the bound".
-BOUND_TOL = 1e-3
 #: Forward finite-difference step in the scaled space.
 FD_STEP = 1e-6
 #: A search ends when a Gauss–Newton step would gain less than this (times s², see ``_solve``).
@@ -248,105 +258,6 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     return _Fit(index=-1, z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=count[0], status=status, message=msg)
 
 
-def _sensitivity_peaks(free, active, x_full: np.ndarray, J: np.ndarray, res,
-                       probe: SensitivityProbe | None, batch: ModelBatch, fd_step: float):
-    """Per free parameter: (frequency of peak |∂lnG/∂z| [Hz] (NaN without frequencies), in-band
-    max / overall max)."""
-    out = {}
-    in_band = res.ln_sensitivity(J)        # |∂ ln G/∂z| per line from the weighted Jacobian (N, n_free)
-    band_max = in_band.max(axis=0)
-    if probe is None or res.frequency_hz is None:
-        for j, k in enumerate(active):
-            out[free[k].name] = (float("nan") if res.frequency_hz is None else
-                                 float(res.frequency_hz[np.argmax(in_band[:, j])]), 1.0)
-        return out
-    f = np.asarray(probe.frequency_hz, dtype=float)
-    X = np.repeat(x_full[None, :], len(active) + 1, axis=0)
-    steps = []
-    for j, k in enumerate(active):
-        fp = free[k]
-        z = float(fp.to_z(x_full[k]))
-        step = fd_step * 100 if z + fd_step * 100 <= fp.z_bounds[1] else -fd_step * 100
-        X[j + 1, k] = float(fp.from_z(z + step))
-        steps.append(step)
-    G = batch.probe(X)
-    base = np.log(G[0])
-    fmin, fmax = res.band_hz
-    inside = (f >= fmin) & (f <= fmax)
-    for j, k in enumerate(active):
-        fp = free[k]
-        sens = np.abs((np.log(G[j + 1]) - base) / steps[j])
-        k = int(np.argmax(sens))
-        peak = float(sens[k])
-        frac = float(sens[inside].max() / peak) if np.any(inside) and peak > 0 else float(band_max[j] > 0)
-        out[fp.name] = (float(f[k]), frac)
-    return out
-
-
-def _identifiability(free_all, active, z, J, cov, x_full, res, probe, batch, fd_step):
-    """Flags and reasons for every active free parameter of one fit (no holding here)."""
-    free = [free_all[k] for k in active]
-    se = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
-    corr = cov / np.outer(d, d)
-    peaks = _sensitivity_peaks(free_all, active, x_full, J, res, probe, batch, fd_step)
-    fmin, fmax = res.band_hz
-    report, badness, dead = {}, {}, []
-    for j, fp in enumerate(free):
-        lo, hi = fp.z_bounds
-        width = 2 * Z95 * se[j]
-        if fp.scale == "log":
-            ratio = width / MAX_CI_DECADES
-            spread = f"its 95 % interval would span {width:.3g} decades"
-        else:
-            ratio = width / (hi - lo)
-            spread = f"its 95 % interval would be {ratio:.3g} times as wide as its bounds"
-        pinned = None
-        if z[j] - lo <= BOUND_TOL * (hi - lo):
-            pinned = "lower" if fp.scale == "linear" or fp.sign > 0 else "upper"
-        elif hi - z[j] <= BOUND_TOL * (hi - lo):
-            pinned = "upper" if fp.scale == "linear" or fp.sign > 0 else "lower"
-        peak_hz, frac = peaks[fp.name]
-        if np.abs(J[:, j]).max() * 0.1 * (hi - lo) <= ZERO_SENSITIVITY:
-            report[fp.name] = Identifiability(False, ZERO_REASON, peak_hz, frac)
-            badness[fp.name] = np.inf
-            dead.append(fp.name)
-            continue
-        where = ""
-        if frac < 0.5:
-            side = "above" if peak_hz > fmax else "below" if peak_hz < fmin else "inside"
-            where = (f"sensitivity peaks at {_fmt_hz(peak_hz)}, {side} the measured band "
-                     f"{_fmt_hz(fmin)}–{_fmt_hz(fmax)} (in-band sensitivity {100 * frac:.2g} % of the peak)")
-        others = [(abs(corr[j, k]), free[k].name) for k in range(len(free)) if k != j and np.isfinite(corr[j, k])]
-        conf = max(others) if others else (0.0, "")
-        if pinned is not None:
-            reason = f"ended at its {pinned} bound ({getattr(fp, pinned):.4g}), so the data do not determine it inside its bounds"
-            if where:
-                reason += "; " + where
-            if np.isfinite(ratio) and ratio > 1.0:
-                reason += "; " + spread
-            report[fp.name] = Identifiability(False, reason, peak_hz, frac)
-            badness[fp.name] = np.inf
-        elif not np.isfinite(ratio) or ratio > 1.0:
-            parts = [spread]
-            if where:
-                parts.insert(0, where)
-            if conf[0] > 0.95:
-                parts.append(f"confounded with {conf[1]} (correlation {conf[0]:.3f})")
-            report[fp.name] = Identifiability(False, "; ".join(parts), peak_hz, frac)
-            badness[fp.name] = ratio if np.isfinite(ratio) else 1e300
-        else:
-            report[fp.name] = Identifiability(True, "determined by the data" + (f" ({where})" if where else ""),
-                                              peak_hz, frac)
-    return report, badness, se, corr, dead
-
-
-def _fmt_hz(f: float) -> str:
-    if f >= 1e3:
-        return f"{f / 1e3:.3g} kHz"
-    return f"{f:.3g} Hz"
-
-
 def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[[Values], np.ndarray] | None,
                    free: Sequence[FreeParameter], *, starts: int = 1, seed: int = 0,
                    predict_many: Callable[[Sequence[Values]], np.ndarray] | None = None,
@@ -382,7 +293,12 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     hold_undetermined : bool or "insensitive"
         Hold undetermined parameters at their start-0 value and refit (one at a time, the worst
         first; those at a bound or with zero sensitivity at once); ``"insensitive"``: only those
-        the data do not depend on (the others keep their fitted value and interval).
+        the data do not depend on (the others keep their fitted value and interval).  A step whose
+        cost increase over the all-free fit exceeds
+        :func:`~physmodel.estimation.identifiability.hold_cost_tolerance` is refused and undone (module
+        doc); ``result.holds`` records every step.  ``"always"``: hold as ``True`` does even when
+        the test fails (the record says so) — for a deliberate modelling choice, e.g. a stored
+        set's derivation.
     probe : SensitivityProbe or None
         Wide-band evaluation locating where each parameter acts.
     progress : callable or None
@@ -406,8 +322,8 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         raise IPMCError("give predict, predict_many or predict_array")
     if int(starts) < 1:
         raise IPMCError(f"starts must be >= 1, got {starts}")
-    if hold_undetermined not in (True, False, "insensitive"):
-        raise IPMCError(f"hold_undetermined must be True, False or 'insensitive', got {hold_undetermined!r}")
+    if hold_undetermined not in (True, False, "insensitive", "always"):
+        raise IPMCError(f"hold_undetermined must be True, False, 'insensitive' or 'always', got {hold_undetermined!r}")
     if max_nfev is not None and int(max_nfev) < 1:
         raise IPMCError(f"max_nfev must be >= 1, got {max_nfev}")
     fixed = dict(fixed or {})
@@ -449,6 +365,10 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     # identifiability: flag, hold the worst, refit the rest; repeat
     z_full = ends[best].copy()
     report: dict = {}
+    holds: list[HoldRecord] = []
+    held_in_loop: list[str] = []
+    free_cost = fit.cost
+    free_gof = goodness_of_fit(free_cost, res.size, len(active), estimated)
     while True:
         act = [free[k] for k in active]
         x_full = np.array([x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))
@@ -466,26 +386,52 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
             d = np.sqrt(np.maximum(np.diag(cov), 1e-300))
             corr = cov / np.outer(d, d)
             break
-        report, badness, se, corr, dead = _identifiability(free, active, fit.z, fit.J, cov, x_full, res, probe,
-                                                           batch, fd_step)
+        report, badness, se, corr, dead = flag_parameters(free, active, fit.z, fit.J, cov, x_full, res, probe,
+                                                          batch, fd_step)
         if not badness or not hold_undetermined or (hold_undetermined == "insensitive" and not dead):
             break
         pinned = [n for n, b in badness.items() if b == np.inf]
         to_hold = dead if hold_undetermined == "insensitive" else pinned or [max(badness, key=badness.get)]
+        # hold them, refit, and test what the hold cost against the free fit (hold_cost_tolerance)
+        saved = (fit, z_full.copy(), list(active), dict(held), converged)
         for n in to_hold:
             held[n] = report[n]
         active = [k for k in active if free[k].name not in held]
         for k, fp in enumerate(free):
             if fp.name in held:
                 z_full[k] = z_init[k]
-        if not active:
-            break
         x_full = np.array([x_init[k] if fp.name in held else float(fp.from_z(z_full[k]))
                            for k, fp in enumerate(free)])
-        fit = _solve(free, active, x_full, z_full[active], batch, res, max_nfev, ftol, fd_step)
-        z_full[active] = fit.z
+        if active:
+            refit = _solve(free, active, x_full, z_full[active], batch, res, max_nfev, ftol, fd_step)
+            z_full[active] = refit.z
+            cost_held = refit.cost
+        else:
+            refit = None
+            cost_held = float(0.5 * np.sum(res(batch(x_full[None, :]))[0] ** 2))
+        what = ", ".join(to_hold)
+        rec = hold_record(tuple(held_in_loop) + tuple(to_hold), tuple(to_hold), free_cost, cost_held, free_gof,
+                          hold_undetermined == "always")
+        holds.append(rec)
+        if not rec.accepted:
+            fit, z_full, active, held, converged = saved
+            for n in to_hold:
+                k = names.index(n)
+                lo, hi = free[k].z_bounds
+                report[n] = refused_identifiability(report[n], rec, min(z_full[k] - lo, hi - z_full[k])
+                                                    <= BOUND_TOL * (hi - lo))
+            message += (f"; hold of {what} refused: it would raise the cost from {free_cost:.6g} to {cost_held:.6g} "
+                        f"(allowed +{rec.threshold:.3g}); un-held fit kept, {what} not determined")
+            break
+        held_in_loop = list(rec.names)
+        if refit is None:
+            break
+        fit = refit
         converged = fit.status > 0
-        message += f"; refit without {', '.join(to_hold)}: {fit.message}"
+        message += (f"; refit without {what}: {fit.message} (cost {free_cost:.6g} -> {cost_held:.6g}, "
+                    f"+{rec.increase:.3g} " + (f"within the {rec.threshold:.3g} allowed)" if rec.within_test else
+                                               f"above the {rec.threshold:.3g} allowed, held anyway: "
+                                               "hold_undetermined='always')"))
 
     # assemble in the order of `free`
     n_act = len(active)
@@ -523,4 +469,5 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         converged=bool(converged), message=message, starts=records, identifiability=ident,
         noise_estimated=estimated, noise_scale=float(noise_scale), held=list(held), free=list(free),
         band_hz=res.band_hz, temperatures_c=res.temperatures_c, elapsed_s=time.perf_counter() - t0, goodness_of_fit=gof,
+        holds=holds,
     )

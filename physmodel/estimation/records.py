@@ -1,7 +1,8 @@
 """Records of the least-squares engine (:mod:`physmodel.estimation.lsq`): what is free
 (:class:`FreeParameter`), how a start went (:class:`StartRecord`), what the data determine
-(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`); with the engine's
-array helpers (:class:`ScaledRows`, :class:`ModelBatch`).  Physical units throughout.
+(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`; what holding cost:
+:class:`~physmodel.estimation.identifiability.HoldRecord`).  The engine's array helpers are in
+:mod:`physmodel.estimation.batching`.  Physical units throughout.
 """
 
 from __future__ import annotations
@@ -11,12 +12,16 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..data.files import atomic_write
 from ..errors import IPMCError, ParameterError
 from ..params import IPMCParameters
+
+if TYPE_CHECKING:
+    from .identifiability import HoldRecord
 
 Values = Mapping[str, float]
 
@@ -154,72 +159,6 @@ def lhs_starts(free: Sequence[FreeParameter], n: int, seed: int) -> np.ndarray:
     return lo + u * (hi - lo)
 
 
-class ScaledRows:
-    """Physical rows (n_sets, n_free) of parameter values: ``x_full`` [each parameter's SI unit]
-    with the ``active`` columns of ``free`` at scaled coordinates ``Z`` (n_sets, n_active) [-];
-    :meth:`FreeParameter.from_z` vectorised over sets and parameters."""
-
-    def __init__(self, free, x_full: np.ndarray, active: Sequence[int]):
-        act = [free[k] for k in active]
-        self.x_full, self.active = np.asarray(x_full, dtype=float), np.asarray(active, dtype=int)
-        self.log = np.array([fp.scale == "log" for fp in act])
-        self.sign = np.array([fp.sign for fp in act])
-        self.lower = np.array([fp.lower for fp in act])
-        self.span = np.array([fp.upper - fp.lower for fp in act])
-
-    def __call__(self, Z: np.ndarray) -> np.ndarray:
-        X = np.repeat(self.x_full[None, :], len(Z), axis=0)
-        # clipped as in FreeParameter.from_z, so that the interval of an undetermined parameter stays finite
-        X[:, self.active] = np.where(self.log, self.sign * 10.0 ** np.clip(Z, -300.0, 300.0), self.lower + Z * self.span)
-        return X
-
-
-class ModelBatch:
-    """A predictor called on rows of physical values of ``free`` (n_sets, n_free) [SI] ->
-    (n_sets, N) complex responses, through ``predict_array`` (one call, no per-set Python) or else
-    ``predict_many``/``predict`` with one values dict per set (``fixed`` added); counts the
-    parameter sets evaluated (``evaluations``) and the calls (``calls``)."""
-
-    def __init__(self, free, fixed: dict, predict, predict_many, predict_array, probe, n_lines: int):
-        self.names = [fp.name for fp in free]
-        self.fixed, self.n_lines, self.probe_ = fixed, n_lines, probe
-        self.predict, self.predict_many, self.predict_array = predict, predict_many, predict_array
-        self.evaluations = 0
-        self.calls = 0
-
-    def jacobian_plan(self, active) -> dict:
-        """The predictor's known Jacobian columns (``predict_array.jacobian_plan``: {k: ("scaled",
-        j, c) | ("constant", dlnG)} over ``free``) re-indexed to the ``active`` columns."""
-        plan = getattr(self.predict_array, "jacobian_plan", None) or {}
-        pos = {int(k): i for i, k in enumerate(active)}
-        return {pos[k]: (p if p[0] == "constant" else ("scaled", pos[p[1]], p[2])) for k, p in plan.items()
-                if k in pos and (p[0] == "constant" or (p[1] in pos and p[1] not in plan))}
-
-    def _dicts(self, X):
-        return [dict(self.fixed, **dict(zip(self.names, map(float, row)))) for row in X]
-
-    def __call__(self, X: np.ndarray) -> np.ndarray:
-        n_sets = len(X)
-        self.evaluations += n_sets
-        self.calls += n_sets if self.predict_array is None and self.predict_many is None else 1
-        if self.predict_array is not None:
-            out = np.asarray(self.predict_array(X), dtype=complex)
-        elif self.predict_many is not None:
-            out = np.asarray(self.predict_many(self._dicts(X)), dtype=complex)
-        else:
-            out = np.stack([np.asarray(self.predict(v), dtype=complex).reshape(-1) for v in self._dicts(X)])
-        if out.shape != (n_sets, self.n_lines):
-            raise IPMCError(f"the predictor returned shape {out.shape}; expected {(n_sets, self.n_lines)} "
-                            "(one complex value per data line and parameter set)")
-        return out
-
-    def probe(self, X: np.ndarray) -> np.ndarray:
-        """The :class:`SensitivityProbe`'s responses (n_sets, n_f) at the rows of ``X``."""
-        self.calls += 1
-        self.evaluations += len(X)
-        if self.probe_.predict_array is not None:
-            return np.asarray(self.probe_.predict_array(X), dtype=complex)
-        return np.asarray(self.probe_.predict_many(self._dicts(X)), dtype=complex)
 
 
 # =============================================================================== results
@@ -318,6 +257,12 @@ class CalibrationResult:
         Wall time of the calibration. [s]
     metadata : dict
         Provenance (data source, base set, settings).
+    goodness_of_fit : GoodnessOfFit or None
+        The χ² test of the final cost (:func:`~physmodel.estimation.residuals.goodness_of_fit`).
+    holds : list of HoldRecord
+        (:class:`~physmodel.estimation.identifiability.HoldRecord`) Every hold step tried, with the cost before (all free) and after; the last one refused
+        (if any) was undone: its ``added`` parameters keep their fitted value (often at a bound)
+        without being determined (:attr:`hold_refused`).
     """
 
     names: list
@@ -346,6 +291,24 @@ class CalibrationResult:
     elapsed_s: float
     metadata: dict = field(default_factory=dict)
     goodness_of_fit: object = None    # physmodel.estimation.residuals.GoodnessOfFit
+    holds: list = field(default_factory=list)
+
+    @property
+    def hold(self) -> HoldRecord | None:
+        """The last hold step (the one that decided), or None when nothing was held."""
+        return self.holds[-1] if self.holds else None
+
+    @property
+    def hold_refused(self) -> list:
+        """Undetermined parameters left free because holding them would worsen the fit beyond the
+        test (their value is the fit's, often at a bound; their interval is not a valid 95 % one)."""
+        from .identifiability import refused_names
+
+        return refused_names(self.holds, self.held)
+
+    def hold_line(self) -> str:
+        """One sentence on the hold: what it cost and whether it was taken ("" when none)."""
+        return "" if self.hold is None else self.hold.line()
 
     @property
     def adequate(self) -> bool:
@@ -354,8 +317,8 @@ class CalibrationResult:
 
     @property
     def determined(self) -> list:
-        """The free parameters the data determine (``names`` without ``held``)."""
-        return [n for n in self.names if n not in self.held]
+        """The free parameters the data determine (``names`` without ``held`` and ``hold_refused``)."""
+        return [n for n in self.names if n not in self.held and n not in self.hold_refused]
 
     def summary(self) -> str:
         """A plain-text report: convergence, data, cost against its expectation, and each
@@ -371,6 +334,7 @@ class CalibrationResult:
             f"{self.elapsed_s:.2f} s",
             *([f"  goodness of fit: {'adequate' if self.adequate else 'INADEQUATE'} — {self.goodness_of_fit.reason}"]
               if self.goodness_of_fit is not None else []),
+            *([f"  hold: {self.hold_line()}"] if self.holds else []),
             f"  {'parameter':34s} {'value':>12s} {'95 % interval':>27s}  status",
         ]
         for n in self.names:
@@ -380,6 +344,10 @@ class CalibrationResult:
             else:
                 ci = f"[{self.ci_lower[n]:.5g}, {self.ci_upper[n]:.5g}]"
                 ok = n not in self.identifiability or self.identifiability[n].identifiable
+                if n in self.hold_refused:
+                    lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci + ' (not valid)':>27s}  "
+                                 f"NOT DETERMINED (hold refused): {ident.reason}")
+                    continue
                 lines.append(f"  {n:34s} {self.values[n]:12.5g} {ci:>27s}  {'ok' if ok else 'NOT ASSESSED (model inadequate)'}")
         return "\n".join(lines)
 
@@ -397,7 +365,7 @@ class CalibrationResult:
             "parameters": [
                 {"name": n, "value": num(self.values[n]), "stderr": num(self.stderr[n]),
                  "ci95_lower": num(self.ci_lower[n]), "ci95_upper": num(self.ci_upper[n]),
-                 "held": n in self.held,
+                 "held": n in self.held, "hold_refused": n in self.hold_refused,
                  "identifiable": bool(self.identifiability[n].identifiable) if n in self.identifiability else None,
                  "reason": self.identifiability[n].reason if n in self.identifiability else "",
                  "sensitivity_peak_hz": (num(self.identifiability[n].sensitivity_peak_hz)
@@ -416,6 +384,7 @@ class CalibrationResult:
                         "nfev": s.nfev, "status": s.status, "message": s.message} for s in self.starts],
             "elapsed_s": float(self.elapsed_s),
             "goodness_of_fit": self.goodness_of_fit.to_dict() if self.goodness_of_fit is not None else None,
+            "holds": [h.to_dict() for h in self.holds],
             "metadata": {k: str(v) for k, v in self.metadata.items()},
         }
 

@@ -113,7 +113,8 @@ def add_parser(subparsers):
     p.add_argument("--seed", type=int, default=0, help="seed of the extra starts (default 0)")
     p.add_argument("--max-nfev", type=int, help="residual evaluations allowed per start (default: scipy's)")
     p.add_argument("--no-hold", action="store_true",
-                   help="report undetermined parameters but do not hold them at their base value")
+                   help="report undetermined parameters but do not hold them at their base value (a hold "
+                        "that would worsen the fit beyond its likelihood-ratio test is refused anyway)")
     p.add_argument("--accept-misfit", action="store_true",
                    help="exit 0 even when the model does not fit the data (goodness-of-fit test failed); "
                         "intervals are then widened by the Birge ratio instead of withheld")
@@ -167,6 +168,8 @@ def run(args) -> int:
               f"({start.verdict.reason}); this calibration is judged afresh on {args.sweep}", file=sys.stderr)
     with output_folder(out, "ipmc calibrate", force=args.force):
         _write(res, data, args, out)
+    if res.hold_refused or (res.holds and not args.quiet):
+        print(f"ipmc calibrate: {res.hold_line()}", file=sys.stderr)
     if not res.converged:
         print(f"ipmc calibrate: the fit did not converge: {res.message}", file=sys.stderr)
         return EXIT_FAILED
@@ -219,6 +222,8 @@ def render_report(res, data, args) -> str:
         f"- weighted cost {res.cost:.5g}; expected for a correct model {res.expected_cost:.5g} ± {res.cost_std:.3g}",
         "- goodness of fit: " + ("n/a" if res.goodness_of_fit is None else
                                  ("adequate" if res.adequate else "**INADEQUATE**") + f" — {res.goodness_of_fit.reason}"),
+        *([f"- hold: {res.hold_line()}", *(f"  - step {i + 1}: {h.reason}" for i, h in enumerate(res.holds))]
+          if res.holds else []),
         "- noise: " + ("**estimated** from the residuals (the sweep has no per-line standard deviations); "
                         f"intervals scaled by {res.noise_scale:.3g}" if res.noise_estimated
                         else "per-line standard deviations from the sweep"),
@@ -235,6 +240,8 @@ def render_report(res, data, args) -> str:
         status = ("determined" if st.identifiable else f"**not assessed**: {st.reason}") if n not in res.held \
             else f"**undetermined** (held at base): {st.reason}"
         ci = "–" if n in res.held else f"[{_g(res.ci_lower[n])}, {_g(res.ci_upper[n])}]"
+        if n in res.hold_refused:
+            status, ci = f"**not determined, hold refused**: {st.reason}", ci + " (not valid)"
         lines.append(f"| `{n}` | {_g(res.values[n])} | {_g(res.stderr[n])} | {ci} | "
                      f"[{fp.lower:.4g}, {fp.upper:.4g}] | {fp.scale} | {status} |")
     det = res.determined

@@ -9,13 +9,15 @@
 The file is an ``ipmc-timeseries`` record (CSV/NPZ/MAT by extension: ``time_s`` and one
 ``<channel>_<unit>`` column); its header carries the design (the multisine's lines and phases, the
 stepped-sine schedule), so ``ipmc frf --lines FILE`` / ``--plan FILE`` can estimate from a record
-of it.  Prints the expected measurement time and the crest factor (peak/RMS of the samples).
+of it.  Prints the expected measurement time and the crest factor (peak/RMS of the samples), and
+warns (stderr and the file's header) when a voltage drive's peak exceeds the 3 V an IPMC strip takes.
 Frequencies [Hz], times [s], amplitudes in ``--unit``.  Exit codes: 0 written, 2 bad input.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -139,12 +141,51 @@ def run(args) -> int:
     u = rec.channels[ch]
     cf = crest_factor(u)
     rec.metadata["crest_factor"] = f"{cf:.4f}"
+    warning = drive_warning(args, u, unit, cf)
+    if warning:
+        rec.metadata["drive_warning"] = warning
     rec.save(out)
+    if warning:
+        print(f"ipmc excite: warning: {warning}", file=sys.stderr)
     if not args.quiet:
         print(f"wrote {out}: {what}")
         print(f"  {u.size} samples at {args.fs:g} Hz; expected duration {float(rec.metadata['expected_duration_s']):g} s; "
               f"crest factor {cf:.3f} (peak {np.max(np.abs(u)):.4g} {unit}, RMS {np.sqrt(np.mean(u**2)):.4g} {unit})")
     return EXIT_OK
+
+
+def drive_warning(args, u: np.ndarray, unit: str, cf: float) -> str:
+    """A sentence when a voltage drive's peak exceeds :data:`inversion.limits.DEFAULT_MAX_VOLTAGE`
+    (what an IPMC strip takes), naming the option that lowers it; "" otherwise (or for a
+    displacement channel)."""
+    import math
+
+    from inversion.limits import DEFAULT_MAX_VOLTAGE
+    from physmodel.data.units import UNITS
+
+    if UNITS.get(unit, ("",))[0] != "voltage":
+        return ""
+    scale = UNITS[unit][1]
+    peak_v = float(np.max(np.abs(u))) * scale
+    if not peak_v > DEFAULT_MAX_VOLTAGE:
+        return ""
+    shrink = DEFAULT_MAX_VOLTAGE / peak_v
+
+    def below(x: float) -> str:        # x rounded DOWN to 3 significant figures
+        k = 10.0 ** (math.floor(math.log10(abs(x))) - 2)
+        return f"{math.floor(x / k) * k:.6g}"
+
+    if args.design == "multisine":
+        opt = f"--rms {below(args.rms * shrink)}" if args.rms is not None else \
+            f"--amplitude {below((1.0 if args.amplitude is None else args.amplitude) * shrink)}"
+        how = f"lower it with {opt} (same crest factor {cf:.3g})"
+        if args.phases != "clipped":
+            how += (f", or lower the crest factor with --phases clipped (iterative clipping of the "
+                    f"{args.phases} phases; keep the RMS, check the new peak)")
+    else:
+        how = f"lower it with --amplitude {below(args.amplitude * shrink)} (a sine's crest factor is fixed at 1.41)"
+    return (f"the drive's peak {peak_v:.4g} V exceeds the {DEFAULT_MAX_VOLTAGE:g} V an IPMC strip takes "
+            f"(the default limit of ipmc feedforward and inversion.feedforward); {how}")
 
 
 def _design(args, ch: str, unit: str):

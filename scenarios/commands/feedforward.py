@@ -8,8 +8,8 @@
    surrogate's output unit (e.g. mm);
 2. inverts the surrogate at ``--temperature`` (:func:`inversion.feedforward`; default preview
    ``auto``: truncation error below ``--preview-tol`` of the full inverse) and checks the voltage
-   against ``--max-voltage`` (default 3 V) and ``--max-rate``: a violation is refused (exit 3,
-   nothing written) unless ``--on-limit warn``;
+   against ``--max-voltage`` (default 3 V; ``--no-voltage-limit`` drops it, said on stderr and in the
+   report) and ``--max-rate``: a violation is refused (exit 3, nothing written) unless ``--on-limit warn``;
 3. **predicts the tracking error on the strip** from the measured sweep (``--data``, or the data
    file named in the physics model's or the surrogate's provenance): the surrogate's misfit to
    the measured lines, carried to ``--temperature`` between the measured temperatures with a
@@ -40,9 +40,11 @@ from pathlib import Path
 
 import numpy as np
 
+from inversion.limits import DEFAULT_MAX_VOLTAGE
+
 from ._common import EXIT_FAILED, EXIT_OK, CLIError, _floats, load_physics, verdict_lines
 
-__all__ = ["add_parser", "run", "build_reference"]
+__all__ = ["add_parser", "run", "build_reference", "drive_limits"]
 
 
 def add_parser(sub):
@@ -68,8 +70,11 @@ def add_parser(sub):
     c = p.add_argument_group("inversion and limits")
     c.add_argument("--preview", default="auto", help="'auto' (tolerance rule), '4/r0', 'inf' or seconds")
     c.add_argument("--preview-tol", type=float, default=1e-3, help="auto preview: relative truncation error")
-    c.add_argument("--max-voltage", type=float, default=3.0, help="largest |V| allowed [V] (IPMCs take ~2-3 V)")
-    c.add_argument("--max-rate", type=float, help="largest |dV/dt| allowed [V/s]")
+    c.add_argument("--max-voltage", type=float, default=None,
+                   help=f"largest |V| allowed [V], > 0 (default {DEFAULT_MAX_VOLTAGE:g} V: IPMCs take ~2-3 V)")
+    c.add_argument("--no-voltage-limit", action="store_true",
+                   help="drop the voltage limit (a virtual plant; never a real strip): said on stderr and in the report")
+    c.add_argument("--max-rate", type=float, help="largest |dV/dt| allowed [V/s], > 0")
     c.add_argument("--on-limit", choices=("error", "warn"), default="error",
                    help="refuse (exit 3, nothing written) or warn and continue")
     c.add_argument("--max-error", type=float, help="fail (exit 3) if the predicted tracking error exceeds this [unit]")
@@ -217,6 +222,20 @@ def _rms(x) -> float:
     return float(np.sqrt(np.mean(np.square(x))))
 
 
+def drive_limits(args) -> tuple[float | None, float | None]:
+    """(max |V| [V] or None, max |dV/dt| [V/s] or None) from ``--max-voltage``, ``--no-voltage-limit``
+    and ``--max-rate``; a CLIError (exit 2) names the option for 0, negative, NaN or infinite values."""
+    for opt, v in (("--max-voltage", args.max_voltage), ("--max-rate", args.max_rate)):
+        if v is not None and not (math.isfinite(v) and v > 0):
+            raise CLIError(f"{opt} {v:g}: expected a finite number > 0 [{'V' if opt == '--max-voltage' else 'V/s'}]"
+                           + ("; to drop the voltage limit say --no-voltage-limit" if opt == "--max-voltage" else ""))
+    if args.no_voltage_limit:
+        if args.max_voltage is not None:
+            raise CLIError(f"--max-voltage {args.max_voltage:g} and --no-voltage-limit: give one of them")
+        return None, args.max_rate
+    return (DEFAULT_MAX_VOLTAGE if args.max_voltage is None else args.max_voltage), args.max_rate
+
+
 def run(args) -> int:
     import json
 
@@ -225,6 +244,7 @@ def run(args) -> int:
     from physmodel.data.files import atomic_write
     from physmodel.data.units import UNITS, unit_scale
 
+    max_v, max_rate = drive_limits(args)
     model = _surrogate(args.surrogate, args.temperature)
     G = model.at(args.temperature)
     in_unit = model.labels.get("input_unit") or "V"
@@ -249,8 +269,11 @@ def run(args) -> int:
               "the noncausal inverse sees a jump to zero there (a voltage spike): use --fade and --lead/--tail",
               file=sys.stderr)
     v_scale = unit_scale(in_unit)                       # surrogate input unit -> V
-    limits = Limits(max_voltage=args.max_voltage / v_scale if args.max_voltage else None,
-                    max_rate=args.max_rate / v_scale if args.max_rate else None, action=args.on_limit)
+    limits = Limits(max_voltage=None if max_v is None else max_v / v_scale,
+                    max_rate=None if max_rate is None else max_rate / v_scale, action=args.on_limit)
+    if max_v is None:
+        print("ipmc feedforward: warning: --no-voltage-limit: the drive voltage is not limited; "
+              "never play it on a real strip without checking its peak", file=sys.stderr)
     try:
         ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits)
     except LimitError as exc:
@@ -262,7 +285,7 @@ def run(args) -> int:
     cols = {"time_s": ref.t, "voltage_V": volts, f"reference_{out_unit}": ref.y}
     summary: dict = {"surrogate": str(args.surrogate), "temperature_c": args.temperature, "unit": out_unit,
                      "reference": ref.description, "reference_rms": r_rms,
-                     "peak_voltage_V": float(ff.limit_report.peak * v_scale)}
+                     "peak_voltage_V": float(ff.limit_report.peak * v_scale), "max_voltage_V": max_v}
 
     # ---- upstream verdicts
     upstream = []
@@ -329,7 +352,8 @@ def run(args) -> int:
                  if ff.preview_choice is not None else "")
               + f"; truncation error {ff.truncation_error * v_scale:.3g} V (bound {ff.truncation_bound * v_scale:.3g} V)",
               f"- peak voltage {ff.limit_report.peak * v_scale:.4g} V, peak rate {ff.limit_report.peak_rate * v_scale:.4g} V/s "
-              f"(limits: max_voltage {args.max_voltage}, max_rate {args.max_rate})"]
+              f"(limits: max_voltage {'**none (--no-voltage-limit)**' if max_v is None else f'{max_v:g} V'}, "
+              f"max_rate {'none' if max_rate is None else f'{max_rate:g} V/s'})"]
     trunc_rel = ff.truncation_error / max(ff.limit_report.peak, 1e-300)
     if trunc_rel > 0.01:
         lines.append(f"- **preview too short: it changes the voltage by {100 * trunc_rel:.0f} % of its peak "
@@ -379,7 +403,7 @@ def run(args) -> int:
             lines.append(f"- steady-state prediction A |P/G - 1| = {A * abs(P / Gj - 1):.4g} {out_unit} "
                          f"(P: this physics, G: surrogate at {f:g} Hz)")
         fig = feedforward_check(ref.t, ref.y, y, volts, out / "feedforward.png", unit=out_unit,
-                                max_voltage=args.max_voltage, body=ref.body,
+                                max_voltage=max_v, body=ref.body,
                                 title=f"{ref.description}, {args.temperature:g} °C, preview {ff.preview_s:.3g} s")
         lines += ["", f"![feedforward]({fig.name})"]
         if args.max_error is not None and e_body > args.max_error:

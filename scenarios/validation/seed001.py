@@ -105,7 +105,9 @@ def _tracking(ctx):
         out = {}
         for ref, fn in REFERENCES.items():
             d = fn(t)
-            b = [float(np.max(np.abs(simulate(plant, 45.0, t, feedforward(g, t, d, preview="inf").output,
+            # the paper's 0.65 mm references ask this virtual plant for more than the 3 V default
+            # limit; the claims are about tracking, so the limit is off
+            b = [float(np.max(np.abs(simulate(plant, 45.0, t, feedforward(g, t, d, preview="inf", limits="off").output,
                                               realization=real).output * 1e3 - d)[win])) for g in (g1, g2)]
             out[ref] = tuple(b)
         return out

@@ -68,7 +68,7 @@ def run_case(plant, real, G, t_track, f_hz):
     sp = split_inverse(G)
     for name, pv in (("auto", "auto"), ("inf", "inf"), ("4/r0", "4/r0")):
         try:
-            ff = feedforward(sp, t, d, preview=pv)
+            ff = feedforward(sp, t, d, preview=pv, limits="off")     # the 4/r0 drive is measured, not refused
         except Exception as exc:   # 4/r0 can exceed short records
             row[name] = (np.nan, np.nan, np.nan, str(exc)[:40])
             continue
@@ -118,7 +118,7 @@ def timing(G, n: int = 1_000_000) -> None:
     u = AMP_MM * np.sin(2 * np.pi * 1.0 * t) * np.sin(np.pi * t / t[-1]) ** 2
     print(f"\ninversion of {n} samples (last surrogate), best of 3:")
     for pv in ("inf", "4/r0", "auto"):
-        best = min(_timed(lambda: feedforward(sp, 1 / FS, u, preview=pv)) for _ in range(3))
+        best = min(_timed(lambda: feedforward(sp, 1 / FS, u, preview=pv, limits="off")) for _ in range(3))
         print(f"  preview={pv:5s} {best:.3f} s")
 
 

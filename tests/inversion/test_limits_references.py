@@ -119,12 +119,48 @@ def test_bad_reference_input(call, match):
         call()
 
 
+def test_feedforward_is_limited_to_3_V_unless_told_otherwise():
+    """Safe by default: without ``limits`` a drive beyond 3 V (a printed constant here, not the
+    library's) is refused; the inverse is linear, so scaling the reference scales the drive, which
+    places the peak on either side of the limit without trusting the check under test."""
+    from inversion import DEFAULT_MAX_VOLTAGE, InversionError, invert
+
+    assert DEFAULT_MAX_VOLTAGE == 3.0
+    G = toy_actuator()
+    ref = R.sine(1.0, 1.0, 6.0, 1 / DT)
+    unit_peak = float(np.max(np.abs(feedforward(G, ref.t, ref.y, limits="off").output)))
+    over, under = ref.y * (4.0 / unit_peak), ref.y * (2.9 / unit_peak)       # 4 V and 2.9 V drives
+    for given in ({}, {"limits": None}, {"limits": "default"}):
+        with pytest.raises(LimitError, match=r"beyond max_voltage = ±3 V"):
+            feedforward(G, ref.t, over, **given)
+    ok = feedforward(G, ref.t, under)
+    assert ok.limit_report.ok and ok.limit_report.peak == pytest.approx(2.9, rel=1e-9)
+    assert ok.limit_report.limits == Limits(max_voltage=3.0)
+    # dropping it takes an explicit word; the peaks are still measured
+    for off in ("off", Limits()):
+        r = feedforward(G, ref.t, over, limits=off)
+        assert r.limit_report.ok and r.limit_report.peak == pytest.approx(4.0, rel=1e-9)
+    assert feedforward(G, ref.t, over, limits="off").limit_report.limits is None
+    # a model whose input is in mV: the default is 3000 mV
+    assert feedforward(G, ref.t, over, input_unit="mV").limit_report.limits == Limits(max_voltage=3000.0)
+    with pytest.raises(LimitError, match=r"beyond max_voltage = ±3000 mV"):
+        feedforward(G, ref.t, over * 1000.0, input_unit="mV")
+    with pytest.raises(InversionError, match="voltage unit"):
+        feedforward(G, ref.t, under, input_unit="mm")
+    with pytest.raises(InversionError, match="expected 'default'"):
+        feedforward(G, ref.t, under, limits=False)
+    # the generic inverse checks nothing (its output may be a displacement): no report
+    assert invert(G, ref.t, over).limit_report is None
+
+
 def test_unfaded_reference_spikes_at_the_end_faded_one_does_not():
     G = toy_actuator()
     faded = R.sine(1.0, 1.0, 6.0, 1 / DT, lead_s=2.0, tail_s=2.0)
     t = faded.t
     raw = np.where(t >= 2.0, np.sin(2 * np.pi * (t - 2.0) + 1.0), 0.0)    # starts and stops abruptly
-    v_raw = feedforward(G, t, raw, preview="inf").output
+    with pytest.raises(LimitError, match="beyond max_voltage = ±3 V"):     # the default 3 V limit
+        feedforward(G, t, raw, preview="inf")
+    v_raw = feedforward(G, t, raw, preview="inf", limits="off").output      # to look at the spike
     v_faded = feedforward(G, t, faded.y, preview="inf").output
     steady = np.max(np.abs(v_faded[faded.body]))
     assert np.max(np.abs(v_faded)) <= 1.01 * steady

@@ -29,6 +29,7 @@ from inversion import (
 )
 from inversion.batch import preview_rule
 from inversion.examples import SEED000_DEN_35C, SEED000_NUM_35C, toy_actuator
+from inversion.limits import LimitError
 from inversion.references import sine
 
 NMP = (list(SEED000_NUM_35C), list(SEED000_DEN_35C))
@@ -175,8 +176,10 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
 
     plant, G, ref, real = seed001_35c
     out = {}
+    with pytest.raises(LimitError, match="beyond max_voltage = ±3 V"):     # refused by default
+        feedforward(G, ref.t, ref.y, preview="4/r0")
     for pv in ("auto", "inf", "4/r0"):
-        ff = feedforward(G, ref.t, ref.y, preview=pv)
+        ff = feedforward(G, ref.t, ref.y, preview=pv, limits="off" if pv == "4/r0" else "default")
         y = simulate(plant, 35.0, ref.t, ff.output, realization=real).output * 1e3
         out[pv] = (float(np.max(np.abs(ff.output))), float(np.max(np.abs(y - ref.y))), ff)
     (va, ea, ffa), (vi, ei, _), (vr, er, _) = out["auto"], out["inf"], out["4/r0"]

@@ -116,3 +116,29 @@ def test_calibrate_with_a_fixed_chain_effect(tmp_path, capsys):
     assert "does not fit the data" in capsys.readouterr().err
     assert main(base + ["--effect", "time_dilation:delay=2e-3", "--out", str(tmp_path / "bad")]) == 2
     assert "time_dilation" in capsys.readouterr().err
+
+
+def test_calibrate_says_what_a_hold_costs_and_refuses_a_costly_one(sweep_file, tmp_path, capsys):
+    """d's bound 3.8e-11 sits below the truth 4e-11 (and below the all-free optimum 3.90e-11): every
+    start ends there; holding d at the base value 3.07e-11 would double the cost, so the un-held fit
+    is kept and the report, calibration.json and stderr say what the hold would have cost;
+    --no-hold gives the same cost."""
+    base = ["calibrate", str(sweep_file), "--set", "seed002_table3", "--free", "d:1e-11:3.8e-11",
+            "--free", "kappa_e:1e-7:1e-5", "--free", "alpha0", "--starts", "4", "--quiet"]
+    assert main(base + ["--out", str(tmp_path / "held")]) == 0
+    err = capsys.readouterr().err
+    assert "ipmc calibrate: hold of d REFUSED" in err
+    cal = json.loads((tmp_path / "held" / "calibration.json").read_text())
+    (h,) = cal["holds"]
+    assert h["accepted"] is False and h["names"] == ["d"] and h["cost_after"] > 2 * h["cost_before"]
+    entry = {e["name"]: e for e in cal["parameters"]}
+    assert entry["d"]["hold_refused"] and not entry["d"]["held"]
+    assert entry["d"]["value"] == pytest.approx(3.8e-11, rel=1e-3)
+    assert all(s["final"]["d"] == pytest.approx(3.8e-11, rel=1e-3) for s in cal["starts"] if s["status"] != -2)
+    report = (tmp_path / "held" / "report.md").read_text()
+    assert "- hold: hold of d REFUSED" in report and "not determined, hold refused" in report
+    assert f"{h['cost_before']:.5g} -> {h['cost_after']:.5g}" in report
+    assert main(base + ["--no-hold", "--out", str(tmp_path / "free")]) == 0
+    free = json.loads((tmp_path / "free" / "calibration.json").read_text())
+    assert free["cost"] == pytest.approx(cal["cost"], rel=1e-9) == pytest.approx(h["cost_before"], rel=1e-9)
+    assert free["holds"] == [] and "hold" not in capsys.readouterr().err

@@ -98,3 +98,40 @@ def test_bad_input_names_the_option(tmp_path, monkeypatch, argv, match):
     with pytest.raises(IPMCError, match=match):
         _run(argv)
     assert not list(tmp_path.iterdir())                      # nothing (half-)written
+
+
+def test_a_drive_above_3_V_is_warned_about_naming_the_options(tmp_path, capsys):
+    """The README's multisine (1 V RMS, Schroeder phases over log-spaced lines) peaks at 3.9 V:
+    written (exit 0) with a warning naming --rms (the value that brings the peak to 3 V, checked
+    here by regenerating with it) and --phases clipped (whose peak, regenerated, is below 3 V)."""
+    import re
+
+    argv = ["multisine", "--fs", "500", "--period", "10", "--fmin", "0.1", "--fmax", "9", "--count", "30",
+            "--periods", "2"]
+    out = tmp_path / "ms.csv"
+    assert _run([*argv, "--rms", "1", "--out", str(out), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    u = read_record(out).channels["voltage"]
+    peak = float(np.max(np.abs(u)))
+    assert peak > 3.0
+    assert f"the drive's peak {peak:.4g} V exceeds the 3 V" in err and "--phases clipped" in err
+    assert "drive_warning" in read_record(out).metadata
+    rms = float(re.search(r"--rms ([0-9.]+)", err).group(1))
+    assert rms == pytest.approx(3.0 / peak, rel=2e-3) and rms <= 3.0 / peak
+    for fix in (["--rms", str(rms)], ["--rms", "1", "--phases", "clipped"]):
+        fixed = tmp_path / "fixed.csv"
+        assert _run([*argv, *fix, "--out", str(fixed), "--quiet"]) == 0
+        assert np.max(np.abs(read_record(fixed).channels["voltage"])) <= 3.0
+        assert "warning" not in capsys.readouterr().err
+    # a sine: the amplitude is the only knob; a displacement channel is no drive voltage
+    assert _run(["chirp", "--fs", "200", "--f0", "1", "--f1", "5", "--sweep-s", "2", "--amplitude", "4",
+                 "--out", str(tmp_path / "c.csv"), "--quiet"]) == 0
+    assert "--amplitude 3 " in capsys.readouterr().err
+    assert _run(["chirp", "--fs", "200", "--f0", "1", "--f1", "5", "--sweep-s", "2", "--amplitude", "4",
+                 "--channel", "tip_displacement", "--out", str(tmp_path / "d.csv"), "--quiet"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    # mV: 2000 mV is 2 V, no warning; 4000 mV is
+    for amp, warned in (("2000", False), ("4000", True)):
+        assert _run(["stepped", "--fs", "200", "--frequencies", "1", "--amplitude", amp, "--unit", "mV",
+                     "--out", str(tmp_path / "s.csv"), "--quiet"]) == 0
+        assert ("exceeds the 3 V" in capsys.readouterr().err) is warned

@@ -164,3 +164,47 @@ def test_a_too_short_preview_is_flagged(model_json, tmp_path, capsys):
                  "--no-check", "--quiet", "--out", str(out)]) == EXIT_OK
     assert "preview too short" in (out / "report.md").read_text()
     assert "changes the voltage by" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("opts, needle", [
+    (["--max-voltage", "0"], "--max-voltage 0: expected a finite number > 0 [V]"),
+    (["--max-voltage", "-1"], "--max-voltage -1: expected a finite number > 0"),
+    (["--max-voltage", "nan"], "--max-voltage nan: expected a finite number > 0"),
+    (["--max-voltage", "inf"], "--max-voltage inf: expected a finite number > 0"),
+    (["--max-rate", "0"], "--max-rate 0: expected a finite number > 0 [V/s]"),
+    (["--max-rate", "-5"], "--max-rate -5: expected a finite number > 0"),
+    (["--max-voltage", "5", "--no-voltage-limit"], "give one of them"),
+])
+def test_limit_options_must_be_positive_exit_2(model_json, tmp_path, capsys, opts, needle):
+    """Today --max-voltage 0 switched the limit off and wrote a 99 V drive with exit 0."""
+    from scenarios.cli import main
+
+    path, _, _ = model_json
+    out = tmp_path / "x"
+    assert main(["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", *opts, "--no-check",
+                 "--quiet", "--out", str(out)]) == 2
+    assert needle in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_no_voltage_limit_is_explicit_and_said(model_json, tmp_path, capsys):
+    """The 4/r0 preview asks this surrogate for tens of volts: refused by default (3 V); with
+    --no-voltage-limit it is written, and stderr and the report say the drive is not limited."""
+    path, _, _ = model_json
+    argv = ["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", "--no-check", "--quiet"]
+    assert _run([*argv, "--out", str(tmp_path / "default")]) == EXIT_FAILED
+    assert "beyond max_voltage = ±3 V" in capsys.readouterr().err
+    out = tmp_path / "unlimited"
+    assert _run([*argv, "--no-voltage-limit", "--out", str(out)]) == EXIT_OK
+    assert "--no-voltage-limit: the drive voltage is not limited" in capsys.readouterr().err
+    v = _cols(out / "voltage.csv")["voltage_V"]
+    assert np.max(np.abs(v)) > 10.0
+    assert "max_voltage **none (--no-voltage-limit)**" in (out / "report.md").read_text()
+    # the CLI default is the library's one constant
+    from inversion.limits import DEFAULT_MAX_VOLTAGE
+    from scenarios.commands.feedforward import drive_limits
+
+    ap = argparse.ArgumentParser()
+    feedforward.add_parser(ap.add_subparsers())
+    args = ap.parse_args(["feedforward", "m.json", "--temperature", "30", "--out", "o"])
+    assert drive_limits(args) == (DEFAULT_MAX_VOLTAGE, None)
