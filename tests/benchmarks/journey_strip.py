@@ -301,9 +301,10 @@ def apply_voltage(strip: Strip, temperature_c: float, t, v, pad_factor: float = 
 
     Linear convolution by FFT: the record is zero-padded to ≥ ``pad_factor`` × (2 N + 4 τ_slow fs)
     samples (τ_slow = :data:`TAU_SLOW_S`), so the response that spills past the record end has
-    decayed before it wraps around; M_true is evaluated on the FFT grid (DC at :data:`F_DC`).  The
-    voltage is held constant over each sample (the DAC's zero-order hold is NOT added here: strip A
-    carries its DAC in its own effect)."""
+    decayed before it wraps around; M_true is evaluated on the FFT grid (DC at :data:`F_DC`), i.e.
+    ``v`` is taken as samples of a band-limited signal.  No extra output hold is applied: at the
+    benchmark's 10 kHz a zero-order hold would add a 50 µs delay (0.03 % of a 1 Hz sine); strip A's
+    own chain (skew + its 1 kHz DAC) is part of M_true."""
     t = np.asarray(t, dtype=float)
     v = np.asarray(v, dtype=float)
     dt = (t[-1] - t[0]) / (t.size - 1)
