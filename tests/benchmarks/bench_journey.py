@@ -75,6 +75,9 @@ Measured (h-bench, 2026-11-26, shared 2-core machine, 8.5 min for both strips)::
     (achieved: whole record; between the fades within 5 % of it.  after: calibrate exit 3 (misfit,
     no cal/model.json yet), diagnose exit 2 -> the route stops: the options do not exist yet.)
 
+Another seed, quick records (``--quick --seed 2``, strip A, before + truth, 105 s): before 0.377 %
+/ 0.778 % achieved vs 0.156 % / 0.24 % predicted, truth 0.104 % / 0.207 %.
+
 Stage by stage (``before``): the FRF is faithful (A 0.096 %, B 0.126 % RMS vs truth; z RMS
 1.05-1.18); calibrate is INADEQUATE (chi2 4.7e5 / 1.8e6 on 177 dof) and 6.2 % / 4.0 % RMS off the
 strip; diagnose as the README writes it exits 2 ("cal/parameters.json has no 'laws'"); the user's
