@@ -9,9 +9,13 @@ sweep H (with per-line σ) stands for P where it was measured:
    deviation σ_m = |H/G|·σ_rel (σ_rel² = (σ_dB·ln10/20)² + σ_rad², the relative complex std of the
    measured line);
 2. :func:`predicted_error` — for a signal r at a target temperature T: at each of the two measured
-   temperatures around T (the nearest one beyond the range, *extrapolated*), m is interpolated
-   over log-frequency onto the signal's spectrum (flat beyond the measured band, and the share of
-   the signal's power outside the band reported), and
+   temperatures around T (the nearest one beyond the range, *extrapolated*), m is carried onto the
+   signal's spectrum by a weighted least-squares polynomial in log-frequency whose degree is the
+   smallest that leaves residuals consistent with the declared noise (χ² test at
+   :data:`SMOOTHING_ALPHA`: the misfit of a model is smooth where the model is, the line noise is
+   not, so the noise averages out over the lines the polynomial spans; line-by-line interpolation
+   when the lines declare no noise), flat beyond the measured band (the share of the signal's power
+   outside the band is reported), and
 
    * the error spectrum is E = m·Y + E_inv, where Y = G·u is the surrogate's output for the drive
      and E_inv = Y − R the inversion's own error (preview truncation, sampling of the inverse;
@@ -191,6 +195,68 @@ def _interp_log(f_new, f, values, sigma):
     return m, (1 - b) ** 2 * sigma[k] ** 2 + b ** 2 * sigma[k + 1] ** 2
 
 
+#: Significance of the χ² test that picks the smoothing degree (the smallest degree whose residuals
+#: are consistent with the declared noise at this level).
+SMOOTHING_ALPHA = 0.05
+#: Highest polynomial degree (in log f) tried before falling back to line-by-line interpolation.
+MAX_SMOOTHING_DEGREE = 8
+
+
+def _smooth_log(f_new, f, values, sigma):
+    """The misfit smoothed over log f by weighted least squares on Legendre polynomials, with the
+    smallest degree whose residuals pass a χ² test against the declared noise (a misfit is smooth
+    where the model is; line noise is not), and the variance of the smoothed value
+    b(f)ᵀ(BᵀWB)⁻¹b(f).  Evaluated flat beyond the measured band.  Falls back to
+    :func:`_interp_log` when the lines have no noise (σ = 0) or no degree passes."""
+    from numpy.polynomial import legendre
+    from scipy.stats import chi2
+
+    n = f.size
+    if n < 3 or not np.all(sigma > 0):
+        return _interp_log(f_new, f, values, sigma)
+    x = np.log10(f)
+    lo, hi = x[0], x[-1]
+    u = (2 * x - lo - hi) / (hi - lo)
+    un = np.clip((2 * np.log10(f_new) - lo - hi) / (hi - lo), -1.0, 1.0)
+    w = 1.0 / sigma
+    for p in range(min(MAX_SMOOTHING_DEGREE, n - 2) + 1):
+        B = legendre.legvander(u, p)
+        A = B * w[:, None]
+        beta, *_ = np.linalg.lstsq(A, values * w, rcond=None)
+        stat = 2.0 * float(np.sum(np.abs((values - B @ beta) * w) ** 2))      # χ² on 2(n − p − 1) dof
+        if chi2.sf(stat, 2 * (n - p - 1)) >= SMOOTHING_ALPHA:
+            cov = np.linalg.inv(A.T @ A)
+            Bn = legendre.legvander(un, p)
+            return Bn @ beta, np.einsum("ij,jk,ik->i", Bn, cov, Bn).real
+    return _interp_log(f_new, f, values, sigma)
+
+
+def power_outside(t, signal, band_hz) -> float:
+    """Share of a signal's power (its mean included) outside ``band_hz``.
+
+    Parameters
+    ----------
+    t : array_like
+        Uniform sample times. [s]
+    signal : array_like
+        The signal. [any unit]
+    band_hz : (float, float)
+        (lowest, highest) frequency. [Hz]
+
+    Returns
+    -------
+    float
+        The share, 0 to 1. [-]
+    """
+    t = np.asarray(t, float)
+    r = np.asarray(signal, float)
+    f = np.fft.rfftfreq(r.size, float(t[1] - t[0]))
+    p = np.abs(np.fft.rfft(r)) ** 2 * np.where(np.arange(f.size) == 0, 1.0, 2.0)
+    inside = (f >= band_hz[0] * (1 - 1e-9)) & (f <= band_hz[1] * (1 + 1e-9))
+    total = float(np.sum(p))
+    return 0.0 if total <= 0 else 1.0 - float(np.sum(p[inside])) / total
+
+
 def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal, inversion_residual=None) -> PredictedError:
     """The RMS error, relative to the signal's RMS, of inverting the surrogate on the measured strip
     for ``signal`` at ``temperature_c`` (see the module doc).
@@ -255,7 +321,7 @@ def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal, inversi
     m_T = np.zeros(f.size, complex)
     s2_T = np.zeros(f.size)
     for i, wt in zip(idx, wts):
-        m, v = _interp_log(fpos, misfit.frequency_hz[i], misfit.misfit[i], misfit.sigma[i])
+        m, v = _smooth_log(fpos, misfit.frequency_hz[i], misfit.misfit[i], misfit.sigma[i])
         upper = math.sqrt(float(np.sum(W * ((np.abs(m) + 2.0 * np.sqrt(v)) * np.abs(Y) + np.abs(Einv)) ** 2)) / total)
         per[float(T[i])] = (math.sqrt(central2(m, v)), upper)
         bounds.append(upper)
@@ -266,4 +332,4 @@ def predicted_error(misfit: DataMisfit, temperature_c: float, t, signal, inversi
                           bool(extrap), out_share, per, inv)
 
 
-__all__ = ["DataMisfit", "PredictedError", "misfit_to_data", "predicted_error"]
+__all__ = ["DataMisfit", "PredictedError", "misfit_to_data", "predicted_error", "power_outside"]

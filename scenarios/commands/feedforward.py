@@ -307,6 +307,16 @@ def run(args) -> int:
             range_notes.append(f"{args.temperature:g} °C is outside the temperatures the physics was fitted at "
                                f"({min(ts_):g}–{max(ts_):g} °C): extrapolated physics")
 
+    fit_band = (model.info.get("data") or {}).get("band_hz")
+    if fit_band:
+        from surrogate.strip_check import power_outside
+
+        share = power_outside(ref.t, ref.y, fit_band)
+        summary["power_outside_surrogate_band"] = share
+        if share > 0.01:
+            range_notes.append(f"{100 * share:.2g} % of the reference's power lies outside the band the surrogate was "
+                               f"fitted on ({fit_band[0]:.4g}–{fit_band[1]:.4g} Hz): unchecked there")
+
     # ---- prediction on the strip
     lines = [f"# Feedforward at {args.temperature:g} °C", ""]
     strip = None

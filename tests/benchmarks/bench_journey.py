@@ -127,7 +127,11 @@ FREE = ("--free d --free C_minus --free kappa_e --free alpha0 --free E --free xi
 GEOMETRY = "--param L={L:g} --param W={W:g} --param h={h:g}"
 #: The dense sweep over the measured temperature range (README 'Command line').
 DENSE = "--temperatures {dense} --fmin 0.1 --fmax 9 --points 40"
-DENSE_NOISE = "--noise magphase --sigma-db 0.1 --sigma-deg 0.5 --seed 3"
+#: Noise added to the dense sweep of a model before the surrogate fit: "none" as the user guide writes
+#: the journey (the model is deterministic), or "readme" as the README's recipe before issue 24 wrote it
+#: (0.1 dB / 0.5°, seed 3).  The same setting is used for every route, the truth route included.
+DENSE_NOISE_CHOICES = {"none": "", "readme": "--noise magphase --sigma-db 0.1 --sigma-deg 0.5 --seed 3"}
+DENSE_NOISE = DENSE_NOISE_CHOICES["none"]
 FIT = "--zeros 4 --poles 4 --degree 2 --exclude {exclude}"
 #: Feedforward at the target temperature; {reference} is one of REFERENCES.
 FEEDFORWARD = "--temperature {target:g} {reference} --fs 10000 --lead 1 --tail 1"
@@ -165,7 +169,7 @@ ROUTES: dict[str, list[Stage]] = {
         # ... and as a user works around "has no 'laws'": the start set, its laws, the same free set
         Stage("diagnose_retry", "diagnose --data sweep.csv --kind actuator --set {start} {geometry} --laws set "
                                 "{free} --out diag_retry", informational=True),
-        Stage("sweep", "sweep --params-json cal/parameters.json {dense_args} {dense_noise} --out dense.csv"),
+        Stage("sweep", "sweep --params-json cal/parameters.json {dense_args} {readme_noise} --out dense.csv"),
         Stage("fit", "fit dense.csv {fit} --out fit"),
         Stage("feedforward", "feedforward fit/model.json {feedforward} --set cal/parameters.json --out ff_{ref}",
               per_reference=True),
@@ -262,6 +266,7 @@ def fill(cmd: str, strip: js.Strip, lab: Path, records: list[Path], ref: str | N
         "free": FREE,
         "dense_args": DENSE.format(dense=",".join(f"{T:g}" for T in dense)),
         "dense_noise": DENSE_NOISE,
+        "readme_noise": DENSE_NOISE_CHOICES["readme"],     # the 'before' route: today's README recipe
         "fit": FIT.format(exclude=exclude),
         "ref": ref or "",
     }
@@ -276,7 +281,9 @@ def builtin_step(cmd: str, strip: js.Strip, cwd: Path) -> tuple[int, str]:
     # same grid and noise level as DENSE / DENSE_NOISE (0.1 dB, 0.5 deg; 40 points 0.1-9 Hz)
     grid = dict(temperatures_c=strip.dense_temperatures_c, fmin_hz=0.1, fmax_hz=9.0, points=40)
     if words[0] == "@true_sweep":
-        js.write_true_sweep(strip, cwd / words[1], sigma_db=0.1, sigma_deg=0.5, seed=3, **grid)
+        noisy = DENSE_NOISE != ""
+        js.write_true_sweep(strip, cwd / words[1], sigma_db=0.1 if noisy else 0.0, sigma_deg=0.5 if noisy else 0.0,
+                            seed=3, **grid)
         return 0, ""
     if words[0] == "@diagnosed_sweep":
         src = (cwd / words[1]).resolve()
@@ -296,7 +303,9 @@ def builtin_step(cmd: str, strip: js.Strip, cwd: Path) -> tuple[int, str]:
             model = EffectModel(apply_values(base, values), "actuator", rep.get("final_effects") or {})
             f = np.geomspace(grid["fmin_hz"], grid["fmax_hz"], grid["points"])
             M = model.frequency_response(f, list(grid["temperatures_c"]))["M"].reshape(len(grid["temperatures_c"]), -1)
-            js.write_sweep_csv(cwd / words[2], grid["temperatures_c"], f, M * 1e3, 0.1, 0.5, 3,
+            noisy = DENSE_NOISE != ""
+            js.write_sweep_csv(cwd / words[2], grid["temperatures_c"], f, M * 1e3, 0.1 if noisy else 0.0,
+                               0.5 if noisy else 0.0, 3,
                                f"diagnosed model of {src} (physmodel.EffectModel)")
             return 0, ""
         except Exception as exc:  # noqa: BLE001 - reported as the stage's failure
@@ -486,9 +495,13 @@ def main(argv=None) -> int:
                          "all = before, emulated, after, truth")
     ap.add_argument("--reference", choices=("sine", "random", "both"), default="both")
     ap.add_argument("--quick", action="store_true", help="3 measured periods instead of 6")
+    ap.add_argument("--dense-noise", choices=sorted(DENSE_NOISE_CHOICES), default="none",
+                    help="noise added to every route's dense sweep before the fit (default none, as the user guide)")
     ap.add_argument("--timeout", type=float, default=900.0, help="per command [s]")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
+    global DENSE_NOISE
+    DENSE_NOISE = DENSE_NOISE_CHOICES[a.dense_noise]
     strips = list(js.STRIPS) if a.strip == "all" else [a.strip]
     routes = ["before", "truth"] if a.route is None else (["before", "emulated", "after", "truth"] if a.route == "all" else [a.route])
     refs = ["sine", "random"] if a.reference == "both" else [a.reference]
