@@ -12,7 +12,7 @@ sweep H (with per-line σ) stands for P where it was measured:
    temperatures around T (the nearest one beyond the range, *extrapolated*), m is carried onto the
    signal's spectrum by a weighted least-squares polynomial in log-frequency whose degree is the
    smallest that leaves residuals consistent with the declared noise (χ² test at
-   :data:`SMOOTHING_ALPHA`: the misfit of a model is smooth where the model is, the line noise is
+   ``SMOOTHING_ALPHA``: the misfit of a model is smooth where the model is, the line noise is
    not, so the noise averages out over the lines the polynomial spans; line-by-line interpolation
    when the lines declare no noise), flat beyond the measured band (the share of the signal's power
    outside the band is reported), and
