@@ -257,24 +257,27 @@ def write_sweep_csv(path, temperatures_c, frequency_hz, response_mm_per_v, sigma
                     sigma_deg: float = 0.0, seed: int = 3, source: str = "") -> Path:
     """``response_mm_per_v`` (n_T, n_f) as an ``ipmc-sweep`` CSV (README 'Data formats'), with
     optional seeded magnitude/phase noise of std ``sigma_db`` / ``sigma_deg`` (then also stated in
-    the std columns, as ``ipmc sweep --noise magphase`` does; 1e-3 dB / 1e-3° when noiseless)."""
+    the std columns, as ``ipmc sweep --noise magphase`` does; without noise no std columns, as
+    ``ipmc sweep`` writes a noise-free sweep)."""
     f = np.asarray(frequency_hz, dtype=float)
     T = np.asarray(temperatures_c, dtype=float)
     M = np.asarray(response_mm_per_v, dtype=complex).reshape(T.size, f.size)
     rng = np.random.default_rng(np.random.SeedSequence([0x24, 0x5EE9, int(seed)]))
     mag = 20 * np.log10(np.abs(M)) + sigma_db * rng.standard_normal(M.shape)
     ph = np.degrees(np.unwrap(np.angle(M), axis=1)) + sigma_deg * rng.standard_normal(M.shape)
+    noisy = sigma_db > 0 or sigma_deg > 0
     rows = []
     for i, Ti in enumerate(T):
         for j, fj in enumerate(f):
-            rows.append(f"{Ti:g},{fj:.10g},{mag[i, j]:.10g},{ph[i, j]:.10g},{max(sigma_db, 1e-3):g},"
-                        f"{max(sigma_deg, 1e-3):g}")
+            rows.append(f"{Ti:g},{fj:.10g},{mag[i, j]:.10g},{ph[i, j]:.10g}"
+                        + (f",{max(sigma_db, 1e-3):g},{max(sigma_deg, 1e-3):g}" if noisy else ""))
     path = Path(path)
     with open(path, "w", encoding="utf-8") as fh:
         fh.write("# ipmc-sweep 1\n# input: voltage [V]\n# output: tip_displacement [mm]\n")
         if source:
             fh.write(f"# source: {source}\n")
-        fh.write("temperature_c,frequency_hz,magnitude_db,phase_deg,magnitude_std_db,phase_std_deg\n")
+        fh.write("temperature_c,frequency_hz,magnitude_db,phase_deg"
+                 + (",magnitude_std_db,phase_std_deg\n" if noisy else "\n"))
         fh.write("\n".join(rows) + "\n")
     return path
 
