@@ -91,6 +91,7 @@ def main(argv=None) -> int:
 
 
 def _main(argv) -> int:
+    from physmodel import interrupts
     from physmodel.errors import IPMCError, NotConvergedError
 
     ap = build_parser()
@@ -111,6 +112,14 @@ def _main(argv) -> int:
         print(f"ipmc {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
+        print(f"ipmc {args.command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except SystemError:
+        # CasADi 3.7 leaves the KeyboardInterrupt it caught inside an IPOPT solve pending, so the solve
+        # returns into "SystemError: ... returned a result with an exception set" (3.8 returns a failed
+        # solve); with an interrupt recorded, that error is the interrupt
+        if interrupts.requested() is None:
+            raise
         print(f"ipmc {args.command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
 

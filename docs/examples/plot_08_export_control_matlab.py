@@ -48,7 +48,7 @@ print(f"state space: {ss30.nstates} states; poles {np.round(np.sort_complex(ss30
 
 omega = frd.omega
 fig, ax = plt.subplots(figsize=(6.5, 4))
-ax.semilogx(omega, 20 * np.log10(np.abs(frd.complex.ravel())), "k.", label="sweep (FRD)")
+ax.semilogx(omega, 20 * np.log10(np.abs(frd.eval(omega))), "k.", label="sweep (FRD)")
 ax.semilogx(omega, 20 * np.log10(np.abs(G30(1j * omega))), label="surrogate.at(30)")
 ax.semilogx(omega, 20 * np.log10(np.abs(reduced(1j * omega) * 1e3)), "--", label="reduced(30), order 3")
 ax.set_xlabel("ω [rad/s]")

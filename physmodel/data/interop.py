@@ -37,7 +37,7 @@ def _frd_arrays(frd: Any, where: str) -> tuple[np.ndarray, np.ndarray]:
     if dt not in (0, None):
         raise IPMCError(f"{where}: the FRD must be continuous-time (dt = 0); got dt = {dt!r}")
     data = getattr(frd, "frdata", None)
-    if data is None:            # python-control < 0.10
+    if data is None:            # python-control < 0.10.2
         data = frd.fresp
     H = np.asarray(data, dtype=complex).reshape(-1)
     w = np.asarray(frd.omega, dtype=float).reshape(-1)

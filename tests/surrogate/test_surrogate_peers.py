@@ -29,7 +29,9 @@ def test_better_than_levy_and_stable(sweep):
 
 
 def test_no_worse_than_aaa(sweep):
-    from scipy.interpolate import AAA
+    AAA = getattr(pytest.importorskip("scipy.interpolate"), "AAA", None)
+    if AAA is None:  # the lowest-versions CI job runs scipy's lower bound
+        pytest.skip("scipy.interpolate.AAA arrived in scipy 1.15")
 
     f, h, truth, res = sweep
     with warnings.catch_warnings():
