@@ -43,8 +43,10 @@ def _path(name):
 
 
 #: Bundled scenarios in the slow tier: seed000_chain's quick run takes minutes on two cores (the fast tier
-#: runs its step on a smaller configuration in test_seed000_chain.py); seed000_sensor's about 10 s.
-SLOW_SCENARIOS = {"seed000_chain", "seed000_sensor"}
+#: runs its step on a smaller configuration in test_seed000_chain.py); seed000_sensor, discrepancy_demo and
+#: seed001_actuator 5-10 s each (the fast tier keeps demo - the seed 001 actuator chain - and runs the
+#: discrepancy workflow through its CLI in test_discrepancy.py).
+SLOW_SCENARIOS = {"seed000_chain", "seed000_sensor", "discrepancy_demo", "seed001_actuator"}
 
 
 @pytest.mark.parametrize("path", [pytest.param(p, id=p.stem, marks=pytest.mark.slow) if p.stem in SLOW_SCENARIOS
@@ -83,7 +85,8 @@ def _held_out_error_from_files(out, held):
     return max(errs)
 
 
-@pytest.mark.parametrize("name", ["demo", "seed001_actuator", pytest.param("seed000_sensor", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("name", ["demo"] + [pytest.param(n, marks=pytest.mark.slow)
+                                              for n in ("seed001_actuator", "seed000_sensor")])
 def test_reported_held_out_error_matches_the_written_files(name, quick_run):
     res = quick_run(name)
     spec = load_scenario(_path(name), quick=True)
