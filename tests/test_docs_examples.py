@@ -26,7 +26,13 @@ def test_the_gallery_is_not_empty():
     assert len(EXAMPLES) >= 9, [p.name for p in EXAMPLES]
 
 
-@pytest.mark.parametrize("script", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+#: The fast tier runs one quick example (the gallery's mechanics: fresh interpreter, warnings as errors);
+#: the others take 2-15 s each and run in the slow tier and in the docs build.
+FAST_EXAMPLES = {"plot_04_calibration_identifiability"}
+
+
+@pytest.mark.parametrize("script", [pytest.param(p, id=p.stem) if p.stem in FAST_EXAMPLES
+                                    else pytest.param(p, id=p.stem, marks=pytest.mark.slow) for p in EXAMPLES])
 def test_example_runs(script, tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=os.pathsep.join(
         [str(ROOT)] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])))

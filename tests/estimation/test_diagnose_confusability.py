@@ -61,6 +61,8 @@ def _oracle_lambda(clean, rival):
     return 2 * fit_parameters(clean, None, fr, predict_many=pm, starts=6, seed=0, max_nfev=400, identify=False).cost
 
 
+#: A seven-candidate diagnose (about 10 s on two cores): the tests that read it are in the slow tier; the
+#: fast tier keeps the refit of an element without a first-order signature (and test_vuong.py).
 @pytest.fixture(scope="module")
 def laser_case():
     clean, noisy = _case("laser_lag", {"time_constant": 1.0 / (2 * math.pi * 400.0)}, 0.01 / math.sqrt(2), 3)
@@ -69,6 +71,7 @@ def laser_case():
     return clean, d
 
 
+@pytest.mark.slow
 def test_confusable_pair_is_never_a_confident_wrong_name(laser_case):
     clean, d = laser_case
     lam = _oracle_lambda(clean, "tip_driven_beam")
@@ -81,6 +84,7 @@ def test_confusable_pair_is_never_a_confident_wrong_name(laser_case):
         assert "Vuong" in d.message
 
 
+@pytest.mark.slow
 def test_report_states_the_data_test_and_the_in_band_cross_fit(laser_case):
     _, d = laser_case
     cf = d.confusability
@@ -92,6 +96,7 @@ def test_report_states_the_data_test_and_the_in_band_cross_fit(laser_case):
     assert "Confusable pairs" in d.summary() and "Vuong" in d.summary()
 
 
+@pytest.mark.slow
 def test_candidate_refits_start_from_the_user_start_too(laser_case):
     _, d = laser_case
     for c in d.candidates.values():

@@ -30,6 +30,9 @@ def _hidden(case: int, effects_fn):
     return data, effects
 
 
+#: Five full diagnoses with null calibration (about 1.5 min on two cores): the tests that use them, and the
+#: other end-to-end diagnoses, are in the slow tier; the fast tier keeps the null mixture, the bad-input,
+#: the implausible-baseline and the CLI tests.
 @pytest.fixture(scope="module")
 def blind():
     cases = {
@@ -57,12 +60,14 @@ def _named_ok(d, truth):
     return False
 
 
+@pytest.mark.slow
 def test_null_data_give_no_discrepancy(blind):
     d = blind["none"]
     assert d.verdict == "none" and d.named == [] and d.final is None
     assert max(c.lr for c in d.candidates.values()) <= d.threshold
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("truth", ["time_delay", "fractional_transport"])
 def test_hidden_library_effect_is_named_and_the_gap_shrinks(blind, truth):
     d = blind[truth]
@@ -74,6 +79,7 @@ def test_hidden_library_effect_is_named_and_the_gap_shrinks(blind, truth):
         assert v["ci95"][0] <= v["value"] <= v["ci95"][1]
 
 
+@pytest.mark.slow
 def test_out_of_library_effect_ends_unexplained(blind):
     d = blind["fixture_resonance"]
     assert "fixture_resonance" in OUT_OF_LIBRARY
@@ -82,12 +88,14 @@ def test_out_of_library_effect_ends_unexplained(blind):
     assert any(r["flagged"] for r in d.localisation_before)
 
 
+@pytest.mark.slow
 def test_two_hidden_effects_are_named_greedily(blind):
     d = blind["two"]
     assert d.verdict == "named", d.message
     assert sorted(d.named) == ["fractional_transport", "time_delay"]
 
 
+@pytest.mark.slow
 def test_report_folder(blind, tmp_path):
     d = blind["time_delay"]
     d.write_report(tmp_path / "rep")
@@ -115,6 +123,7 @@ def test_report_folder(blind, tmp_path):
     assert not list((tmp_path / "rep").glob("*.tmp*"))
 
 
+@pytest.mark.slow
 def test_sensor_amplifier_pole_is_named():
     ps = get_parameter_set("seed000_sensor_dev")
     rng = np.random.default_rng(np.random.SeedSequence(SEALED, spawn_key=(99,)))
@@ -142,6 +151,7 @@ def test_linearised_null_gives_the_chi_bar_squared_boundary_mixture():
     assert np.quantile(_constrained_lr(S2, np.array([True, True]), E), 0.95) == pytest.approx(4.231, abs=0.15)
 
 
+@pytest.mark.slow
 def test_a_candidate_at_its_bound_is_never_a_confident_name():
     """Hidden contact resistance 3e-3 Ω·m² with the candidate bound set to 1e-3 (issue 11, cause 1):
     diffusivity_temperature (declared confusable) then closes the gap, but the report says that
@@ -160,6 +170,7 @@ def test_a_candidate_at_its_bound_is_never_a_confident_name():
     assert cr.ci_lower["r2_specific"] <= 3e-3 <= cr.ci_upper["r2_specific"] and not cr.at_bound
 
 
+@pytest.mark.slow
 def test_temperature_laws_are_chosen_and_stated():
     from physmodel.temperature import ISOTHERMAL
 
@@ -177,6 +188,7 @@ def test_temperature_laws_are_chosen_and_stated():
         diagnose(data, P, free=FREE, laws={"viscosity": "Constant"})
 
 
+@pytest.mark.slow
 def test_cost_inconsistent_with_the_declared_noise_is_reported_with_its_factor():
     data = synthesize_sweep(EffectModel(P, "actuator"), "M", F, T, MagnitudePhaseNoise(0.05, 0.3), seed=8)
     big = type(data)(**{**data.__dict__, "magnitude_std_db": data.magnitude_std_db * 10,
@@ -263,6 +275,7 @@ def test_cli_writes_the_report_and_rejects_bad_input(tmp_path):
         bad.func(bad)
 
 
+@pytest.mark.slow
 def test_a_baseline_stuck_short_of_its_optimum_is_refitted_not_taken_for_an_effect(monkeypatch):
     """The first baseline fit is held away from its optimum (d confined to 1.6× the start, as a
     multi-start that missed the best basin would leave it); every candidate refit from there then
@@ -294,6 +307,7 @@ def test_a_baseline_stuck_short_of_its_optimum_is_refitted_not_taken_for_an_effe
                                                      null_refits=0).baseline.cost, abs=1e-3)
 
 
+@pytest.mark.slow
 def test_a_second_effect_that_only_takes_a_share_of_the_noise_is_not_named():
     """A 3 ms delay with a weak fractional transport (β = 0.97, noiseless λ 89 on top of the fitted
     delay at 0.2 dB / 1°).  In this draw the fitted delay absorbs most of the transport and leaves

@@ -10,6 +10,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from scenarios.cli import main
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -26,6 +28,7 @@ def _scenario(d: Path, name: str, points: int = 12) -> Path:
     return fuzzcases.write_scenario(d, doc, f"{name}.toml")
 
 
+@pytest.mark.slow          # waits for a 400 000-point run to finish (about 10 s)
 def test_a_second_job_into_a_busy_folder_is_refused(tmp_path):
     out = tmp_path / "Z"
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}

@@ -16,6 +16,7 @@ def registered(monkeypatch):
     monkeypatch.setitem(runner.STEPS, "control_route", step_control_route)
 
 
+@pytest.mark.slow          # the full (not quick) run; the fast tier runs it quick in test_scenarios.py
 def test_control_route_scenario_passes_its_checks(registered, tmp_path):
     path = spec.bundled_scenarios()[0].parent / "control_route.toml"
     res = runner.run_scenario(spec.load_scenario(path), tmp_path, quiet=True)

@@ -74,7 +74,7 @@ def test_local_processes_give_the_identical_table(serial):
     assert not run_study(parse_study({"study": {**SPEC["study"], "seed": 6}}), backend="serial").equals(serial)
 
 
-@pytest.mark.parametrize("processes", [False, True])
+@pytest.mark.parametrize("processes", [False, pytest.param(True, marks=pytest.mark.slow)])     # worker processes: ~5 s
 def test_dask_local_cluster_gives_the_identical_table(serial, processes):
     distributed = pytest.importorskip("distributed")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=processes,
