@@ -155,10 +155,6 @@ def model_metadata(mf) -> dict[str, str]:
     return meta
 
 
-def _model(args, mf):
-    return mf.model()
-
-
 def _add_model_args(p, default_set: str | None = DEFAULT_SET):
     p.add_argument("--kind", choices=("actuator", "sensor"), default=None,
                    help="actuator (voltage in) or sensor (tip displacement in, short-circuit current out); "

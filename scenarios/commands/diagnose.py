@@ -46,7 +46,9 @@ pairs, null calibration), summary.md, bode_before.png and bode_after.png.
 Flags: --laws NAME, --law QUANTITY=LAW[:P=V,...] (repeatable), --candidate-bound EFFECT.PARAM=LO:HI,
 --candidate-start EFFECT.PARAM=V, --plausible NAME=LO:HI, --no-prior, --baseline-starts N.
 
-Exit codes: 0 for any verdict, 2 bad input, 130 interrupted.
+Exit codes: 0 when the model it ends with fits the data (any verdict), 3 when it does not (the verdict
+``unexplained``, or a named model still outside the noise; ``--accept-misfit`` to exit 0 — model.json
+says so either way), 2 bad input, 130 interrupted.
 """
 
 from __future__ import annotations
@@ -58,7 +60,7 @@ from pathlib import Path
 from physmodel.errors import IPMCError, ParameterError
 
 from .. import plots
-from ._common import EXIT_OK, parse_assignments
+from ._common import EXIT_FAILED, EXIT_OK, parse_assignments
 from .calibrate import parse_effect, provenance_of, start_model
 
 _GEOMETRY = ("L", "W", "h")
@@ -103,6 +105,8 @@ def add_parser(subparsers):
     p.add_argument("--out", help="report folder (default diagnosis)")
     p.add_argument("--force", "--overwrite", action="store_true",
                    help="write into a folder that holds another run's results")
+    p.add_argument("--accept-misfit", action="store_true",
+                   help="exit 0 even when the model diagnose ends with does not fit the data (model.json says so)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=run)
     return p
@@ -317,7 +321,8 @@ def build(args):
 
 
 def run(args) -> int:
-    """Execute ``ipmc diagnose``: 0 for any verdict; bad input raises IPMCError (exit 2)."""
+    """Execute ``ipmc diagnose``: 0 when the final model fits the data, 3 when not (unless
+    ``--accept-misfit``); bad input raises IPMCError (exit 2)."""
     from physmodel.data.files import check_output_folder, output_folder
     from physmodel.estimation.discrepancy import diagnose, gap_shrink
 
@@ -354,7 +359,9 @@ def run(args) -> int:
         print(f"model: {out}/model.json — {mf.describe()}; use it downstream with --model {out}/model.json")
     if not mf.adequate:
         print(f"ipmc diagnose: the diagnosed model does not fit the data ({mf.verdict.reason}); model.json says so "
-              "and every command that reads it will too", file=sys.stderr)
+              "and every command that reads it will too"
+              + ("" if args.accept_misfit else " (exit 3; --accept-misfit to exit 0)"), file=sys.stderr)
+        return EXIT_OK if args.accept_misfit else EXIT_FAILED
     return EXIT_OK
 
 

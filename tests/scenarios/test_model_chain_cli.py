@@ -152,3 +152,15 @@ def test_invert_refuses_a_surrogate_of_a_misfit_model_unless_accepted(chain, tmp
     head = [ln for ln in (tmp_path / "v.csv").read_text().splitlines() if ln.startswith("#")]
     assert any("upstream_misfit" in h for h in head) and any("predicted_error_on_strip" in h for h in head)
     assert main([*args, "--accept-misfit", "--out", str(tmp_path / "v2.csv")]) == 0
+
+
+def test_diagnose_exits_3_when_the_model_it_ends_with_does_not_fit(chain, tmp_path, capsys):
+    # only a candidate that cannot make a 4 ms delay: the gap stays open, the verdict is not a fit
+    argv = ["diagnose", "--data", str(chain / "sweep.csv"), "--set", "seed001_actuator", "--laws", "set",
+            "--free", "alpha0", "--candidates", "leakage", "--null-draws", "400", "--null-refits", "0", "--quiet"]
+    capsys.readouterr()
+    assert main([*argv, "--out", str(tmp_path / "d1")]) == 3
+    assert "does not fit the data" in capsys.readouterr().err
+    mf = json.loads((tmp_path / "d1" / "model.json").read_text())
+    assert mf["verdict"]["adequate"] is False
+    assert main([*argv, "--accept-misfit", "--out", str(tmp_path / "d2")]) == 0
