@@ -38,6 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import ParameterError
+from .fit_record import FitVerdict, Provenance, file_sha256
 from .params import IPMCParameters
 
 #: Format name and version of the model file.
@@ -59,183 +60,6 @@ def finite_json(obj):
     if isinstance(obj, float) and math.isinf(obj):
         return "inf" if obj > 0 else "-inf"
     return obj
-
-
-def _num(v) -> float | None:
-    if v is None:
-        return None
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        return None
-    return x if math.isfinite(x) else None
-
-
-def file_sha256(path) -> str:
-    """SHA-256 of a file's bytes (hex), read in blocks."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
-# =============================================================================== records
-@dataclass(frozen=True)
-class FitVerdict:
-    """Whether a model fits the data it was fitted to.
-
-    Parameters
-    ----------
-    adequate : bool
-        The goodness-of-fit test passed (χ² consistent with the declared noise).
-    chi2 : float or None
-        Σ r² of the standardised residuals at the optimum. [-]
-    dof : int or None
-        Residual degrees of freedom.
-    p_value : float or None
-        P(χ²_dof ≥ chi2); None when the noise was estimated from the residuals. [-]
-    reason : str
-        The test's sentence.
-    diagnosis : str or None
-        The verdict of ``ipmc diagnose`` (none, named, ambiguous, at_bound, unexplained) when the
-        model came from a diagnosis, with ``named`` the effects it named.
-    named : tuple of str
-        Effects the diagnosis named.
-    """
-
-    adequate: bool
-    chi2: float | None
-    dof: int | None
-    p_value: float | None
-    reason: str
-    diagnosis: str | None = None
-    named: tuple = ()
-
-    @classmethod
-    def from_goodness(cls, gof, diagnosis: str | None = None, named=()) -> FitVerdict:
-        """From a :class:`physmodel.estimation.residuals.GoodnessOfFit` (or its ``to_dict()``).
-
-        Parameters
-        ----------
-        gof : GoodnessOfFit or dict
-            The test.
-        diagnosis : str or None
-            The diagnosis verdict, when there was one.
-        named : sequence of str
-            The effects it named.
-        """
-        d = gof.to_dict() if hasattr(gof, "to_dict") else dict(gof)
-        dof = d.get("dof")
-        return cls(bool(d.get("adequate")), _num(d.get("chi2")), None if dof is None else int(dof),
-                   _num(d.get("p_value")), str(d.get("reason", "")), diagnosis, tuple(named))
-
-    def to_dict(self) -> dict:
-        """JSON-ready data (non-finite numbers as None)."""
-        return {"adequate": bool(self.adequate), "chi2": _num(self.chi2), "dof": self.dof,
-                "p_value": _num(self.p_value), "reason": self.reason, "diagnosis": self.diagnosis,
-                "named": list(self.named)}
-
-    @classmethod
-    def from_dict(cls, d: dict, where: str = "model file") -> FitVerdict:
-        """Read :meth:`to_dict`'s data.
-
-        Parameters
-        ----------
-        d : dict
-            The record.
-        where : str
-            The file, for messages.
-        """
-        if not isinstance(d, dict) or "adequate" not in d:
-            raise ParameterError(f"{where}: 'verdict' must be an object with 'adequate', got {d!r}")
-        dof = d.get("dof")
-        return cls(bool(d["adequate"]), _num(d.get("chi2")), None if dof is None else int(dof),
-                   _num(d.get("p_value")), str(d.get("reason", "")), d.get("diagnosis"), tuple(d.get("named") or ()))
-
-    def line(self) -> str:
-        """One sentence: adequate or not, with χ²/dof and p."""
-        stat = (f"chi2 {self.chi2:.4g} on {self.dof} dof" if self.chi2 is not None and self.dof else "chi2 n/a") + (
-            f", p = {self.p_value:.2g}" if self.p_value is not None else "")
-        diag = f"; diagnosis: {self.diagnosis}" + (f" ({', '.join(self.named)})" if self.named else "") \
-            if self.diagnosis else ""
-        return ("fits its data" if self.adequate else "DOES NOT FIT its data") + f" ({stat}{diag})"
-
-
-@dataclass(frozen=True)
-class Provenance:
-    """Where a model came from.
-
-    Parameters
-    ----------
-    creator : str
-        The command or function that made it (``"ipmc calibrate"``, ``"ipmc diagnose"``, ...).
-    data_file : str or None
-        The data file it was fitted to, as given.
-    data_sha256 : str or None
-        SHA-256 of that file's bytes.
-    data_fingerprint : str or None
-        SHA-256 of the sweep's numerical content (:meth:`FrequencySweep.fingerprint`).
-    temperatures_c : tuple of float
-        Temperatures of the data. [°C]
-    band_hz : tuple of float or None
-        (lowest, highest) frequency of the data. [Hz]
-    command : str
-        The command line.
-    library_version : str
-        ``physmodel.__version__`` of the writer.
-    """
-
-    creator: str
-    data_file: str | None = None
-    data_sha256: str | None = None
-    data_fingerprint: str | None = None
-    temperatures_c: tuple = ()
-    band_hz: tuple | None = None
-    command: str = ""
-    library_version: str = ""
-
-    def to_dict(self) -> dict:
-        """JSON-ready data."""
-        return {"creator": self.creator, "data_file": self.data_file, "data_sha256": self.data_sha256,
-                "data_fingerprint": self.data_fingerprint, "temperatures_c": [float(t) for t in self.temperatures_c],
-                "band_hz": None if self.band_hz is None else [float(b) for b in self.band_hz],
-                "command": self.command, "library_version": self.library_version}
-
-    @classmethod
-    def from_dict(cls, d: dict, where: str = "model file") -> Provenance:
-        """Read :meth:`to_dict`'s data.
-
-        Parameters
-        ----------
-        d : dict
-            The record.
-        where : str
-            The file, for messages.
-        """
-        if not isinstance(d, dict):
-            raise ParameterError(f"{where}: 'provenance' must be an object, got {d!r}")
-        band = d.get("band_hz")
-        return cls(str(d.get("creator", "")), d.get("data_file"), d.get("data_sha256"), d.get("data_fingerprint"),
-                   tuple(float(t) for t in d.get("temperatures_c") or ()),
-                   None if band is None else (float(band[0]), float(band[1])),
-                   str(d.get("command", "")), str(d.get("library_version", "")))
-
-    def data_path(self, relative_to=None) -> Path | None:
-        """The data file, resolved against the model file's folder when relative and not found
-        from the working directory; None when unknown.
-
-        Parameters
-        ----------
-        relative_to : str or Path or None
-            The model file's path.
-        """
-        if not self.data_file:
-            return None
-        p = Path(self.data_file)
-        if p.is_absolute() or p.exists() or relative_to is None:
-            return p
-        return Path(relative_to).parent / p
 
 
 @dataclass(frozen=True)
@@ -395,10 +219,13 @@ class ModelFile:
             raise ParameterError(f"{where}: 'effects' must be an object of {{effect: {{parameter: value}}}}, got {effects!r}")
         verdict = None if d.get("verdict") is None else FitVerdict.from_dict(d["verdict"], where)
         prov = None if d.get("provenance") is None else Provenance.from_dict(d["provenance"], where)
+        est = d.get("estimates") or []
+        if not (isinstance(est, list) and all(isinstance(e, dict) for e in est)):
+            raise ParameterError(f"{where}: 'estimates' must be a list of objects, got {est!r}")
         try:
             return cls(str(d["kind"]), params, {k: {p: float(v) for p, v in e.items()} for k, e in effects.items()},
                        d.get("quantity"), str(d.get("kernel") or "boundary_charge"), verdict,
-                       tuple(d.get("estimates") or ()), prov, path)
+                       tuple(est), prov, path)
         except (ParameterError, TypeError, ValueError) as exc:
             raise ParameterError(f"{where}: {exc}") from None
 
@@ -433,6 +260,9 @@ def _legacy(data: dict, where: str, kind: str | None, path: str) -> ModelFile:
         meta = cal.get("metadata") or {}
         if cal.get("goodness_of_fit"):
             verdict = FitVerdict.from_goodness(cal["goodness_of_fit"])
+        if kind is not None and meta.get("kind") not in (None, "", kind):
+            raise ParameterError(f"{where} is a {meta['kind']} model (its calibration record says so); this command "
+                                 f"needs a {kind} model (--kind)")
         kind = kind or meta.get("kind")
         quantity = meta.get("quantity") or None
         kernel = meta.get("kernel") or "boundary_charge"

@@ -390,6 +390,9 @@ def simulate(model, temperature_c: float, t, u, output: str = "auto", chain=None
         raise IPMCError(f"realization= cannot be combined with a chain of finite op-amps (gbw_hz={chain.gbw_hz}, "
                         f"dc_gain={chain.dc_gain}): the chain is realised together with the strip "
                         "(model_realization(..., chain=chain)); pass one or the other")
+    if getattr(model, "effects", None) and finite_opamps:
+        raise IPMCError("a model with effects cannot be simulated with a chain of finite op-amps (the chain's response "
+                        "depends on the strip's impedance, which the effects change): use ideal op-amps or the plain model")
     if realization is None and getattr(model, "effects", None) and output == ("displacement" if is_act else "current"):
         from .fftsim import RestRealization  # effects (a delay, say) have no finite realisation
 

@@ -397,7 +397,8 @@ class CalibrationResult:
         out = []
         for n in self.names:
             held = n in self.held
-            status = "held at base (undetermined)" if held else (
+            status = "held at base (undetermined)" if held else "hold refused (at its bound, not determined)" if (
+                n in self.hold_refused) else (
                 "determined" if n not in self.identifiability or self.identifiability[n].identifiable
                 else "not assessed")
             out.append({"name": n, "value": num(self.values[n]), "ci95": [num(self.ci_lower[n]), num(self.ci_upper[n])],
@@ -431,6 +432,11 @@ class CalibrationResult:
                 eff.setdefault(e, {})[p] = float(self.values[n])
         verdict = None if self.goodness_of_fit is None else FitVerdict.from_goodness(
             self.goodness_of_fit, diagnosis, named)
+        if not self.converged:
+            verdict = FitVerdict(False, None if verdict is None else verdict.chi2, None if verdict is None else verdict.dof,
+                                 None if verdict is None else verdict.p_value,
+                                 f"the fit did not converge ({self.message}): its parameters are not an estimate",
+                                 diagnosis, tuple(named))
         if provenance is None:
             provenance = Provenance("physmodel.calibrate", data_fingerprint=self.metadata.get("data_fingerprint"),
                                     temperatures_c=tuple(self.temperatures_c), band_hz=tuple(self.band_hz))

@@ -87,8 +87,11 @@ def load_physics(args, command: str, *, default_set: str | None = DEFAULT_SET):
                                  ("--set", getattr(args, "set", None))) if v]
     if len(given) > 1:
         raise CLIError(f"{command}: give one of --model, --params-json, --set (got {', '.join(o for o, _ in given)})")
+    over = parse_assignments(getattr(args, "param", None))
     if not given:
         if default_set is None:
+            if over:
+                raise CLIError(f"{command}: --param needs the physics it overrides: give --model or --set")
             return None, False
         given = [("--set", default_set)]
     option, source = given[0]
@@ -99,7 +102,6 @@ def load_physics(args, command: str, *, default_set: str | None = DEFAULT_SET):
         mf = load_model(source, kind=kind)
     except IPMCError as exc:
         raise CLIError(f"{option} {source}: {exc}") from None
-    over = parse_assignments(getattr(args, "param", None))
     if over:
         mf = mf.with_parameters(mf.parameters.replace(**over))
     if mf.path is None and getattr(args, "kernel", None):       # a named set: the kernel is the command's
@@ -137,9 +139,12 @@ def warn_verdict(mf, command: str) -> None:
               f"({mf.verdict.reason}); results computed from it inherit the misfit", file=sys.stderr)
 
 
-def model_metadata(mf) -> dict[str, str]:
-    """What a sweep written from ``mf`` records of it (``model_*`` keys, read back by ``ipmc fit``)."""
-    meta = {"model_file": str(mf.path or mf.name), "model_sha256": mf.fingerprint(), "model_kind": mf.kind,
+def model_metadata(mf, overridden: bool = False) -> dict[str, str]:
+    """What a sweep or record written from ``mf`` records of it (``model_*`` keys, read back by
+    ``ipmc fit``); ``overridden``: its parameters were changed with --param."""
+    path = str(Path(mf.path).resolve()) if mf.path and Path(mf.path).is_file() else str(mf.path or mf.name)
+    meta = {"model_file": path, "model_sha256": mf.fingerprint(), "model_kind": mf.kind,
+            "model_quantity": mf.quantity or ("M" if mf.kind == "actuator" else "S"),
             "model_effects": ", ".join(mf.effects) or "none",
             "model_verdict": ("unchecked" if mf.verdict is None else ("adequate" if mf.verdict.adequate else "MISFIT")),
             "model_verdict_reason": "" if mf.verdict is None else mf.verdict.reason}
@@ -152,7 +157,42 @@ def model_metadata(mf) -> dict[str, str]:
         if prov.data_file:
             data = prov.data_path(mf.path)
             meta["model_data_file"] = str(Path(data).resolve()) if data is not None and Path(data).exists() else prov.data_file
+            if prov.data_sha256:
+                meta["model_data_sha256"] = prov.data_sha256
+    if overridden:
+        meta["model_overridden"] = "parameters overridden with --param: the verdict describes the file's parameters"
     return meta
+
+
+def provenance_data(mf, info: dict) -> tuple:
+    """The measured sweep a model or a surrogate names as its data, when it is still that file:
+    the physics model's provenance first, then the surrogate's source model, then — for a surrogate
+    fitted straight to a measured sweep — that sweep.  A candidate is skipped (and a note says why)
+    when the file is gone, its SHA-256 differs from the one recorded, or it holds another quantity
+    than the tip displacement per volt.  Returns ``(path or None, how found, notes)``."""
+    from physmodel.model_file import file_sha256
+
+    notes: list[str] = []
+    cands = []
+    if mf is not None and mf.provenance is not None and mf.provenance.data_file:
+        cands.append((mf.provenance.data_path(mf.path), f"the physics model's provenance ({mf.path or mf.name})",
+                      mf.provenance.data_sha256, mf.quantity))
+    src = info.get("source_model") or {}
+    if src.get("data_file"):
+        cands.append((Path(src["data_file"]), "the surrogate's source model", src.get("data_sha256"), src.get("quantity")))
+    own = (info.get("data") or {}).get("file")
+    if not src and own:
+        cands.append((Path(own), "the surrogate's own data (it was fitted to a measured sweep)", None, None))
+    for path, how, sha, quantity in cands:
+        if path is None or not path.is_file():
+            notes.append(f"{how} names {path}, which is not found")
+        elif quantity not in (None, "", "M"):
+            notes.append(f"{how} names {path}, fitted to quantity {quantity}, not the tip displacement per volt")
+        elif sha and file_sha256(path) != sha:
+            notes.append(f"{how} names {path}, which has changed since the model was fitted (SHA-256 differs)")
+        else:
+            return path, how, notes
+    return None, "", notes
 
 
 def _add_model_args(p, default_set: str | None = DEFAULT_SET):

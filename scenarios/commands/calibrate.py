@@ -79,11 +79,13 @@ def parse_effect(item: str, option: str = "--effect") -> tuple[str, dict]:
 def provenance_of(data_file, data, creator: str):
     """The :class:`physmodel.model_file.Provenance` of a model fitted to ``data`` read from ``data_file``."""
     import shlex
+    from pathlib import Path
 
     import physmodel
     from physmodel.model_file import Provenance, file_sha256
 
-    return Provenance(creator, str(data_file), file_sha256(data_file), data.fingerprint(),
+    # absolute, so that a later command run from another folder finds it (and its hash guards it)
+    return Provenance(creator, str(Path(data_file).resolve()), file_sha256(data_file), data.fingerprint(),
                       tuple(float(t) for t in data.temperatures()),
                       (float(np.min(data.frequency_hz)), float(np.max(data.frequency_hz))),
                       " ".join(shlex.quote(a) for a in ["ipmc", *sys.argv[1:]]), physmodel.__version__)

@@ -42,7 +42,7 @@ import numpy as np
 
 from inversion.limits import DEFAULT_MAX_VOLTAGE
 
-from ._common import EXIT_FAILED, EXIT_OK, CLIError, _floats, load_physics, verdict_lines
+from ._common import EXIT_FAILED, EXIT_OK, CLIError, _floats, load_physics, provenance_data, verdict_lines
 
 __all__ = ["add_parser", "run", "build_reference", "drive_limits"]
 
@@ -77,7 +77,9 @@ def add_parser(sub):
     c.add_argument("--max-rate", type=float, help="largest |dV/dt| allowed [V/s], > 0")
     c.add_argument("--on-limit", choices=("error", "warn"), default="error",
                    help="refuse (exit 3, nothing written) or warn and continue")
-    c.add_argument("--max-error", type=float, help="fail (exit 3) if the predicted tracking error exceeds this [unit]")
+    c.add_argument("--max-error", type=float,
+                   help="fail (exit 3) if the error against the physics (max between the fades) or the predicted RMS "
+                        "error on the strip exceeds this [unit]")
     m = p.add_argument_group("checks: your measured data and the physics")
     m.add_argument("--data", help="the measured sweep of the strip (.csv/.npz/.mat); default: the data file named "
                                   "in the physics model's provenance, else in the surrogate's")
@@ -151,35 +153,29 @@ def physics_for(args, model, command: str):
     if not path:
         return None, False, ("no physics model given and the surrogate names none (it was fitted to measured data): "
                              "the error against the physics is not computed")
-    if not Path(path).is_file():
+    from physmodel import available_parameter_sets
+
+    if not Path(path).is_file() and path not in available_parameter_sets():
         return None, False, f"the surrogate's physics model {path} is not found: pass --model"
-    mf = load_model(path)
+    mf = load_model(path, kind=src.get("kind"))
     if src.get("sha256") and mf.fingerprint() != src["sha256"]:
+        if src.get("overridden"):
+            return None, False, (f"the surrogate's sweep was made from {path} with --param overrides: pass --model "
+                                 "with the same --param to check against that physics")
         return None, False, (f"{path} has changed since the surrogate's sweep was made from it (sha256 differs): "
                              "pass --model explicitly")
     return mf, False, f"physics: the model the surrogate's sweep was made from ({path})"
 
 
 def measured_data(args, mf, model):
-    """The measured sweep to check against: ``--data``, else the data file in the physics model's
-    provenance, else in the surrogate's source model, else — for a surrogate fitted straight to a
-    measured sweep (no source model) — that sweep.  Returns ``(path or None, how found)``."""
+    """The measured sweep to check against: ``--data``, else what the physics model or the
+    surrogate names (:func:`~scenarios.commands._common.provenance_data`: only if still the same
+    file and the same quantity).  Returns ``(path or None, how found, notes)``."""
     if args.data:
         if not Path(args.data).is_file():
             raise CLIError(f"--data {args.data}: no such file")
-        return Path(args.data), "--data"
-    if mf is not None and mf.provenance is not None:
-        p = mf.provenance.data_path(mf.path)
-        if p is not None and p.is_file():
-            return p, f"the physics model's provenance ({mf.path})"
-    src_model = model.info.get("source_model") or {}
-    src = src_model.get("data_file")
-    if src and Path(src).is_file():
-        return Path(src), "the surrogate's source model"
-    own = (model.info.get("data") or {}).get("file")
-    if not src_model and own and Path(own).is_file():    # fitted straight to a measured sweep: that sweep
-        return Path(own), "the surrogate's own data (it was fitted to a measured sweep)"
-    return None, ""
+        return Path(args.data), "--data", []
+    return provenance_data(mf, model.info)
 
 
 def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_unit, drive=None):
@@ -193,8 +189,9 @@ def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_un
     try:
         sweep = sweep.in_units(in_unit, out_unit)
     except IPMCError as exc:
-        raise CLIError(f"--data {data_path}: its units {sweep.output_unit}/{sweep.input_unit} do not match the "
-                       f"surrogate's {out_unit}/{in_unit}: {exc}") from None
+        raise CLIError(f"{data_path}: its units {sweep.output_unit}/{sweep.input_unit} do not match the "
+                       f"surrogate's {out_unit}/{in_unit} ({exc}); give the tip-displacement-per-volt sweep with "
+                       "--data") from None
     mis = misfit_to_data(model, sweep, source=f"{data_path} (fingerprint {sweep.fingerprint()[:12]})")
     residual = None
     if drive is not None:
@@ -255,11 +252,15 @@ def run(args) -> int:
     if UNITS[in_unit][0] != "voltage" or UNITS[out_unit][0] != "length":
         raise CLIError(f"{args.surrogate}: expected an actuator surrogate (length per voltage), got "
                        f"{out_unit}/{in_unit}")
+    if args.no_check and (args.model or args.set or args.params_json or args.param):
+        raise CLIError("--no-check: no physics check is run, so --model/--set/--params-json/--param have nothing to do")
     mf, overridden, phys_note = (None, False, "physics check skipped (--no-check)") if args.no_check else \
         physics_for(args, model, "ipmc feedforward")
     if mf is not None and mf.kind != "actuator":
         raise CLIError(f"{mf.path or mf.name}: a {mf.kind} model cannot check an actuator's feedforward")
-    data_path, data_how = measured_data(args, mf, model)
+    data_path, data_how, data_notes = measured_data(args, mf, model)
+    if args.max_error is not None and data_path is None and mf is None:
+        raise CLIError("--max-error: nothing to check it against (no measured data and no physics model)")
     ref = build_reference(args, out_unit)
     from inversion.references import edge_jump
 
@@ -348,6 +349,9 @@ def run(args) -> int:
     for u in upstream:
         lines.append(f"- **UPSTREAM MISFIT**: {u}")
         print(f"ipmc feedforward: {u}", file=sys.stderr)
+    for n in data_notes:
+        lines.append(f"- not used as data: {n}")
+        print(f"ipmc feedforward: note: not used as data: {n}", file=sys.stderr)
     for n in range_notes:
         lines.append(f"- **{n}**")
         print(f"ipmc feedforward: warning: {n}", file=sys.stderr)
@@ -419,6 +423,10 @@ def run(args) -> int:
         if args.max_error is not None and e_body > args.max_error:
             lines.append(f"- **tracking error {e_body:.4g} {out_unit} exceeds --max-error {args.max_error:g}**")
             status = EXIT_FAILED
+    if args.max_error is not None and strip is not None and strip.rms * r_rms > args.max_error:
+        lines.append(f"- **predicted RMS error on the strip {strip.rms * r_rms:.4g} {out_unit} exceeds --max-error "
+                     f"{args.max_error:g}**")
+        status = EXIT_FAILED
     if upstream and not args.accept_misfit:
         status = EXIT_FAILED
     summary["exit_code"] = status

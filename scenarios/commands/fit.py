@@ -140,6 +140,8 @@ def upstream_lines(info: dict) -> str:
             "- its verdict on its own data: " + {"adequate": "fits its data", "MISFIT": "**DOES NOT FIT its data**",
                                                  "unchecked": "never compared with measured data"}.get(v, v)
             + (f" — {src['verdict_reason']}" if src.get("verdict_reason") else "")]
+    if src.get("overridden"):
+        text.append(f"- **{src['overridden']}**")
     if src.get("fitted_temperatures_c"):
         text.append(f"- that model was fitted at {src['fitted_temperatures_c']} °C"
                     + (f", {src['fitted_band_hz'].replace(',', '–')} Hz" if src.get("fitted_band_hz") else ""))

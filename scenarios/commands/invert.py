@@ -239,10 +239,17 @@ def _verdicts(args: argparse.Namespace, smodel: Any, t: np.ndarray, y: np.ndarra
         print(f"ipmc invert: {msg}" + ("" if args.accept_misfit else " (exit 3; --accept-misfit to accept)"),
               file=sys.stderr)
         status = EXIT_OK if args.accept_misfit else 3
-    data = args.data or src.get("data_file") or (None if src else (smodel.info.get("data") or {}).get("file"))
-    if data is None or not Path(data).is_file():
-        if args.data is not None:
+    from ._common import provenance_data
+
+    if args.data is not None:
+        if not Path(args.data).is_file():
             raise InversionError(f"--data {args.data}: no such file")
+        data = Path(args.data)
+    else:
+        data, _, skipped = provenance_data(None, smodel.info)
+        for n in skipped:
+            print(f"ipmc invert: note: not used as data: {n}", file=sys.stderr)
+    if data is None:
         notes.append("predicted_error_on_strip: unchecked against measurement (no --data)")
         print("ipmc invert: warning: the decoding error is unchecked against measurement (give --data)", file=sys.stderr)
         return notes, status

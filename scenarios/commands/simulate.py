@@ -63,7 +63,7 @@ def run(args) -> int:
     mf, overridden = load_physics(args, "ipmc simulate")
     warn_verdict(mf, "ipmc simulate")
     model = mf.model()
-    args.model_metadata = model_metadata(mf)
+    args.model_metadata = model_metadata(mf, overridden)
     kw = dict(output_noise_rms=args.noise_rms, input_noise_rms=args.input_noise_rms, seed=args.seed)
     if args.chain:
         if args.kind != "sensor":

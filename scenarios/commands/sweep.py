@@ -75,9 +75,7 @@ def run(args) -> int:
         sw = synthesize_sweep(model, quantity, f, temps, noise=noise, seed=args.seed, progress=bar)
     finally:
         bar.close()
-    meta = model_metadata(mf)
-    if overridden:
-        meta["model_overridden"] = "parameters overridden with --param: the verdict describes the file's parameters"
+    meta = model_metadata(mf, overridden)
     from dataclasses import replace
 
     sw = replace(sw, metadata={**sw.metadata, **meta})

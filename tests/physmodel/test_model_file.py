@@ -73,3 +73,44 @@ def test_a_file_of_another_format_is_refused_with_its_name(tmp_path):
     p.write_text(json.dumps({"format": "something-else", "parameters": {}}))
     with pytest.raises(ParameterError, match="x.json.*format"):
         load_model(p)
+
+
+@pytest.mark.parametrize("patch, needle", [
+    ({"verdict": {"adequate": "false"}}, "adequate"),                 # a string is not a verdict
+    ({"verdict": {"adequate": True, "dof": "abc"}}, "dof"),
+    ({"provenance": {"creator": "x", "band_hz": 5}}, "band_hz"),
+    ({"provenance": {"creator": "x", "temperatures_c": "25"}}, "temperatures_c"),
+    ({"estimates": "abc"}, "estimates"),
+    ({"effects": {"time_delay": 3}}, "effects"),
+])
+def test_a_badly_typed_model_file_is_refused_naming_the_key(tmp_path, patch, needle):
+    d = _model_file().to_dict()
+    d.update(patch)
+    p = tmp_path / "m.json"
+    p.write_text(json.dumps(d))
+    with pytest.raises(ParameterError, match=needle):
+        load_model(p)
+
+
+def test_an_older_file_of_another_kind_is_refused(tmp_path):
+    params = json.loads(json.dumps(get_parameter_set("seed000_sensor").to_dict(), default=str))
+    old = {"format": "ipmc-parameter-set", "version": 1, "parameters": params,
+           "calibration": {"metadata": {"kind": "sensor", "quantity": "S"}}}
+    p = tmp_path / "parameters.json"
+    p.write_text(json.dumps(old).replace("Infinity", '"inf"'))
+    assert load_model(p).kind == "sensor"
+    with pytest.raises(ParameterError, match="sensor model"):
+        load_model(p, kind="actuator")
+
+
+def test_a_calibration_that_did_not_converge_writes_a_model_that_does_not_fit():
+    from physmodel import MagnitudePhaseNoise, calibrate, synthesize_sweep
+    from physmodel.estimation.calibration import default_free_parameter
+
+    p = get_parameter_set("seed001_actuator")
+    sw = synthesize_sweep(EffectModel(p, "actuator", {}), "M", np.logspace(-1, 1, 20), [25.0],
+                          noise=MagnitudePhaseNoise(0.05, 0.3), seed=2)
+    res = calibrate(sw, p.replace(d=3 * p.d), [default_free_parameter(p, "d")], starts=1, max_nfev=1)
+    assert not res.converged
+    mf = res.to_model_file()
+    assert mf.adequate is False and "did not converge" in mf.verdict.reason

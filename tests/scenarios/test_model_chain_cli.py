@@ -71,8 +71,7 @@ def test_the_misfit_travels_through_sweep_fit_and_feedforward(chain, capsys):
     assert rc == 3
     assert "does not fit its data" in capsys.readouterr().err
     rep = json.loads((chain / "ff" / "report.json").read_text())
-    assert rep["upstream_misfit"] and rep["physics_model"].endswith("model.json")
-    assert "seed001_actuator" != rep["physics_model"]
+    assert rep["upstream_misfit"] and rep["physics_model"] == str((chain / "cal" / "model.json").resolve())
     # the voltage on the strip itself (the truth with its delay; simulated exactly in the frequency domain,
     # a simulation checked against lsim and an exact shift in tests/physmodel/test_fftsim.py)
     achieved = _achieved_on_truth(chain / "ff")
@@ -100,7 +99,6 @@ def test_feedforward_without_data_says_its_prediction_is_unchecked(chain, tmp_pa
                  "--quiet"]) == 0
     rep = json.loads((tmp_path / "ff" / "report.json").read_text())
     assert rep["physics_error_rms"] is None and rep["predicted_error_on_strip_rms"] is not None
-    (chain / "moved.csv").write_bytes((chain / "sweep.csv").read_bytes())
     info["data"]["file"] = str(tmp_path / "gone.csv")
     doc = json.loads((tmp_path / "fit" / "model.json").read_text())
     doc["info"] = info
@@ -164,3 +162,48 @@ def test_diagnose_exits_3_when_the_model_it_ends_with_does_not_fit(chain, tmp_pa
     mf = json.loads((tmp_path / "d1" / "model.json").read_text())
     assert mf["verdict"]["adequate"] is False
     assert main([*argv, "--accept-misfit", "--out", str(tmp_path / "d2")]) == 0
+
+
+def test_provenance_data_is_used_only_while_it_is_the_same_file(chain, tmp_path, monkeypatch, capsys):
+    """A relative data path is stored absolute (a command run elsewhere finds it); a data file changed
+    since the fit is not used as the strip's data, and the report says why."""
+    work = tmp_path / "lab"
+    work.mkdir()
+    (work / "sweep.csv").write_bytes((chain / "sweep.csv").read_bytes())
+    monkeypatch.chdir(work)
+    assert main(["calibrate", "sweep.csv", "--set", "seed001_actuator", "--free", "alpha0", "--starts", "1",
+                 "--accept-misfit", "--out", "cal", "--quiet"]) == 0
+    prov = json.loads((work / "cal" / "model.json").read_text())["provenance"]
+    assert prov["data_file"] == str((work / "sweep.csv").resolve())
+    assert main(["sweep", "--model", "cal/model.json", "--temperatures", "20,30,40,50", "--fmin", "0.1", "--fmax", "9",
+                 "--points", "30", "--out", "dense.csv", "--quiet"]) == 0
+    assert main(["fit", "dense.csv", "--zeros", "4", "--poles", "4", "--degree", "2", "--out", "fit", "--quiet"]) == 0
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    assert main(["feedforward", str(work / "fit" / "model.json"), *FF, "--accept-misfit", "--out", "ff1",
+                 "--quiet"]) == 0
+    assert json.loads((elsewhere / "ff1" / "report.json").read_text())["predicted_error_on_strip_rms"] is not None
+    # the lab re-measures into the same file name: the model's data are gone, the hash says so
+    sw = read_sweep(work / "sweep.csv")
+    write_sweep(type(sw)(**{**sw.__dict__, "response": sw.response * 1.01}), work / "sweep.csv")
+    capsys.readouterr()
+    assert main(["feedforward", str(work / "fit" / "model.json"), *FF, "--accept-misfit", "--out", "ff2",
+                 "--quiet"]) == 0
+    assert "has changed since the model was fitted" in capsys.readouterr().err
+    assert json.loads((elsewhere / "ff2" / "report.json").read_text())["predicted_error_on_strip_rms"] is None
+
+
+def test_param_without_the_physics_it_overrides_is_bad_input(chain, capsys):
+    if not (chain / "fit" / "model.json").exists():          # run alone: make the misfit surrogate here
+        assert main(["sweep", "--model", str(chain / "cal" / "model.json"), "--temperatures", "20,30,40,50",
+                     "--fmin", "0.1", "--fmax", "9", "--points", "30", "--out", str(chain / "dense.csv"), "--quiet"]) == 0
+        assert main(["fit", str(chain / "dense.csv"), "--zeros", "4", "--poles", "4", "--degree", "2",
+                     "--out", str(chain / "fit"), "--quiet"]) == 0
+    # the surrogate's own physics is used by default; --param has no --model/--set to apply to
+    assert main(["feedforward", str(chain / "fit" / "model.json"), *FF, "--param", "d=1e-11",
+                 "--out", str(chain / "ffp"), "--quiet"]) == 2
+    assert "--param needs the physics it overrides" in capsys.readouterr().err
+    assert main(["feedforward", str(chain / "fit" / "model.json"), *FF, "--no-check", "--model",
+                 str(chain / "cal" / "model.json"), "--param", "d=1e-11", "--out", str(chain / "ffq"), "--quiet"]) == 2
+    assert "--no-check" in capsys.readouterr().err

@@ -1,7 +1,7 @@
 """The error predicted on the strip from a surrogate's misfit to measured data
 (:mod:`surrogate.strip_check`), against closed-form values: a constant relative misfit m gives
-exactly |m| for any in-band signal; a sine sees |m(f0)|; between two temperatures the squared
-misfit interpolates linearly; measurement noise is removed on average (debiased |m|² − σ²)."""
+exactly |m| for any in-band signal; a sine sees |m(f0)|; between two temperatures the misfit
+interpolates linearly; measurement noise is removed on average (debiased |m|² − σ²)."""
 
 from __future__ import annotations
 
