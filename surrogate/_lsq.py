@@ -83,6 +83,23 @@ def _layout(structure: Structure) -> dict:
     return lay
 
 
+
+def one_blas_thread(fn):
+    """Run ``fn`` with BLAS held to one thread: the solves here are small, so threads only stall, and
+    the iterates must not depend on the machine's thread count (the reduction order of a threaded
+    BLAS changes the last bits, and with them which start wins a race or where a solver stops —
+    seen with numpy 1.24's OpenBLAS on two cores)."""
+    import functools
+
+    from threadpoolctl import threadpool_limits
+
+    @functools.wraps(fn)
+    def wrapped(*args, **kwargs):
+        with threadpool_limits(limits=1, user_api="blas"):
+            return fn(*args, **kwargs)
+
+    return wrapped
+
 class Evaluator:
     """Residual and Jacobian of one fit problem (a :class:`surrogate._nlp.Problem`) for one
     parameter vector (p,) or a stack of them (S, p)."""
@@ -353,6 +370,7 @@ class LevenbergMarquardt:
         self.status[i] = status
         self.converged[i] = converged
 
+    @one_blas_thread
     def run(self, max_iterations: int, only=None) -> LevenbergMarquardt:
         """Advance the running starts (or those in ``only``) by up to ``max_iterations``."""
         t0 = time.perf_counter()

@@ -10,7 +10,7 @@ import numpy as np
 from . import _fit as F
 from ._data import FrequencyData, to_data
 from ._init import initial_candidates
-from ._lsq import Evaluator
+from ._lsq import Evaluator, one_blas_thread
 from ._structure import Structure
 
 __all__ = ["RationalFit"]
@@ -95,6 +95,7 @@ class RationalFit:
         data = F.as_data(frequency_hz, temperature_c, response, magnitude_std_db, phase_std_deg)
         return self.fit_data(data)
 
+    @one_blas_thread
     def fit_data(self, data: FrequencyData, theta0=None, *, stage: str = "per-temperature"):
         """Fit a ``FrequencyData`` or a ``physmodel.data.sweep.FrequencySweep``.
 

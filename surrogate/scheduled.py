@@ -19,7 +19,7 @@ from . import _fit as F
 from ._convert import convert
 from ._data import FrequencyData, to_data
 from ._init import levy
-from ._lsq import STATUS_STOPPED, Evaluator
+from ._lsq import STATUS_STOPPED, Evaluator, one_blas_thread
 from ._nlp import SolveOutcome, get_solver
 from ._structure import FORMS, Structure
 from .models import RationalModel, Scaling
@@ -318,6 +318,7 @@ class ScheduledFit:
                             f"({bad.min():g}-{bad.max():g} °C)",
                             False, out.iterations, out.time_s, out.objective_trace)
 
+    @one_blas_thread
     def fit_data(self, data: FrequencyData):
         """Fit a ``FrequencyData`` or a ``physmodel.data.sweep.FrequencySweep``."""
         t_start = time.perf_counter()
