@@ -261,8 +261,8 @@ def _legacy(data: dict, where: str, kind: str | None, path: str) -> ModelFile:
         if cal.get("goodness_of_fit"):
             verdict = FitVerdict.from_goodness(cal["goodness_of_fit"])
         if kind is not None and meta.get("kind") not in (None, "", kind):
-            raise ParameterError(f"{where} is a {meta['kind']} model (its calibration record says so); this command "
-                                 f"needs a {kind} model (--kind)")
+            raise ParameterError(f"{where} holds a model of kind {meta['kind']!r} (its calibration record says so); "
+                                 f"this command needs kind {kind!r} (--kind)")
         kind = kind or meta.get("kind")
         quantity = meta.get("quantity") or None
         kernel = meta.get("kernel") or "boundary_charge"
@@ -327,7 +327,7 @@ def load_model(source: str | os.PathLike, *, kind: str | None = None, **override
         else:
             mf = _legacy(data, where, kind, text)
         if kind is not None and mf.kind != kind:
-            raise ParameterError(f"{where} is a {mf.kind} model; this command needs a {kind} model (--kind)")
+            raise ParameterError(f"{where} holds a model of kind {mf.kind!r}; this command needs kind {kind!r} (--kind)")
     if overrides:
         mf = mf.with_parameters(mf.parameters.replace(**overrides))
     return mf

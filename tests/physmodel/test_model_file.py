@@ -44,7 +44,7 @@ def test_a_named_set_has_no_verdict_and_kind_conflicts_are_refused(tmp_path):
     mf = load_model("seed002_table3")
     assert mf.verdict is None and mf.adequate is None and mf.effects == {}
     _model_file().save(tmp_path / "m.json")
-    with pytest.raises(ParameterError, match="actuator model"):
+    with pytest.raises(ParameterError, match="kind 'actuator'"):
         load_model(tmp_path / "m.json", kind="sensor")
 
 
@@ -99,7 +99,7 @@ def test_an_older_file_of_another_kind_is_refused(tmp_path):
     p = tmp_path / "parameters.json"
     p.write_text(json.dumps(old).replace("Infinity", '"inf"'))
     assert load_model(p).kind == "sensor"
-    with pytest.raises(ParameterError, match="sensor model"):
+    with pytest.raises(ParameterError, match="kind 'sensor'"):
         load_model(p, kind="actuator")
 
 
