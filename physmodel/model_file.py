@@ -31,7 +31,6 @@ from __future__ import annotations
 import ast
 import hashlib
 import json
-import math
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -39,27 +38,8 @@ from typing import Any
 
 from .errors import ParameterError
 from .fit_record import FitVerdict, Provenance, file_sha256
+from .formats import MODEL_FORMAT, MODEL_VERSION, PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
 from .params import IPMCParameters
-
-#: Format name and version of the model file.
-MODEL_FORMAT = "ipmc-model"
-MODEL_VERSION = 1
-
-#: Format name and version of a bare parameter-set file (:func:`physmodel.save_parameter_set`).
-PARAMETER_SET_FORMAT = "ipmc-parameter-set"
-PARAMETER_SET_VERSION = 1
-
-
-def finite_json(obj):
-    """``obj`` with infinite floats as the strings "inf"/"-inf" (which ``float()`` reads back), so
-    that it is strict JSON (NaN is left to fail there: a parameter is never NaN)."""
-    if isinstance(obj, dict):
-        return {str(k): finite_json(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [finite_json(v) for v in obj]
-    if isinstance(obj, float) and math.isinf(obj):
-        return "inf" if obj > 0 else "-inf"
-    return obj
 
 
 @dataclass(frozen=True)

@@ -208,3 +208,25 @@ def _gelsd_work(rows: int, cols: int, cond: float) -> tuple[int, int]:
 def principal_sqrt(z):
     """Principal complex square root (Re ≥ 0), the branch the closed forms assume."""
     return np.sqrt(np.asarray(z, dtype=complex))
+
+def one_blas_thread(fn):
+    """Run ``fn`` with BLAS held to one thread (a decorator): for small solves threads only stall, and
+    the iterates must not depend on the machine's thread count (the reduction order of a threaded
+    BLAS changes the last bits, and with them which start wins a race or where a solver stops —
+    seen with numpy 1.24's OpenBLAS on two cores).
+
+    Parameters
+    ----------
+    fn : callable
+        The function to wrap.
+    """
+    import functools
+
+    from threadpoolctl import threadpool_limits
+
+    @functools.wraps(fn)
+    def wrapped(*args, **kwargs):
+        with threadpool_limits(limits=1, user_api="blas"):
+            return fn(*args, **kwargs)
+
+    return wrapped

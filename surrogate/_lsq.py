@@ -26,6 +26,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from physmodel.numerics import one_blas_thread
+
 from ._lm_control import step_control
 from ._structure import Structure
 
@@ -83,22 +85,6 @@ def _layout(structure: Structure) -> dict:
     return lay
 
 
-
-def one_blas_thread(fn):
-    """Run ``fn`` with BLAS held to one thread: the solves here are small, so threads only stall, and
-    the iterates must not depend on the machine's thread count (the reduction order of a threaded
-    BLAS changes the last bits, and with them which start wins a race or where a solver stops —
-    seen with numpy 1.24's OpenBLAS on two cores)."""
-    import functools
-
-    from threadpoolctl import threadpool_limits
-
-    @functools.wraps(fn)
-    def wrapped(*args, **kwargs):
-        with threadpool_limits(limits=1, user_api="blas"):
-            return fn(*args, **kwargs)
-
-    return wrapped
 
 class Evaluator:
     """Residual and Jacobian of one fit problem (a :class:`surrogate._nlp.Problem`) for one

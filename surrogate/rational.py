@@ -7,10 +7,12 @@ import time
 
 import numpy as np
 
+from physmodel.numerics import one_blas_thread
+
 from . import _fit as F
 from ._data import FrequencyData, to_data
 from ._init import initial_candidates
-from ._lsq import Evaluator, one_blas_thread
+from ._lsq import Evaluator
 from ._structure import Structure
 
 __all__ = ["RationalFit"]

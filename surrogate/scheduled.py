@@ -15,11 +15,13 @@ import time
 
 import numpy as np
 
+from physmodel.numerics import one_blas_thread
+
 from . import _fit as F
 from ._convert import convert
 from ._data import FrequencyData, to_data
 from ._init import levy
-from ._lsq import STATUS_STOPPED, Evaluator, one_blas_thread
+from ._lsq import STATUS_STOPPED, Evaluator
 from ._nlp import SolveOutcome, get_solver
 from ._structure import FORMS, Structure
 from .models import RationalModel, Scaling

@@ -16,8 +16,8 @@ from ..data.sweep import FrequencySweep, sweep_layout
 from ..errors import IPMCError, ParameterError
 from ..parameter_paths import StateMap, apply_values, base_value, check_parameter_name
 from ..params import IPMCParameters
+from .identifiability import Identifiability
 from .lsq import CalibrationResult, FreeParameter, SensitivityProbe, fit_parameters
-from .records import Identifiability
 
 
 def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:

@@ -17,15 +17,44 @@ Holds (:class:`HoldRecord`, :func:`hold_cost_tolerance`)
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import IPMCError
 from .batching import ModelBatch
-from .records import Identifiability, SensitivityProbe
 from .residuals import ZERO_REASON, ZERO_SENSITIVITY, GoodnessOfFit
+
+
+@dataclass(frozen=True)
+class Identifiability:
+    """Whether the data determine one parameter, and why not.
+
+    ``sensitivity_peak_hz``: frequency where |∂ ln G/∂z| is largest (over the probe band when a
+    :class:`SensitivityProbe` was given, else over the data); ``in_band_fraction``: the largest
+    in-band sensitivity over that peak (1 = the peak is inside the measured band).
+    """
+
+    identifiable: bool
+    reason: str
+    sensitivity_peak_hz: float | None = None
+    in_band_fraction: float | None = None
+
+
+@dataclass(frozen=True)
+class SensitivityProbe:
+    """A wide-band evaluation used to locate where each parameter acts.
+
+    ``predict_many(list_of_value_dicts) -> (n_sets, n_f) complex`` at ``frequency_hz`` [Hz]
+    (one representative temperature); ``predict_array(X) -> (n_sets, n_f)``, when given, takes
+    the rows of physical values (n_sets, n_free) in the order of the free parameters instead.
+    """
+
+    frequency_hz: np.ndarray
+    predict_many: Callable[[Sequence[Mapping[str, float]]], np.ndarray]
+    predict_array: Callable[[np.ndarray], np.ndarray] | None = None
+
 
 #: Two-sided 95 % normal quantile.
 Z95 = 1.959963984540054

@@ -79,6 +79,8 @@ from .identifiability import (
     BOUND_TOL,
     Z95,
     HoldRecord,
+    Identifiability,
+    SensitivityProbe,
     flag_parameters,
     hold_record,
     refused_identifiability,
@@ -87,8 +89,6 @@ from .observations import ScalarObservations
 from .records import (
     CalibrationResult,
     FreeParameter,
-    Identifiability,
-    SensitivityProbe,
     StartRecord,
     Values,
     lhs_starts,

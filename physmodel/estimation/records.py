@@ -1,7 +1,7 @@
 """Records of the least-squares engine (:mod:`physmodel.estimation.lsq`): what is free
-(:class:`FreeParameter`), how a start went (:class:`StartRecord`), what the data determine
-(:class:`Identifiability`) and the outcome (:class:`CalibrationResult`; what holding cost:
-:class:`~physmodel.estimation.identifiability.HoldRecord`).  The engine's array helpers are in
+(:class:`FreeParameter`), how a start went (:class:`StartRecord`) and the outcome (:class:`CalibrationResult`; what holding cost:
+:class:`~physmodel.estimation.identifiability.HoldRecord`; what the data determine:
+:class:`~physmodel.estimation.identifiability.Identifiability`).  The engine's array helpers are in
 :mod:`physmodel.estimation.batching`.  Physical units throughout.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -175,35 +175,6 @@ class StartRecord:
     message: str
 
 
-@dataclass(frozen=True)
-class Identifiability:
-    """Whether the data determine one parameter, and why not.
-
-    ``sensitivity_peak_hz``: frequency where |∂ ln G/∂z| is largest (over the probe band when a
-    :class:`SensitivityProbe` was given, else over the data); ``in_band_fraction``: the largest
-    in-band sensitivity over that peak (1 = the peak is inside the measured band).
-    """
-
-    identifiable: bool
-    reason: str
-    sensitivity_peak_hz: float | None = None
-    in_band_fraction: float | None = None
-
-
-@dataclass(frozen=True)
-class SensitivityProbe:
-    """A wide-band evaluation used to locate where each parameter acts.
-
-    ``predict_many(list_of_value_dicts) -> (n_sets, n_f) complex`` at ``frequency_hz`` [Hz]
-    (one representative temperature); ``predict_array(X) -> (n_sets, n_f)``, when given, takes
-    the rows of physical values (n_sets, n_free) in the order of the free parameters instead.
-    """
-
-    frequency_hz: np.ndarray
-    predict_many: Callable[[Sequence[Values]], np.ndarray]
-    predict_array: Callable[[np.ndarray], np.ndarray] | None = None
-
-
 @dataclass
 class CalibrationResult:
     """Outcome of a calibration.  Physical units throughout; intervals are 95 %.
@@ -240,7 +211,7 @@ class CalibrationResult:
     starts : list of StartRecord
         Every start: where it began, where it ended.
     identifiability : dict
-        {name: Identifiability}: whether the data determine the parameter, and why not.
+        {name: :class:`~physmodel.estimation.identifiability.Identifiability`}: whether the data determine the parameter, and why not.
     noise_estimated : bool
         True when the data had no per-line σ and the noise level was estimated from the residuals.
     noise_scale : float
@@ -457,7 +428,7 @@ class CalibrationResult:
         Path
             The file written.
         """
-        from ..model_file import PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
+        from ..formats import PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
 
         payload: dict = {}
         if self.parameters is not None:

@@ -74,7 +74,7 @@ def save_parameter_set(params: IPMCParameters, path: str | os.PathLike) -> Path:
     """Write ``params`` as a versioned JSON parameter file (atomically) and return its path (no
     verdict, no effects: :class:`physmodel.ModelFile` writes a whole model)."""
     from ..data.files import atomic_write
-    from ..model_file import PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
+    from ..formats import PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
 
     path = Path(path)
     payload = {"format": PARAMETER_SET_FORMAT, "version": PARAMETER_SET_VERSION,
@@ -89,12 +89,38 @@ def load_parameter_set(path: str | os.PathLike) -> IPMCParameters:
     a parameter file written by :func:`save_parameter_set` or an older ``ipmc calibrate``, or of a
     bare parameter record.  Effects and the data's verdict are not parameters: read the whole model
     with :func:`physmodel.load_model`."""
-    from ..model_file import load_model
+    from ..data.files import read_text
+    from ..errors import DataFormatError
+    from ..formats import MODEL_FORMAT, MODEL_VERSION, PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION
 
     path = Path(path)
     if not path.is_file():
         raise ParameterError(f"parameter file {str(path)!r} does not exist")
-    return load_model(path).parameters
+    try:
+        data = json.loads(read_text(path, "parameter file"))
+    except DataFormatError as exc:
+        raise ParameterError(str(exc)) from None
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from None
+    if isinstance(data, dict) and "parameters" in data:
+        known = {PARAMETER_SET_FORMAT: PARAMETER_SET_VERSION, MODEL_FORMAT: MODEL_VERSION}
+        fmt = data.get("format")
+        if fmt not in known:
+            raise ParameterError(f"parameter file {str(path)!r} has format {fmt!r}, expected one of {sorted(known)}")
+        version = data.get("version", 0)
+        if isinstance(version, bool) or not isinstance(version, int) or version < 0:
+            raise ParameterError(f"parameter file {str(path)!r}: version must be a non-negative integer, "
+                                 f"got {version!r}")
+        if version > known[fmt]:
+            raise ParameterError(f"parameter file {str(path)!r} has {fmt} version {version}, "
+                                 f"this library reads up to {known[fmt]}")
+        data = data["parameters"]
+    if not isinstance(data, dict):
+        raise ParameterError(f"parameter file {str(path)!r} holds {type(data).__name__}, expected an object")
+    try:
+        return IPMCParameters.from_dict(data)
+    except ParameterError as exc:
+        raise ParameterError(f"parameter file {str(path)!r}: {exc}") from None
 
 
 def register_parameter_set(name: str, factory: Callable[[], IPMCParameters], *, overwrite: bool = False) -> None:

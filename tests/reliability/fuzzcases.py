@@ -144,7 +144,7 @@ def valid_sweep(d: Path, name="sweep.csv", temps=(20.0, 40.0), points=8, noise=T
 
 def _params_record() -> dict:
     from physmodel import get_parameter_set
-    from physmodel.model_file import finite_json as _finite_json
+    from physmodel.formats import finite_json as _finite_json
 
     return _finite_json(get_parameter_set("seed002_table3").to_dict())
 
