@@ -61,6 +61,23 @@ def check_plot_path(path, option: str = "--plot") -> Path:
     return p
 
 
+def refuse_overwriting_inputs(outputs: dict, inputs: dict) -> None:
+    """A CLIError (exit 2) when an output file would replace an input: ``outputs`` and ``inputs``
+    map an option or role (e.g. ``"--out"``, ``"RECORD"``) to a path or None; two paths are the same
+    file when they resolve to the same place (links included), whether or not the output exists yet."""
+    def same(a: Path, b: Path) -> bool:
+        try:
+            return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+        except OSError:
+            return False
+
+    for o_opt, o in outputs.items():
+        for i_opt, i in inputs.items():
+            if o is not None and i is not None and same(Path(o), Path(i)):
+                raise CLIError(f"{o_opt} {o} is the input {i_opt} {i}: an output never replaces an input; "
+                               "choose another file name")
+
+
 def check_out_file(path, suffixes, option: str = "--out") -> Path:
     """An output file name with one of ``suffixes`` that is not an existing folder."""
     p = Path(path)

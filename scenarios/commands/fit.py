@@ -30,6 +30,11 @@ from ._common import EXIT_FAILED as EXIT_NOT_CONVERGED
 
 __all__ = ["add_parser", "run", "read_csv"]
 
+#: Highest temperature a sweep may hold [°C]: a hydrated ionomer works in liquid water (the
+#: physics' laws are valid to 100 °C); 150 °C leaves a margin, and lab temperatures in kelvin
+#: (273–373) are all above it.
+MAX_PLAUSIBLE_C = 150.0
+
 
 def read_csv(path) -> FrequencyData:
     """Read a sweep file (.csv, .npz or .mat in the physmodel format) into ``FrequencyData``.
@@ -157,6 +162,10 @@ def run(args) -> int:
     try:
         data = read_csv(args.csv)
         temps = data.temperatures()
+        if temps.size and float(np.max(temps)) > MAX_PLAUSIBLE_C:
+            raise ValueError(f"{args.csv}: temperature_c holds {float(np.min(temps)):g}–{float(np.max(temps)):g}, above "
+                             f"{MAX_PLAUSIBLE_C:g} °C where no hydrated IPMC works — kelvin? The sweep format's "
+                             "temperature_c is in °C (subtract 273.15)")
         excl = np.array(sorted(set(args.exclude)), float)
         for t in excl:
             if not np.any(np.isclose(temps, t)):

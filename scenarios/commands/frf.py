@@ -38,7 +38,7 @@ import numpy as np
 
 from physmodel.errors import IPMCError
 
-from ._common import EXIT_OK, CLIError, _floats
+from ._common import EXIT_OK, CLIError, _floats, refuse_overwriting_inputs
 from .excite import as_options
 
 SUFFIXES = (".csv", ".npz", ".mat")
@@ -208,6 +208,8 @@ def run(args) -> int:
     out = Path(args.out)
     if out.suffix.lower() not in SUFFIXES:
         raise CLIError(f"--out {out}: use a .csv, .npz or .mat file name")
+    refuse_overwriting_inputs({"--out": out, "--plot": args.plot},
+                              {**{f"RECORD {k + 1}": r for k, r in enumerate(args.records)}, "--lines": args.lines})
     if args.plot and Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
         raise CLIError(f"--plot {args.plot}: use a .png, .pdf or .svg file name")
     if len(set(args.output)) != len(args.output):

@@ -108,10 +108,15 @@ def model_from_surrogate(path: str, temperature_c: float) -> Any:
 
     read_text(path, "--surrogate")           # missing file, folder, not UTF-8: a clear message
     try:
-        return surrogate.load(path).at(float(temperature_c))
+        model = surrogate.load(path)
     except (ValueError, KeyError, TypeError, IndexError, AttributeError, json.JSONDecodeError) as exc:
         what = f"missing key {exc}" if isinstance(exc, KeyError) else f"{type(exc).__name__}: {exc}"
         raise InversionError(f"--surrogate {path}: not a usable surrogate model JSON ({what})") from None
+    lo_hi = model.temperature_range_c
+    if model.is_scheduled and lo_hi is not None and not (lo_hi[0] <= float(temperature_c) <= lo_hi[1]):
+        raise InversionError(f"--temperature {float(temperature_c):g} °C is outside the surrogate's range "
+                             f"[{lo_hi[0]:g}, {lo_hi[1]:g}] °C ({path})")
+    return model.at(float(temperature_c))
 
 
 def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
@@ -148,6 +153,10 @@ def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
 
 def run(args: argparse.Namespace) -> int:
     """Execute ``ipmc invert``; 0 on success (bad input raises and ``ipmc`` exits 2)."""
+    from ._common import refuse_overwriting_inputs
+
+    refuse_overwriting_inputs({"--out": args.out, "--plot": args.plot},
+                              {"INPUT": args.input, "--surrogate": args.surrogate, "--data": args.data})
     if args.surrogate is not None:
         if args.num is not None or args.den is not None:
             raise InversionError("give either --num/--den or --surrogate, not both")

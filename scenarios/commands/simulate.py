@@ -21,6 +21,7 @@ from ._common import (
     check_plot_path,
     load_physics,
     model_metadata,
+    refuse_overwriting_inputs,
     warn_verdict,
 )
 
@@ -58,6 +59,9 @@ def run(args) -> int:
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".npz", ".mat"):
         raise CLIError(f"--out {out}: use a .csv, .npz or .mat file name")
+    refuse_overwriting_inputs({"--out": out, "--plot": args.plot},
+                              {"--input": args.input_file, "--model": getattr(args, "model", None),
+                               "--set": getattr(args, "set", None), "--params-json": getattr(args, "params_json", None)})
     if args.plot:
         check_plot_path(args.plot)
     mf, overridden = load_physics(args, "ipmc simulate")
