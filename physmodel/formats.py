@@ -38,4 +38,28 @@ def finite_json(obj):
     return obj
 
 
-__all__ = ["MODEL_FORMAT", "MODEL_VERSION", "PARAMETER_SET_FORMAT", "PARAMETER_SET_VERSION", "finite_json"]
+def read_json(path, what: str):
+    """The JSON held in the file at ``path``; a :class:`~physmodel.errors.ParameterError` naming the
+    file (``what`` says which kind) when it cannot be read as text or is not valid JSON.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    what : str
+        What the file is, for messages (e.g. ``"model file"``).
+    """
+    import json
+
+    from .data.files import read_text
+    from .errors import DataFormatError, ParameterError
+
+    try:
+        return json.loads(read_text(path, what))
+    except DataFormatError as exc:
+        raise ParameterError(str(exc)) from None
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"{what} {str(path)!r} is not valid JSON: {exc}") from None
+
+
+__all__ = ["read_json", "MODEL_FORMAT", "MODEL_VERSION", "PARAMETER_SET_FORMAT", "PARAMETER_SET_VERSION", "finite_json"]

@@ -38,7 +38,14 @@ from typing import Any
 
 from .errors import ParameterError
 from .fit_record import FitVerdict, Provenance, file_sha256
-from .formats import MODEL_FORMAT, MODEL_VERSION, PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, finite_json
+from .formats import (
+    MODEL_FORMAT,
+    MODEL_VERSION,
+    PARAMETER_SET_FORMAT,
+    PARAMETER_SET_VERSION,
+    finite_json,
+    read_json,
+)
 from .params import IPMCParameters
 
 
@@ -279,8 +286,6 @@ def load_model(source: str | os.PathLike, *, kind: str | None = None, **override
     -------
     ModelFile
     """
-    from .data.files import read_text
-    from .errors import DataFormatError
     from .parameter_sets import available_parameter_sets, get_parameter_set
 
     text = os.fspath(source)
@@ -294,12 +299,7 @@ def load_model(source: str | os.PathLike, *, kind: str | None = None, **override
         if not path.is_file():
             raise ParameterError(f"model file {text!r} does not exist")
         where = f"model file {text!r}"
-        try:
-            data = json.loads(read_text(path, "model file"))
-        except DataFormatError as exc:
-            raise ParameterError(str(exc)) from None
-        except json.JSONDecodeError as exc:
-            raise ParameterError(f"{where} is not valid JSON: {exc}") from None
+        data = read_json(path, "model file")
         if not isinstance(data, dict):
             raise ParameterError(f"{where} holds {type(data).__name__}, expected an object")
         if data.get("format") == MODEL_FORMAT:

@@ -60,14 +60,7 @@ print(f"peak voltage {ff.limit_report.peak:.3g} V")
 # %%
 # Predicted on the strip (from the measured sweep) vs achieved on the strip
 # -------------------------------------------------------------------------
-class AtT:                                                       # the surrogate at 35 °C, one model interface
-    kind = "rational"
-
-    def response(self, f, T):
-        return np.atleast_2d(sur.frequency_response(np.asarray(f), 35.0))
-
-
-residual = simulate_at_rest(AtT(), 35.0, ref.t, ff.output).y - ref.y         # the inversion's own error
+residual = simulate_at_rest(sur, 35.0, ref.t, ff.output).y - ref.y           # the inversion's own error
 pred = predicted_error(misfit_to_data(sur, measured), 35.0, ref.t, ref.y, inversion_residual=residual)
 y_strip = simulate_at_rest(strip, 35.0, ref.t, ff.output).y * 1e3             # m -> mm
 achieved = np.sqrt(np.mean((y_strip - ref.y) ** 2) / np.mean(ref.y ** 2))

@@ -89,19 +89,12 @@ def load_parameter_set(path: str | os.PathLike) -> IPMCParameters:
     a parameter file written by :func:`save_parameter_set` or an older ``ipmc calibrate``, or of a
     bare parameter record.  Effects and the data's verdict are not parameters: read the whole model
     with :func:`physmodel.load_model`."""
-    from ..data.files import read_text
-    from ..errors import DataFormatError
-    from ..formats import MODEL_FORMAT, MODEL_VERSION, PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION
+    from ..formats import MODEL_FORMAT, MODEL_VERSION, PARAMETER_SET_FORMAT, PARAMETER_SET_VERSION, read_json
 
     path = Path(path)
     if not path.is_file():
         raise ParameterError(f"parameter file {str(path)!r} does not exist")
-    try:
-        data = json.loads(read_text(path, "parameter file"))
-    except DataFormatError as exc:
-        raise ParameterError(str(exc)) from None
-    except json.JSONDecodeError as exc:
-        raise ParameterError(f"parameter file {str(path)!r} is not valid JSON: {exc}") from None
+    data = read_json(path, "parameter file")
     if isinstance(data, dict) and "parameters" in data:
         known = {PARAMETER_SET_FORMAT: PARAMETER_SET_VERSION, MODEL_FORMAT: MODEL_VERSION}
         fmt = data.get("format")

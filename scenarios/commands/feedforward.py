@@ -197,22 +197,8 @@ def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_un
     if drive is not None:
         from physmodel.data.fftsim import simulate_at_rest
 
-        residual = simulate_at_rest(_AtTemperature(model), temperature_c, t, drive).y - signal
+        residual = simulate_at_rest(model, temperature_c, t, drive).y - signal     # the one model interface
     return mis, predicted_error(mis, temperature_c, t, signal, inversion_residual=residual)
-
-
-class _AtTemperature:
-    """A surrogate in the one model interface for the frequency-domain simulation (extrapolation
-    allowed: the range was checked when it was loaded)."""
-
-    kind = "rational"
-
-    def __init__(self, model):
-        self.model = model
-
-    def response(self, frequency_hz, temperature_c):
-        return np.atleast_2d(self.model.frequency_response(np.asarray(frequency_hz), float(np.ravel(temperature_c)[0]),
-                                                           extrapolate=True))
 
 
 def _rms(x) -> float:
