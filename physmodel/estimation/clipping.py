@@ -102,3 +102,25 @@ def detect_clipping(x, channel: str = "signal", *, ratio: float = 8.0, min_sampl
         n_hi = int(np.count_nonzero(v == high)) if high is not None else 0
         n_lo = int(np.count_nonzero(v == low)) if low is not None else 0
     return Clipping(channel, (n_hi + n_lo) / v.size, n_hi + n_lo, high, low)
+
+
+def check_clipping(channels: dict, max_clipped_fraction: float | None = None) -> list[str]:
+    """Warnings for the clipped channels of ``{name: samples}``; an :class:`IPMCError` naming them
+    when one holds more than ``max_clipped_fraction`` of its samples at a rail.
+
+    Parameters
+    ----------
+    channels : dict
+        Channel name → (n,) samples.
+    max_clipped_fraction : float or None
+        Largest clipped fraction accepted (default :data:`MAX_CLIPPED_FRACTION`; 1 only warns).
+    """
+    limit = MAX_CLIPPED_FRACTION if max_clipped_fraction is None else float(max_clipped_fraction)
+    if not 0 <= limit <= 1:
+        raise IPMCError(f"max_clipped_fraction={max_clipped_fraction!r} must lie in [0, 1]")
+    clips = [detect_clipping(x, name) for name, x in channels.items()]
+    bad = [c for c in clips if c.clipped and c.fraction > limit]
+    if bad:
+        raise IPMCError("clipped: " + "; ".join(c.describe() for c in bad) + f" — more than max_clipped_fraction="
+                        f"{limit:g}; the estimate would be biased (reduce the drive or widen the input range)")
+    return ["clipped: " + c.describe() for c in clips if c.clipped]

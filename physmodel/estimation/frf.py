@@ -323,7 +323,7 @@ def estimate_frf(t_or_fs, u, y, *, estimator: str = "h1", excitation: str = "aut
     import warnings as _warnings
     from dataclasses import replace
 
-    from .clipping import MAX_CLIPPED_FRACTION, detect_clipping
+    from .clipping import check_clipping
     from .excitation_detection import Excitation, detect_excitation
     from .frf_estimate import FRFWarning, low_coherence_warning
     from .periodic import periodic_frf
@@ -343,14 +343,7 @@ def estimate_frf(t_or_fs, u, y, *, estimator: str = "h1", excitation: str = "aut
     if n < MIN_NPERSEG + MIN_NPERSEG // 2:
         raise IPMCError(f"the record has {n} samples ({n / fs:g} s): too short for one line of a frequency "
                         f"response with σ (at least {MIN_NPERSEG * 3 // 2} samples)")
-    limit = MAX_CLIPPED_FRACTION if max_clipped_fraction is None else float(max_clipped_fraction)
-    notes: list[str] = []
-    clips = [detect_clipping(x, nm) for x, nm in zip([u, *ys], [input_name, *names])]
-    bad = [c for c in clips if c.clipped and c.fraction > limit]
-    if bad:
-        raise IPMCError("clipped: " + "; ".join(c.describe() for c in bad) + f" — more than max_clipped_fraction="
-                        f"{limit:g}; the estimate would be biased (reduce the drive or widen the input range)")
-    notes += ["clipped: " + c.describe() for c in clips if c.clipped]
+    notes = check_clipping({input_name: u, **dict(zip(names, ys))}, max_clipped_fraction)
     exc = Excitation("random", fs, evidence={"forced": "random"}) if excitation == "random" \
         else detect_excitation(None, u, fs_hz=fs)
     if excitation not in ("auto", "random") and exc.kind != excitation:
@@ -391,8 +384,7 @@ def estimate_frf(t_or_fs, u, y, *, estimator: str = "h1", excitation: str = "aut
     low = low_coherence_warning(est)
     if low:
         notes.append(low)
-    est = replace(est, settings={**est.settings, "excitation": exc.describe(), "clipped_fraction_max":
-                                 round(max(c.fraction for c in clips), 6)}, warnings=tuple(notes))
+    est = replace(est, settings={**est.settings, "excitation": exc.describe()}, warnings=tuple(notes))
     for note in notes:
         _warnings.warn(FRFWarning(note), stacklevel=2)
     return est

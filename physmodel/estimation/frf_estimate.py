@@ -236,19 +236,25 @@ def coherence_threshold(averages: float, alpha: float = COHERENCE_ALPHA) -> floa
     return float(1.0 - alpha ** (1.0 / (n - 1.0)))
 
 
-def phasor_scatter(U: np.ndarray, Y: np.ndarray, H: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def phasor_scatter(U: np.ndarray, Y: np.ndarray, H: np.ndarray,
+                   pooled: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """σ of ln|H| and of the phase [rad] from the scatter of per-period phasors, and the coherence.
 
     ``U`` (P, n_f) input phasors, ``Y`` (P, n_out, n_f) output phasors of P whole periods, ``H``
     (n_out, n_f) the estimate.  ``δ_p = (Y_p − H U_p)/Ȳ``: the real and imaginary parts give the
     σ of ln|H| and of the phase (sample variance with P − 1 degrees of freedom, divided by P);
-    the coherence is ``|Σ conj(U_p) Y_p|² / (Σ|U_p|² Σ|Y_p|²)``.
+    ``pooled=True`` uses ``|δ_p|²/2`` for both (2(P − 1) degrees of freedom), right when the noise
+    of a line is circular (a DFT bin of stationary noise, not DC or Nyquist).  The coherence is
+    ``|Σ conj(U_p) Y_p|² / (Σ|U_p|² Σ|Y_p|²)``.
     """
     P = U.shape[0]
     with np.errstate(divide="ignore", invalid="ignore"):
         z = (Y - H[None] * U[:, None]) / Y.mean(axis=0)[None]
-        sl = np.sqrt(np.sum(z.real**2, axis=0) / ((P - 1) * P))
-        sp = np.sqrt(np.sum(z.imag**2, axis=0) / ((P - 1) * P))
+        if pooled:
+            sl = sp = np.sqrt(np.sum(np.abs(z)**2, axis=0) / (2 * (P - 1) * P))
+        else:
+            sl = np.sqrt(np.sum(z.real**2, axis=0) / ((P - 1) * P))
+            sp = np.sqrt(np.sum(z.imag**2, axis=0) / ((P - 1) * P))
         Suy = np.einsum("pf,pof->of", U.conj(), Y)
         coh = np.abs(Suy)**2 / (np.sum(np.abs(U)**2, axis=0)[None] * np.sum(np.abs(Y)**2, axis=0))
     sl = np.where(np.isfinite(sl), sl, np.inf)

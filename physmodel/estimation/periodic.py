@@ -6,9 +6,10 @@ DFT at the excited lines gives input and output phasors ``U_p``, ``Y_p``.  Leadi
 the transient are discarded (:func:`leading_transient`), then
 
 * H1 = ``Σ conj(U_p) Y_p / Σ |U_p|²`` (noise on the output), H2 = ``Σ |Y_p|² / Σ conj(Y_p) U_p``;
-* σ of ln|H| and of the phase from the scatter of ``δ_p = (Y_p − H U_p)/Ȳ`` between periods
-  (:func:`~physmodel.estimation.frf_estimate.phasor_scatter`; with the input repeating exactly this
-  σ has ν = 2(P − 1) degrees of freedom, see :mod:`physmodel.estimation.frf`);
+* σ of ln|H| and of the phase from the scatter of ``δ_p = (Y_p − H U_p)/Ȳ`` between periods,
+  real and imaginary parts pooled (the noise of a DFT line is circular), so σ has ν = 2(P − 1)
+  degrees of freedom (:func:`~physmodel.estimation.frf_estimate.phasor_scatter`; for an input
+  repeating exactly it equals the Welch σ from the coherence, see :mod:`physmodel.estimation.frf`);
 * the coherence over the periods, and the threshold an unrelated output exceeds 1 % of the time.
 
 No window is needed: a whole period of a periodic signal has no leakage.
@@ -167,7 +168,7 @@ def periodic_frf(t_or_fs, u, y, period_samples: int, lines, *, estimator: str = 
             H = Suy / np.sum(np.abs(U)**2, axis=0)[None]
         else:
             H = np.sum(np.abs(Y)**2, axis=0) / Suy.conj()
-    sl, sp, coh = phasor_scatter(U, Y, H)
+    sl, sp, coh = phasor_scatter(U, Y, H, pooled=True)
     names, units = channel_names(output_names, output_units, len(ys), "output")
     settings = {"fs_hz": fs, "period_samples": N, "period_s": N / fs, "window": "none (whole periods)",
                 "periods_in_record": P_all, "transient_periods": drop,
