@@ -82,14 +82,14 @@ class Excitation:
     @property
     def frequency_hz(self) -> np.ndarray:
         """Excited lines (periodic) or step frequencies (stepped sine). [Hz]"""
-        if self.kind == "periodic":
+        if self.kind == "periodic" and self.period_samples:
             return self.lines * self.fs_hz / self.period_samples
         return self.step_frequency_hz
 
     def describe(self) -> str:
         """One line: what was detected and on what evidence."""
         ev = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in self.evidence.items())
-        if self.kind == "periodic":
+        if self.kind == "periodic" and self.period_samples:
             f = self.frequency_hz
             return (f"periodic input: period {self.period_samples} samples ({self.period_samples / self.fs_hz:.6g} s), "
                     f"{self.lines.size} excited lines {f.min():.4g}-{f.max():.4g} Hz ({ev})")

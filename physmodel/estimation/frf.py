@@ -1,5 +1,19 @@
 """Frequency responses with per-line uncertainty, estimated from time records.
 
+Front door
+----------
+:func:`estimate_frf` (and :func:`estimate_record` with its default ``method="auto"``) reads the
+excitation from the input channel and picks the estimator: clipping is checked on every channel
+(:mod:`physmodel.estimation.clipping`: refused above 1 % of samples held at a rail, warned below),
+the excitation is detected (:mod:`physmodel.estimation.excitation_detection`), then a periodic
+input is estimated at its excited lines over whole steady periods
+(:mod:`physmodel.estimation.periodic`), a stepped sine on its detected steps
+(:mod:`physmodel.estimation.stepped`), and only a random input by Welch (below) with a segment
+that resolves the requested band.  A record too short for one line in the band is refused; every
+estimate carries a per-line coherence and ``settings['coherence_threshold']``; low coherence,
+clipping below the limit and unused steps are ``FRFEstimate.warnings`` (and ``FRFWarning``).
+``tests/benchmarks/bench_frf_excitation.py`` measures it on records from its own generator.
+
 Estimators
 ----------
 :func:`h1`, :func:`h2`
@@ -351,7 +365,7 @@ def estimate_frf(t_or_fs, u, y, *, estimator: str = "h1", excitation: str = "aut
     common = dict(block_samples=block_samples, input_name=input_name, input_unit=input_unit, output_names=names,
                   output_units=units)
     if exc.kind == "periodic":
-        N = exc.period_samples
+        N = int(exc.period_samples or 0)
         lines = exc.lines[_in_band(exc.frequency_hz, band_hz)]
         if lines.size == 0:
             raise IPMCError(f"no excited line in band_hz={band_hz!r}; the input's lines are "

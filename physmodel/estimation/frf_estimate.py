@@ -30,6 +30,7 @@ COHERENCE_ALPHA = 0.01
 
 # ----------------------------------------------------------------------------------- inputs
 def as_signal(x, name: str, n: int | None = None):
+    """``x`` when it is 1-D (of ``n`` samples, if given); an :class:`IPMCError` naming ``name`` otherwise."""
     if np.ndim(x) != 1:
         raise IPMCError(f"{name} must be 1-D samples, got shape {np.shape(x)}")
     if n is not None and len(x) != n:
@@ -53,6 +54,7 @@ def as_outputs(y, n: int) -> list:
 
 
 def channel_names(names, units, k: int, default: str):
+    """Names and units of ``k`` output channels (``default``, ``default0``... and "1" when not given)."""
     names = tuple(names) if names is not None else ((default,) if k == 1 else tuple(f"{default}{i}" for i in range(k)))
     units = tuple(units) if units is not None else ("1",) * k
     if len(names) != k or len(units) != k:
@@ -61,6 +63,8 @@ def channel_names(names, units, k: int, default: str):
 
 
 def finite_block(x, name: str, offset: int) -> np.ndarray:
+    """A block of samples as floats; an :class:`IPMCError` naming the first non-finite samples
+    (indices counted from ``offset``)."""
     x = np.asarray(x, dtype=float)
     if not np.all(np.isfinite(x)):
         bad = np.flatnonzero(~np.isfinite(x))[:5] + offset

@@ -153,7 +153,7 @@ def periodic_frf(t_or_fs, u, y, period_samples: int, lines, *, estimator: str = 
     if auto:
         drop = max([leading_transient(U)] + [leading_transient(Y[:, c]) for c in range(len(ys))])
     else:
-        drop = int(discard_periods)
+        drop = int(discard_periods or 0)
         if drop != discard_periods or drop < 0:
             raise IPMCError(f"discard_periods={discard_periods!r} must be a whole number >= 0")
     P = P_all - drop
