@@ -229,7 +229,9 @@ def compare_figure(comparison, path, title: str = "") -> Path:
     fig, (ax_m, ax_p) = new_figure(2, 1, sharex=True, figsize=(7.5, 6.5))
     plot_compare(comparison, (ax_m, ax_p))
     ax_m.legend(fontsize=7, ncol=2)
-    ax_m.set_title(title or f"data (markers, ±2σ) vs {comparison.model_name} (lines, ±2σ band)", fontsize=9)
+    banded = len(ax_m.collections) > (0 if comparison.data.magnitude_std_db is None else len(ax_m.containers))
+    ax_m.set_title(title or f"data (markers{', ±2σ' if comparison.data.magnitude_std_db is not None else ''}) vs "
+                   f"{comparison.model_name} (lines{', ±2σ band' if banded else ''})", fontsize=9)
     fig.tight_layout()
     return save_figure(fig, path)
 
