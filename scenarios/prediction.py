@@ -207,8 +207,17 @@ def _correlation_beside(model, names) -> np.ndarray | None:
     if any(n not in cn or fitted.get(n) is None or values.get(n) is None or
            not math.isclose(float(fitted[n]), float(values[n]), rel_tol=1e-9) for n in names):
         return None
-    idx = [cn.index(n) for n in names]
-    R = np.nan_to_num(M[np.ix_(idx, idx)], nan=0.0)
+    return _select(cn, M, names)
+
+
+def _select(all_names, matrix, names) -> np.ndarray:
+    """The rows and columns of ``names`` in a correlation over ``all_names`` (NaN of held
+    parameters as 0, unit diagonal)."""
+    missing = [n for n in names if n not in list(all_names)]
+    if missing:
+        raise IPMCError(f"correlation: no row for {missing}; it has {list(all_names)}")
+    idx = [list(all_names).index(n) for n in names]
+    R = np.nan_to_num(np.asarray(matrix, float)[np.ix_(idx, idx)], nan=0.0)
     np.fill_diagonal(R, 1.0)
     return R
 
@@ -238,6 +247,9 @@ def _band_model_file(model, rows, quantity, correlation, notes) -> tuple[np.ndar
         src = "their correlation from calibration.json" if correlation is not None else \
             "no correlation recorded (treated as independent: the band may be too wide or too narrow)"
     else:
+        if isinstance(correlation, tuple) and len(correlation) == 2 and not np.isscalar(correlation[0]) and \
+                all(isinstance(n, str) for n in correlation[0]):
+            correlation = _select(correlation[0], correlation[1], names)
         correlation = np.asarray(correlation, float)
         src = "the correlation given"
     C = np.eye(len(names)) if correlation is None else correlation
@@ -295,9 +307,11 @@ def predict_sweep(model, frequency_hz=None, temperatures_c=None, *, like: Freque
         Physics quantity (M, H, I, Z, S); default the model file's, else the kind's primary one.
     uncertainty : bool
         Compute the band (σ per line); False: the nominal response only.
-    correlation : array_like or None
-        Correlation (p, p) of a model file's parameters with an interval, in the order of its
-        estimates; None: from ``calibration.json`` beside it, else none.
+    correlation : array_like, (names, array_like) or None
+        Correlation of a model file's parameters: (p, p) over those with an interval, in the order
+        of its estimates, or ``(names, matrix)`` over any superset (e.g. ``(result.names,
+        result.correlation)`` of a calibration; NaN rows of held parameters ignored); None: from
+        ``calibration.json`` beside the file, else none (said in the notes).
 
     Returns
     -------

@@ -31,6 +31,7 @@ OUTPUTS = ("compare.json", "compare.png")
 
 
 def add_parser(sub):
+    """Add ``ipmc compare`` to the subcommands ``sub`` (an ``argparse`` subparsers object)."""
     p = sub.add_parser("compare", help="a model against measured data per temperature (fit %%, chi2, overlay)",
                        description="Overlay a model (physics model.json or a surrogate) on a measured sweep and give "
                                    "the fit %% and chi2 per temperature.")
@@ -57,6 +58,7 @@ def _check_inputs(args):
 
 
 def run(args) -> int:
+    """Run ``ipmc compare`` on parsed ``args``; returns the exit code (see the module doc)."""
     from physmodel.data.files import atomic_write, check_output_folder, output_folder, read_sweep
     from physmodel.errors import IPMCError
 

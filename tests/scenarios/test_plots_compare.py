@@ -145,20 +145,24 @@ def test_the_surrogate_band_matches_a_monte_carlo_of_its_parameters():
     np.testing.assert_allclose(s.phase_std_deg, sd_deg, rtol=0.08)
 
 
-def test_a_model_file_band_matches_a_monte_carlo_of_its_intervals():
-    """Two parameters with 95 % intervals (independent: no calibration.json), drawn log-normally
-    from them and evaluated as parameter sets of the plain ActuatorModel (not the predictor)."""
+@pytest.mark.parametrize("rho", [None, 0.9, -0.9])
+def test_a_model_file_band_matches_a_monte_carlo_of_its_intervals(rho):
+    """Two parameters with 95 % intervals (independent, or correlated as given), drawn from them
+    (d log-normal, E normal) and evaluated as parameter sets of the plain ActuatorModel (not the
+    predictor the band uses)."""
     d, E = BASE.d, BASE.E
     est = ({"name": "d", "value": d, "ci95": [d / 1.05, d * 1.05], "status": "determined"},
            {"name": "E", "value": E, "ci95": [E - 0.02 * E, E + 0.02 * E], "status": "determined"},
            {"name": "xi", "value": BASE.xi, "ci95": [None, None], "status": "held at base (undetermined)"})
     mf = ModelFile("actuator", BASE, estimates=est)
-    s = predict_sweep(mf, F, [30.0])
+    R = np.eye(2) if rho is None else np.array([[1.0, rho], [rho, 1.0]])
+    corr = None if rho is None else (["xi", "d", "E"], np.array([[1, np.nan, np.nan], [np.nan, 1, rho],
+                                                                  [np.nan, rho, 1]]))
+    s = predict_sweep(mf, F, [30.0], correlation=corr)
     assert "(d, E)" in s.metadata["notes"] and "xi" in s.metadata["notes"]
-    rng = np.random.default_rng(1)
-    n = 2000
-    dd = d * np.exp(rng.standard_normal(n) * math.log(1.05) / Z95)
-    EE = E + rng.standard_normal(n) * 0.02 * E / Z95
+    z = np.random.default_rng(1).multivariate_normal([0.0, 0.0], R, size=2000)
+    dd = d * np.exp(z[:, 0] * math.log(1.05) / Z95)
+    EE = E + z[:, 1] * 0.02 * E / Z95
     sets = [BASE.replace(d=a, E=b) for a, b in zip(dd, EE)]
     H = ActuatorModel(sets).frequency_response(F, [30.0], quantities=("M",))["M"][:, 0, :]
     H0 = ActuatorModel(BASE).response(F, [30.0])[0]
