@@ -28,6 +28,7 @@ import sys
 
 from .commands import (
     calibrate,
+    compare,
     demo,
     diagnose,
     excite,
@@ -46,7 +47,7 @@ from .commands._common import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED
 
 #: The subcommands, in the order ``ipmc --help`` lists them.
 COMMANDS = (sets, sweep, simulate, excite, frf, demo, run, study, fit, invert, feedforward, calibrate, diagnose,
-            validate)
+            compare, validate)
 
 
 def _version() -> str:

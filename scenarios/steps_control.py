@@ -49,7 +49,7 @@ def step_control_route(ctx) -> None:
     from surrogate.crossval import ScheduleWarning, check_schedule
 
     from . import plots
-    from .plots_control import feedforward_check
+    from .plots import feedforward_check
 
     cfg = ctx.spec.section("control_route")
     if ctx.spec.section("model")["kind"] != "actuator":

@@ -55,9 +55,30 @@ def test_no_import_runs_up_a_layer():
 
 
 def test_only_scenarios_plots_draws():
-    users = sorted(str(path.relative_to(ROOT)) for pkg, path in _modules()
+    """matplotlib is imported by the plotting package ``scenarios/plots/`` alone (one face:
+    ``from scenarios.plots import ...``), and importing the package does not import it."""
+    users = sorted(path.relative_to(ROOT).as_posix() for pkg, path in _modules()
                    if any(top == "matplotlib" for top, _ in _imported_top_levels(path, pkg)))
-    assert users == ["scenarios/plots.py"]
+    assert users and all(u.startswith("scenarios/plots/") for u in users), users
+    assert not (ROOT / "scenarios" / "plots.py").exists()
+    import subprocess
+    import sys
+
+    code = "import sys, scenarios.plots; print('matplotlib' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_the_plotting_package_imports_no_step():
+    """The figures take data as arguments: no module of ``scenarios/plots/`` imports a step or the
+    runner (the circle plots_chain ↔ steps_chain ↔ steps_chain_temperature is gone)."""
+    bad = []
+    for path in sorted((ROOT / "scenarios" / "plots").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module and \
+                    node.module.split(".")[-1].startswith(("steps", "runner")):
+                bad.append(f"{path.name}:{node.lineno} imports {node.module}")
+    assert bad == []
 
 
 def _size(path: Path) -> int:

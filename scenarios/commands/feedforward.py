@@ -378,7 +378,7 @@ def run(args) -> int:
     else:
         from physmodel.data.fftsim import simulate_at_rest
 
-        from ..plots_control import feedforward_check
+        from ..plots import feedforward_check
 
         if phys_note:
             lines.append(f"- {phys_note}")
