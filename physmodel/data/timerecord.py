@@ -36,7 +36,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFormatError, IPMCError
-from .files import atomic_write, by_extension, read_text
+from .columns import ColumnMapError, pick, read_table, suffix_unit
+from .fileio import atomic_write, by_extension, read_text
+from .units import UNITS
 
 #: Samples read per block when checking long (memory-mapped) time bases.
 TIME_BLOCK_SAMPLES = 1 << 20
@@ -350,13 +352,19 @@ def read_csv(path, unitless: str | None = None) -> TimeRecord:
     return _build(cols, meta, where, unitless)
 
 
+#: How to read a file whose columns are not ``time_s`` and ``<name>_<unit>`` (said by the errors).
+MAPPING_HINT = ("or map the file's own columns: read_record(path, columns={'time': 't', 'voltage': 'volts'}, "
+                "units={'voltage': 'V'}) (ipmc: --time-column, --input-column/--input-unit, "
+                "--output-column/--output-unit)")
+
+
 def _build(cols: dict, meta: dict, where: str, unitless: str | None = None) -> TimeRecord:
     if unitless is not None:
         cols = {(k if k == TIME_COLUMN or "_" in k else f"{k}_{unitless}"): v for k, v in cols.items()}
     try:
         return TimeRecord.from_columns(cols, meta, where)
-    except DataFormatError:
-        raise
+    except DataFormatError as exc:
+        raise DataFormatError(f"{exc}; {MAPPING_HINT}") from None
     except IPMCError as exc:
         raise DataFormatError(f"{where}{exc}") from None
 
@@ -426,12 +434,107 @@ def read_mat(path, unitless: str | None = None) -> TimeRecord:
     return _build(cols, {k: str(v) for k, v in dict(meta).items()}, where, unitless)
 
 
-def read_record(path, unitless: str | None = None) -> TimeRecord:
+#: Units of a time column, as multiples of a second.
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "min": 60.0}
+
+
+def _time_column(table, columns: dict, units: dict) -> tuple[str, np.ndarray]:
+    if "time" in columns:
+        tcol = pick(table, columns["time"], "time")
+    elif TIME_COLUMN in table.data:
+        tcol = TIME_COLUMN
+    else:
+        raise ColumnMapError(f"{table.where}: which column holds the time? give columns={{'time': NAME or INDEX}} "
+                             f"(ipmc: --time-column NAME); the file has {table.describe()}", "columns", "time")
+    unit = units.get("time")
+    if unit is None:
+        suffix = tcol.rsplit("_", 1)[-1] if "_" in tcol else ""
+        unit = suffix if suffix in TIME_UNITS else "s"
+    if unit not in TIME_UNITS:
+        raise ColumnMapError(f"{table.where}: units['time'] = {unit!r}; expected one of {list(TIME_UNITS)}",
+                             "units", "time")
+    return tcol, table.data[tcol] * TIME_UNITS[unit]
+
+
+def read_mapped_record(path, columns: dict | None = None, units: dict | None = None,
+                       temperature_c: float | None = None, unitless: str | None = None) -> TimeRecord:
+    """A time record from a user's own CSV/NPZ/MAT file through a column and unit mapping.
+
+    ``columns``: channel name → column name (or its ``<name>`` before a ``_<unit>`` suffix) or
+    0-based index; the key ``'time'`` names the time column (default ``time_s``).  Only the
+    channels named are read (all columns when only ``'time'`` is mapped).  ``units``: channel (or
+    column) name → unit (one of :data:`physmodel.data.units.UNITS`; ``'time'``: s, ms, us or
+    min); a column named ``<name>_<unit>`` carries its unit, which a stated unit must not
+    contradict.  ``temperature_c``: the record's temperature [°C] (replaces a header's).
+
+    Raises
+    ------
+    ColumnMapError (a DataFormatError)
+        naming the argument and key that fix the problem.
+    """
+    columns, units = dict(columns or {}), dict(units or {})
+    table = read_table(path, "time-record")
+    where = table.where
+    tcol, t = _time_column(table, columns, units)
+    chosen = {k: v for k, v in columns.items() if k != "time"}
+    mapped = bool(chosen)
+    if not mapped:
+        chosen = {c: c for c in table.names if c != tcol}
+    chans, cunits, used = {}, {}, {"time"}
+    for key, spec in chosen.items():
+        src = pick(table, spec, key) if mapped else spec
+        su = suffix_unit(src)
+        name = key if mapped or su is None else su[0]
+        ukey = next((k for k in (key, src, name) if k in units), None)
+        unit = units[ukey] if ukey is not None else (su[1] if su else unitless)
+        used.add(ukey or key)
+        if unit is None:
+            raise ColumnMapError(f"{where}: column {src!r} has no unit in its name; state it: units={{{name!r}: UNIT}} "
+                                 "(ipmc: --input-unit/--output-unit)", "units", key)
+        if unit not in UNITS:
+            raise ColumnMapError(f"{where}: unit {unit!r} of column {src!r} is not one of {sorted(UNITS)}", "units", key)
+        if su is not None and su[1] != unit:
+            raise ColumnMapError(f"{where}: column {src!r} is in {su[1]} by its name but its unit is given as {unit!r}; "
+                                 "drop one of them (a unit that is not the file's would scale the data wrongly)",
+                                 "units", key)
+        if not _NAME.match(name) or name in chans:
+            raise ColumnMapError(f"{where}: channel name {name!r} (column {src!r}) must be unique, start with a letter "
+                                 "and hold letters, digits and '_'", "columns", key)
+        chans[name], cunits[name] = table.data[src], unit
+    extra = sorted(set(units) - used)
+    if extra:
+        raise ColumnMapError(f"{where}: units[{extra[0]!r}]: no channel or column of that name is read; channels "
+                             f"{sorted(chans)}", "units", extra[0])
+    _check_finite({tcol: t, **chans}, f"{where}: ")
+    meta = {k: v for k, v in table.header.items() if k not in table.data and not k.startswith(FORMAT)}
+    if temperature_c is not None:
+        try:
+            T = float(temperature_c)
+        except (TypeError, ValueError):
+            T = math.nan
+        if not math.isfinite(T) or T <= -273.15:
+            raise ColumnMapError(f"{where}: temperature_c = {temperature_c!r}; expected a number of °C",
+                                 "temperature_c", "temperature")
+        if "temperature_c" in meta and meta["temperature_c"] != str(T):
+            meta["temperature_c_header"] = meta["temperature_c"]
+        meta["temperature_c"] = str(T)
+    try:
+        return TimeRecord(t, chans, cunits, meta)
+    except IPMCError as exc:
+        raise DataFormatError(f"{where}: {exc}") from None
+
+
+def read_record(path, unitless: str | None = None, *, columns: dict | None = None, units: dict | None = None,
+                temperature_c: float | None = None) -> TimeRecord:
     """Read a time record by extension (.csv, .npz, .mat).
 
     ``unitless``: unit given to a column named without a ``_<unit>`` suffix (files of the older
     ``inversion.references.Reference.save``, which wrote a bare ``reference`` column when the
     reference had no unit; hand-made files with e.g. ``time_s,target``); None refuses such a column.
+    ``columns``, ``units``, ``temperature_c``: a user's own file (a DAQ's ``t, volts, disp``, a
+    MATLAB session's variables) through a mapping, see :func:`read_mapped_record`.
     """
+    if columns or units or temperature_c is not None:
+        return read_mapped_record(path, columns, units, temperature_c, unitless)
     reader = by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "time-record")
     return reader(path, unitless)

@@ -1,0 +1,198 @@
+"""A user's own tables: columns chosen by name or index, units stated by the user.
+
+The time-record and sweep readers (:func:`physmodel.data.timerecord.read_record`,
+:func:`physmodel.data.files.read_sweep`) read the library's own formats without help; a file a
+DAQ, an analyser or a MATLAB session wrote (``t, volts, disp``; ``T_degC,freq_Hz,gain_dB,...``;
+variables ``t``, ``u``, ``y``) is read through a *mapping*: ``columns={role: name or index}`` and
+``units={role: unit}``.  This module holds what both readers share: :func:`read_table` (any CSV
+with one header row, NPZ archive or MATLAB file as named numeric columns), :func:`pick` (a column
+by name, by ``<name>_<unit>`` prefix or by 0-based index) and :class:`ColumnMapError`, which
+names the argument and the key that fix the problem so that a command can name its option.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataFormatError
+from .fileio import by_extension, read_text
+from .units import UNITS
+
+__all__ = ["ColumnMapError", "Table", "read_table", "pick", "suffix_unit"]
+
+
+class ColumnMapError(DataFormatError):
+    """A column or unit the mapping must give: ``argument`` (``'columns'``, ``'units'`` or
+    ``'temperature_c'``) and ``key`` (the role or channel) say which entry fixes it."""
+
+    def __init__(self, message: str, argument: str, key: str):
+        super().__init__(message)
+        self.argument = argument
+        self.key = key
+
+
+@dataclass(frozen=True)
+class Table:
+    """Named numeric columns of one file, in file order, and its ``# key: value`` header lines
+    (CSV) or string entries (NPZ ``header`` JSON metadata, MATLAB strings)."""
+
+    names: list
+    data: dict
+    header: dict
+    where: str
+
+    def describe(self) -> str:
+        return ", ".join(f"{k}:{n}" for k, n in enumerate(self.names))
+
+
+def suffix_unit(column: str, known=UNITS) -> tuple[str, str] | None:
+    """``('tip', 'mm')`` for ``'tip_mm'`` when the part after the last ``_`` is a unit in ``known``."""
+    if "_" not in column:
+        return None
+    name, unit = column.rsplit("_", 1)
+    return (name, unit) if name and unit in known else None
+
+
+def pick(table: Table, spec, key: str, argument: str = "columns") -> str:
+    """The column of ``table`` that ``spec`` names: its name, the one column ``<spec>_<unit>``, or a
+    0-based index (an int or a string of digits that is not a column name)."""
+    names = table.names
+    if isinstance(spec, str):
+        if spec in table.data:
+            return spec
+        pre = [n for n in names if suffix_unit(n) and suffix_unit(n)[0] == spec]   # type: ignore[index]
+        if len(pre) == 1:
+            return pre[0]
+        if spec.strip().lstrip("-").isdigit():
+            spec = int(spec)
+    if isinstance(spec, int | np.integer) and not isinstance(spec, bool):
+        k = int(spec)
+        if not 0 <= k < len(names):
+            raise ColumnMapError(f"{table.where}: {argument}[{key!r}] = {k}: no column {k} (0-based); the file has "
+                                 f"{len(names)} column(s): {table.describe()}", argument, key)
+        return names[k]
+    raise ColumnMapError(f"{table.where}: {argument}[{key!r}] = {spec!r}: no such column; the file has "
+                         f"{table.describe()} (give a name or a 0-based index)", argument, key)
+
+
+# ----------------------------------------------------------------------------------- reading
+def _delimiter(line: str) -> str:
+    if "," in line:
+        return ","
+    return ";" if ";" in line else ("\t" if "\t" in line else ",")
+
+
+def _csv_table(path) -> Table:
+    where = str(path)
+    lines = read_text(path, "data file").splitlines()
+    header: dict[str, str] = {}
+    i = 0
+    while i < len(lines) and (not lines[i].strip() or lines[i].lstrip().startswith("#")):
+        body = lines[i].strip().lstrip("#").strip()
+        if ":" in body:
+            k, v = body.split(":", 1)
+            header[k.strip()] = v.strip()
+        i += 1
+    if i >= len(lines):
+        raise DataFormatError(f"{where}: no column header line (expected one row of column names)")
+    delim = _delimiter(lines[i])
+    names = [n.strip() for n in next(csv.reader([lines[i]], delimiter=delim))]
+    if len(set(names)) != len(names):
+        dup = sorted({n for n in names if names.count(n) > 1})
+        raise DataFormatError(f"{where}:{i + 1}: column name(s) {dup} appear more than once")
+    body = [ln for ln in lines[i + 1:] if ln.strip() and not ln.lstrip().startswith("#")]
+    if not body:
+        raise DataFormatError(f"{where}: no data rows after the column header (line {i + 1})")
+    try:
+        data = np.loadtxt(io.StringIO("\n".join(body)), delimiter=delim, ndmin=2, dtype=float)
+    except ValueError:
+        data = None
+    if data is None or data.shape[1] != len(names):      # find the first bad line for the message
+        for j in range(i + 1, len(lines)):
+            raw = lines[j]
+            if not raw.strip() or raw.lstrip().startswith("#"):
+                continue
+            parts = next(csv.reader([raw], delimiter=delim))
+            if len(parts) != len(names):
+                raise DataFormatError(f"{where}:{j + 1}: {len(parts)} values; the header has {len(names)} columns")
+            for n, p in zip(names, parts):
+                try:
+                    float(p)
+                except ValueError:
+                    raise DataFormatError(f"{where}:{j + 1}: {n} = {p.strip()!r} is not a number") from None
+        raise DataFormatError(f"{where}: the data rows are not a numeric table")  # pragma: no cover
+    return Table(names, {n: data[:, k] for k, n in enumerate(names)}, header, where)
+
+
+def _numeric(v) -> np.ndarray | None:
+    a = np.asarray(v)
+    if a.dtype.kind not in "iuf" or a.size == 0 or (a.ndim > 1 and max(a.shape) != a.size):
+        return None
+    return a.reshape(-1).astype(float)
+
+
+def _npz_table(path) -> Table:
+    where = str(path)
+    try:
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
+            raw = {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise DataFormatError(f"{where}: no such file") from None
+    except (OSError, ValueError, EOFError, AttributeError, TypeError, zipfile.BadZipFile) as exc:
+        raise DataFormatError(f"{where}: not a readable NPZ archive ({type(exc).__name__}: {exc})") from None
+    return _arrays_table(raw, where)
+
+
+def _mat_table(path) -> Table:
+    from scipy.io import loadmat
+
+    where = str(path)
+    if not Path(path).is_file():
+        raise DataFormatError(f"{where}: no such file")
+    try:   # scipy's parser raises many exception types on a malformed file; all mean "not readable"
+        raw = {k: v for k, v in loadmat(path).items() if not k.startswith("__")}
+    except Exception as exc:  # noqa: BLE001
+        raise DataFormatError(f"{where}: not a readable MATLAB .mat file ({type(exc).__name__}: {exc})") from None
+    return _arrays_table(raw, where)
+
+
+def _arrays_table(raw: dict, where: str) -> Table:
+    names, data, header = [], {}, {}
+    for k, v in raw.items():
+        a = np.asarray(v)
+        if a.dtype.kind == "U" and a.size == 1:
+            text = str(a.reshape(-1)[0])
+            if k in ("header", "metadata_json"):
+                try:
+                    d = json.loads(text)
+                except ValueError:
+                    d = None
+                if isinstance(d, dict):
+                    header.update({str(kk): str(vv) for kk, vv in (d.get("metadata", d) or {}).items()})
+                    for kk in ("input", "output"):
+                        if isinstance(d.get(kk), str):
+                            header[kk] = d[kk]
+                    continue
+            header[k] = text
+            continue
+        col = _numeric(a)
+        if col is not None:
+            names.append(k)
+            data[k] = col
+    if not names:
+        raise DataFormatError(f"{where}: no numeric vector in the file (variables: {sorted(raw)})")
+    return Table(names, data, header, where)
+
+
+def read_table(path, what: str = "data") -> Table:
+    """Named numeric columns of a CSV (one header row of names; ``,``, ``;`` or tab; ``#`` lines
+    before it are ``key: value`` header lines), an NPZ archive or a MATLAB .mat file (each numeric
+    vector a column, in file order; string entries become header entries)."""
+    return by_extension(path, {".csv": _csv_table, ".npz": _npz_table, ".mat": _mat_table}, what)(path)
