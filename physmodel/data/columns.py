@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +26,7 @@ from ..errors import DataFormatError
 from .fileio import by_extension, read_text
 from .units import UNITS
 
-__all__ = ["ColumnMapError", "Table", "read_table", "pick", "suffix_unit"]
+__all__ = ["ColumnMapError", "Table", "read_table", "pick", "suffix_unit", "map_record", "TIME_UNITS"]
 
 
 class ColumnMapError(DataFormatError):
@@ -196,3 +197,91 @@ def read_table(path, what: str = "data") -> Table:
     before it are ``key: value`` header lines), an NPZ archive or a MATLAB .mat file (each numeric
     vector a column, in file order; string entries become header entries)."""
     return by_extension(path, {".csv": _csv_table, ".npz": _npz_table, ".mat": _mat_table}, what)(path)
+
+
+# ----------------------------------------------------------------------------------- records
+#: Units of a time column, as multiples of a second.
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "min": 60.0}
+
+
+def _time_column(table, columns: dict, units: dict) -> tuple[str, np.ndarray]:
+    if "time" in columns:
+        tcol = pick(table, columns["time"], "time")
+    elif "time_s" in table.data:
+        tcol = "time_s"
+    else:
+        raise ColumnMapError(f"{table.where}: which column holds the time? give columns={{'time': NAME or INDEX}} "
+                             f"(ipmc: --time-column NAME); the file has {table.describe()}", "columns", "time")
+    unit = units.get("time")
+    if unit is None:
+        suffix = tcol.rsplit("_", 1)[-1] if "_" in tcol else ""
+        unit = suffix if suffix in TIME_UNITS else "s"
+    if unit not in TIME_UNITS:
+        raise ColumnMapError(f"{table.where}: units['time'] = {unit!r}; expected one of {list(TIME_UNITS)}",
+                             "units", "time")
+    return tcol, table.data[tcol] * TIME_UNITS[unit]
+
+
+def map_record(path, columns: dict | None = None, units: dict | None = None, temperature_c: float | None = None,
+               unitless: str | None = None) -> tuple:
+    """``(t [s], channels, units, metadata, where)`` of a time record in a user's own CSV/NPZ/MAT
+    file, read through a column and unit mapping
+    (:func:`physmodel.data.timerecord.read_mapped_record` makes the record).
+
+    ``columns``: channel name → column name (or its ``<name>`` before a ``_<unit>`` suffix) or
+    0-based index; the key ``'time'`` names the time column (default ``time_s``).  Only the
+    channels named are read (all columns when only ``'time'`` is mapped).  ``units``: channel (or
+    column) name → unit (one of :data:`physmodel.data.units.UNITS`; ``'time'``: s, ms, us or
+    min); a column named ``<name>_<unit>`` carries its unit, which a stated unit must not
+    contradict.  ``temperature_c``: the record's temperature [°C] (replaces a header's).
+
+    Raises
+    ------
+    ColumnMapError (a DataFormatError)
+        naming the argument and key that fix the problem.
+    """
+    columns, units = dict(columns or {}), dict(units or {})
+    table = read_table(path, "time-record")
+    where = table.where
+    tcol, t = _time_column(table, columns, units)
+    chosen = {k: v for k, v in columns.items() if k != "time"}
+    mapped = bool(chosen)
+    if not mapped:
+        chosen = {c: c for c in table.names if c != tcol}
+    chans, cunits, used = {}, {}, {"time"}
+    for key, spec in chosen.items():
+        src = pick(table, spec, key) if mapped else spec
+        su = suffix_unit(src)
+        name = key if mapped or su is None else su[0]
+        ukey = next((k for k in (key, src, name) if k in units), None)
+        unit = units[ukey] if ukey is not None else (su[1] if su else unitless)
+        used.add(ukey or key)
+        if unit is None:
+            raise ColumnMapError(f"{where}: column {src!r} has no unit in its name; state it: units={{{name!r}: UNIT}} "
+                                 "(ipmc: --input-unit/--output-unit)", "units", key)
+        if unit not in UNITS:
+            raise ColumnMapError(f"{where}: unit {unit!r} of column {src!r} is not one of {sorted(UNITS)}", "units", key)
+        if su is not None and su[1] != unit:
+            raise ColumnMapError(f"{where}: column {src!r} is in {su[1]} by its name but its unit is given as {unit!r}; "
+                                 "drop one of them (a unit that is not the file's would scale the data wrongly)",
+                                 "units", key)
+        if name in chans:
+            raise ColumnMapError(f"{where}: channel {name!r} is read twice (column {src!r})", "columns", key)
+        chans[name], cunits[name] = table.data[src], unit
+    extra = sorted(set(units) - used)
+    if extra:
+        raise ColumnMapError(f"{where}: units[{extra[0]!r}]: no channel or column of that name is read; channels "
+                             f"{sorted(chans)}", "units", extra[0])
+    meta = {k: v for k, v in table.header.items() if k not in table.data and not k.startswith("ipmc-")}
+    if temperature_c is not None:
+        try:
+            T = float(temperature_c)
+        except (TypeError, ValueError):
+            T = math.nan
+        if not math.isfinite(T) or T <= -273.15:
+            raise ColumnMapError(f"{where}: temperature_c = {temperature_c!r}; expected a number of °C",
+                                 "temperature_c", "temperature")
+        if "temperature_c" in meta and meta["temperature_c"] != str(T):
+            meta["temperature_c_header"] = meta["temperature_c"]
+        meta["temperature_c"] = str(T)
+    return t, chans, cunits, meta, where

@@ -19,18 +19,24 @@ import numpy as np
 
 from ..errors import DataFormatError, IPMCError
 from .columns import ColumnMapError, Table, pick, read_table
-from .fileio import (  # noqa: F401  (re-exported: the library's file plumbing has always been here)
-                     OWNER_FILES,
-                     atomic_write,
-                     by_extension,
-                     check_output_folder,
-                     folder_owner,
-                     output_folder,
-                     read_text,
+from .fileio import atomic_write, by_extension, check_output_folder, folder_owner, output_folder, read_text
+from .sweep import (
+    MAX_SWEEP_LINES,
+    OPTIONAL_COLUMNS,
+    REQUIRED_COLUMNS,
+    FrequencySweep,
+    write_csv,
+    write_mat,
+    write_npz,
+    write_sweep,
 )
-from .sweep import FORMAT_VERSION, MAX_SWEEP_LINES, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, FrequencySweep
-from .sweep import write_csv, write_mat, write_npz, write_sweep  # noqa: F401  (re-exported)
 from .units import UNITS
+
+# the file plumbing (data.fileio) and the sweep writers (data.sweep) are re-exported: callers have
+# always found them here
+__all__ = ["read_sweep", "read_csv", "read_npz", "read_mat", "read_mapped_sweep", "write_sweep", "write_csv",
+           "write_npz", "write_mat", "atomic_write", "by_extension", "check_output_folder", "folder_owner",
+           "output_folder", "read_text", "MAPPING_HINT", "ROLES"]
 
 #: How to map a sweep file that is not in the library's format (said by every "missing column" error).
 MAPPING_HINT = ("map the file's own columns: read_sweep(path, columns={'temperature': ..., 'frequency': ..., "
@@ -47,7 +53,7 @@ UNITS_HINT = ("state the units of the response: units={'input': 'V', 'output': '
 def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], where: str) -> FrequencySweep:
     def unit_of(key):
         if key not in header:
-            raise ColumnMapError(f"{where}: no '# {key}: <name> [<unit>]' header line; {UNITS_HINT}", "units", key)
+            raise ColumnMapError(f"{where}: missing header line '# {key}: <name> [<unit>]'; {UNITS_HINT}", "units", key)
         text = header[key].strip()
         if not (text.endswith("]") and "[" in text):
             raise DataFormatError(f"{where}: header '{key}: {text}' must look like 'name [unit]'")
