@@ -50,6 +50,7 @@ class Table:
     where: str
 
     def describe(self) -> str:
+        """``'0:t, 1:volts, 2:disp'``: the columns with their 0-based indices (said by the errors)."""
         return ", ".join(f"{k}:{n}" for k, n in enumerate(self.names))
 
 

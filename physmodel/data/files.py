@@ -456,10 +456,25 @@ def read_sweep(path, *, columns: Mapping | None = None, units: Mapping | None = 
                temperature_c: float | None = None) -> FrequencySweep:
     """Read a sweep by file extension (.csv, .npz, .mat).
 
-    With no mapping, the library's format (see :mod:`physmodel.data.sweep`); with ``columns``,
-    ``units`` or ``temperature_c``, a user's own file (:func:`read_mapped_sweep`).  A file that
-    is neither is a :class:`~physmodel.errors.DataFormatError` (a :class:`ColumnMapError` when a
-    mapping entry fixes it) naming the argument and the ``ipmc`` option to give.
+    Parameters
+    ----------
+    path : str or Path
+        The file.  With no mapping it must be in the library's format (see
+        :mod:`physmodel.data.sweep`).
+    columns : mapping or None
+        A user's own file: role (temperature, frequency, magnitude, phase, magnitude_std,
+        phase_std) → column name or 0-based index (:func:`read_mapped_sweep`).
+    units : mapping or None
+        ``input``/``output`` units of the response (e.g. ``'V'``, ``'mm'``) and the units of the
+        number columns (magnitude dB/linear, phase deg/rad, frequency Hz/rad/s, temperature degC/K).
+    temperature_c : float or None
+        Temperature [°C] of every line of a file without a temperature column.
+
+    Raises
+    ------
+    DataFormatError
+        naming the file and the problem; a :class:`~physmodel.data.columns.ColumnMapError` when a
+        mapping entry fixes it, naming the argument and the ``ipmc`` option to give.
     """
     if columns or units or temperature_c is not None:
         return read_mapped_sweep(path, columns, units, temperature_c)

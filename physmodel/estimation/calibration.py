@@ -238,9 +238,12 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
         A measurement chain or other effects ({effect: {parameter: value}}, SI,
         :mod:`physmodel.effects`) held fixed while the physical parameters are fitted: the model
         is ``EffectModel(base, kind, effects)``.
-    temperature_c, input_unit, output_unit : float, str, str or None
-        For data that carry no temperature or units (a ``control.FrequencyResponseData``, an
-        estimate from bare arrays): passed to :func:`~physmodel.data.interop.as_sweep`.
+    temperature_c : float or None
+        Temperature [°C] of data that carry none (a ``control.FrequencyResponseData``); passed to
+        :func:`~physmodel.data.interop.as_sweep`.
+    input_unit, output_unit : str or None
+        Units of data that carry none (an FRD, an estimate from bare arrays), e.g. ``"V"`` and
+        ``"mm"``; a sweep in other units of the same kind is converted.
     **kwargs
         Passed to :func:`~physmodel.estimation.lsq.fit_parameters` (``fixed``, ``ftol``, ``fd_step``).
 
