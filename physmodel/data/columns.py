@@ -109,11 +109,11 @@ def _csv_table(path) -> Table:
     if len(set(names)) != len(names):
         dup = sorted({n for n in names if names.count(n) > 1})
         raise DataFormatError(f"{where}:{i + 1}: column name(s) {dup} appear more than once")
-    body = [ln for ln in lines[i + 1:] if ln.strip() and not ln.lstrip().startswith("#")]
-    if not body:
+    rows = [ln for ln in lines[i + 1:] if ln.strip() and not ln.lstrip().startswith("#")]
+    if not rows:
         raise DataFormatError(f"{where}: no data rows after the column header (line {i + 1})")
     try:
-        data = np.loadtxt(io.StringIO("\n".join(body)), delimiter=delim, ndmin=2, dtype=float)
+        data = np.loadtxt(io.StringIO("\n".join(rows)), delimiter=delim, ndmin=2, dtype=float)
     except ValueError:
         data = None
     if data is None or data.shape[1] != len(names):      # find the first bad line for the message

@@ -12,6 +12,7 @@ import secrets
 from collections.abc import Callable, Mapping
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 from .. import interrupts
 from ..errors import DataFormatError, IPMCError
@@ -29,7 +30,8 @@ def atomic_write(path, write_fn, mode: str = "w") -> Path:
     tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
     try:
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        with os.fdopen(fd, mode, **({"newline": "", "encoding": "utf-8"} if "b" not in mode else {})) as fh:
+        text: dict[str, Any] = {"newline": "", "encoding": "utf-8"} if "b" not in mode else {}
+        with os.fdopen(fd, mode, **text) as fh:
             write_fn(fh)
             fh.flush()
             os.fsync(fh.fileno())
@@ -122,7 +124,7 @@ def output_folder(path, identity: str, *, force: bool = False, option: str = "--
         try:
             import fcntl
         except ImportError:  # pragma: no cover - not POSIX: no lock, the ownership check still applies
-            fcntl = None
+            fcntl = None  # type: ignore[assignment]
         if fcntl is not None:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)

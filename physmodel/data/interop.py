@@ -81,11 +81,15 @@ def _relabel(sw: FrequencySweep, input_unit: str | None, output_unit: str | None
     if input_unit is None and output_unit is None:
         return sw
     iu, ou = input_unit or sw.input_unit, output_unit or sw.output_unit
-    label = {k: u for k, u, have in (("input_unit", iu, sw.input_unit), ("output_unit", ou, sw.output_unit))
-             if have == "1" and u != "1"}
-    if label:
-        unit_scale(iu), unit_scale(ou)
-        sw = replace(sw, **label)
+    for arg, u in (("input_unit", iu), ("output_unit", ou)):
+        try:
+            unit_scale(u)
+        except IPMCError as exc:
+            raise IPMCError(f"as_sweep: {arg}={u!r}: {exc}") from None
+    if sw.input_unit == "1" and iu != "1":          # dimensionless: labelled, not converted
+        sw = replace(sw, input_unit=iu)
+    if sw.output_unit == "1" and ou != "1":
+        sw = replace(sw, output_unit=ou)
     try:
         return sw.in_units(iu, ou)
     except IPMCError as exc:

@@ -36,6 +36,7 @@ import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -377,8 +378,8 @@ def merge_sweeps(data: FrequencySweep | Sequence[FrequencySweep]) -> FrequencySw
 
 
 # ----------------------------------------------------------------------------------- writing
-def _file_columns(sw: FrequencySweep) -> dict[str, np.ndarray]:
-    cols = {
+def _file_columns(sw: FrequencySweep) -> dict[str, Any]:
+    cols: dict[str, Any] = {
         "temperature_c": sw.temperature_c,
         "frequency_hz": sw.frequency_hz,
         "magnitude_db": sw.magnitude_db,
@@ -434,7 +435,7 @@ def write_mat(sw: FrequencySweep, path) -> Path:
     """MATLAB .mat (v5) with one column vector per field, the complex response and header strings."""
     from scipy.io import savemat
 
-    cols = {k: v.reshape(-1, 1) for k, v in _file_columns(sw).items()}
+    cols: dict[str, Any] = {k: v.reshape(-1, 1) for k, v in _file_columns(sw).items()}
     cols["response"] = sw.response.reshape(-1, 1)
     cols["input"] = f"{sw.input_name} [{sw.input_unit}]"
     cols["output"] = f"{sw.output_name} [{sw.output_unit}]"

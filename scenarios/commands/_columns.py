@@ -19,8 +19,7 @@ argument; :func:`read_record_mapped` and :func:`read_sweep_mapped` re-raise it a
 from __future__ import annotations
 
 from pathlib import Path
-
-from physmodel.data.columns import ColumnMapError
+from typing import Any
 
 from ._common import CLIError
 
@@ -89,7 +88,7 @@ def record_mapping(args, channels: dict) -> dict:
     return {"columns": columns, "units": units}
 
 
-def _record_option(exc: ColumnMapError, channels: dict) -> str:
+def _record_option(exc: Any, channels: dict) -> str:
     if exc.key == "time":
         return "--time-unit" if exc.argument == "units" else "--time-column"
     for role, names in channels.items():
@@ -101,6 +100,7 @@ def _record_option(exc: ColumnMapError, channels: dict) -> str:
 def read_record_mapped(path, args, channels: dict, option: str = "RECORD"):
     """The time record at ``path`` read with the options' mapping (:func:`record_mapping`); a
     mapping problem is a CLIError naming the option that fixes it."""
+    from physmodel.data.columns import ColumnMapError
     from physmodel.data.timerecord import read_record
 
     if not Path(path).exists():
@@ -165,6 +165,7 @@ def sweep_mapping(args) -> dict:
 def read_sweep_mapped(path, args, option: str = "SWEEP_FILE"):
     """The sweep at ``path`` read with the options' mapping; a problem a mapping entry fixes is a
     CLIError naming ``--sweep-columns ROLE=...``, ``--sweep-units KEY=...`` or ``--sweep-temperature``."""
+    from physmodel.data.columns import ColumnMapError
     from physmodel.data.files import read_sweep
 
     if not Path(path).exists():
