@@ -223,3 +223,18 @@ def signal_scale(column: str, unit: str | None, labels: dict, command: str, fix:
         print(f"{command}: note: column {column!r} is in {unit}; converted to the surrogate's {want} (×{k:g})",
               file=sys.stderr)
     return k
+
+
+def reference_column_unit(path, column) -> tuple[str, str | None]:
+    """(column, unit in its name or None) of the value column of a reference file (default: the
+    first column that is not ``time_s``); a missing file or column is left to the reader's message."""
+    from physmodel.data.columns import pick, read_table, suffix_unit
+    from physmodel.errors import IPMCError
+
+    try:
+        table = read_table(path, "reference")
+        name = pick(table, column, "reference") if column is not None else \
+            next(n for n in table.names if n != "time_s")
+    except (IPMCError, StopIteration):
+        return str(column), None
+    return name, (suffix_unit(name) or (None, None))[1]

@@ -42,7 +42,7 @@ import numpy as np
 
 from inversion.limits import DEFAULT_MAX_VOLTAGE
 
-from ._columns import add_sweep_options, signal_scale, surrogate_role
+from ._columns import add_sweep_options, reference_column_unit, signal_scale, surrogate_role
 from ._common import EXIT_FAILED, EXIT_OK, CLIError, _floats, load_physics, provenance_data, verdict_lines
 
 __all__ = ["add_parser", "run", "build_reference", "drive_limits"]
@@ -242,8 +242,12 @@ def run(args) -> int:
     if UNITS[in_unit][0] != "voltage" or UNITS[out_unit][0] != "length":
         raise CLIError(f"{args.surrogate}: {surrogate_role({'input_unit': in_unit, 'output_unit': out_unit, **model.labels})}: "
                        "a feedforward needs an actuator surrogate (tip displacement per volt, e.g. mm/V)")
-    ref_scale = signal_scale("reference", args.unit or out_unit, {**model.labels, "output_unit": out_unit},
-                             "ipmc feedforward", "--unit")
+    labels = {**model.labels, "output_unit": out_unit}
+    ref_scale = signal_scale("reference", args.unit or out_unit, labels, "ipmc feedforward", "--unit")
+    if args.reference_file:                             # a column with its own unit: its kind checked, a
+        col, unit = reference_column_unit(args.reference_file, args.reference_column)   # conversion said
+        if unit is not None:
+            signal_scale(col, unit, labels, "ipmc feedforward", "--reference-column/--unit")
     if args.no_check and (args.model or args.set or args.params_json or args.param):
         raise CLIError("--no-check: no physics check is run, so --model/--set/--params-json/--param have nothing to do")
     mf, overridden, phys_note = (None, False, "physics check skipped (--no-check)") if args.no_check else \

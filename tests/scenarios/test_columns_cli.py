@@ -223,3 +223,20 @@ def test_feedforward_reference_unit_is_converted_or_refused(surrogates, tmp_path
     assert rc == 2 and "current" in err and "--unit" in err
     rc, err = _ff(sen, tmp_path / "sen", capsys)
     assert rc == 2 and "sensor surrogate" in err and "actuator surrogate" in err
+
+
+def test_feedforward_reference_file_column_unit(surrogates, tmp_path, capsys):
+    act, _ = surrogates
+    t = np.arange(0, 4, 1e-3)
+    x = 0.2 * np.sin(2 * np.pi * t) * np.sin(np.pi * t / 4) ** 2            # [mm], at rest at both ends
+    files = {"mm": _write(tmp_path / "r_mm.csv", ["time_s", "target_mm"], [t, x]),
+             "m": _write(tmp_path / "r_m.csv", ["time_s", "target_m"], [t, x * 1e-3]),
+             "uA": _write(tmp_path / "r_uA.csv", ["time_s", "target_uA"], [t, x])}
+    rc, err = _ff(act, tmp_path / "fmm", capsys, "--reference-file", files["mm"])
+    assert rc == 0, err
+    rc, err = _ff(act, tmp_path / "fm", capsys, "--reference-file", files["m"])
+    assert rc == 0 and "'target_m' is in m; converted to the surrogate's mm" in err
+    a, b = (_table(tmp_path / k / "voltage.csv") for k in ("fmm", "fm"))
+    np.testing.assert_allclose(b, a, rtol=0, atol=1e-8 * np.max(np.abs(a)))   # rounding only (see above)
+    rc, err = _ff(act, tmp_path / "fuA", capsys, "--reference-file", files["uA"])
+    assert rc == 2 and "current" in err and "--reference-column" in err
