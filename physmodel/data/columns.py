@@ -17,7 +17,7 @@ import io
 import json
 import math
 import zipfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +48,7 @@ class Table:
     data: dict
     header: dict
     where: str
+    text: dict = field(default_factory=dict)     # column → why it is not numeric (its first bad line)
 
     def describe(self) -> str:
         """``'0:t, 1:volts, 2:disp'``: the columns with their 0-based indices (said by the errors)."""
@@ -64,10 +65,18 @@ def suffix_unit(column: str, known=UNITS) -> tuple[str, str] | None:
 
 def pick(table: Table, spec, key: str, argument: str = "columns") -> str:
     """The column of ``table`` that ``spec`` names: its name, the one column ``<spec>_<unit>``, or a
-    0-based index (an int or a string of digits that is not a column name)."""
+    0-based index (an int or a string of digits that is not a column name); a column that is not
+    numeric is a DataFormatError naming its first line that is not a number."""
+    name = _pick(table, spec, key, argument)
+    if name in table.text:
+        raise DataFormatError(table.text[name])
+    return name
+
+
+def _pick(table: Table, spec, key: str, argument: str) -> str:
     names = table.names
     if isinstance(spec, str):
-        if spec in table.data:
+        if spec in names:
             return spec
         pre = [n for n in names if suffix_unit(n) and suffix_unit(n)[0] == spec]   # type: ignore[index]
         if len(pre) == 1:
@@ -116,21 +125,25 @@ def _csv_table(path) -> Table:
         data = np.loadtxt(io.StringIO("\n".join(rows)), delimiter=delim, ndmin=2, dtype=float)
     except ValueError:
         data = None
-    if data is None or data.shape[1] != len(names):      # find the first bad line for the message
-        for j in range(i + 1, len(lines)):
-            raw = lines[j]
-            if not raw.strip() or raw.lstrip().startswith("#"):
-                continue
-            parts = next(csv.reader([raw], delimiter=delim))
-            if len(parts) != len(names):
-                raise DataFormatError(f"{where}:{j + 1}: {len(parts)} values; the header has {len(names)} columns")
-            for n, p in zip(names, parts):
-                try:
-                    float(p)
-                except ValueError:
-                    raise DataFormatError(f"{where}:{j + 1}: {n} = {p.strip()!r} is not a number") from None
-        raise DataFormatError(f"{where}: the data rows are not a numeric table")  # pragma: no cover
-    return Table(names, {n: data[:, k] for k, n in enumerate(names)}, header, where)
+    if data is not None and data.shape[1] == len(names):
+        return Table(names, {n: data[:, k] for k, n in enumerate(names)}, header, where)
+    # a text column (a status, a time stamp) or a ragged row: column by column, a text column is
+    # refused only when it is used (pick), naming its first line that is not a number
+    values: list[list[float]] = [[] for _ in names]
+    bad: dict[str, str] = {}
+    for j in range(i + 1, len(lines)):
+        raw = lines[j]
+        if not raw.strip() or raw.lstrip().startswith("#"):
+            continue
+        parts = next(csv.reader([raw], delimiter=delim))
+        if len(parts) != len(names):
+            raise DataFormatError(f"{where}:{j + 1}: {len(parts)} values; the header has {len(names)} columns")
+        for k, (n, p) in enumerate(zip(names, parts)):
+            try:
+                values[k].append(float(p))
+            except ValueError:
+                bad.setdefault(n, f"{where}:{j + 1}: {n} = {p.strip()!r} is not a number")
+    return Table(names, {n: np.array(v) for n, v in zip(names, values) if n not in bad}, header, where, bad)
 
 
 def _numeric(v) -> np.ndarray | None:
@@ -208,8 +221,8 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "min": 60.0}
 def _time_column(table, columns: dict, units: dict) -> tuple[str, np.ndarray]:
     if "time" in columns:
         tcol = pick(table, columns["time"], "time")
-    elif "time_s" in table.data:
-        tcol = "time_s"
+    elif "time_s" in table.names:
+        tcol = pick(table, "time_s", "time")
     else:
         raise ColumnMapError(f"{table.where}: which column holds the time? give columns={{'time': NAME or INDEX}} "
                              f"(ipmc: --time-column NAME); the file has {table.describe()}", "columns", "time")
@@ -251,7 +264,7 @@ def map_record(path, columns: dict | None = None, units: dict | None = None, tem
         chosen = {c: c for c in table.names if c != tcol}
     chans, cunits, used = {}, {}, {"time"}
     for key, spec in chosen.items():
-        src = pick(table, spec, key) if mapped else spec
+        src = pick(table, spec, key)
         su = suffix_unit(src)
         name = key if mapped or su is None else su[0]
         ukey = next((k for k in (key, src, name) if k in units), None)

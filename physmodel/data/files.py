@@ -390,8 +390,8 @@ def read_mapped_sweep(path, columns: Mapping | None = None, units: Mapping | Non
     for role, default in zip(ROLES, REQUIRED_COLUMNS + OPTIONAL_COLUMNS):
         if role in columns:
             picked[role] = pick(table, columns[role], role)
-        elif default in table.data and not (role == "temperature" and temperature_c is not None):
-            picked[role] = default
+        elif default in table.names and not (role == "temperature" and temperature_c is not None):
+            picked[role] = pick(table, default, role)
     T = _temperatures(table, picked, columns, units, temperature_c)
     for role in ("frequency", "magnitude", "phase"):
         if role not in picked:
@@ -428,7 +428,7 @@ def read_mapped_sweep(path, columns: Mapping | None = None, units: Mapping | Non
 
 
 def _temperatures(table: Table, picked: dict, columns: Mapping, units: Mapping, temperature_c) -> np.ndarray:
-    n = len(table.data[table.names[0]])
+    n = max((v.size for v in table.data.values()), default=0)
     if temperature_c is not None:
         if "temperature" in columns:
             raise ColumnMapError(f"{table.where}: give temperature_c or columns['temperature'], not both",

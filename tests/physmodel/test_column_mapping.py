@@ -247,3 +247,48 @@ def test_calibrate_takes_the_frd_temperature_and_units():
         calibrate(frd, base, ["E"], temperature_c=30, starts=1)
     res = calibrate(frd, base, ["E"], temperature_c=30, input_unit="V", output_unit="mm", starts=1)
     assert res.parameters.E == pytest.approx(base.E, rel=1e-6)     # exact data: the base value back
+
+
+def test_a_text_column_is_refused_only_when_used(tmp_path):
+    p = tmp_path / "an.csv"
+    p.write_text("clock,T_degC,freq_Hz,gain_dB,phase_deg,status\n12:00,30,1,-10,-5,OK\n12:01,30,2,-11,-8,OK\n")
+    m = {"temperature": "T_degC", "frequency": "freq_Hz", "magnitude": "gain_dB"}
+    sw = read_sweep(p, columns=m, units={"input": "V", "output": "mm"})
+    np.testing.assert_allclose(sw.magnitude_db, [-10, -11], rtol=1e-12)
+    with pytest.raises(DataFormatError, match=r"an.csv:2: status = 'OK' is not a number"):
+        read_sweep(p, columns={**m, "phase": "status"}, units={"input": "V", "output": "mm"})
+    with pytest.raises(DataFormatError, match="clock = '12:00' is not a number"):
+        read_record(p, columns={"time": "clock"})
+
+
+def test_malformed_analyser_files_never_escape_as_another_exception(tmp_path):
+    """Seeded mutations of an analyser file (cut, bytes replaced, cells emptied, separators
+    changed), read with and without a mapping: a result or an IPMCError, never another
+    exception or a warning (warnings are errors under pytest here)."""
+    rng = np.random.default_rng(26)
+    H = _plant(F)
+    base = "T_degC,freq_Hz,gain_dB,phase_deg\n" + "".join(
+        f"30,{float(f)!r},{float(20 * np.log10(abs(h)))!r},{float(np.degrees(np.angle(h)))!r}\n" for f, h in zip(F, H))
+    alphabet = list(",;\t\n#.-e0123456789 ab\"") + ["1e400", "nan", "inf", "-0", "\ufeff"]
+    m = {"temperature": 0, "frequency": 1, "magnitude": 2, "phase": 3}
+    outcomes = {"read": 0, "refused": 0}
+    for k in range(300):
+        s = list(base)
+        for _ in range(int(rng.integers(1, 6))):
+            i = int(rng.integers(0, len(s)))
+            op = rng.integers(0, 3)
+            if op == 0:
+                s[i] = str(rng.choice(alphabet))
+            elif op == 1:
+                del s[i:i + int(rng.integers(1, 8))]
+            else:
+                s.insert(i, str(rng.choice(alphabet)))
+        p = tmp_path / f"m{k}.csv"
+        p.write_text("".join(s), encoding="utf-8")
+        for kw in ({}, {"columns": m, "units": {"input": "V", "output": "mm"}}):
+            try:
+                read_sweep(p, **kw)
+                outcomes["read"] += 1
+            except IPMCError:
+                outcomes["refused"] += 1
+    assert outcomes["read"] > 0 and outcomes["refused"] > 0       # both paths were exercised
