@@ -19,7 +19,11 @@ Examples::
 Exit codes: 0 success, 2 bad input (unreadable/invalid CSV, invalid model or options).
 
 A surrogate JSON (``--surrogate model.json --temperature T``, what ``ipmc fit`` writes) can
-replace ``--num``/``--den``.
+replace ``--num``/``--den``.  The signal must be the surrogate's output quantity (a displacement
+for an actuator surrogate, a current for a sensor surrogate): its unit comes from the column name
+(``tip_mm``) or ``--input-unit``; another kind is refused (exit 2), another unit of the same kind
+(``tip_m`` for a mm surrogate) converted and said on stderr.  ``--column``/``--input-column`` and
+``--time-column`` take a name or a 0-based index.
 """
 
 from __future__ import annotations
@@ -191,7 +195,10 @@ def run(args: argparse.Namespace) -> int:
     if args.surrogate is not None:     # the signal must be what the surrogate outputs, in its unit
         from physmodel.data.columns import suffix_unit
 
-        unit = args.input_unit or (suffix_unit(ucol) or (None, None))[1]
+        named = (suffix_unit(ucol) or (None, None))[1]
+        if args.input_unit and named and args.input_unit != named:
+            raise InversionError(f"--input-unit {args.input_unit}: column {ucol!r} is in {named} by its name; drop one")
+        unit = args.input_unit or named
         u = u * signal_scale(ucol, unit, smodel.labels, "ipmc invert", "--input-unit")
     if not (math.isfinite(args.preview_tol) and 0 < args.preview_tol < 1):
         raise InversionError(f"--preview-tol must be in (0, 1), got {args.preview_tol!r}")

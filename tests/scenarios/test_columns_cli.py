@@ -240,3 +240,8 @@ def test_feedforward_reference_file_column_unit(surrogates, tmp_path, capsys):
     np.testing.assert_allclose(b, a, rtol=0, atol=1e-8 * np.max(np.abs(a)))   # rounding only (see above)
     rc, err = _ff(act, tmp_path / "fuA", capsys, "--reference-file", files["uA"])
     assert rc == 2 and "current" in err and "--reference-column" in err
+
+
+def test_invert_input_unit_must_agree_with_the_column_name(surrogates, tmp_path, capsys):
+    rc, err = _invert(_signal(tmp_path, "tip_mm", 1.0), surrogates[0], tmp_path / "o.csv", capsys, "--input-unit", "m")
+    assert rc == 2 and "--input-unit m" in err and "in mm by its name" in err
