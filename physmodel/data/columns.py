@@ -138,9 +138,9 @@ def _csv_table(path) -> Table:
         parts = next(csv.reader([raw], delimiter=delim))
         if len(parts) != len(names):
             raise DataFormatError(f"{where}:{j + 1}: {len(parts)} values; the header has {len(names)} columns")
-        for k, (n, p) in enumerate(zip(names, parts)):
+        for c, (n, p) in enumerate(zip(names, parts)):
             try:
-                values[k].append(float(p))
+                values[c].append(float(p))
             except ValueError:
                 bad.setdefault(n, f"{where}:{j + 1}: {n} = {p.strip()!r} is not a number")
     return Table(names, {n: np.array(v) for n, v in zip(names, values) if n not in bad}, header, where, bad)
