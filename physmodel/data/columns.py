@@ -266,7 +266,7 @@ def map_record(path, columns: dict | None = None, units: dict | None = None, tem
     for key, spec in chosen.items():
         src = pick(table, spec, key)
         su = suffix_unit(src)
-        name = key if mapped or su is None else su[0]
+        name = su[0] if su is not None and (not mapped or key == src) else key
         ukey = next((k for k in (key, src, name) if k in units), None)
         unit = units[ukey] if ukey is not None else (su[1] if su else unitless)
         used.add(ukey or key)

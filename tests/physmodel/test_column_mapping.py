@@ -292,3 +292,9 @@ def test_malformed_analyser_files_never_escape_as_another_exception(tmp_path):
             except IPMCError:
                 outcomes["refused"] += 1
     assert outcomes["read"] > 0 and outcomes["refused"] > 0       # both paths were exercised
+
+
+def test_a_channel_named_by_its_column_keeps_the_name_before_the_unit(tmp_path):
+    p = _csv(tmp_path / "daq.csv", ["t", "drive_V", "tip_mm"], [T, U, Y])
+    rec = read_record(p, columns={"time": "t", "drive_V": "drive_V", "tip_mm": "tip_mm"})
+    assert rec.units == {"drive": "V", "tip": "mm"} and rec.columns_names() == ["drive_V", "tip_mm"]
