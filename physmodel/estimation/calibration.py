@@ -198,7 +198,8 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
               starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
               identify: bool = True, hold_undetermined: bool | str = True, name: str | None = None,
               progress: Callable[[int], None] | None = None, misfit: str = "widen",
-              effects: Mapping[str, Mapping[str, float]] | None = None, **kwargs) -> CalibrationResult:
+              effects: Mapping[str, Mapping[str, float]] | None = None, temperature_c: float | None = None,
+              input_unit: str | None = None, output_unit: str | None = None, **kwargs) -> CalibrationResult:
     """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
 
     Start 0 is the base value (or ``initial``); ``starts − 1`` more are seeded Latin-hypercube
@@ -237,6 +238,12 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
         A measurement chain or other effects ({effect: {parameter: value}}, SI,
         :mod:`physmodel.effects`) held fixed while the physical parameters are fitted: the model
         is ``EffectModel(base, kind, effects)``.
+    temperature_c : float or None
+        Temperature [°C] of data that carry none (a ``control.FrequencyResponseData``); passed to
+        :func:`~physmodel.data.interop.as_sweep`.
+    input_unit, output_unit : str or None
+        Units of data that carry none (an FRD, an estimate from bare arrays), e.g. ``"V"`` and
+        ``"mm"``; a sweep in other units of the same kind is converted.
     **kwargs
         Passed to :func:`~physmodel.estimation.lsq.fit_parameters` (``fixed``, ``ftol``, ``fd_step``).
 
@@ -249,7 +256,7 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
         raise ParameterError(f"misfit must be 'widen' or 'withhold', got {misfit!r}")
     if not isinstance(base, IPMCParameters):
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
-    data = as_sweep(data)
+    data = as_sweep(data, temperature_c, input_unit=input_unit, output_unit=output_unit)
     if effects is not None:
         if not isinstance(effects, Mapping):
             raise ParameterError(f"effects must map effect names to {{parameter: value}}, got {effects!r}")

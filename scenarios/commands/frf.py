@@ -57,6 +57,7 @@ import numpy as np
 
 from physmodel.errors import IPMCError
 
+from ._columns import add_record_options, read_record_mapped
 from ._common import EXIT_OK, CLIError, _floats, refuse_overwriting_inputs
 from .excite import as_options
 
@@ -104,6 +105,7 @@ def add_parser(sub):
     p.add_argument("--reciprocal", action="store_true", help="write input/output instead of output/input")
     p.add_argument("--plot", help="figure of the estimate with ±2σ bands and coherence (PNG)")
     p.add_argument("--quiet", action="store_true", help="no summary")
+    add_record_options(p)
     p.set_defaults(func=run)
     return p
 
@@ -290,7 +292,7 @@ def run(args) -> int:
         raise CLIError(f"--max-clipped-fraction {args.max_clipped_fraction}: must lie in [0, 1]")
     if args.max_std_db is not None and not args.max_std_db > 0:
         raise CLIError(f"--max-std-db {args.max_std_db}: must be > 0 [dB]")
-    records = [_read(p, "RECORD") for p in args.records]
+    records = [read_record_mapped(p, args, {"input": args.input, "output": args.output}) for p in args.records]
     temps = _temperatures(args, records)
     if len(set(temps)) != len(temps):
         raise CLIError(f"--temperature: records at the same temperature {temps}; one record per temperature")
