@@ -18,7 +18,10 @@ ALLOWED = {
     "inversion": {"physmodel", "inversion"},
     "scenarios": {"physmodel", "surrogate", "inversion", "scenarios"},
 }
-MAX_LINES = 500
+#: Lines of a module, imports not counted.  A module is cut along a concept, not at a line count: one
+#: that holds one concept (the discrepancy workflow, a file format) may run to this many lines
+#: rather than be split into pieces that must then share their insides (issue 30).
+MAX_LINES = 800
 
 
 def _modules():
