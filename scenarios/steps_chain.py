@@ -44,8 +44,8 @@ import math
 
 import numpy as np
 
+from .context import md_table as _table
 from .spec import ScenarioError
-from .steps_chain_temperature import markdown_table as _table
 
 __all__ = ["misfit", "printed_sweep", "step_chain"]
 

@@ -40,8 +40,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .context import md_table
+
 __all__ = ["A0Series", "LawCalibration", "a0_series", "calibrate_laws", "law_free_parameters", "levy_4_4",
-           "markdown_table", "printed_a0", "series_model", "trend_signs"]
+           "printed_a0", "series_model", "trend_signs"]
 
 #: The Fig. 5 temperatures of the printed trends [°C].
 TRENDS_C = (25.0, 45.0, 65.0)
@@ -51,12 +53,6 @@ _T_DENSE = np.linspace(20.0, 70.0, 101)
 
 
 # ----------------------------------------------------------------------------- printed data
-def markdown_table(header, rows) -> str:
-    """A Markdown table: ``header`` (column titles) and ``rows`` (sequences of cells, printed with str)."""
-    return "\n".join(["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-                     + ["| " + " | ".join(str(c) for c in r) + " |" for r in rows])
-
-
 def _published():
     from physmodel.parameter_sets.published import load_published
 
@@ -376,7 +372,7 @@ def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed, documented=None)
 
     wr = float(water_permittivity(65.0) / water_permittivity(23.0))
 
-    dt = markdown_table(["T [°C]", "printed a0 [1e10/s⁴]", "σ ln a0"] + [f"{v['label']}: model a0 (Δ %)" for v in out.values()],
+    dt = md_table(["T [°C]", "printed a0 [1e10/s⁴]", "σ ln a0"] + [f"{v['label']}: model a0 (Δ %)" for v in out.values()],
                 [(f"{t:g}", f"{a / 1e10:.4g}", f"{s:.3f}") + tuple(
                     f"{v['cal'].a0_model[i] / 1e10:.3g} ({v['a0_pct'][i]:+.1f})" for v in out.values())
                  for i, (t, a, s) in enumerate(zip(data.temperatures_c, data.a0, data.sigma_ln))])
@@ -411,16 +407,16 @@ def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed, documented=None)
         "so elsewhere the misfit is a0's.", "",
         dt, "", "Goodness of fit (χ² of the a0 residuals against its expectation; a misfit widens the intervals by "
         "the Birge ratio and withholds the identifiability verdict, as `calibrate` does):", "",
-        markdown_table(["calibration", "χ²", "dof", "p", "fits", "converged", "a0 RMS %", "a0 max %"], fits), "",
-        markdown_table(["calibration", "parameter", "value", "95 % interval", "determined", "why"], rows), "",
+        md_table(["calibration", "χ²", "dof", "p", "fits", "converged", "a0 RMS %", "a0 max %"], fits), "",
+        md_table(["calibration", "parameter", "value", "95 % interval", "determined", "why"], rows), "",
         "What the laws imply between 23 and 65 °C (factor of d, κe, E at 65 over 23 °C, with the interval where "
-        "determined):", "", markdown_table(["calibration", "d(65)/d(23)", "κe(65)/κe(23)", "E(65)/E(23)"], impl), "",
+        "determined):", "", md_table(["calibration", "d(65)/d(23)", "κe(65)/κe(23)", "E(65)/E(23)"], impl), "",
         f"Literature: {lit}.", "",
         f"χ² profile over Ea (chain fixed, κe ∝ ε_water; {data.a0.size} a0 values, E does not act on a0): "
         + "; ".join(f"{ea / 1e3:g} kJ/mol: {c2:.3g}" for ea, c2 in prof.items()) + ".", "",
         "Printed trends (25 → 45 → 65 °C) reproduced by the calibrated model (cutoff: lowest line within 3 dB of "
         "|G(f_max)|; gain |G(f_max)| [µA/mm]; mean lag −∠G over the band [°]):", "",
-        markdown_table(["calibration", "cutoff falls", "gain falls", "lag grows", "cutoff [Hz]", "gain", "mean lag"],
+        md_table(["calibration", "cutoff falls", "gain falls", "lag grows", "cutoff [Hz]", "gain", "mean lag"],
                trends), "",
         f"d at 35 °C (the chain fit): {d_row['value']:.3g} m²/s, "
         + ("determined and inside its sourced range" if d_ok else

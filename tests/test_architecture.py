@@ -196,9 +196,6 @@ def _circles(graph: dict[str, set[str]]) -> list[list[str]]:
 #: listed fails.  Break one by moving the shared piece down (CONTRIBUTING.md, "A module's contract").
 KNOWN_CIRCLES = [
     ["inversion.batch", "inversion.preview"],
-    ["physmodel.data.files", "physmodel.data.sweep"],
-    ["physmodel.estimation.frf", "physmodel.estimation.stepped"],
-    ["scenarios.plots_chain", "scenarios.steps_chain", "scenarios.steps_chain_temperature"],
 ]
 
 
