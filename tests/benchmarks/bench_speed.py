@@ -36,6 +36,8 @@ joint   Joint zpk schedules on the seed 001 physics (``seed001_actuator``, 0.1�
         noise 0.2 dB / 1°, 3/5/10/20 temperatures on 19–55 °C, zpk 3/3 and 4/4, quadratic in T):
         time, convergence, iterations, and the held-out error against the noise-free physics at
         temperatures between the fitted ones.
+zpk     Joint zpk ÷ coefficient schedule on seed001_actuator and seed002_table3 (10 T × 60 lines,
+        0.1–9 Hz, 4/4 cubic): time ratio per noise seed and the joint iterations (issue 29).
 stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilter`` with
         carried state and against the batch inverse; finite-preview batch throughput as a
         ratio to ``scipy.signal.lfilter`` at 1, 5 and 20 kHz.
@@ -331,6 +333,49 @@ def joint_section(args):
                   f"{np.mean(errs2):.4f} ({np.max(errs2):.4f}) |")
 
 
+def zpk_section(args):
+    """Joint zpk ÷ coefficient schedule (issue 29): 10 temperatures × 60 lines, 4/4 cubic."""
+    from _timing import interleaved
+
+    from surrogate import ScheduledFit, from_sweep
+
+    seeds = [1, 2, 3] if args.quick else [1, 2, 3, 4, 5]
+    reps = 1 if args.quick else 3
+    print("\n## Joint zpk schedule against the coefficient schedule\n")
+    print("10 temperatures (19–55 °C) × 60 log-spaced lines on 0.1–9 Hz, noise 0.2 dB / 1° (noise seeds "
+          f"{seeds}), order 4/4, cubic in T; whole `ScheduledFit(...).fit_data` calls (per-temperature stage "
+          f"included), interleaved, median of {reps} per seed after one warm-up. Joint iterations: those of the "
+          "start that won (the starts run in lockstep), and of the coefficient-form solve that gives the zpk "
+          "fit its start.\n")
+    print("| physics | noise seed | coefficients [s] | zpk [s] | zpk ÷ coefficients | zpk joint iterations "
+          "(winner; coefficient-form start) | cost zpk / coefficients | converged |")
+    print("|:--|--:|--:|--:|--:|--:|--:|:--:|")
+    f_hz = np.geomspace(0.1, 9.0, 60)
+    for pset in ("seed001_actuator", "seed002_table3"):
+        ratios = []
+        for seed in seeds:
+            data = from_sweep(sweep(physics("actuator", pset), "M", f_hz, T001, seed))
+            out = {}
+
+            def run(form, data=data, out=out):
+                out[form] = ScheduledFit(form, 4, 4, 3, raise_on_failure=False).fit_data(data)
+
+            run("coefficients")
+            run("zpk")
+            t = interleaved({"coefficients": lambda: run("coefficients"), "zpk": lambda: run("zpk")}, reps)
+            rz, rc = out["zpk"], out["coefficients"]
+            joint = [e for e in rz.history if e["stage"].startswith("joint") and "coefficient form" not in e["stage"]]
+            won = [e for e in joint if e["converged"] or e is joint[-1]]
+            its_won = sum(e["iterations"] for e in joint if e["start"] == won[0]["start"])
+            its_c = sum(e["iterations"] for e in rz.history if "coefficient form" in e["stage"])
+            ratio = t["zpk"] / t["coefficients"]
+            ratios.append(ratio)
+            print(f"| {pset} | {seed} | {t['coefficients']:.3f} | {t['zpk']:.3f} | {ratio:.1f} | {its_won} "
+                  f"({won[0]['start']}); {its_c} | {rz.cost / rc.cost:.4f} | {rz.converged} |")
+        print(f"| {pset} | median | | | {np.median(ratios):.1f} (max {np.max(ratios):.1f}) | | | goal ≤ 5: "
+              f"{'met' if np.median(ratios) <= 5 else 'NOT met'} (median) |")
+
+
 # ============================================================================ build
 _BUILD_SNIPPET = """
 import sys, time, warnings
@@ -479,7 +524,8 @@ def stream_section(args):
 
 
 # ============================================================================ main
-SECTIONS = {"fit": fit_section, "build": build_section, "joint": joint_section, "stream": stream_section}
+SECTIONS = {"fit": fit_section, "build": build_section, "joint": joint_section, "zpk": zpk_section,
+            "stream": stream_section}
 
 
 def main(argv=None):
