@@ -188,7 +188,7 @@ def truncation_error(split: InverseSplit, dt: float, u: np.ndarray, N: int) -> n
     """``e_N = y_N - y_inf`` [output units] of one sampled signal for a preview of ``N`` samples.
 
     Exact (module doc): ``e_N[k] = -(C_r Phi**N) x[k+N]``, one pass of the anticausal recursion
-    with the output row ``-C_r Phi**N`` over ``u[N:]`` (zero for ``N >= len(u)``).
+    with the output row ``C_r Phi**N`` over ``u[N:]``, negated (zero for ``N >= len(u)``).
     """
     n = u.size
     out = np.zeros(n)

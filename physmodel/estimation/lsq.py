@@ -32,7 +32,8 @@ Scaled space
 
 Search and stopping (see ``_solve``)
     Gauss–Newton steps while they lower the cost inside the bounds; a later start then takes up to
-    :data:`LM_STEPS` Levenberg–Marquardt steps clipped to the bounds (``_damped_steps``: it
+    :data:`~physmodel.estimation.lm_steps.LM_STEPS` Levenberg–Marquardt steps clipped to the bounds
+    (:func:`~physmodel.estimation.lm_steps.damped_steps`: it
     usually reaches an earlier optimum or converges there, for a third of the overhead of scipy's
     trust region, which rebuilds its model from an SVD every iteration); then — start 0 directly —
     scipy's trust-region reflective search.  The later starts' first points share one model call.
@@ -89,6 +90,7 @@ from .identifiability import (
     hold_record,
     refused_identifiability,
 )
+from .lm_steps import damped_steps
 from .observations import ScalarObservations
 from .records import (
     CalibrationResult,
@@ -190,42 +192,6 @@ def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[
     return _residuals_and_jacobian(batch, ScaledRows(free, x, range(len(free))), z, hi, fd_step, res)
 
 
-#: Damped steps a later start takes before handing over to scipy's trust region.
-LM_STEPS = 30
-
-
-def _damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
-    """Levenberg-Marquardt from the point ``pt`` (a tuple of :func:`_solve`'s ``evaluate``): steps
-    ``(JᵀJ + λ diag JᵀJ) d = -Jᵀr`` clipped to the box [lo, hi], λ divided by 3 after a decrease
-    and multiplied by 4 after an increase; ends at a point with a status (converged, or joined an
-    earlier optimum), after ``LM_STEPS`` points, when λ exceeds 1e10 or a clipped step no longer
-    moves.  Returns the lowest point reached (a later start's search is cheaper this way than in
-    scipy's trust region, which rebuilds its model from an SVD every iteration)."""
-    lam = 1e-3
-    for _ in range(LM_STEPS):
-        if pt[3] is not None or stopped_at_budget() or lam > 1e10:
-            break
-        z, r, J = pt[0], pt[1], pt[2]
-        A = J.T @ J
-        g = J.T @ r
-        d = np.maximum(np.diag(A), 1e-12 * max(float(np.max(np.diag(A))), 1e-300))
-        try:
-            step = np.linalg.solve(A + lam * np.diag(d), -g)
-        except np.linalg.LinAlgError:
-            lam *= 4.0
-            continue
-        z_new = np.clip(z + step, lo, hi)
-        if np.array_equal(z_new, z):
-            break
-        count[0] += 1
-        new = evaluate(z_new)
-        if new[6] < pt[6]:
-            pt, lam = new, lam / 3.0
-        else:
-            lam *= 4.0
-    return pt
-
-
 class _Stop(Exception):
     """Ends scipy's search from inside the residual function."""
 
@@ -303,7 +269,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     if pt[3] is None and optima and not stopped_at_budget():
         # a later start: damped Gauss-Newton (Levenberg-Marquardt) steps kept in the box until it
         # converges or reaches an earlier optimum; scipy's trust region (below) only if it stalls
-        pt = _damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget)
+        pt = damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget)
     status, msg = pt[3], pt[4]
     if status is None and stopped_at_budget():
         status, msg = 0, f"stopped after {count[0]} function evaluations (max_nfev={max_nfev}) before converging"

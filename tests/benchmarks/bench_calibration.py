@@ -9,7 +9,9 @@
 3. the same coverage check on sweeps without per-line std, where the noise level is estimated;
 4. ``--ratio ROUNDS [--root CHECKOUT]`` (issue 29): the 4-start calibration above against 100 model
    evaluations on the same 500 lines (``ActuatorModel(base).frequency_response(FREQS, TEMPS)``,
-   100 calls), interleaved in one interpreter, medians over the rounds (goal <= 1.14);
+   100 calls), interleaved in one interpreter, medians over the rounds (goal <= 1.14).  Measured
+   2026-11-26 (2 shared cores, 30 rounds, two runs each): before (d968249) 1.209 / 1.219, after
+   1.047 / 1.044 (4-start estimates bit for bit equal on 8 noise draws);
 5. ``--speed PAIRS --root OTHER``: wall time of the calibrations above against another checkout
    (e.g. the commit before the speed work), paired and interleaved: each pair runs one fresh
    interpreter per checkout (order alternating), each times ``--reps`` calls after one warm-up

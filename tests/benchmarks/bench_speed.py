@@ -38,9 +38,15 @@ joint   Joint zpk schedules on the seed 001 physics (``seed001_actuator``, 0.1�
         temperatures between the fitted ones.
 zpk     Joint zpk ÷ coefficient schedule on seed001_actuator and seed002_table3 (10 T × 60 lines,
         0.1–9 Hz, 4/4 cubic): time ratio per noise seed and the joint iterations (issue 29).
+        Measured 2026-11-26 against d968249: seed 001 median 3.1 (max 6.6) -> 2.9 (3.7);
+        seed 002 median 4.0 (max 10.2, 1,227 iterations) -> 4.0 (5.4; 68 iterations on that draw).
 stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilter`` with
         carried state and against the batch inverse; finite-preview batch throughput as a
-        ratio to ``scipy.signal.lfilter`` at 1, 5 and 20 kHz.
+        ratio to ``scipy.signal.lfilter`` at 1, 5 and 20 kHz, and ``preview='auto'`` against
+        inverting with the preview it chooses (issue 29: ≤ 1.5).  Measured 2026-11-26 against
+        d968249 (``--root``): auto ÷ chosen 8.45 / 9.01 / 10.19 before, 1.30 / 1.23 / 1.37 after
+        (1 / 5 / 20 kHz); the preview chosen is 243 / 1203 / 4849 samples instead of the
+        smallest, 203 / 1009 / 4043 (a bound instead of a search).
 """
 
 from __future__ import annotations
