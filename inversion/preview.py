@@ -90,7 +90,7 @@ def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
     w, H = w[keep], H[keep]
     step = 0.05 / split.r0
     T = step * np.arange(2001)                    # up to 100/r0 (exp(-100) of the kernel)
-    ratio = np.max(np.abs(split._truncation_terms(T, w)) / H, axis=1)
+    ratio = np.max(np.abs(split.truncation_terms(T, w)) / H, axis=1)
     bad = np.flatnonzero(ratio > tol)
     if bad.size == 0:
         return 0.0, float(ratio[0])

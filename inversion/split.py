@@ -260,14 +260,26 @@ class InverseSplit:
         """
         T = np.atleast_1d(np.asarray(preview_s, dtype=float))
         w = np.atleast_1d(np.asarray(omega, dtype=float))
-        out = self._truncation_terms(T, w)
+        out = self.truncation_terms(T, w)
         if self.n_unstable:
             out = out * np.exp(1j * np.outer(np.where(np.isfinite(T), T, 0.0), w))
         return out[0] if np.ndim(preview_s) == 0 else out
 
-    def _truncation_terms(self, T: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """``C_u (j w I - A_u)^{-1} exp(-A_u T) B_u`` (the truncation response without its unit-
-        modulus factor ``exp(j w T)``), shape (T.size, w.size)."""
+    def truncation_terms(self, T: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``C_u (j w I - A_u)^{-1} exp(-A_u T) B_u``: :meth:`truncation_response` without its
+        unit-modulus factor ``exp(j w T)`` (its magnitude, as the preview rules use it).
+
+        Parameters
+        ----------
+        T : ndarray, shape (m,)
+            Previews [s] (``inf`` gives 0).
+        w : ndarray, shape (k,)
+            Angular frequencies [rad/s].
+
+        Returns
+        -------
+        ndarray of complex, shape (m, k)
+        """
         if self.n_unstable == 0:
             return np.zeros((T.size, w.size), complex)
         n = self.n_unstable
