@@ -16,13 +16,19 @@ def damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
     """Levenberg-Marquardt from the point ``pt``, a tuple ``(z, r, J, status, message, step,
     cost)`` as the engine's ``evaluate(z)`` returns it (cached and counted in ``count``).
 
-    Steps ``(JᵀJ + λ diag JᵀJ) d = -Jᵀr`` clipped to the box [lo, hi]; λ is divided by 3 after a
+    Steps ``(JᵀJ + λ diag JᵀJ) d = -Jᵀr`` clipped to just inside the box [lo, hi]; λ is divided by 3 after a
     decrease and multiplied by 4 after an increase.  Ends at a point with a status (converged, or
     joined an earlier optimum), after ``LM_STEPS`` points, at the budget, when λ exceeds 1e10 or
     when a clipped step no longer moves.  Returns the lowest point reached (a later start's
     search is cheaper this way than in scipy's trust region, which rebuilds its model from an
     SVD every iteration).
     """
+    # strictly inside the box, as scipy's trust region keeps its points: a bound itself can map
+    # back to a physical value a rounding outside it (10**log10(0.005) < 0.005)
+    lo_in = lo + 1e-10 * np.maximum(1.0, np.abs(lo))
+    hi_in = hi - 1e-10 * np.maximum(1.0, np.abs(hi))
+    tight = lo_in > hi_in
+    lo_in[tight] = hi_in[tight] = 0.5 * (lo[tight] + hi[tight])
     lam = 1e-3
     for _ in range(LM_STEPS):
         if pt[3] is not None or stopped_at_budget() or lam > 1e10:
@@ -36,7 +42,7 @@ def damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
         except np.linalg.LinAlgError:
             lam *= 4.0
             continue
-        z_new = np.clip(z + step, lo, hi)
+        z_new = np.clip(z + step, lo_in, hi_in)
         if np.array_equal(z_new, z):
             break
         count[0] += 1
