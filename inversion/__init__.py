@@ -5,8 +5,9 @@ The inverse ``1/G`` of a proper model is split into a causal stable part (run fo
 time), an anticausal part (run backward in time) and, for strictly proper models, a
 polynomial part (Devasia–Chen–Paden stable inversion, as used by seed papers 000 and 001).
 The anticausal part can be truncated to a finite preview ``T_p`` (Zou–Devasia).  The default
-``preview="auto"`` chooses the smallest ``T_p`` whose truncation error is below ``preview_tol``
-(1e-3) of the full inverse, for the signal at hand (batch) or for every sinusoid up to the Nyquist
+``preview="auto"`` chooses the shortest ``T_p`` whose bound on the truncation error is below
+``preview_tol`` (1e-3) of the full inverse, for the signal at hand (batch: the discarded kernel's
+l1 norm times the signal's peak; the exact error is reported) or for every sinusoid up to the Nyquist
 frequency (streaming, bounded-memory, scheduled); the seed-000 rule ``T_p* = 4/r0`` (``r0`` the
 real part of the least unstable inverse pole) stays available as ``preview="4/r0"``.  Limits
 (:mod:`inversion.limits`) refuse or flag feedforward voltages and rates, and decoded ranges, that
@@ -28,7 +29,8 @@ Batch inversion (:mod:`inversion.batch`)
 
 Automatic preview (:mod:`inversion.preview`)
     choose_preview(split, dt, u, tol=1e-3, norm="linf") -> PreviewChoice (samples, seconds,
-        relative_error, max_error, tail_bound, rule_4_over_r0_s); TruncationModes (exact e_N)
+        relative_error, max_error, tail_bound, error_bound, rule_4_over_r0_s);
+    truncation_error(split, dt, u, N) (exact e_N); discrete_tail_l1(split, dt, n) (the bound)
 
 Model split (:mod:`inversion.split`)
     split_inverse(model, *, improper="error", filter_bandwidth=None) -> InverseSplit

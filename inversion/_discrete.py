@@ -62,11 +62,11 @@ from typing import Any
 import numpy as np
 import scipy.signal as sig
 
-from ._sections import FusedPass, _sos
+from ._sections import FusedPass, sos_sections
 from .split import InverseSplit
 
 __all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan",
-           "central_difference_kernel", "FUSED_BLOCK"]
+           "central_difference_kernel", "left_powers", "FUSED_BLOCK"]
 
 #: Samples per block of the fused finite-preview backward pass (intermediates stay in cache).
 FUSED_BLOCK = 1 << 16
@@ -174,7 +174,7 @@ class FOHFilter:
         scale = float(np.max(np.abs(exact)))
         if np.all(np.abs(tf_val - exact) <= 1e-10 * np.maximum(ref, 1e-3 * scale)):
             return cls(Phi=Phi, alpha=alpha, beta=beta, C=C, D=Dd, b=b, a=a, sos=None)
-        sos = _sos(Phi, Bd, C, Dd, zs, exact)
+        sos = sos_sections(Phi, Bd, C, Dd, zs, exact)
         return cls(Phi=Phi, alpha=alpha, beta=beta, C=C, D=Dd, b=None, a=None, sos=sos)
 
     @property
@@ -208,6 +208,21 @@ class FOHFilter:
         if self.sos is None:
             return sig.lfilter(self.b, self.a, X, axis=1)
         return sig.sosfilt(self.sos, X, axis=1)
+
+
+def left_powers(row: np.ndarray, Phi: np.ndarray, count: int) -> np.ndarray:
+    """Rows ``row @ Phi**q`` for q = 0..count-1 (by doubling)."""
+    out = np.empty((count, row.size))
+    if count == 0:
+        return out
+    out[0] = row
+    filled, P = 1, Phi
+    while filled < count:
+        m = min(filled, count - filled)
+        out[filled:filled + m] = out[:m] @ P
+        filled += m
+        P = P @ P
+    return out
 
 
 def central_difference_kernel(coeffs: np.ndarray, dt: float) -> tuple[np.ndarray, int]:

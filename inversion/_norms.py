@@ -7,8 +7,11 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
+__all__ = ["abs_impulse", "l1_norm", "propagate", "to_tf"]
 
-def _to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
+
+def to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
+    """``C (sI - A)^-1 B`` as a ``control.TransferFunction`` (None for an empty block)."""
     if A.shape[0] == 0:
         return None
     import control
@@ -18,7 +21,7 @@ def _to_tf(A: np.ndarray, B: np.ndarray, C: np.ndarray) -> Any:
     return control.tf(np.atleast_1d(b[0]), a)
 
 
-def _abs_impulse(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[float, np.ndarray]:
+def abs_impulse(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[float, np.ndarray]:
     """``(step, |C exp(M t_i) B|)`` on a uniform grid ``t_i = i*step`` covering the response
     of a stable ``M`` down to ``exp(-40)`` of its slowest mode."""
     n = M.shape[0]
@@ -43,7 +46,7 @@ def _abs_impulse(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> tuple[float, np
     return step, np.abs(xs @ C)
 
 
-def _propagate(M: np.ndarray, B: np.ndarray, T: np.ndarray) -> np.ndarray:
+def propagate(M: np.ndarray, B: np.ndarray, T: np.ndarray) -> np.ndarray:
     """Rows ``exp(M T_i) B`` (0 for infinite ``T_i``).  A uniform grid starting at 0 is filled by
     repeated multiplication with one ``exp(M step)`` (vectorised doubling); otherwise one matrix
     exponential per entry."""
@@ -66,9 +69,9 @@ def _propagate(M: np.ndarray, B: np.ndarray, T: np.ndarray) -> np.ndarray:
     return out
 
 
-def _l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
+def l1_norm(M: np.ndarray, B: np.ndarray, C: np.ndarray) -> float:
     """``int_0^inf |C exp(M t) B| dt`` for a stable ``M`` (trapezoid on a fine grid)."""
     if M.shape[0] == 0:
         return 0.0
-    step, h = _abs_impulse(M, B, C)
+    step, h = abs_impulse(M, B, C)
     return float(step * (h.sum() - 0.5 * (h[0] + h[-1])))

@@ -9,11 +9,14 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.signal as sig
 
-__all__ = ["FusedPass"]
+__all__ = ["FusedPass", "sos_sections"]
 
 
-def _sos(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray,
+def sos_sections(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray,
          exact: np.ndarray) -> np.ndarray:
+    """Second-order sections of the discrete system ``(Phi, Bd, C, Dd)``: poles the eigenvalues of
+    ``Phi``, zeros the finite generalised eigenvalues of the Rosenbrock pencil, gain matched to
+    ``exact`` (the response at the points ``zs``) where the product form is largest."""
     n = Phi.shape[0]
     poles = np.linalg.eigvals(Phi)
     pencil_a = np.block([[Phi, Bd.reshape(n, 1)], [C.reshape(1, n), np.array([[Dd]])]])
@@ -108,7 +111,7 @@ class FusedPass:
         den = np.prod([np.polyval(r[3:][::-1], zinv) for r in sos], axis=0)
         for f in (f1, f2):
             exact = f.response(zs)
-            num_sos = f.sos if f.sos is not None else _sos(f.Phi, f.Phi @ f.alpha + f.beta, f.C, f.D, zs, exact)
+            num_sos = f.sos if f.sos is not None else sos_sections(f.Phi, f.Phi @ f.alpha + f.beta, f.C, f.D, zs, exact)
             fir = [np.trim_zeros(np.asarray(r[:3], float), "b") for r in num_sos]
             fir = [k if k.size else np.zeros(1) for k in fir]
             # the zeros' sections carry their own denominators (the same poles): divide out

@@ -7,21 +7,25 @@ truncation; see :mod:`inversion.split` for the split of ``1/G``.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from physmodel.data.timerecord import UNIFORM_RTOL as _UNIFORM_RTOL
-from physmodel.data.timerecord import uniform_interval
-from physmodel.errors import IPMCError
-
 from ._discrete import Plan
-from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
-from .preview import DEFAULT_PREVIEW_TOL, PreviewChoice, TruncationModes, choose_preview, preview_rule, resolve_preview
-from .split import InverseSplit, split_inverse
+from ._errors import InversionError, NonFiniteSignalError
+from .preview import (
+    DEFAULT_PREVIEW_TOL,
+    PreviewChoice,
+    auto_preview_passes,
+    choose_preview,
+    preview_rule,
+    resolve_preview,
+    truncation_error,
+)
+from .signals import as_signal, as_split, sampling_interval, time_base
+from .split import InverseSplit
 
 __all__ = [
     "InversionResult",
@@ -39,9 +43,6 @@ __all__ = [
 
 #: Samples processed per chunk (bounds the working memory to a few times 8 MiB).
 DEFAULT_CHUNK = 1 << 20
-
-#: Relative tolerance on the spread of the time steps (the library's default).
-UNIFORM_RTOL = _UNIFORM_RTOL
 
 
 class SampledRecord:
@@ -118,8 +119,7 @@ class InversionResult(SampledRecord):
             return self.preview_choice.max_error
         if self.preview_samples is None or self.split.n_unstable == 0:
             return 0.0
-        modes = TruncationModes(self.split, self.dt, self.input)
-        return float(np.max(np.abs(modes.error(self.preview_samples))))
+        return float(np.max(np.abs(truncation_error(self.split, self.dt, self.input, self.preview_samples))))
 
     @cached_property
     def truncation_bound(self) -> float:
@@ -140,60 +140,6 @@ class InversionResult(SampledRecord):
         finite-difference error of the ``"differentiate"`` mode.
         """
         return _disc_estimate(self.split, self.input, self.preview_samples)
-
-
-def time_base(t: Any, u: np.ndarray) -> tuple[np.ndarray | None, float]:
-    """``(time stamps or None, dt)`` for a scalar sampling interval or an array of times matching ``u``."""
-    if np.ndim(t) == 0:
-        return None, sampling_interval(t)
-    ta = np.asarray(t, dtype=float)
-    if ta.shape != u.shape:
-        raise InversionError(f"t and u must have the same length; got {ta.shape} and {u.shape}")
-    return ta, sampling_interval(ta)
-
-
-def sampling_interval(t: Any) -> float:
-    """Return the sampling interval [s] of uniformly spaced time stamps ``t`` [s] (or of a scalar
-    interval): :func:`physmodel.data.timerecord.uniform_interval`, the library's one uniform-time
-    check, with its default tolerance (a step within ``UNIFORM_RTOL`` of the mean step).
-
-    Raises
-    ------
-    NonUniformSamplingError
-        if ``t`` has fewer than 2 samples, is not finite, not increasing, or not uniform (the
-        message names the offending sample and step).
-    """
-    try:
-        return uniform_interval(t, rtol=UNIFORM_RTOL)
-    except IPMCError as exc:
-        raise NonUniformSamplingError(str(exc)) from None
-
-
-def _as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:
-    if isinstance(model, InverseSplit):
-        return model
-    return split_inverse(model, improper=improper, filter_bandwidth=filter_bandwidth)
-
-
-def _signal(u: Any) -> np.ndarray:
-    ua = np.asarray(u, dtype=float)
-    if ua.ndim != 1:
-        raise InversionError(f"the signal must be 1-D; got shape {ua.shape}")
-    if ua.size < 2:
-        raise InversionError(f"the signal must have at least 2 samples; got {ua.size}")
-    # a finite sum proves every sample finite (NaN/inf propagate) without an n-sized mask;
-    # only a non-finite sum (a bad sample, or overflow) needs the element-wise check
-    with np.errstate(over="ignore", invalid="ignore"):
-        total = float(np.add.reduce(ua))
-    if math.isfinite(total):
-        return ua
-    finite = np.isfinite(ua)
-    if not finite.all():
-        i = int(np.flatnonzero(~finite)[0])
-        raise NonFiniteSignalError(
-            f"the signal must be finite; sample {i} is {ua[i]!r} (NaN/inf are not allowed: "
-            "fill or interpolate gaps before inverting)")
-    return ua
 
 
 def _disc_estimate(split: InverseSplit, u: np.ndarray, n_preview: int | None) -> float:
@@ -263,23 +209,47 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     :func:`feedforward` (3 V limit by default); for decoding, :func:`decode_sensor` (limits on
     request); or :func:`inversion.limits.check_limits` on ``result.output``.
     """
-    split = _as_split(model, improper, filter_bandwidth)
-    ua = _signal(u)
+    split = as_split(model, improper, filter_bandwidth)
+    ua = as_signal(u)
     ta, dt = time_base(t, ua)
     rule = preview_rule(preview)
     choice = None
-    if rule == "auto":
-        choice = choose_preview(split, dt, ua, tol=preview_tol, norm=preview_norm, checked=True)
-        n_prev, prev_s = choice.samples, choice.seconds
-    else:
-        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
-    plan = Plan(split, dt, n_prev)
+    finite = False
     if chunk_size is None:
         chunk_size = ua.size
     if not (isinstance(chunk_size, int | np.integer) and chunk_size > 0):
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
-    n = ua.size
     chunk = int(chunk_size)
+    if rule == "auto":
+        # the choice runs the causal and the full anticausal pass and the truncation error of
+        # the preview it picks: their sums are the finite-preview inverse (to rounding)
+        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm)
+        choice = passes.choice
+        n_prev, prev_s = choice.samples, choice.seconds
+        if chunk >= ua.size:
+            stable, unstable, output = passes.stable, passes.unstable, passes.output
+            finite = passes.finite
+        else:
+            stable, unstable, output = _passes(Plan(split, dt, n_prev), ua, chunk)
+    else:
+        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
+        stable, unstable, output = _passes(Plan(split, dt, n_prev), ua, chunk)
+    bad = None if finite else ~np.isfinite(output)
+    if bad is not None and bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise NonFiniteSignalError(
+            f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
+            "scale the signal to the model's units")
+    return InversionResult(
+        input=ua, output=output, stable_part=stable, unstable_part=unstable,
+        preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
+        auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
+        time_stamps=ta, preview_rule=rule, preview_choice=choice)
+
+
+def _passes(plan: Plan, ua: np.ndarray, chunk: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(stable, unstable, output)`` of the plan's inverse of ``ua``, ``chunk`` samples at a time."""
+    n = ua.size
     parts: dict[str, Any] = {}
     if chunk >= n:
         # single chunk: keep the filter output itself, no copy
@@ -294,38 +264,25 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     plan.forward(ua, n, chunk, put_s, check=False)
     stable = parts["s"]
     if plan.anti is None:
-        unstable = np.zeros(n)
-        output = stable.copy()
-    elif chunk >= n and plan.fused is None:
+        return stable, np.zeros(n), stable.copy()
+    if chunk >= n and plan.fused is None:
         # one whole-record backward pass: keep its output itself
         def put_u(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
             parts["u"] = y
 
         plan.backward(ua, n, chunk, put_u)
-        unstable = parts["u"]
-        output = stable + unstable
-    else:
-        # block by block (chunked, or the fused finite-preview pass): write both results
-        # while the block is in cache
-        unstable = np.empty(n)
-        output = np.empty(n)
+        return stable, parts["u"], stable + parts["u"]
+    # block by block (chunked, or the fused finite-preview pass): write both results while
+    # the block is in cache
+    unstable = np.empty(n)
+    output = np.empty(n)
 
-        def put_u(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            unstable[c0:c1] = y
-            np.add(stable[c0:c1], y, out=output[c0:c1])
+    def put_b(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+        unstable[c0:c1] = y
+        np.add(stable[c0:c1], y, out=output[c0:c1])
 
-        plan.backward(ua, n, chunk, put_u)
-    bad = ~np.isfinite(output)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise NonFiniteSignalError(
-            f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
-            "scale the signal to the model's units")
-    return InversionResult(
-        input=ua, output=output, stable_part=stable, unstable_part=unstable,
-        preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
-        auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
-        time_stamps=ta, preview_rule=rule, preview_choice=choice)
+    plan.backward(ua, n, chunk, put_b)
+    return stable, unstable, output
 
 
 @dataclass(frozen=True)
@@ -376,7 +333,7 @@ def invert_to(model: Any, dt: float, u: Any, out: Any, *, preview: Any = "auto",
     preview, improper, filter_bandwidth, chunk_size
         As in :func:`invert`.
     """
-    split = _as_split(model, improper, filter_bandwidth)
+    split = as_split(model, improper, filter_bandwidth)
     dt = sampling_interval(dt)
     n = len(u)
     if len(out) != n:

@@ -39,8 +39,9 @@ import numpy as np
 
 from ._discrete import Plan
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .batch import DEFAULT_CHUNK, SampledRecord, _signal, preview_rule, resolve_preview, sampling_interval, time_base
-from .preview import DEFAULT_PREVIEW_TOL, frequency_preview
+from .batch import DEFAULT_CHUNK, SampledRecord
+from .preview import DEFAULT_PREVIEW_TOL, frequency_preview, preview_rule, resolve_preview
+from .signals import as_signal, sampling_interval, time_base
 from .split import InverseSplit, split_inverse
 from .streaming import StreamingInverter
 
@@ -219,7 +220,7 @@ def invert_scheduled(model_at: Callable[[float], Any], t: Any, u: Any, temperatu
     -------
     ScheduledInversionResult
     """
-    ua = _signal(u)
+    ua = as_signal(u)
     n = ua.size
     Ta = _check_temperature(temperature, n)
     ta, dt = time_base(t, ua)

@@ -51,7 +51,7 @@ import scipy.linalg as sla
 
 from ._coefficients import model_coefficients
 from ._errors import ImproperInverseError, InversionError, NonHyperbolicModelError
-from ._norms import _abs_impulse, _l1_norm, _propagate, _to_tf
+from ._norms import abs_impulse, l1_norm, propagate, to_tf
 
 __all__ = ["InverseSplit", "split_inverse", "model_coefficients", "IMPROPER_MODES"]
 
@@ -191,11 +191,11 @@ class InverseSplit:
 
     def stable_tf(self) -> Any:
         """``H_s`` as a ``control.TransferFunction`` (None if empty)."""
-        return _to_tf(self.A_s, self.B_s, self.C_s)
+        return to_tf(self.A_s, self.B_s, self.C_s)
 
     def unstable_tf(self) -> Any:
         """``H_u`` as a ``control.TransferFunction`` (None if empty)."""
-        return _to_tf(self.A_u, self.B_u, self.C_u)
+        return to_tf(self.A_u, self.B_u, self.C_u)
 
     def l1_norms(self) -> tuple[float, float]:
         """L1 norms of the impulse responses of ``H_s`` and ``H_u`` (integral of |h|).
@@ -203,7 +203,7 @@ class InverseSplit:
         Used for the discretisation error estimate: a bounded input perturbation ``e``
         changes each part's output by at most ``||h||_1 * max|e|``.
         """
-        return _l1_norm(self.A_s, self.B_s, self.C_s), _l1_norm(-self.A_u, self.B_u, self.C_u)
+        return l1_norm(self.A_s, self.B_s, self.C_s), l1_norm(-self.A_u, self.B_u, self.C_u)
 
     def tail_l1_norm(self, preview_s: Any) -> np.ndarray:
         """L1 norm of the anticausal kernel beyond the preview, ``int_T^inf |h_u(-sigma)| d sigma``.
@@ -231,7 +231,7 @@ class InverseSplit:
     def _tail_curve(self) -> tuple[np.ndarray, np.ndarray]:
         cached = self.__dict__.get("_tail_cache")
         if cached is None:
-            step, h = _abs_impulse(-self.A_u, self.B_u, self.C_u)
+            step, h = abs_impulse(-self.A_u, self.B_u, self.C_u)
             # cumulative trapezoid from the far end: tail[i] = int_{t_i}^{horizon} |h|
             seg = 0.5 * step * (h[1:] + h[:-1])
             tail = np.concatenate((np.cumsum(seg[::-1])[::-1], [0.0]))
@@ -260,14 +260,26 @@ class InverseSplit:
         """
         T = np.atleast_1d(np.asarray(preview_s, dtype=float))
         w = np.atleast_1d(np.asarray(omega, dtype=float))
-        out = self._truncation_terms(T, w)
+        out = self.truncation_terms(T, w)
         if self.n_unstable:
             out = out * np.exp(1j * np.outer(np.where(np.isfinite(T), T, 0.0), w))
         return out[0] if np.ndim(preview_s) == 0 else out
 
-    def _truncation_terms(self, T: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """``C_u (j w I - A_u)^{-1} exp(-A_u T) B_u`` (the truncation response without its unit-
-        modulus factor ``exp(j w T)``), shape (T.size, w.size)."""
+    def truncation_terms(self, T: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """``C_u (j w I - A_u)^{-1} exp(-A_u T) B_u``: :meth:`truncation_response` without its
+        unit-modulus factor ``exp(j w T)`` (its magnitude, as the preview rules use it).
+
+        Parameters
+        ----------
+        T : ndarray, shape (m,)
+            Previews [s] (``inf`` gives 0).
+        w : ndarray, shape (k,)
+            Angular frequencies [rad/s].
+
+        Returns
+        -------
+        ndarray of complex, shape (m, k)
+        """
         if self.n_unstable == 0:
             return np.zeros((T.size, w.size), complex)
         n = self.n_unstable
@@ -275,7 +287,7 @@ class InverseSplit:
         lhs = (1j * w)[:, None, None] * np.eye(n) - self.A_u
         R = np.linalg.solve(np.transpose(lhs, (0, 2, 1)),
                             np.broadcast_to(self.C_u.astype(complex), (w.size, n))[..., None])[..., 0]
-        V = _propagate(-self.A_u, self.B_u, T)                           # (m, n)
+        V = propagate(-self.A_u, self.B_u, T)                           # (m, n)
         return V @ R.T
 
 

@@ -44,9 +44,10 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import Plan
+from ._discrete import Plan, left_powers
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .batch import _as_split, resolve_preview, sampling_interval
+from .preview import resolve_preview
+from .signals import as_split, sampling_interval
 
 __all__ = ["StreamingInverter"]
 
@@ -59,21 +60,6 @@ BLOCK_RATIO = 2
 MIN_BLOCK = 32
 #: Initial capacity of the sample buffers (they grow for larger chunks).
 BUFFER = 1 << 12
-
-
-def _left_powers(row: np.ndarray, Phi: np.ndarray, count: int) -> np.ndarray:
-    """Rows ``row @ Phi**q`` for q = 0..count-1 (by doubling)."""
-    out = np.empty((count, row.size))
-    if count == 0:
-        return out
-    out[0] = row
-    filled, P = 1, Phi
-    while filled < count:
-        m = min(filled, count - filled)
-        out[filled:filled + m] = out[:m] @ P
-        filled += m
-        P = P @ P
-    return out
 
 
 class StreamingInverter:
@@ -108,7 +94,7 @@ class StreamingInverter:
 
     def __init__(self, model: Any, dt: float, preview: Any = "auto", *, improper: str = "error",
                  filter_bandwidth: float | None = None):
-        self.split = _as_split(model, improper, filter_bandwidth)
+        self.split = as_split(model, improper, filter_bandwidth)
         self.dt = sampling_interval(dt)
         n_prev, prev_s = resolve_preview(preview, self.split, self.dt)
         if n_prev is None:
@@ -125,7 +111,7 @@ class StreamingInverter:
         self._blocks_ok = False
         if p.anti is not None:
             N = n_prev
-            rows = _left_powers(p.anti_C, p.anti_phi, N + 1)        # C_r Phi^q
+            rows = left_powers(p.anti_C, p.anti_phi, N + 1)        # C_r Phi^q
             taps = np.zeros(N + 1)
             taps[:N] += rows[:N] @ p.anti_alpha
             taps[1:] += rows[:N] @ p.anti_beta
@@ -134,8 +120,8 @@ class StreamingInverter:
                 self._blocks_ok = True
                 self._Wr = rows                                      # C_r Phi^q
                 self._Wa = rows @ p.anti_alpha                       # C_r Phi^q alpha
-                self._Pa = _left_powers(p.anti_alpha, p.anti_phi.T, N)   # Phi^i alpha
-                self._Pb = _left_powers(p.anti_beta, p.anti_phi.T, N)    # Phi^i beta
+                self._Pa = left_powers(p.anti_alpha, p.anti_phi.T, N)   # Phi^i alpha
+                self._Pb = left_powers(p.anti_beta, p.anti_phi.T, N)    # Phi^i beta
         # one kernel for a single output: anticausal taps and the difference stencil over
         # the window u[k-h .. k+delay]
         kern = np.zeros(h + d + 1)

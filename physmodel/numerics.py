@@ -16,6 +16,7 @@ mpmath at 50 digits.
 from __future__ import annotations
 
 import functools
+import threading
 
 import numpy as np
 
@@ -215,6 +216,11 @@ def one_blas_thread(fn):
     BLAS changes the last bits, and with them which start wins a race or where a solver stops —
     seen with numpy 1.24's OpenBLAS on two cores).
 
+    The BLAS libraries are looked up once (a ``threadpoolctl.ThreadpoolController`` built on the
+    first call, after numpy and scipy are loaded: a fresh lookup reads ``/proc/self/maps``, about
+    2 ms, which was a third of a small rational fit), and a call made while the limit is already
+    held (a decorated function calling another) does not set it again.
+
     Parameters
     ----------
     fn : callable
@@ -222,11 +228,26 @@ def one_blas_thread(fn):
     """
     import functools
 
-    from threadpoolctl import threadpool_limits
-
     @functools.wraps(fn)
     def wrapped(*args, **kwargs):
-        with threadpool_limits(limits=1, user_api="blas"):
+        if getattr(_BLAS_HELD, "held", False):
             return fn(*args, **kwargs)
+        with _blas_controller().limit(limits=1, user_api="blas"):
+            _BLAS_HELD.held = True
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                _BLAS_HELD.held = False
 
     return wrapped
+
+
+_BLAS_HELD = threading.local()
+
+
+@functools.lru_cache(maxsize=1)
+def _blas_controller():
+    """The process's BLAS thread pools (looked up once)."""
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()

@@ -31,8 +31,13 @@ Scaled space
     counts the batched calls.
 
 Search and stopping (see ``_solve``)
-    Gauss–Newton steps while they lower the cost inside the bounds, then scipy's trust-region
-    reflective search.  A start ends (status 1) when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
+    Gauss–Newton steps while they lower the cost inside the bounds; a later start then takes up to
+    :data:`~physmodel.estimation.lm_steps.LM_STEPS` Levenberg–Marquardt steps clipped to the bounds
+    (:func:`~physmodel.estimation.lm_steps.damped_steps`: it
+    usually reaches an earlier optimum or converges there, for a third of the overhead of scipy's
+    trust region, which rebuilds its model from an SVD every iteration); then — start 0 directly —
+    scipy's trust-region reflective search.  The later starts' first points share one model call.
+    A start ends (status 1) when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
     below :data:`GN_DECREMENT`·s² (within 1.4e-6 standard errors of the optimum), or on scipy's
     tests.  A later start stops early (status −2, never chosen as best) once its cost is within
     :data:`JOIN_COST`·s² of a converged earlier start's and its Gauss–Newton step lands within
@@ -85,6 +90,7 @@ from .identifiability import (
     hold_record,
     refused_identifiability,
 )
+from .lm_steps import damped_steps
 from .observations import ScalarObservations
 from .records import (
     CalibrationResult,
@@ -131,16 +137,34 @@ def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step,
     """Standardised residuals (2N,) at scaled ``z`` and their Jacobian (2N, n) in one batched model
     call: forward differences (step ``fd_step``, backwards at the upper bound ``hi``) except for
     the columns the predictor knows by the chain rule (:meth:`ModelBatch.jacobian_plan`)."""
+    return _residuals_and_jacobians(batch, rows, [z], hi, fd_step, res)[0]
+
+
+def _residuals_and_jacobians(batch: ModelBatch, rows: ScaledRows, zs, hi, fd_step, res) -> list:
+    """:func:`_residuals_and_jacobian` at several points ``zs`` in one batched model call (a model
+    call costs about the same for one row or twenty: its per-call work dominates)."""
     plan = batch.jacobian_plan(rows.active)
-    fd = [i for i in range(z.size) if i not in plan]
-    steps = np.where(z + fd_step <= hi, fd_step, -fd_step)[fd]
-    Z = z[None, :] + np.vstack([np.zeros_like(z), np.eye(z.size)[fd] * steps[:, None]])
-    R = res(batch(rows(Z)))
-    J = np.empty((R.shape[1], z.size))
-    J[:, fd] = ((R[1:] - R[0][None, :]) / steps[:, None]).T
-    for i, p in plan.items():
-        J[:, i] = res.scaled_column(J[:, p[1]], p[2]) if p[0] == "scaled" else res.constant_column(p[1])
-    return R[0], J
+    n = len(zs[0])
+    fd = [i for i in range(n) if i not in plan]
+    eye = np.eye(n)[fd]
+    blocks, all_steps = [], []
+    for z in zs:
+        steps = np.where(z + fd_step <= hi, fd_step, -fd_step)[fd]
+        blocks.append(z[None, :] + np.vstack([np.zeros_like(z), eye * steps[:, None]]))
+        all_steps.append(steps)
+    R = res(batch(rows(np.vstack(blocks))))
+    # the known columns: constant ones are the same at every point, scaled ones a fixed factor
+    known = {i: (res.constant_column(p[1]) if p[0] == "constant" else (p[1], res.scaled_column(1.0, p[2])))
+             for i, p in plan.items()}
+    out = []
+    for b, steps in enumerate(all_steps):
+        Rb = R[b * (len(fd) + 1):(b + 1) * (len(fd) + 1)]
+        J = np.empty((Rb.shape[1], n))
+        J[:, fd] = ((Rb[1:] - Rb[0][None, :]) / steps[:, None]).T
+        for i, k in known.items():
+            J[:, i] = k if not isinstance(k, tuple) else J[:, k[0]] * k[1]
+        out.append((Rb[0], J))
+    return out
 
 
 def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[FreeParameter], values: Values, *,
@@ -173,12 +197,13 @@ class _Stop(Exception):
 
 
 def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatch, res, max_nfev, ftol,
-           fd_step, optima: Sequence[_Fit] = ()) -> _Fit:
+           fd_step, optima: Sequence[_Fit] = (), first: tuple | None = None) -> _Fit:
     """Least squares over the ``active`` parameters of ``free`` in their scaled space (the others
     at ``x_full``); search and stopping in the module doc.  A point costs one batched model call,
     residuals and Jacobian together (a Broyden-updated Jacobian needed three times the points).
     Plain Gauss–Newton steps converge in 6–7 points on the benchmark where scipy's trust region,
     which starts small, needs 9–10.  s² = 2·cost/dof scales the tests to standard errors.
+    ``first``: the residuals and Jacobian at the (clipped) start, already computed.
     """
     act = [free[k] for k in active]
     lo = np.array([fp.z_bounds[0] for fp in act])
@@ -228,7 +253,10 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
 
     stopped_at_budget = lambda: max_nfev is not None and count[0] >= max_nfev  # noqa: E731
     count[0] = 1
-    pt = evaluate(np.clip(np.asarray(z0, dtype=float), lo, hi))
+    z_start = np.clip(np.asarray(z0, dtype=float), lo, hi)
+    if first is not None:
+        cache[z_start.tobytes()] = (z_start.copy(), first[0], first[1], *assess(z_start, *first))
+    pt = evaluate(z_start)
     while pt[3] is None and pt[5] is not None and not stopped_at_budget():      # Gauss–Newton steps
         z_new = pt[0] + pt[5]
         if np.any(z_new < lo) or np.any(z_new > hi):
@@ -238,6 +266,10 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         if not new[6] < pt[6]:
             break
         pt = new
+    if pt[3] is None and optima and not stopped_at_budget():
+        # a later start: damped Gauss-Newton (Levenberg-Marquardt) steps kept in the box until it
+        # converges or reaches an earlier optimum; scipy's trust region (below) only if it stalls
+        pt = damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget)
     status, msg = pt[3], pt[4]
     if status is None and stopped_at_budget():
         status, msg = 0, f"stopped after {count[0]} function evaluations (max_nfev={max_nfev}) before converging"
@@ -345,8 +377,16 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     z_starts = np.vstack([z_init[None, :], lhs_starts(free, int(starts) - 1, seed)])
     z_starts[:, [k for k in range(len(free)) if k not in active]] = z_init[[k for k in range(len(free)) if k not in active]]
     records, fits, ends = [], [], []
+    firsts: dict = {}
     for i, z0 in enumerate(z_starts):
-        fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits)
+        if i == 1 and len(z_starts) > 2:
+            # the later starts' first points in one model call (it costs about one point's)
+            lo_a = np.array([free[k].z_bounds[0] for k in active])
+            hi_a = np.array([free[k].z_bounds[1] for k in active])
+            pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[1:]]
+            firsts = dict(enumerate(_residuals_and_jacobians(batch, ScaledRows(free, x_full, active), pts, hi_a,
+                                                             fd_step, res), start=1))
+        fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits, firsts.get(i))
         fit.index = i
         fits.append(fit)
         ends.append(z0.copy())

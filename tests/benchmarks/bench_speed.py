@@ -36,9 +36,17 @@ joint   Joint zpk schedules on the seed 001 physics (``seed001_actuator``, 0.1�
         noise 0.2 dB / 1°, 3/5/10/20 temperatures on 19–55 °C, zpk 3/3 and 4/4, quadratic in T):
         time, convergence, iterations, and the held-out error against the noise-free physics at
         temperatures between the fitted ones.
+zpk     Joint zpk ÷ coefficient schedule on seed001_actuator and seed002_table3 (10 T × 60 lines,
+        0.1–9 Hz, 4/4 cubic): time ratio per noise seed and the joint iterations (issue 29).
+        Measured 2026-11-26 against d968249: seed 001 median 3.1 (max 6.6) -> 2.9 (3.7);
+        seed 002 median 4.0 (max 10.2, 1,227 iterations) -> 4.0 (5.4; 68 iterations on that draw).
 stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilter`` with
         carried state and against the batch inverse; finite-preview batch throughput as a
-        ratio to ``scipy.signal.lfilter`` at 1, 5 and 20 kHz.
+        ratio to ``scipy.signal.lfilter`` at 1, 5 and 20 kHz, and ``preview='auto'`` against
+        inverting with the preview it chooses (issue 29: ≤ 1.5).  Measured 2026-11-26 against
+        d968249 (``--root``): auto ÷ chosen 8.45 / 9.01 / 10.19 before, 1.30 / 1.23 / 1.37 after
+        (1 / 5 / 20 kHz); the preview chosen is 243 / 1203 / 4849 samples instead of the
+        smallest, 203 / 1009 / 4043 (a bound instead of a search).
 """
 
 from __future__ import annotations
@@ -331,6 +339,49 @@ def joint_section(args):
                   f"{np.mean(errs2):.4f} ({np.max(errs2):.4f}) |")
 
 
+def zpk_section(args):
+    """Joint zpk ÷ coefficient schedule (issue 29): 10 temperatures × 60 lines, 4/4 cubic."""
+    from _timing import interleaved
+
+    from surrogate import ScheduledFit, from_sweep
+
+    seeds = [1, 2, 3] if args.quick else [1, 2, 3, 4, 5]
+    reps = 1 if args.quick else 3
+    print("\n## Joint zpk schedule against the coefficient schedule\n")
+    print("10 temperatures (19–55 °C) × 60 log-spaced lines on 0.1–9 Hz, noise 0.2 dB / 1° (noise seeds "
+          f"{seeds}), order 4/4, cubic in T; whole `ScheduledFit(...).fit_data` calls (per-temperature stage "
+          f"included), interleaved, median of {reps} per seed after one warm-up. Joint iterations: those of the "
+          "start that won (the starts run in lockstep), and of the coefficient-form solve that gives the zpk "
+          "fit its start.\n")
+    print("| physics | noise seed | coefficients [s] | zpk [s] | zpk ÷ coefficients | zpk joint iterations "
+          "(winner; coefficient-form start) | cost zpk / coefficients | converged |")
+    print("|:--|--:|--:|--:|--:|--:|--:|:--:|")
+    f_hz = np.geomspace(0.1, 9.0, 60)
+    for pset in ("seed001_actuator", "seed002_table3"):
+        ratios = []
+        for seed in seeds:
+            data = from_sweep(sweep(physics("actuator", pset), "M", f_hz, T001, seed))
+            out = {}
+
+            def run(form, data=data, out=out):
+                out[form] = ScheduledFit(form, 4, 4, 3, raise_on_failure=False).fit_data(data)
+
+            run("coefficients")
+            run("zpk")
+            t = interleaved({"coefficients": lambda: run("coefficients"), "zpk": lambda: run("zpk")}, reps)
+            rz, rc = out["zpk"], out["coefficients"]
+            joint = [e for e in rz.history if e["stage"].startswith("joint") and "coefficient form" not in e["stage"]]
+            won = [e for e in joint if e["converged"] or e is joint[-1]]
+            its_won = sum(e["iterations"] for e in joint if e["start"] == won[0]["start"])
+            its_c = sum(e["iterations"] for e in rz.history if "coefficient form" in e["stage"])
+            ratio = t["zpk"] / t["coefficients"]
+            ratios.append(ratio)
+            print(f"| {pset} | {seed} | {t['coefficients']:.3f} | {t['zpk']:.3f} | {ratio:.1f} | {its_won} "
+                  f"({won[0]['start']}); {its_c} | {rz.cost / rc.cost:.4f} | {rz.converged} |")
+        print(f"| {pset} | median | | | {np.median(ratios):.1f} (max {np.max(ratios):.1f}) | | | goal ≤ 5: "
+              f"{'met' if np.median(ratios) <= 5 else 'NOT met'} (median) |")
+
+
 # ============================================================================ build
 _BUILD_SNIPPET = """
 import sys, time, warnings
@@ -445,13 +496,14 @@ def stream_section(args):
           f"{1e9 * t['batch'] / n2:.1f} | {r2:.2f} | ≤ 1.5× batch: {'met' if r2 <= 1.5 else 'NOT met'} |")
     print("\nFinite-preview batch throughput as a ratio to `scipy.signal.lfilter` (4th-order Butterworth) "
           "over the same samples, 2^21 samples:\n")
-    print("The pass itself runs with the preview given (the signal-independent rule's length); `preview='auto'` "
-          "adds the search for the smallest preview meeting the truncation tolerance on this signal (an "
-          "infinite-preview inverse and the truncation modes: several passes), reported beside it.\n")
-    print("| sampling rate | preview [samples] | anticausal filter | invert, preview given [ns/sample] | "
-          "invert, preview='auto' [ns/sample] | lfilter [ns/sample] | ratio (lfilter / invert, preview given) | "
-          "ratio with 'auto' | goal ≥ 0.3 |")
-    print("|--:|--:|:--|--:|--:|--:|--:|--:|:--|")
+    print("'given' runs with the signal-independent 4/r0 preview; 'chosen' with the preview `preview='auto'` "
+          "picks for this signal (its `preview_samples`); 'auto' includes the choice (issue 29: auto ÷ chosen "
+          "≤ 1.5).  Medians over interleaved rounds.\n")
+    print("| sampling rate | 4/r0 preview [samples] | auto preview [samples] | anticausal filter | "
+          "invert, 4/r0 given [ns/sample] | invert, chosen preview given [ns/sample] | "
+          "invert, preview='auto' [ns/sample] | lfilter [ns/sample] | lfilter / given (≥ 0.3) | "
+          "lfilter / auto | auto / chosen (≤ 1.5) |")
+    print("|--:|--:|--:|:--|--:|--:|--:|--:|--:|--:|--:|")
     n3 = 1 << (19 if args.quick else 21)
     from inversion import split_inverse
     from inversion._discrete import Plan
@@ -462,19 +514,24 @@ def stream_section(args):
         u3 = np.sin(2 * np.pi * 20 * d * np.arange(n3)) + 0.1 * rng.standard_normal(n3)
         plan = Plan(sp, d, round(sp.auto_preview_s / d))
         tp = plan.n_preview * d
+        n_auto = invert(sp, d, u3, preview="auto").preview_samples
         t = _median_interleaved({"invert": lambda d=d, u3=u3, tp=tp: invert(sp, d, u3, preview=tp),
+                                 "chosen": lambda d=d, u3=u3, na=n_auto: invert(sp, d, u3, preview=na * d),
                                  "auto": lambda d=d, u3=u3: invert(sp, d, u3, preview="auto"),
                                  "lfilter": lambda u3=u3: ss.lfilter(b4, a4, u3)}, reps)
         kind = "fused" if getattr(plan, "fused", None) is not None else (
             plan.anti.kind if plan.anti is not None else "none")
         ratio = t["lfilter"] / t["invert"]
-        print(f"| {fs / 1e3:g} kHz | {plan.n_preview} | {kind} | {1e9 * t['invert'] / n3:.1f} | "
-              f"{1e9 * t['auto'] / n3:.1f} | {1e9 * t['lfilter'] / n3:.1f} | {ratio:.2f} | "
-              f"{t['lfilter'] / t['auto']:.2f} | {'met' if ratio >= 0.3 else 'NOT met'} |")
+        ra = t["auto"] / t["chosen"]
+        print(f"| {fs / 1e3:g} kHz | {plan.n_preview} | {n_auto} | {kind} | {1e9 * t['invert'] / n3:.1f} | "
+              f"{1e9 * t['chosen'] / n3:.1f} | {1e9 * t['auto'] / n3:.1f} | {1e9 * t['lfilter'] / n3:.1f} | "
+              f"{ratio:.2f} {'met' if ratio >= 0.3 else 'NOT met'} | {t['lfilter'] / t['auto']:.2f} | "
+              f"{ra:.2f} {'met' if ra <= 1.5 else 'NOT met'} |")
 
 
 # ============================================================================ main
-SECTIONS = {"fit": fit_section, "build": build_section, "joint": joint_section, "stream": stream_section}
+SECTIONS = {"fit": fit_section, "build": build_section, "joint": joint_section, "zpk": zpk_section,
+            "stream": stream_section}
 
 
 def main(argv=None):

@@ -1,0 +1,76 @@
+"""Checks shared by every inversion entry point: the signal, its time base and the model split.
+
+Kept below :mod:`inversion.preview`, :mod:`inversion.batch`, :mod:`inversion.streaming` and
+:mod:`inversion.scheduled` so that none of them has to import another for these helpers (the
+automatic preview used to import them back from ``batch``: an import circle).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from physmodel.data.timerecord import UNIFORM_RTOL, uniform_interval
+from physmodel.errors import IPMCError
+
+from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
+from .split import InverseSplit, split_inverse
+
+__all__ = ["UNIFORM_RTOL", "as_signal", "as_split", "sampling_interval", "time_base"]
+
+def sampling_interval(t: Any) -> float:
+    """Return the sampling interval [s] of uniformly spaced time stamps ``t`` [s] (or of a scalar
+    interval): :func:`physmodel.data.timerecord.uniform_interval`, the library's one uniform-time
+    check, with its default tolerance (a step within ``UNIFORM_RTOL`` of the mean step).
+
+    Raises
+    ------
+    NonUniformSamplingError
+        if ``t`` has fewer than 2 samples, is not finite, not increasing, or not uniform (the
+        message names the offending sample and step).
+    """
+    try:
+        return uniform_interval(t, rtol=UNIFORM_RTOL)
+    except IPMCError as exc:
+        raise NonUniformSamplingError(str(exc)) from None
+
+
+def time_base(t: Any, u: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """``(time stamps or None, dt)`` for a scalar sampling interval or an array of times matching ``u``."""
+    if np.ndim(t) == 0:
+        return None, sampling_interval(t)
+    ta = np.asarray(t, dtype=float)
+    if ta.shape != u.shape:
+        raise InversionError(f"t and u must have the same length; got {ta.shape} and {u.shape}")
+    return ta, sampling_interval(ta)
+
+
+def as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:
+    """The model's :class:`InverseSplit` (a split is returned as it is)."""
+    if isinstance(model, InverseSplit):
+        return model
+    return split_inverse(model, improper=improper, filter_bandwidth=filter_bandwidth)
+
+
+def as_signal(u: Any) -> np.ndarray:
+    """The signal as a finite 1-D float array of at least 2 samples (else a message naming the sample)."""
+    ua = np.asarray(u, dtype=float)
+    if ua.ndim != 1:
+        raise InversionError(f"the signal must be 1-D; got shape {ua.shape}")
+    if ua.size < 2:
+        raise InversionError(f"the signal must have at least 2 samples; got {ua.size}")
+    # a finite sum proves every sample finite (NaN/inf propagate) without an n-sized mask;
+    # only a non-finite sum (a bad sample, or overflow) needs the element-wise check
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = float(np.add.reduce(ua))
+    if math.isfinite(total):
+        return ua
+    finite = np.isfinite(ua)
+    if not finite.all():
+        i = int(np.flatnonzero(~finite)[0])
+        raise NonFiniteSignalError(
+            f"the signal must be finite; sample {i} is {ua[i]!r} (NaN/inf are not allowed: "
+            "fill or interpolate gaps before inverting)")
+    return ua
