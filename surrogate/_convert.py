@@ -8,7 +8,7 @@ import itertools
 
 import numpy as np
 
-from ._structure import Structure, _factor_roots, _section_polys, polynomials, roots, slot_values
+from ._structure import Structure, factor_roots, polynomials, roots, section_polys, slot_values
 
 
 # --------------------------------------------------- grouping roots into factors
@@ -124,13 +124,13 @@ def groups_from_theta(structure: Structure, theta, which: str):
     v = slot_values(structure, theta, 0.0)
     if which == "poles":
         n = structure.n_poles
-        secs = _section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True)
+        secs = section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True)
         odd = n % 2 == 1
     else:
         m = structure.n_zeros
-        secs = _section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
+        secs = section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
         odd = m % 2 == 1
-    rts = [_factor_roots(s) for s in secs]
+    rts = [factor_roots(s) for s in secs]
     if odd:
         return rts[:-1], rts[-1]
     return rts, None

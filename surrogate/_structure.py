@@ -316,7 +316,7 @@ def slot_values(structure: Structure, theta, tau: float) -> dict:
     return dict(zip(structure.slots, mat @ tp))
 
 
-def _section_polys(vals, p1, p0, count, single, log):
+def section_polys(vals, p1, p0, count, single, log):
     f = np.exp if log else (lambda x: x)
     out = []
     for k in range(count):
@@ -332,7 +332,7 @@ def polynomials(structure: Structure, theta, tau: float = 0.0):
     m, n = structure.n_zeros, structure.n_poles
     if structure.form == "zpk":
         num = np.array([v["k"]])
-        for sec in _section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False):
+        for sec in section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False):
             num = P.polymul(num, sec)
     else:
         num = np.array([v[f"b{i}"] for i in range(m + 1)])
@@ -340,7 +340,7 @@ def polynomials(structure: Structure, theta, tau: float = 0.0):
         den = np.append([v[f"a{j}"] for j in range(n)], 1.0)
     else:
         den = np.array([1.0])
-        for sec in _section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True):
+        for sec in section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True):
             den = P.polymul(den, sec)
     return np.asarray(num, float), np.asarray(den, float)
 
@@ -370,7 +370,7 @@ def section_max_real_part(structure: Structure, theta, taus) -> np.ndarray:
     """Largest real part of the poles in s̃ of a section denominator ('sections', 'zpk') at
     many scaled temperatures at once, shape (len(taus),).  Each section s̃² + a1 s̃ + a0 in
     closed form: −a1/2 for a complex pair, else the root nearer zero, a0/q with
-    q = −(a1 + sign(a1)·√disc)/2 (cancellation-free, as ``_factor_roots``); (s̃ + c): −c."""
+    q = −(a1 + sign(a1)·√disc)/2 (cancellation-free, as ``factor_roots``); (s̃ + c): −c."""
     if structure.form == "coefficients":
         raise ValueError("section_max_real_part needs a section denominator ('sections' or 'zpk')")
     taus = np.atleast_1d(np.asarray(taus, float))
@@ -392,7 +392,7 @@ def section_max_real_part(structure: Structure, theta, taus) -> np.ndarray:
     return best
 
 
-def _factor_roots(poly_asc) -> np.ndarray:
+def factor_roots(poly_asc) -> np.ndarray:
     """Roots of c0 + c1 s + s² (or c0 + s); real pairs by the cancellation-free formula
     q = −(c1 + sign(c1)·√disc)/2, roots q and c0/q (a root much smaller than the other is
     otherwise lost to rounding and can come out as exactly 0)."""
@@ -415,15 +415,15 @@ def roots(structure: Structure, theta, tau: float = 0.0) -> tuple[np.ndarray, np
     m, n = structure.n_zeros, structure.n_poles
     num, den = polynomials(structure, theta, tau)
     if structure.form == "zpk":
-        secs = _section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
-        zeros = np.concatenate([_factor_roots(s) for s in secs]) if secs else np.array([], complex)
+        secs = section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
+        zeros = np.concatenate([factor_roots(s) for s in secs]) if secs else np.array([], complex)
     else:
         zeros = np.roots(num[::-1]) if np.any(num) else np.array([], complex)
     if structure.form == "coefficients":
         poles = np.roots(den[::-1])
     else:
-        secs = _section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True)
-        poles = np.concatenate([_factor_roots(s) for s in secs])
+        secs = section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True)
+        poles = np.concatenate([factor_roots(s) for s in secs])
     return zeros.astype(complex), poles.astype(complex)
 
 
