@@ -17,9 +17,16 @@ from __future__ import annotations
 
 import signal
 import threading
+import time
 from contextlib import contextmanager
 
 _requested: int | None = None
+_raised_at = -1e9
+
+#: A repeated signal raises ``KeyboardInterrupt`` again only this long [s] after the last one, so a
+#: double Ctrl-C (or SIGINT then SIGTERM) cannot interrupt the clean-up and reporting the first
+#: one started; a deliberate repeat later still breaks out of a loop that swallowed the first.
+REPEAT_S = 2.0
 
 #: The signals :func:`handling` turns into ``KeyboardInterrupt``.
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -38,8 +45,9 @@ def requested() -> int | None:
 
 def reset() -> None:
     """Forget a recorded interrupt."""
-    global _requested
+    global _requested, _raised_at
     _requested = None
+    _raised_at = -1e9
 
 
 def check() -> None:
@@ -49,8 +57,20 @@ def check() -> None:
 
 
 def _handler(signum, frame):
+    global _raised_at
     request(signum)
-    raise KeyboardInterrupt(f"interrupted by {signal.Signals(signum).name}")
+    now = time.monotonic()
+    if now - _raised_at >= REPEAT_S:
+        _raised_at = now
+        raise KeyboardInterrupt(f"interrupted by {signal.Signals(signum).name}")
+
+
+def worker_init() -> None:
+    """For worker processes (``ProcessPoolExecutor(initializer=...)``): SIGINT is ignored (a Ctrl-C
+    reaches the whole process group; the parent reports it and stops the workers) and SIGTERM ends
+    the worker quietly (the default action, no Python traceback)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 @contextmanager
@@ -70,4 +90,4 @@ def handling():
             signal.signal(s, h)
 
 
-__all__ = ["request", "requested", "reset", "check", "handling", "SIGNALS"]
+__all__ = ["request", "requested", "reset", "check", "handling", "worker_init", "SIGNALS", "REPEAT_S"]

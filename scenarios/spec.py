@@ -301,6 +301,7 @@ def _check_values(data: dict, where: str) -> None:
     def temps(sec, key, values):
         for t in values if isinstance(values, list) else [values]:
             need(t > -273.15, sec, key, values, "temperatures above absolute zero (-273.15 °C)")
+            need(t <= 150.0, sec, key, values, "°C, at most 150 °C (no hydrated IPMC works above; kelvin? subtract 273.15)")
 
     if "sweep" in data:
         sw = data["sweep"]

@@ -10,7 +10,6 @@ import math
 import os
 import secrets
 from collections.abc import Callable, Mapping
-from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 
@@ -33,7 +32,10 @@ def atomic_write(path, write_fn, mode: str = "w") -> Path:
     # finds and removes it (mkstemp's name is only known once it returns)
     tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
     try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        except OSError as exc:         # name the file asked for, not the temporary one
+            raise OSError(exc.errno, exc.strerror, str(path)) from None
         with os.fdopen(fd, mode, **({"newline": "", "encoding": "utf-8"} if "b" not in mode else {})) as fh:
             write_fn(fh)
             fh.flush()
@@ -71,73 +73,8 @@ def read_text(path, what: str = "file") -> str:
                               "save the file as UTF-8") from None
 
 
-#: What each ipmc command leaves in its output folder, to recognise whose results a folder holds:
-#: (file, identity, or a function of the file's JSON giving the identity).
-OWNER_FILES = (("metrics.json", lambda d: f"ipmc run {d['scenario']}"), ("calibration.json", lambda d: "ipmc calibrate"),
-               ("model.json", lambda d: "ipmc fit"), ("report.json", lambda d: "ipmc diagnose"))
-
-
-def folder_owner(folder) -> str | None:
-    """Whose results ``folder`` holds: ``"ipmc run <scenario>"``, ``"ipmc calibrate"``, ``"ipmc fit"``,
-    ``"ipmc diagnose"``, a description of other files, or None when it is empty."""
-    folder = Path(folder)
-    entries = sorted(p.name for p in folder.iterdir())
-    if not entries:
-        return None
-    for name, identity in OWNER_FILES:
-        if name in entries:
-            try:
-                return identity(json.loads((folder / name).read_text(encoding="utf-8")))
-            except (OSError, ValueError, KeyError, TypeError):
-                continue
-    return f"files not written by a finished ipmc run ({', '.join(entries[:3])}{', ...' if len(entries) > 3 else ''})"
-
-
-def check_output_folder(path, identity: str, *, force: bool = False, option: str = "--out") -> Path:
-    """The refusals of :func:`output_folder` without creating or locking anything: for commands
-    that compute first and write at the end (they claim the folder then)."""
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise IPMCError(f"{option} {path}: exists and is not a folder")
-    owner = folder_owner(path) if path.is_dir() else None
-    if owner is not None and owner != identity and not force:
-        held = owner if owner.startswith("files") else f"the results of {owner!r}"
-        raise IPMCError(f"{option} {path}: the folder holds {held}, not of {identity!r}; choose another "
-                        "folder or pass --force to write into it")
-    return path
-
-
-@contextmanager
-def output_folder(path, identity: str, *, force: bool = False, option: str = "--out"):
-    """Claim the folder ``path`` for one run (a context manager yielding it as a Path).
-
-    The folder is created if needed and locked (``fcntl.flock`` on the folder itself) for the
-    duration of the block, so a second run into the same folder is refused while the first one
-    writes.  A folder that holds another run's results (:func:`folder_owner` differs from
-    ``identity``, e.g. another scenario, or files ipmc did not finish writing) is refused unless
-    ``force``; the same command or scenario may replace its own results.  Errors are
-    :class:`~physmodel.errors.IPMCError` naming ``option`` and the folder.
-    """
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise IPMCError(f"{option} {path}: exists and is not a folder")
-    path.mkdir(parents=True, exist_ok=True)
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        try:
-            import fcntl
-        except ImportError:  # pragma: no cover - not POSIX: no lock, the ownership check still applies
-            fcntl = None
-        if fcntl is not None:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                raise IPMCError(f"{option} {path}: another ipmc run is writing into this folder; wait for it "
-                                "or choose another folder") from None
-        check_output_folder(path, identity, force=force, option=option)
-        yield path
-    finally:
-        os.close(fd)                   # closing the descriptor releases the lock
+# result folders (all or nothing, completion marker): physmodel.data.results; the names stay importable here
+from .results import OWNER_FILES, check_output_folder, folder_owner, output_folder  # noqa: E402, F401
 
 
 def _columns(sw: FrequencySweep) -> dict[str, np.ndarray]:

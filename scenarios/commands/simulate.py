@@ -18,6 +18,7 @@ from ._common import (
     CLIError,
     _add_model_args,
     _floats,
+    check_celsius,
     check_plot_path,
     load_physics,
     model_metadata,
@@ -64,6 +65,7 @@ def run(args) -> int:
                                "--set": getattr(args, "set", None), "--params-json": getattr(args, "params_json", None)})
     if args.plot:
         check_plot_path(args.plot)
+    check_celsius(args.temperature, "--temperature")
     mf, overridden = load_physics(args, "ipmc simulate")
     warn_verdict(mf, "ipmc simulate")
     model = mf.model()

@@ -10,6 +10,7 @@ from ._common import (
     _add_model_args,
     _floats,
     _Progress,
+    check_celsius,
     check_out_file,
     check_plot_path,
     load_physics,
@@ -49,9 +50,7 @@ def run(args) -> int:
     if not 2 <= args.points <= MAX_SWEEP_LINES // len(temps):
         raise CLIError(f"--points must be 2 to {MAX_SWEEP_LINES // len(temps)} (at most {MAX_SWEEP_LINES} lines over "
                        f"{len(temps)} temperature(s)), got {args.points}")
-    bad = [t for t in temps if t <= -273.15]
-    if bad:
-        raise CLIError(f"--temperatures {bad}: below absolute zero (-273.15 °C)")
+    check_celsius(temps, "--temperatures")
     if args.seed is not None and args.seed < 0:
         raise CLIError(f"--seed must be a non-negative integer, got {args.seed}")
     for opt, v in (("--sigma-db", args.sigma_db), ("--sigma-deg", args.sigma_deg), ("--sigma", args.sigma)):
