@@ -127,6 +127,10 @@ def _early_handlers():
     return seen, {s: signal.signal(s, early) for s in (signal.SIGINT, signal.SIGTERM)}
 
 
+def _noted(signum, frame) -> None:
+    """While a finished or interrupted command cleans up: a further signal changes nothing."""
+
+
 def _say_interrupted(what: str, signum) -> None:
     import signal
 
@@ -178,6 +182,8 @@ def main(argv=None) -> int:
         _say_interrupted(what, seen[-1] if seen else None)
         return EXIT_INTERRUPTED
     finally:
+        for s in previous:                    # clean-up is not interrupted: later signals are only noted
+            signal.signal(s, _noted)
         results = sys.modules.get("physmodel.data.results")
         if results is not None:
             results.abort()                   # result folders the command left open: removed

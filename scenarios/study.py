@@ -348,11 +348,12 @@ def run_study(spec: dict, *, scheduler=None, workers: int | None = None, backend
 
 def _stop_workers(ex) -> None:
     """Cancel what has not started and end the worker processes now (not after their chunks)."""
-    ex.shutdown(wait=False, cancel_futures=True)
-    for proc in list((getattr(ex, "_processes", None) or {}).values()):
+    procs = list((getattr(ex, "_processes", None) or {}).values())    # shutdown() forgets them
+    for proc in procs:
         if proc.is_alive():
-            proc.terminate()
-    for proc in list((getattr(ex, "_processes", None) or {}).values()):
+            proc.terminate()                  # SIGTERM: a worker ends quietly (interrupts.worker_init)
+    ex.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
         proc.join(timeout=5)
 
 

@@ -260,9 +260,12 @@ def begin(path, identity: str, *, force: bool = False, option: str = "--out") ->
                         "or choose another folder")
     path.parent.mkdir(parents=True, exist_ok=True)
     stage = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
+    # registered before it exists, so an interrupt at any point after creation still removes it
+    _OPEN[stage] = (path, identity, -1)
     try:
         os.mkdir(stage, 0o777)
     except OSError as exc:
+        _OPEN.pop(stage, None)
         raise IPMCError(f"{option} {path}: cannot create a folder next to it ({exc.strerror})") from None
     fd = os.open(stage, os.O_RDONLY)
     _OPEN[stage] = (path, identity, fd)
@@ -293,7 +296,7 @@ def abort(stage=None) -> None:
     """Remove the temporary folder ``stage`` (every open one when None) and release its lock."""
     for st in ([Path(stage)] if stage is not None else list(_OPEN)):
         entry = _OPEN.pop(st, None)
-        if entry is not None:
+        if entry is not None and entry[2] >= 0:
             os.close(entry[2])
         if st.exists():
             shutil.rmtree(st, ignore_errors=True)
