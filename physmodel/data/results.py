@@ -255,6 +255,7 @@ def begin(path, identity: str, *, force: bool = False, option: str = "--out") ->
     ``ipmc`` aborts every folder left open when a command ends."""
     path = Path(path)
     check_output_folder(path, identity, force=force, option=option)
+    path = Path(os.path.abspath(path))          # "." or "x/..": a real name for the sibling
     if _busy(path):
         raise IPMCError(f"{option} {path}: another ipmc run is writing into this folder; wait for it "
                         "or choose another folder")

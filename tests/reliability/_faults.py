@@ -52,7 +52,7 @@ def interrupted_contract(p, out: Path, before) -> str:
     if len(said) != 1 or not said[0].startswith("ipmc"):
         return f"expected one line saying what was interrupted, got {said}"
     if snapshot(out) != before:
-        return f"{out} changed: {sorted((snapshot(out) or {}))} (before: {sorted(before or {})})"
+        return f"{out} changed: {sorted(snapshot(out) or {})} (before: {sorted(before or {})})"
     left = leftovers(out.parent)
     if left:
         return f"temporary files left: {left}"
