@@ -13,6 +13,7 @@ outputs.  "bad": anything else (the first few are listed).  The address space is
 from __future__ import annotations
 
 import argparse
+import os
 import random
 import resource
 import sys
@@ -36,6 +37,7 @@ def main():
     lim = int(a.memory_gb * 2 ** 30)
     resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
     sys.path.insert(0, str(Path(a.root).resolve()))
+    os.environ["IPMC_FAULT_ROOT"] = str(Path(a.root).resolve())        # subprocess cases run that checkout
     sys.path.insert(1, str(HERE / "tests" / "reliability"))
     import fuzzcases
 

@@ -9,7 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+#: The checkout whose packages the subprocesses run (``fuzz_report.py --root`` sets IPMC_FAULT_ROOT).
+ROOT = Path(os.environ.get("IPMC_FAULT_ROOT") or Path(__file__).resolve().parents[2])
 DRIVER = Path(__file__).with_name("phase_driver.py")
 
 
