@@ -110,7 +110,7 @@ def _command_in(argv) -> str | None:
     return None
 
 
-def _early_handlers():
+def _early_handlers() -> tuple[list[int], dict]:
     """Before :mod:`physmodel.interrupts` is imported (it pulls numpy): SIGINT/SIGTERM raise
     ``KeyboardInterrupt``, recorded so that the full handler can take the record over."""
     import signal
