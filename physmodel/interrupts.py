@@ -22,6 +22,7 @@ from contextlib import contextmanager
 
 _requested: int | None = None
 _raised_at = -1e9
+_deferring = 0
 
 #: A repeated signal raises ``KeyboardInterrupt`` again only this long [s] after the last one, so a
 #: double Ctrl-C (or SIGINT then SIGTERM) cannot interrupt the clean-up and reporting the first
@@ -59,10 +60,31 @@ def check() -> None:
 def _handler(signum, frame):
     global _raised_at
     request(signum)
+    if _deferring:
+        return                         # inside held(): raised when the block ends
     now = time.monotonic()
     if now - _raised_at >= REPEAT_S:
         _raised_at = now
         raise KeyboardInterrupt(f"interrupted by {signal.Signals(signum).name}")
+
+
+@contextmanager
+def held():
+    """A block no SIGINT/SIGTERM interrupts (a few renames that must all happen): the signals are
+    blocked for this thread and, under :func:`handling`, only recorded — a signal another thread
+    received still runs the handler in the main thread — and ``KeyboardInterrupt`` is raised when
+    the block ends if one arrived."""
+    global _deferring
+    blocked = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS)) if blocked else None
+    _deferring += 1
+    try:
+        yield
+    finally:
+        _deferring -= 1
+        if blocked:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+    check()
 
 
 def worker_init() -> None:
@@ -90,4 +112,4 @@ def handling():
             signal.signal(s, h)
 
 
-__all__ = ["request", "requested", "reset", "check", "handling", "worker_init", "SIGNALS", "REPEAT_S"]
+__all__ = ["request", "requested", "reset", "check", "handling", "held", "worker_init", "SIGNALS", "REPEAT_S"]

@@ -31,7 +31,6 @@ import json
 import os
 import secrets
 import shutil
-import signal
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -216,33 +215,36 @@ def _in_place_only(path: Path) -> bool:
 def _commit(stage: Path, path: Path) -> None:
     """Move the complete ``stage`` to ``path`` with SIGINT/SIGTERM held back, so no interrupt lands
     between the renames; the previous folder (now at a temporary name) is then removed."""
-    blocked = hasattr(signal, "pthread_sigmask")
-    if blocked:
-        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, set(interrupts.SIGNALS))
+    trash = None
     try:
-        if not path.exists():
-            os.rename(stage, path)
-            return
-        if _in_place_only(path):                 # move the files one by one; the marker last
-            (path / MARKER).unlink(missing_ok=True)
-            for entry in sorted(stage.iterdir(), key=lambda p: p.name == MARKER):
-                dst = path / entry.name
-                if dst.is_dir() and not dst.is_symlink():
-                    shutil.rmtree(dst)
-                os.replace(entry, dst)
-            stage.rmdir()
-            return
-        _carry_over(path, stage)
-        if _exchange(stage, path):
-            trash = stage
-        else:
-            trash = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.old"
-            os.rename(path, trash)
-            os.rename(stage, path)
+        with interrupts.held():            # an interrupt meanwhile is raised after the renames
+            trash = _swap(stage, path)
     finally:
-        if blocked:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
-    shutil.rmtree(trash, ignore_errors=True)
+        if trash is not None:
+            shutil.rmtree(trash, ignore_errors=True)
+
+
+def _swap(stage: Path, path: Path) -> Path | None:
+    """The renames of :func:`_commit`; returns the previous folder's temporary name, if any."""
+    if not path.exists():
+        os.rename(stage, path)
+        return None
+    if _in_place_only(path):                     # move the files one by one; the marker last
+        (path / MARKER).unlink(missing_ok=True)
+        for entry in sorted(stage.iterdir(), key=lambda p: p.name == MARKER):
+            dst = path / entry.name
+            if dst.is_dir() and not dst.is_symlink():
+                shutil.rmtree(dst)
+            os.replace(entry, dst)
+        stage.rmdir()
+        return None
+    _carry_over(path, stage)
+    if _exchange(stage, path):
+        return stage
+    trash = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.old"
+    os.rename(path, trash)
+    os.rename(stage, path)
+    return trash
 
 
 #: Temporary folders claimed and not yet committed: stage → (final path, identity, locked descriptor).
@@ -321,6 +323,26 @@ def output_folder(path, identity: str, *, force: bool = False, option: str = "--
         abort(stage)
 
 
+@contextmanager
+def files_together(paths):
+    """Write several files as one result (a data file and its plot): yields temporary names next to
+    ``paths`` (same folder, same extension, so writers that pick the format by extension work);
+    when the block ends normally they are renamed onto ``paths`` with SIGINT/SIGTERM held back, so
+    an interrupt leaves all of them or none; otherwise the temporary files are removed."""
+    paths = [Path(p) for p in paths]
+    tmps = [p.parent / f".{p.stem}.{os.getpid()}.{secrets.token_hex(4)}.part{p.suffix}" for p in paths]
+    try:
+        yield tmps
+        interrupts.check()
+        with interrupts.held():
+            for t, p in zip(tmps, paths):
+                if t.exists():
+                    os.replace(t, p)
+    finally:
+        for t in tmps:
+            t.unlink(missing_ok=True)
+
+
 def _written_by_ipmc(file: Path) -> bool:
     """Whether the JSON ``file`` records that an ipmc folder command wrote it."""
     if file.suffix.lower() != ".json" or not file.is_file():
@@ -361,4 +383,4 @@ def check_complete(file, option: str) -> None:
 
 
 __all__ = ["MARKER", "OWNER_FILES", "folder_owner", "check_output_folder", "check_writable_parent", "output_folder",
-           "begin", "commit", "abort", "check_complete"]
+           "begin", "commit", "abort", "files_together", "check_complete"]

@@ -78,11 +78,14 @@ def run(args) -> int:
     from dataclasses import replace
 
     sw = replace(sw, metadata={**sw.metadata, **meta})
-    write_sweep(sw, out)
-    if args.plot:
-        from ..plots import bode
+    from physmodel.data.results import files_together
 
-        bode(sw, args.plot, title=f"{model.params[0].name}: {sw.metadata['description']}")
+    with files_together([out, *([args.plot] if args.plot else [])]) as tmp:     # both or neither
+        write_sweep(sw, tmp[0])
+        if args.plot:
+            from ..plots import bode
+
+            bode(sw, tmp[1], title=f"{model.params[0].name}: {sw.metadata['description']}")
     if not args.quiet:
         print(f"wrote {out} ({sw.frequency_hz.size} lines, {len(temps)} temperatures, "
               f"{sw.output_unit}/{sw.input_unit}) from {mf.describe()}" + (f" and {args.plot}" if args.plot else ""))

@@ -35,7 +35,7 @@ def snapshot(folder: Path) -> dict | None:
 
 def leftovers(parent: Path) -> list[str]:
     """Temporary files or folders of an unfinished write anywhere under ``parent``."""
-    return sorted(p.name for p in parent.rglob("*") if p.name.endswith((".part", ".old")))
+    return sorted(p.name for p in parent.rglob("*") if p.name.endswith((".part", ".old")) or ".part." in p.name)
 
 
 def interrupted_contract(p, out: Path, before) -> str:

@@ -2,6 +2,8 @@
 
 - ``write:NAME``   just after a file named NAME is committed (``os.replace`` onto it): the moment a
                    result file "appears";
+- ``temp:STEM``    just after a temporary file ``.STEM.<pid>.<random>.part<suffix>`` is complete (a
+                   file written together with others, e.g. a sweep and its plot);
 - ``import:MOD``   when module MOD is about to be imported (an import hook), i.e. during start-up;
 - ``begin``        just after a result folder's temporary sibling was created;
 - ``twice:NAME``   as write:NAME, then the other of SIGINT/SIGTERM 1 ms later (a double Ctrl-C).
@@ -33,12 +35,13 @@ def fire():
         os.kill(os.getpid(), signal.SIGTERM if SIG == signal.SIGINT else signal.SIGINT)
 
 
-if KIND in ("write", "twice"):
+if KIND in ("write", "twice", "temp"):
     _replace = os.replace
 
     def replace(src, dst, *a, **k):
         _replace(src, dst, *a, **k)
-        if Path(dst).name == ARG:
+        name = Path(dst).name
+        if name == ARG if KIND != "temp" else (name.startswith(f".{ARG}.") and ".part" in name):
             fire()
 
     os.replace = replace

@@ -112,3 +112,32 @@ def test_a_study_interrupted_while_its_workers_run(work, sig, group):
     assert not out.exists() and not leftovers(work)
     for k in kids:                                        # no orphaned worker
         assert not Path(f"/proc/{k}").exists() or "zombie" in Path(f"/proc/{k}/status").read_text().lower()
+
+
+@pytest.mark.parametrize("cmd", ["sweep", "simulate"])
+@pytest.mark.parametrize("sig,phase", [("SIGINT", "temp:o"), ("SIGTERM", "temp:o"), ("SIGTERM", "write:o.csv")])
+def test_a_data_file_and_its_plot_appear_together_or_not_at_all(work, cmd, sig, phase):
+    d = work / f"pair-{cmd}-{sig}-{phase.replace(':', '-')}"
+    d.mkdir()
+    argv = [cmd, "--out", "o.csv", "--plot", "o.png", "--quiet"] + (["--points", "10"] if cmd == "sweep"
+                                                                      else ["--duration", "0.5"])
+    p = ipmc(argv, d, signal=sig, phase=phase)
+    assert p.returncode == 130 and "Traceback" not in p.stderr, p.stderr[-1500:]
+    files = sorted(f.name for f in d.iterdir())
+    # interrupted while the files were being written: neither; at the final renames: both (complete)
+    assert files in ([], ["o.csv", "o.png"]), files
+    assert files == ([] if phase.startswith("temp") else ["o.csv", "o.png"])
+
+
+def test_held_defers_an_interrupt_to_the_end_of_the_block():
+    from physmodel import interrupts
+
+    done = []
+    with interrupts.handling():
+        with pytest.raises(KeyboardInterrupt):
+            with interrupts.held():
+                os.kill(os.getpid(), signal.SIGTERM)
+                for _ in range(1000):             # the handler runs between these bytecodes ...
+                    done.append(1)
+        assert len(done) == 1000                  # ... and did not break the block
+        assert interrupts.requested() == signal.SIGTERM
