@@ -170,7 +170,12 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
             if k in nz and _num(nz[k], f"{where}: [study.noise] {k}") < 0:
                 raise StudyError(f"{where}: [study.noise] {k} = {nz[k]!r}: expected >= 0")
     # fail now, not in a worker, on a bad set, parameter value or temperature
-    _base(s)
+    from physmodel.plausible import check_physical
+
+    try:
+        check_physical(_base(s))
+    except IPMCError as exc:
+        raise StudyError(f"{where}: [study] set {s['set']!r}: {exc}") from None
     from physmodel.data.units import QUANTITY_UNITS
 
     if (s["kind"], s["quantity"]) not in QUANTITY_UNITS:

@@ -130,3 +130,21 @@ def test_every_shipped_parameter_set_is_physical():
 
     for name in available_parameter_sets():
         check_physical(get_parameter_set(name))
+
+
+def test_a_scenario_or_study_with_an_absurd_length_is_refused(tmp_path, capsys):
+    from physmodel import get_parameter_set, save_parameter_set
+
+    doc = fuzzcases._deep(fuzzcases.MINI_SCENARIO)
+    doc["model"]["params"] = {"L": 1e300}
+    doc.pop("surrogate")
+    assert main(["run", str(fuzzcases.write_scenario(tmp_path, doc)), "--out", str(tmp_path / "r"), "--quiet"]) == 2
+    assert "params.L = 1e+300" in capsys.readouterr().err and not (tmp_path / "r").exists()
+    path = save_parameter_set(get_parameter_set("seed001_actuator_dev"), tmp_path / "p.json")
+    d = json.loads(path.read_text())
+    d["parameters"]["L"] = 1e300
+    path.write_text(json.dumps(d))
+    text = (Path(__file__).resolve().parents[2] / "scenarios" / "studies" / "actuator_mc.toml").read_text()
+    (tmp_path / "s.toml").write_text(text.replace('set = "seed001_actuator_dev"', f'set = "{path}"'))
+    assert main(["study", str(tmp_path / "s.toml"), "--out", str(tmp_path / "t.csv"), "--quiet", "--serial"]) == 2
+    assert "L = 1e+300 m" in capsys.readouterr().err
