@@ -44,9 +44,11 @@ MARKER_FORMAT = "ipmc-result"
 
 #: What each ipmc command leaves in its output folder, to recognise whose results a folder holds:
 #: (file, identity, or a function of the file's JSON giving the identity).
+#: (report.json before model.json: a diagnosis folder holds both; a fit folder only model.json)
 OWNER_FILES = (("metrics.json", lambda d: f"ipmc run {d['scenario']}"), ("calibration.json", lambda d: "ipmc calibrate"),
-               ("model.json", lambda d: "ipmc fit"), ("validation.json", lambda d: "ipmc validate"),
-               ("report.json", lambda d: "ipmc feedforward" if "peak_voltage_V" in d else "ipmc diagnose"))
+               ("validation.json", lambda d: "ipmc validate"),
+               ("report.json", lambda d: "ipmc feedforward" if "peak_voltage_V" in d else "ipmc diagnose"),
+               ("model.json", lambda d: "ipmc fit"))
 
 #: Files only ipmc result folders hold, and the reports older versions wrote last.
 _RESULT_SIGNS = ("calibration.json", "metrics.json", "report.json")

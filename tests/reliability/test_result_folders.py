@@ -153,3 +153,17 @@ def test_an_output_folder_that_is_the_working_directory_is_updated_in_place(tmp_
         (st / "a.txt").write_text("1")
     assert Path.cwd() == tmp_path and (tmp_path / "input.csv").read_text() == "keep"
     assert (tmp_path / "a.txt").read_text() == "1" and (tmp_path / results.MARKER).exists()
+
+
+def test_whose_results_an_unmarked_folder_holds(tmp_path):
+    """Folders of older versions (no marker) are still recognised by their files."""
+    cases = {"diag": (("report.json", {"verdict": "adequate"}), ("model.json", {})),
+             "ff": (("report.json", {"peak_voltage_V": 1.0}),), "fit": (("model.json", {}),),
+             "cal": (("calibration.json", {}), ("model.json", {})), "run": (("metrics.json", {"scenario": "s"}),)}
+    want = {"diag": "ipmc diagnose", "ff": "ipmc feedforward", "fit": "ipmc fit", "cal": "ipmc calibrate",
+            "run": "ipmc run s"}
+    for name, files in cases.items():
+        (tmp_path / name).mkdir()
+        for f, d in files:
+            (tmp_path / name / f).write_text(json.dumps(d))
+        assert results.folder_owner(tmp_path / name) == want[name], name
