@@ -1,9 +1,12 @@
 """Counts of inputs tried / refused clearly or handled / bad, per category, over every file reader
-and ``ipmc`` entry point (issue 13).  The generators and the judge are those of the hypothesis
-suite (``tests/reliability/fuzzcases.py``); here each category draws ``--n`` seeded cases.
+and ``ipmc`` entry point (issue 13) and the fault classes of issue 28 (``faultcases.py``: a signal
+at a random phase of a command, huge counts, fake Dask schedulers, kelvin, physical ranges,
+incomplete result folders).  The generators and the judge are those of the hypothesis suite
+(``tests/reliability/fuzzcases.py``); here each category draws ``--n`` seeded cases.
 
     python tests/benchmarks/fuzz_report.py --n 40                 # this checkout
     python tests/benchmarks/fuzz_report.py --n 40 --root OTHER    # another checkout (e.g. before)
+    python tests/benchmarks/fuzz_report.py --n 20 --only interrupt_phase,huge_counts,scheduler,kelvin,physical_range,result_folder
 
 "clear": no traceback, an expected exit code, a refusal that names the file/key/value, finite
 outputs.  "bad": anything else (the first few are listed).  The address space is capped
