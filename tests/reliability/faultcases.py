@@ -184,6 +184,20 @@ def gen_scheduler(rnd, d: Path) -> Case:
 
 
 # ------------------------------------------------------------------------------------------ kelvin
+def set_temperature_column(path: Path, new) -> Path:
+    """Rewrite the ``temperature_c`` column of the sweep CSV at ``path`` with ``new(old value)``."""
+    lines = path.read_text().splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln and not ln.startswith("#"))
+    col = lines[head].split(",").index("temperature_c")
+    for i in range(head + 1, len(lines)):
+        if lines[i] and not lines[i].startswith("#"):
+            f = lines[i].split(",")
+            f[col] = repr(float(new(float(f[col]))))
+            lines[i] = ",".join(f)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
 def gen_kelvin(rnd, d: Path) -> Case:
     t = round(rnd.uniform(150.5, 500.0), 2)
     which = rnd.choice(["sweep", "simulate", "feedforward", "study", "run", "calibrate", "fit"])
@@ -208,12 +222,7 @@ def gen_kelvin(rnd, d: Path) -> Case:
         doc.pop("surrogate")
         return Case("kelvin", f"scenario temperatures_c {t}", ["run", write_scenario(d, doc), "--out", d / "r",
                                                                 "--quiet"], tokens=("temperatures_c",))
-    p = valid_sweep(d, "k.csv", temps=(20.0, 40.0), points=8)
-    text = p.read_text().replace(",40.0,", f",{t},")
-    if f",{t}," not in text:
-        text = "\n".join(ln.replace(",40.0", f",{t}", 1) if ln and not ln.startswith("#") else ln
-                         for ln in p.read_text().splitlines()) + "\n"
-    p.write_text(text)
+    p = set_temperature_column(valid_sweep(d, "k.csv", temps=(20.0, 40.0), points=8), lambda c: t if c > 30 else c)
     argv = (["calibrate", p, "--set", "seed002_table3", "--free", "d", "--out", d / "c", "--quiet"] if which == "calibrate"
             else ["fit", p, "--out", d / "f", "--quiet"])
     return Case("kelvin", f"{which}: temperature_c {t} in the sweep", argv, tokens=(str(p), "temperature_c"))

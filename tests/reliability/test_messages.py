@@ -84,16 +84,10 @@ def test_a_write_that_fails_names_the_file_asked_for_not_the_temporary_one(tmp_p
 # ------------------------------------------------------------------------------------- kelvin
 def _kelvin_sweep(d: Path) -> Path:
     """A sweep whose temperature_c column holds 293.15/313.15 (kelvin written into the °C column)."""
-    p = fuzzcases.valid_sweep(d, "k.csv", temps=(20.0, 40.0), points=8)
-    lines = p.read_text().splitlines()
-    head = [i for i, ln in enumerate(lines) if ln and not ln.startswith("#")][0]
-    col = lines[head].split(",").index("temperature_c")
-    for i in range(head + 1, len(lines)):
-        f = lines[i].split(",")
-        f[col] = repr(float(f[col]) + 273.15)
-        lines[i] = ",".join(f)
-    p.write_text("\n".join(lines) + "\n")
-    return p
+    from faultcases import set_temperature_column
+
+    return set_temperature_column(fuzzcases.valid_sweep(d, "k.csv", temps=(20.0, 40.0), points=8),
+                                  lambda c: c + 273.15)
 
 
 def _kelvin_cases(d: Path):
