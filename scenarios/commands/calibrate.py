@@ -178,7 +178,11 @@ def run(args) -> int:
         print(f"ipmc calibrate: note: the start model {args.base_set} did not fit its own data "
               f"({start.verdict.reason}); this calibration is judged afresh on {args.sweep}", file=sys.stderr)
     with output_folder(out, "ipmc calibrate", force=args.force) as stage:
-        _write(res, data, args, stage, final=out)
+        _write(res, data, args, stage)
+    if not args.quiet:                      # said once the folder is in place, not before
+        print(res.summary())
+        print(f"wrote {out}/model.json (the model for every later command: --model {out}/model.json), "
+              "parameters.json, calibration.json, report.md, bode.png")
     if res.hold_refused or (res.holds and not args.quiet):
         print(f"ipmc calibrate: {res.hold_line()}", file=sys.stderr)
     if not res.converged:
@@ -192,8 +196,8 @@ def run(args) -> int:
     return EXIT_OK
 
 
-def _write(res, data, args, out, final=None):
-    """Write the results into ``out`` (the temporary folder that becomes ``final``)."""
+def _write(res, data, args, out):
+    """Write the results into ``out`` (the temporary folder that becomes the --out folder)."""
     from physmodel.data.files import atomic_write
     from physmodel.estimation.calibration import model_sweep
 
@@ -209,11 +213,6 @@ def _write(res, data, args, out, final=None):
     plots.calibration_figure(data, model, res, out / "bode.png")
     report = render_report(res, data, args)
     atomic_write(out / "report.md", lambda fh: fh.write(report))
-    if not args.quiet:
-        print(res.summary())
-        final = final or out
-        print(f"wrote {final}/model.json (the model for every later command: --model {final}/model.json), "
-              "parameters.json, calibration.json, report.md, bode.png")
 
 
 def _g(v) -> str:
