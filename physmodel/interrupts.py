@@ -88,11 +88,15 @@ def held():
 
 
 def worker_init() -> None:
-    """For worker processes (``ProcessPoolExecutor(initializer=...)``): SIGINT is ignored (a Ctrl-C
-    reaches the whole process group; the parent reports it and stops the workers) and SIGTERM ends
-    the worker quietly (the default action, no Python traceback)."""
+    """For worker processes (``ProcessPoolExecutor(initializer=...)``): SIGINT and SIGTERM are
+    ignored.  A Ctrl-C or a SIGTERM sent to the whole process group reaches every worker; the parent
+    reports it, cancels the work not started and lets each worker finish its current task and exit
+    normally.  A worker killed while it sends a result back would leave a partial message in the
+    result pipe, on which the executor's manager thread — and with it the parent's exit — waits
+    forever; a worker that dies of a signal prints no traceback, but one that receives a
+    ``KeyboardInterrupt`` does."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 @contextmanager

@@ -50,6 +50,7 @@ COMMANDS = (
     ("feedforward", "feedforward voltage of a surrogate, checked on the physics"),
     ("calibrate", "calibrate physical parameters to a measured sweep (estimates, intervals, identifiability)"),
     ("diagnose", "locate a model/data discrepancy, name the missing effect, refit, show the gap shrink"),
+    ("compare", "a model against measured data per temperature (fit %%, chi2, overlay)"),
     ("validate", "check every published claim of the seed papers against the project's numbers"),
 )
 NAMES = tuple(n for n, _ in COMMANDS)

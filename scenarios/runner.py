@@ -11,13 +11,14 @@ from __future__ import annotations
 import json
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .context import RunContext, md_table
 from .spec import Scenario, ScenarioError
-from .steps import STEPS, _build_model, _md_table
+from .steps import STEPS, build_model
 
 
 # ---------------------------------------------------------------------------- results
@@ -57,33 +58,6 @@ class RunResult:
     @property
     def exit_code(self) -> int:
         return 0 if self.passed else 3
-
-
-@dataclass
-class _Ctx:
-    spec: Scenario
-    out: Path
-    say: callable
-    metrics: dict = field(default_factory=dict)
-    files: list = field(default_factory=list)
-    report: list = field(default_factory=list)
-    model: object = None
-    base_params: object = None
-    data: object = None      # noisy sweep (what a lab would measure)
-    exact: object = None     # noise-free physics on the same grid
-    fit: object = None       # surrogate FitResult
-
-    def file(self, path: Path) -> Path:
-        self.files.append(Path(path).relative_to(self.out).as_posix())
-        return path
-
-    def section(self, title: str, *lines: str):
-        self.report += [f"## {title}", "", *lines, ""]
-
-    def metric(self, name: str, value) -> float:
-        v = float(value)
-        self.metrics[name] = v
-        return v
 
 
 # ---------------------------------------------------------------------------- checks and report
@@ -141,8 +115,8 @@ def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:
     t0 = time.perf_counter()
     (out / "report.md").unlink(missing_ok=True)         # a stale report must not vouch for new files
     say = (lambda *a: None) if quiet else (lambda *a: print(*a, file=sys.stderr))
-    ctx = _Ctx(spec, out, say)
-    _build_model(ctx)
+    ctx = RunContext(spec, out, say)
+    build_model(ctx)
     steps = spec.steps
     bar = None
     if not quiet:
@@ -175,7 +149,7 @@ def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:
              f"Model: {m['kind']} `{ctx.base_params.name}` ({ctx.base_params.source})"
              + (f", overrides {m['params']}" if m.get("params") else "") + ".", "", *ctx.report,
              "## Checks", "",
-             _md_table(["check", "result", "measured", "expected", "what"],
+             md_table(["check", "result", "measured", "expected", "what"],
                        [(c.name, "PASS" if c.passed else "FAIL", f"{c.value:.4g}", f"`{c.metric}` {c.bound_text()}",
                          c.description) for c in checks]), "",
              f"{sum(c.passed for c in checks)}/{len(checks)} checks passed; ran in {elapsed:.1f} s.", "",

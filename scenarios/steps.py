@@ -1,5 +1,5 @@
 """The steps a scenario can run (``[sweep]``, ``[surrogate]``, ``[inversion]`` ...), each a function
-of the run context (:class:`scenarios.runner._Ctx`) that adds data files, figures, metrics and a
+of the run context (:class:`scenarios.context.RunContext`) that adds data files, figures, metrics and a
 report section; :data:`STEPS` maps a scenario table to its step.  A new step is a function here
 (or in a module of its own, like :mod:`scenarios.steps_control`), its table in
 :data:`scenarios.spec.SECTIONS` and its place in :data:`scenarios.spec.STEP_ORDER`.
@@ -11,22 +11,13 @@ import json
 import re
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .context import RunContext, md_table
 from .spec import ScenarioError
 from .steps_chain import step_chain
 from .steps_control import step_control_route
-
-if TYPE_CHECKING:
-    from .runner import _Ctx
-
-
-def _md_table(header, rows) -> str:
-    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
-    return "\n".join(out)
 
 
 def _slug(text: str) -> str:
@@ -41,7 +32,8 @@ def _grid(cfg: dict, fmin: float, fmax: float, points: int) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- steps
-def _build_model(ctx: _Ctx):
+def build_model(ctx: RunContext):
+    """The ``[model]`` table: the parameter set (with its overrides) and the physics model, into ``ctx``."""
     from physmodel import get_parameter_set, physics_model
 
     m = ctx.spec.section("model")
@@ -82,7 +74,7 @@ def _resonance_hz(f, h) -> float:
     return float(f[k[np.argmax(a[k])]]) if k.size else float("nan")
 
 
-def step_sweep(ctx: _Ctx):
+def step_sweep(ctx: RunContext):
     from physmodel.data.sweep import synthesize_sweep
 
     from . import plots
@@ -137,7 +129,7 @@ def step_sweep(ctx: _Ctx):
                 if T.size > 1 else f"Resonance peak at {pk[0]:.3g} Hz.")
 
 
-def step_surrogate(ctx: _Ctx):
+def step_surrogate(ctx: RunContext):
     from surrogate import fit_sweep, relative_rms_error
 
     from . import plots
@@ -192,12 +184,12 @@ def step_surrogate(ctx: _Ctx):
                 f"({'converged' if fit.converged else 'NOT CONVERGED: ' + str(fit.status)}); model in `surrogate.json`.",
                 "", "![surrogate Bode](surrogate_bode.png)", "", "![pole/zero locus](pole_zero_locus.png)", "",
                 "Relative RMS error sqrt(mean |G/P − 1|²) against the noise-free physics P:", "",
-                _md_table(["T [°C]", "role", "rel. RMS error"], rows), "",
+                md_table(["T [°C]", "role", "rel. RMS error"], rows), "",
                 f"Right-half-plane zeros over {lo:g}–{hi:g} °C: {min(n_rhp)}–{max(n_rhp)}; "
                 f"largest pole real part {stab.max_pole_real_part_rad_s:.3g} rad/s.")
 
 
-def _plant_response(ctx: _Ctx, f_hz: float, T: float) -> complex:
+def _plant_response(ctx: RunContext, f_hz: float, T: float) -> complex:
     """The physics response at one line in the sweep's display units (mm/V or uA/mm)."""
     from physmodel.data.sweep import synthesize_sweep
 
@@ -214,7 +206,7 @@ def _stimulus(exp: dict, t: np.ndarray, lead: float = 0.0, ramp: float = 0.0) ->
     return env * sum(a * np.sin(2 * np.pi * fr * tau) for fr in freqs)
 
 
-def step_inversion(ctx: _Ctx):
+def step_inversion(ctx: RunContext):
     from inversion import Limits, decode_sensor, feedforward
     from physmodel.data.timesim import free_release, simulate, time_grid
 
@@ -305,10 +297,10 @@ def step_inversion(ctx: _Ctx):
     ctx.section("Stable inversion", f"{what}; preview {preview}; {fs:g} Hz, {dur:g} s records; error bound = "
                 f"max |error| over {settle:g}–{t[-1] - margin:g} s unless the experiment sets its own window (shaded)."
                 + drive, "",
-                _md_table(["experiment", "plant T [°C]", "model T [°C]", "max |error| [mm]", "relative", "traces"], rows))
+                md_table(["experiment", "plant T [°C]", "model T [°C]", "max |error| [mm]", "relative", "traces"], rows))
 
 
-def step_widths(ctx: _Ctx):
+def step_widths(ctx: RunContext):
     from physmodel import ActuatorModel
 
     from . import plots
@@ -327,7 +319,7 @@ def step_widths(ctx: _Ctx):
                 "![widths](widths.png)")
 
 
-def step_taylor(ctx: _Ctx):
+def step_taylor(ctx: RunContext):
     from physmodel import ActuatorModel
     from physmodel.reduced import reduced_frequency_response
 
@@ -350,10 +342,10 @@ def step_taylor(ctx: _Ctx):
     ctx.file(plots.curves(f, curves, ctx.out / "taylor_orders.png", "frequency [Hz]", "magnitude [dB mm/V]",
                           f"reduced (Taylor) models around the first mode, {T:g} °C"))
     ctx.section("Reduced (Taylor) models", "![Taylor orders](taylor_orders.png)", "",
-                _md_table(["Taylor order", f"max |error| {lo:g}–{hi:g} Hz [dB]"], rows))
+                md_table(["Taylor order", f"max |error| {lo:g}–{hi:g} Hz [dB]"], rows))
 
 
-def step_blackbox(ctx: _Ctx):
+def step_blackbox(ctx: RunContext):
     from surrogate import RationalFit, fit_percent
 
     from . import plots
@@ -375,11 +367,11 @@ def step_blackbox(ctx: _Ctx):
     ctx.file(plots.curves(sw.frequency_hz, curves, ctx.out / "blackbox.png", "frequency [Hz]",
                           f"magnitude [dB {sw.output_unit}/{sw.input_unit}]", f"black-box fits at {T:g} °C"))
     ctx.section("Black-box orders", "fit = 100 (1 − NRMSE) on the sweep at "
-                f"{T:g} °C.", "", _md_table(["zeros", "poles", "fit [%]", "converged"], rows), "",
+                f"{T:g} °C.", "", md_table(["zeros", "poles", "fit [%]", "converged"], rows), "",
                 "![black-box fits](blackbox.png)")
 
 
-def step_discrepancy(ctx: _Ctx):
+def step_discrepancy(ctx: RunContext):
     from physmodel.data.sweep import synthesize_sweep
     from physmodel.effects import EffectModel
     from physmodel.estimation.discrepancy import diagnose
@@ -438,7 +430,7 @@ def step_discrepancy(ctx: _Ctx):
                 "Full diagnosis: `discrepancy/summary.md`, `discrepancy/report.json`.")
 
 
-def step_fixtures(ctx: _Ctx):
+def step_fixtures(ctx: RunContext):
     from physmodel.data.files import read_sweep, write_sweep
     from physmodel.data.sweep import synthesize_sweep
     from physmodel.data.timesim import step

@@ -44,6 +44,7 @@ import math
 
 import numpy as np
 
+from .context import md_table as _table
 from .spec import ScenarioError
 
 __all__ = ["misfit", "printed_sweep", "step_chain"]
@@ -250,7 +251,7 @@ def step_chain(ctx) -> None:
     from physmodel.effects import get_effect
     from physmodel.effects.sensing import PLAUSIBLE
 
-    from . import plots_chain
+    from . import plots
 
     cfg = ctx.spec.section("chain")
     m = ctx.spec.section("model")
@@ -344,11 +345,11 @@ def step_chain(ctx) -> None:
                                                                    {"color": "C3"}),
               "documented chain, sourced ranges": (_response(base, {**docres.values, **held}, doc_effects, fp, T),
                                                    {"color": "C2", "ls": ":"})}
-    ctx.file(plots_chain.bode_overlay(fp, curves, ctx.out / "chain_bode.png", (fd[0], fd[-1]),
+    ctx.file(plots.bode_overlay(fp, curves, ctx.out / "chain_bode.png", (fd[0], fd[-1]),
                                       f"seed 000 printed {T:g} °C model: verdict {final_verdict}"))
-    ctx.file(plots_chain.pole_zero_maps({k: (r["zeros"], r["poles"]) for k, r in rat.items()},
+    ctx.file(plots.pole_zero_maps({k: (r["zeros"], r["poles"]) for k, r in rat.items()},
                                         ctx.out / "chain_pole_zero.png", "4/4 fits over the band"))
-    ctx.file(plots_chain.effect_intervals([dict(r, name=f"{r['fit']}: {r['name']}") for r in rows],
+    ctx.file(plots.effect_intervals([dict(r, name=f"{r['fit']}: {r['name']}") for r in rows],
                                           ctx.out / "chain_effects.png", "greedy chain and documented fit"))
     _report(ctx, data, sign, steps, chosen, f"{final_verdict}: {why}", mis, rows, rat, dec, docres, doc_effects, prof)
     # ---- temperature series: chain fixed at its 35 °C values, the polymer's laws calibrated to a0(T)
@@ -406,11 +407,6 @@ def _fmt_roots(z):
     z = sorted(np.asarray(z), key=lambda c: (c.real, c.imag))
     return ", ".join(f"{c.real:.4g}±{abs(c.imag):.4g}j" if abs(c.imag) > 1e-9 * max(1, abs(c)) else f"{c.real:.4g}"
                      for c in z if c.imag >= -1e-9 * max(1, abs(c)))
-
-
-def _table(header, rows):
-    return "\n".join(["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-                     + ["| " + " | ".join(str(c) for c in r) + " |" for r in rows])
 
 
 def _report(ctx, data, sign, steps, chosen, verdict, mis, rows, rat, dec, docres, doc_effects, prof):

@@ -40,12 +40,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .context import md_table
+
 __all__ = ["A0Series", "LawCalibration", "a0_series", "calibrate_laws", "law_free_parameters", "levy_4_4",
            "printed_a0", "series_model", "trend_signs"]
 
 #: The Fig. 5 temperatures of the printed trends [°C].
 TRENDS_C = (25.0, 45.0, 65.0)
 _EA, _SK, _SE = "laws.d.activation_energy", "laws.kappa_e.slope", "laws.E.slope"
+#: Temperatures the printed a0(T) polynomial is drawn at. [°C]
+_T_DENSE = np.linspace(20.0, 70.0, 101)
 
 
 # ----------------------------------------------------------------------------- printed data
@@ -309,7 +313,7 @@ def step_temperature(ctx, base, vals, effects, sweep35, mis35, d_row, seed=0, do
     range, d at 35 °C plausible or at its range's edge), write metrics, figures and the section."""
     import time
 
-    from . import plots_chain
+    from . import plots
 
     t0 = time.perf_counter()
     data, out, prof = run_series(base, vals, effects, sweep35, seed=seed)
@@ -342,7 +346,7 @@ def step_temperature(ctx, base, vals, effects, sweep35, mis35, d_row, seed=0, do
     ctx.metric("chain.temperature.d_35c", d_row["value"])
     ctx.metric("chain.temperature.d_35c_plausible", d_ok)
     ctx.metric("chain.temperature.elapsed_s", time.perf_counter() - t0)
-    ctx.file(plots_chain.a0_series(data, out, ctx.out / "chain_a0_temperature.png"))
+    ctx.file(plots.a0_series(data, out, ctx.out / "chain_a0_temperature.png", (_T_DENSE, printed_a0(_T_DENSE))))
     main = out[VARIANTS[0][0]]
     curves: dict = {f"{t:g} °C, chain fixed, calibrated laws": (main["trend_response"][i] * 1e3, {"color": f"C{i}"})
               for i, t in enumerate(TRENDS_C)}
@@ -350,7 +354,7 @@ def step_temperature(ctx, base, vals, effects, sweep35, mis35, d_row, seed=0, do
     curves.update({f"{t:g} °C, beam follows E(T)": (beam["trend_response"][i] * 1e3, {"color": f"C{i}", "ls": ":"})
                    for i, t in enumerate(TRENDS_C)})
     curves["printed 35 °C model"] = (sweep35.response, {"color": "k", "lw": 2.0})
-    ctx.file(plots_chain.bode_overlay(sweep35.frequency_hz, curves, ctx.out / "chain_bode_temperatures.png",
+    ctx.file(plots.bode_overlay(sweep35.frequency_hz, curves, ctx.out / "chain_bode_temperatures.png",
                                       None, "physics + chain at the Fig. 5 temperatures, calibrated laws"))
     _section(ctx, data, out, prof, mis35, d_row, d_ok, time.perf_counter() - t0, documented)
 
@@ -367,9 +371,8 @@ def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed, documented=None)
     from physmodel.temperature import water_permittivity
 
     wr = float(water_permittivity(65.0) / water_permittivity(23.0))
-    from .steps_chain import _table
 
-    dt = _table(["T [°C]", "printed a0 [1e10/s⁴]", "σ ln a0"] + [f"{v['label']}: model a0 (Δ %)" for v in out.values()],
+    dt = md_table(["T [°C]", "printed a0 [1e10/s⁴]", "σ ln a0"] + [f"{v['label']}: model a0 (Δ %)" for v in out.values()],
                 [(f"{t:g}", f"{a / 1e10:.4g}", f"{s:.3f}") + tuple(
                     f"{v['cal'].a0_model[i] / 1e10:.3g} ({v['a0_pct'][i]:+.1f})" for v in out.values())
                  for i, (t, a, s) in enumerate(zip(data.temperatures_c, data.a0, data.sigma_ln))])
@@ -404,16 +407,16 @@ def _section(ctx, data, out, prof, mis35, d_row, d_ok, elapsed, documented=None)
         "so elsewhere the misfit is a0's.", "",
         dt, "", "Goodness of fit (χ² of the a0 residuals against its expectation; a misfit widens the intervals by "
         "the Birge ratio and withholds the identifiability verdict, as `calibrate` does):", "",
-        _table(["calibration", "χ²", "dof", "p", "fits", "converged", "a0 RMS %", "a0 max %"], fits), "",
-        _table(["calibration", "parameter", "value", "95 % interval", "determined", "why"], rows), "",
+        md_table(["calibration", "χ²", "dof", "p", "fits", "converged", "a0 RMS %", "a0 max %"], fits), "",
+        md_table(["calibration", "parameter", "value", "95 % interval", "determined", "why"], rows), "",
         "What the laws imply between 23 and 65 °C (factor of d, κe, E at 65 over 23 °C, with the interval where "
-        "determined):", "", _table(["calibration", "d(65)/d(23)", "κe(65)/κe(23)", "E(65)/E(23)"], impl), "",
+        "determined):", "", md_table(["calibration", "d(65)/d(23)", "κe(65)/κe(23)", "E(65)/E(23)"], impl), "",
         f"Literature: {lit}.", "",
         f"χ² profile over Ea (chain fixed, κe ∝ ε_water; {data.a0.size} a0 values, E does not act on a0): "
         + "; ".join(f"{ea / 1e3:g} kJ/mol: {c2:.3g}" for ea, c2 in prof.items()) + ".", "",
         "Printed trends (25 → 45 → 65 °C) reproduced by the calibrated model (cutoff: lowest line within 3 dB of "
         "|G(f_max)|; gain |G(f_max)| [µA/mm]; mean lag −∠G over the band [°]):", "",
-        _table(["calibration", "cutoff falls", "gain falls", "lag grows", "cutoff [Hz]", "gain", "mean lag"],
+        md_table(["calibration", "cutoff falls", "gain falls", "lag grows", "cutoff [Hz]", "gain", "mean lag"],
                trends), "",
         f"d at 35 °C (the chain fit): {d_row['value']:.3g} m²/s, "
         + ("determined and inside its sourced range" if d_ok else

@@ -26,6 +26,7 @@ import warnings
 
 import numpy as np
 
+from .context import md_table
 from .spec import ScenarioError
 
 __all__ = ["step_control_route"]
@@ -49,7 +50,7 @@ def step_control_route(ctx) -> None:
     from surrogate.crossval import ScheduleWarning, check_schedule
 
     from . import plots
-    from .plots_control import feedforward_check
+    from .plots import feedforward_check
 
     cfg = ctx.spec.section("control_route")
     if ctx.spec.section("model")["kind"] != "actuator":
@@ -142,11 +143,6 @@ def step_control_route(ctx) -> None:
         "![schedule error](control_route_schedule_error.png)", "",
         f"Feedforward of a faded {A:g} mm, {fr:g} Hz sine at {T_ff:g} °C through the true physics "
         f"({fs:g} Hz; error between the fades):", "",
-        plots_table(["schedule", "preview [s]", "peak [V]", "tracking error [um]", "A|P/G-1| [um]"], rows), "",
+        md_table(["schedule", "preview [s]", "peak [V]", "tracking error [um]", "A|P/G-1| [um]"], rows), "",
         "![feedforward](control_route_feedforward.png)")
 
-
-def plots_table(header, rows) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
-    return "\n".join(lines)

@@ -326,20 +326,22 @@ def run_study(spec: dict, *, scheduler=None, workers: int | None = None, backend
             tick(1)
     elif backend == "processes":
         import concurrent.futures as cf
-
-        from physmodel.interrupts import worker_init
+        import multiprocessing as mp
 
         parts = [None] * len(chunks)
-        # workers ignore SIGINT (a Ctrl-C reaches the whole process group) and die quietly on SIGTERM:
-        # this process reports the interrupt and stops them, no worker prints a traceback
+        # workers ignore SIGINT/SIGTERM (a Ctrl-C reaches the whole process group): this process
+        # reports the interrupt, sets `stop` (chunks already queued to a worker return at once) and
+        # cancels what is left; no worker prints a traceback
+        stop = mp.get_context().Event()
         ex = cf.ProcessPoolExecutor(max_workers=workers or min(len(chunks), os.cpu_count() or 1),
-                                    initializer=worker_init)
+                                    initializer=_worker_init, initargs=(stop,))
         try:
-            futs = {ex.submit(evaluate_chunk, spec, c): k for k, c in enumerate(chunks)}
+            futs = {ex.submit(_chunk_task, spec, c): k for k, c in enumerate(chunks)}
             for fut in cf.as_completed(futs):
                 parts[futs[fut]] = fut.result()
                 tick(1)
         except BaseException:
+            stop.set()
             _stop_workers(ex)
             raise
         ex.shutdown()
@@ -351,15 +353,31 @@ def run_study(spec: dict, *, scheduler=None, workers: int | None = None, backend
     return StudyTable(cols, spec, backend, time.perf_counter() - t0)
 
 
+_STOP = None
+
+
+def _worker_init(stop) -> None:
+    """A study worker: SIGINT/SIGTERM ignored (:func:`physmodel.interrupts.worker_init`); ``stop``
+    (a multiprocessing Event) set by the parent on an interrupt."""
+    from physmodel.interrupts import worker_init
+
+    global _STOP
+    worker_init()
+    _STOP = stop
+
+
+def _chunk_task(spec, indices):
+    """:func:`evaluate_chunk` in a worker, or None at once when the parent has stopped the study."""
+    if _STOP is not None and _STOP.is_set():
+        return None
+    return evaluate_chunk(spec, indices)
+
+
 def _stop_workers(ex) -> None:
-    """Cancel what has not started and end the worker processes now (not after their chunks)."""
-    procs = list((getattr(ex, "_processes", None) or {}).values())    # shutdown() forgets them
-    for proc in procs:
-        if proc.is_alive():
-            proc.terminate()                  # SIGTERM: a worker ends quietly (interrupts.worker_init)
+    """Cancel the chunks not started; the workers finish the chunk they hold and exit (they ignore
+    SIGINT/SIGTERM, :func:`physmodel.interrupts.worker_init`: a worker killed while it sends its
+    result back would leave the executor — and this process's exit — waiting forever)."""
     ex.shutdown(wait=False, cancel_futures=True)
-    for proc in procs:
-        proc.join(timeout=5)
 
 
 #: A Dask handshake is a few hundred bytes; a first frame announcing more is another protocol.

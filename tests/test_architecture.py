@@ -18,7 +18,10 @@ ALLOWED = {
     "inversion": {"physmodel", "inversion"},
     "scenarios": {"physmodel", "surrogate", "inversion", "scenarios"},
 }
-MAX_LINES = 500
+#: Lines of a module, imports not counted.  A module is cut along a concept, not at a line count: one
+#: that holds one concept (the discrepancy workflow, a file format) may run to this many lines
+#: rather than be split into pieces that must then share their insides (issue 30).
+MAX_LINES = 800
 
 
 def _modules():
@@ -55,9 +58,30 @@ def test_no_import_runs_up_a_layer():
 
 
 def test_only_scenarios_plots_draws():
-    users = sorted(str(path.relative_to(ROOT)) for pkg, path in _modules()
+    """matplotlib is imported by the plotting package ``scenarios/plots/`` alone (one face:
+    ``from scenarios.plots import ...``), and importing the package does not import it."""
+    users = sorted(path.relative_to(ROOT).as_posix() for pkg, path in _modules()
                    if any(top == "matplotlib" for top, _ in _imported_top_levels(path, pkg)))
-    assert users == ["scenarios/plots.py"]
+    assert users and all(u.startswith("scenarios/plots/") for u in users), users
+    assert not (ROOT / "scenarios" / "plots.py").exists()
+    import subprocess
+    import sys
+
+    code = "import sys, scenarios.plots; print('matplotlib' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_the_plotting_package_imports_no_step():
+    """The figures take data as arguments: no module of ``scenarios/plots/`` imports a step or the
+    runner (the circle plots_chain ↔ steps_chain ↔ steps_chain_temperature is gone)."""
+    bad = []
+    for path in sorted((ROOT / "scenarios" / "plots").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module and \
+                    node.module.split(".")[-1].startswith(("steps", "runner")):
+                bad.append(f"{path.name}:{node.lineno} imports {node.module}")
+    assert bad == []
 
 
 def _size(path: Path) -> int:
@@ -102,3 +126,85 @@ def test_every_model_satisfies_the_model_protocol(which):
     assert isinstance(m, FrequencyModel) and m.kind == which
     r = m.response(f, [20.0, 30.0] if which != "rational" else None)
     assert r.shape == ((2, 3) if which != "rational" else (1, 3)) and np.all(np.isfinite(r))
+
+
+def _module_name(path: Path) -> str:
+    return ".".join(path.relative_to(ROOT).with_suffix("").parts)
+
+
+def _import_graph() -> dict[str, set[str]]:
+    """``{module: modules of the four packages it imports}``, imports inside functions included.
+    A package's ``__init__.py`` is its face (it only hands names on) and is left out, as source
+    and as target: an arrow through it says nothing about which file needs which."""
+    files = {_module_name(p): p for _, p in _modules() if p.name != "__init__.py"}
+    graph: dict[str, set[str]] = {m: set() for m in files}
+    for mod, path in files.items():
+        pkg_parts = mod.split(".")[:-1]
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            targets = []
+            if isinstance(node, ast.Import):
+                targets = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = pkg_parts[:len(pkg_parts) - node.level + 1]
+                    stem = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    stem = node.module or ""
+                targets = [stem] + [f"{stem}.{a.name}" for a in node.names]
+            for t in targets:
+                if t in files and t != mod:
+                    graph[mod].add(t)
+    return graph
+
+
+def _circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(out)
+
+
+#: Circles still being broken (issue 30), each to be removed from here with its fix; a circle not
+#: listed fails.  Break one by moving the shared piece down (CONTRIBUTING.md, "A module's contract").
+KNOWN_CIRCLES = [
+    ["inversion.batch", "inversion.preview"],
+]
+
+
+def test_the_circle_finder_on_a_known_graph():
+    g = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"f"}, "f": set()}
+    assert _circles(g) == [["a", "b", "c"]]
+    assert _circles({"a": {"b"}, "b": set()}) == []
+
+
+def test_no_new_import_circle_between_files():
+    new = [c for c in _circles(_import_graph()) if c not in KNOWN_CIRCLES]
+    assert new == [], f"import circles between files: {new}"

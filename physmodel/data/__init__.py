@@ -7,8 +7,10 @@ units     UNITS, unit_scale, QUANTITY_UNITS — file units as multiples of SI; e
 sweep     FrequencySweep (tidy frequency-response record with per-line σ), MagnitudePhaseNoise,
           ComplexGaussianNoise, synthesize_sweep, sweep_layout, merge_sweeps
 interop   as_sweep — a FrequencySweep from a sweep, python-control FRD objects or arrays
-files     read_sweep / write_sweep (.csv, .npz, .mat by extension) and the per-format readers and
-          writers; atomic_write (the library's one atomic writer)
+files     read_sweep / write_sweep (.csv, .npz, .mat by extension), the per-format readers and
+          writers, a user's own sweep files through columns=/units= (read_mapped_sweep)
+columns   a user's own CSV/NPZ/MAT as named columns (read_table, pick, ColumnMapError)
+fileio    atomic_write (the library's one atomic writer), read_text, by_extension, output folders
 timesim   realize, simulate, sine, step, free_release, TimeSeries — time-domain virtual experiments
 """
 

@@ -1,99 +1,60 @@
-"""Sweep files: the tidy CSV (the project's exchange format), NPZ and MATLAB .mat, and the one
-atomic writer every file of the library goes through (temporary file, then rename)."""
+"""Sweep files: the tidy CSV (the project's exchange format), NPZ and MATLAB .mat, and a user's own
+sweep files (an analyser's ``T_degC,freq_Hz,gain_dB,phase_deg,...``) read through a column and unit
+mapping (:func:`read_sweep` ``columns=``/``units=``/``temperature_c=``).
+
+The writers live with the record (:mod:`physmodel.data.sweep`) and the file plumbing below both
+(:mod:`physmodel.data.fileio`); both are re-exported here, where callers have always found them.
+"""
 
 from __future__ import annotations
 
 import csv
-import io
 import json
 import math
-import os
-import secrets
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from .. import interrupts
 from ..errors import DataFormatError, IPMCError
-from .sweep import FORMAT_VERSION, MAX_SWEEP_LINES, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, FrequencySweep
+from .columns import ColumnMapError, Table, pick, read_table
+from .fileio import atomic_write, by_extension, read_text
+from .results import check_output_folder, folder_owner, output_folder
+from .sweep import (
+    MAX_SWEEP_LINES,
+    OPTIONAL_COLUMNS,
+    REQUIRED_COLUMNS,
+    FrequencySweep,
+    write_csv,
+    write_mat,
+    write_npz,
+    write_sweep,
+)
 from .units import UNITS
 
+# the file plumbing (data.fileio) and the sweep writers (data.sweep) are re-exported: callers have
+# always found them here
+__all__ = ["read_sweep", "read_csv", "read_npz", "read_mat", "read_mapped_sweep", "write_sweep", "write_csv",
+           "write_npz", "write_mat", "atomic_write", "by_extension", "check_output_folder", "folder_owner",
+           "output_folder", "read_text", "MAPPING_HINT", "ROLES"]
 
-# ----------------------------------------------------------------------------------- I/O helpers
-def atomic_write(path, write_fn, mode: str = "w") -> Path:
-    """Write ``path`` via ``write_fn(fh)`` into a temporary file in the same folder, flushed to disk,
-    then renamed over ``path``: never a half-written file, even on Ctrl-C.  ``mode``: "w" (UTF-8 text,
-    no newline translation) or "wb".  The file gets the usual permissions (0666 less the umask)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    # the name is fixed before the file exists, so an interrupt at any point after creation still
-    # finds and removes it (mkstemp's name is only known once it returns)
-    tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
-    try:
-        try:
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        except OSError as exc:         # name the file asked for, not the temporary one
-            raise OSError(exc.errno, exc.strerror, str(path)) from None
-        with os.fdopen(fd, mode, **({"newline": "", "encoding": "utf-8"} if "b" not in mode else {})) as fh:
-            write_fn(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)   # created 0600
-        interrupts.check()             # an interrupt a solver swallowed must not commit a file
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return path
-
-
-def read_text(path, what: str = "file") -> str:
-    """The text of ``path`` decoded as UTF-8, a leading byte-order mark dropped (Excel writes one).
-
-    Every text reader of the library (sweep CSV, scenario/study/experiment TOML, parameter JSON,
-    signal CSV) goes through here, so a file that is not UTF-8 is a :class:`DataFormatError` naming
-    the file, the line and the byte, never a ``UnicodeDecodeError``.
-    """
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise DataFormatError(f"{what} {str(path)!r}: no such file") from None
-    except IsADirectoryError:
-        raise DataFormatError(f"{what} {str(path)!r} is a folder; expected a file") from None
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise DataFormatError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
-                              "save the file as UTF-8") from None
-
-
-# result folders (all or nothing, completion marker): physmodel.data.results; the names stay importable here
-from .results import OWNER_FILES, check_output_folder, folder_owner, output_folder  # noqa: E402, F401
-
-
-def _columns(sw: FrequencySweep) -> dict[str, np.ndarray]:
-    cols = {
-        "temperature_c": sw.temperature_c,
-        "frequency_hz": sw.frequency_hz,
-        "magnitude_db": sw.magnitude_db,
-        "phase_deg": sw.phase_deg,
-    }
-    if sw.magnitude_std_db is not None:
-        cols["magnitude_std_db"] = sw.magnitude_std_db
-        cols["phase_std_deg"] = sw.phase_std_deg
-    return cols
+#: How to map a sweep file that is not in the library's format (said by every "missing column" error).
+MAPPING_HINT = ("map the file's own columns: read_sweep(path, columns={'temperature': ..., 'frequency': ..., "
+                "'magnitude': ..., 'phase': ...}, units={'input': 'V', 'output': 'mm', 'magnitude': 'dB', "
+                "'phase': 'deg'}) (ipmc: --sweep-columns temperature=T_degC,frequency=freq_Hz,magnitude=gain_dB,"
+                "phase=phase_deg --sweep-units input=V,output=mm)")
+#: Roles of a sweep's columns (keys of ``columns=``) and the library's own column for each.
+ROLES = ("temperature", "frequency", "magnitude", "phase", "magnitude_std", "phase_std")
+ROLE_OF = dict(zip(REQUIRED_COLUMNS + OPTIONAL_COLUMNS, ROLES))
+UNITS_HINT = ("state the units of the response: units={'input': 'V', 'output': 'mm'} "
+              "(ipmc: --sweep-units input=V,output=mm)")
 
 
 def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], where: str) -> FrequencySweep:
     def unit_of(key):
         if key not in header:
-            raise DataFormatError(f"{where}: missing header line '# {key}: <name> [<unit>]'")
+            raise ColumnMapError(f"{where}: missing header line '# {key}: <name> [<unit>]'; {UNITS_HINT}", "units", key)
         text = header[key].strip()
         if not (text.endswith("]") and "[" in text):
             raise DataFormatError(f"{where}: header '{key}: {text}' must look like 'name [unit]'")
@@ -105,7 +66,7 @@ def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], whe
 
     in_name, in_unit = unit_of("input")
     out_name, out_unit = unit_of("output")
-    H = 10 ** (cols["magnitude_db"] / 20) * np.exp(1j * np.radians(cols["phase_deg"]))
+    H = _response(cols["magnitude_db"], cols["phase_deg"], "dB", "deg", where)
     meta = {k: v for k, v in header.items() if k not in ("input", "output", "ipmc-sweep")}
     has_std = "magnitude_std_db" in cols
     return FrequencySweep(cols["temperature_c"], cols["frequency_hz"], H,
@@ -114,31 +75,7 @@ def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], whe
                           in_name, in_unit, out_name, out_unit, meta)
 
 
-def _header_lines(sw: FrequencySweep) -> list[str]:
-    lines = [f"ipmc-sweep {FORMAT_VERSION}", f"input: {sw.input_name} [{sw.input_unit}]",
-             f"output: {sw.output_name} [{sw.output_unit}]"]
-    for k, v in sw.metadata.items():
-        v = str(v).replace("\n", " ")
-        lines.append(f"{k}: {v}")
-    return lines
-
-
 # ----------------------------------------------------------------------------------- CSV
-def write_csv(sw: FrequencySweep, path) -> Path:
-    """Write the tidy CSV (see module doc), atomically."""
-    cols = _columns(sw)
-
-    def write(fh):
-        for line in _header_lines(sw):
-            fh.write(f"# {line}\n")
-        w = csv.writer(fh, lineterminator="\n")
-        w.writerow(list(cols))
-        for row in zip(*cols.values()):
-            w.writerow([repr(float(v)) for v in row])
-
-    return atomic_write(path, write)
-
-
 def read_csv(path) -> FrequencySweep:
     """Read the tidy CSV; a malformed file raises :class:`DataFormatError` naming the line."""
     path = Path(path)
@@ -156,13 +93,18 @@ def read_csv(path) -> FrequencySweep:
         i += 1
     if i >= len(lines):
         raise DataFormatError(f"{path}: no column header line after the '#' header")
-    colnames = [c.strip() for c in lines[i].split(",")]
+    colnames = [c.strip() for c in next(csv.reader([lines[i]]))]
+    if len(set(colnames)) != len(colnames):
+        raise DataFormatError(f"{path}:{i + 1}: column name(s) {sorted({c for c in colnames if colnames.count(c) > 1})} "
+                              "appear more than once")
     missing = [c for c in REQUIRED_COLUMNS if c not in colnames]
     if missing:
-        raise DataFormatError(f"{path}:{i + 1}: missing column(s) {missing}; found {colnames}")
+        raise ColumnMapError(f"{path}:{i + 1}: missing column(s) {missing}; found {colnames}; {MAPPING_HINT}",
+                             "columns", ROLE_OF[missing[0]])
     unknown = [c for c in colnames if c not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS]
     if unknown:
-        raise DataFormatError(f"{path}:{i + 1}: unknown column(s) {unknown}; expected {list(REQUIRED_COLUMNS + OPTIONAL_COLUMNS)}")
+        raise DataFormatError(f"{path}:{i + 1}: unknown column(s) {unknown}; expected "
+                              f"{list(REQUIRED_COLUMNS + OPTIONAL_COLUMNS)}, or {MAPPING_HINT}")
     has_std = [c in colnames for c in OPTIONAL_COLUMNS]
     if any(has_std) and not all(has_std):
         raise DataFormatError(f"{path}:{i + 1}: give both {OPTIONAL_COLUMNS} or neither")
@@ -217,18 +159,6 @@ def read_csv(path) -> FrequencySweep:
 
 
 # ----------------------------------------------------------------------------------- NPZ / MAT
-def write_npz(sw: FrequencySweep, path) -> Path:
-    cols = _columns(sw)
-    header = json.dumps({"format": "ipmc-sweep", "version": FORMAT_VERSION,
-                         "input": f"{sw.input_name} [{sw.input_unit}]",
-                         "output": f"{sw.output_name} [{sw.output_unit}]", "metadata": sw.metadata})
-
-    def write(fh):
-        np.savez(fh, header=np.array(header), response_real=sw.response.real, response_imag=sw.response.imag, **cols)
-
-    return atomic_write(path, write, "wb")
-
-
 #: The arrays a sweep NPZ may hold (others are ignored without being decompressed).
 NPZ_ARRAYS = ("header",) + REQUIRED_COLUMNS + OPTIONAL_COLUMNS + ("response_real", "response_imag")
 #: Largest array accepted from a sweep file [bytes], checked before it is decompressed: 16 bytes
@@ -280,7 +210,8 @@ def read_npz(path) -> FrequencySweep:
     with zf:
         members = {n[:-4]: n for n in zf.namelist() if n.endswith(".npy")}
         if "header" not in members:
-            raise DataFormatError(f"{where}: not an ipmc-sweep NPZ (no 'header' array)")
+            raise ColumnMapError(f"{where}: not an ipmc-sweep NPZ (no 'header' array); {MAPPING_HINT}", "columns",
+                             "temperature")
         for key in NPZ_ARRAYS:
             if key not in members:
                 continue
@@ -326,36 +257,11 @@ def read_npz(path) -> FrequencySweep:
     return _sweep_from_arrays(cols, header, response, where)
 
 
-def write_mat(sw: FrequencySweep, path) -> Path:
-    """MATLAB .mat (v5) with one column vector per field, the complex response and header strings."""
-    from scipy.io import savemat
-
-    cols = {k: v.reshape(-1, 1) for k, v in _columns(sw).items()}
-    cols["response"] = sw.response.reshape(-1, 1)
-    cols["input"] = f"{sw.input_name} [{sw.input_unit}]"
-    cols["output"] = f"{sw.output_name} [{sw.output_unit}]"
-    cols["format"] = f"ipmc-sweep {FORMAT_VERSION}"
-    cols["metadata_json"] = json.dumps(sw.metadata)
-
-    buf = io.BytesIO()
-    savemat(buf, cols, do_compression=True)
-    data = bytearray(buf.getvalue())
-    # the 116-byte descriptive text of a v5 header carries the creation time; a fixed text makes
-    # the file byte-reproducible like the CSV and NPZ (MATLAB ignores the text)
-    data[:116] = MAT_HEADER_TEXT
-
-    return atomic_write(path, lambda fh: fh.write(bytes(data)), "wb")
-
-
 def _mat_text(data: dict, key: str, where: str) -> str:
     v = np.asarray(data[key])
     if v.dtype.kind != "U" or v.size != 1:
         raise DataFormatError(f"{where}: variable {key!r} must be a string, got {v.dtype} with shape {v.shape}")
     return str(v.reshape(-1)[0])
-
-
-#: The descriptive text at the start of every .mat file written here (no timestamp).
-MAT_HEADER_TEXT = f"MATLAB 5.0 MAT-file, written by ipmc (ipmc-sweep {FORMAT_VERSION})".encode("ascii").ljust(116)
 
 
 def read_mat(path) -> FrequencySweep:
@@ -379,7 +285,8 @@ def read_mat(path) -> FrequencySweep:
         raise DataFormatError(f"{where}: not a readable MATLAB .mat file ({type(exc).__name__}: {exc})") from None
     missing = [c for c in REQUIRED_COLUMNS + ("input", "output") if c not in data]
     if missing:
-        raise DataFormatError(f"{where}: missing variable(s) {missing}")
+        raise ColumnMapError(f"{where}: missing variable(s) {missing}; {MAPPING_HINT}",
+                             "columns" if missing[0] in REQUIRED_COLUMNS else "units", ROLE_OF.get(missing[0], missing[0]))
     cols = {k: _column(data[k], k, where) for k in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if k in data}
     meta = {}
     if "metadata_json" in data:
@@ -396,19 +303,180 @@ def read_mat(path) -> FrequencySweep:
     return _sweep_from_arrays(cols, header, response, where)
 
 
-def by_extension(path, handlers: Mapping[str, Callable], what: str) -> Callable:
-    """The handler for ``path``'s file extension, or a DataFormatError listing the accepted ones."""
-    ext = Path(path).suffix.lower()
-    if ext not in handlers:
-        raise DataFormatError(f"{path}: unknown {what} file type {ext!r}; expected {', '.join(handlers)}")
-    return handlers[ext]
+#: Units of the number columns (keys of ``units=`` besides input/output): accepted spellings.
+NUMBER_UNITS = {
+    "magnitude": {"dB": ("db",), "linear": ("linear", "lin", "abs", "1")},
+    "phase": {"deg": ("deg", "degree", "degrees", "°"), "rad": ("rad", "radian", "radians")},
+    "frequency": {"Hz": ("hz",), "rad/s": ("rad/s", "rad_s", "rads")},
+    "temperature": {"degC": ("degc", "c", "°c", "celsius"), "K": ("k", "kelvin")},
+}
 
 
-def read_sweep(path) -> FrequencySweep:
-    """Read a sweep by file extension (.csv, .npz, .mat)."""
+def _number_unit(role: str, given, column: str, where: str) -> str:
+    """The unit of the ``role`` column: ``given`` (units=) checked against the column name's suffix."""
+    table = NUMBER_UNITS[role]
+    canon = {a: k for k, al in table.items() for a in (k.lower(), *al)}
+    suffix = column.rsplit("_", 1)[-1].lower() if "_" in column else ""
+    from_name = canon.get(suffix)
+    if given is None:
+        return from_name or next(iter(table))
+    unit = canon.get(str(given).strip().lower())
+    if unit is None:
+        raise ColumnMapError(f"{where}: units[{role!r}] = {given!r}; expected one of {list(table)}", "units", role)
+    if from_name is not None and from_name != unit:
+        raise ColumnMapError(f"{where}: column {column!r} is in {from_name} by its name but units[{role!r}] = "
+                             f"{given!r}; drop one of them", "units", role)
+    return unit
+
+
+def _response(mag, phase, mag_unit: str, phase_unit: str, where: str) -> np.ndarray:
+    with np.errstate(over="ignore", invalid="ignore"):
+        m = 10 ** (np.asarray(mag, float) / 20) if mag_unit == "dB" else np.asarray(mag, float)
+        H = m * np.exp(1j * (np.radians(phase) if phase_unit == "deg" else np.asarray(phase, float)))
+    bad = np.flatnonzero(~np.isfinite(H) | (m <= 0) | ~np.isfinite(m))
+    if bad.size:
+        k = int(bad[0])
+        raise DataFormatError(f"{where}: line {k + 1}: magnitude {float(np.asarray(mag)[k])!r} {mag_unit} gives no "
+                              f"finite nonzero response (a magnitude in dB between -600 and 600, or > 0 linear)")
+    return H
+
+
+def _response_units(units: Mapping, header: Mapping, where: str) -> dict:
+    labels = {}
+    for key in ("input", "output"):
+        u = units.get(key)
+        if u is None:
+            text = str(header.get(key, "")).strip()
+            if text.endswith("]") and "[" in text:
+                name, u = (x.strip() for x in text[:-1].split("[", 1))
+                labels[f"{key}_name"] = name or key
+            else:
+                raise ColumnMapError(f"{where}: the {key} unit of the response is not known; {UNITS_HINT}", "units", key)
+        if u not in UNITS:
+            raise ColumnMapError(f"{where}: units[{key!r}] = {u!r} is not a unit of the library; expected one of "
+                                 f"{sorted(UNITS)}", "units", key)
+        labels[f"{key}_unit"] = u
+        labels.setdefault(f"{key}_name", {"length": "displacement"}.get(UNITS[u][0], UNITS[u][0]))
+    return labels
+
+
+def read_mapped_sweep(path, columns: Mapping | None = None, units: Mapping | None = None,
+                      temperature_c: float | None = None) -> FrequencySweep:
+    """A sweep from a user's own CSV/NPZ/MAT file through a column and unit mapping.
+
+    ``columns``: role → column name or 0-based index, roles :data:`ROLES` (unmapped roles use
+    the library's column if present: ``temperature_c``, ``frequency_hz``, ...).  ``units``:
+    ``input``/``output`` (the response is output/input, e.g. ``'mm'``/``'V'``; default: the
+    file's ``# input: name [unit]`` header), ``magnitude`` (``'dB'`` or ``'linear'``), ``phase``
+    (``'deg'`` or ``'rad'``), ``frequency`` (``'Hz'`` or ``'rad/s'``), ``temperature``
+    (``'degC'`` or ``'K'``); a column-name suffix (``gain_dB``, ``phase_rad``) sets them too and
+    must agree.  The σ columns are in the magnitude's and phase's units (a linear σ is converted
+    to dB at each line's magnitude).  ``temperature_c``: one temperature [°C] for a file without
+    a temperature column.  Lines are sorted by temperature, then frequency.
+
+    Raises
+    ------
+    ColumnMapError (a DataFormatError)
+        naming the argument and key that fix the problem (``columns['frequency']``, ``units['input']``).
+    """
+    columns, units = dict(columns or {}), dict(units or {})
+    bad = sorted(set(columns) - set(ROLES)) or sorted(set(units) - {"input", "output", *NUMBER_UNITS})
+    if bad:
+        arg = "columns" if set(columns) - set(ROLES) else "units"
+        allowed = list(ROLES) if arg == "columns" else ["input", "output", *NUMBER_UNITS]
+        raise ColumnMapError(f"{path}: {arg}[{bad[0]!r}]: not a role of a sweep; expected {allowed}", arg, bad[0])
+    table = read_table(path, "sweep")
+    where = table.where
+    picked: dict[str, str] = {}
+    for role, default in zip(ROLES, REQUIRED_COLUMNS + OPTIONAL_COLUMNS):
+        if role in columns:
+            picked[role] = pick(table, columns[role], role)
+        elif default in table.names and not (role == "temperature" and temperature_c is not None):
+            picked[role] = pick(table, default, role)
+    T = _temperatures(table, picked, columns, units, temperature_c)
+    for role in ("frequency", "magnitude", "phase"):
+        if role not in picked:
+            raise ColumnMapError(f"{where}: which column holds the {role}? give columns={{{role!r}: NAME or INDEX}} "
+                                 f"(ipmc: --sweep-columns {role}=NAME); the file has {table.describe()}", "columns", role)
+    if ("magnitude_std" in picked) != ("phase_std" in picked):
+        miss = "phase_std" if "magnitude_std" in picked else "magnitude_std"
+        raise ColumnMapError(f"{where}: give both σ columns or neither; columns[{miss!r}] is missing", "columns", miss)
+    u = {r: _number_unit(r, units.get(r), picked.get(r, ""), where) for r in ("magnitude", "phase", "frequency")}
+    col = {r: table.data[c] for r, c in picked.items()}
+    for r, c in picked.items():
+        nonfinite = np.flatnonzero(~np.isfinite(col[r]))
+        if nonfinite.size:
+            raise DataFormatError(f"{where}: column {c!r} ({r}) is not finite at line(s) {(nonfinite[:5] + 1).tolist()}")
+    f = col["frequency"] / (2 * np.pi) if u["frequency"] == "rad/s" else col["frequency"]
+    H = _response(col["magnitude"], col["phase"], u["magnitude"], u["phase"], where)
+    std = None
+    if "magnitude_std" in col:
+        ms = col["magnitude_std"] if u["magnitude"] == "dB" else 20 / np.log(10) * col["magnitude_std"] / np.abs(H)
+        std = (ms, col["phase_std"] if u["phase"] == "deg" else np.degrees(col["phase_std"]))
+    labels = _response_units(units, table.header, where)
+    order = np.lexsort((f, T))
+    dup = np.flatnonzero((np.diff(T[order]) == 0) & (np.diff(f[order]) == 0))
+    if dup.size:
+        k = order[dup[0]]
+        raise DataFormatError(f"{where}: two lines at {f[k]:g} Hz and {T[k]:g} °C")
+    meta = {k: v for k, v in table.header.items() if k not in ("input", "output", "ipmc-sweep", "temperature_c")}
+    meta["columns"] = ", ".join(f"{r}={c}" for r, c in picked.items())
+    try:
+        return FrequencySweep(T[order], f[order], H[order], None if std is None else std[0][order],
+                              None if std is None else std[1][order], metadata=meta, **labels)
+    except IPMCError as exc:
+        raise DataFormatError(f"{where}: {exc}") from None
+
+
+def _temperatures(table: Table, picked: dict, columns: Mapping, units: Mapping, temperature_c) -> np.ndarray:
+    n = max((v.size for v in table.data.values()), default=0)
+    if temperature_c is not None:
+        if "temperature" in columns:
+            raise ColumnMapError(f"{table.where}: give temperature_c or columns['temperature'], not both",
+                                 "temperature_c", "temperature")
+        try:
+            t = float(temperature_c)
+        except (TypeError, ValueError):
+            t = math.nan
+        if not math.isfinite(t):
+            raise ColumnMapError(f"{table.where}: temperature_c = {temperature_c!r}; expected a number [°C]",
+                                 "temperature_c", "temperature")
+        return np.full(n, t)
+    if "temperature" not in picked:
+        if "temperature_c" in table.header:        # a '# temperature_c: 30' header line
+            return _temperatures(table, picked, columns, units, table.header["temperature_c"])
+        raise ColumnMapError(f"{table.where}: no temperature: give columns={{'temperature': NAME or INDEX}} or "
+                             "temperature_c=<°C> (ipmc: --sweep-columns temperature=NAME or --sweep-temperature T)",
+                             "columns", "temperature")
+    T = table.data[picked["temperature"]]
+    unit = _number_unit("temperature", units.get("temperature"), picked["temperature"], table.where)
+    return T - 273.15 if unit == "K" else T
+
+
+def read_sweep(path, *, columns: Mapping | None = None, units: Mapping | None = None,
+               temperature_c: float | None = None) -> FrequencySweep:
+    """Read a sweep by file extension (.csv, .npz, .mat).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.  With no mapping it must be in the library's format (see
+        :mod:`physmodel.data.sweep`).
+    columns : mapping or None
+        A user's own file: role (temperature, frequency, magnitude, phase, magnitude_std,
+        phase_std) → column name or 0-based index (:func:`read_mapped_sweep`).
+    units : mapping or None
+        ``input``/``output`` units of the response (e.g. ``'V'``, ``'mm'``) and the units of the
+        number columns (magnitude dB/linear, phase deg/rad, frequency Hz/rad/s, temperature degC/K).
+    temperature_c : float or None
+        Temperature [°C] of every line of a file without a temperature column.
+
+    Raises
+    ------
+    DataFormatError
+        naming the file and the problem; a :class:`~physmodel.data.columns.ColumnMapError` when a
+        mapping entry fixes it, naming the argument and the ``ipmc`` option to give.
+    """
+    if columns or units or temperature_c is not None:
+        return read_mapped_sweep(path, columns, units, temperature_c)
     return by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "sweep")(path)
-
-
-def write_sweep(sw: FrequencySweep, path) -> Path:
-    """Write a sweep by file extension (.csv, .npz, .mat), atomically."""
-    return by_extension(path, {".csv": write_csv, ".npz": write_npz, ".mat": write_mat}, "sweep")(sw, path)

@@ -9,18 +9,23 @@
 * arrays ``(frequency_hz, response)`` with ``temperature_c`` a scalar or one value per line.
 
 An FRD carries no units: give ``input_unit``/``output_unit`` (e.g. ``"V"``, ``"mm"``) when the
-consumer checks them (calibration does).  Lines are sorted by frequency within each temperature.
+consumer checks them (calibration does: ``calibrate(frd, base, free, temperature_c=30,
+input_unit="V", output_unit="mm")``).  The same arguments label a dimensionless sweep (e.g. an
+estimate from bare arrays) and convert a sweep in other units of the same kind.  Lines are sorted
+by frequency within each temperature.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import IPMCError
 from .sweep import FrequencySweep, merge_sweeps
+from .units import unit_scale
 
 __all__ = ["as_sweep", "is_frd"]
 
@@ -71,8 +76,28 @@ def _build(T: np.ndarray, f: np.ndarray, H: np.ndarray, labels: dict, meta: dict
     return FrequencySweep(T[order], f[order], H[order], metadata=meta, **labels)
 
 
-def as_sweep(obj: Any, temperature_c: Any = None, *, input_name: str = "input", input_unit: str = "1",
-             output_name: str = "output", output_unit: str = "1") -> FrequencySweep:
+def _relabel(sw: FrequencySweep, input_unit: str | None, output_unit: str | None) -> FrequencySweep:
+    """``sw`` in the given units: a dimensionless side is labelled, another unit converted."""
+    if input_unit is None and output_unit is None:
+        return sw
+    iu, ou = input_unit or sw.input_unit, output_unit or sw.output_unit
+    for arg, u in (("input_unit", iu), ("output_unit", ou)):
+        try:
+            unit_scale(u)
+        except IPMCError as exc:
+            raise IPMCError(f"as_sweep: {arg}={u!r}: {exc}") from None
+    if sw.input_unit == "1" and iu != "1":          # dimensionless: labelled, not converted
+        sw = replace(sw, input_unit=iu)
+    if sw.output_unit == "1" and ou != "1":
+        sw = replace(sw, output_unit=ou)
+    try:
+        return sw.in_units(iu, ou)
+    except IPMCError as exc:
+        raise IPMCError(f"as_sweep: input_unit={iu!r}/output_unit={ou!r}: {exc}") from None
+
+
+def as_sweep(obj: Any, temperature_c: Any = None, *, input_name: str = "input", input_unit: str | None = None,
+             output_name: str = "output", output_unit: str | None = None) -> FrequencySweep:
     """A :class:`FrequencySweep` from a sweep, FRD object(s), a mapping or arrays (see the module doc).
 
     Parameters
@@ -83,19 +108,22 @@ def as_sweep(obj: Any, temperature_c: Any = None, *, input_name: str = "input", 
         Temperature [°C]: a scalar for one FRD / one ``(frequency_hz, response)`` pair, a sequence
         for a sequence of FRDs, or one value per line for arrays.  Not used for sweeps or mappings.
     input_name, input_unit, output_name, output_unit : str
-        Labels and units of the response (``output_unit``/``input_unit``); ignored for sweeps.
+        Labels and units of the response (``output_unit``/``input_unit``; default ``"1"``,
+        dimensionless).  For sweeps: a dimensionless side takes the unit given, another unit is
+        converted to it (same kind only).
 
     Raises
     ------
     IPMCError
         naming the item and what was expected.
     """
-    labels = dict(input_name=input_name, input_unit=input_unit, output_name=output_name, output_unit=output_unit)
+    labels = dict(input_name=input_name, input_unit=input_unit or "1", output_name=output_name,
+                  output_unit=output_unit or "1")
     if isinstance(obj, FrequencySweep):
-        return obj
+        return _relabel(obj, input_unit, output_unit)
     if isinstance(obj, Sequence) and not isinstance(obj, str | bytes) and obj \
             and all(isinstance(s, FrequencySweep) for s in obj):
-        return merge_sweeps(list(obj))
+        return _relabel(merge_sweeps(list(obj)), input_unit, output_unit)
     meta = {"source": "physmodel.data.interop.as_sweep"}
     if isinstance(obj, Mapping):
         if not obj:
@@ -113,8 +141,9 @@ def as_sweep(obj: Any, temperature_c: Any = None, *, input_name: str = "input", 
         return _build(np.concatenate(Ts), np.concatenate(fs), np.concatenate(Hs), labels, meta)
     if is_frd(obj):
         if temperature_c is None or np.ndim(temperature_c) != 0:
-            raise IPMCError("as_sweep: an FRD carries no temperature; pass temperature_c=<°C> (a scalar) "
-                            "or a mapping {temperature_c: frd}")
+            got = "" if temperature_c is None else f" (got temperature_c={temperature_c!r}, not a scalar)"
+            raise IPMCError(f"as_sweep: an FRD carries no temperature; pass temperature_c=<°C> (a scalar) "
+                            f"or a mapping {{temperature_c: frd}}{got}")
         f, H = _frd_arrays(obj, "as_sweep")
         return _build(np.full(f.size, float(temperature_c)), f, H, labels, meta)
     if isinstance(obj, Sequence) and obj and all(is_frd(x) for x in obj):

@@ -37,6 +37,7 @@ from pathlib import Path
 
 from .. import interrupts
 from ..errors import IPMCError
+from .fileio import atomic_write
 
 #: The completion marker, written last into every result folder.
 MARKER = ".ipmc-complete.json"
@@ -46,7 +47,7 @@ MARKER_FORMAT = "ipmc-result"
 #: (file, identity, or a function of the file's JSON giving the identity).
 #: (report.json before model.json: a diagnosis folder holds both; a fit folder only model.json)
 OWNER_FILES = (("metrics.json", lambda d: f"ipmc run {d['scenario']}"), ("calibration.json", lambda d: "ipmc calibrate"),
-               ("validation.json", lambda d: "ipmc validate"),
+               ("validation.json", lambda d: "ipmc validate"), ("compare.json", lambda d: "ipmc compare"),
                ("report.json", lambda d: "ipmc feedforward" if "peak_voltage_V" in d else "ipmc diagnose"),
                ("model.json", lambda d: "ipmc fit"))
 
@@ -198,8 +199,6 @@ def _files(folder: Path) -> list[str]:
 
 def _write_marker(stage: Path, identity: str) -> None:
     from .. import __version__
-    from .files import atomic_write
-
     doc = {"format": MARKER_FORMAT, "version": 1, "command": identity, "files": _files(stage),
            "written": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "library_version": __version__}
     atomic_write(stage / MARKER, lambda fh: fh.write(json.dumps(doc, indent=2) + "\n"))

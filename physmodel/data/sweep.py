@@ -29,14 +29,19 @@ Rows are grouped by temperature; inside a group frequencies strictly increase.  
 
 from __future__ import annotations
 
+import csv
 import hashlib
+import io
+import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..errors import DataFormatError, IPMCError
+from .fileio import atomic_write, by_extension
 from .units import QUANTITY_UNITS, UNITS, unit_scale
 
 FORMAT_VERSION = 1
@@ -248,18 +253,12 @@ class FrequencySweep:
 
     # -------------------------------------------------------------- files
     def to_csv(self, path) -> Path:
-        from .files import write_csv
-
         return write_csv(self, path)
 
     def to_npz(self, path) -> Path:
-        from .files import write_npz
-
         return write_npz(self, path)
 
     def to_mat(self, path) -> Path:
-        from .files import write_mat
-
         return write_mat(self, path)
 
 
@@ -338,9 +337,15 @@ def sweep_layout(data: FrequencySweep, kind: str, quantity: str | None = None) -
     want_in, want_out = UNITS[unit_in][0], UNITS[unit_out][0]
     got_in, got_out = UNITS[data.input_unit][0], UNITS[data.output_unit][0]
     if (got_in, got_out) != (want_in, want_out):
+        hint = ""
+        if "dimensionless" in (got_in, got_out) and "dimensionless" not in (want_in, want_out):
+            hint = (f"; the data carry no units (an FRD or an estimate from bare arrays): state them with "
+                    f"input_unit={unit_in!r}, output_unit={unit_out!r} (calibrate(..., input_unit=, output_unit=) or "
+                    f"as_sweep(..., input_unit=, output_unit=)), or units={{'input': ..., 'output': ...}} of read_sweep")
         raise DataFormatError(f"the sweep is {data.output_name} [{data.output_unit}] per {data.input_name} "
                               f"[{data.input_unit}] ({got_out}/{got_in}); {kind} quantity {q} needs "
-                              f"{want_out}/{want_in} (see physmodel.sweep.QUANTITY_UNITS {QUANTITY_UNITS[(kind, q)]})")
+                              f"{want_out}/{want_in} (see physmodel.sweep.QUANTITY_UNITS {QUANTITY_UNITS[(kind, q)]})"
+                              + hint)
     factor = unit_scale(data.input_unit) / unit_scale(data.output_unit)   # SI response -> sweep units
     fu, inv_f = np.unique(data.frequency_hz, return_inverse=True)
     Tu, inv_T = np.unique(data.temperature_c, return_inverse=True)
@@ -370,3 +375,83 @@ def merge_sweeps(data: FrequencySweep | Sequence[FrequencySweep]) -> FrequencySw
                           cat("magnitude_std_db") if std else None, cat("phase_std_deg") if std else None,
                           first.input_name, first.input_unit, first.output_name, first.output_unit,
                           dict(first.metadata))
+
+
+# ----------------------------------------------------------------------------------- writing
+def _file_columns(sw: FrequencySweep) -> dict[str, Any]:
+    cols: dict[str, Any] = {
+        "temperature_c": sw.temperature_c,
+        "frequency_hz": sw.frequency_hz,
+        "magnitude_db": sw.magnitude_db,
+        "phase_deg": sw.phase_deg,
+    }
+    if sw.magnitude_std_db is not None:
+        cols["magnitude_std_db"] = sw.magnitude_std_db
+        cols["phase_std_deg"] = sw.phase_std_deg
+    return cols
+
+
+def _header_lines(sw: FrequencySweep) -> list[str]:
+    lines = [f"ipmc-sweep {FORMAT_VERSION}", f"input: {sw.input_name} [{sw.input_unit}]",
+             f"output: {sw.output_name} [{sw.output_unit}]"]
+    for k, v in sw.metadata.items():
+        v = str(v).replace("\n", " ")
+        lines.append(f"{k}: {v}")
+    return lines
+
+
+def write_csv(sw: FrequencySweep, path) -> Path:
+    """Write the tidy CSV (see module doc), atomically."""
+    cols = _file_columns(sw)
+
+    def write(fh):
+        for line in _header_lines(sw):
+            fh.write(f"# {line}\n")
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(list(cols))
+        for row in zip(*cols.values()):
+            w.writerow([repr(float(v)) for v in row])
+
+    return atomic_write(path, write)
+
+
+def write_npz(sw: FrequencySweep, path) -> Path:
+    cols = _file_columns(sw)
+    header = json.dumps({"format": "ipmc-sweep", "version": FORMAT_VERSION,
+                         "input": f"{sw.input_name} [{sw.input_unit}]",
+                         "output": f"{sw.output_name} [{sw.output_unit}]", "metadata": sw.metadata})
+
+    def write(fh):
+        np.savez(fh, header=np.array(header), response_real=sw.response.real, response_imag=sw.response.imag, **cols)
+
+    return atomic_write(path, write, "wb")
+
+
+#: The descriptive text at the start of every .mat file written here (no timestamp).
+MAT_HEADER_TEXT = f"MATLAB 5.0 MAT-file, written by ipmc (ipmc-sweep {FORMAT_VERSION})".encode("ascii").ljust(116)
+
+
+def write_mat(sw: FrequencySweep, path) -> Path:
+    """MATLAB .mat (v5) with one column vector per field, the complex response and header strings."""
+    from scipy.io import savemat
+
+    cols: dict[str, Any] = {k: v.reshape(-1, 1) for k, v in _file_columns(sw).items()}
+    cols["response"] = sw.response.reshape(-1, 1)
+    cols["input"] = f"{sw.input_name} [{sw.input_unit}]"
+    cols["output"] = f"{sw.output_name} [{sw.output_unit}]"
+    cols["format"] = f"ipmc-sweep {FORMAT_VERSION}"
+    cols["metadata_json"] = json.dumps(sw.metadata)
+
+    buf = io.BytesIO()
+    savemat(buf, cols, do_compression=True)
+    data = bytearray(buf.getvalue())
+    # the 116-byte descriptive text of a v5 header carries the creation time; a fixed text makes
+    # the file byte-reproducible like the CSV and NPZ (MATLAB ignores the text)
+    data[:116] = MAT_HEADER_TEXT
+
+    return atomic_write(path, lambda fh: fh.write(bytes(data)), "wb")
+
+
+def write_sweep(sw: FrequencySweep, path) -> Path:
+    """Write a sweep by file extension (.csv, .npz, .mat), atomically."""
+    return by_extension(path, {".csv": write_csv, ".npz": write_npz, ".mat": write_mat}, "sweep")(sw, path)

@@ -36,7 +36,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFormatError, IPMCError
-from .files import atomic_write, by_extension, read_text
+from .columns import ColumnMapError, map_record
+from .fileio import atomic_write, by_extension, read_text
 
 #: Samples read per block when checking long (memory-mapped) time bases.
 TIME_BLOCK_SAMPLES = 1 << 20
@@ -350,13 +351,19 @@ def read_csv(path, unitless: str | None = None) -> TimeRecord:
     return _build(cols, meta, where, unitless)
 
 
+#: How to read a file whose columns are not ``time_s`` and ``<name>_<unit>`` (said by the errors).
+MAPPING_HINT = ("or map the file's own columns: read_record(path, columns={'time': 't', 'voltage': 'volts'}, "
+                "units={'voltage': 'V'}) (ipmc: --time-column, --input-column/--input-unit, "
+                "--output-column/--output-unit)")
+
+
 def _build(cols: dict, meta: dict, where: str, unitless: str | None = None) -> TimeRecord:
     if unitless is not None:
         cols = {(k if k == TIME_COLUMN or "_" in k else f"{k}_{unitless}"): v for k, v in cols.items()}
     try:
         return TimeRecord.from_columns(cols, meta, where)
-    except DataFormatError:
-        raise
+    except DataFormatError as exc:
+        raise DataFormatError(f"{exc}; {MAPPING_HINT}") from None
     except IPMCError as exc:
         raise DataFormatError(f"{where}{exc}") from None
 
@@ -426,12 +433,40 @@ def read_mat(path, unitless: str | None = None) -> TimeRecord:
     return _build(cols, {k: str(v) for k, v in dict(meta).items()}, where, unitless)
 
 
-def read_record(path, unitless: str | None = None) -> TimeRecord:
+def read_mapped_record(path, columns: dict | None = None, units: dict | None = None,
+                       temperature_c: float | None = None, unitless: str | None = None) -> TimeRecord:
+    """A time record from a user's own CSV/NPZ/MAT file through a column and unit mapping
+    (:func:`physmodel.data.columns.map_record` says how ``columns``, ``units`` and
+    ``temperature_c`` are read).
+
+    Raises
+    ------
+    ColumnMapError (a DataFormatError)
+        naming the argument and key that fix the problem.
+    """
+    t, chans, cunits, meta, where = map_record(path, columns, units, temperature_c, unitless)
+    bad = [n for n in chans if not _NAME.match(n)]
+    if bad:
+        raise ColumnMapError(f"{where}: channel name {bad[0]!r} must start with a letter and hold letters, digits "
+                             "and '_'", "columns", bad[0])
+    _check_finite({TIME_COLUMN: t, **chans}, f"{where}: ")
+    try:
+        return TimeRecord(t, chans, cunits, meta)
+    except IPMCError as exc:
+        raise DataFormatError(f"{where}: {exc}") from None
+
+
+def read_record(path, unitless: str | None = None, *, columns: dict | None = None, units: dict | None = None,
+                temperature_c: float | None = None) -> TimeRecord:
     """Read a time record by extension (.csv, .npz, .mat).
 
     ``unitless``: unit given to a column named without a ``_<unit>`` suffix (files of the older
     ``inversion.references.Reference.save``, which wrote a bare ``reference`` column when the
     reference had no unit; hand-made files with e.g. ``time_s,target``); None refuses such a column.
+    ``columns``, ``units``, ``temperature_c``: a user's own file (a DAQ's ``t, volts, disp``, a
+    MATLAB session's variables) through a mapping, see :func:`read_mapped_record`.
     """
+    if columns or units or temperature_c is not None:
+        return read_mapped_record(path, columns, units, temperature_c, unitless)
     reader = by_extension(path, {".csv": read_csv, ".npz": read_npz, ".mat": read_mat}, "time-record")
     return reader(path, unitless)

@@ -114,10 +114,12 @@ def split_values(values: Mapping[str, float]) -> tuple[dict, dict]:
     """Split ``{"alpha0": .., "time_delay.delay": ..}`` into base-parameter and effect dicts.
 
     Base names are IPMCParameters fields, ``omega_n`` or ``laws.<quantity>.<attribute>``
-    (see :func:`physmodel.estimation.calibration.apply_values`)."""
+    (see :func:`physmodel.parameter_paths.apply_values`)."""
+    from ..parameter_paths import is_effect_parameter
+
     base, eff = {}, {}
     for k, v in values.items():
-        if "." in k and not k.startswith("laws."):
+        if is_effect_parameter(k):
             e, p = k.split(".", 1)
             eff.setdefault(e, {})[p] = float(v)
         else:
@@ -126,12 +128,13 @@ def split_values(values: Mapping[str, float]) -> tuple[dict, dict]:
 
 
 # --------------------------------------------------------------------------- the model
-def _apply(p: IPMCParameters, base_vals: Mapping[str, float]) -> IPMCParameters:
+def _apply(p: IPMCParameters, base_vals: Mapping[str, float], paths: dict | None = None) -> IPMCParameters:
+    """``p`` with ``base_vals``; ``paths``: names resolved against ``p`` (kept across calls)."""
     if not base_vals:
         return p
     from ..parameter_paths import apply_values
 
-    return apply_values(p, base_vals)
+    return apply_values(p, base_vals, paths)
 
 
 class _EffectMixin:
@@ -253,6 +256,8 @@ class _EffectMixin:
             r = m.frequency_response(freqs, temps, quantities=(q,))[q][0]
             return r[ti, fi] * scale
 
+        paths: dict = {}        # the base names, each resolved once against self.params[0]
+
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
             # one batched model call per distinct set of effect values (base values vary freely)
             out = np.empty((len(values_list), data.response.size), dtype=complex)
@@ -266,7 +271,7 @@ class _EffectMixin:
                 effects = {n: dict(v) for n, v in self.effects.items()}
                 for n, pv in e.items():
                     effects.setdefault(n, {}).update(pv)
-                plist = [_apply(self.params[0], b) for _, b, _ in items]
+                plist = [_apply(self.params[0], b, paths) for _, b, _ in items]
                 m = make_effect_model(plist, self.kind, effects, **self._extra())
                 r = m.frequency_response(freqs, temps, quantities=(q,))[q]
                 for k, (i, _, _) in enumerate(items):

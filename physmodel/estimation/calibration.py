@@ -14,14 +14,14 @@ import numpy as np
 from ..data.interop import as_sweep
 from ..data.sweep import FrequencySweep, sweep_layout
 from ..errors import IPMCError, ParameterError
-from ..parameter_paths import StateMap, apply_values, base_value, check_parameter_name
+from ..parameter_paths import ParameterPath, StateMap, apply_values, resolve_path, resolve_paths
 from ..params import IPMCParameters
 from .identifiability import Identifiability
 from .lsq import CalibrationResult, FreeParameter, SensitivityProbe, fit_parameters
 
 
-def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
-    """Default bounds for a bare name (initial = base value):
+def default_free_parameter(base: IPMCParameters, name: str | ParameterPath) -> FreeParameter:
+    """Default bounds for a bare name, or its path already resolved against ``base`` (initial = base value):
 
     * positive fields and ``omega_n``: [base/10, 10·base], log (``xi`` capped at 2; ``omega_n`` ×/÷ 3);
     * signed couplings ``alpha0``/``a0``: the same decade either side, log of the magnitude, sign kept;
@@ -29,9 +29,10 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
       ``laws.*.alpha``: [−5e-3, 5e-3] /K, linear.
     A zero or infinite base value (e.g. ``Rp_specific = inf``) needs explicit bounds.
     """
-    v = base_value(base, name)
-    if name.startswith("laws."):
-        attr = name.split(".")[2]
+    path = name if isinstance(name, ParameterPath) else resolve_path(base, name)
+    name, v = path.name, path.value
+    if path.is_law:
+        attr = path.attribute
         defaults = {"activation_energy": (0.0, 60e3), "slope": (-0.05, 0.05), "alpha": (-5e-3, 5e-3)}
         if attr not in defaults:
             raise ParameterError(f"no default bounds for {name!r}; give them as FreeParameter(name, lower, upper)")
@@ -51,7 +52,8 @@ def default_free_parameter(base: IPMCParameters, name: str) -> FreeParameter:
 def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "actuator",
                       quantity: str | None = None, kernel: str = "boundary_charge",
                       free: Sequence[FreeParameter] | None = None,
-                      effects: Mapping[str, Mapping[str, float]] | None = None):
+                      effects: Mapping[str, Mapping[str, float]] | None = None,
+                      paths: Mapping[str, ParameterPath] | None = None):
     """``predict_many(list of values) -> (n_sets, N)`` in the sweep's units, plus a wide-band
     :class:`SensitivityProbe` at the median data temperature.  One model call per batch
     (sets × temperatures × union of frequencies).
@@ -64,6 +66,9 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
     With ``effects`` ({effect: {parameter: value}}, see :mod:`physmodel.effects`) the predictions
     are those of ``EffectModel(sets, kind, effects)`` (the measurement chain fixed at those values;
     no array path).
+
+    ``paths``: names already resolved against ``base`` (:func:`~physmodel.parameter_paths.resolve_paths`,
+    e.g. by :func:`calibrate`); the free names it lacks are resolved here, once.
     """
     from ..params import STATE_FIELDS, State
     from ..protocol import physics_model
@@ -72,8 +77,11 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
     q, factor, fu, inv_f, Tu, inv_T = (lay.quantity, lay.factor, lay.frequencies_hz, lay.f_index,
                                        lay.temperatures_c, lay.t_index)
 
+    paths = dict(paths or {})         # each name read once, for every set below
+    paths.update(resolve_paths(base, [fp.name for fp in free or () if fp.name not in paths]))
+
     def model_of(values_list):
-        plist = [apply_values(base, v) for v in values_list]
+        plist = [apply_values(base, v, paths) for v in values_list]
         if effects:
             from ..effects import EffectModel
 
@@ -92,10 +100,10 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
         return model_of(values_list).frequency_response(f_probe, [t_probe], quantities=(q,))[q][:, 0, :] * factor
 
     predict_many.array = probe_array = None
-    smap = None if not free or effects else StateMap.build(base, [fp.name for fp in free], [fp.lower for fp in free],
-                                                [fp.upper for fp in free],
-                                                [base_value(base, fp.name) if fp.initial is None else fp.initial
-                                                 for fp in free], Tu)
+    smap = None if not free or effects else StateMap.build(base, [paths[fp.name] for fp in free],
+                                                           [fp.lower for fp in free], [fp.upper for fp in free],
+                                                           [paths[fp.name].value if fp.initial is None else fp.initial
+                                                            for fp in free], Tu)
     if smap is not None:
         # the same model class, evaluated on states built as arrays
         model = physics_model(kind, base, kernel=kernel)
@@ -198,7 +206,8 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
               starts: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int | None = None,
               identify: bool = True, hold_undetermined: bool | str = True, name: str | None = None,
               progress: Callable[[int], None] | None = None, misfit: str = "widen",
-              effects: Mapping[str, Mapping[str, float]] | None = None, **kwargs) -> CalibrationResult:
+              effects: Mapping[str, Mapping[str, float]] | None = None, temperature_c: float | None = None,
+              input_unit: str | None = None, output_unit: str | None = None, **kwargs) -> CalibrationResult:
     """Calibrate physical parameters of ``base`` to frequency-response data at one or many temperatures.
 
     Start 0 is the base value (or ``initial``); ``starts − 1`` more are seeded Latin-hypercube
@@ -237,6 +246,12 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
         A measurement chain or other effects ({effect: {parameter: value}}, SI,
         :mod:`physmodel.effects`) held fixed while the physical parameters are fitted: the model
         is ``EffectModel(base, kind, effects)``.
+    temperature_c : float or None
+        Temperature [°C] of data that carry none (a ``control.FrequencyResponseData``); passed to
+        :func:`~physmodel.data.interop.as_sweep`.
+    input_unit, output_unit : str or None
+        Units of data that carry none (an FRD, an estimate from bare arrays), e.g. ``"V"`` and
+        ``"mm"``; a sweep in other units of the same kind is converted.
     **kwargs
         Passed to :func:`~physmodel.estimation.lsq.fit_parameters` (``fixed``, ``ftol``, ``fd_step``).
 
@@ -249,21 +264,22 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
         raise ParameterError(f"misfit must be 'widen' or 'withhold', got {misfit!r}")
     if not isinstance(base, IPMCParameters):
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
-    data = as_sweep(data)
+    data = as_sweep(data, temperature_c, input_unit=input_unit, output_unit=output_unit)
     if effects is not None:
         if not isinstance(effects, Mapping):
             raise ParameterError(f"effects must map effect names to {{parameter: value}}, got {effects!r}")
         from ..effects import normalize_effects
 
         effects = normalize_effects(effects)
-    fps = []
+    fps, paths = [], {}           # each name resolved once against base (ParameterPath)
     for item in free:
         if isinstance(item, str):
-            fps.append(default_free_parameter(base, item))
+            path = paths[item] = resolve_path(base, item)
+            fps.append(default_free_parameter(base, path))
         elif isinstance(item, FreeParameter):
-            check_parameter_name(base, item.name)
+            path = paths[item.name] = resolve_path(base, item.name)
             if item.initial is None:
-                v = base_value(base, item.name)
+                v = path.value
                 if not item.lower <= v <= item.upper:
                     raise ParameterError(f"free parameter {item.name}: the base value {v!r} lies outside the "
                                          f"bounds [{item.lower!r}, {item.upper!r}]; give an initial value")
@@ -273,7 +289,7 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
             raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
     fixed = kwargs.get("fixed") or {}
     predict_many, probe, q = physics_predictor(data, apply_values(base, fixed) if fixed else base, kind, quantity,
-                                               kernel, free=fps, effects=effects)
+                                               kernel, free=fps, effects=effects, paths=None if fixed else paths)
     res = fit_parameters(data, None, fps, starts=starts, seed=seed, predict_many=predict_many,
                          predict_array=predict_many.array, max_nfev=max_nfev, identify=identify,
                          hold_undetermined=hold_undetermined, probe=probe, progress=progress, **kwargs)
@@ -284,7 +300,7 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
            + (f"; undetermined, NOT held (holding would worsen the fit beyond its test): {', '.join(res.hold_refused)}"
               if res.hold_refused else "")
            + f"; base: {base.name}")
-    res.parameters = replace(apply_values(base, res.values), name=label, source=src)
+    res.parameters = replace(apply_values(base, res.values, paths), name=label, source=src)
     res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
                          "data_fingerprint": data.fingerprint(), "seed": seed})
     if effects:
@@ -340,4 +356,4 @@ def model_sweep(result: CalibrationResult, data: FrequencySweep, kind: str | Non
                    metadata={"source": "calibrated model", "parameter_set": result.parameters.name})
 
 
-__all__ = ["default_free_parameter", "physics_predictor", "calibrate", "model_sweep"]
+__all__ = ["default_free_parameter", "physics_predictor", "calibrate", "apply_misfit_policy", "model_sweep"]

@@ -138,7 +138,7 @@ class Diagnosis:
             Where the data came from (the caller knows the file and the command).
         """
         from ..model_file import FitVerdict, ModelFile, Provenance
-        from ..parameter_paths import apply_values
+        from ..parameter_paths import apply_values, is_effect_parameter
         from .residuals import goodness_of_fit
 
         if self.base_parameters is None:
@@ -149,7 +149,7 @@ class Diagnosis:
         effects = {k: dict(v) for k, v in (self.metadata.get("baseline_effects") or {}).items()}
         base_vals = {}
         for n, v in fit.values.items():
-            if "." in n and not n.startswith("laws."):
+            if is_effect_parameter(n):
                 e, p = n.split(".", 1)
                 effects.setdefault(e, {})[p] = float(v)
             else:
@@ -409,60 +409,16 @@ def resolve_laws(base, laws):
     raise ParameterError(f"laws must be None, a name, a mapping or TemperatureLaws; got {type(laws).__name__}")
 
 
-def _candidate_overrides(candidate_bounds, candidate_starts) -> tuple[dict, dict]:
-    """``{"effect.param": (lo, hi) | {"lower"|"upper"|"typical": v}}`` → {effect: {param: {...}}};
-    ``{"effect.param": value}`` → {effect: {param: value}}."""
-    bounds: dict = {}
-    for key, v in (candidate_bounds or {}).items():
-        if "." not in key:
-            raise ParameterError(f"candidate bound {key!r}: expected 'effect.parameter'")
-        e, p = key.split(".", 1)
-        get_effect(e).parameter(p)
-        if isinstance(v, Mapping):
-            spec = dict(v)
-        else:
-            try:
-                lo, hi = (float(x) for x in v)
-            except (TypeError, ValueError):
-                raise ParameterError(f"candidate bound {key!r}: expected (lower, upper) or a table of "
-                                     f"lower/upper/typical, got {v!r}") from None
-            spec = {"lower": lo, "upper": hi}
-        bounds.setdefault(get_effect(e).name, {})[p] = spec
-    starts: dict = {}
-    for key, v in (candidate_starts or {}).items():
-        if "." not in key:
-            raise ParameterError(f"candidate start {key!r}: expected 'effect.parameter'")
-        e, p = key.split(".", 1)
-        get_effect(e).parameter(p)
-        try:
-            starts.setdefault(get_effect(e).name, {})[p] = float(v)
-        except (TypeError, ValueError):
-            raise ParameterError(f"candidate start {key!r} = {v!r}: expected a number") from None
-    return bounds, starts
-
-
-def _hard_sides(cpars: dict) -> dict:
-    """Bounds that are physical limits or the effect's off value (no reason to widen)."""
-    out = {}
-    for c, pars in cpars.items():
-        for p in pars:
-            sides = set(p.limits)
-            if p.off == p.lower:
-                sides.add("lower")
-            if p.off == p.upper:
-                sides.add("upper")
-            out[f"{c}.{p.name}"] = tuple(sides)
-    return out
-
-
-def _named_msg(c: str, cr: CandidateResult) -> str:
+def named_message(c: str, cr: CandidateResult) -> str:
+    """The sentence that names effect ``c``: its title, LR and each fitted value with its 95 % interval."""
     e = LIBRARY[c]
     vals = "; ".join(f"{p.name} = {cr.values[p.name]:.4g} {p.unit} (95 % CI [{cr.ci_lower[p.name]:.3g}, "
                      f"{cr.ci_upper[p.name]:.3g}])" for p in e.parameters)
     return f"Named: {c} ({e.title}), LR {cr.lr:.4g}; {vals}."
 
 
-def _worst_cells(rows) -> str:
+def worst_cells(rows) -> str:
+    """The (up to three) most significant flagged cells of a localisation table, as words."""
     flagged = sorted((r for r in rows if r["flagged"] and r["temperature_c"] is not None), key=lambda r: r["p_value"])
     if not flagged:
         return "no single cell (a diffuse misfit)"
@@ -471,7 +427,7 @@ def _worst_cells(rows) -> str:
     return ", ".join(parts)
 
 
-def _audit_notes(verdict: str, at_bound: list, widen: list, audit0: dict, final_implausible: list, res0, cres: dict) -> str:
+def audit_notes(verdict: str, at_bound: list, widen: list, audit0: dict, final_implausible: list, res0, cres: dict) -> str:
     """The sentences a diagnosis message ends with: parameters at a bound (final fit, and the baseline's
     when nothing was named), plausible-range violations, and fits that did not converge."""
     out = ""

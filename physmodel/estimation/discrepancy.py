@@ -21,7 +21,7 @@ user's free parameters, and:
    null at the fitted baseline (constrained LR per candidate: χ̄² mixtures for effects whose off
    value is a bound; for a candidate with parameters that act only once it is on — the damping
    of a resonance, a fluid's viscosity — the supremum over a grid of them, Davies' look-elsewhere
-   correction, :func:`~physmodel.estimation.nullstats._scan_lr`), ``null_draws`` draws, scaled by
+   correction, :func:`~physmodel.estimation.nullstats.scan_lr`), ``null_draws`` draws, scaled by
    the ratio of full-refit to linearised LR on ``null_refits`` parametric-bootstrap draws
    (clipped to [1, 3]);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
@@ -69,6 +69,7 @@ import numpy as np
 from ..data.sweep import FrequencySweep
 from ..effects import DEFAULT_QUANTITY, LIBRARY, EffectModel, candidates_for, get_effect, normalize_effects
 from ..errors import IPMCError, ParameterError
+from ..parameter_paths import is_effect_parameter
 from ..params import IPMCParameters
 from ..plausible import plausible_ranges
 from .diagnosis import (
@@ -78,21 +79,19 @@ from .diagnosis import (
     VERDICTS,
     CandidateResult,
     Diagnosis,
-    _audit_notes,
-    _candidate_overrides,
-    _hard_sides,
-    _named_msg,
-    _worst_cells,
+    audit_notes,
     gap_shrink,
+    named_message,
     resolve_laws,
+    worst_cells,
 )
-from .nullstats import _constrained_lr, _scan_lr, bootstrap_ratio, signature_stage
+from .nullstats import bootstrap_ratio, constrained_lr, scan_lr, signature_stage
 from .priors import (
     WALL_DECADES,
     PenalisedProblem,
-    _free_list,
     bound_audit,
     cost_warning,
+    free_parameters_for,
     multistart_spread,
     penalties_for,
     plausible_audit,
@@ -100,14 +99,14 @@ from .priors import (
 from .records import CalibrationResult, FreeParameter
 from .residuals import standardised_residuals
 from .signatures import (
-    _confusability,
-    _declare,
-    _gap,
-    _localise,
-    _orth,
-    _pair_members,
-    _project_out,
-    _spread,
+    declare_confusable,
+    gap_statistics,
+    localise,
+    orth,
+    pair_members,
+    project_out,
+    refit_spread,
+    vuong_confusability,
     vuong_critical,
     vuong_z,
 )
@@ -177,7 +176,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     cbounds, cstarts = _candidate_overrides(candidate_bounds, candidate_starts)
     model0 = EffectModel(base, kind, beff, kernel=kernel)
     pm = model0.predictor(data, q).many
-    free0 = _free_list(base, list(free) + [f for f in extra_free if f not in free], beff)
+    free0 = free_parameters_for(base, list(free) + [f for f in extra_free if f not in free], beff)
     names0 = [fp.name for fp in free0]
     ranges = plausible_ranges(base, plausible)
     prob = PenalisedProblem(data, pm, penalties_for(free0, ranges) if prior else [])
@@ -227,10 +226,10 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     # ---- 3. linearised null Monte Carlo
     rng = np.random.default_rng(seed + 7919)
     E = rng.standard_normal((2 * N, int(null_draws)))
-    Ep = _project_out(Q0, E)
-    lin = {c: _constrained_lr(S, sided[c], Ep) for c, S in sigs.items()}
+    Ep = project_out(Q0, E)
+    lin = {c: constrained_lr(S, sided[c], Ep) for c, S in sigs.items()}
     for c in [c for c in sigs if c in degenerate]:      # look-elsewhere over parameters without a first-order signature
-        lin[c] = np.maximum(lin[c], _scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep))
+        lin[c] = np.maximum(lin[c], scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep))
     lin_max = np.max(np.vstack(list(lin.values())), axis=0) if lin else np.zeros(E.shape[1])
     cost2_null = np.sum(Ep * Ep, axis=0)
     T_lin = float(np.quantile(lin_max, 1 - alpha))
@@ -264,12 +263,12 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                 runs.append((origin, res))
                 if best is None or res.cost < best.cost:
                     best, best_origin = res, origin
-        best.metadata["refit_multistart"] = _spread(runs, best, best_origin)
+        best.metadata["refit_multistart"] = refit_spread(runs, best, best_origin)
         return best
 
     def lin_start(c, r_now, Qb):
         """Linearised estimate of the effect's values from the current residual."""
-        S = _project_out(Qb, sigs[c])
+        S = project_out(Qb, sigs[c])
         d, *_ = np.linalg.lstsq(S, -r_now, rcond=None)
         return {p.name: p.off + d[j] * (p.typical - p.off) for j, p in enumerate(cpars[c])}
 
@@ -299,7 +298,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             c, ev, {p: res.ci_lower[f"{c}.{p}"] for p in ev}, {p: res.ci_upper[f"{c}.{p}"] for p in ev},
             dc, lr, 2 * res.cost + 2 * (k0 + k), 2 * res.cost + (k0 + k) * math.log(n_res), k,
             False, False, res.converged, float(np.linalg.norm(sigs[c])),
-            float(_constrained_lr(sigs[c], sided[c], -_project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""),
+            float(constrained_lr(sigs[c], sided[c], -project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""),
             bounds={p.name: [p.lower, p.upper] for p in cpars[c]}, at_bound=ab, implausible=imp,
             penalty=res.metadata["penalty"], multistart=res.metadata["refit_multistart"])
     say(f"{len(cres)} candidates refitted")
@@ -330,7 +329,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     def gap_thr(effs: Sequence[str]) -> float:
         if not effs:
             return gap_thr0
-        Qs = _orth(np.hstack([sigs[c] for c in effs]))
+        Qs = orth(np.hstack([sigs[c] for c in effs]))
         after = cost2_null - np.sum((Qs.T @ Ep) ** 2, axis=0)
         return float(np.quantile(after, 1 - alpha_gap))
 
@@ -350,7 +349,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     final_fit: CalibrationResult | None = None
     pair_tried: list = []
     named2: list = []
-    where = _worst_cells(_localise(data, r0, alpha))
+    where = worst_cells(localise(data, r0, alpha))
     if not sig:
         if gap0_sig:
             verdict = "unexplained"
@@ -365,8 +364,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         def explainers(a, pool):
             """Candidates of ``pool`` that best explain what a leaves (linearised LR on its residual)."""
             r_a = standardised_residuals(pm([fits[a].values])[0], data, s_ln, s_ph)
-            Qa = _orth(np.hstack([J0, sigs[a]]))
-            sc = {b: float(_constrained_lr(_project_out(Qa, sigs[b]), sided[b], -_project_out(Qa, r_a[:, None]))[0])
+            Qa = orth(np.hstack([J0, sigs[a]]))
+            sc = {b: float(constrained_lr(project_out(Qa, sigs[b]), sided[b], -project_out(Qa, r_a[:, None]))[0])
                   for b in pool if b != a}
             return [b for b in sorted(sc, key=lambda k: -sc[k])[:PAIR_POOL - 1]], r_a, Qa
 
@@ -411,7 +410,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                             best2[1].cost, x[1].cost)
                 if z < z_crit:
                     alt.append((x[0], z))
-                    for m, o in _pair_members(best2[0], x[0], sigs):
+                    for m, o in pair_members(best2[0], x[0], sigs):
                         confusability.setdefault("pairs", []).append({"top": m, "other": o, "z": z, "separated": False})
             msg = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
                    f"{best2[2]:.4g}, {best2[3]:.4g} > {T:.3g}); the gap closes.")
@@ -428,7 +427,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            confusability = _confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit, refit)
+            confusability = vuong_confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit, refit)
             amb = [top] + [x["other"] for x in confusability["data"] if not x["separated"]]
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
@@ -439,7 +438,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                            f"α = {alpha:g}: {zs}). "
                            "Separate them with a wider band, more temperatures, or magnitude vs phase.")
             else:
-                verdict, message = "named", _named_msg(top, cres[top])
+                verdict, message = "named", named_message(top, cres[top])
             # forward step: a second significant candidate (not one of the closers, not confusable
             # with the first) that is significant on top of it
             pool = [c for c in sig if c not in amb and frozenset((top, c)) not in conf_set]
@@ -479,7 +478,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     if final_fit is not None:
         final_bounds, final_implausible = audit(final_fit, [fp for c in final_effects for fp in eff_free(c)])
     at_bound = [a for a in final_bounds if a["status"] == "at"]
-    widen = [a for a in at_bound if not a["hard"] and "." in a["name"] and not a["name"].startswith("laws.")
+    widen = [a for a in at_bound if not a["hard"] and is_effect_parameter(a["name"])
              and a["name"].split(".", 1)[0] in final_effects]
     # a significant candidate confusable with a named effect that stopped at a widenable bound: its
     # LR there is only a lower bound, so it might beat the named effect once the bound is widened (not an absolute one)
@@ -502,7 +501,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             message += (" The best candidate ended at its bound (" + "; ".join(
                 f"{a['name']} = {a['value']:.4g}, {a['side']} bound {a['bound']:.4g}" for a in stuck)
                 + "): widen it — the effect may be larger than allowed.")
-    message += _audit_notes(verdict, at_bound, widen, audit0, final_implausible, res0, cres)
+    message += audit_notes(verdict, at_bound, widen, audit0, final_implausible, res0, cres)
     named = list(final_effects) if verdict in ("named", "ambiguous", "at_bound") else []
     if verdict == "ambiguous":
         named = named2 if named2 else amb
@@ -516,15 +515,15 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
     if warn:
         message += f" Cost vs declared noise: {warn}."
-    _declare(confusable, separation, confusability, sigs, raw_sigs, data)
+    declare_confusable(confusable, separation, confusability, sigs, raw_sigs, data)
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
         verdict=verdict, named=named, message=message, kind=kind, quantity=q, alpha=alpha, threshold=T,
         gap_threshold=gap_thr0, baseline=res0, final=final_fit, final_effects=fe, candidates=cres,
-        skipped=skipped, confusable=confusable, separation=separation, localisation_before=_localise(data, r0, alpha),
-        localisation_after=_localise(data, rf, alpha), gap_before=_gap(data, r0, k0),
-        gap_after=_gap(data, rf, n_free_after),
+        skipped=skipped, confusable=confusable, separation=separation, localisation_before=localise(data, r0, alpha),
+        localisation_after=localise(data, rf, alpha), gap_before=gap_statistics(data, r0, k0),
+        gap_after=gap_statistics(data, rf, n_free_after),
         null={"method": "linearised Gaussian null at the fitted baseline (constrained LR per candidate, "
                         "max over candidates) scaled by full-refit parametric bootstrap",
               "draws": int(null_draws), "refits": int(null_refits), "lr_threshold_linearised": T_lin,
@@ -539,6 +538,53 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
         cost_warning=warn, confusability=confusability, base_parameters=base,
     )
+
+
+# =============================================================================== inputs
+def _candidate_overrides(candidate_bounds, candidate_starts) -> tuple[dict, dict]:
+    """``{"effect.param": (lo, hi) | {"lower"|"upper"|"typical": v}}`` → {effect: {param: {...}}};
+    ``{"effect.param": value}`` → {effect: {param: value}}."""
+    bounds: dict = {}
+    for key, v in (candidate_bounds or {}).items():
+        if "." not in key:
+            raise ParameterError(f"candidate bound {key!r}: expected 'effect.parameter'")
+        e, p = key.split(".", 1)
+        get_effect(e).parameter(p)
+        if isinstance(v, Mapping):
+            spec = dict(v)
+        else:
+            try:
+                lo, hi = (float(x) for x in v)
+            except (TypeError, ValueError):
+                raise ParameterError(f"candidate bound {key!r}: expected (lower, upper) or a table of "
+                                     f"lower/upper/typical, got {v!r}") from None
+            spec = {"lower": lo, "upper": hi}
+        bounds.setdefault(get_effect(e).name, {})[p] = spec
+    starts: dict = {}
+    for key, v in (candidate_starts or {}).items():
+        if "." not in key:
+            raise ParameterError(f"candidate start {key!r}: expected 'effect.parameter'")
+        e, p = key.split(".", 1)
+        get_effect(e).parameter(p)
+        try:
+            starts.setdefault(get_effect(e).name, {})[p] = float(v)
+        except (TypeError, ValueError):
+            raise ParameterError(f"candidate start {key!r} = {v!r}: expected a number") from None
+    return bounds, starts
+
+
+def _hard_sides(cpars: dict) -> dict:
+    """Bounds that are physical limits or the effect's off value (no reason to widen)."""
+    out = {}
+    for c, pars in cpars.items():
+        for p in pars:
+            sides = set(p.limits)
+            if p.off == p.lower:
+                sides.add("lower")
+            if p.off == p.upper:
+                sides.add("upper")
+            out[f"{c}.{p.name}"] = tuple(sides)
+    return out
 
 
 __all__ = ["diagnose", "Diagnosis", "CandidateResult", "VERDICTS", "gap_shrink", "CONFUSABLE_COSINE",

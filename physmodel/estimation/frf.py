@@ -1,5 +1,19 @@
 """Frequency responses with per-line uncertainty, estimated from time records.
 
+Front door
+----------
+:func:`estimate_frf` (and :func:`estimate_record` with its default ``method="auto"``) reads the
+excitation from the input channel and picks the estimator: clipping is checked on every channel
+(:mod:`physmodel.estimation.clipping`: refused above 1 % of samples held at a rail, warned below),
+the excitation is detected (:mod:`physmodel.estimation.excitation_detection`), then a periodic
+input is estimated at its excited lines over whole steady periods
+(:mod:`physmodel.estimation.periodic`), a stepped sine on its detected steps
+(:mod:`physmodel.estimation.stepped`), and only a random input by Welch (below) with a segment
+that resolves the requested band.  A record too short for one line in the band is refused; every
+estimate carries a per-line coherence and ``settings['coherence_threshold']``; low coherence,
+clipping below the limit and unused steps are ``FRFEstimate.warnings`` (and ``FRFWarning``).
+``tests/benchmarks/bench_frf_excitation.py`` measures it on records from its own generator.
+
 Estimators
 ----------
 :func:`h1`, :func:`h2`
@@ -46,7 +60,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import fft as sp_fft
@@ -55,165 +68,19 @@ from scipy import signal
 from ..data.sweep import FrequencySweep
 from ..data.timerecord import sample_rate
 from ..errors import IPMCError
+from .frf_estimate import (
+    BLOCK_SAMPLES,
+    FRFEstimate,
+    as_outputs,
+    as_signal,
+    channel_names,
+    coherence_threshold,
+    finite_block,
+    sigma_from_coherence,
+)
 
-NEPER_TO_DB = 20.0 / math.log(10.0)
-BLOCK_SAMPLES = 1 << 20
-
-
-# ----------------------------------------------------------------------------------- inputs
-def _as_signal(x, name: str, n: int | None = None):
-    if np.ndim(x) != 1:
-        raise IPMCError(f"{name} must be 1-D samples, got shape {np.shape(x)}")
-    if n is not None and len(x) != n:
-        raise IPMCError(f"{name} has {len(x)} samples; the input has {n}")
-    return x
-
-
-def _as_outputs(y, n: int) -> list:
-    """Output channels as a list of 1-D sample arrays (views, not copies)."""
-    if isinstance(y, (list, tuple)):
-        outs = list(y)
-    elif np.ndim(y) == 1:
-        outs = [y]
-    elif np.ndim(y) == 2:
-        outs = [y[i] for i in range(np.shape(y)[0])]
-    else:
-        raise IPMCError(f"y must be (n,) or (channels, n) samples, got shape {np.shape(y)}")
-    if not outs:
-        raise IPMCError("y: no output channels")
-    return [_as_signal(v, f"y[{i}]", n) for i, v in enumerate(outs)]
-
-
-def _names(names, units, k: int, default: str):
-    names = tuple(names) if names is not None else ((default,) if k == 1 else tuple(f"{default}{i}" for i in range(k)))
-    units = tuple(units) if units is not None else ("1",) * k
-    if len(names) != k or len(units) != k:
-        raise IPMCError(f"output_names/output_units: {len(names)} names and {len(units)} units for {k} output channels")
-    return names, units
-
-
-def _finite_block(x, name: str, offset: int) -> np.ndarray:
-    x = np.asarray(x, dtype=float)
-    if not np.all(np.isfinite(x)):
-        bad = np.flatnonzero(~np.isfinite(x))[:5] + offset
-        raise IPMCError(f"{name} contains NaN or inf at samples {bad.tolist()}")
-    return x
-
-
-# ----------------------------------------------------------------------------------- result
-@dataclass(frozen=True)
-class FRFEstimate:
-    """Estimated frequency response of one input to one or more output channels.
-
-    Attributes
-    ----------
-    frequency_hz : (n_f,) ndarray          lines, increasing. [Hz]
-    response : (n_out, n_f) complex ndarray   output/input in ``output_units[i]/input_unit``
-    magnitude_std_db : (n_out, n_f) ndarray   σ of 20·log10|H|. [dB]
-    phase_std_deg : (n_out, n_f) ndarray      σ of the phase. [deg]
-    coherence : (n_out, n_f) ndarray or None  ordinary coherence γ² (Welch estimators only)
-    n_averages : (n_f,) ndarray            segments (Welch) or whole periods (stepped sine) per line
-    method : str                           "h1", "h2" or "stepped_sine"
-    input_name, input_unit : str
-    output_names, output_units : tuple of str
-    settings : dict                        estimator settings (fs, nperseg, window, settle, ...)
-    """
-
-    frequency_hz: np.ndarray
-    response: np.ndarray
-    magnitude_std_db: np.ndarray
-    phase_std_deg: np.ndarray
-    coherence: np.ndarray | None
-    n_averages: np.ndarray
-    method: str
-    input_name: str = "input"
-    input_unit: str = "1"
-    output_names: tuple = ("output",)
-    output_units: tuple = ("1",)
-    settings: dict = field(default_factory=dict)
-
-    def index(self, output: str | int | None) -> int:
-        """Row of an output channel (by name or index; None = the only one)."""
-        if output is None:
-            if len(self.output_names) != 1:
-                raise IPMCError(f"output: the estimate has channels {list(self.output_names)}; name one")
-            return 0
-        if isinstance(output, (int, np.integer)) and 0 <= output < len(self.output_names):
-            return int(output)
-        if output in self.output_names:
-            return self.output_names.index(output)
-        raise IPMCError(f"output {output!r} is not a channel of the estimate; expected one of {list(self.output_names)}")
-
-    def channel(self, output: str | int | None) -> FRFEstimate:
-        """The estimate for one output channel."""
-        i = self.index(output)
-        return replace(self, response=self.response[i:i + 1], magnitude_std_db=self.magnitude_std_db[i:i + 1],
-                       phase_std_deg=self.phase_std_deg[i:i + 1],
-                       coherence=None if self.coherence is None else self.coherence[i:i + 1],
-                       output_names=(self.output_names[i],), output_units=(self.output_units[i],))
-
-    def reciprocal(self, output: str | int | None = None) -> FRFEstimate:
-        """input/output of one channel (e.g. impedance V/I from the admittance I/V estimated with the
-        voltage as reference).  σ of ln|H| and of the phase are unchanged by inversion."""
-        c = self.channel(output)
-        return replace(c, response=1.0 / c.response, input_name=c.output_names[0], input_unit=c.output_units[0],
-                       output_names=(c.input_name,), output_units=(c.input_unit,),
-                       settings={**c.settings, "reciprocal": True})
-
-    def to_sweep(self, temperature_c: float, output: str | int | None = None, *, min_coherence: float | None = None,
-                 band_hz: tuple | None = None, max_std_db: float | None = None, quantity: str | None = None,
-                 metadata: dict | None = None) -> FrequencySweep:
-        """A :class:`~physmodel.sweep.FrequencySweep` of one channel at ``temperature_c`` [°C].
-
-        ``min_coherence``, ``band_hz`` [Hz] and ``max_std_db`` [dB] drop lines (e.g. the unexcited
-        bins of a multisine, or lines whose log-magnitude error is too large to be Gaussian: beyond
-        about 1 dB the ±2σ interval of 20·log10|H| covers less than 95 %, see the module doc); a kept
-        line without a finite response and σ is an error naming its frequency.
-        """
-        if not math.isfinite(float(temperature_c)):
-            raise IPMCError(f"temperature_c={temperature_c!r} must be a finite number [°C]")
-        i = self.index(output)
-        f = self.frequency_hz
-        keep = np.ones(f.size, dtype=bool)
-        if band_hz is not None:
-            lo, hi = (float(v) for v in band_hz)
-            if not lo <= hi:
-                raise IPMCError(f"band_hz={band_hz!r} must be (low, high) with low <= high [Hz]")
-            keep &= (f >= lo) & (f <= hi)
-        if min_coherence is not None:
-            if self.coherence is None:
-                raise IPMCError(f"min_coherence: a {self.method} estimate has no coherence; use band_hz")
-            with np.errstate(invalid="ignore"):
-                keep &= self.coherence[i] >= float(min_coherence)
-        if max_std_db is not None:
-            if not float(max_std_db) > 0:
-                raise IPMCError(f"max_std_db={max_std_db!r} must be > 0 [dB]")
-            with np.errstate(invalid="ignore"):
-                keep &= self.magnitude_std_db[i] <= float(max_std_db)
-        if not keep.any():
-            raise IPMCError(f"no lines left after band_hz={band_hz!r}, min_coherence={min_coherence!r} "
-                            f"and max_std_db={max_std_db!r}")
-        H, sm, sp = self.response[i, keep], self.magnitude_std_db[i, keep], self.phase_std_deg[i, keep]
-        bad = ~(np.isfinite(H) & (H != 0) & np.isfinite(sm) & np.isfinite(sp))
-        if bad.any():
-            raise IPMCError(f"lines at {f[keep][bad][:5].tolist()} Hz have no finite response or σ "
-                            f"(no excitation there?); drop them with min_coherence=, band_hz= or the "
-                            f"estimator's frequencies_hz=")
-        meta = {"source": f"physmodel.estimation.frf.{self.method}", "method": self.method,
-                **{k: str(v) for k, v in self.settings.items()}}
-        if quantity is not None:
-            meta["quantity"] = quantity
-        meta.update({k: str(v) for k, v in (metadata or {}).items()})
-        return FrequencySweep(np.full(H.size, float(temperature_c)), f[keep], H, sm, sp, self.input_name,
-                              self.input_unit, self.output_names[i], self.output_units[i], meta)
-
-
-def _sigma_from_coherence(coh: np.ndarray, dof: float) -> tuple[np.ndarray, np.ndarray]:
-    """σ [dB], σ [deg] of an FRF line from coherence and degrees of freedom (Bendat & Piersol 9.90)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.sqrt(np.clip(1.0 - coh, 0.0, None) / (2.0 * dof * coh))
-    s = np.where(coh > 0, s, np.inf)
-    return NEPER_TO_DB * s, np.degrees(s)
+__all__ = ["FRFEstimate", "effective_averages", "welch_frf", "h1", "h2", "estimate_frf", "estimate_record",
+           "frf_sweep"]
 
 
 # ----------------------------------------------------------------------------------- Welch
@@ -272,9 +139,9 @@ def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = Non
         raise IPMCError(f"estimator={estimator!r}; expected 'h1' or 'h2'")
     if detrend not in ("constant", "linear", False, None):
         raise IPMCError(f"detrend={detrend!r}; expected 'constant', 'linear' or False")
-    u = _as_signal(u, "u")
+    u = as_signal(u, "u")
     n_all = len(u)
-    ys = _as_outputs(y, n_all)
+    ys = as_outputs(y, n_all)
     fs = sample_rate(t_or_fs, n_all, block_samples)
     if not (math.isfinite(discard_s) and discard_s >= 0):
         raise IPMCError(f"discard_s={discard_s!r} must be a finite number >= 0 [s]")
@@ -311,11 +178,11 @@ def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = Non
     for k0 in range(0, K, B):
         k1 = min(K, k0 + B)
         a, b = start + k0 * step, start + (k1 - 1) * step + nperseg
-        U = _spectra(_finite_block(u[a:b], "u", a), nperseg, step, win, detrend)
+        U = _spectra(finite_block(u[a:b], "u", a), nperseg, step, win, detrend)
         Suu += _power(U)
         np.conjugate(U, out=U)
         for c, yc in enumerate(ys):
-            Y = _spectra(_finite_block(yc[a:b], f"y[{c}]", a), nperseg, step, win, detrend)
+            Y = _spectra(finite_block(yc[a:b], f"y[{c}]", a), nperseg, step, win, detrend)
             Suy[c] += np.einsum("ij,ij->j", U, Y)
             Syy[c] += _power(Y)
             del Y
@@ -336,12 +203,12 @@ def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = Non
         coh = np.abs(Suy)**2 / (Suu * Syy)
     coh = np.where(np.isfinite(coh), coh, 0.0)
     n_eff = effective_averages(win, step, K)
-    sm, sp = _sigma_from_coherence(coh, n_eff - 1.0)
-    names, units = _names(output_names, output_units, len(ys), "output")
+    sm, sp = sigma_from_coherence(coh, n_eff - 1.0)
+    names, units = channel_names(output_names, output_units, len(ys), "output")
     settings = {"fs_hz": fs, "nperseg": nperseg, "noverlap": int(noverlap),
                 "window": window if isinstance(window, (str, tuple)) else "custom", "detrend": detrend,
                 "discard_s": discard_s, "segments": K, "effective_averages": round(n_eff, 3),
-                "resolution_hz": fs / nperseg}
+                "resolution_hz": fs / nperseg, "coherence_threshold": round(coherence_threshold(max(n_eff, 2.0)), 4)}
     return FRFEstimate(f, H, sm, sp, coh, np.full(f.size, K), estimator, input_name, input_unit, names, units, settings)
 
 
@@ -355,20 +222,219 @@ def h2(t_or_fs, u, y, **kw) -> FRFEstimate:
     return welch_frf(t_or_fs, u, y, estimator="h2", **kw)
 
 
-# ----------------------------------------------------------------------------------- records
-def estimate_record(record, input: str, outputs: Sequence[str] | None = None, method: str = "h1",
+# ----------------------------------------------------------------------------------- reading the excitation
+#: Welch segments of a random excitation: at least this many samples.
+MIN_NPERSEG = 16
+#: Keywords that ask for a Welch estimate explicitly (:func:`estimate_record` with ``method="auto"``).
+WELCH_KEYWORDS = ("nperseg", "noverlap", "window", "detrend", "frequencies_hz")
+
+
+def _in_band(f: np.ndarray, band_hz) -> np.ndarray:
+    if band_hz is None:
+        return np.ones(f.size, dtype=bool)
+    lo, hi = (float(v) for v in band_hz)
+    if not 0 <= lo <= hi:
+        raise IPMCError(f"band_hz={band_hz!r} must be (low, high) with 0 <= low <= high [Hz]")
+    return (f >= lo) & (f <= hi)
+
+
+def _random_nperseg(n: int, fs: float, band_hz) -> int:
+    """Longest power of two giving ≥ 16 Hann segments at 50 % overlap, lengthened so the bin width
+    is at most half the band's lower edge; refused when not 2 segments of MIN_NPERSEG remain."""
+    nper = 1 << max(int(math.floor(math.log2(max(2 * n / 17, 1)))), 0)
+    lo = float(band_hz[0]) if band_hz is not None else 0.0
+    if lo > 0:
+        nper = max(nper, 1 << int(math.ceil(math.log2(2 * fs / lo))))
+    nper = max(nper, MIN_NPERSEG)
+    if (n - nper) // (nper // 2) + 1 < 2:
+        need = "" if lo <= 0 else f" to resolve band_hz={tuple(band_hz)!r} (bin width {lo / 2:g} Hz)"
+        raise IPMCError(f"the record has {n} samples: too short for a random-excitation estimate{need}; it needs "
+                        f"2 half-overlapping segments of {nper} samples ({nper * 3 // 2} samples, "
+                        f"{nper * 1.5 / fs:g} s)")
+    return nper
+
+
+def _stepped_schedule(exc, u, ys, fs: float, block: int, notes: list):
+    """Per step: frequency, start, stop, settle periods (transient found from the period phasors;
+    a trailing period that mixes two steps cut)."""
+    from .periodic import leading_transient
+    from .stepped import period_phasors
+
+    f, a, b = exc.step_frequency_hz, exc.step_start_s, exc.step_stop_s
+    keep = np.ones(f.size, dtype=bool)
+    _, first = np.unique(f, return_index=True)
+    rep = np.setdiff1d(np.arange(f.size), first)
+    if rep.size:
+        keep[rep] = False
+        notes.append(f"stepped sine: repeated steps at {f[rep][:5].round(6).tolist()} Hz not used (first kept)")
+    fast = f > fs / 4
+    if fast.any():
+        keep &= ~fast
+        notes.append(f"stepped sine: steps above fs/4 ({f[fast][:5].round(3).tolist()} Hz) not used")
+    rows = []
+    for i in np.flatnonzero(keep):
+        P = int(round((b[i] - a[i]) * f[i]))
+        ph = period_phasors([u, *ys], fs, 0.0, a[i], f[i], P, block)
+        U, Y = ph[:, 0], ph[:, 1:]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lead = max(leading_transient(U), leading_transient(Y / U[:, None]))
+        trail = leading_transient(U[::-1])
+        if P - lead - trail < 2:
+            notes.append(f"stepped sine: the step at {f[i]:.6g} Hz has {P} periods, {lead + trail} unsettled; not used")
+            continue
+        rows.append((f[i], a[i], a[i] + (P - trail) / f[i], lead))
+    if not rows:
+        raise IPMCError("stepped sine: no step keeps 2 settled whole periods; record longer steps")
+    return (np.array(v) for v in zip(*rows))
+
+
+def estimate_frf(t_or_fs, u, y, *, estimator: str = "h1", excitation: str = "auto", band_hz=None,
+                 discard_s: float | None = None, max_clipped_fraction: float | None = None,
+                 block_samples: int = BLOCK_SAMPLES, input_name: str = "input", input_unit: str = "1",
+                 output_names: Sequence[str] | None = None, output_units: Sequence[str] | None = None) -> FRFEstimate:
+    """The FRF estimate the input's excitation calls for, found from the samples.
+
+    1. Clipping: each channel is checked for samples held at a rail
+       (:func:`~physmodel.estimation.clipping.detect_clipping`); more than
+       ``max_clipped_fraction`` on any channel is refused, less is a warning.
+    2. The excitation (:func:`~physmodel.estimation.excitation_detection.detect_excitation`):
+       *periodic* → :func:`~physmodel.estimation.periodic.periodic_frf` at the excited lines over
+       whole periods, the transient found from the period scatter; *stepped sine* →
+       :func:`~physmodel.estimation.stepped.stepped_sine` on the detected steps, each step's
+       transient found the same way; *random* → Welch (:func:`welch_frf`, Hann, 50 % overlap) with
+       the longest power-of-two segment giving ≥ 16 segments, lengthened to resolve ``band_hz``.
+    3. Lines outside ``band_hz`` (and the Nyquist line) are not estimated; a record too short for
+       one line in the band is refused.  ``settings['excitation']`` says what was detected and
+       ``settings['coherence_threshold']`` what an unrelated output exceeds 1 % of the time; more
+       than half of a channel's lines below it is a low-coherence warning.  Warnings are in
+       ``FRFEstimate.warnings`` and issued as :class:`~physmodel.estimation.frf_estimate.FRFWarning`.
+
+    Parameters
+    ----------
+    t_or_fs : float or (n,) array_like
+        Sample rate [Hz] or uniform sample times [s].
+    u : (n,) array_like
+        Input samples.
+    y : (n,) or (n_out, n) array_like, or a list of (n,) arrays
+        Output channels.
+    estimator : "h1" | "h2"
+        Ratio for periodic and random excitation (a stepped sine is always the ratio of mean phasors).
+    excitation : "auto" | "periodic" | "stepped_sine" | "random"
+        Expected excitation: "auto" takes what is detected, another value refuses a record where
+        something else is detected ("random" always runs Welch).
+    band_hz : (float, float) or None
+        Lines kept, (low, high). [Hz]
+    discard_s : float or None
+        Leading time not used (periodic and random); None: periodic finds its transient, random uses all. [s]
+    max_clipped_fraction : float or None
+        Largest fraction of clipped samples accepted on a channel (default
+        :data:`~physmodel.estimation.clipping.MAX_CLIPPED_FRACTION`; 1 only warns).
+    block_samples : int
+        Samples read per block (bounds the memory).
+    input_name, input_unit, output_names, output_units : str or sequences of str
+        Channel names and units carried into the estimate.
+    """
+    import warnings as _warnings
+    from dataclasses import replace
+
+    from .clipping import check_clipping
+    from .excitation_detection import Excitation, detect_excitation
+    from .frf_estimate import FRFWarning, low_coherence_warning
+    from .periodic import periodic_frf
+    from .stepped import stepped_sine
+
+    if estimator not in ("h1", "h2"):
+        raise IPMCError(f"estimator={estimator!r}; expected 'h1' or 'h2'")
+    if excitation not in ("auto", "periodic", "stepped_sine", "random"):
+        raise IPMCError(f"excitation={excitation!r}; expected 'auto', 'periodic', 'stepped_sine' or 'random'")
+    if discard_s is not None and not (math.isfinite(discard_s) and discard_s >= 0):
+        raise IPMCError(f"discard_s={discard_s!r} must be a finite number >= 0 [s]")
+    u = as_signal(u, "u")
+    n = len(u)
+    ys = as_outputs(y, n)
+    fs = sample_rate(t_or_fs, n, block_samples)
+    names, units = channel_names(output_names, output_units, len(ys), "output")
+    if n < MIN_NPERSEG + MIN_NPERSEG // 2:
+        raise IPMCError(f"the record has {n} samples ({n / fs:g} s): too short for one line of a frequency "
+                        f"response with σ (at least {MIN_NPERSEG * 3 // 2} samples)")
+    notes = check_clipping({input_name: u, **dict(zip(names, ys))}, max_clipped_fraction)
+    exc = Excitation("random", fs, evidence={"forced": "random"}) if excitation == "random" \
+        else detect_excitation(None, u, fs_hz=fs)
+    if excitation not in ("auto", "random") and exc.kind != excitation:
+        raise IPMCError(f"excitation={excitation!r}, but the input looks {exc.describe()}")
+    common = dict(block_samples=block_samples, input_name=input_name, input_unit=input_unit, output_names=names,
+                  output_units=units)
+    if exc.kind == "periodic":
+        N = int(exc.period_samples or 0)
+        lines = exc.lines[_in_band(exc.frequency_hz, band_hz)]
+        if lines.size == 0:
+            raise IPMCError(f"no excited line in band_hz={band_hz!r}; the input's lines are "
+                            f"{exc.frequency_hz.min():g}-{exc.frequency_hz.max():g} Hz")
+        drop = None
+        if discard_s is not None:
+            drop = max(0, int(math.ceil((discard_s * fs - n % N) / N - 1e-9)))
+        est = periodic_frf(fs, u, ys, N, lines, estimator=estimator, discard_periods=drop, **common)
+    elif exc.kind == "stepped_sine":
+        if discard_s is not None:
+            raise IPMCError("discard_s applies to periodic and random excitation; a stepped sine's transient is "
+                            "found step by step (or estimate with stepped_sine(..., settle_s=))")
+        f, a, b, settle = _stepped_schedule(exc, u, ys, fs, block_samples, notes)
+        inb = _in_band(f, band_hz)
+        if not inb.any():
+            raise IPMCError(f"no step in band_hz={band_hz!r}; the steps are {f.min():g}-{f.max():g} Hz")
+        est = stepped_sine(fs, u, ys, f[inb], a[inb], b[inb], settle_periods=settle[inb], **common)
+    else:
+        start = int(math.ceil((discard_s or 0.0) * fs - 1e-9))
+        nper = _random_nperseg(n - start, fs, band_hz)
+        est = welch_frf(fs, u, ys, estimator=estimator, nperseg=nper, discard_s=discard_s or 0.0, **common)
+        keep = _in_band(est.frequency_hz, band_hz) & (est.frequency_hz < fs / 2)
+        if not keep.any():
+            raise IPMCError(f"no line of a {nper}-sample segment (bin width {fs / nper:g} Hz) lies in "
+                            f"band_hz={band_hz!r}; record longer or widen the band")
+        est = replace(est, frequency_hz=est.frequency_hz[keep], response=est.response[:, keep],
+                      magnitude_std_db=est.magnitude_std_db[:, keep], phase_std_deg=est.phase_std_deg[:, keep],
+                      coherence=None if est.coherence is None else est.coherence[:, keep],
+                      n_averages=est.n_averages[keep])
+    low = low_coherence_warning(est)
+    if low:
+        notes.append(low)
+    est = replace(est, settings={**est.settings, "excitation": exc.describe()}, warnings=tuple(notes))
+    for note in notes:
+        _warnings.warn(FRFWarning(note), stacklevel=2)
+    return est
+
+
+def estimate_record(record, input: str, outputs: Sequence[str] | None = None, method: str = "auto",
                     **kw) -> FRFEstimate:
     """FRF from channel ``input`` to ``outputs`` (default: every other channel) of a
-    :class:`~physmodel.estimation.records.TimeRecord`, in the record's units.
+    :class:`~physmodel.data.timerecord.TimeRecord`, in the record's units.
 
-    ``method``: "h1", "h2" (keywords of :func:`welch_frf`) or "stepped_sine" (keywords of
+    ``method``: "auto" (default: :func:`estimate_frf`, which reads the excitation from the input;
+    with any of ``nperseg``, ``noverlap``, ``window``, ``detrend``, ``frequencies_hz`` it is an
+    explicit Welch H1), "h1", "h2" (keywords of :func:`welch_frf`) or "stepped_sine" (keywords of
     :func:`~physmodel.estimation.stepped.stepped_sine`).
+
+    Parameters
+    ----------
+    record : TimeRecord
+        The record.
+    input : str
+        Input (reference) channel.
+    outputs : sequence of str or None
+        Output channels; None: every other channel.
+    method : str
+        Estimator, see above.
+    **kw
+        Keywords of the estimator.
     """
     from .stepped import stepped_sine
 
-    fns: dict[str, Callable[..., FRFEstimate]] = {"h1": h1, "h2": h2, "stepped_sine": stepped_sine}
+    fns: dict[str, Callable[..., FRFEstimate]] = {"auto": estimate_frf, "h1": h1, "h2": h2,
+                                                  "stepped_sine": stepped_sine}
     if method not in fns:
         raise IPMCError(f"method={method!r}; expected one of {list(fns)}")
+    if method == "auto" and any(k in kw for k in WELCH_KEYWORDS):
+        method = "h1"
     inp = record.resolve(input)
     outs = [c for c in record.channels if c != inp] if outputs is None else [record.resolve(o) for o in outputs]
     if not outs:

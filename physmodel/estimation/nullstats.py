@@ -13,7 +13,7 @@ import numpy as np
 from ..data.sweep import FrequencySweep
 from .diagnosis import CONFUSABLE_COSINE, MIN_SIGNATURE_LR
 from .residuals import standardised_residuals
-from .signatures import _orth, _project_out, _separation, _signature, _simulated, _z_jacobian
+from .signatures import effect_signature, orth, project_out, separation_hint, with_noise, z_jacobian
 
 #: A candidate parameter whose tangent signature at off is below this fraction of its secant to the
 #: typical size (the first-order term carries < 10 % of the change, e.g. a resonance
@@ -25,17 +25,17 @@ def signature_stage(pm, v0: dict, free0, cand, cpars: dict, r0, data, s_ln, s_ph
     """Signatures of every candidate at the fitted baseline ``v0`` (columns d r/d δ, the baseline
     Jacobian projected out), which are one-sided, skipped (no signature on these data), described by
     the secant, *degenerate* (parameters with no first-order signature at off, scanned by
-    :func:`_scan_lr`), and the pairs whose signatures are confusable (canonical correlation
+    :func:`scan_lr`), and the pairs whose signatures are confusable (canonical correlation
     ≥ ``CONFUSABLE_COSINE``) with what separates them.
 
     Returns ``(J0, Q0, sigs, sided, skipped, first_order, raw_sigs, degenerate, confusable, separation)``."""
-    J0 = _z_jacobian(pm, v0, free0, r0, data, s_ln, s_ph)
-    Q0 = _orth(J0)
+    J0 = z_jacobian(pm, v0, free0, r0, data, s_ln, s_ph)
+    Q0 = orth(J0)
     sigs, sided, skipped, first_order, raw_sigs, degenerate = {}, {}, {}, {}, {}, {}
     for c in cand:
-        S, one = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
+        S, one = effect_signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c])
         reach = np.array([max(abs(p.upper - p.off), abs(p.lower - p.off)) / abs(p.typical - p.off) for p in cpars[c]])
-        Ssec, _ = _signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c], h=1.0)    # secant to the typical size
+        Ssec, _ = effect_signature(pm, v0, c, r0, data, s_ln, s_ph, cpars[c], h=1.0)    # secant to the typical size
         sec = np.linalg.norm(S, axis=0) < SECANT_RATIO * np.linalg.norm(Ssec, axis=0)
         if len(cpars[c]) > 1 and np.all(np.isfinite(S)):
             dead = _needs_others(pm, v0, c, cpars[c], np.where(sec[None, :], Ssec, S), r0, data, s_ln, s_ph,
@@ -48,7 +48,7 @@ def signature_stage(pm, v0: dict, free0, cand, cpars: dict, r0, data, s_ln, s_ph
             S = np.where(sec[None, :], Ssec, S)
             first_order[c] = ("no first-order signature at off in " + ", ".join(
                 p.name for p, x in zip(cpars[c], sec) if x) + " (secant to the typical size there; refitted)")
-        Sp = _project_out(Q0, S)
+        Sp = project_out(Q0, S)
         max_lr = float(np.sum((np.linalg.norm(Sp, axis=0) * reach) ** 2))
         if not np.all(np.isfinite(S)) or np.sum((np.linalg.norm(S, axis=0) * reach) ** 2) < MIN_SIGNATURE_LR:
             skipped[c] = "no signature on these data (cannot change the cost by the noise level)"
@@ -57,18 +57,18 @@ def signature_stage(pm, v0: dict, free0, cand, cpars: dict, r0, data, s_ln, s_ph
         if max_lr < MIN_SIGNATURE_LR and c not in first_order:
             first_order[c] = "confounded with the free parameters to first order (refitted; only nonlinear terms can show it)"
     confusable = []
-    orth = {c: _orth(S) for c, S in sigs.items() if c not in first_order or first_order[c].startswith("no first")}
-    for a, b in combinations(orth, 2):
-        if orth[a].shape[1] == 0 or orth[b].shape[1] == 0:
+    bases = {c: orth(S) for c, S in sigs.items() if c not in first_order or first_order[c].startswith("no first")}
+    for a, b in combinations(bases, 2):
+        if bases[a].shape[1] == 0 or bases[b].shape[1] == 0:
             continue
-        cos = float(np.linalg.svd(orth[a].T @ orth[b], compute_uv=False).max())
+        cos = float(np.linalg.svd(bases[a].T @ bases[b], compute_uv=False).max())
         if cos >= CONFUSABLE_COSINE:
             confusable.append((a, b, min(cos, 1.0)))
-    separation = {f"{a}~{b}": _separation(a, b, raw_sigs, data) for a, b, _ in confusable}
+    separation = {f"{a}~{b}": separation_hint(a, b, raw_sigs, data) for a, b, _ in confusable}
     return J0, Q0, sigs, sided, skipped, first_order, raw_sigs, degenerate, confusable, separation
 
 
-def _constrained_lr(S, one_sided, E):
+def constrained_lr(S, one_sided, E):
     """Max over δ (one-sided components ≥ 0) of 2δᵀSᵀe − δᵀSᵀSδ for every column e of E.
 
     Exact for ≤ 3 parameters by enumerating active sets (concave quadratic)."""
@@ -76,7 +76,7 @@ def _constrained_lr(S, one_sided, E):
 
 
 def _constrained_lr_gram(G, B, one_sided):
-    """:func:`_constrained_lr` from the Gram matrix ``G`` = SᵀS (..., k, k) and ``B`` = SᵀE (..., k, n),
+    """:func:`constrained_lr` from the Gram matrix ``G`` = SᵀS (..., k, k) and ``B`` = SᵀE (..., k, n),
     batched over any leading axes (a zero column is a parameter left out); returns (..., n)."""
     k = G.shape[-1]
     best = np.zeros(B.shape[:-2] + B.shape[-1:])
@@ -95,7 +95,7 @@ def _constrained_lr_gram(G, B, one_sided):
     return best
 
 
-#: Largest number of grid points of :func:`_scan_lr` per candidate (a few model evaluations each).
+#: Largest number of grid points of :func:`scan_lr` per candidate (a few model evaluations each).
 SCAN_POINTS = 256
 
 
@@ -111,7 +111,7 @@ def _scan_axis(p, n: int) -> np.ndarray:
     return np.linspace(p.lower, p.upper, n)
 
 
-def _scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, data, s_ln, s_ph, Q0, E,
+def scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, data, s_ln, s_ph, Q0, E,
              h: float = 1e-3, max_points: int = SCAN_POINTS) -> np.ndarray:
     """Linearised null LR of a candidate whose parameters include *degenerate* ones (no first-order
     signature at off: a shape that only exists once the effect is on, e.g. the frequency and damping
@@ -188,7 +188,7 @@ def bootstrap_ratio(E, lin_max, G0, data, s_ln, s_ph, n_refits: int, fit_null, r
     Returns ``(ratio, full_max, lin_used)``."""
     full_max, lin_used = [], []
     for b in range(n_refits):
-        sim = FrequencySweep(data.temperature_c, data.frequency_hz, _simulated(G0, E[:, b], s_ln, s_ph),
+        sim = FrequencySweep(data.temperature_c, data.frequency_hz, with_noise(G0, E[:, b], s_ln, s_ph),
                              np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
                              data.input_unit, data.output_name, data.output_unit)
         full_max.append(float(refit_max(sim, fit_null(sim))))

@@ -26,7 +26,7 @@ import numpy as np
 from ..data.sweep import FrequencySweep
 from ..effects import get_effect
 from ..errors import ParameterError
-from ..parameter_paths import base_value
+from ..parameter_paths import is_effect_parameter, resolve_path
 from ..params import IPMCParameters
 from ..plausible import PlausibleRange
 from .calibration import default_free_parameter
@@ -118,13 +118,23 @@ def penalties_for(free: Sequence[FreeParameter], ranges: Mapping[str, PlausibleR
 
 
 # =============================================================================== free parameters
-def _free_list(base: IPMCParameters, free, effects: dict) -> list:
+def free_parameters_for(base: IPMCParameters, free, effects: dict) -> list:
+    """The free parameters of a diagnosis as :class:`FreeParameter` records, each with an initial value.
+
+    ``free``: names or records; a parameter of the set (a field, ``omega_n``, ``laws.<q>.<a>``) gets
+    :func:`~physmodel.estimation.calibration.default_free_parameter`'s bounds, an effect's
+    (``"effect.parameter"``) its library bounds and, as its initial value, its value in ``effects``
+    ({effect: {parameter: value}}, the baseline effects); an initial value left out is the value in
+    ``base`` or ``effects``, clipped to the bounds.  Each name of the set is resolved once
+    (:func:`~physmodel.parameter_paths.resolve_path`).
+    """
     out = []
     for item in free:
+        path = None
         if isinstance(item, FreeParameter):
             fp = item
         elif isinstance(item, str):
-            if "." in item and not item.startswith("laws."):
+            if is_effect_parameter(item):
                 e, p = item.split(".", 1)
                 if e not in effects:
                     raise ParameterError(f"free parameter {item!r} belongs to effect {e!r}, which is not among "
@@ -132,15 +142,16 @@ def _free_list(base: IPMCParameters, free, effects: dict) -> list:
                 par = get_effect(e).parameter(p)
                 fp = FreeParameter(item, par.lower, par.upper, "linear", effects[e][p])
             else:
-                fp = default_free_parameter(base, item)
+                path = resolve_path(base, item)
+                fp = default_free_parameter(base, path)
         else:
             raise ParameterError(f"free parameters must be names or FreeParameter, got {item!r}")
         if fp.initial is None:
-            if "." in fp.name and not fp.name.startswith("laws."):
+            if is_effect_parameter(fp.name):
                 e, p = fp.name.split(".", 1)
                 v = effects[e][p]
             else:
-                v = base_value(base, fp.name)
+                v = (path or resolve_path(base, fp.name)).value
             fp = fp.with_initial(min(max(v, fp.lower), fp.upper))
         out.append(fp)
     return out
@@ -216,5 +227,5 @@ def cost_warning(cost: float, n_lines: int, n_free: int, level: float = 1e-3) ->
     return ""
 
 
-__all__ = ["RangePenalty", "PenalisedProblem", "penalties_for", "WALL_DECADES", "bound_audit", "plausible_audit",
-           "multistart_spread", "cost_warning", "AT_BOUND", "NEAR_BOUND"]
+__all__ = ["RangePenalty", "PenalisedProblem", "penalties_for", "free_parameters_for", "WALL_DECADES", "bound_audit",
+           "plausible_audit", "multistart_spread", "cost_warning", "AT_BOUND", "NEAR_BOUND"]

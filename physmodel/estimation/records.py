@@ -393,12 +393,13 @@ class CalibrationResult:
             metadata (``calibrate(effects=...)``) with any fitted ``effect.parameter`` values.
         """
         from ..model_file import FitVerdict, ModelFile, Provenance
+        from ..parameter_paths import is_effect_parameter
 
         if self.parameters is None:
             raise IPMCError("this calibration produced no parameter set; there is no model to write")
         eff = {k: dict(v) for k, v in (effects if effects is not None else self.metadata.get("effects") or {}).items()}
         for n in self.names:
-            if "." in n and not n.startswith("laws."):
+            if is_effect_parameter(n):
                 e, p = n.split(".", 1)
                 eff.setdefault(e, {})[p] = float(self.values[n])
         verdict = None if self.goodness_of_fit is None else FitVerdict.from_goodness(

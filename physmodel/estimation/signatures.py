@@ -16,7 +16,7 @@ from .records import FreeParameter
 from .residuals import noise_std, standardised_residuals
 
 
-def _z_jacobian(predict_many, values: dict, params: Sequence[FreeParameter], r0, data, s_ln, s_ph, step=1e-4):
+def z_jacobian(predict_many, values: dict, params: Sequence[FreeParameter], r0, data, s_ln, s_ph, step=1e-4):
     """Forward-difference Jacobian of the standardised residuals in the scaled z space."""
     pts, steps = [], []
     for fp in params:
@@ -32,7 +32,7 @@ def _z_jacobian(predict_many, values: dict, params: Sequence[FreeParameter], r0,
     return ((R - r0[None, :]) / np.array(steps)[:, None]).T
 
 
-def _signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph, params=None, h=1e-3):
+def effect_signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph, params=None, h=1e-3):
     """Columns d r/d δ at "off" for each effect parameter, δ in units of (typical − off);
     and which are one-sided (off at a bound).  ``params``: the effect's parameters with their
     candidate bounds (default: the library's).  ``h``: the step in δ (1: the secant to the typical
@@ -51,7 +51,9 @@ def _signature(predict_many, values: dict, effect: str, r0, data, s_ln, s_ph, pa
     return ((R - r0[None, :]) / np.array(steps)[:, None]).T, np.array(one_sided)
 
 
-def _orth(A):
+def orth(A):
+    """An orthonormal basis of the columns of ``A`` (QR; columns that add nothing above 1e-10 of the
+    largest dropped); ``A`` itself when it has no column."""
     if A.shape[1] == 0:
         return A
     Q, R = np.linalg.qr(A)
@@ -59,11 +61,12 @@ def _orth(A):
     return Q[:, keep]
 
 
-def _project_out(Q, A):
+def project_out(Q, A):
+    """The columns of ``A`` with the span of the orthonormal ``Q`` (:func:`orth`) removed."""
     return A - Q @ (Q.T @ A) if Q.shape[1] else A
 
 
-def _localise(data: FrequencySweep, r: np.ndarray, alpha: float, n_bands: int = 4) -> list:
+def localise(data: FrequencySweep, r: np.ndarray, alpha: float, n_bands: int = 4) -> list:
     """Standardised residuals by band × temperature × part, flagged at Bonferroni level α."""
     from scipy.stats import chi2
 
@@ -113,7 +116,10 @@ def _norm_sf(z):
     return 0.5 * math.erfc(z / math.sqrt(2))
 
 
-def _gap(data: FrequencySweep, r: np.ndarray, n_free: int) -> dict:
+def gap_statistics(data: FrequencySweep, r: np.ndarray, n_free: int) -> dict:
+    """The gap test's numbers for standardised residuals ``r`` of ``data`` with ``n_free`` fitted
+    parameters: cost ½Σr², its expectation N − n_free/2 and spread, their z, and the RMS misfit per
+    temperature in dB and degrees."""
     N = data.frequency_hz.size
     s_ln, s_ph, _ = noise_std(data)
     cost = float(0.5 * r @ r)
@@ -128,7 +134,7 @@ def _gap(data: FrequencySweep, r: np.ndarray, n_free: int) -> dict:
             "rms_deg": [float(np.sqrt(np.mean(deg[data.temperature_c == t] ** 2))) for t in temps]}
 
 
-def _separation(a: str, b: str, raw: dict, data: FrequencySweep) -> str:
+def separation_hint(a: str, b: str, raw: dict, data: FrequencySweep) -> str:
     """What tells two confusable candidates apart: their magnitude/phase split, their dependence on
     temperature and where in frequency their (unprojected) signatures act."""
     N = data.frequency_hz.size
@@ -159,7 +165,7 @@ def _separation(a: str, b: str, raw: dict, data: FrequencySweep) -> str:
     return "Separate by " + "; ".join(hints) + "."
 
 
-def _simulated(G, e, s_ln, s_ph):
+def with_noise(G, e, s_ln, s_ph):
     """``G`` with standardised log-magnitude/phase noise ``e`` (2N,) applied at σ ``s_ln`` [Np], ``s_ph`` [rad]."""
     N = G.size
     return G * np.exp(e[:N] * s_ln + 1j * e[N:] * s_ph)
@@ -210,7 +216,7 @@ def _noiseless(data: FrequencySweep, G, s_ln, s_ph) -> FrequencySweep:
                           np.degrees(s_ph), data.input_name, data.input_unit, data.output_name, data.output_unit)
 
 
-def _confusability(top: str, sig: Sequence[str], fits: dict, cres: dict, pm, data: FrequencySweep, s_ln, s_ph,
+def vuong_confusability(top: str, sig: Sequence[str], fits: dict, cres: dict, pm, data: FrequencySweep, s_ln, s_ph,
                    z_crit: float, refit) -> dict:
     """Is the best closer ``top`` separated from each other significant candidate?
 
@@ -246,15 +252,15 @@ def _confusability(top: str, sig: Sequence[str], fits: dict, cres: dict, pm, dat
 
 def _cosine(Sa, Sb) -> float:
     """Largest canonical correlation between two signature blocks (nan if either is empty)."""
-    Qa, Qb = _orth(Sa), _orth(Sb)
+    Qa, Qb = orth(Sa), orth(Sb)
     if Qa.shape[1] == 0 or Qb.shape[1] == 0:
         return float("nan")
     return float(min(np.linalg.svd(Qa.T @ Qb, compute_uv=False).max(), 1.0))
 
 
-def _declare(confusable: list, separation: dict, confusability: dict, sigs: dict, raw_sigs: dict, data) -> None:
+def declare_confusable(confusable: list, separation: dict, confusability: dict, sigs: dict, raw_sigs: dict, data) -> None:
     """Add to ``confusable``/``separation`` (in place) the pairs the data do not separate and those
-    confusable in this band (from :func:`_confusability`), each with its reason."""
+    confusable in this band (from :func:`vuong_confusability`), each with its reason."""
     declared = {frozenset(x[:2]) for x in confusable}
     rows = [(x, f"not separated by the data (Vuong z = {x['z']:.3g})")
             for x in confusability["data"] + confusability.get("pairs", []) if not x["separated"]]
@@ -267,11 +273,11 @@ def _declare(confusable: list, separation: dict, confusability: dict, sigs: dict
         if frozenset((a, b)) not in declared:
             declared.add(frozenset((a, b)))
             confusable.append((a, b, _cosine(sigs[a], sigs[b])))
-            separation[key] = _separation(a, b, raw_sigs, data)
+            separation[key] = separation_hint(a, b, raw_sigs, data)
         separation[key] = separation.get(key, "") + f" Declared: {why}."
 
 
-def _spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:
+def refit_spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:
     """Multi-start record of a candidate refit: ``runs`` = [(origin, CalibrationResult)]; the costs,
     origins, the best's origin, how many reach the best cost within ``tol`` (½Δχ²), the cost spread
     and each parameter's range over the starts that reach it."""
@@ -283,7 +289,7 @@ def _spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:
                        for n in best.names}}
 
 
-def _pair_members(best: Sequence[str], other: Sequence[str], sigs: dict) -> list:
+def pair_members(best: Sequence[str], other: Sequence[str], sigs: dict) -> list:
     """The members in which two pairs differ, matched one to one (by the larger signature cosine
     when both differ)."""
     db, do = [m for m in best if m not in other], [m for m in other if m not in best]

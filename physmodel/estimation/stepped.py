@@ -9,7 +9,10 @@ the end of a step is not used, and a request for a fractional number of periods 
 σ comes from the scatter between periods: ``δ ln H_k = (Y_k − H U_k)/Ȳ``, whose real and
 imaginary parts give the σ of ln|H| and of the phase (sample variance with P − 1 degrees of
 freedom, divided by P), reported in dB (×20/ln 10) and degrees.  It assumes the noise of different
-periods is independent (white or short-memory noise).
+periods is independent (white or short-memory noise).  The coherence of each step over its periods,
+``|Σ conj(U_k) Y_k|²/(Σ|U_k|² Σ|Y_k|²)``, shows whether the output follows the input at all
+(``settings['coherence_threshold']``: the value an unrelated output exceeds with probability 1 %
+at the fewest periods of any step).
 """
 
 from __future__ import annotations
@@ -21,7 +24,17 @@ import numpy as np
 
 from ..data.timerecord import sample_rate
 from ..errors import IPMCError
-from .frf import BLOCK_SAMPLES, NEPER_TO_DB, FRFEstimate, _as_outputs, _as_signal, _finite_block, _names
+from .frf_estimate import (
+    BLOCK_SAMPLES,
+    NEPER_TO_DB,
+    FRFEstimate,
+    as_outputs,
+    as_signal,
+    channel_names,
+    coherence_threshold,
+    finite_block,
+    phasor_scatter,
+)
 
 
 def _per_step(x, name: str, shape, what: str) -> np.ndarray:
@@ -34,8 +47,27 @@ def _per_step(x, name: str, shape, what: str) -> np.ndarray:
     return v
 
 
-def _period_phasors(chans: list, fs: float, t0: float, m0: float, f: float, P: int, block: int) -> np.ndarray:
-    """(P, n_channels) phasors (a − jb of a·cos + b·sin + c, phase from ``m0``) of P whole periods."""
+def period_phasors(chans: list, fs: float, t0: float, m0: float, f: float, P: int,
+                   block: int = BLOCK_SAMPLES) -> np.ndarray:
+    """(P, n_channels) phasors (a − jb of a·cos + b·sin + c, phase from ``m0``) of P whole periods.
+
+    Parameters
+    ----------
+    chans : list of (n,) arrays
+        Channels sampled together (the first is called ``u`` in errors, the others ``y[i]``).
+    fs : float
+        Sample rate. [Hz]
+    t0 : float
+        Time of sample 0. [s]
+    m0 : float
+        Start of the first period. [s]
+    f : float
+        Frequency of the sine. [Hz]
+    P : int
+        Whole periods fitted, one phasor each.
+    block : int
+        Samples read per block (bounds the memory).
+    """
     n = len(chans[0])
     a = max(int(math.ceil((m0 - t0) * fs - 1e-9)), 0)
     b = min(int(math.ceil((m0 + P / f - t0) * fs - 1e-9)), n)
@@ -49,7 +81,7 @@ def _period_phasors(chans: list, fs: float, t0: float, m0: float, f: float, P: i
         for k, (p, q) in enumerate(((c, c), (c, s), (c, None), (s, s), (s, None), (None, None))):
             sums[k] += np.bincount(g, weights=None if p is None else p if q is None else p * q, minlength=P)
         for x_i, x in enumerate(chans):
-            xb = _finite_block(x[a0:b0], "u" if x_i == 0 else f"y[{x_i - 1}]", a0)
+            xb = finite_block(x[a0:b0], "u" if x_i == 0 else f"y[{x_i - 1}]", a0)
             for k, q in enumerate((c, s, None)):
                 sums[6 + 3 * x_i + k] += np.bincount(g, weights=xb if q is None else xb * q, minlength=P)
     cc, cs, c1, ss, s1, n1 = sums[:6]
@@ -82,9 +114,9 @@ def stepped_sine(t_or_fs, u, y, frequencies_hz=None, step_start_s=None, step_sto
         period left in the step (a trailing partial period is not used).  Non-integer values are
         refused: a fractional period would leak.
     """
-    u = _as_signal(u, "u")
+    u = as_signal(u, "u")
     n = len(u)
-    ys = _as_outputs(y, n)
+    ys = as_outputs(y, n)
     fs = sample_rate(t_or_fs, n, block_samples)
     t0 = float(t_or_fs[0]) if np.ndim(t_or_fs) else 0.0
     if plan is not None:
@@ -141,22 +173,22 @@ def stepped_sine(t_or_fs, u, y, frequencies_hz=None, step_start_s=None, step_sto
     H = np.empty((len(ys), f.size), dtype=complex)
     sl = np.empty((len(ys), f.size))
     sp = np.empty((len(ys), f.size))
+    coh = np.empty((len(ys), f.size))
     for i in range(f.size):
         Pi = int(P[i])
-        ph = _period_phasors(chans, fs, t0, m0[i], f[i], Pi, block_samples)
+        ph = period_phasors(chans, fs, t0, m0[i], f[i], Pi, block_samples)
         U, Y = ph[:, 0], ph[:, 1:]
         if np.mean(U) == 0:
             raise IPMCError(f"step {i} ({f[i]:g} Hz): the input has no component at this frequency")
         Hi = Y.mean(axis=0) / U.mean()
-        with np.errstate(divide="ignore", invalid="ignore"):
-            z = (Y - Hi * U[:, None]) / Y.mean(axis=0)
         H[:, i] = Hi
-        sl[:, i] = np.sqrt(np.sum(z.real**2, axis=0) / ((Pi - 1) * Pi))
-        sp[:, i] = np.sqrt(np.sum(z.imag**2, axis=0) / ((Pi - 1) * Pi))
+        s_l, s_p, c = phasor_scatter(U[:, None], Y[:, :, None], Hi[:, None])
+        sl[:, i], sp[:, i], coh[:, i] = s_l[:, 0], s_p[:, 0], c[:, 0]
     order = np.argsort(f)
-    names, units = _names(output_names, output_units, len(ys), "output")
+    names, units = channel_names(output_names, output_units, len(ys), "output")
     settings = {"fs_hz": fs, "steps": f.size, "settle_s_min": float(settle.min()), "settle_s_max": float(settle.max()),
                 "periods_min": int(P.min()), "periods_max": int(P.max()),
-                "unused_tail_s_max": float(np.max(stops - m0 - P / f))}
-    return FRFEstimate(f[order], H[:, order], NEPER_TO_DB * sl[:, order], np.degrees(sp[:, order]), None,
+                "unused_tail_s_max": float(np.max(stops - m0 - P / f)),
+                "coherence_threshold": round(coherence_threshold(float(P.min())), 4)}
+    return FRFEstimate(f[order], H[:, order], NEPER_TO_DB * sl[:, order], np.degrees(sp[:, order]), coh[:, order],
                        P[order].astype(int), "stepped_sine", input_name, input_unit, names, units, settings)

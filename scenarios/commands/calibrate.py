@@ -30,6 +30,7 @@ import numpy as np
 from physmodel.errors import ParameterError
 
 from .. import plots
+from ._columns import add_sweep_options
 from ._common import EXIT_FAILED, EXIT_OK, check_celsius, parse_assignments
 
 
@@ -133,17 +134,18 @@ def add_parser(subparsers):
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--name", help="name of the calibrated parameter set (default <base>_calibrated)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    add_sweep_options(p)
     p.set_defaults(func=run)
     return p
 
 
 def run(args) -> int:
     """Execute ``ipmc calibrate``; returns 0, or 3 when the fit did not converge (bad input raises)."""
-    from physmodel.data.files import read_sweep
+    from ._columns import read_sweep_mapped
 
     if args.starts < 1:
         raise ParameterError(f"--starts must be >= 1, got {args.starts}")
-    data = read_sweep(args.sweep)
+    data = read_sweep_mapped(args.sweep, args)
     check_celsius(data.temperatures(), f"{args.sweep}: temperature_c")
     over = parse_assignments(args.param)
     start = start_model(args.base_set, args.kind, over)

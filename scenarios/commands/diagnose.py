@@ -60,6 +60,7 @@ from pathlib import Path
 from physmodel.errors import IPMCError, ParameterError
 
 from .. import plots
+from ._columns import add_sweep_options
 from ._common import EXIT_FAILED, EXIT_OK, check_celsius, parse_assignments
 from .calibrate import parse_effect, provenance_of, start_model
 
@@ -108,6 +109,7 @@ def add_parser(subparsers):
     p.add_argument("--accept-misfit", action="store_true",
                    help="exit 0 even when the model diagnose ends with does not fit the data (model.json says so)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    add_sweep_options(p, "--data")
     p.set_defaults(func=run)
     return p
 
@@ -247,8 +249,9 @@ def _free(spec: str, base, effects: dict):
 
 def build(args):
     """Resolve TOML + flags into ``(data, base, kwargs for diagnose, out folder, spec)``."""
-    from physmodel.data.files import read_sweep
     from physmodel.effects import normalize_effects
+
+    from ._columns import read_sweep_mapped
 
     spec = _load_toml(Path(args.experiment)) if args.experiment else {}
     pick = lambda flag, key, default=None: flag if flag is not None else spec.get(key, default)  # noqa: E731
@@ -269,7 +272,7 @@ def build(args):
     over.update(parse_assignments(args.param))
     start = start_model(set_name, pick(args.kind, "kind"), over)
     base = start.parameters
-    data = read_sweep(data_path)
+    data = read_sweep_mapped(data_path, args, "--data")
     check_celsius(data.temperatures(), f"{data_path}: temperature_c")
     # the start model's effects are in the model (fixed at their values) unless the TOML/flags say otherwise
     effects_spec = {**start.effects, **dict(spec.get("baseline_effects", {}))}

@@ -42,6 +42,7 @@ import numpy as np
 
 from inversion.limits import DEFAULT_MAX_VOLTAGE
 
+from ._columns import add_sweep_options, reference_column_unit, signal_scale, surrogate_role
 from ._common import (
     EXIT_FAILED,
     EXIT_OK,
@@ -77,7 +78,8 @@ def add_parser(sub):
     g.add_argument("--fade", type=float, help="fade-in and fade-out length [s] (default 2 periods; file: 0)")
     g.add_argument("--lead", type=float, default=1.0, help="rest before the reference [s]")
     g.add_argument("--tail", type=float, default=1.0, help="rest after the reference [s]")
-    g.add_argument("--unit", help="reference unit (default: the surrogate's output unit)")
+    g.add_argument("--unit", help="reference unit (default: the surrogate's output unit; another length unit is "
+                                  "converted to it, another kind refused)")
     c = p.add_argument_group("inversion and limits")
     c.add_argument("--preview", default="auto", help="'auto' (tolerance rule), '4/r0', 'inf' or seconds")
     c.add_argument("--preview-tol", type=float, default=1e-3, help="auto preview: relative truncation error")
@@ -108,6 +110,7 @@ def add_parser(sub):
     m.add_argument("--no-check", action="store_true", help="only write V(t); skip the physics simulation")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--quiet", action="store_true")
+    add_sweep_options(p, "--data")
     p.set_defaults(func=run)
     return p
 
@@ -193,14 +196,15 @@ def measured_data(args, mf, model):
     return provenance_data(mf, model.info)
 
 
-def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_unit, drive=None):
+def strip_prediction(data_path, model, temperature_c, t, signal, in_unit, out_unit, drive=None, args=None):
     """(DataMisfit, PredictedError) of the surrogate against the measured sweep at ``data_path``;
     with ``drive`` (the computed input, surrogate units) the inversion's own error is included."""
-    from physmodel.data.files import read_sweep
     from physmodel.errors import IPMCError
     from surrogate.strip_check import misfit_to_data, predicted_error
 
-    sweep = read_sweep(data_path)
+    from ._columns import read_sweep_mapped
+
+    sweep = read_sweep_mapped(data_path, args, "--data")
     try:
         sweep = sweep.in_units(in_unit, out_unit)
     except IPMCError as exc:
@@ -248,13 +252,19 @@ def run(args) -> int:
     model = _surrogate(args.surrogate, args.temperature)
     G = model.at(args.temperature)
     in_unit = model.labels.get("input_unit") or "V"
-    out_unit = args.unit or model.labels.get("output_unit") or "mm"
+    out_unit = model.labels.get("output_unit") or "mm"
     for u, what in ((in_unit, "input"), (out_unit, "output")):
         if u not in UNITS:
             raise CLIError(f"{args.surrogate}: {what} unit {u!r} is not one of {sorted(UNITS)}")
     if UNITS[in_unit][0] != "voltage" or UNITS[out_unit][0] != "length":
-        raise CLIError(f"{args.surrogate}: expected an actuator surrogate (length per voltage), got "
-                       f"{out_unit}/{in_unit}")
+        raise CLIError(f"{args.surrogate}: {surrogate_role({'input_unit': in_unit, 'output_unit': out_unit, **model.labels})}: "
+                       "a feedforward needs an actuator surrogate (tip displacement per volt, e.g. mm/V)")
+    labels = {**model.labels, "output_unit": out_unit}
+    ref_scale = signal_scale("reference", args.unit or out_unit, labels, "ipmc feedforward", "--unit")
+    if args.reference_file:                             # a column with its own unit: its kind checked, a
+        col, unit = reference_column_unit(args.reference_file, args.reference_column)   # conversion said
+        if unit is not None:
+            signal_scale(col, unit, labels, "ipmc feedforward", "--reference-column/--unit")
     if args.no_check and (args.model or args.set or args.params_json or args.param):
         raise CLIError("--no-check: no physics check is run, so --model/--set/--params-json/--param have nothing to do")
     mf, overridden, phys_note = (None, False, "physics check skipped (--no-check)") if args.no_check else \
@@ -264,7 +274,11 @@ def run(args) -> int:
     data_path, data_how, data_notes = measured_data(args, mf, model)
     if args.max_error is not None and data_path is None and mf is None:
         raise CLIError("--max-error: nothing to check it against (no measured data and no physics model)")
-    ref = build_reference(args, out_unit)
+    ref = build_reference(args, args.unit or out_unit)
+    if ref_scale != 1.0:                                # the reference in the surrogate's unit
+        from dataclasses import replace
+
+        ref = replace(ref, y=ref.y * ref_scale, unit=out_unit)
     from inversion.references import edge_jump
 
     jump = edge_jump(ref.y)
@@ -332,7 +346,7 @@ def run(args) -> int:
     strip = None
     if data_path is not None:
         mis, strip = strip_prediction(data_path, model, args.temperature, ref.t, ref.y, in_unit, out_unit,
-                                      drive=ff.output)
+                                      drive=ff.output, args=args)
         summary["predicted_error_on_strip_rms"] = strip.rms
         summary["predicted_error_on_strip_bound"] = strip.bound
         summary["strip_check"] = {**strip.to_dict(), "data": str(data_path), "found_by": data_how,
@@ -401,7 +415,7 @@ def run(args) -> int:
     else:
         from physmodel.data.fftsim import simulate_at_rest
 
-        from ..plots_control import feedforward_check
+        from ..plots import feedforward_check
 
         if phys_note:
             lines.append(f"- {phys_note}")

@@ -26,6 +26,7 @@ from surrogate._fit import WEIGHTINGS
 from surrogate._nlp import ConvergenceError
 
 from .. import plots
+from ._columns import add_sweep_options
 from ._common import EXIT_BAD_INPUT, EXIT_OK
 from ._common import EXIT_FAILED as EXIT_NOT_CONVERGED
 
@@ -37,16 +38,18 @@ __all__ = ["add_parser", "run", "read_csv"]
 MAX_PLAUSIBLE_C = 150.0
 
 
-def read_csv(path) -> FrequencyData:
+def read_csv(path, args=None) -> FrequencyData:
     """Read a sweep file (.csv, .npz or .mat in the physmodel format) into ``FrequencyData``.
 
     Parsing and validation are physmodel's (:func:`physmodel.data.sweep.read_sweep`): a malformed file
-    raises ``DataFormatError`` (a ``ValueError``) naming the line and the problem.
+    raises ``DataFormatError`` (a ``ValueError``) naming the line and the problem.  With ``args``, a
+    file of another layout is read through its ``--sweep-columns``/``--sweep-units`` options.
     """
-    from physmodel.data.files import read_sweep
     from surrogate._data import from_sweep
 
-    return from_sweep(read_sweep(path))
+    from ._columns import read_sweep_mapped
+
+    return from_sweep(read_sweep_mapped(path, args, "CSV"))
 
 
 def add_parser(subparsers):
@@ -71,6 +74,7 @@ def add_parser(subparsers):
                    help="write into a folder that holds another run's results")
     p.add_argument("--out", default="fit-out", help="output directory (default fit-out)")
     p.add_argument("--quiet", action="store_true", help="no summary line")
+    add_sweep_options(p)
     p.set_defaults(func=run)
     return p
 
@@ -161,7 +165,7 @@ def run(args) -> int:
 
     check_output_folder(args.out, "ipmc fit", force=args.force)     # refuse before the fit, not after
     try:
-        data = read_csv(args.csv)
+        data = read_csv(args.csv, args)
         temps = data.temperatures()
         if temps.size and float(np.max(temps)) > MAX_PLAUSIBLE_C:
             raise ValueError(f"{args.csv}: temperature_c holds {float(np.min(temps)):g}–{float(np.max(temps)):g}, above "

@@ -1,43 +1,63 @@
 """``ipmc frf`` — frequency responses with per-line σ from time records → a sweep file.
 
     ipmc frf RECORD [RECORD ...] --out sweep.csv --input voltage --output tip_displacement
-             [--output current] [--method h1|h2|stepped] [--temperature T ...]
+             [--output current] [--method auto|h1|h2|stepped] [--temperature T ...]
              [--nperseg N] [--noverlap N] [--window hann] [--discard-s S]
              [--lines SIGNAL | --frequencies F1,F2,...] [--plan SIGNAL]
-             [--settle-s S] [--settle-periods P] [--periods P]
-             [--min-coherence G] [--max-std-db D] [--band LO HI] [--reciprocal] [--plot fig.png] [--quiet]
+             [--settle-s S] [--settle-periods P] [--periods P] [--max-clipped-fraction F]
+             [--min-coherence G|auto] [--max-std-db D] [--band LO HI] [--reciprocal] [--plot fig.png] [--quiet]
 
 One record per temperature (``--temperature``, one value per record; default each record's
 ``temperature_c`` header).  Channels are named as in the record (``voltage`` or the column
 ``voltage_V``); the sweep is in the record's units.  Several ``--output`` channels give one sweep
 file per channel, ``<out stem>_<channel><suffix>``.
 
-Methods (physmodel.estimation.frf / .stepped):
+Methods (physmodel.estimation.frf / .periodic / .stepped):
 
-* ``h1`` (default) / ``h2``: Welch-averaged spectra, σ from the coherence.  ``--lines SIGNAL``
+* ``auto`` (default): the excitation is read from the input channel
+  (physmodel.estimation.excitation_detection).  A *periodic* input (its period found from the
+  record and checked period by period) is estimated by H1 at its excited lines only, over whole
+  periods, the leading transient periods found and discarded, σ from the scatter between periods;
+  a *stepped sine* by per-period sine fits on each detected step (its transient found the same
+  way); anything else (*random*) by Welch H1 (Hann, 50 % overlap) with a segment long enough to
+  resolve ``--band``.  The summary, and the sweep's metadata (``excitation``, ``method``), say
+  what was detected and used.  ``--discard-s`` discards a leading time instead of finding it.
+* ``h1`` / ``h2``: the same with that ratio; with ``--nperseg``, ``--noverlap``, ``--window`` or
+  ``--frequencies`` (with any method but stepped) the estimate is plain Welch-averaged spectra,
+  σ from the coherence.  ``--lines SIGNAL``
   takes a multisine's lines from its signal file (``ipmc excite multisine``) and sets
   ``--nperseg`` = one period, ``--noverlap 0``, ``--window boxcar`` and ``--discard-s`` = its
   transient periods unless given; a record whose own header holds the multisine uses it without
   ``--lines``.
 * ``stepped``: per-period sine fits after each step's transient, σ from the scatter between
-  periods; the schedule comes from ``--plan SIGNAL`` (``ipmc excite stepped``) or the record's own
-  header; ``--settle-s``/``--settle-periods``/``--periods`` override the plan's.
+  periods; the schedule comes from ``--plan SIGNAL`` (``ipmc excite stepped``), the record's own
+  header, or else is detected from the input; ``--settle-s``/``--settle-periods``/``--periods``
+  override the plan's.
 
-``--min-coherence``, ``--max-std-db`` and ``--band`` drop lines; ``--reciprocal`` writes
-input/output (e.g. impedance V/A from a current channel).  ``--plot`` draws magnitude and phase
-with their ±2σ bands and the coherence (H1/H2) or σ (stepped).  Exit codes: 0 written, 2 bad input.
+Checks on every record: a channel with samples held at a rail (clipping) is refused when more than
+``--max-clipped-fraction`` (default 0.01) of its samples are clipped, and warned about below that.
+``--min-coherence`` (default ``auto``: the coherence an output unrelated to the input exceeds
+with probability 1 %, from the number of averages), ``--max-std-db`` and ``--band`` drop lines;
+more than half of a channel's lines below the coherence threshold is a low-coherence warning
+(noise only? wrong channel?).  Warnings go to stderr and into the sweep's ``warnings`` metadata.
+``--reciprocal`` writes input/output (e.g. impedance V/A from a current channel).  ``--plot``
+draws magnitude and phase with their ±2σ bands and the coherence.  Exit codes: 0 written (with
+any warnings on stderr), 2 bad input (too short, clipped, no line left).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from physmodel.errors import IPMCError
 
+from ._columns import add_record_options, read_record_mapped
 from ._common import EXIT_OK, CLIError, _floats, check_celsius, refuse_overwriting_inputs
 from .excite import as_options
 
@@ -45,7 +65,10 @@ SUFFIXES = (".csv", ".npz", ".mat")
 #: Estimator argument names → the options that set them (error messages name the option).
 OPTIONS = {"frequencies_hz": "--frequencies", "nperseg": "--nperseg", "noverlap": "--noverlap", "window": "--window",
            "discard_s": "--discard-s", "settle_s": "--settle-s", "settle_periods": "--settle-periods",
-           "periods": "--periods", "max_std_db": "--max-std-db", "band_hz": "--band", "min_coherence": "--min-coherence"}
+           "periods": "--periods", "max_std_db": "--max-std-db", "band_hz": "--band", "min_coherence": "--min-coherence",
+           "max_clipped_fraction": "--max-clipped-fraction"}
+#: Options that ask for a plain Welch estimate.
+WELCH_OPTIONS = ("nperseg", "noverlap", "window", "frequencies")
 
 
 def add_parser(sub):
@@ -55,7 +78,8 @@ def add_parser(sub):
     p.add_argument("--out", required=True, help="sweep file (.csv, .npz or .mat)")
     p.add_argument("--input", required=True, help="input (reference) channel, e.g. voltage")
     p.add_argument("--output", action="append", required=True, help="output channel (repeatable)")
-    p.add_argument("--method", choices=("h1", "h2", "stepped"), default="h1", help="estimator (default h1)")
+    p.add_argument("--method", choices=("auto", "h1", "h2", "stepped"), default="auto",
+                   help="estimator (default auto: read the excitation from the input channel)")
     p.add_argument("--temperature", action="append",
                    help="bath temperature [°C], one per record (repeatable or comma-separated); "
                         "default each record's temperature_c header")
@@ -72,12 +96,16 @@ def add_parser(sub):
     s.add_argument("--settle-periods", type=float, help="transient discarded per step [periods]")
     s.add_argument("--periods", type=int, help="whole periods used per step (default: all whole periods)")
     k = p.add_argument_group("lines kept")
-    k.add_argument("--min-coherence", type=float, help="drop lines with coherence below this (h1/h2)")
+    k.add_argument("--min-coherence", default="auto",
+                   help="drop lines with coherence below this (default auto: the 1 %% level of an unrelated output)")
+    k.add_argument("--max-clipped-fraction", type=float,
+                   help="refuse a channel with more clipped samples than this fraction (default 0.01; 1 only warns)")
     k.add_argument("--max-std-db", type=float, help="drop lines whose magnitude σ exceeds this [dB]")
     k.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="keep lines in [LO, HI] Hz")
     p.add_argument("--reciprocal", action="store_true", help="write input/output instead of output/input")
     p.add_argument("--plot", help="figure of the estimate with ±2σ bands and coherence (PNG)")
     p.add_argument("--quiet", action="store_true", help="no summary")
+    add_record_options(p)
     p.set_defaults(func=run)
     return p
 
@@ -147,10 +175,15 @@ def _plan(args, records):
 def _estimator_kwargs(args, records) -> tuple[dict, str]:
     """Keyword arguments of estimate_record and a description of where they came from."""
     if args.method == "stepped":
-        bad = [o for o in ("nperseg", "noverlap", "window", "discard_s", "lines", "frequencies", "min_coherence")
+        bad = [o for o in ("nperseg", "noverlap", "window", "discard_s", "lines", "frequencies")
                if getattr(args, o) is not None]
         if bad:
             raise CLIError(f"--{bad[0].replace('_', '-')} applies to h1/h2, not to --method stepped")
+        if not args.plan and "stepped_sine_plan" not in records[0].metadata:
+            if any(getattr(args, k) is not None for k in ("settle_s", "settle_periods", "periods")):
+                raise CLIError("--settle-s/--settle-periods/--periods override a plan; give it with --plan SIGNAL")
+            return {"method": "auto", "excitation": "stepped_sine", "band_hz": _band(args),
+                    "max_clipped_fraction": args.max_clipped_fraction}, "stepped-sine schedule detected from the input"
         plan = _plan(args, records)
         over = {k: getattr(args, k) for k in ("settle_s", "settle_periods", "periods") if getattr(args, k) is not None}
         if not over:
@@ -160,8 +193,13 @@ def _estimator_kwargs(args, records) -> tuple[dict, str]:
     bad = [o for o in ("plan", "settle_s", "settle_periods", "periods") if getattr(args, o) is not None]
     if bad:
         raise CLIError(f"--{bad[0].replace('_', '-')} applies to --method stepped, not to {args.method}")
-    kw = {"method": args.method}
+    ratio = "h1" if args.method == "auto" else args.method
     found = _multisine(args, records)
+    if found is None and all(getattr(args, o) is None for o in WELCH_OPTIONS):
+        kw = {"method": "auto", "estimator": ratio, "band_hz": _band(args), "discard_s": args.discard_s,
+              "max_clipped_fraction": args.max_clipped_fraction}
+        return kw, "excitation read from the input"
+    kw = {"method": ratio}
     how = "Welch"
     if found is not None:
         ms, tp = found
@@ -180,8 +218,17 @@ def _estimator_kwargs(args, records) -> tuple[dict, str]:
     return kw, how
 
 
+def _band(args):
+    return tuple(args.band) if args.band else None
+
+
 def _estimate(rec, path: str, args, kw: dict):
+    """The estimate of one record, with the warnings of every method (clipping, low coherence)."""
+    from dataclasses import replace
+
+    from physmodel.estimation.clipping import check_clipping
     from physmodel.estimation.frf import estimate_record
+    from physmodel.estimation.frf_estimate import FRFWarning, low_coherence_warning
 
     kw = dict(kw)
     plan = kw.pop("_plan", None)
@@ -191,15 +238,39 @@ def _estimate(rec, path: str, args, kw: dict):
         kw.update(frequencies_hz=plan.frequency_hz, step_start_s=plan.step_start_s + t0,
                   step_stop_s=plan.step_stop_s + t0)
     try:
-        return estimate_record(rec, args.input, args.output, **kw)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FRFWarning)        # printed below from est.warnings
+            est = estimate_record(rec, args.input, args.output, **kw)
+        if kw["method"] != "auto":           # the auto path checks these itself
+            inp = rec.resolve(args.input)
+            notes = check_clipping({inp: rec.channels[inp], **{rec.resolve(o): rec.channel(o) for o in args.output}},
+                                   args.max_clipped_fraction)
+            low = low_coherence_warning(est)
+            est = replace(est, warnings=tuple(notes + ([low] if low else [])))
     except IPMCError as exc:
-        raise as_options(exc, OPTIONS, f"{path}: ") from None
+        text = str(exc)
+        if kw.get("excitation") == "stepped_sine":
+            text += "; give the schedule with --plan SIGNAL (written by 'ipmc excite stepped')"
+        raise as_options(IPMCError(text), OPTIONS, f"{path}: ") from None
+    return est
 
 
 def _out_paths(out: Path, outputs: list[str]) -> list[Path]:
     if len(outputs) == 1:
         return [out]
     return [out.with_name(f"{out.stem}_{o}{out.suffix}") for o in outputs]
+
+
+def _min_coherence(text):
+    if text is None or str(text).strip().lower() == "auto":
+        return "auto"
+    try:
+        v = float(text)
+    except ValueError:
+        raise CLIError(f"--min-coherence {text!r}: expected a number in [0, 1] or 'auto'") from None
+    if not 0 <= v <= 1:
+        raise CLIError(f"--min-coherence {text}: must lie in [0, 1]")
+    return v
 
 
 # ---------------------------------------------------------------------------- run
@@ -218,11 +289,12 @@ def run(args) -> int:
         raise CLIError(f"--output repeats a channel: {args.output}")
     if args.band is not None and not (0 <= args.band[0] <= args.band[1]):
         raise CLIError(f"--band {args.band[0]:g} {args.band[1]:g}: need 0 <= LO <= HI [Hz]")
-    if args.min_coherence is not None and not 0 <= args.min_coherence <= 1:
-        raise CLIError(f"--min-coherence {args.min_coherence}: must lie in [0, 1]")
+    args.min_coherence = _min_coherence(args.min_coherence)
+    if args.max_clipped_fraction is not None and not 0 <= args.max_clipped_fraction <= 1:
+        raise CLIError(f"--max-clipped-fraction {args.max_clipped_fraction}: must lie in [0, 1]")
     if args.max_std_db is not None and not args.max_std_db > 0:
         raise CLIError(f"--max-std-db {args.max_std_db}: must be > 0 [dB]")
-    records = [_read(p, "RECORD") for p in args.records]
+    records = [read_record_mapped(p, args, {"input": args.input, "output": args.output}) for p in args.records]
     temps = _temperatures(args, records)
     if len(set(temps)) != len(temps):
         raise CLIError(f"--temperature: records at the same temperature {temps}; one record per temperature")
@@ -237,8 +309,6 @@ def run(args) -> int:
     ests = [_estimate(rec, p, args, kw) for rec, p in zip(records, args.records)]
     keep = {"min_coherence": args.min_coherence, "band_hz": tuple(args.band) if args.band else None,
                 "max_std_db": args.max_std_db}
-    if args.method == "stepped" and args.min_coherence is not None:
-        raise CLIError("--min-coherence: a stepped-sine estimate has no coherence; use --max-std-db or --band")
     written, lines = [], []
     for o, path in zip(args.output, _out_paths(out, args.output)):
         sweeps, kept = [], []
@@ -248,7 +318,9 @@ def run(args) -> int:
             try:
                 sw = c.to_sweep(T, **keep, metadata={"record": Path(src).name})
             except IPMCError as exc:
-                raise as_options(exc, OPTIONS, f"{src} ({o}): ") from None
+                why = "; ".join(c.warnings)
+                raise as_options(IPMCError(f"{exc}{' (' + why + ')' if why else ''}"), OPTIONS,
+                                 f"{src} ({o}): ") from None
             sweeps.append(sw)
             kept.append((c, T, np.isin(c.frequency_hz, sw.frequency_hz)))
             lines.append(f"  {Path(src).name} at {T:g} °C, {sw.output_name}/{sw.input_name}: {sw.frequency_hz.size} "
@@ -266,10 +338,16 @@ def run(args) -> int:
             plots.frf_estimate(kept, ppath, title=f"{sweep.output_name} [{sweep.output_unit}] / "
                                                   f"{sweep.input_name} [{sweep.input_unit}], {args.method}")
             written.append(ppath)
+    for e, src in zip(ests, args.records):
+        for w in e.warnings:
+            print(f"warning: {src}: {w}", file=sys.stderr)
     if not args.quiet:
         st = ests[0].settings
-        print(f"{args.method} from {len(records)} record(s), {how}; settings: "
-              + ", ".join(f"{k}={v}" for k, v in st.items()))
+        print(f"{ests[0].method} from {len(records)} record(s), {how}; settings: "
+              + ", ".join(f"{k}={v}" for k, v in st.items() if k != "excitation"))
+        for e, src in zip(ests, args.records):
+            if "excitation" in e.settings:
+                print(f"  {Path(src).name}: {e.settings['excitation']}")
         print("\n".join(lines))
         print("wrote " + ", ".join(str(p) for p in written))
     return EXIT_OK

@@ -19,7 +19,11 @@ Examples::
 Exit codes: 0 success, 2 bad input (unreadable/invalid CSV, invalid model or options).
 
 A surrogate JSON (``--surrogate model.json --temperature T``, what ``ipmc fit`` writes) can
-replace ``--num``/``--den``.
+replace ``--num``/``--den``.  The signal must be the surrogate's output quantity (a displacement
+for an actuator surrogate, a current for a sensor surrogate): its unit comes from the column name
+(``tip_mm``) or ``--input-unit``; another kind is refused (exit 2), another unit of the same kind
+(``tip_m`` for a mm surrogate) converted and said on stderr.  ``--column``/``--input-column`` and
+``--time-column`` take a name or a 0-based index.
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ from inversion import InversionError, invert
 from physmodel.data.files import atomic_write
 
 from .. import plots
+from ._columns import add_record_options, add_sweep_options, resolve_column, signal_scale
 from ._common import EXIT_OK, check_plot_path
 
 __all__ = ["add_parser", "run", "model_from_surrogate", "read_csv"]
@@ -64,9 +69,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("input", help="input CSV with a header, a time_s column and signal columns")
     p.add_argument("-o", "--out", required=True, help="output CSV path")
     p.add_argument("--quiet", action="store_true", help="no summary line")
-    p.add_argument("--column", default=None,
-                   help="signal column to invert (default: first column other than time_s)")
-    p.add_argument("--time-column", default="time_s", help="time column name [s] (default time_s)")
+    p.add_argument("--column", default=None, metavar="NAME|INDEX",
+                   help="signal column to invert (default: first column other than time_s); same as --input-column")
     p.add_argument("--reference", default=None,
                    help="column with the true signal; adds reference and error columns/plot")
     p.add_argument("--num", nargs="+", default=None, metavar="C",
@@ -92,6 +96,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
                         "surrogate's misfit to it is reported (default: the data file in the surrogate's provenance)")
     p.add_argument("--accept-misfit", action="store_true",
                    help="exit 0 even when the physics behind the surrogate does not fit its data")
+    add_record_options(p, ("input",), time_default="time_s")
+    add_sweep_options(p, "--data")
     p.set_defaults(func=run)
     return p
 
@@ -177,17 +183,26 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_plot_path(args.plot)
     header, data = read_csv(args.input)
-    if args.time_column not in header:
-        raise InversionError(f"{args.input}: no time column {args.time_column!r} in header {header}")
-    it = header.index(args.time_column)
-    others = [h for h in header if h != args.time_column]
-    ucol = args.column if args.column is not None else (others[0] if others else None)
-    if ucol is None or ucol not in header:
-        raise InversionError(f"{args.input}: no signal column {ucol!r} in header {header}")
+    tcol = resolve_column(header, args.time_column, "--time-column", args.input, "time column")
+    if args.column is not None and args.input_column is not None:
+        raise InversionError("--column and --input-column name the same thing; give one of them")
+    spec, opt = (args.column, "--column") if args.column is not None else (args.input_column, "--input-column")
+    others = [h for h in header if h != tcol]
+    if spec is None and not others:
+        raise InversionError(f"{args.input}: no signal column besides the time column in header {header}")
+    ucol = resolve_column(header, spec, opt, args.input, "signal column") if spec is not None else others[0]
     if args.reference is not None and args.reference not in header:
         raise InversionError(f"{args.input}: no reference column {args.reference!r} in header {header}")
-    t = data[:, it]
+    t = data[:, header.index(tcol)] * {None: 1.0, "s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0}[args.time_unit]
     u = data[:, header.index(ucol)]
+    if args.surrogate is not None:     # the signal must be what the surrogate outputs, in its unit
+        from physmodel.data.columns import suffix_unit
+
+        named = (suffix_unit(ucol) or (None, None))[1]
+        if args.input_unit and named and args.input_unit != named:
+            raise InversionError(f"--input-unit {args.input_unit}: column {ucol!r} is in {named} by its name; drop one")
+        unit = args.input_unit or named
+        u = u * signal_scale(ucol, unit, smodel.labels, "ipmc invert", "--input-unit")
     if not (math.isfinite(args.preview_tol) and 0 < args.preview_tol < 1):
         raise InversionError(f"--preview-tol must be in (0, 1), got {args.preview_tol!r}")
     try:
@@ -205,8 +220,8 @@ def run(args: argparse.Namespace) -> int:
                              f"({np.count_nonzero(~np.isfinite(y))} non-finite outputs from t = {t[k]:.6g} s; "
                              f"largest |input| {np.max(np.abs(u)):.3g}); scale the signal or check the model")
     ref = data[:, header.index(args.reference)] if args.reference is not None else None
-    cols = [args.time_column, ucol, "reconstruction"]
-    table = [t, u, y]
+    cols = [tcol, ucol, "reconstruction"]
+    table = [data[:, header.index(tcol)], data[:, header.index(ucol)], y]      # the file's own columns
     if ref is not None:
         cols += [args.reference, "error"]
         table += [ref, y - ref]
@@ -241,8 +256,9 @@ def _verdicts(args: argparse.Namespace, smodel: Any, t: np.ndarray, y: np.ndarra
     import sys
     from pathlib import Path
 
-    from physmodel.data.files import read_sweep
     from surrogate.strip_check import misfit_to_data, predicted_error
+
+    from ._columns import read_sweep_mapped
 
     notes, status = [], EXIT_OK
     src = smodel.info.get("source_model") or {}
@@ -267,7 +283,7 @@ def _verdicts(args: argparse.Namespace, smodel: Any, t: np.ndarray, y: np.ndarra
         notes.append("predicted_error_on_strip: unchecked against measurement (no --data)")
         print("ipmc invert: warning: the decoding error is unchecked against measurement (give --data)", file=sys.stderr)
         return notes, status
-    sweep = read_sweep(data)
+    sweep = read_sweep_mapped(data, args, "--data")
     lab = smodel.labels
     try:
         sweep = sweep.in_units(lab.get("input_unit") or sweep.input_unit, lab.get("output_unit") or sweep.output_unit)

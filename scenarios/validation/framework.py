@@ -5,7 +5,8 @@ Every key of every section of ``published.toml`` (the seed papers' printed numbe
 an index (``actuator_seed001.order_claims[1]``).  The keys ``citation``, ``cite_as`` and
 ``location`` describe the paper and where each claim is printed; they are not claims.
 
-Each claim id is mapped in :data:`CHECKS` (filled by the per-seed modules) to a :class:`Claim`:
+Each claim id is mapped in :data:`~scenarios.validation.claims.CHECKS` (filled by the per-seed modules) to a
+:class:`~scenarios.validation.claims.Claim`:
 the check, what the project expects (reproduce / a known finding / not checkable) and the
 comparison's *kind*.  An id without a mapping becomes a failing row.
 
@@ -54,9 +55,10 @@ from pathlib import Path
 
 from physmodel.parameter_sets import published as _published_module
 
+from .claims import CHECKS, EXTRA_ROWS, KINDS, Claim
+
 STATUSES = ("reproduced", "not-reproduced", "not-checkable", "fail")
 BASES = ("independent", "calibrated", "round-trip", "input", "paper", "metadata")
-KINDS = ("model", "round-trip", "input", "paper", "metadata")
 #: Statuses of a row where something was compared (``not-checkable`` compares nothing).
 COMPARED = ("reproduced", "not-reproduced", "fail")
 #: Keys of a section that describe the paper, not claims.
@@ -174,44 +176,6 @@ class ValidationReport:
         return "\n".join(lines) + "\n"
 
 
-@dataclass
-class Outcome:
-    """What a check returns: our number, the criterion and whether it is met."""
-
-    ours: str
-    criterion: str
-    ok: bool
-    note: str = ""
-
-
-@dataclass(frozen=True)
-class Claim:
-    """How one claim is checked.
-
-    ``check(ctx, printed value) -> Outcome`` (None for a claim that is not checkable);
-    ``expect``: ``"reproduce"``, ``"finding: <why the physics does not reproduce it>"`` or
-    ``"not-checkable: <why>"``; ``kind``: one of :data:`KINDS`; ``uses``: the parameter set whose
-    ``CALIBRATION`` decides between ``calibrated`` and ``independent`` (kind ``model``);
-    ``note``: why the row has its basis (optional for ``model``); ``implied_by``: the id of a claim
-    that implies this one on the grid the calibration of ``uses`` searched (a test shows it): when
-    that claim is calibrated, so is this row.
-    """
-
-    check: Callable | None
-    expect: str
-    kind: str
-    uses: str | None = None
-    note: str = ""
-    implied_by: str | None = None
-
-
-#: claim id -> Claim; filled by the per-seed modules.
-CHECKS: dict[str, Claim] = {}
-#: claim id -> [(tag, printed statement, Claim)]: a second, separately judged statement of a claim;
-#: its row has the id ``<claim id>+<tag>`` and follows the claim's row.
-EXTRA_ROWS: dict[str, list] = {}
-
-
 # ============================================================================ enumeration
 def load_published(path=None) -> dict:
     """The printed claims: the bundled file, or ``path``."""
@@ -261,6 +225,8 @@ class Context:
         self.pub = published
         self.path = Path(path)
         self._memo: dict = {}
+        #: what checks record for the report beside their rows (``ValidationReport.metadata``)
+        self.metadata: dict = {}
         #: parameter sets used in place of the named ones (what-if runs: what does a check depend on?)
         self.sets = dict(sets or {})
 
@@ -355,4 +321,4 @@ def validate(*, quick: bool = False, progress=None, published=None, sets: dict |
     papers = {str(t.get("cite_as", s)): str(t.get("citation", t.get("paper", s)))
               for s, t in data.items() if isinstance(t, dict)}
     return ValidationReport(tuple(rows), bool(quick), str(path), time.perf_counter() - t0,
-                            dict(ctx._memo.get("metadata", {})), ctx.calibration, papers)
+                            dict(ctx.metadata), ctx.calibration, papers)

@@ -16,7 +16,7 @@ import numpy as np
 
 from physmodel.parameter_sets import derivation as sc
 
-from .framework import CHECKS, EXTRA_ROWS, Claim, Outcome
+from .claims import CHECKS, EXTRA_ROWS, Claim, Outcome
 from .shared import ZERO_REACH, geometry_check, io_check, paper_check, rhp
 
 SET = "seed000_sensor"
@@ -38,7 +38,7 @@ def _misfit(ctx):
         m = sc.sensor_misfit_35c(_sensor(c))
         from dataclasses import asdict
 
-        c._memo.setdefault("metadata", {})["sensor_misfit_35c"] = asdict(m)
+        c.metadata["sensor_misfit_35c"] = asdict(m)
         return m
     return ctx.memo("s0:misfit", compute)
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from physmodel.parameter_sets import derivation as sc
 
-from .framework import CHECKS, EXTRA_ROWS, Claim, Outcome
+from .claims import CHECKS, EXTRA_ROWS, Claim, Outcome
 from .shared import VISIBLE_MISFIT, ZERO_REACH, geometry_check, io_check, paper_check, rhp
 
 SET = "seed001_actuator"

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .framework import CHECKS, Claim, Outcome
+from .claims import CHECKS, Claim, Outcome
 from .shared import paper_check
 
 SET = "seed002_table3"

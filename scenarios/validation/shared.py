@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from .framework import Outcome
+from .claims import Outcome
 
 #: How far beyond the top of the fitted band a zero may lie and still count [× band top]: a zero a
 #: decade above the highest fitted frequency changes the in-band response by at most about 6° of

@@ -122,7 +122,7 @@ sys.path.insert(0, str(ROOT / "tests" / "discrepancy"))
 from physmodel import IPMCParameters, get_parameter_set  # noqa: E402
 from physmodel.data.sweep import FrequencySweep, MagnitudePhaseNoise, synthesize_sweep  # noqa: E402
 from physmodel.effects import LIBRARY, EffectModel, candidates_for  # noqa: E402
-from physmodel.estimation.discrepancy import _free_list, diagnose, gap_shrink  # noqa: E402
+from physmodel.estimation.discrepancy import diagnose, free_parameters_for, gap_shrink  # noqa: E402
 from physmodel.estimation.lsq import fit_parameters  # noqa: E402
 
 SEALED = 0xB11D_2026
@@ -171,7 +171,7 @@ def library_case(label, level, rng):
 def library_noncentrality(exact):
     pred = EffectModel(P, "actuator").predictor(exact)
     with np.errstate(over="ignore", invalid="ignore"):
-        res = fit_parameters(exact, None, _free_list(P, FREE, {}), predict_many=pred.many, identify=False)
+        res = fit_parameters(exact, None, free_parameters_for(P, FREE, {}), predict_many=pred.many, identify=False)
     return 2 * res.cost
 
 

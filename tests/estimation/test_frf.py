@@ -337,7 +337,7 @@ def test_unexcited_lines_are_flagged_by_coherence_and_unexcitable_ones_refused()
     (lambda u, y: stepped_sine(FS, u, y, [10.0, 20.0], [0.0, 3.95]), r"step 1 \(20 Hz\): 1 whole"),
     (lambda u, y: stepped_sine(FS, u, y, [10.0, 20.0], [0.0, 9.0]), r"step 0 .* must lie in the record"),
     (lambda u, y: stepped_sine(FS, u, y, [10.0], None), "step_start_s"),
-    (lambda u, y: stepped_sine(FS, u, y, [10.0], [0.0]).to_sweep(25.0, min_coherence=0.5), "min_coherence"),
+    (lambda u, y: stepped_sine(FS, u, y, [10.0], [0.0]).to_sweep(25.0, min_coherence="high"), "min_coherence"),
     (lambda u, y: stepped_sine(FS, u, y, [10.0], [0.0], settle_s=-1), "settle"),
 ])
 def test_bad_input_names_the_argument(call, match):

@@ -1,4 +1,4 @@
-"""The look-elsewhere scan of the linearised null (physmodel.estimation.nullstats._scan_lr).
+"""The look-elsewhere scan of the linearised null (physmodel.estimation.nullstats.scan_lr).
 
 Oracle: a bump in log-magnitude, ln|G| = a·exp(−(log10 f − c)²/(2w²)), whose centre c is not
 identified under the null (a = 0).  With a baseline gain column projected out, the likelihood ratio
@@ -18,8 +18,8 @@ import numpy as np
 
 from physmodel.data.sweep import FrequencySweep
 from physmodel.effects.base import EffectParameter
-from physmodel.estimation.nullstats import _needs_others, _scan_lr
-from physmodel.estimation.signatures import _signature
+from physmodel.estimation.nullstats import _needs_others, scan_lr
+from physmodel.estimation.signatures import effect_signature
 
 N = 40
 F = np.logspace(-1, 2, N)
@@ -62,7 +62,7 @@ def _oracle(Ep, Q0, n=255 * 12 + 1):          # contains the scan's 256 grid poi
 
 def test_scan_reaches_the_davies_supremum_and_never_exceeds_it():
     r0, Q0, Ep = _setup()
-    scan = _scan_lr(predict_many, {}, "bump", PARAMS, np.array([False, True]), r0, DATA, ONES, ONES, Q0, Ep)
+    scan = scan_lr(predict_many, {}, "bump", PARAMS, np.array([False, True]), r0, DATA, ONES, ONES, Q0, Ep)
     sup = _oracle(Ep, Q0)
     assert np.all(scan <= sup * (1 + 1e-6) + 1e-9)
     assert abs(np.quantile(scan, 0.95) / np.quantile(sup, 0.95) - 1) < 0.005
@@ -72,6 +72,6 @@ def test_scan_reaches_the_davies_supremum_and_never_exceeds_it():
 
 def test_centre_is_flagged_as_acting_only_with_the_amplitude_on():
     r0, Q0, _ = _setup(draws=10)
-    S, _ = _signature(predict_many, {}, "bump", r0, DATA, ONES, ONES, PARAMS)
+    S, _ = effect_signature(predict_many, {}, "bump", r0, DATA, ONES, ONES, PARAMS)
     flags = _needs_others(predict_many, {}, "bump", PARAMS, S, r0, DATA, ONES, ONES, 0.1)
     assert flags.tolist() == [False, True]

@@ -10,7 +10,7 @@ import pytest
 from physmodel import IPMCError, ParameterError, get_parameter_set
 from physmodel.data.sweep import MagnitudePhaseNoise, synthesize_sweep
 from physmodel.effects.library import OUT_OF_LIBRARY, EffectModel
-from physmodel.estimation.discrepancy import VERDICTS, _constrained_lr, diagnose, gap_shrink
+from physmodel.estimation.discrepancy import VERDICTS, constrained_lr, diagnose, gap_shrink
 
 P = get_parameter_set("seed002_table3")
 F = np.logspace(-1, 1.7, 30)
@@ -143,12 +143,12 @@ def test_linearised_null_gives_the_chi_bar_squared_boundary_mixture():
     rng = np.random.default_rng(3)
     S = rng.standard_normal((40, 1))
     E = rng.standard_normal((40, 40000))
-    assert np.quantile(_constrained_lr(S, np.array([True]), E), 0.95) == pytest.approx(2.706, abs=0.12)
-    assert np.quantile(_constrained_lr(S, np.array([False]), E), 0.95) == pytest.approx(3.841, abs=0.15)
-    assert np.mean(_constrained_lr(S, np.array([True]), E) == 0) == pytest.approx(0.5, abs=0.01)
+    assert np.quantile(constrained_lr(S, np.array([True]), E), 0.95) == pytest.approx(2.706, abs=0.12)
+    assert np.quantile(constrained_lr(S, np.array([False]), E), 0.95) == pytest.approx(3.841, abs=0.15)
+    assert np.mean(constrained_lr(S, np.array([True]), E) == 0) == pytest.approx(0.5, abs=0.01)
     # two one-sided parameters, orthogonal: ¼χ²0 + ½χ²1 + ¼χ²2, 95 % point 4.23
     S2 = np.linalg.qr(rng.standard_normal((40, 2)))[0]
-    assert np.quantile(_constrained_lr(S2, np.array([True, True]), E), 0.95) == pytest.approx(4.231, abs=0.15)
+    assert np.quantile(constrained_lr(S2, np.array([True, True]), E), 0.95) == pytest.approx(4.231, abs=0.15)
 
 
 @pytest.mark.slow

@@ -79,7 +79,7 @@ def test_a_signal_during_start_up_imports_gives_no_traceback(work, sig, module):
 
 def _study(work: Path) -> Path:
     text = (Path(__file__).resolve().parents[2] / "scenarios" / "studies" / "actuator_mc.toml").read_text()
-    text = text.replace("samples = 200", "samples = 20000").replace("chunk_size = 25", "chunk_size = 400")
+    text = text.replace("samples = 200", "samples = 20000").replace("chunk_size = 25", "chunk_size = 100")
     (work / "long.toml").write_text(text.replace("points = 40", "points = 400"))
     return work / "long.toml"
 
@@ -87,8 +87,9 @@ def _study(work: Path) -> Path:
 @pytest.mark.parametrize("sig,group", [("SIGINT", True), ("SIGTERM", True), ("SIGTERM", False)])
 def test_a_study_interrupted_while_its_workers_run(work, sig, group):
     """Ctrl-C reaches the whole process group (every worker too); a SIGTERM may reach only the
-    parent.  Either way: no worker traceback, the parent reports in one line and stops the workers
-    at once, and no table (or temporary file) is left."""
+    parent.  Either way: no worker traceback, the parent reports in one line, cancels the chunks not
+    started, the workers finish the one they hold (a worker killed while sending its result back
+    would leave the parent waiting forever at exit), and no table (or temporary file) is left."""
     spec = _study(work)
     out = work / f"study-{sig}-{group}.csv"
     p = subprocess.Popen([sys.executable, "-m", "scenarios.cli", "study", str(spec), "--out", str(out), "--workers",
@@ -108,7 +109,7 @@ def test_a_study_interrupted_while_its_workers_run(work, sig, group):
     assert p.returncode == 130, err[-1500:]
     assert "Traceback" not in err, err[-2000:]
     assert [ln for ln in err.splitlines() if ln.strip()] == [ln for ln in err.splitlines() if "ipmc study: interrupted" in ln]
-    assert stopped < 10, f"took {stopped:.1f} s to stop"
+    assert stopped < 30, f"took {stopped:.1f} s to stop"      # a chunk of 100 samples: about a second
     assert not out.exists() and not leftovers(work)
     for k in kids:                                        # no orphaned worker
         assert not Path(f"/proc/{k}").exists() or "zombie" in Path(f"/proc/{k}/status").read_text().lower()
