@@ -17,9 +17,17 @@ from __future__ import annotations
 
 import signal
 import threading
+import time
 from contextlib import contextmanager
 
 _requested: int | None = None
+_raised_at = -1e9
+_deferring = 0
+
+#: A repeated signal raises ``KeyboardInterrupt`` again only this long [s] after the last one, so a
+#: double Ctrl-C (or SIGINT then SIGTERM) cannot interrupt the clean-up and reporting the first
+#: one started; a deliberate repeat later still breaks out of a loop that swallowed the first.
+REPEAT_S = 2.0
 
 #: The signals :func:`handling` turns into ``KeyboardInterrupt``.
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -38,8 +46,9 @@ def requested() -> int | None:
 
 def reset() -> None:
     """Forget a recorded interrupt."""
-    global _requested
+    global _requested, _raised_at
     _requested = None
+    _raised_at = -1e9
 
 
 def check() -> None:
@@ -49,8 +58,45 @@ def check() -> None:
 
 
 def _handler(signum, frame):
+    global _raised_at
     request(signum)
-    raise KeyboardInterrupt(f"interrupted by {signal.Signals(signum).name}")
+    if _deferring:
+        return                         # inside held(): raised when the block ends
+    now = time.monotonic()
+    if now - _raised_at >= REPEAT_S:
+        _raised_at = now
+        raise KeyboardInterrupt(f"interrupted by {signal.Signals(signum).name}")
+
+
+@contextmanager
+def held():
+    """A block no SIGINT/SIGTERM interrupts (a few renames that must all happen): the signals are
+    blocked for this thread and, under :func:`handling`, only recorded — a signal another thread
+    received still runs the handler in the main thread — and ``KeyboardInterrupt`` is raised when
+    the block ends if one arrived."""
+    global _deferring
+    blocked = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS)) if blocked else None
+    _deferring += 1
+    try:
+        yield
+    finally:
+        _deferring -= 1
+        if blocked:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+    check()
+
+
+def worker_init() -> None:
+    """For worker processes (``ProcessPoolExecutor(initializer=...)``): SIGINT and SIGTERM are
+    ignored.  A Ctrl-C or a SIGTERM sent to the whole process group reaches every worker; the parent
+    reports it, cancels the work not started and lets each worker finish its current task and exit
+    normally.  A worker killed while it sends a result back would leave a partial message in the
+    result pipe, on which the executor's manager thread — and with it the parent's exit — waits
+    forever; a worker that dies of a signal prints no traceback, but one that receives a
+    ``KeyboardInterrupt`` does."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 @contextmanager
@@ -70,4 +116,4 @@ def handling():
             signal.signal(s, h)
 
 
-__all__ = ["request", "requested", "reset", "check", "handling", "SIGNALS"]
+__all__ = ["request", "requested", "reset", "check", "handling", "held", "worker_init", "SIGNALS", "REPEAT_S"]

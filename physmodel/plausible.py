@@ -116,4 +116,32 @@ def plausible_ranges(params: IPMCParameters, overrides: Mapping[str, PlausibleRa
     return out
 
 
-__all__ = ["PlausibleRange", "DEFAULT_RANGES", "plausible_ranges"]
+#: Physical limits: values outside these are no IPMC strip at all (and break the numerics), unlike the
+#: plausible ranges above, which a fit may leave.  Geometry [m] from the smallest micro-fabricated
+#: strips (tens of µm) to the longest cast actuators (tens of cm), with margin; material, electrode
+#: and mechanical fields three decades beyond their plausible range either way; T_ref [K] the
+#: liquid-water window of hydrated Nafion with margin.
+PHYSICAL_LIMITS: dict[str, tuple[float, float, str]] = {
+    "L": (1e-5, 10.0, "m"), "W": (1e-6, 1.0, "m"), "h": (1e-7, 1e-2, "m"), "T_ref": (150.0, 600.0, "K"),
+    **{k: (r.lower * 1e-3, r.upper * 1e3, r.unit) for k, r in DEFAULT_RANGES.items() if k != "xi"},
+    "xi": (1e-5, 100.0, "1"),
+}
+
+
+def check_physical(params: IPMCParameters) -> None:
+    """Raise :class:`ParameterError` naming the first field of ``params`` outside
+    :data:`PHYSICAL_LIMITS` (zero stays allowed where the field allows it, e.g. ``r1_sheet = 0``,
+    and an infinite ``Rp_specific`` means no leakage)."""
+    for name, (lo, hi, unit) in PHYSICAL_LIMITS.items():
+        v = getattr(params, name, None)
+        if v is None:
+            continue
+        v = abs(float(v))
+        if v == 0.0 or (name == "Rp_specific" and math.isinf(v)):
+            continue
+        if not lo <= v <= hi:
+            raise ParameterError(f"{name} = {float(getattr(params, name)):g} {unit} is outside any physical range for an "
+                                 f"IPMC strip [{lo:g}, {hi:g}] {unit}" + (" (SI units: metres)" if unit == "m" else ""))
+
+
+__all__ = ["PlausibleRange", "DEFAULT_RANGES", "plausible_ranges", "PHYSICAL_LIMITS", "check_physical"]

@@ -94,14 +94,18 @@ def evaluate_checks(spec: Scenario, metrics: dict) -> list[CheckResult]:
 def run_scenario(spec: Scenario, out, *, quiet: bool = False, force: bool = False) -> RunResult:
     """Run every step of ``spec`` into folder ``out`` and write its report (last).
 
-    The folder is claimed for the run (:func:`physmodel.data.files.output_folder`): a second run
-    into it is refused while this one writes, and a folder holding another run's results is
-    refused unless ``force``.  An interrupt (even one a solver swallowed) ends the run before the
-    next step and before ``report.md``."""
+    The folder is written all or nothing (:func:`physmodel.data.results.output_folder`: a temporary
+    sibling moved into place when complete, with a completion marker): a second run into it is
+    refused while this one writes, and a folder holding another run's results is refused unless
+    ``force``.  An interrupt (even one a solver swallowed) ends the run before the next step and
+    leaves ``out`` as it was."""
+    from dataclasses import replace
+
     from physmodel.data.files import output_folder
 
     with output_folder(out, f"ipmc run {spec.name}", force=force) as folder:
-        return _run_scenario(spec, folder, quiet)
+        res = _run_scenario(spec, folder, quiet)
+    return replace(res, out=Path(out))
 
 
 def _run_scenario(spec: Scenario, out: Path, quiet: bool) -> RunResult:

@@ -301,7 +301,14 @@ def _check_values(data: dict, where: str) -> None:
     def temps(sec, key, values):
         for t in values if isinstance(values, list) else [values]:
             need(t > -273.15, sec, key, values, "temperatures above absolute zero (-273.15 °C)")
+            need(t <= 150.0, sec, key, values, "°C, at most 150 °C (no hydrated IPMC works above; kelvin? subtract 273.15)")
 
+    from physmodel.plausible import PHYSICAL_LIMITS
+
+    for key, v in (data["model"].get("params") or {}).items():      # L = 1e300: refused, not an SVD failure
+        if key in PHYSICAL_LIMITS and v != 0 and not (key == "Rp_specific" and math.isinf(v)):
+            lo, hi, unit = PHYSICAL_LIMITS[key]
+            need(lo <= abs(v) <= hi, "model", f"params.{key}", v, f"a value in [{lo:g}, {hi:g}] {unit} (any physical IPMC)")
     if "sweep" in data:
         sw = data["sweep"]
         for key in ("temperatures_c", "held_out_c", "plot_temperatures_c"):

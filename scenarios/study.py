@@ -57,6 +57,8 @@ _NOISE_KEYS = {"kind", "sigma_db", "sigma_deg", "sigma"}
 
 #: Most rows (samples × temperatures × frequencies) of one study table, checked before evaluation.
 MAX_STUDY_ROWS = 50_000_000
+#: Seconds a Dask scheduler has to accept the connection and send its handshake (--scheduler-timeout).
+SCHEDULER_TIMEOUT_S = 20.0
 
 
 class StudyError(ScenarioError):
@@ -113,9 +115,12 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
         f = np.geomspace(lo, hi, n).tolist()
     if min(f) <= 0:
         raise StudyError(f"{where}: [study] frequencies must be > 0 Hz")
-    cold = [t for t in s["temperatures_c"] if t <= -273.15]
-    if cold:
-        raise StudyError(f"{where}: [study] temperatures_c {cold}: below absolute zero (-273.15 °C)")
+    from .commands._common import check_celsius
+
+    try:
+        check_celsius(s["temperatures_c"], f"{where}: [study] temperatures_c")
+    except IPMCError as exc:
+        raise StudyError(str(exc)) from None
     s["frequencies_hz"] = f
     for k in ("fmin_hz", "fmax_hz", "points"):
         s.pop(k, None)
@@ -165,7 +170,12 @@ def parse_study(raw: dict, where: str = "<study>") -> dict:
             if k in nz and _num(nz[k], f"{where}: [study.noise] {k}") < 0:
                 raise StudyError(f"{where}: [study.noise] {k} = {nz[k]!r}: expected >= 0")
     # fail now, not in a worker, on a bad set, parameter value or temperature
-    _base(s)
+    from physmodel.plausible import check_physical
+
+    try:
+        check_physical(_base(s))
+    except IPMCError as exc:
+        raise StudyError(f"{where}: [study] set {s['set']!r}: {exc}") from None
     from physmodel.data.units import QUANTITY_UNITS
 
     if (s["kind"], s["quantity"]) not in QUANTITY_UNITS:
@@ -296,12 +306,13 @@ def _chunks(spec) -> list[list[int]]:
 
 
 def run_study(spec: dict, *, scheduler=None, workers: int | None = None, backend: str | None = None,
-              progress=None) -> StudyTable:
+              progress=None, timeout_s: float = SCHEDULER_TIMEOUT_S) -> StudyTable:
     """Evaluate a validated study (:func:`parse_study`).
 
     ``backend``: "serial" (this process), "processes" (concurrent.futures, ``workers`` processes;
     the default) or "dask" (a ``distributed.Client`` on ``scheduler``: an address string or a
-    Client/cluster object; the default when ``scheduler`` is given).  ``progress(n_chunks_done)``
+    Client/cluster object; the default when ``scheduler`` is given; an address is probed first,
+    :func:`probe_scheduler`, with ``timeout_s``).  ``progress(n_chunks_done)``
     is called as chunks finish.  Results are assembled in sample order, identical across backends.
     """
     backend = backend or ("dask" if scheduler is not None else "processes")
@@ -315,34 +326,129 @@ def run_study(spec: dict, *, scheduler=None, workers: int | None = None, backend
             tick(1)
     elif backend == "processes":
         import concurrent.futures as cf
+        import multiprocessing as mp
 
         parts = [None] * len(chunks)
-        with cf.ProcessPoolExecutor(max_workers=workers or min(len(chunks), os.cpu_count() or 1)) as ex:
-            futs = {ex.submit(evaluate_chunk, spec, c): k for k, c in enumerate(chunks)}
-            try:
-                for fut in cf.as_completed(futs):
-                    parts[futs[fut]] = fut.result()
-                    tick(1)
-            except BaseException:
-                for fut in futs:
-                    fut.cancel()
-                raise
+        # workers ignore SIGINT/SIGTERM (a Ctrl-C reaches the whole process group): this process
+        # reports the interrupt, sets `stop` (chunks already queued to a worker return at once) and
+        # cancels what is left; no worker prints a traceback
+        stop = mp.get_context().Event()
+        ex = cf.ProcessPoolExecutor(max_workers=workers or min(len(chunks), os.cpu_count() or 1),
+                                    initializer=_worker_init, initargs=(stop,))
+        try:
+            futs = {ex.submit(_chunk_task, spec, c): k for k, c in enumerate(chunks)}
+            for fut in cf.as_completed(futs):
+                parts[futs[fut]] = fut.result()
+                tick(1)
+        except BaseException:
+            stop.set()
+            _stop_workers(ex)
+            raise
+        ex.shutdown()
     elif backend == "dask":
-        parts = _run_dask(spec, chunks, scheduler, tick)
+        parts = _run_dask(spec, chunks, scheduler, tick, timeout_s)
     else:
         raise StudyError(f"backend must be 'serial', 'processes' or 'dask', got {backend!r}")
     cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     return StudyTable(cols, spec, backend, time.perf_counter() - t0)
 
 
-def _run_dask(spec, chunks, scheduler, tick):
+_STOP = None
+
+
+def _worker_init(stop) -> None:
+    """A study worker: SIGINT/SIGTERM ignored (:func:`physmodel.interrupts.worker_init`); ``stop``
+    (a multiprocessing Event) set by the parent on an interrupt."""
+    from physmodel.interrupts import worker_init
+
+    global _STOP
+    worker_init()
+    _STOP = stop
+
+
+def _chunk_task(spec, indices):
+    """:func:`evaluate_chunk` in a worker, or None at once when the parent has stopped the study."""
+    if _STOP is not None and _STOP.is_set():
+        return None
+    return evaluate_chunk(spec, indices)
+
+
+def _stop_workers(ex) -> None:
+    """Cancel the chunks not started; the workers finish the chunk they hold and exit (they ignore
+    SIGINT/SIGTERM, :func:`physmodel.interrupts.worker_init`: a worker killed while it sends its
+    result back would leave the executor — and this process's exit — waiting forever)."""
+    ex.shutdown(wait=False, cancel_futures=True)
+
+
+#: A Dask handshake is a few hundred bytes; a first frame announcing more is another protocol.
+_MAX_HANDSHAKE_BYTES = 1 << 20
+
+
+def probe_scheduler(address: str, timeout_s: float = SCHEDULER_TIMEOUT_S) -> None:
+    """Check that ``address`` (``tcp://HOST:PORT``) is a Dask scheduler before a client connects: it
+    must accept within ``timeout_s`` and send the start of a Dask handshake (a scheduler speaks
+    first: an 8-byte frame length, then the frames) within ``timeout_s``.  A port that accepts and
+    stays silent, or answers another protocol (an HTTP or SSH server, whose first bytes read as a
+    length of exabytes), is a StudyError naming the address — the Dask client itself would wait
+    forever or try to allocate that length."""
+    import socket
+    import struct
+
+    scheme, sep, loc = address.partition("://")
+    if not sep:
+        scheme, loc = "tcp", address
+    if scheme not in ("tcp", "tls"):
+        return                                      # inproc://, ucx://: the client's own checks
+    host, _, port = loc.rpartition(":")
+    host = host.strip("[]")
+    try:
+        port_n = int(port.split("/")[0])
+    except ValueError:
+        raise StudyError(f"--scheduler {address!r}: expected an address such as tcp://HOST:8786") from None
+    where = f"--scheduler {address}"
+    try:
+        sock = socket.create_connection((host or "localhost", port_n), timeout=timeout_s)
+    except TimeoutError:
+        raise StudyError(f"{where}: no connection within {timeout_s:g} s") from None
+    except OSError as exc:
+        raise StudyError(f"{where}: cannot connect ({exc.strerror or exc}); expected a Dask scheduler "
+                         "such as tcp://HOST:8786") from None
+    if scheme == "tls":                             # the TLS handshake comes first: cannot read Dask's
+        sock.close()
+        return
+    try:
+        sock.settimeout(timeout_s)
+        head = b""
+        deadline = time.monotonic() + timeout_s
+        while len(head) < 8:
+            sock.settimeout(max(0.01, deadline - time.monotonic()))
+            chunk = sock.recv(8 - len(head))
+            if not chunk:
+                raise StudyError(f"{where}: the server closed the connection without a Dask handshake")
+            head += chunk
+    except TimeoutError:
+        raise StudyError(f"{where}: accepted the connection but sent no Dask handshake within {timeout_s:g} s; is "
+                         "it a Dask scheduler (dask scheduler --port ...)?") from None
+    except OSError as exc:
+        raise StudyError(f"{where}: connection failed during the handshake ({exc.strerror or exc})") from None
+    finally:
+        sock.close()
+    (n,) = struct.unpack("Q", head)          # native order, as distributed.comm.tcp
+    if not 0 < n <= _MAX_HANDSHAKE_BYTES:
+        raise StudyError(f"{where}: answered {head!r}, not a Dask handshake (another protocol on that port?)")
+
+
+def _run_dask(spec, chunks, scheduler, tick, timeout_s: float = SCHEDULER_TIMEOUT_S):
     try:
         from distributed import Client, as_completed
     except ModuleNotFoundError:
         raise StudyError("the Dask backend needs dask[distributed]: pip install 'ipmc[dask]'") from None
     own = isinstance(scheduler, str)
+    if own:
+        probe_scheduler(scheduler, timeout_s)
     try:
-        client = Client(scheduler, timeout="20s") if own else (scheduler if isinstance(scheduler, Client) else Client(scheduler))
+        client = Client(scheduler, timeout=f"{timeout_s}s") if own else (scheduler if isinstance(scheduler, Client)
+                                                                         else Client(scheduler))
     except (ValueError, TypeError, OSError, TimeoutError) as exc:   # malformed or unreachable address
         raise StudyError(f"--scheduler {scheduler!r}: cannot connect to a Dask scheduler "
                          f"({type(exc).__name__}: {exc}); expected an address such as tcp://HOST:8786") from None
@@ -360,4 +466,4 @@ def _run_dask(spec, chunks, scheduler, tick):
             client.close()
 
 
-__all__ = ["parse_study", "load_study", "run_study", "evaluate_chunk", "sample_values", "StudyTable", "StudyError"]
+__all__ = ["parse_study", "load_study", "run_study", "probe_scheduler", "SCHEDULER_TIMEOUT_S", "evaluate_chunk", "sample_values", "StudyTable", "StudyError"]

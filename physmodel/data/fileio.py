@@ -1,21 +1,19 @@
 """The library's file plumbing: the one atomic writer (temporary file, then rename), the one UTF-8
-text reader, the extension dispatcher and the output-folder claim of the commands.
+text reader and the extension dispatcher (the output-folder claim: physmodel.data.results).
 
 Below every file format (sweeps, time records, model files, studies): nothing here knows a format.
 """
 
 from __future__ import annotations
 
-import json
 import os
 import secrets
 from collections.abc import Callable, Mapping
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 from .. import interrupts
-from ..errors import DataFormatError, IPMCError
+from ..errors import DataFormatError
 
 
 # ----------------------------------------------------------------------------------- I/O helpers
@@ -29,7 +27,10 @@ def atomic_write(path, write_fn, mode: str = "w") -> Path:
     # finds and removes it (mkstemp's name is only known once it returns)
     tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
     try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        except OSError as exc:         # name the file asked for, not the temporary one
+            raise OSError(exc.errno, exc.strerror, str(path)) from None
         text: dict[str, Any] = {"newline": "", "encoding": "utf-8"} if "b" not in mode else {}
         with os.fdopen(fd, mode, **text) as fh:
             write_fn(fh)
@@ -68,73 +69,8 @@ def read_text(path, what: str = "file") -> str:
                               "save the file as UTF-8") from None
 
 
-#: What each ipmc command leaves in its output folder, to recognise whose results a folder holds:
-#: (file, identity, or a function of the file's JSON giving the identity).
-OWNER_FILES = (("metrics.json", lambda d: f"ipmc run {d['scenario']}"), ("calibration.json", lambda d: "ipmc calibrate"),
-               ("model.json", lambda d: "ipmc fit"), ("report.json", lambda d: "ipmc diagnose"))
-
-
-def folder_owner(folder) -> str | None:
-    """Whose results ``folder`` holds: ``"ipmc run <scenario>"``, ``"ipmc calibrate"``, ``"ipmc fit"``,
-    ``"ipmc diagnose"``, a description of other files, or None when it is empty."""
-    folder = Path(folder)
-    entries = sorted(p.name for p in folder.iterdir())
-    if not entries:
-        return None
-    for name, identity in OWNER_FILES:
-        if name in entries:
-            try:
-                return identity(json.loads((folder / name).read_text(encoding="utf-8")))
-            except (OSError, ValueError, KeyError, TypeError):
-                continue
-    return f"files not written by a finished ipmc run ({', '.join(entries[:3])}{', ...' if len(entries) > 3 else ''})"
-
-
-def check_output_folder(path, identity: str, *, force: bool = False, option: str = "--out") -> Path:
-    """The refusals of :func:`output_folder` without creating or locking anything: for commands
-    that compute first and write at the end (they claim the folder then)."""
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise IPMCError(f"{option} {path}: exists and is not a folder")
-    owner = folder_owner(path) if path.is_dir() else None
-    if owner is not None and owner != identity and not force:
-        held = owner if owner.startswith("files") else f"the results of {owner!r}"
-        raise IPMCError(f"{option} {path}: the folder holds {held}, not of {identity!r}; choose another "
-                        "folder or pass --force to write into it")
-    return path
-
-
-@contextmanager
-def output_folder(path, identity: str, *, force: bool = False, option: str = "--out"):
-    """Claim the folder ``path`` for one run (a context manager yielding it as a Path).
-
-    The folder is created if needed and locked (``fcntl.flock`` on the folder itself) for the
-    duration of the block, so a second run into the same folder is refused while the first one
-    writes.  A folder that holds another run's results (:func:`folder_owner` differs from
-    ``identity``, e.g. another scenario, or files ipmc did not finish writing) is refused unless
-    ``force``; the same command or scenario may replace its own results.  Errors are
-    :class:`~physmodel.errors.IPMCError` naming ``option`` and the folder.
-    """
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise IPMCError(f"{option} {path}: exists and is not a folder")
-    path.mkdir(parents=True, exist_ok=True)
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        try:
-            import fcntl
-        except ImportError:  # pragma: no cover - not POSIX: no lock, the ownership check still applies
-            fcntl = None  # type: ignore[assignment]
-        if fcntl is not None:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                raise IPMCError(f"{option} {path}: another ipmc run is writing into this folder; wait for it "
-                                "or choose another folder") from None
-        check_output_folder(path, identity, force=force, option=option)
-        yield path
-    finally:
-        os.close(fd)                   # closing the descriptor releases the lock
+# the output-folder claim of the commands lives in physmodel.data.results (all or nothing, with a
+# completion marker), above this module; physmodel.data.files re-exports its names
 
 
 def by_extension(path, handlers: Mapping[str, Callable], what: str) -> Callable:

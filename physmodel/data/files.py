@@ -19,7 +19,8 @@ import numpy as np
 
 from ..errors import DataFormatError, IPMCError
 from .columns import ColumnMapError, Table, pick, read_table
-from .fileio import atomic_write, by_extension, check_output_folder, folder_owner, output_folder, read_text
+from .fileio import atomic_write, by_extension, read_text
+from .results import check_output_folder, folder_owner, output_folder
 from .sweep import (
     MAX_SWEEP_LINES,
     OPTIONAL_COLUMNS,

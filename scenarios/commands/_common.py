@@ -3,6 +3,7 @@ the model options (--kind/--set/--params-json/--param/--kernel) and a progress b
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -78,6 +79,104 @@ def refuse_overwriting_inputs(outputs: dict, inputs: dict) -> None:
                                "choose another file name")
 
 
+def available_memory() -> int:
+    """Bytes this process can still allocate: the kernel's MemAvailable (else free RAM), capped by
+    the address-space limit (ulimit -v) when one is set."""
+    avail = None
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    avail = int(line.split()[1]) * 1024
+                    break
+    except (OSError, ValueError, IndexError):
+        pass
+    if avail is None:
+        try:
+            avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+            avail = 8 << 30
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft != resource.RLIM_INFINITY:
+            avail = min(avail, soft)
+    except (ImportError, OSError, ValueError):  # pragma: no cover - not POSIX
+        pass
+    return int(avail)
+
+
+#: Share of the available memory one count-driven allocation may claim.
+MEMORY_SHARE = 0.5
+
+
+def bound_count(value, option: str, bytes_each: float, *, what: str = "items") -> int:
+    """``value`` (a count that drives an allocation of ``bytes_each`` per unit) when this machine can
+    hold it; a CLIError (exit 2) naming ``option`` and the largest value it can hold otherwise —
+    checked before anything is allocated."""
+    value = int(value)
+    limit = max(1, int(available_memory() * MEMORY_SHARE // max(float(bytes_each), 1.0)))
+    if value > limit:
+        raise CLIError(f"{option} {value}: at most {limit} on this machine ({what} of about {bytes_each:.0f} bytes "
+                       f"each, {available_memory() / 2**30:.3g} GiB available)")
+    return value
+
+
+def check_result_file(path, option: str) -> Path:
+    """``path`` when the result folder holding it is complete (:func:`physmodel.data.results.check_complete`):
+    a file of a run interrupted in its write phase is refused, naming ``option`` and the folder."""
+    from physmodel.data.results import check_complete
+
+    try:
+        check_complete(path, option)
+    except IPMCError as exc:
+        raise CLIError(str(exc)) from None
+    return Path(path)
+
+
+def check_plausible(params, option: str) -> None:
+    """Refuse (CLIError) parameters outside any physical range before numerical work: a length of
+    1e300 m would end in an SVD failure, not a message (:func:`physmodel.plausible.check_physical`)."""
+    from physmodel.plausible import check_physical
+
+    try:
+        check_physical(params)
+    except IPMCError as exc:
+        raise CLIError(f"{option}: {exc}") from None
+
+
+#: Highest plausible operating temperature of a hydrated IPMC [°C] (the physics' laws hold to 100 °C);
+#: a °C column or option above it almost always holds kelvin (293–373 K).
+MAX_PLAUSIBLE_C = 150.0
+
+
+def check_celsius(values, where: str) -> None:
+    """Refuse (CLIError naming ``where``) temperatures in °C that are below absolute zero or above
+    :data:`MAX_PLAUSIBLE_C` — the latter almost always kelvin in a °C column or option."""
+    v = np.atleast_1d(np.asarray(values, dtype=float))
+    if v.size == 0:
+        return
+    if np.any(v <= -273.15):
+        raise CLIError(f"{where} {v[v <= -273.15][:5].tolist()}: below absolute zero (-273.15 °C)")
+    if np.any(v > MAX_PLAUSIBLE_C):
+        hot = v[v > MAX_PLAUSIBLE_C]
+        raise CLIError(f"{where} holds {float(hot.min()):g}{'' if hot.size == 1 else f'–{float(hot.max()):g}'}, above "
+                       f"{MAX_PLAUSIBLE_C:g} °C where no hydrated IPMC works — kelvin? Temperatures are in °C "
+                       "(subtract 273.15)")
+
+
+def as_flags(message: str) -> str:
+    """A library message's keyword arguments (``improper='filter'``, ``filter_bandwidth=<rad/s>``)
+    spelled as the command-line flags of ``ipmc invert``/``feedforward`` (``--improper filter``,
+    ``--filter-bandwidth RAD_PER_S``), so that a message names what the user can type."""
+    import re
+
+    message = re.sub(r"improper='(\w+)'", r"--improper \1", message)
+    message = re.sub(r"filter_bandwidth=<rad/s>", "--filter-bandwidth RAD_PER_S", message)
+    return re.sub(r"filter_bandwidth=", "--filter-bandwidth ", message)
+
+
 def check_out_file(path, suffixes, option: str = "--out") -> Path:
     """An output file name with one of ``suffixes`` that is not an existing folder."""
     p = Path(path)
@@ -114,6 +213,8 @@ def load_physics(args, command: str, *, default_set: str | None = DEFAULT_SET):
     option, source = given[0]
     if option != "--set" and not Path(source).is_file():
         raise CLIError(f"{option} {source}: no such file")
+    if Path(source).is_file():
+        check_result_file(source, option)          # not from a folder an interrupted run left behind
     kind = getattr(args, "kind", None)
     try:
         mf = load_model(source, kind=kind)
@@ -121,6 +222,7 @@ def load_physics(args, command: str, *, default_set: str | None = DEFAULT_SET):
         raise CLIError(f"{option} {source}: {exc}") from None
     if over:
         mf = mf.with_parameters(mf.parameters.replace(**over))
+    check_plausible(mf.parameters, f"{option} {source}" + (" with --param" if over else ""))
     if mf.path is None and getattr(args, "kernel", None):       # a named set: the kernel is the command's
         from dataclasses import replace
 

@@ -31,7 +31,7 @@ from physmodel.errors import ParameterError
 
 from .. import plots
 from ._columns import add_sweep_options
-from ._common import EXIT_FAILED, EXIT_OK, parse_assignments
+from ._common import EXIT_FAILED, EXIT_OK, check_celsius, parse_assignments
 
 
 def parse_free(spec: str, base):
@@ -65,9 +65,17 @@ def parse_free(spec: str, base):
 def start_model(source: str, kind: str | None, overrides: dict):
     """The start of a calibration or diagnosis: a named set or a model/parameter file (its effects
     come along), with ``overrides`` (SI) applied."""
+    from pathlib import Path
+
     from physmodel.model_file import load_model
 
-    return load_model(source, kind=kind, **overrides)
+    from ._common import check_plausible, check_result_file
+
+    if Path(source).is_file():
+        check_result_file(source, "--set")          # not from a folder an interrupted run left behind
+    mf = load_model(source, kind=kind, **overrides)
+    check_plausible(mf.parameters, f"--set {source}" + (" with the overrides" if overrides else ""))
+    return mf
 
 
 def parse_effect(item: str, option: str = "--effect") -> tuple[str, dict]:
@@ -138,6 +146,7 @@ def run(args) -> int:
     if args.starts < 1:
         raise ParameterError(f"--starts must be >= 1, got {args.starts}")
     data = read_sweep_mapped(args.sweep, args)
+    check_celsius(data.temperatures(), f"{args.sweep}: temperature_c")
     over = parse_assignments(args.param)
     start = start_model(args.base_set, args.kind, over)
     args.kind = start.kind
@@ -170,8 +179,12 @@ def run(args) -> int:
     if start.verdict is not None and not start.verdict.adequate and not args.quiet:
         print(f"ipmc calibrate: note: the start model {args.base_set} did not fit its own data "
               f"({start.verdict.reason}); this calibration is judged afresh on {args.sweep}", file=sys.stderr)
-    with output_folder(out, "ipmc calibrate", force=args.force):
-        _write(res, data, args, out)
+    with output_folder(out, "ipmc calibrate", force=args.force) as stage:
+        _write(res, data, args, stage)
+    if not args.quiet:                      # said once the folder is in place, not before
+        print(res.summary())
+        print(f"wrote {out}/model.json (the model for every later command: --model {out}/model.json), "
+              "parameters.json, calibration.json, report.md, bode.png")
     if res.hold_refused or (res.holds and not args.quiet):
         print(f"ipmc calibrate: {res.hold_line()}", file=sys.stderr)
     if not res.converged:
@@ -186,6 +199,7 @@ def run(args) -> int:
 
 
 def _write(res, data, args, out):
+    """Write the results into ``out`` (the temporary folder that becomes the --out folder)."""
     from physmodel.data.files import atomic_write
     from physmodel.estimation.calibration import model_sweep
 
@@ -201,10 +215,6 @@ def _write(res, data, args, out):
     plots.calibration_figure(data, model, res, out / "bode.png")
     report = render_report(res, data, args)
     atomic_write(out / "report.md", lambda fh: fh.write(report))
-    if not args.quiet:
-        print(res.summary())
-        print(f"wrote {out}/model.json (the model for every later command: --model {out}/model.json), "
-              "parameters.json, calibration.json, report.md, bode.png")
 
 
 def _g(v) -> str:

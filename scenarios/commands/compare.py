@@ -96,7 +96,7 @@ def run(args) -> int:
             atomic_write(out / "compare.json", lambda fh: fh.write(text + "\n"))
             plots.compare_figure(result, out / "compare.png")
         if not args.quiet:
-            print(f"wrote {out}/compare.json and {out}/compare.png")
+            print(f"wrote {args.out}/compare.json and {args.out}/compare.png")     # the final folder
     if not result.adequate:
         print(f"ipmc compare: {result.verdict()}", file=sys.stderr)
         return EXIT_OK if args.accept_misfit else EXIT_FAILED

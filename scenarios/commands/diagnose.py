@@ -61,7 +61,7 @@ from physmodel.errors import IPMCError, ParameterError
 
 from .. import plots
 from ._columns import add_sweep_options
-from ._common import EXIT_FAILED, EXIT_OK, parse_assignments
+from ._common import EXIT_FAILED, EXIT_OK, check_celsius, parse_assignments
 from .calibrate import parse_effect, provenance_of, start_model
 
 _GEOMETRY = ("L", "W", "h")
@@ -273,6 +273,7 @@ def build(args):
     start = start_model(set_name, pick(args.kind, "kind"), over)
     base = start.parameters
     data = read_sweep_mapped(data_path, args, "--data")
+    check_celsius(data.temperatures(), f"{data_path}: temperature_c")
     # the start model's effects are in the model (fixed at their values) unless the TOML/flags say otherwise
     effects_spec = {**start.effects, **dict(spec.get("baseline_effects", {}))}
     for item in args.baseline_effect or []:
@@ -319,6 +320,11 @@ def build(args):
               kernel=pick(args.kernel, "kernel", "boundary_charge"))
     if kw["kind"] not in ("actuator", "sensor"):
         raise IPMCError(f"kind = {kw['kind']!r}; expected 'actuator' or 'sensor'")
+    from ._common import bound_count
+
+    # the null Monte Carlo holds two (2·lines × draws) float64 arrays and a few rows per candidate
+    bound_count(kw["null_draws"], "--null-draws" if args.null_draws is not None else f"null_draws (in {args.experiment})",
+                8 * (4 * data.frequency_hz.size + 16), what="draws")
     args.data_path = data_path
     return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
 
@@ -348,10 +354,10 @@ def run(args) -> int:
         if bar is not None:
             bar.close()
     mf = d.to_model_file(provenance_of(args.data_path, data, "ipmc diagnose"))
-    with output_folder(out, "ipmc diagnose", force=args.force):
-        d.write_report(out)
-        mf.save(out / "model.json")
-        plots.diagnosis_figures(d, out)
+    with output_folder(out, "ipmc diagnose", force=args.force) as stage:     # all or nothing
+        d.write_report(stage)
+        mf.save(stage / "model.json")
+        plots.diagnosis_figures(d, stage)
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)

@@ -188,6 +188,18 @@ def drive_warning(args, u: np.ndarray, unit: str, cf: float) -> str:
             f"(the default limit of ipmc feedforward and inversion.feedforward); {how}")
 
 
+#: Bytes per record sample while a design is generated and saved (time, drive, file buffer, FFT work).
+BYTES_PER_SAMPLE = 48
+
+
+def _bound_samples(n, option: str) -> None:
+    """Refuse (exit 2) a record longer than this machine can hold, before it is generated."""
+    from ._common import bound_count
+
+    if np.isfinite(n) and n > 0:
+        bound_count(min(float(n), 2.0**62), option, BYTES_PER_SAMPLE, what="samples")
+
+
 def _design(args, ch: str, unit: str):
     from physmodel.data.excitation import chirp, multisine, stepped_sine_plan
 
@@ -200,6 +212,8 @@ def _design(args, ch: str, unit: str):
             note = f" ({args.count - f.size} requested lines coincided on the 1/period = {1 / args.period:g} Hz grid)"
         if args.amplitude is not None and args.rms is not None:
             raise CLIError("--amplitude and --rms: give one of them")
+        _bound_samples(args.period * args.fs * (max(args.periods, 0) + max(args.transient_periods, 0)),
+                       "--period × --fs × (--periods + --transient-periods)")
         ms = multisine(f, args.fs, args.period, amplitude=1.0 if args.amplitude is None else args.amplitude,
                        rms=args.rms, phases=args.phases, seed=args.seed, channel=ch, unit=unit)
         rec = ms.record(args.periods, args.transient_periods)
@@ -210,10 +224,13 @@ def _design(args, ch: str, unit: str):
         plan = stepped_sine_plan(f, args.fs, amplitude=args.amplitude, periods=args.periods,
                                  min_measure_s=args.min_measure_s, settle_s=args.settle_s,
                                  settle_periods=args.settle_periods, channel=ch, unit=unit)
+        _bound_samples(plan.n_samples, "the stepped-sine record (--fs × the steps' --periods and --settle-s)")
         rec = plan.record()
         what = (f"stepped sine: {f.size} steps {f.min():g}-{f.max():g} Hz, {int(plan.periods.min())}-"
                 f"{int(plan.periods.max())} periods per step, settle {plan.settle_s.min():g}-{plan.settle_s.max():g} s")
     else:
+        if np.isfinite(args.sweep_s) and np.isfinite(args.fs):
+            _bound_samples(args.sweep_s * args.fs * max(args.repeats, 1), "--sweep-s × --fs × --repeats")
         rec = chirp(args.f0, args.f1, args.sweep_s, args.fs, amplitude=args.amplitude, method=args.method,
                     repeats=args.repeats, channel=ch, unit=unit)
         what = f"{args.method} chirp {args.f0:g}-{args.f1:g} Hz, {args.sweep_s:g} s x {args.repeats}"

@@ -43,7 +43,18 @@ import numpy as np
 from inversion.limits import DEFAULT_MAX_VOLTAGE
 
 from ._columns import add_sweep_options, reference_column_unit, signal_scale, surrogate_role
-from ._common import EXIT_FAILED, EXIT_OK, CLIError, _floats, load_physics, provenance_data, verdict_lines
+from ._common import (
+    EXIT_FAILED,
+    EXIT_OK,
+    CLIError,
+    _floats,
+    as_flags,
+    check_celsius,
+    check_result_file,
+    load_physics,
+    provenance_data,
+    verdict_lines,
+)
 
 __all__ = ["add_parser", "run", "build_reference", "drive_limits"]
 
@@ -72,6 +83,10 @@ def add_parser(sub):
     c = p.add_argument_group("inversion and limits")
     c.add_argument("--preview", default="auto", help="'auto' (tolerance rule), '4/r0', 'inf' or seconds")
     c.add_argument("--preview-tol", type=float, default=1e-3, help="auto preview: relative truncation error")
+    c.add_argument("--improper", choices=("error", "filter", "differentiate"), default="error",
+                   help="a strictly proper surrogate (improper inverse): refuse, low-pass the inverse "
+                        "(--filter-bandwidth) or apply its s^k terms as finite differences")
+    c.add_argument("--filter-bandwidth", type=float, default=None, help="low-pass bandwidth [rad/s] for --improper filter")
     c.add_argument("--max-voltage", type=float, default=None,
                    help=f"largest |V| allowed [V], > 0 (default {DEFAULT_MAX_VOLTAGE:g} V: IPMCs take ~2-3 V)")
     c.add_argument("--no-voltage-limit", action="store_true",
@@ -226,12 +241,14 @@ def drive_limits(args) -> tuple[float | None, float | None]:
 def run(args) -> int:
     import json
 
-    from inversion import feedforward
+    from inversion import InversionError, feedforward
     from inversion.limits import LimitError, Limits
     from physmodel.data.files import atomic_write
     from physmodel.data.units import UNITS, unit_scale
 
     max_v, max_rate = drive_limits(args)
+    check_celsius(args.temperature, "--temperature")
+    check_result_file(args.surrogate, "SURROGATE")          # not from a fit interrupted in its write phase
     model = _surrogate(args.surrogate, args.temperature)
     G = model.at(args.temperature)
     in_unit = model.labels.get("input_unit") or "V"
@@ -276,12 +293,18 @@ def run(args) -> int:
         print("ipmc feedforward: warning: --no-voltage-limit: the drive voltage is not limited; "
               "never play it on a real strip without checking its peak", file=sys.stderr)
     try:
-        ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits)
+        ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits,
+                         improper=args.improper, filter_bandwidth=args.filter_bandwidth)
     except LimitError as exc:
         print(f"ipmc feedforward: refused: {exc}", file=sys.stderr)
         return EXIT_FAILED
+    except InversionError as exc:            # the library's keywords, spelled as this command's flags
+        raise CLIError(f"{args.surrogate}: {as_flags(str(exc))}") from None
     volts = ff.output * v_scale
-    out = Path(args.out)
+    from physmodel.data import results
+
+    final = Path(args.out)          # written into a temporary sibling, moved into place when complete
+    out = results.begin(final, "ipmc feedforward", force=True)
     r_rms = _rms(ref.y)
     cols = {"time_s": ref.t, "voltage_V": volts, f"reference_{out_unit}": ref.y}
     summary: dict = {"surrogate": str(args.surrogate), "temperature_c": args.temperature, "unit": out_unit,
@@ -443,14 +466,14 @@ def run(args) -> int:
         fh.write(",".join(cols) + "\n")
         np.savetxt(fh, arr, delimiter=",", fmt="%.12g")
 
-    out.mkdir(parents=True, exist_ok=True)
     text = json.dumps(summary, indent=2, allow_nan=False, default=float)
     atomic_write(out / "voltage.csv", write_csv)
     atomic_write(out / "report.json", lambda fh: fh.write(text + "\n"))
     atomic_write(out / "report.md", lambda fh: fh.write("\n".join(lines) + "\n"))
+    results.commit(out)
     if not args.quiet:
         print("\n".join(lines[2:]).replace("**", ""))
-        print(f"ipmc feedforward: wrote {out / 'voltage.csv'}, report.md and report.json")
+        print(f"ipmc feedforward: wrote {final / 'voltage.csv'}, report.md and report.json")
     if upstream and not args.accept_misfit:
         print("ipmc feedforward: an upstream model does not fit its data (exit 3; --accept-misfit to accept it)",
               file=sys.stderr)

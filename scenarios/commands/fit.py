@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -208,8 +209,10 @@ def run(args) -> int:
         schedule = check_schedule(fitter, fit_data, res.model, warn=False)     # leave-one-temperature-out
         if not schedule.ok:
             print(f"ipmc fit: WARNING: {schedule.message}", file=sys.stderr)
-    with output_folder(args.out, "ipmc fit", force=args.force) as out:
+    with output_folder(args.out, "ipmc fit", force=args.force) as out:          # all or nothing
         _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, schedule)
+    if not args.quiet:
+        print(f"ipmc fit: wrote {Path(args.out) / 'model.json'} and {Path(args.out) / 'report.md'}")
     if not res.converged:
         print(f"ipmc fit: the fit did not converge (IPOPT status {res.status!r})", file=sys.stderr)
         return EXIT_NOT_CONVERGED
@@ -250,5 +253,3 @@ def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, sche
                    + "\n" + ("OK: " if schedule.ok else "**WARNING**: ") + schedule.message
                    + "\n")
     atomic_write(out / "report.md", lambda fh: fh.write(report))
-    if not args.quiet:
-        print(f"ipmc fit: wrote {out / 'model.json'} and {out / 'report.md'}")

@@ -58,7 +58,7 @@ import numpy as np
 from physmodel.errors import IPMCError
 
 from ._columns import add_record_options, read_record_mapped
-from ._common import EXIT_OK, CLIError, _floats, refuse_overwriting_inputs
+from ._common import EXIT_OK, CLIError, _floats, check_celsius, refuse_overwriting_inputs
 from .excite import as_options
 
 SUFFIXES = (".csv", ".npz", ".mat")
@@ -124,12 +124,14 @@ def _temperatures(args, records) -> list[float]:
         temps = [v for item in args.temperature for v in _floats(item, "--temperature")]
         if len(temps) != len(records):
             raise CLIError(f"--temperature: {len(temps)} value(s) for {len(records)} record(s); give one per record")
+        check_celsius(temps, "--temperature")
         return temps
     temps = []
     for path, rec in zip(args.records, records):
         T = rec.temperature_c()
         if T is None:
             raise CLIError(f"{path}: no 'temperature_c' header; give --temperature (one per record)")
+        check_celsius(T, f"{path}: header temperature_c")
         temps.append(T)
     return temps
 

@@ -168,6 +168,9 @@ def run(args: argparse.Namespace) -> int:
             raise InversionError("give either --num/--den or --surrogate, not both")
         if args.temperature is None:
             raise InversionError("--surrogate needs --temperature (degC)")
+        from ._common import check_result_file
+
+        check_result_file(args.surrogate, "--surrogate")        # not from a fit interrupted in its write phase
         model: Any = model_from_surrogate(args.surrogate, args.temperature)
         import surrogate as _surrogate_pkg
 
@@ -206,7 +209,9 @@ def run(args: argparse.Namespace) -> int:
         res = invert(model, t, u, preview=preview, preview_tol=args.preview_tol, improper=args.improper,
                      filter_bandwidth=args.filter_bandwidth)
     except InversionError as exc:
-        raise InversionError(f"{args.input}: {exc}") from None
+        from ._common import as_flags
+
+        raise InversionError(f"{args.input}: {as_flags(str(exc))}") from None
     y = res.output
     if not np.all(np.isfinite(y)):
         # the CLI boundary guard: the library should refuse this itself (see the issue-13 report)

@@ -18,6 +18,7 @@ from ._common import (
     CLIError,
     _add_model_args,
     _floats,
+    check_celsius,
     check_plot_path,
     load_physics,
     model_metadata,
@@ -64,6 +65,7 @@ def run(args) -> int:
                                "--set": getattr(args, "set", None), "--params-json": getattr(args, "params_json", None)})
     if args.plot:
         check_plot_path(args.plot)
+    check_celsius(args.temperature, "--temperature")
     mf, overridden = load_physics(args, "ipmc simulate")
     warn_verdict(mf, "ipmc simulate")
     model = mf.model()
@@ -101,11 +103,14 @@ def run(args) -> int:
 
 def _finish(args, ts, model, what: str, out: Path) -> int:
     ts.metadata.update(getattr(args, "model_metadata", {}))
-    ts.save(out)
-    if args.plot:
-        from ..plots import traces
+    from physmodel.data.results import files_together
 
-        traces(ts, args.plot, title=f"{what}, {model.params[0].name}, {args.temperature:g} °C")
+    with files_together([out, *([args.plot] if args.plot else [])]) as tmp:     # both or neither
+        ts.save(tmp[0])
+        if args.plot:
+            from ..plots import traces
+
+            traces(ts, tmp[1], title=f"{what}, {model.params[0].name}, {args.temperature:g} °C")
     if not args.quiet:
         print(f"wrote {out} ({ts.t.size} samples; {ts.metadata.get('realization', 'free response of the first mode')})")
     return EXIT_OK

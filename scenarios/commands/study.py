@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ..spec import resolve_bundled
-from ..study import StudyError, _chunks, load_study, run_study
+from ..study import SCHEDULER_TIMEOUT_S, StudyError, _chunks, load_study, run_study
 
 
 def add_parser(subparsers):
@@ -18,6 +18,8 @@ def add_parser(subparsers):
     p.add_argument("spec", help="study TOML file, or the name of a bundled study (e.g. actuator_mc)")
     p.add_argument("--out", required=True, help="output table (.csv or .npz)")
     p.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://10.0.0.5:8786); default: local processes")
+    p.add_argument("--scheduler-timeout", type=float, default=SCHEDULER_TIMEOUT_S, metavar="SECONDS",
+                   help="seconds the Dask scheduler has to connect and answer (default %(default)g)")
     p.add_argument("--workers", type=int, help="local worker processes (default: number of CPUs)")
     p.add_argument("--serial", action="store_true", help="evaluate in this process (no workers)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
@@ -31,6 +33,18 @@ def run(args) -> int:
         raise StudyError(f"--out {out}: use a .csv or .npz file name")
     if args.workers is not None and args.workers < 1:
         raise StudyError(f"--workers must be >= 1, got {args.workers}")
+    if not 0 < args.scheduler_timeout <= 3600:
+        raise StudyError(f"--scheduler-timeout {args.scheduler_timeout:g}: expected seconds in (0, 3600]")
+    from physmodel.data.results import check_writable_parent
+
+    from ._common import bound_count, check_out_file
+
+    check_out_file(out, (".csv", ".npz"))
+    check_writable_parent(out)                  # before the study runs, not after
+    rows = spec["samples"] * len(spec["temperatures_c"]) * len(spec["frequencies_hz"])
+    # the columns (parameters + 7) as float64, held about three times (chunks, table, file buffer)
+    bound_count(rows, f"{args.spec}: [study] samples × temperatures_c × frequencies", 24 * (len(spec["parameters"]) + 7),
+                what="rows")
     bar = None
     if not args.quiet:
         from tqdm import tqdm
@@ -38,7 +52,8 @@ def run(args) -> int:
         bar = tqdm(total=len(_chunks(spec)), desc=spec["name"], unit="chunk", file=sys.stderr)
     try:
         table = run_study(spec, scheduler=args.scheduler, workers=args.workers,
-                          backend="serial" if args.serial else None, progress=bar.update if bar else None)
+                          backend="serial" if args.serial else None, progress=bar.update if bar else None,
+                          timeout_s=args.scheduler_timeout)
     finally:
         if bar is not None:
             bar.close()

@@ -10,6 +10,7 @@ from ._common import (
     _add_model_args,
     _floats,
     _Progress,
+    check_celsius,
     check_out_file,
     check_plot_path,
     load_physics,
@@ -49,9 +50,7 @@ def run(args) -> int:
     if not 2 <= args.points <= MAX_SWEEP_LINES // len(temps):
         raise CLIError(f"--points must be 2 to {MAX_SWEEP_LINES // len(temps)} (at most {MAX_SWEEP_LINES} lines over "
                        f"{len(temps)} temperature(s)), got {args.points}")
-    bad = [t for t in temps if t <= -273.15]
-    if bad:
-        raise CLIError(f"--temperatures {bad}: below absolute zero (-273.15 °C)")
+    check_celsius(temps, "--temperatures")
     if args.seed is not None and args.seed < 0:
         raise CLIError(f"--seed must be a non-negative integer, got {args.seed}")
     for opt, v in (("--sigma-db", args.sigma_db), ("--sigma-deg", args.sigma_deg), ("--sigma", args.sigma)):
@@ -79,11 +78,14 @@ def run(args) -> int:
     from dataclasses import replace
 
     sw = replace(sw, metadata={**sw.metadata, **meta})
-    write_sweep(sw, out)
-    if args.plot:
-        from ..plots import bode
+    from physmodel.data.results import files_together
 
-        bode(sw, args.plot, title=f"{model.params[0].name}: {sw.metadata['description']}")
+    with files_together([out, *([args.plot] if args.plot else [])]) as tmp:     # both or neither
+        write_sweep(sw, tmp[0])
+        if args.plot:
+            from ..plots import bode
+
+            bode(sw, tmp[1], title=f"{model.params[0].name}: {sw.metadata['description']}")
     if not args.quiet:
         print(f"wrote {out} ({sw.frequency_hz.size} lines, {len(temps)} temperatures, "
               f"{sw.output_unit}/{sw.input_unit}) from {mf.describe()}" + (f" and {args.plot}" if args.plot else ""))

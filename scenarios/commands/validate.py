@@ -48,8 +48,11 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    atomic_write(out / "validation.json", lambda fh: fh.write(rep.to_json() + "\n"))
-    atomic_write(out / "validation.md", lambda fh: fh.write(rep.to_markdown()))
+    from physmodel.data.results import output_folder
+
+    with output_folder(out, "ipmc validate", force=True) as stage:        # all or nothing
+        atomic_write(stage / "validation.json", lambda fh: fh.write(rep.to_json() + "\n"))
+        atomic_write(stage / "validation.md", lambda fh: fh.write(rep.to_markdown()))
     if not args.quiet:
         print(f"wrote {out / 'validation.md'} and {out / 'validation.json'}: {rep.headline()}")
         for r in rep.regressions:

@@ -1,9 +1,12 @@
 """Counts of inputs tried / refused clearly or handled / bad, per category, over every file reader
-and ``ipmc`` entry point (issue 13).  The generators and the judge are those of the hypothesis
-suite (``tests/reliability/fuzzcases.py``); here each category draws ``--n`` seeded cases.
+and ``ipmc`` entry point (issue 13) and the fault classes of issue 28 (``faultcases.py``: a signal
+at a random phase of a command, huge counts, fake Dask schedulers, kelvin, physical ranges,
+incomplete result folders).  The generators and the judge are those of the hypothesis suite
+(``tests/reliability/fuzzcases.py``); here each category draws ``--n`` seeded cases.
 
     python tests/benchmarks/fuzz_report.py --n 40                 # this checkout
     python tests/benchmarks/fuzz_report.py --n 40 --root OTHER    # another checkout (e.g. before)
+    python tests/benchmarks/fuzz_report.py --n 20 --only interrupt_phase,huge_counts,scheduler,kelvin,physical_range,result_folder
 
 "clear": no traceback, an expected exit code, a refusal that names the file/key/value, finite
 outputs.  "bad": anything else (the first few are listed).  The address space is capped
@@ -13,6 +16,7 @@ outputs.  "bad": anything else (the first few are listed).  The address space is
 from __future__ import annotations
 
 import argparse
+import os
 import random
 import resource
 import sys
@@ -36,6 +40,7 @@ def main():
     lim = int(a.memory_gb * 2 ** 30)
     resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
     sys.path.insert(0, str(Path(a.root).resolve()))
+    os.environ["IPMC_FAULT_ROOT"] = str(Path(a.root).resolve())        # subprocess cases run that checkout
     sys.path.insert(1, str(HERE / "tests" / "reliability"))
     import fuzzcases
 

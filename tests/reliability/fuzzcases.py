@@ -876,3 +876,9 @@ GENERATORS = {
     "interop": gen_interop,
     "goodness_of_fit": gen_goodness_of_fit,
 }
+
+# the issue-28 fault classes (signals at chosen phases, huge counts, fake schedulers, kelvin,
+# physical ranges, incomplete result folders)
+from faultcases import FAULT_GENERATORS  # noqa: E402
+
+GENERATORS.update(FAULT_GENERATORS)

@@ -25,7 +25,9 @@ N = int(os.environ.get("IPMC_FUZZ_EXAMPLES", "0"))
 #: Default examples per category: cheap readers get more, whole runs fewer.
 DEFAULT = {"encoding": 12, "sweep_csv": 20, "sweep_binary": 20, "params_json": 20, "surrogate_json": 10,
            "scenario": 4, "output_folder": 2, "cli_options": 12, "study_diagnose_toml": 12, "physics": 20,
-           "invert_values": 10, "interop": 4, "goodness_of_fit": 2}
+           "invert_values": 10, "interop": 4, "goodness_of_fit": 2,
+           "interrupt_phase": 2, "huge_counts": 8, "scheduler": 3, "kelvin": 8, "physical_range": 12,
+           "result_folder": 8}
 
 
 @pytest.mark.parametrize("category", sorted(fuzzcases.GENERATORS))

@@ -37,9 +37,11 @@ def test_a_second_job_into_a_busy_folder_is_refused(tmp_path):
                              env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and not (out / "data").exists():
+        # the first job writes into a temporary sibling, moved into place when complete (issue 28)
+        while time.monotonic() < deadline and not list(tmp_path.glob(".Z.*.part/data")):
             time.sleep(0.02)
-        assert (out / "data").exists(), "the first job never started writing"
+        assert list(tmp_path.glob(".Z.*.part/data")), "the first job never started writing"
+        assert not out.exists()                                   # nothing in place before it is complete
         second = subprocess.run([sys.executable, "-m", "scenarios.cli", "run", str(_scenario(tmp_path, "other")),
                                  "--out", str(out), "--quiet"], env=env, capture_output=True, text=True, timeout=300)
         assert second.returncode == 2, second.stderr

@@ -33,7 +33,8 @@ def test_calibrate_end_to_end(sweep_file, tmp_path, capsys):
                "--starts", "2", "--seed", "1", "--out", str(out), "--name", "strip7", "--quiet"])
     assert rc == 0
     assert capsys.readouterr().out == ""                       # --quiet
-    assert sorted(p.name for p in out.iterdir()) == ["bode.png", "calibration.json", "model.json", "parameters.json", "report.md"]
+    assert sorted(p.name for p in out.iterdir()) == [".ipmc-complete.json", "bode.png", "calibration.json", "model.json",
+                                                     "parameters.json", "report.md"]
     p = get_parameter_set(str(out / "parameters.json"))        # loadable as a named set by path
     assert p.name == "strip7"
     cal = json.loads((out / "calibration.json").read_text())

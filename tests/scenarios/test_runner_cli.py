@@ -87,6 +87,7 @@ def test_interrupt_leaves_no_report_and_no_partial_files(tmp_path, monkeypatch, 
     p = _write(tmp_path, SMALL.format(bound="1e-12"))
     assert main(["run", str(p), "--out", str(out), "--quiet"]) == 0        # a complete earlier run
     assert (out / "report.md").exists()
+    before = {f.relative_to(out): f.read_bytes() for f in out.rglob("*") if f.is_file()}
 
     def boom(ctx):
         raise KeyboardInterrupt
@@ -94,8 +95,10 @@ def test_interrupt_leaves_no_report_and_no_partial_files(tmp_path, monkeypatch, 
     monkeypatch.setitem(R.STEPS, "widths", boom)
     assert main(["run", str(p), "--out", str(out), "--quiet"]) == 130
     assert "interrupted" in capsys.readouterr().err
-    assert not (out / "report.md").exists()            # the stale report no longer vouches for the folder
-    assert not [f for f in out.rglob("*") if f.name.endswith(".part")]
+    # all or nothing (issue 28): the folder still holds the earlier complete result, byte for byte,
+    # and no temporary folder or file is left next to it
+    assert {f.relative_to(out): f.read_bytes() for f in out.rglob("*") if f.is_file()} == before
+    assert not [f for f in tmp_path.rglob("*") if f.name.endswith(".part")]
 
 
 def test_interrupt_inside_a_figure_write_leaves_no_file(tmp_path, monkeypatch):
