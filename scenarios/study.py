@@ -300,7 +300,8 @@ class StudyTable:
         return by_extension(path, {".csv": self.to_csv, ".npz": self.to_npz}, "study table")(path)
 
 
-def _chunks(spec) -> list[list[int]]:
+def chunk_indices(spec) -> list[list[int]]:
+    """The study's sample indices cut into chunks of ``spec["chunk_size"]`` (one task each)."""
     n, c = spec["samples"], spec["chunk_size"]
     return [list(range(a, min(a + c, n))) for a in range(0, n, c)]
 
@@ -316,7 +317,7 @@ def run_study(spec: dict, *, scheduler=None, workers: int | None = None, backend
     is called as chunks finish.  Results are assembled in sample order, identical across backends.
     """
     backend = backend or ("dask" if scheduler is not None else "processes")
-    chunks = _chunks(spec)
+    chunks = chunk_indices(spec)
     t0 = time.perf_counter()
     tick = progress or (lambda n: None)
     if backend == "serial":
@@ -466,4 +467,4 @@ def _run_dask(spec, chunks, scheduler, tick, timeout_s: float = SCHEDULER_TIMEOU
             client.close()
 
 
-__all__ = ["parse_study", "load_study", "run_study", "probe_scheduler", "SCHEDULER_TIMEOUT_S", "evaluate_chunk", "sample_values", "StudyTable", "StudyError"]
+__all__ = ["parse_study", "load_study", "run_study", "probe_scheduler", "SCHEDULER_TIMEOUT_S", "evaluate_chunk", "chunk_indices", "sample_values", "StudyTable", "StudyError"]

@@ -206,3 +206,44 @@ def test_the_circle_finder_on_a_known_graph():
 def test_no_new_import_circle_between_files():
     new = [c for c in _circles(_import_graph()) if c not in KNOWN_CIRCLES]
     assert new == [], f"import circles between files: {new}"
+
+
+#: At most this many imports of another module's ``_private`` name (CONTRIBUTING.md, "A module's
+#: contract"); each must say why at the import with a ``# private:`` comment.
+MAX_PRIVATE_IMPORTS = 10
+
+
+def _private_imports(path: Path) -> list[tuple[int, str, str]]:
+    """(line, source module as written, name) for every ``from X import _name`` in ``path``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            src = "." * node.level + (node.module or "")
+            out += [(node.lineno, src, a.name) for a in node.names
+                    if a.name.startswith("_") and not a.name.startswith("__")]
+    return out
+
+
+def test_private_names_stay_in_their_module():
+    lines_of = {}
+    found = []
+    for _pkg, path in _modules():
+        for lineno, src, name in _private_imports(path):
+            if src == ".":
+                continue        # ``from . import _fit``: a package-private module inside its own package
+            text = lines_of.setdefault(path, path.read_text(encoding="utf-8").splitlines())
+            found.append((path.relative_to(ROOT).as_posix(), lineno, src, name,
+                          "# private:" in text[lineno - 1]))
+    unexplained = [f for f in found if not f[4]]
+    assert unexplained == [], f"private names imported without a '# private:' reason: {unexplained}"
+    assert len(found) <= MAX_PRIVATE_IMPORTS, f"{len(found)} private imports (at most {MAX_PRIVATE_IMPORTS}): {found}"
+
+
+def test_the_private_import_finder_sees_one():
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "m.py"
+        p.write_text("from .a import _x, y\nfrom . import _fit\n", encoding="utf-8")
+        assert _private_imports(p) == [(1, ".a", "_x"), (2, ".", "_fit")]

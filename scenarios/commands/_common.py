@@ -35,7 +35,8 @@ class CLIError(IPMCError):
 
 
 # ------------------------------------------------------------------------ argument helpers
-def _floats(text: str, what: str) -> list[float]:
+def floats(text: str, what: str) -> list[float]:
+    """Comma- (or semicolon-) separated numbers in ``text``; IPMCError naming ``what`` otherwise."""
     try:
         vals = [float(v) for v in text.replace(";", ",").split(",") if v.strip()]
     except ValueError:
@@ -314,7 +315,8 @@ def provenance_data(mf, info: dict) -> tuple:
     return None, "", notes
 
 
-def _add_model_args(p, default_set: str | None = DEFAULT_SET):
+def add_model_args(p, default_set: str | None = DEFAULT_SET):
+    """Add the model options every model-evaluating command shares (kind, set, model file, --param)."""
     p.add_argument("--kind", choices=("actuator", "sensor"), default=None,
                    help="actuator (voltage in) or sensor (tip displacement in, short-circuit current out); "
                         "default: the model file's kind, else actuator")
@@ -330,7 +332,9 @@ def _add_model_args(p, default_set: str | None = DEFAULT_SET):
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
 
 
-class _Progress:
+class Progress:
+    """A tqdm bar on stderr for long evaluations (none when ``quiet`` or under 200,000 points)."""
+
     def __init__(self, total: int, quiet: bool, desc: str):
         self.bar = None
         if not quiet and total >= 200_000:

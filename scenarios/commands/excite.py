@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import EXIT_OK, CLIError, _floats
+from ._common import EXIT_OK, CLIError, floats
 
 SUFFIXES = (".csv", ".npz", ".mat")
 
@@ -81,7 +81,7 @@ def _frequencies(args, grid: float | None) -> np.ndarray:
     if args.frequencies is not None:
         if any(v is not None for v in (args.fmin, args.fmax, args.count)):
             raise CLIError("--frequencies: give either --frequencies or --fmin/--fmax/--count, not both")
-        return np.asarray(_floats(args.frequencies, "--frequencies"))
+        return np.asarray(floats(args.frequencies, "--frequencies"))
     if args.fmin is None or args.fmax is None or args.count is None:
         raise CLIError("give --frequencies, or all of --fmin, --fmax and --count")
     if not (0 < args.fmin <= args.fmax) or not np.isfinite(args.fmax):

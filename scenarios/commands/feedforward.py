@@ -47,10 +47,10 @@ from ._common import (
     EXIT_FAILED,
     EXIT_OK,
     CLIError,
-    _floats,
     as_flags,
     check_celsius,
     check_result_file,
+    floats,
     load_physics,
     provenance_data,
     verdict_lines,
@@ -125,10 +125,10 @@ def build_reference(args, unit: str):
         return R.from_file(args.reference_file, column=args.reference_column, fade_in_s=fade,
                            fade_out_s=fade, lead_s=lead, tail_s=tail, unit=unit)
     if args.reference == "steps":
-        return R.smoothed_steps(_floats(args.levels, "--levels"), args.hold, args.fs,
+        return R.smoothed_steps(floats(args.levels, "--levels"), args.hold, args.fs,
                                 transition_s=args.transition, lead_s=lead, tail_s=tail, unit=unit)
-    amps = _floats(args.amplitude, "--amplitude")
-    freqs = _floats(args.frequency, "--frequency")
+    amps = floats(args.amplitude, "--amplitude")
+    freqs = floats(args.frequency, "--frequency")
     fmin = min(freqs)
     dur = args.duration if args.duration is not None else max(8.0 / fmin, 4.0)
     if args.reference == "sine":
@@ -433,8 +433,8 @@ def run(args) -> int:
                   f"{e_max:.4g} {out_unit} over the record, {e_body:.4g} {out_unit} between the fades (reference peak "
                   f"{float(np.max(np.abs(ref.y))):.4g} {out_unit})"]
         if not args.reference_file and args.reference == "sine":
-            f = _floats(args.frequency, "--frequency")[0]
-            A = _floats(args.amplitude, "--amplitude")[0]
+            f = floats(args.frequency, "--frequency")[0]
+            A = floats(args.amplitude, "--amplitude")[0]
             P = complex(mf.model().response(np.array([f]), [args.temperature])[0, 0]) / unit_scale(out_unit) * v_scale
             Gj = complex(G(2j * math.pi * f))
             lines.append(f"- steady-state prediction A |P/G - 1| = {A * abs(P / Gj - 1):.4g} {out_unit} "

@@ -58,7 +58,7 @@ import numpy as np
 from physmodel.errors import IPMCError
 
 from ._columns import add_record_options, read_record_mapped
-from ._common import EXIT_OK, CLIError, _floats, check_celsius, refuse_overwriting_inputs
+from ._common import EXIT_OK, CLIError, check_celsius, floats, refuse_overwriting_inputs
 from .excite import as_options
 
 SUFFIXES = (".csv", ".npz", ".mat")
@@ -121,7 +121,7 @@ def _read(path: str, option: str):
 
 def _temperatures(args, records) -> list[float]:
     if args.temperature:
-        temps = [v for item in args.temperature for v in _floats(item, "--temperature")]
+        temps = [v for item in args.temperature for v in floats(item, "--temperature")]
         if len(temps) != len(records):
             raise CLIError(f"--temperature: {len(temps)} value(s) for {len(records)} record(s); give one per record")
         check_celsius(temps, "--temperature")
@@ -210,7 +210,7 @@ def _estimator_kwargs(args, records) -> tuple[dict, str]:
             if abs(rec.fs - ms.fs_hz) > 1e-9 * ms.fs_hz:
                 raise CLIError(f"{path}: sampled at {rec.fs:g} Hz but the multisine was designed at {ms.fs_hz:g} Hz")
     elif args.frequencies is not None:
-        kw["frequencies_hz"] = _floats(args.frequencies, "--frequencies")
+        kw["frequencies_hz"] = floats(args.frequencies, "--frequencies")
     for opt in ("nperseg", "noverlap", "window", "discard_s"):
         v = getattr(args, opt)
         if v is not None:

@@ -46,7 +46,7 @@ from ._common import EXIT_OK, check_plot_path
 __all__ = ["add_parser", "run", "model_from_surrogate", "read_csv"]
 
 
-def _floats(tokens: list[str]) -> list[float]:
+def floats(tokens: list[str]) -> list[float]:
     out: list[float] = []
     for tok in tokens:
         for part in tok.replace(";", ",").split(","):
@@ -178,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         if args.num is None or args.den is None:
             raise InversionError("the model is missing: give --num and --den (or --surrogate)")
-        model = (_floats(args.num), _floats(args.den))
+        model = (floats(args.num), floats(args.den))
     preview: Any = args.preview
     if args.plot:
         check_plot_path(args.plot)

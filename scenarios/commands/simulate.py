@@ -16,10 +16,10 @@ from pathlib import Path
 from ._common import (
     EXIT_OK,
     CLIError,
-    _add_model_args,
-    _floats,
+    add_model_args,
     check_celsius,
     check_plot_path,
+    floats,
     load_physics,
     model_metadata,
     refuse_overwriting_inputs,
@@ -31,7 +31,7 @@ def add_parser(sub):
     p = sub.add_parser("simulate", help="time-domain virtual experiment",
                        description="Sine, step or free-release experiment with the exact model (via a verified "
                                    "rational realisation); SI units in the output file.")
-    _add_model_args(p)
+    add_model_args(p)
     p.add_argument("--experiment", choices=("sine", "step", "release"), default=None,
                    help="built-in excitation (default sine); not with --input")
     p.add_argument("--input", dest="input_file", metavar="FILE",
@@ -74,7 +74,7 @@ def run(args) -> int:
     if args.chain:
         if args.kind != "sensor":
             raise CLIError("--chain applies to the sensor's current output (use --kind sensor)")
-        r = _floats(args.chain, "--chain")
+        r = floats(args.chain, "--chain")
         if len(r) != 3:
             raise CLIError(f"--chain expects R1,R2,R3 in ohm, got {args.chain!r}")
         kw["chain"] = TransimpedanceChain(*r)

@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ..spec import resolve_bundled
-from ..study import SCHEDULER_TIMEOUT_S, StudyError, _chunks, load_study, run_study
+from ..study import SCHEDULER_TIMEOUT_S, StudyError, chunk_indices, load_study, run_study
 
 
 def add_parser(subparsers):
@@ -49,7 +49,7 @@ def run(args) -> int:
     if not args.quiet:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(_chunks(spec)), desc=spec["name"], unit="chunk", file=sys.stderr)
+        bar = tqdm(total=len(chunk_indices(spec)), desc=spec["name"], unit="chunk", file=sys.stderr)
     try:
         table = run_study(spec, scheduler=args.scheduler, workers=args.workers,
                           backend="serial" if args.serial else None, progress=bar.update if bar else None,

@@ -7,12 +7,12 @@ import numpy as np
 from ._common import (
     EXIT_OK,
     CLIError,
-    _add_model_args,
-    _floats,
-    _Progress,
+    Progress,
+    add_model_args,
     check_celsius,
     check_out_file,
     check_plot_path,
+    floats,
     load_physics,
     model_metadata,
     warn_verdict,
@@ -23,7 +23,7 @@ def add_parser(sub):
     p = sub.add_parser("sweep", help="synthetic frequency sweep at several temperatures",
                        description="Evaluate the physics model on a log frequency grid at several temperatures, "
                                    "optionally add seeded noise, and write CSV/NPZ/MAT (+ a Bode plot).")
-    _add_model_args(p)
+    add_model_args(p)
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
     p.add_argument("--temperatures", default="20,40,60", help="comma-separated temperatures [°C] (default 20,40,60)")
     p.add_argument("--fmin", type=float, default=0.1, help="lowest frequency [Hz] (default 0.1)")
@@ -42,7 +42,7 @@ def run(args) -> int:
     from physmodel.data.files import write_sweep
     from physmodel.data.sweep import ComplexGaussianNoise, MagnitudePhaseNoise, synthesize_sweep
 
-    temps = _floats(args.temperatures, "--temperatures")
+    temps = floats(args.temperatures, "--temperatures")
     if not (np.isfinite(args.fmin) and np.isfinite(args.fmax) and 0 < args.fmin < args.fmax):
         raise CLIError(f"need 0 < --fmin < --fmax, got {args.fmin} and {args.fmax}")
     from physmodel.data.sweep import MAX_SWEEP_LINES
@@ -69,7 +69,7 @@ def run(args) -> int:
     elif args.noise == "complex":
         noise = ComplexGaussianNoise(args.sigma)
     f = np.logspace(np.log10(args.fmin), np.log10(args.fmax), args.points)
-    bar = _Progress(len(f) * len(temps), args.quiet, "sweep")
+    bar = Progress(len(f) * len(temps), args.quiet, "sweep")
     try:
         sw = synthesize_sweep(model, quantity, f, temps, noise=noise, seed=args.seed, progress=bar)
     finally:
