@@ -103,10 +103,15 @@ def worker_init() -> None:
 def handling():
     """Within the block, SIGINT and SIGTERM are recorded and raise ``KeyboardInterrupt``; the
     record starts empty and the previous handlers are restored afterwards.  Outside the main
-    thread (where Python cannot install handlers) it only resets the record."""
+    thread (where Python cannot install handlers) it only resets the record.  The record is
+    forgotten when the block ends: an interrupt is the block's to report (read :func:`requested`
+    inside it), and must not stop later work in the same process (a notebook, a test session)."""
     reset()
     if threading.current_thread() is not threading.main_thread():
-        yield
+        try:
+            yield
+        finally:
+            reset()
         return
     previous = {s: signal.signal(s, _handler) for s in SIGNALS}
     try:
@@ -114,6 +119,7 @@ def handling():
     finally:
         for s, h in previous.items():
             signal.signal(s, h)
+        reset()
 
 
 __all__ = ["request", "requested", "reset", "check", "handling", "held", "worker_init", "SIGNALS", "REPEAT_S"]

@@ -142,3 +142,17 @@ def test_held_defers_an_interrupt_to_the_end_of_the_block():
                     done.append(1)
         assert len(done) == 1000                  # ... and did not break the block
         assert interrupts.requested() == signal.SIGTERM
+
+
+def test_an_interrupt_handled_in_one_block_does_not_stop_later_work():
+    """After an interrupted ``handling()`` block, the same process (a notebook) works on."""
+    from physmodel import interrupts
+
+    with interrupts.handling():
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGTERM)
+            for _ in range(1000):
+                pass
+        assert interrupts.requested() == signal.SIGTERM
+    assert interrupts.requested() is None
+    interrupts.check()                            # raises if the old interrupt were still recorded
