@@ -11,8 +11,7 @@ the pairs that are the same physics in two forms (:func:`declared_confusable`). 
 base model, and acts at one of four levels:
 
 ``parameter``  it changes the parameter values at each temperature (the :class:`State`);
-``strip``      it changes the strip's own responses, impedance included, by a factor (an interface
-               CPE distributed along the electrodes), before the chain and the series elements;
+``strip``      it changes the strip's own responses and impedance (a distributed interface CPE);
 ``response``   it multiplies a response by a factor (amplifier pole, delay, higher modes, coupling);
 ``series``     it adds an impedance in series with the strip (series resistance, interface CPE);
 ``kernel``     it changes the charge dynamics itself (fractional transport).
