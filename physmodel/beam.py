@@ -161,3 +161,37 @@ def modal_tip_response(s, omega_1, xi_1, x, n_modes: int, viscous_share=1.0):
     g = 1.0 / (eps[..., None] + 2.0 * np.asarray(xi_1)[..., None] * nu[..., None] * (w1 / wn) * sn + sn * sn)
     pi = moment_participation(x, n_modes)
     return 1.0 / eps + np.sum(pi * (g - 1.0 / eps[..., None]), axis=-1)
+
+
+def modal_damping_response(s, omega_1, xi_1, zeta_higher, x, n_modes: int):
+    """Tip deflection over the quasi-static one with modal (not Rayleigh) damping [-]:
+
+        1 + Σ_{n ≤ N} π_n(x) (g_n − 1),   g_1 = first_mode(s, ω1, ξ1),
+        g_n = 1/(1 + 2 ζ_h s/ω_n + (s/ω_n)²)  (n ≥ 2),  ω_n = ω1 (λn/λ1)²,
+
+    the modes above N quasi-static (g_n = 1, through Σ π_n = 1).  Every mode above the first has
+    the same damping ratio ``zeta_higher`` ζ_h (the usual modal-damping assumption, Clough &
+    Penzien, Dynamics of Structures, §12-5; Meirovitch, Fundamentals of Vibrations, §7.16), so the
+    higher modes' damping is one number, independent of ξ1 (which the first mode's fit absorbs
+    together with the fluid and the polymer's losses).  ``s`` [1/s], ``omega_1`` [rad/s],
+    ``xi_1``, ``zeta_higher``, ``x`` (line argument of :mod:`physmodel.electrode`): all
+    broadcast together."""
+    lam = cantilever_roots(n_modes)
+    s = np.asarray(s)
+    w1 = np.asarray(omega_1, dtype=float)[..., None]
+    wn = w1 * (lam / lam[0]) ** 2
+    z = np.where(np.arange(n_modes) == 0, np.asarray(xi_1, dtype=float)[..., None],
+                 np.asarray(zeta_higher, dtype=float)[..., None])
+    sn = s[..., None] / wn
+    g = 1.0 / (1.0 + 2.0 * z * sn + sn * sn)
+    pi = moment_participation(x, n_modes)
+    return 1.0 + np.sum(pi * (g - 1.0), axis=-1)
+
+
+def tip_force_participation(n_modes: int) -> np.ndarray:
+    """π_n = 3 φ_n(1)²/λ_n⁴ of a cantilever loaded by a force at its tip (the sensing loading: a
+    probe or slit pushing the tip) [-]: the share of mode n in the static tip deflection F L³/(3EI)
+    (w(L) = Σ φ_n(1)² F L³/(EI λ_n⁴); Σ π_n = 1): 0.970688, 0.024716, 0.003152, …"""
+    lam = cantilever_roots(n_modes)
+    phi1, _, _ = mode_tip_values(lam)
+    return 3.0 * phi1 * phi1 / lam**4

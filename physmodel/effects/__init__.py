@@ -8,6 +8,7 @@ from .base import Effect, EffectParameter
 from .library import (
                       ALIASES,
                       ALL_EFFECTS,
+                      CONFUSABLE,
                       DEFAULT_QUANTITY,
                       KINDS,
                       LIBRARY,
@@ -17,6 +18,7 @@ from .library import (
                       EffectSensorModel,
                       candidate_free_parameters,
                       candidates_for,
+                      declared_confusable,
                       get_effect,
                       make_effect_model,
                       normalize_effects,
@@ -24,5 +26,5 @@ from .library import (
 )
 
 __all__ = ["Effect", "EffectParameter", "LIBRARY", "OUT_OF_LIBRARY", "ALL_EFFECTS", "ALIASES", "KINDS",
-           "DEFAULT_QUANTITY", "EffectModel", "EffectActuatorModel", "EffectSensorModel", "make_effect_model",
+           "DEFAULT_QUANTITY", "CONFUSABLE", "declared_confusable", "EffectModel", "EffectActuatorModel", "EffectSensorModel", "make_effect_model",
            "get_effect", "candidates_for", "normalize_effects", "split_values", "candidate_free_parameters"]

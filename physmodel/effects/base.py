@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 from ..errors import ParameterError
 
 KINDS = ("actuator", "sensor")
-LEVELS = ("parameter", "response", "series", "kernel")
+LEVELS = ("parameter", "strip", "response", "series", "kernel")
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,8 @@ class EffectParameter:
 class Effect:
     """A named candidate effect: meaning, reference, parameters and where it applies.
 
-    ``level``: ``parameter`` (changes the State), ``response`` (a factor on a response),
+    ``level``: ``parameter`` (changes the State), ``strip`` (a factor on every quantity of the strip
+    itself, its impedance included, applied before the chain), ``response`` (a factor on a response),
     ``series`` (an impedance in series with the strip), ``kernel`` (changes the charge dynamics).
     ``apply`` is private machinery of the declaring module.  ``switch``: the parameter whose off
     value switches the effect off whatever the others are (None: all parameters at off).

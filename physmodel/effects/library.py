@@ -2,12 +2,16 @@
 model that composes them with a base parameter set.
 
 The effects are declared in :mod:`physmodel.effects.physical` (polymer, electrodes, beam,
-temperature laws) and :mod:`physmodel.effects.chain` (amplifier, delay, series resistance, series
-interface CPE, excitation coupling); :mod:`physmodel.effects.base` holds the records.  Each
+temperature laws), :mod:`physmodel.effects.chain` (amplifier, delay, series resistance, series
+interface CPE, excitation coupling), :mod:`physmodel.effects.sensing` (seed 000's sensing chain) and
+:mod:`physmodel.effects.forms` (higher modes with their own damping, a distributed interface CPE, a
+compliant clamp mount); :mod:`physmodel.effects.base` holds the records.  :data:`CONFUSABLE` declares
+the pairs that are the same physics in two forms (:func:`declared_confusable`).  Each
 :class:`Effect` has one or two parameters and an "off" value at which the model is exactly the
 base model, and acts at one of four levels:
 
 ``parameter``  it changes the parameter values at each temperature (the :class:`State`);
+``strip``      it changes the strip's own responses and impedance (a distributed interface CPE);
 ``response``   it multiplies a response by a factor (amplifier pole, delay, higher modes, coupling);
 ``series``     it adds an impedance in series with the strip (series resistance, interface CPE);
 ``kernel``     it changes the charge dynamics itself (fractional transport).
@@ -37,14 +41,17 @@ from ..model import DEFAULT_CHUNK, FrequencyResponse, check_frequencies, evaluat
 from ..params import STATE_FIELDS, IPMCParameters, State, first_mode_omega
 from ..sensor import SensorModel
 from ..transport import debye_rate
-from . import chain, physical, sensing
+from . import chain, forms, physical, sensing
 from .base import KINDS, Effect, EffectParameter
 from .physical import CPE_REFERENCE_HZ, SECOND_MODE_RATIO
 
 DEFAULT_QUANTITY = {"actuator": "M", "sensor": "S"}
 
 #: The candidate library, by name.
-LIBRARY: dict[str, Effect] = {e.name: e for e in physical.EFFECTS + chain.EFFECTS + sensing.EFFECTS}
+LIBRARY: dict[str, Effect] = {e.name: e for e in physical.EFFECTS + chain.EFFECTS + sensing.EFFECTS + forms.EFFECTS}
+#: Pairs of library effects declared confusable with the effects ({frozenset((a, b)): reason}):
+#: the same physics in two forms, which a band may not separate.
+CONFUSABLE: dict[frozenset, str] = dict(forms.CONFUSABLE)
 #: Effects kept OUT of the candidate list: used by blind generators only.
 OUT_OF_LIBRARY: dict[str, Effect] = {e.name: e for e in chain.OUT_OF_LIBRARY}
 ALL_EFFECTS = {**LIBRARY, **OUT_OF_LIBRARY}
@@ -75,6 +82,11 @@ def candidate_free_parameters(effect: str, params: IPMCParameters | None = None,
     """The parameters of library ``effect`` with candidate bounds for the strip ``params`` (see
     :meth:`Effect.candidate_parameters`); ``overrides = {param: {"lower"|"upper"|"typical": value}}``."""
     return get_effect(effect).candidate_parameters(params, overrides)
+
+
+def declared_confusable(a: str, b: str) -> str | None:
+    """The reason library effects ``a`` and ``b`` are declared confusable (:data:`CONFUSABLE`), or None."""
+    return CONFUSABLE.get(frozenset((ALIASES.get(a, a), ALIASES.get(b, b))))
 
 
 def get_effect(name: str) -> Effect:
@@ -196,6 +208,13 @@ class _EffectMixin:
                     vals["M"] = vals["H"] * G
         T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
         ctx = _Context(s[None, None, :], s_kernel[None, None, :], st, dict(vals), T_ref)
+        strip = [(e, v) for e, v in self._active if e.level == "strip"]
+        if strip:                           # the strip itself: every quantity computed, Z included
+            for q in need:
+                for e, ev in strip:
+                    if q in e.quantities:
+                        vals[q] = vals[q] * e.apply(q, ctx, ev)
+            ctx.base = dict(vals)
         for q in qs:
             fac = [e.apply(q, ctx, ev) for e, ev in resp if q in e.quantities]
             if fac:
@@ -340,5 +359,5 @@ def EffectModel(base_params: IPMCParameters | Sequence[IPMCParameters], kind: st
 
 __all__ = ["Effect", "EffectParameter", "EffectModel", "EffectActuatorModel", "EffectSensorModel",
            "LIBRARY", "OUT_OF_LIBRARY", "ALL_EFFECTS", "ALIASES", "get_effect", "candidates_for", "normalize_effects",
-           "split_values", "candidate_free_parameters", "CPE_REFERENCE_HZ", "SECOND_MODE_RATIO", "DEFAULT_QUANTITY",
+           "split_values", "candidate_free_parameters", "CONFUSABLE", "declared_confusable", "CPE_REFERENCE_HZ", "SECOND_MODE_RATIO", "DEFAULT_QUANTITY",
            "KINDS"]

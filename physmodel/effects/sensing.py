@@ -13,7 +13,8 @@ both signals are sampled by a dSPACE DS1104.  What the paper's G contains beside
     B   tip-driven beam: the strip is clamped at the root and pinned in the slit (the slit fixes the
         tip's lateral position and lets it rotate); its own inertia (mostly added water) bends it
         away from the static shape, and the charge follows the curvature (tip_driven_beam)
-    T   cup -> tip transmissibility if the wood piece rides on a compliant joint (base_excited_resonance);
+    T   cup -> tip transmissibility if the wood piece rides on a compliant joint (base_excited_resonance:
+        the joint's own damping; mount_resonance: damped by the surroundings, a plain pole pair);
         the paper assumes T = 1 ("nearly rigid")
     A   the two-op-amp transimpedance circuit with the strip's own impedance as source (transimpedance)
     HP, LP  an AC coupling or an anti-alias/smoothing filter in the current channel (none printed)
@@ -152,6 +153,24 @@ def base_excited_resonance(s, time_constant=0.0, damping=0.05) -> np.ndarray:
     tau, z = _par("time_constant", time_constant), _par("damping", damping, 0.0, 10.0, lo_open=True)
     num = 1.0 + 2.0 * z * tau * s
     return num / (num + (tau * s) ** 2)
+
+
+def mount_resonance(s, time_constant=0.0, damping=0.05, relative_share=0.0) -> np.ndarray:
+    """Tip/cup motion of a mount (wood piece + tip, mass m) on a joint (stiffness k) to the driven
+    cup, its damping c split between the joint (relative, c_r = ν c) and the surroundings (absolute:
+    the water around the piece, c_a = (1 − ν) c):
+
+        m x'' + c_r (x' − y') + c_a x' + k (x − y) = 0
+        ⇒ x/y = (1 + 2νζτs)/(1 + 2ζτs + τ²s²),   τ = sqrt(m/k) = 1/ω_f,  ζ = c/(2 sqrt(k m)).
+
+    ν = 1 is :func:`base_excited_resonance` (the joint's own damping: a real zero at 1/(2ζτ));
+    ν = 0 the plain second-order resonance, its own pole pair and no zero (Thomson & Dahleh, Theory
+    of Vibration with Applications, 5th ed., §3.5 base excitation; absolute damping §3.1).
+    ``time_constant`` τ [s] (off 0: rigid), ``damping`` ζ [-], ``relative_share`` ν [-]."""
+    s = _s(s)
+    tau, z = _par("time_constant", time_constant), _par("damping", damping, 0.0, 10.0, lo_open=True)
+    nu = _par("relative_share", relative_share, 0.0, 1.0)
+    return (1.0 + 2.0 * nu * z * tau * s) / (1.0 + 2.0 * z * tau * s + (tau * s) ** 2)
 
 
 def tip_driven_beam(s, time_constant=0.0, damping=0.05, coupling_ratio=0.0) -> np.ndarray:
@@ -377,6 +396,18 @@ _ELEMENTS = (
          _P("damping", "1", 0.05, 0.005, 1.0, 0.1, None, "joint damping, not printed")),
         lambda s, v, Z: base_excited_resonance(s, v["time_constant"], v["damping"])),
     ChainElement(
+        "mount_resonance", "mount resonance (second-order mechanical element, cup → tip)", "displacement",
+        "The piece holding the tip (mass m) rides on a joint of stiffness k to the cup the laser reads and is "
+        "damped by its surroundings (water), not by the joint: tip/cup = 1/(1 + 2ζτs + τ²s²), τ = 1/ω_f — its "
+        "own pole pair and no zero (mount_resonance with relative share ν = 0; ν = 1 is fixture_joint).  The "
+        "paper assumes a rigid coupling (τ = 0).",
+        "Thomson & Dahleh, Theory of Vibration with Applications (1998) §3.1, §3.5 (base excitation, absolute "
+        "vs relative damping); seed 000 Sec. II-A, Fig. 3 ('nearly rigid')",
+        (_P("time_constant", "s", 0.0, 0.0, 1.0 / (2 * math.pi * 10.0), 1.0 / (2 * math.pi * 150.0),
+            (0.0, 1.0 / (2 * math.pi * 200.0)), "rigid as the paper assumes, or a mount resonance above ~200 Hz"),
+         _P("damping", "1", 0.05, 0.005, 1.0, 0.1, None, "mount damping (to the surroundings), not printed")),
+        lambda s, v, Z: mount_resonance(s, v["time_constant"], v["damping"], 0.0)),
+    ChainElement(
         "tip_driven_beam", "tip-driven strip dynamics (clamped-pinned, water added mass)", "mechanical",
         "The strip's own inertia, mostly added water (π ρ_f W²/4 per length, 12x the strip's mass for seed 000), "
         "bends it away from the static shape: antiresonance at 0.64 ω1 and resonance at the first "
@@ -434,7 +465,7 @@ def chain_response(s, settings: Mapping[str, Mapping[str, float]], source_impeda
 #: ``acquisition_delay`` (``time_delay``: e^{-sτ}, τ in [0, 50 ms]), ``current_lag`` and real-pole
 #: ``current_lowpass2`` (``amplifier_bandwidth``: two real poles); ``polarity`` is the sign of a0,
 #: not an effect; ``ac_coupling2`` has no source beyond ``ac_coupling``.
-REGISTERED = ("laser_lag", "ac_coupling", "fixture_joint", "tip_driven_beam", "transimpedance")
+REGISTERED = ("laser_lag", "ac_coupling", "fixture_joint", "mount_resonance", "tip_driven_beam", "transimpedance")
 #: Sourced ranges of the parameters of library effects that model seed 000's chain (``time_delay``
 #: and ``amplifier_bandwidth`` included): {"effect.param": (lower, upper, source)}.
 PLAUSIBLE = {f"{n}.{p.name}": (p.plausible[0], p.plausible[1], p.source)
@@ -461,7 +492,7 @@ def _as_effect(el: ChainElement) -> Effect:
         rng = f"; sourced range [{p.plausible[0]:.3g}, {p.plausible[1]:.3g}]" if p.plausible else ""
         pars.append(EffectParameter(p.name, p.unit, p.off, p.lower, p.upper, typical, f"{p.doc or p.name}{rng} "
                                     f"({p.source})"))
-    switch = "time_constant" if el.name in ("fixture_joint", "tip_driven_beam") else None
+    switch = "time_constant" if el.name in ("fixture_joint", "mount_resonance", "tip_driven_beam") else None
 
     def apply(q, ctx, v, _el=el):
         Z = _strip_impedance(ctx) if _el.needs_source_impedance else None
@@ -479,5 +510,5 @@ EFFECTS = [_as_effect(ELEMENTS[n]) for n in REGISTERED]
 __all__ = ["CLAMPED_PINNED_LAMBDA1", "EFFECTS", "ELEMENTS", "PLAUSIBLE", "REGISTERED", "SEED000_R1", "SEED000_R2",
            "SEED000_R3", "ChainElement", "ChainParameter", "base_excited_resonance", "chain_elements",
            "chain_response", "clamped_pinned_frequency_hz", "first_order_lag", "get_element", "highpass",
-           "laser_lag", "polarity", "pure_delay", "second_order_lowpass", "tip_driven_beam", "transimpedance",
+           "laser_lag", "mount_resonance", "polarity", "pure_delay", "second_order_lowpass", "tip_driven_beam", "transimpedance",
            "transimpedance_factor"]

@@ -37,6 +37,46 @@ def _hermite_d2(zeta, le):
     return np.stack([(-6 + 12 * zeta) / le**2, (-4 + 6 * zeta) / le, (6 - 12 * zeta) / le**2, (-2 + 6 * zeta) / le])
 
 
+def fe_cantilever_tip_modal(s_values, moment, zetas, *, n_el=80, L=1.0, EI=1.0, rhoA=1.0, gauss=6):
+    """As :func:`fe_cantilever_tip` with a modal damping matrix instead of Rayleigh's:
+    C = M Φ diag(2 ζ_k ω_k) Φᵀ M over the FE modes Φ (Mᵀ-orthonormal, scipy.linalg.eigh), mode k
+    damped by ``zetas(k)`` (k = 0 the first mode) — Clough & Penzien, Dynamics of Structures, eq. 12-38.
+    Solved directly (dense) at each s; returns ``(tip, tip_static)``."""
+    from scipy.linalg import eigh
+
+    K, M, f = _fe_system(moment, n_el, L, EI, rhoA, gauss)
+    w2, Phi = eigh(K, M)
+    w = np.sqrt(w2)
+    z = np.array([zetas(k) for k in range(w.size)])
+    MP = M @ Phi
+    C = MP @ np.diag(2 * z * w) @ MP.T
+    tip_static = np.linalg.solve(K.astype(complex), f)[-2]
+    tip = np.array([np.linalg.solve(K + s * C + s * s * M, f)[-2] for s in np.atleast_1d(s_values)])
+    return tip, tip_static
+
+
+def _fe_system(moment, n_el, L, EI, rhoA, gauss):
+    """Clamped (K, M, f) of the Hermite-element cantilever under the active moment ``moment(z)``."""
+    le = L / n_el
+    ke = EI / le**3 * np.array([[12, 6 * le, -12, 6 * le], [6 * le, 4 * le**2, -6 * le, 2 * le**2],
+                                [-12, -6 * le, 12, -6 * le], [6 * le, 2 * le**2, -6 * le, 4 * le**2]])
+    me = rhoA * le / 420 * np.array([[156, 22 * le, 54, -13 * le], [22 * le, 4 * le**2, 13 * le, -3 * le**2],
+                                     [54, 13 * le, 156, -22 * le], [-13 * le, -3 * le**2, -22 * le, 4 * le**2]])
+    n = 2 * (n_el + 1)
+    K = np.zeros((n, n))
+    M = np.zeros((n, n))
+    f = np.zeros(n, dtype=complex)
+    t, w = np.polynomial.legendre.leggauss(gauss)
+    zq, wq = (t + 1) / 2, w / 2
+    for e in range(n_el):
+        idx = slice(2 * e, 2 * e + 4)
+        K[idx, idx] += ke
+        M[idx, idx] += me
+        m = np.asarray(moment(e * le + le * zq), dtype=complex)
+        f[idx] += _hermite_d2(zq, le) @ (m * wq) * le
+    return K[2:, 2:], M[2:, 2:], f[2:]
+
+
 def fe_cantilever_tip(s_values, moment, *, n_el=80, L=1.0, EI=1.0, rhoA=1.0, rayleigh=(0.0, 0.0), gauss=6):
     """Tip deflection of a clamped-free Euler–Bernoulli beam driven by the active moment ``moment(z)``.
 

@@ -107,8 +107,21 @@ EFFECT_SPECS: dict[str, tuple] = {
     "viscoelastic_creep": (None, {"delta": ("log", 0.01, 0.4), "tau_s": ("log", 0.3, 10.0), "a": ("lin", 0.5, 1.0)},
                            {"delta": 0.0, "tau_s": 1.0, "a": 1.0}),
 }
+#: Effects in their physical form (issue 27): drawn only when asked for by name, so the labels and
+#: seeds of the earlier sets (LABELS) stay as they were.
+PHYSICAL_FORM_SPECS: dict[str, tuple] = {
+    # Interface CPE in every slice of the electrode line (de Levie's line with a CPE wall), the
+    # same q_area and n ranges as the series CPE above; the library's distributed_cpe.
+    "distributed_cpe": ("distributed_cpe", {"n": ("lin", 0.95, 0.6), "q_area": ("log", 2000.0, 2.0)},
+                        {"n": 0.8, "q_area": math.inf}),
+    # Modes 2..8 of the cantilever with one modal damping ratio of their own (water-loaded higher
+    # modes of a cm-size strip: ζ 0.01-0.2), not Rayleigh damping tied to ζ1; the library's higher_modes.
+    "bending_modes": ("higher_modes", {"n_modes": ("fix", 8, 8), "zeta_higher": ("log", 0.2, 0.01)},
+                      {"n_modes": 1, "zeta_higher": 0.05}),
+}
 IN_LIBRARY = tuple(k for k, v in EFFECT_SPECS.items() if v[0] is not None)
 OUT_OF_LIBRARY = tuple(k for k, v in EFFECT_SPECS.items() if v[0] is None)
+EFFECT_SPECS.update(PHYSICAL_FORM_SPECS)
 #: Effects that need data at several temperatures (always the case here).
 THERMAL_EFFECTS = ("modulus_temperature", "diffusivity_temperature", "permittivity_temperature", "water_uptake")
 #: Two-effect cases named by issue 11, plus contact resistance with a mechanical/measurement effect.
@@ -291,6 +304,6 @@ def case_grid(labels=LABELS, n_per_label: int = 1, first_seed: int = 0, **kw) ->
     return out
 
 
-__all__ = ["make_case", "case_grid", "draw_effect", "draw_base", "off_values", "library_fields", "noncentrality",
+__all__ = ["make_case", "case_grid", "PHYSICAL_FORM_SPECS", "draw_effect", "draw_base", "off_values", "library_fields", "noncentrality",
            "baseline_noncentrality", "EFFECT_SPECS", "IN_LIBRARY", "OUT_OF_LIBRARY", "PAIRS", "LABELS",
            "START_SEED002", "SEALED", "FREQUENCIES_HZ", "TEMPERATURES_C", "PERTURBED"]

@@ -190,10 +190,12 @@ def base_state(base: dict, temperature_c) -> dict:
     return st
 
 
-def strip_response(st: dict, s, s_transport=None) -> dict:
+def strip_response(st: dict, s, s_transport=None, z_interface=None) -> dict:
     """Electrical and quasi-static quantities of the strip at Laplace points s (shape (1, n_f)).
 
-    ``s_transport`` replaces s inside the charge dynamics (fractional transport); default s."""
+    ``s_transport`` replaces s inside the charge dynamics (fractional transport); default s.
+    ``z_interface``: an impedance per unit length [Ω·m] in series with the polymer branch of every
+    slice (an interface CPE along the electrodes: de Levie's line with a CPE wall); default none."""
     st_ = s if s_transport is None else s_transport
     K = FARADAY**2 * st["d"] * st["C"] / (st["eps"] * R_GAS * st["T"])
     W, h, L = st["W"], st["h"], st["L"]
@@ -203,6 +205,8 @@ def strip_response(st: dict, s, s_transport=None) -> dict:
     y_p = W * st["eps"] * st_ * gam * (st_ + K) / (2.0 * h * den)
     r1, r2 = st["r1s"] / W, st["r2s"] / W
     z_branch = 1.0 / y_p + 2.0 * r2
+    if z_interface is not None:
+        z_branch = z_branch + z_interface
     y = 1.0 / z_branch + st["Gp"] * W
     f_pol = (1.0 / y_p) / z_branch
     x = L * np.sqrt(2.0 * r1 * y + 0j)
@@ -243,6 +247,20 @@ def modal_mechanics(x, s, w1, zeta1, n_modes: int = 1, viscous_share: float = 1.
     e_, mu_ = np.asarray(ekv)[..., None], np.asarray(mu)[..., None]
     g = 1.0 / (e_ + 2 * z1_ * viscous_share * (w1_ / wn) * sn + (1 + mu_) * sn * sn)
     return 1.0 / ekv + np.sum(modal_participation(x, n_modes) * (g - 1.0 / e_), axis=-1)
+
+
+def modes_with_modal_damping(x, s, w1, zeta1, zeta_higher, n_modes: int):
+    """Tip deflection / quasi-static tip deflection with every mode n ≤ N dynamic and the rest
+    static: Σ_{n ≤ N} π_n(x) η_n + (1 − Σ_{n ≤ N} π_n(x)), η_1 = 1/(1 + 2ζ1 s/ω1 + (s/ω1)²) and
+    η_n = 1/(1 + 2ζ_h s/ω_n + (s/ω_n)²) for n ≥ 2 (one damping ratio for the higher modes)."""
+    lam = cantilever_roots(n_modes)
+    wn = np.asarray(w1)[..., None] * (lam / lam[0]) ** 2
+    z = np.concatenate([[0.0], np.full(n_modes - 1, float(zeta_higher))])
+    z = np.where(np.arange(n_modes) == 0, np.asarray(zeta1)[..., None], z)
+    sn = np.asarray(s)[..., None] / wn
+    eta = 1.0 / (1.0 + 2.0 * z * sn + sn * sn)
+    pi = modal_participation(x, n_modes)
+    return np.sum(pi * eta, axis=-1) + (1.0 - np.sum(pi, axis=-1))
 
 
 # --------------------------------------------------------------------------- hidden effects
@@ -296,7 +314,12 @@ def actuator_response(base: dict, frequency_hz, temperature_c, effects: dict | N
         p = eff["fractional_transport"]
         wc = 2 * np.pi * p["f_ref_hz"]
         s_tr = wc * (s / wc) ** p["beta"]
-    sr = strip_response(st, s, s_tr)
+    z_if = None
+    if "distributed_cpe" in eff:           # interface CPE in every slice: Q' = q_area·W per length
+        p = eff["distributed_cpe"]
+        if p["q_area"] != np.inf:
+            z_if = 1.0 / (p["q_area"] * st["W"] * s ** p["n"])
+    sr = strip_response(st, s, s_tr, z_if)
     Z, H = sr["Z"], sr["Hqs"]
     z_ser = np.zeros_like(s)
     if "series_resistance" in eff:         # leads, clamp contact, amplifier output resistance [Ω]
@@ -319,6 +342,10 @@ def actuator_response(base: dict, frequency_hz, temperature_c, effects: dict | N
         mu = p["mass_ratio"] * np.conj(hydrodynamic_gamma(p["reynolds"] * w / w1))
     sm = eff.get("second_mode", {})
     mech = modal_mechanics(sr["x"], s, w1, st["zeta"], int(sm.get("n_modes", 1)), sm.get("viscous_share", 1.0), e, mu)
+    bm = eff.get("bending_modes", {"n_modes": 1})
+    if int(bm["n_modes"]) > 1:            # modes 2..N with one modal damping ratio (replaces the folded mode)
+        p = bm
+        mech = modes_with_modal_damping(sr["x"], s, w1, st["zeta"], p["zeta_higher"], int(p["n_modes"]))
     M = H * mech
     if "amplifier_bandwidth" in eff:       # dominant pole f_a and a non-dominant one at ratio·f_a
         p = eff["amplifier_bandwidth"]
@@ -344,9 +371,9 @@ def actuator_response(base: dict, frequency_hz, temperature_c, effects: dict | N
 EFFECT_NAMES = ("electrode_resistance", "contact_resistance", "leakage", "second_mode", "added_fluid_mass",
                 "modulus_temperature", "diffusivity_temperature", "permittivity_temperature", "water_uptake",
                 "amplifier_bandwidth", "time_delay", "series_resistance", "fractional_transport", "series_cpe",
-                "fixture_resonance", "gain_ripple", "viscoelastic_creep")
+                "fixture_resonance", "gain_ripple", "viscoelastic_creep", "distributed_cpe", "bending_modes")
 
 __all__ = ["FARADAY", "R_GAS", "T_ZERO", "cantilever_roots", "mode_shape", "uniform_moment_participation",
            "modal_participation", "line_profile", "bending_kernel", "x_coth_x", "water_permittivity",
            "ea_from_q10", "q10_from_ea", "base_state", "strip_response", "hydrodynamic_gamma",
-           "actuator_response", "modal_mechanics", "EFFECT_NAMES", "PT_TCR"]
+           "actuator_response", "modal_mechanics", "modes_with_modal_damping", "EFFECT_NAMES", "PT_TCR"]

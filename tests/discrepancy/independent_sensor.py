@@ -30,6 +30,8 @@ Chain elements (own parametrisation), each a factor on G:
                   slope per tip displacement from the 4×4 boundary-value problem of
                   EI w'''' = −m̃ (s² + 2ζ ω s) w solved per frequency (numpy.linalg.solve), over its
                   static value 3/(2L); first clamped-pinned frequency f_cp [Hz], damping ζ
+``mount``         (issue 27) the wood piece on a joint to the cup, damped by the water around it:
+                  k/(m s² + c s + k), resonance f_m [Hz], damping ratio ζ (no zero: the damping is not the joint's)
 ``opamp``         seed 000's two inverting stages (R1 470 kΩ, R2 = R3 10 kΩ) with single-pole
                   op-amps (GBW, A0) and the strip's impedance Z as source: the node equations solved
                   per frequency, over the ideal gain
@@ -78,6 +80,11 @@ EFFECT_SPECS = {
 }
 IN_LIBRARY = tuple(k for k, v in EFFECT_SPECS.items() if v[0] is not None)
 OUT_OF_LIBRARY = tuple(k for k, v in EFFECT_SPECS.items() if v[0] is None)
+#: Added for issue 27 (drawn only by name, so IN_LIBRARY and the earlier sets' seeds stay as they were):
+#: ``mount`` the wood piece (mass m) on a joint of stiffness k to the cup, damped by the water around it
+#: (not by the joint): m x'' + c x' + k (x − y) = 0, resonance f_m [Hz], damping ratio ζ = c/(2 sqrt(k m)).
+PHYSICAL_FORM_SPECS = {"mount": ("mount_resonance", {"f_m": ("log", 1500.0, 60.0), "zeta": ("lin", 0.05, 0.3)})}
+EFFECT_SPECS.update(PHYSICAL_FORM_SPECS)
 
 
 # --------------------------------------------------------------------------- strip
@@ -144,6 +151,10 @@ def chain_factor(name: str, v: dict, s, Z, f_hz):
         wj = 2 * np.pi * v["f_j"]
         num = 1 + 2 * v["zeta"] * s / wj
         return num / (num + (s / wj) ** 2)
+    if name == "mount":
+        wm = 2 * np.pi * v["f_m"]
+        k, m = wm * wm, 1.0                                   # unit mass: k = ω², c = 2ζω
+        return k / (m * s * s + 2 * v["zeta"] * wm * s + k)
     if name == "slit_beam":
         return slit_beam(s, v["f_cp"], v["zeta"])
     if name == "opamp":
@@ -227,6 +238,7 @@ __all__ = [
     "EFFECT_SPECS",
     "IN_LIBRARY",
     "OUT_OF_LIBRARY",
+    "PHYSICAL_FORM_SPECS",
     "START",
     "chain_factor",
     "library_fields",

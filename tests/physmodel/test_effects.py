@@ -41,7 +41,7 @@ def test_library_has_at_least_ten_documented_candidates():
     assert len(LIBRARY) >= 10
     assert not set(OUT_OF_LIBRARY) & set(LIBRARY)
     for e in LIBRARY.values():
-        assert e.description and e.reference and e.parameters and e.level in ("parameter", "response", "series", "kernel")
+        assert e.description and e.reference and e.parameters and e.level in ("parameter", "strip", "response", "series", "kernel")
         for p in e.parameters:
             assert p.lower <= p.off <= p.upper and p.typical != p.off
     for kind, q in (("actuator", "M"), ("sensor", "S"), ("actuator", "Z")):
