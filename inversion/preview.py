@@ -214,7 +214,7 @@ def _truncation_head(split: InverseSplit, dt: float, u: np.ndarray, N: int) -> n
 
 
 def discrete_tail_l1(split: InverseSplit, dt: float, n: int) -> np.ndarray:
-    """``tail[N]``, ``N = 0 .. K``: the l1 norm of the sampled anticausal kernel a preview of ``N``
+    """``tail[N]`` for ``0 <= N <= K``: the l1 norm of the sampled anticausal kernel a preview of ``N``
     samples discards, so that ``|e_N[k]| <= tail[N] max|u|`` and ``||e_N||_2 <= tail[N] ||u||_2``.
 
     With ``r_j = C_r Phi**j`` the truncation error is ``e_N[k] = -sum_l G_l u[k+N+l]``,

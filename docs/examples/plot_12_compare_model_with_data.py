@@ -1,6 +1,6 @@
 """
 Model vs your data: Bode plots on your own Axes, bands, and a fit figure per temperature
-=======================================================================================
+========================================================================================
 
 ``scenarios.plots.plot_bode`` draws a sweep or a model on matplotlib Axes you give it (in a
 notebook, beside your own curves) and returns them: a measured sweep with its per-line σ as

@@ -13,19 +13,19 @@ Two kinds of function:
 
 Figures are matplotlib ``Figure`` objects on an Agg canvas (no pyplot state: safe in threads and
 workers).  The package is the only place that imports matplotlib, and only when a figure is drawn.
-Modules: :mod:`~scenarios.plots.bode` (Bode plots and comparisons), :mod:`~scenarios.plots.residuals`
-(fits against their data), :mod:`~scenarios.plots.traces` (signals against time),
+Modules: :mod:`~scenarios.plots.frequency` (Bode plots and comparisons), :mod:`~scenarios.plots.residuals`
+(fits against their data), :mod:`~scenarios.plots.timeseries` (signals against time),
 :mod:`~scenarios.plots.roots` (poles and zeros), :mod:`~scenarios.plots.chain` (parameter
 estimates), :mod:`~scenarios.plots.canvas` (new figures and the writer they share).
 """
 
 from __future__ import annotations
 
-from .bode import bode, bode_overlay, compare_figure, plot_bode, plot_compare, save_bode
+from .frequency import bode, bode_overlay, compare_figure, plot_bode, plot_compare, save_bode
 from .chain import a0_series, effect_intervals
 from .residuals import calibration_figure, diagnosis_figures, frf_estimate, residual_bode
 from .roots import pole_zero_locus, pole_zero_maps, save_poles_zeros_vs_temperature
-from .traces import curves, feedforward_check, inversion_traces, plot_time, traces, tracking
+from .timeseries import curves, feedforward_check, inversion_traces, plot_time, traces, tracking
 
 __all__ = [
     "plot_bode", "plot_compare", "plot_time",
