@@ -111,6 +111,8 @@ class Diagnosis:
     cost_warning: str = ""
     confusability: dict = field(default_factory=dict)
     base_parameters: object = field(default=None, repr=False)    # the base set with the laws used (IPMCParameters)
+    reduced: list = field(default_factory=list)      # named effects' parameters at their off value (simpler form)
+    sign_flip: dict = field(default_factory=dict)    # costs of the baseline and of its sign reversal
 
     # ---------------------------------------------------------------- views
     def named_effect(self) -> dict | None:
@@ -206,7 +208,8 @@ class Diagnosis:
             "temperature_laws": self.laws, "baseline_audit": self.baseline_audit,
             "baseline_parameters": self._baseline_rows(), "final_at_bound": self.final_at_bound,
             "final_outside_plausible_range": self.final_implausible, "cost_warning": self.cost_warning,
-            "confusability": self.confusability,
+            "confusability": self.confusability, "reduced_to_simpler_form": self.reduced,
+            "sign_flip": self.sign_flip,
         })
 
     def _baseline_rows(self) -> list:

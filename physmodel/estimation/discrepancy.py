@@ -44,8 +44,11 @@ user's free parameters, and:
    λ, z has mean ≈ √λ/2, so a wrong confident name has chance ≤ α/2 and a pair with λ ≥ 25 is
    told apart in about 70 % of draws; the best pair likewise against every other closing pair,
    the members in which two unseparated pairs differ being declared confusable), ``at_bound`` (the named
-   effect closes the gap only with a parameter at its candidate bound: "widen the bound, or the
-   effect is larger than allowed" — never a confident name), ``unexplained`` (a significant gap
+   effect closes the gap only with one of its *own* parameters at a candidate bound that matters —
+   relaxing it would gain more than χ²₁ at α, :mod:`~physmodel.estimation.verdicts`: "widen the
+   bound, or the effect is larger than allowed" — never a confident name; another candidate at its
+   bound is only noted, and a parameter ending at its off value reports the effect in its simpler
+   form), ``unexplained`` (a significant gap
    nothing closes).  The gap test
    compares 2·cost (data lines only) with the (1 − α/5) quantile of its null distribution; an
    effect that leaves at most :data:`CLOSE_FRACTION` of the baseline's excess above it also
@@ -110,6 +113,7 @@ from .signatures import (
     vuong_critical,
     vuong_z,
 )
+from .verdicts import reduced_parameters, reduced_sentence, relax_gain, relax_threshold, residual_sentence, sign_flip
 
 #: Pairs of two effects: every pair among this many most significant candidates, and each of the
 #: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
@@ -468,31 +472,47 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                            f"{gap_thr(final_effects):.4g}) in {where}; no candidate or pair of candidates in the "
                            "library explains it.")
     if verdict in ("named", "ambiguous") and final_fit is not None:
-        thr_f = gap_thr(final_effects)
-        if 2 * final_fit.metadata["data_cost"] > thr_f:
-            message += (f" A small residual misfit remains ({100 * (2 * final_fit.metadata['data_cost'] - thr_f) / max(2 * cost0 - gap_thr0, 1e-300):.2g} % "
-                        "of the baseline's excess over the gap threshold): the data's own law for this effect "
-                        "differs slightly from the library's parametrisation.")
-    # ---- 7. audits of the final model
+        message += residual_sentence(final_fit.metadata["data_cost"], final_fit.expected_cost,
+                                     gap_thr(final_effects), max(2 * cost0 - gap_thr0, 0.0))
+    # ---- 7. audits of the final model: a named effect's own parameter at a bound that matters
+    # (relaxing it would gain more than χ²₁ at α) makes the name 'at bound'; one at its off value
+    # reduces the effect to its simpler form; another candidate's bound is only noted
     final_bounds, final_implausible = ([], [])
     if final_fit is not None:
         final_bounds, final_implausible = audit(final_fit, [fp for c in final_effects for fp in eff_free(c)])
-    at_bound = [a for a in final_bounds if a["status"] == "at"]
-    widen = [a for a in at_bound if not a["hard"] and is_effect_parameter(a["name"])
-             and a["name"].split(".", 1)[0] in final_effects]
-    # a significant candidate confusable with a named effect that stopped at a widenable bound: its
-    # LR there is only a lower bound, so it might beat the named effect once the bound is widened (not an absolute one)
-    widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
-              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
-              and a["bound"] != getattr(LIBRARY[c].parameter(a["name"].split(".", 1)[1]), a["side"])]
+    reduced = reduced_parameters(final_effects, final_bounds, final_fit.values, cpars) if final_fit is not None else []
+    red_names = {x["name"] for x in reduced}
+    at_bound = [a for a in final_bounds if a["status"] == "at" and a["name"] not in red_names]
+    own = [a for a in at_bound if not a["hard"] and is_effect_parameter(a["name"])
+           and a["name"].split(".", 1)[0] in final_effects]
+    if own and final_fit is not None:
+        gains = relax_gain(pm, final_fit.values, final_fit.free, [a["name"] for a in own], data, s_ln, s_ph)
+        for a in own:
+            a["relax_lr"] = gains.get(a["name"], float("nan"))
+    relax_thr = relax_threshold(alpha)
+    widen = [a for a in own if not (a.get("relax_lr", math.inf) <= relax_thr)]
+    others_stuck = [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
+                    for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
+                    and a["bound"] != getattr(LIBRARY[c].parameter(a["name"].split(".", 1)[1]), a["side"])]
     if verdict in ("named", "ambiguous") and widen:
         verdict = "at_bound"
         message = ("At bound — widen or the effect is larger than allowed: " + "; ".join(
-            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in widen)
-            + ". The gap closes only there, or a confusable candidate stopped there, so this is not a confident "
-            "name (raise the bound with "
+            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g} (relaxing it would gain "
+            f"LR {a.get('relax_lr', float('nan')):.3g} > {relax_thr:.3g})" for a in widen)
+            + ". The gap closes only there, so this is not a confident name (raise the bound with "
             "candidate_bounds / --candidate-bound, or the effect is outside the physical range assumed). "
             + message)
+    loose = [a for a in own if a not in widen]
+    if loose and verdict in ("named", "ambiguous"):
+        message += " " + "; ".join(f"{a['name']} = {a['value']:.4g} stopped at its {a['side']} bound {a['bound']:.4g}, "
+                                   f"but relaxing it gains only LR {a['relax_lr']:.3g} ≤ {relax_thr:.3g}: the bound "
+                                   "does not limit the fit" for a in loose) + "."
+    if others_stuck and verdict in ("named", "ambiguous", "at_bound"):
+        message += (" Noted, not a reason to doubt the name: the confusable candidate(s) " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in others_stuck)
+            + " stopped at a candidate bound without closing the gap.")
+    if verdict in ("named", "ambiguous", "at_bound"):
+        message += reduced_sentence(reduced)
     if verdict == "unexplained" and final_effects:
         stuck = [a for c in final_effects for a in cres[c].at_bound if c in cres and a["status"] == "at"
                  and not a["hard"] and a["name"].startswith(c + ".")] if len(final_effects) == 1 else [
@@ -501,6 +521,27 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             message += (" The best candidate ended at its bound (" + "; ".join(
                 f"{a['name']} = {a['value']:.4g}, {a['side']} bound {a['bound']:.4g}" for a in stuck)
                 + "): widen it — the effect may be larger than allowed.")
+    # a sign flip: the baseline with its sign reversed, refitted, explains what the candidates leave
+    flip: dict = {}
+    resid_sig = final_fit is not None and 2 * final_fit.metadata["data_cost"] > gap_thr(final_effects)
+    if gap0_sig and (verdict in ("unexplained", "at_bound") or resid_sig):
+        pneg = PenalisedProblem(data, lambda vals: -np.asarray(pm(vals)), prob.penalties)
+        rflip = min((pneg.fit(from_(v0), seed=seed, max_nfev=max_nfev, identify=False, hold_undetermined=False),
+                     pneg.fit(free0, seed=seed, max_nfev=max_nfev, identify=False, hold_undetermined=False)),
+                    key=lambda x: x.cost)
+        flip = sign_flip(pm([rflip.values])[0], data, s_ln, s_ph)
+        cost_now = final_fit.metadata["data_cost"] if final_fit is not None else cost0
+        flip["refit_cost"] = float(rflip.metadata["data_cost"])
+        flip["recognised"] = bool(flip["refit_cost"] < cost_now and (
+            closes_gap(flip["refit_cost"], []) or flip["refit_cost"] < 0.1 * cost0))
+        if flip["recognised"]:
+            verdict, final_effects, final_fit, at_bound, widen = "unexplained", [], None, [], []
+            message = (f"Sign flip: the data are the model with its sign reversed — a constant "
+                       f"{flip['phase_offset_deg']:.0f}° phase offset over the band with the magnitude matching "
+                       f"(RMS {flip['magnitude_rms_db']:.2g} dB): with the sign reversed the baseline refits to "
+                       f"2·cost {2 * flip['refit_cost']:.4g} (gap threshold {gap_thr0:.4g}; as given "
+                       f"{2 * cost0:.4g}). No physical effect is needed: check the polarity of the excitation or "
+                       "the sensor wiring and the sign convention of the measured quantity, then rerun.")
     message += audit_notes(verdict, at_bound, widen, audit0, final_implausible, res0, cres)
     named = list(final_effects) if verdict in ("named", "ambiguous", "at_bound") else []
     if verdict == "ambiguous":
@@ -537,6 +578,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
         cost_warning=warn, confusability=confusability, base_parameters=base,
+        reduced=reduced, sign_flip=flip,
     )
 
 
