@@ -309,6 +309,8 @@ def _line(i, n, r):
 def outcome(r):
     if r["verdict"] in ("named", "at_bound"):
         return ("AT BOUND " if r["verdict"] == "at_bound" else "") + "+".join(r["named"])
+    if r["verdict"] == "ambiguous":
+        return "ambiguous[" + ",".join(r["named"]) + "]"
     return r["verdict"]
 
 
