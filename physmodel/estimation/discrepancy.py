@@ -344,7 +344,14 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     T = T_lin * ratio
     say("null", f"null threshold {T:.3g} (linearised {T_lin:.3g} × nonlinearity ratio {ratio:.3g})")
 
-    # ---- 6. verdict
+    # ---- 6. verdict (its steps are not known in advance: each one moves the share done on)
+    v_steps = [0]
+
+    def say_v(msg: str) -> None:
+        v_steps[0] += 1
+        say("verdict", msg, v_steps[0], v_steps[0] + 4)
+
+    say_v("testing significance and the gap")
     def gap_thr(effs: Sequence[str]) -> float:
         if not effs:
             return gap_thr0
@@ -448,7 +455,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         def pair_fits(pairs):
             out = []
             for i_p, (a, b) in enumerate(pairs):
-                say("verdict", f"pair {i_p + 1}/{len(pairs)}: {a} + {b}", i_p, len(pairs) + 1)
+                say_v(f"pair {i_p + 1}/{len(pairs)}: {a} + {b}")
                 res2 = fit_pair(a, b)
                 lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)   # each on top
                 gain = 2 * (best_single - res2.cost)                                           # over the best single
@@ -522,7 +529,9 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            confusability = vuong_confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit, refit)
+            confusability = vuong_confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit,
+                                                lambda *a, **k: (say_v(f"cross-fit of {a[0][0]} (Vuong's test)"),
+                                                                 refit(*a, **k))[1])
             amb = [top] + [x["other"] for x in confusability["data"] if not x["separated"]]
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
@@ -603,7 +612,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         fw = [replace(fp, **{wide[fp.name]: getattr(LIBRARY[c].parameter(fp.name.split(".", 1)[1]), wide[fp.name])})
               .with_initial(fits[c].values[fp.name]) if fp.name in wide else fp.with_initial(fits[c].values[fp.name])
               for fp in fits[c].free]
-        say("verdict", f"widening the bound of {c} (a confusable candidate stopped there)", 0.9, 1)
+        say_v(f"widening the bound of {c} (a confusable candidate stopped there)")
         rw = fit(fw, identify=False)
         lr_w = 2 * (res0.cost - rw.cost)
         for a in mine:
@@ -637,7 +646,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     flip: dict = {}
     resid_sig = final_fit is not None and 2 * final_fit.metadata["data_cost"] > gap_thr(final_effects)
     if gap0_sig and (verdict in ("unexplained", "at_bound") or resid_sig):
-        say("verdict", "checking for a sign flip (the baseline with its sign reversed)", 0.95, 1)
+        say_v("checking for a sign flip (the baseline with its sign reversed)")
         pneg = PenalisedProblem(data, lambda vals: -np.asarray(pm(vals)), prob.penalties)
         rflip = min((pneg.fit(from_(v0), seed=seed, max_nfev=max_nfev, identify=False, hold_undetermined=False),
                      pneg.fit(free0, seed=seed, max_nfev=max_nfev, identify=False, hold_undetermined=False)),
