@@ -114,8 +114,8 @@ def reduced_sentence(reduced: Sequence[Mapping]) -> str:
     if not reduced:
         return ""
     return " " + "; ".join(
-        f"{x['effect']} in its simpler form: {x['parameter']} = {x['value']:.3g} {x['unit']} is its off value "
-        f"{x['off']:g} ({x['doc'] or 'not needed'}), so the data need the effect without it, not a wider bound"
+        f"{x['effect']} in its simpler form: {x['parameter']} ({x['doc'] or x['parameter']}) ends at its off value "
+        f"{x['off']:g} ({x['value']:.3g} {x['unit']}), so the data need the effect without it, not a wider bound"
         for x in reduced) + "."
 
 
