@@ -30,6 +30,41 @@ CLOSE_FRACTION = 0.005
 MIN_SIGNATURE_LR = 1.0
 
 
+# =============================================================================== progress
+class ProgressMessage(str):
+    """A progress message (a ``str``, so a ``progress(message)`` callback that prints it still
+    works) that also carries how far the whole diagnosis is, ``fraction`` ∈ [0, 1], and its stage."""
+
+    fraction: float
+    stage: str
+
+    def __new__(cls, text: str, fraction: float, stage: str = ""):
+        out = super().__new__(cls, text)
+        out.fraction = float(min(max(fraction, 0.0), 1.0))
+        out.stage = stage
+        return out
+
+
+#: Share of the whole diagnosis at the end of each stage (progress within a stage is interpolated).
+STAGE_ENDS = {"baseline": 0.08, "signatures": 0.12, "candidates": 0.45, "null": 0.70, "verdict": 0.97,
+              "audit": 1.0}
+
+
+def stage_progress(progress):
+    """``say(stage, message, done=1, total=1)``: calls ``progress`` with a :class:`ProgressMessage`
+    at the share of the whole reached after ``done`` of ``total`` steps of ``stage``."""
+    order = list(STAGE_ENDS)
+
+    def say(stage: str, message: str, done: float = 1, total: float = 1) -> None:
+        if progress is None:
+            return
+        i = order.index(stage)
+        lo = STAGE_ENDS[order[i - 1]] if i else 0.0
+        frac = lo + (STAGE_ENDS[stage] - lo) * (min(done, total) / total if total > 0 else 1.0)
+        progress(ProgressMessage(message, frac, stage))
+    return say
+
+
 # =============================================================================== results
 
 
@@ -111,6 +146,8 @@ class Diagnosis:
     cost_warning: str = ""
     confusability: dict = field(default_factory=dict)
     base_parameters: object = field(default=None, repr=False)    # the base set with the laws used (IPMCParameters)
+    reduced: list = field(default_factory=list)      # named effects' parameters at their off value (simpler form)
+    sign_flip: dict = field(default_factory=dict)    # costs of the baseline and of its sign reversal
 
     # ---------------------------------------------------------------- views
     def named_effect(self) -> dict | None:
@@ -206,7 +243,8 @@ class Diagnosis:
             "temperature_laws": self.laws, "baseline_audit": self.baseline_audit,
             "baseline_parameters": self._baseline_rows(), "final_at_bound": self.final_at_bound,
             "final_outside_plausible_range": self.final_implausible, "cost_warning": self.cost_warning,
-            "confusability": self.confusability,
+            "confusability": self.confusability, "reduced_to_simpler_form": self.reduced,
+            "sign_flip": self.sign_flip,
         })
 
     def _baseline_rows(self) -> list:

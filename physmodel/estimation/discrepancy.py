@@ -44,8 +44,11 @@ user's free parameters, and:
    λ, z has mean ≈ √λ/2, so a wrong confident name has chance ≤ α/2 and a pair with λ ≥ 25 is
    told apart in about 70 % of draws; the best pair likewise against every other closing pair,
    the members in which two unseparated pairs differ being declared confusable), ``at_bound`` (the named
-   effect closes the gap only with a parameter at its candidate bound: "widen the bound, or the
-   effect is larger than allowed" — never a confident name), ``unexplained`` (a significant gap
+   effect closes the gap only with one of its *own* parameters at a candidate bound that matters —
+   relaxing it would gain more than χ²₁ at α, :mod:`~physmodel.estimation.verdicts`: "widen the
+   bound, or the effect is larger than allowed" — never a confident name; another candidate at its
+   bound is only noted, and a parameter ending at its off value reports the effect in its simpler
+   form), ``unexplained`` (a significant gap
    nothing closes).  The gap test
    compares 2·cost (data lines only) with the (1 − α/5) quantile of its null distribution; an
    effect that leaves at most :data:`CLOSE_FRACTION` of the baseline's excess above it also
@@ -62,6 +65,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from itertools import combinations
 
 import numpy as np
@@ -83,6 +87,7 @@ from .diagnosis import (
     gap_shrink,
     named_message,
     resolve_laws,
+    stage_progress,
     worst_cells,
 )
 from .nullstats import bootstrap_ratio, constrained_lr, scan_lr, signature_stage
@@ -110,10 +115,14 @@ from .signatures import (
     vuong_critical,
     vuong_z,
 )
+from .verdicts import reduced_parameters, reduced_sentence, relax_gain, relax_threshold, residual_sentence, sign_flip
 
-#: Pairs of two effects: every pair among this many most significant candidates, and each of the
-#: two most significant with the PAIR_POOL − 1 candidates that best explain its remaining residual.
+#: Pairs of two effects: every pair among this many most significant candidates, and each of them
+#: with the PAIR_EXPLAINERS candidates that best explain what its refit leaves; the PAIR_FITS best
+#: of those (by LR of the first + linearised LR of the second on its residual) are refitted jointly.
 PAIR_POOL = 4
+PAIR_EXPLAINERS = 2
+PAIR_FITS = 6
 
 
 # =============================================================================== main entry
@@ -166,7 +175,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         raise IPMCError(f"baseline_starts={baseline_starts!r} must be >= 1")
     base, laws_note = resolve_laws(base, laws)
     q = quantity or DEFAULT_QUANTITY.get(kind, "")
-    say = progress or (lambda msg: None)
+    say = stage_progress(progress)
     if isinstance(baseline_effects, Mapping):
         beff = normalize_effects(baseline_effects)
         extra_free = []
@@ -204,7 +213,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     audit0 = {"at_bound": bound_audit(res0, free0), "implausible": plausible_audit(v0, ranges),
               "multistart": multistart_spread(res0), "penalty": res0.metadata["penalty"],
               "plausible_ranges": {k: ranges[k].describe() for k in names0 if k in ranges}}
-    say(f"baseline fitted: cost {cost0:.4g} (expected {res0.expected_cost:.4g})")
+    say("baseline", f"baseline fitted: cost {cost0:.4g} (expected {res0.expected_cost:.4g})")
 
     # ---- 2. signatures, confusability
     cand = [get_effect(c).name for c in candidates] if candidates is not None else [
@@ -235,7 +244,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     T_lin = float(np.quantile(lin_max, 1 - alpha))
     alpha_gap = alpha / GAP_ALPHA_DIVISOR
     gap_thr0 = float(np.quantile(cost2_null, 1 - alpha_gap))
-    say(f"linearised null: LR threshold {T_lin:.3g} from {E.shape[1]} draws")
+    say("signatures", f"linearised null: LR threshold {T_lin:.3g} from {E.shape[1]} draws")
 
     # ---- 4. candidate refits
     def eff_free(c, start=None):
@@ -286,7 +295,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     fits: dict[str, CalibrationResult] = {}
     k0 = len(free0)
     n_res = 2 * N
-    for c in sigs:
+    for i_c, c in enumerate(sigs):
+        say("candidates", f"refitting candidate {i_c + 1}/{len(sigs)}: {c}", i_c, len(sigs))
         res = refit([c], v0, starts_for(c, r0, Q0), from_user=True)
         fits[c] = res
         k = len(cpars[c])
@@ -301,13 +311,13 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             float(constrained_lr(sigs[c], sided[c], -project_out(Q0, r0[:, None]))[0]), first_order.get(c, ""),
             bounds={p.name: [p.lower, p.upper] for p in cpars[c]}, at_bound=ab, implausible=imp,
             penalty=res.metadata["penalty"], multistart=res.metadata["refit_multistart"])
-    say(f"{len(cres)} candidates refitted")
+    say("candidates", f"{len(cres)} candidates refitted")
     for c in sorted(cres, key=lambda c: -cres[c].lr)[:3] if _restart is None else []:
         if cres[c].lr <= T_lin:
             break
         rb = fit(from_(fits[c].values))
         if rb.cost < res0.cost - 0.5:       # ½Δχ² > ½: a better baseline basin, not the effect
-            say(f"baseline basin from the {c} refit: cost {rb.cost:.4g} < {res0.cost:.4g}; restarting")
+            say("candidates", f"baseline basin from the {c} refit: cost {rb.cost:.4g} < {res0.cost:.4g}; restarting")
             out = diagnose(data, base_in, **args, _restart=rb.values)
             out.metadata["baseline_restart"] = {"from_candidate": c, "cost_before": res0.cost, "cost_after": rb.cost}
             return out
@@ -316,16 +326,32 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         return min((fit(from_(v0), sim=sim, identify=False),
                     fit(free0, sim=sim, starts=int(baseline_starts), identify=False)), key=lambda x: x.cost)
 
+    n_boot = int(null_refits) * (len(sigs) + 1)
+    boot_done = [0]
+
     def refit_max(sim, rb):
         r_b = standardised_residuals(pm([rb.values])[0], sim, s_ln, s_ph)
-        return max([2 * (rb.cost - refit([c], rb.values, starts_for(c, r_b, Q0), sim=sim, identify=False,
-                                         from_user=True).cost) for c in sigs], default=0.0)
+        best = 0.0
+        boot_done[0] += 1
+        for c in sigs:
+            say("null", f"null refit {boot_done[0] // (len(sigs) + 1) + 1}/{int(null_refits)}: {c}", boot_done[0], n_boot)
+            best = max(best, 2 * (rb.cost - refit([c], rb.values, starts_for(c, r_b, Q0), sim=sim, identify=False,
+                                                   from_user=True).cost))
+            boot_done[0] += 1
+        return best
 
     ratio, full_max, lin_used = bootstrap_ratio(E, lin_max, G0, data, s_ln, s_ph, int(null_refits), fit_null, refit_max)
     T = T_lin * ratio
-    say(f"null threshold {T:.3g} (linearised {T_lin:.3g} × nonlinearity ratio {ratio:.3g})")
+    say("null", f"null threshold {T:.3g} (linearised {T_lin:.3g} × nonlinearity ratio {ratio:.3g})")
 
-    # ---- 6. verdict
+    # ---- 6. verdict (its steps are not known in advance: each one moves the share done on)
+    v_steps = [0]
+
+    def say_v(msg: str) -> None:
+        v_steps[0] += 1
+        say("verdict", msg, v_steps[0], v_steps[0] + 4)
+
+    say_v("testing significance and the gap")
     def gap_thr(effs: Sequence[str]) -> float:
         if not effs:
             return gap_thr0
@@ -361,40 +387,115 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                        f"{max([c.lr for c in cres.values()], default=0.0):.3g} ≤ threshold {T:.3g}, and the "
                        f"baseline cost {cost0:.4g} is within its null band.")
     else:
-        def explainers(a, pool):
-            """Candidates of ``pool`` that best explain what a leaves (linearised LR on its residual)."""
-            r_a = standardised_residuals(pm([fits[a].values])[0], data, s_ln, s_ph)
-            Qa = orth(np.hstack([J0, sigs[a]]))
-            sc = {b: float(constrained_lr(project_out(Qa, sigs[b]), sided[b], -project_out(Qa, r_a[:, None]))[0])
-                  for b in pool if b != a}
-            return [b for b in sorted(sc, key=lambda k: -sc[k])[:PAIR_POOL - 1]], r_a, Qa
+        expl_cache: dict = {}
+
+        def explain_scores(a):
+            """Linearised LR of every other candidate on what a's refit leaves (its residual, with the
+            baseline Jacobian and a's signature projected out), with that residual and projector."""
+            if a not in expl_cache:
+                r_a = standardised_residuals(pm([fits[a].values])[0], data, s_ln, s_ph)
+                Qa = orth(np.hstack([J0, sigs[a]]))
+                rr = -project_out(Qa, r_a[:, None])
+                expl_cache[a] = ({b: float(constrained_lr(project_out(Qa, sigs[b]), sided[b], rr)[0])
+                                  for b in sigs if b != a}, r_a, Qa)
+            return expl_cache[a]
 
         def strict(res, effs) -> bool:
             """2·cost within its null band (no tolerance for a parametrisation mismatch)."""
             return 2 * res.metadata["data_cost"] <= gap_thr(effs)
 
+        def screen_pairs(exclude=frozenset()):
+            """Pairs among the PAIR_POOL most significant candidates and each of them with the
+            PAIR_EXPLAINERS candidates that best explain what its refit leaves (significant alone or
+            not), ranked by LR(first) + linearised LR(second on the first's residual), best order;
+            never a declared-confusable pair nor two of ``exclude``; the PAIR_FITS best."""
+            top = sig[:PAIR_POOL]
+            pool = {frozenset(x) for x in combinations(top, 2)}
+            for a in top:
+                sc = explain_scores(a)[0]
+                pool |= {frozenset((a, b)) for b in sorted(sc, key=lambda k: -sc[k])[:PAIR_EXPLAINERS]}
+            pool = {x for x in pool if x not in conf_set and not x <= exclude}
+
+            def score(x):
+                a, b = sorted(x)
+                return max(cres[a].lr + explain_scores(a)[0][b], cres[b].lr + explain_scores(b)[0][a])
+            ranked = sorted(pool, key=lambda x: (-score(x), sorted(x)))[:PAIR_FITS]
+            return [tuple(sorted(x, key=lambda c: -cres[c].lr)) for x in ranked]
+
+        def joint_start(a, b):
+            """Both effects' values from the linearised joint fit of their signatures to the baseline residual."""
+            S = project_out(Q0, np.hstack([sigs[a], sigs[b]]))
+            d, *_ = np.linalg.lstsq(S, -r0, rcond=None)
+            out, j = {}, 0
+            for c in (a, b):
+                out[c] = {p.name: float(np.clip(p.off + d[j + k] * (p.typical - p.off), p.lower, p.upper))
+                          for k, p in enumerate(cpars[c])}
+                j += len(cpars[c])
+            return out
+
+        best_single = min(fits[c].cost for c in fits)
+        fitted_pairs: dict = {}
+
+        def fit_pair(a, b):
+            """Joint refit of a + b, the best of starts from a's own fit (b from its own fit and from
+            its linearised estimate on a's residual), from b's own fit (a likewise) and from the
+            joint linearised estimate at the baseline."""
+            key = frozenset((a, b))
+            if key not in fitted_pairs:
+                own = {**fits[a].values, **{k: v for k, v in fits[b].values.items() if k.startswith(b + ".")}}
+                own_b = {**fits[b].values, **{k: v for k, v in fits[a].values.items() if k.startswith(a + ".")}}
+                _, r_a, Qa = explain_scores(a)
+                _, r_b, Qb = explain_scores(b)
+                runs = [refit([a, b], own, [None, {b: lin_start(b, r_a, Qa)}]),
+                        refit([a, b], own_b, [{a: lin_start(a, r_b, Qb)}]),
+                        refit([a, b], v0, [joint_start(a, b)])]
+                fitted_pairs[key] = min(runs, key=lambda x: x.cost)
+            return fitted_pairs[key]
+
         def pair_fits(pairs):
             out = []
-            for a, b in pairs:
-                va = {**fits[a].values, **{k: v for k, v in fits[b].values.items() if k.startswith(b + ".")}}
-                _, r_a, Qa = explainers(a, [])
-                res2 = refit([a, b], va, [{b: {p.name: p.off for p in cpars[b]}}, {b: lin_start(b, r_a, Qa)}])
+            for i_p, (a, b) in enumerate(pairs):
+                say_v(f"pair {i_p + 1}/{len(pairs)}: {a} + {b}")
+                res2 = fit_pair(a, b)
                 lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)   # each on top
+                gain = 2 * (best_single - res2.cost)                                           # over the best single
                 closes = closes_gap(res2.metadata["data_cost"], [a, b])
-                # each member significant on top of the other, and either carrying more than the
-                # share of the excess a closing effect may leave, or the pair closes the gap strictly
-                # (within the noise band) where neither member alone does and each explains the
-                # majority of what the other leaves above its χ² expectation (not a share of noise)
+                # the pair's gain over the best single passes the calibrated threshold, and either
+                # carries more than the share of the excess a closing effect may leave, or the pair
+                # closes the gap strictly (within the noise band) where neither member alone does and
+                # each explains the majority of what the other leaves above its χ² expectation
                 left = {c: 2 * fits[c].metadata["data_cost"] - (n_res - len(fits[c].names)) for c in (a, b)}
                 rescue = (strict(res2, [a, b]) and not strict(fits[a], [a]) and not strict(fits[b], [b])
                           and lr_b >= 0.5 * left[a] and lr_a >= 0.5 * left[b])
-                accepted = min(lr_a, lr_b) > T and (min(lr_a, lr_b) > T2 or rescue)
+                accepted = gain > T and (gain > T2 or rescue)
                 pair_tried.append({"pair": [a, b], "cost": res2.metadata["data_cost"], "lr_first_on_top": lr_a,
-                                   "lr_second_on_top": lr_b, "closes_gap": closes, "closes_strictly": rescue,
-                                   "accepted": accepted})
+                                   "lr_second_on_top": lr_b, "gain_over_best_single": gain, "closes_gap": closes,
+                                   "closes_strictly": rescue, "accepted": accepted})
                 if accepted:
                     out.append(((a, b), res2, lr_a, lr_b, closes))
             return sorted(out, key=lambda x: x[1].cost)
+
+        def with_alternatives(ok, alias):
+            """``ok`` plus the pairs that swap a member of the best pair for a candidate declared
+            confusable with it (first-order signatures, or ``alias``: not separated by the data), so
+            name_pair's test reports them."""
+            if not ok:
+                return ok
+            best2 = ok[0][0]
+            seen = {frozenset(x[0]) for x in ok}
+            for m in best2:
+                other = [x for x in best2 if x != m][0]
+                for c in sigs:
+                    if c in best2 or not (frozenset((m, c)) in conf_set or (m in alias and c in alias)):
+                        continue
+                    key = frozenset((other, c))
+                    if key in seen or key in conf_set or cres[c].lr <= T:
+                        continue
+                    seen.add(key)
+                    res2 = fit_pair(other, c)
+                    ok = ok + [((other, c), res2, 2 * (fits[c].cost - res2.cost), 2 * (fits[other].cost - res2.cost),
+                                closes_gap(res2.metadata["data_cost"], [other, c]))]
+            return ok
 
         def name_pair(ok):
             """The best pair, ambiguous with every closing pair Vuong's test does not separate from it
@@ -412,8 +513,9 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                     alt.append((x[0], z))
                     for m, o in pair_members(best2[0], x[0], sigs):
                         confusability.setdefault("pairs", []).append({"top": m, "other": o, "z": z, "separated": False})
-            msg = (f"Named two effects: {a} and {b} (joint refit; LR of each on top of the other "
-                   f"{best2[2]:.4g}, {best2[3]:.4g} > {T:.3g}); the gap closes.")
+            msg = (f"Named two effects: {a} and {b} (joint refit; gain over the best single effect LR "
+                   f"{2 * (best_single - best2[1].cost):.4g} > {T:.3g}; LR of each on top of the other "
+                   f"{best2[2]:.4g}, {best2[3]:.4g})" + ("; the gap closes." if best2[4] else "."))
             if alt:
                 return ("ambiguous", sorted({a, b} | {c for x, _ in alt for c in x}), list(best2[0]), best2[1],
                         msg.replace("Named two effects", "Ambiguous: best pair")
@@ -427,7 +529,9 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
-            confusability = vuong_confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit, refit)
+            confusability = vuong_confusability(top, sig, fits, cres, pm, data, s_ln, s_ph, z_crit,
+                                                lambda *a, **k: (say_v(f"cross-fit of {a[0][0]} (Vuong's test)"),
+                                                                 refit(*a, **k))[1])
             amb = [top] + [x["other"] for x in confusability["data"] if not x["separated"]]
             final_effects, final_fit = [top], fits[top]
             if len(amb) > 1:
@@ -439,23 +543,19 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                            "Separate them with a wider band, more temperatures, or magnitude vs phase.")
             else:
                 verdict, message = "named", named_message(top, cres[top])
-            # forward step: a second significant candidate (not one of the closers, not confusable
-            # with the first) that is significant on top of it
-            pool = [c for c in sig if c not in amb and frozenset((top, c)) not in conf_set]
-            ok = pair_fits([(top, b) for b in explainers(top, pool)[0]]) if pool else []
+            # a second effect: pairs searched (not only grown from the first), accepted when their
+            # gain over the best single passes the calibrated threshold
+            ok = with_alternatives(pair_fits(screen_pairs(frozenset(amb))), amb)
             if ok:
                 v2, n2, final_effects, final_fit, m2 = name_pair(ok)
-                if verdict == "ambiguous":       # the first effect stays ambiguous
+                if verdict == "ambiguous" and top in final_effects:       # the first effect stays ambiguous
                     v2, n2 = "ambiguous", sorted(set(n2) | set(amb))
                     m2 += f" The first effect is ambiguous between {', '.join(amb)}."
                 verdict, named2, message = v2, n2, m2
         else:
-            # two effects: every pair among the most significant candidates and each of the two best
-            # with the candidates that best explain what it leaves, refitted jointly
-            pairs = [tuple(x) for x in combinations(sig[:PAIR_POOL], 2)]
-            for a in sig[:2]:
-                pairs += [(a, b) for b in explainers(a, sigs)[0] if (a, b) not in pairs and (b, a) not in pairs]
-            ok = pair_fits([x for x in pairs if frozenset(x) not in conf_set])
+            # two effects: pairs among the most significant candidates and each of them with the
+            # candidates that best explain what it leaves, refitted jointly from several starts
+            ok = with_alternatives(pair_fits(screen_pairs()), [])
             if ok and ok[0][4]:
                 verdict, named2, final_effects, final_fit, message = name_pair(ok)
             else:
@@ -468,31 +568,72 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                            f"{gap_thr(final_effects):.4g}) in {where}; no candidate or pair of candidates in the "
                            "library explains it.")
     if verdict in ("named", "ambiguous") and final_fit is not None:
-        thr_f = gap_thr(final_effects)
-        if 2 * final_fit.metadata["data_cost"] > thr_f:
-            message += (f" A small residual misfit remains ({100 * (2 * final_fit.metadata['data_cost'] - thr_f) / max(2 * cost0 - gap_thr0, 1e-300):.2g} % "
-                        "of the baseline's excess over the gap threshold): the data's own law for this effect "
-                        "differs slightly from the library's parametrisation.")
-    # ---- 7. audits of the final model
+        message += residual_sentence(final_fit.metadata["data_cost"], final_fit.expected_cost,
+                                     gap_thr(final_effects), max(2 * cost0 - gap_thr0, 0.0))
+    # ---- 7. audits of the final model: a named effect's own parameter at a bound that matters
+    # (relaxing it would gain more than χ²₁ at α) makes the name 'at bound'; one at its off value
+    # reduces the effect to its simpler form; another candidate's bound is only noted
     final_bounds, final_implausible = ([], [])
     if final_fit is not None:
         final_bounds, final_implausible = audit(final_fit, [fp for c in final_effects for fp in eff_free(c)])
-    at_bound = [a for a in final_bounds if a["status"] == "at"]
-    widen = [a for a in at_bound if not a["hard"] and is_effect_parameter(a["name"])
-             and a["name"].split(".", 1)[0] in final_effects]
-    # a significant candidate confusable with a named effect that stopped at a widenable bound: its
-    # LR there is only a lower bound, so it might beat the named effect once the bound is widened (not an absolute one)
-    widen += [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
-              for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
-              and a["bound"] != getattr(LIBRARY[c].parameter(a["name"].split(".", 1)[1]), a["side"])]
+    reduced = reduced_parameters(final_effects, final_bounds, final_fit.values, cpars) if final_fit is not None else []
+    red_names = {x["name"] for x in reduced}
+    at_bound = [a for a in final_bounds if a["status"] == "at" and a["name"] not in red_names]
+    own = [a for a in at_bound if not a["hard"] and is_effect_parameter(a["name"])
+           and a["name"].split(".", 1)[0] in final_effects]
+    if own and final_fit is not None:
+        gains = relax_gain(pm, final_fit.values, final_fit.free, [a["name"] for a in own], data, s_ln, s_ph)
+        for a in own:
+            a["relax_lr"] = gains.get(a["name"], float("nan"))
+    relax_thr = relax_threshold(alpha)
+    widen = [a for a in own if not (a.get("relax_lr", math.inf) <= relax_thr)]
+    others_stuck = [a for c in sig if c not in final_effects and any(frozenset((c, n)) in conf_set for n in final_effects)
+                    for a in cres[c].at_bound if a["status"] == "at" and not a["hard"] and a["name"].startswith(c + ".")
+                    and a["bound"] != getattr(LIBRARY[c].parameter(a["name"].split(".", 1)[1]), a["side"])]
     if verdict in ("named", "ambiguous") and widen:
         verdict = "at_bound"
         message = ("At bound — widen or the effect is larger than allowed: " + "; ".join(
-            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in widen)
-            + ". The gap closes only there, or a confusable candidate stopped there, so this is not a confident "
-            "name (raise the bound with "
+            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g} (relaxing it would gain "
+            f"LR {a.get('relax_lr', float('nan')):.3g} > {relax_thr:.3g})" for a in widen)
+            + ". The gap closes only there, so this is not a confident name (raise the bound with "
             "candidate_bounds / --candidate-bound, or the effect is outside the physical range assumed). "
             + message)
+    loose = [a for a in own if a not in widen]
+    if loose and verdict in ("named", "ambiguous"):
+        message += " " + "; ".join(f"{a['name']} = {a['value']:.4g} stopped at its {a['side']} bound {a['bound']:.4g}, "
+                                   f"but relaxing it gains only LR {a['relax_lr']:.3g} ≤ {relax_thr:.3g}: the bound "
+                                   "does not limit the fit" for a in loose) + "."
+    # another candidate's bound matters only when, widened to its absolute bound, it competes with
+    # the name: it closes the gap, or its LR comes within χ²₁(α) of the named model's
+    lr_named = 2 * (res0.cost - final_fit.cost) if final_fit is not None else 0.0
+    for c in {a["name"].split(".", 1)[0] for a in others_stuck}:
+        mine = [a for a in others_stuck if a["name"].startswith(c + ".")]
+        wide = {a["name"]: a["side"] for a in mine}
+        fw = [replace(fp, **{wide[fp.name]: getattr(LIBRARY[c].parameter(fp.name.split(".", 1)[1]), wide[fp.name])})
+              .with_initial(fits[c].values[fp.name]) if fp.name in wide else fp.with_initial(fits[c].values[fp.name])
+              for fp in fits[c].free]
+        say_v(f"widening the bound of {c} (a confusable candidate stopped there)")
+        rw = fit(fw, identify=False)
+        lr_w = 2 * (res0.cost - rw.cost)
+        for a in mine:
+            a["lr_widened"] = float(lr_w)
+            a["competes"] = bool(closes_gap(rw.metadata["data_cost"], [c]) or lr_w >= lr_named - relax_threshold(alpha))
+    if verdict in ("named", "ambiguous") and any(a["competes"] for a in others_stuck):
+        verdict = "at_bound"
+        rival = [a for a in others_stuck if a["competes"]]
+        message = ("At bound — a confusable candidate stopped at its bound and, widened, could compete with the "
+                   "name: " + "; ".join(f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g} "
+                                        f"(widened: LR {a['lr_widened']:.4g} vs the name's {lr_named:.4g})" for a in rival)
+                   + " — widen it (candidate_bounds / --candidate-bound) before trusting the name. " + message)
+        widen = widen + rival
+    others_stuck = [a for a in others_stuck if not a["competes"]]
+    if others_stuck and verdict in ("named", "ambiguous", "at_bound"):
+        message += (" Noted, not a reason to doubt the name: the confusable candidate(s) " + "; ".join(
+            f"{a['name']} = {a['value']:.4g} at its {a['side']} bound {a['bound']:.4g}" for a in others_stuck)
+            + " stopped at a candidate bound without closing the gap; relaxing it could not let it compete "
+            "with the name.")
+    if verdict in ("named", "ambiguous", "at_bound"):
+        message += reduced_sentence(reduced)
     if verdict == "unexplained" and final_effects:
         stuck = [a for c in final_effects for a in cres[c].at_bound if c in cres and a["status"] == "at"
                  and not a["hard"] and a["name"].startswith(c + ".")] if len(final_effects) == 1 else [
@@ -501,6 +642,28 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             message += (" The best candidate ended at its bound (" + "; ".join(
                 f"{a['name']} = {a['value']:.4g}, {a['side']} bound {a['bound']:.4g}" for a in stuck)
                 + "): widen it — the effect may be larger than allowed.")
+    # a sign flip: the baseline with its sign reversed, refitted, explains what the candidates leave
+    flip: dict = {}
+    resid_sig = final_fit is not None and 2 * final_fit.metadata["data_cost"] > gap_thr(final_effects)
+    if gap0_sig and (verdict in ("unexplained", "at_bound") or resid_sig):
+        say_v("checking for a sign flip (the baseline with its sign reversed)")
+        pneg = PenalisedProblem(data, lambda vals: -np.asarray(pm(vals)), prob.penalties)
+        rflip = min((pneg.fit(from_(v0), seed=seed, max_nfev=max_nfev, identify=False, hold_undetermined=False),
+                     pneg.fit(free0, seed=seed, max_nfev=max_nfev, identify=False, hold_undetermined=False)),
+                    key=lambda x: x.cost)
+        flip = sign_flip(pm([rflip.values])[0], data, s_ln, s_ph)
+        cost_now = final_fit.metadata["data_cost"] if final_fit is not None else cost0
+        flip["refit_cost"] = float(rflip.metadata["data_cost"])
+        flip["recognised"] = bool(flip["refit_cost"] < cost_now and (
+            closes_gap(flip["refit_cost"], []) or flip["refit_cost"] < 0.1 * cost0))
+        if flip["recognised"]:
+            verdict, final_effects, final_fit, at_bound, widen = "unexplained", [], None, [], []
+            message = (f"Sign flip: the data are the model with its sign reversed — a constant "
+                       f"{flip['phase_offset_deg']:.0f}° phase offset over the band with the magnitude matching "
+                       f"(RMS {flip['magnitude_rms_db']:.2g} dB): with the sign reversed the baseline refits to "
+                       f"2·cost {2 * flip['refit_cost']:.4g} (gap threshold {gap_thr0:.4g}; as given "
+                       f"{2 * cost0:.4g}). No physical effect is needed: check the polarity of the excitation or "
+                       "the sensor wiring and the sign convention of the measured quantity, then rerun.")
     message += audit_notes(verdict, at_bound, widen, audit0, final_implausible, res0, cres)
     named = list(final_effects) if verdict in ("named", "ambiguous", "at_bound") else []
     if verdict == "ambiguous":
@@ -516,6 +679,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     if warn:
         message += f" Cost vs declared noise: {warn}."
     declare_confusable(confusable, separation, confusability, sigs, raw_sigs, data)
+    say("audit", f"verdict {verdict}" + (f": {', '.join(named)}" if named else ""))
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
@@ -537,6 +701,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
         cost_warning=warn, confusability=confusability, base_parameters=base,
+        reduced=reduced, sign_flip=flip,
     )
 
 

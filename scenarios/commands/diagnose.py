@@ -341,12 +341,17 @@ def run(args) -> int:
     if not args.quiet:
         from tqdm import tqdm
 
-        bar = tqdm(total=5, desc="diagnose", unit="stage", file=sys.stderr)
+        bar = tqdm(total=100, desc="diagnose", unit="%", file=sys.stderr,
+                   bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining} {postfix}")
 
     def progress(msg):
+        # every candidate refit, null refit and pair fit reports, with the share of the whole done
         if bar is not None:
-            bar.set_postfix_str(msg[:60])
-            bar.update(1)
+            frac = getattr(msg, "fraction", None)
+            bar.set_postfix_str(str(msg)[:60], refresh=False)
+            if frac is not None:
+                bar.n = int(round(100 * frac))
+            bar.refresh()
 
     try:
         d = diagnose(data, base, progress=progress, **kw)

@@ -5,6 +5,7 @@
     python3 tests/benchmarks/bench_discrepancy.py --generator library --library-reps 1 --workers 2
     python3 tests/benchmarks/bench_discrepancy.py --real-only           # published models only
     python3 tests/benchmarks/bench_discrepancy.py --generator independent --first-seed 1000 --null 20
+    python3 tests/benchmarks/bench_discrepancy.py --generator independent --labels pairs --workers 1   # two effects only
 
 The independent cases with seeds 0-63 were inspected while the workflow was developed (issue 11);
 ``--first-seed 1000`` draws held-out cases nobody looked at.
@@ -98,6 +99,40 @@ with a CI run.)  Pairs not named exactly are 'ambiguous' with both truths listed
 declared confusable with them: contact resistance ~ the diffusivity's temperature law, time delay ~
 amplifier pole.  The out-of-library miss is a λ = 46 viscoelastic creep that library effects
 reproduce within the noise ('ambiguous', not a confident name).
+
+Issue 27 (pairs searched — top singles and the best explainers of each single's residual, each pair
+started from both members' own fits and from the joint linearised estimate, a second effect accepted
+when the pair's gain over the best single passes the calibrated threshold; verdict semantics).
+Before = a0ebfbf, after = this branch; held-out seeds 41000-41045 never run before; each diagnosis
+in one process (--workers 1) while three such runs and other sessions shared the 2 cores::
+
+    E  ... --generator independent --first-seed 41000 --n-per-label 2 --null 0 --labels pairs --workers 1 --no-real
+    F  ... --generator independent --first-seed 41000 --n-per-label 1 --null 6 --labels singles,oo,none --workers 1 --no-real
+
+    figure                                              before     after
+    two effects, both named (E; ambiguous only among    7/10       8/10
+      declared-confusable names counts)
+      the same, detectable after the workflow's set     7/9        8/9
+      of those, verdict 'named' exactly                 2/9        2/9
+    detectable single effects, confident name (F)       10/11      10/11
+    FPR on null data (F)                                0/6        0/6
+    out of library -> unexplained (F)                   2/3        2/3
+    correct names downgraded to 'at bound' (E + F)      1          0
+    verdicts at a bound without saying so               0          0
+    CPU s per diagnosis (process_time, same 3 cases:    25.1/27.8/ 23.2/24.8/
+      null 41000, water_uptake 41009, pair 41038)       29.0       27.4
+
+Wall time per diagnosis is not comparable between the runs (load varied 1-4x); the CPU times come
+from one process per version running the three cases in turn.  What limits the pairs: 6 of the 8
+"both named" are 'ambiguous' because one member has a declared-confusable twin the data cannot
+separate in this band (contact resistance ~ the diffusivity's temperature law, time delay ~
+amplifier pole: issue 27 item 3, the next measurement, separates them); contact_resistance +
+leakage -> contact_resistance + water_uptake (water uptake stood in for leakage, λ 223 after the
+workflow's free set; not examined further, the seed is held out); time_delay + leakage -> time_delay
+(leakage's λ after the workflow frees κe is 1.2: not detectable).  Singles: electrode resistance
+(λ 17445) -> before 'at bound' leakage, after ambiguous [leakage, water_uptake] (leakage's bound no
+longer matters, so the same miss now shows as a wrong ambiguous list); viscoelastic creep (out of
+library, λ 54) -> series_cpe in both.
 """
 
 from __future__ import annotations
@@ -186,13 +221,25 @@ def library_plan(reps: int):
 
 
 # =============================================================================== independent generator
-def independent_plan(n_per_label: int, n_null: int, first_seed: int = 0):
+def independent_plan(n_per_label: int, n_null: int, first_seed: int = 0, labels: str | None = None):
+    """Cases ``(generator, label, seed)``; ``labels`` keeps only some of them (comma-separated labels
+    or the groups ``pairs``, ``singles``, ``oo`` (out of library), ``none``) with the seeds they have
+    in the full plan, so a filtered run scores the same cases as a full one."""
     import independent_generator as ig
 
     plan = [("independent", lab, first_seed + s)
             for s, lab in enumerate(lab for lab in ig.LABELS for _ in range(n_per_label))]
     first = first_seed + len(plan)
     plan += [("independent", "none", first + k) for k in range(max(0, n_null - n_per_label))]
+    if labels:
+        groups = {"pairs": set(ig.PAIRS), "singles": set(ig.IN_LIBRARY), "oo": set(ig.OUT_OF_LIBRARY),
+                  "none": {"none"}}
+        keep: set = set()
+        for x in (w.strip() for w in labels.split(",") if w.strip()):
+            if x not in groups and x not in ig.LABELS:
+                raise SystemExit(f"--labels: {x!r} is neither a label of {list(ig.LABELS)} nor a group of {sorted(groups)}")
+            keep |= groups.get(x, {x})
+        plan = [c for c in plan if c[1] in keep]
     return plan
 
 
@@ -230,7 +277,7 @@ def summarise(d, *, generator, label, expected, lam, detectable, out_of_library,
                 detectable=detectable, oo=out_of_library, verdict=d.verdict, named=sorted(d.named),
                 declared=declared, t=dt, gap_shrink=gap_shrink(d),
                 cost_ratio=d.gap_before["cost"] / d.gap_after["cost"],
-                final_at_bound=final_at_bound, at_bound_said=at_bound_said,
+                final_at_bound=final_at_bound, at_bound_said=at_bound_said, at_bound_params=fab,
                 cost_warning=getattr(d, "cost_warning", "") or "")
 
 
@@ -297,6 +344,8 @@ def _line(i, n, r):
 def outcome(r):
     if r["verdict"] in ("named", "at_bound"):
         return ("AT BOUND " if r["verdict"] == "at_bound" else "") + "+".join(r["named"])
+    if r["verdict"] == "ambiguous":
+        return "ambiguous[" + ",".join(r["named"]) + "]"
     return r["verdict"]
 
 
@@ -385,6 +434,10 @@ def report(rows, title):
               + f"\n  unexplained among all: {_rate(sum(r['verdict'] == 'unexplained' for r in oo), len(oo))}"
               f"\n  unexplained among those not 'none': {_rate(sum(r['verdict'] == 'unexplained' for r in vis), len(vis))}"
               f"\n  confident wrong names: {len(conf)}" + "".join(f"\n    {r['label']} -> {outcome(r)}" for r in conf))
+    down = [r for r in rows if r["verdict"] == "at_bound" and r["expected"] and r["named"] == r["expected"]]
+    print(f"\n=== Correct names downgraded to 'at bound': {len(down)} ===")
+    for r in down:
+        print(f"    {r['label']:45s} -> {outcome(r)}; bound: {r.get('at_bound_params', [])}")
     hidden = [r for r in rows if r["verdict"] == "named" and r["final_at_bound"] and not r["at_bound_said"]]
     print(f"\n=== Verdicts resting on a parameter at its bound without saying so: {len(hidden)} ===")
     ok = [r for r in rows if correct(r)]
@@ -463,6 +516,8 @@ def main(argv=None):
     ap.add_argument("--first-seed", type=int, default=0,
                     help="independent: first case seed (seeds 0-63 were looked at while developing; use e.g. "
                          "1000 for held-out cases)")
+    ap.add_argument("--labels", help="independent: only these labels, comma-separated (or the groups pairs, "
+                    "singles, oo, none), with the seeds they have in the full plan")
     ap.add_argument("--library-reps", type=int, default=1, help="library: cases per effect and noise level")
     ap.add_argument("--library-null", type=int, default=0,
                     help="library: extra null cases (noise levels in turn; seeds apart from the main plan)")
@@ -473,7 +528,7 @@ def main(argv=None):
     if not args.real_only:
         plan = []
         if args.generator in ("independent", "both"):
-            plan += independent_plan(args.n_per_label, args.null, args.first_seed)
+            plan += independent_plan(args.n_per_label, args.null, args.first_seed, args.labels)
         if args.generator in ("library", "both"):
             plan += [(g, lab, (i, lev)) for i, (g, lab, lev) in enumerate(library_plan(args.library_reps))]
             levels = list(NOISE)
