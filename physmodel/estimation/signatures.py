@@ -11,7 +11,7 @@ from itertools import combinations
 import numpy as np
 
 from ..data.sweep import FrequencySweep
-from ..effects import LIBRARY
+from ..effects import LIBRARY, declared_confusable
 from .records import FreeParameter
 from .residuals import noise_std, standardised_residuals
 
@@ -275,6 +275,9 @@ def declare_confusable(confusable: list, separation: dict, confusability: dict, 
             confusable.append((a, b, _cosine(sigs[a], sigs[b])))
             separation[key] = separation_hint(a, b, raw_sigs, data)
         separation[key] = separation.get(key, "") + f" Declared: {why}."
+        same_physics = declared_confusable(a, b)
+        if same_physics and "two forms" not in separation[key]:
+            separation[key] += f" The library holds them as one physics in two forms: {same_physics}."
 
 
 def refit_spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:

@@ -341,3 +341,20 @@ def test_mount_resonance_calibrated_closes_the_independent_gap():
                                   [{"time_constant": 1 / (2 * math.pi * 100), "damping": 0.1},
                                    {"time_constant": 1 / (2 * math.pi * 300), "damping": 0.3}])
     assert lam_b > 3 * limit and lam_e < limit
+
+
+def test_a_pair_the_data_do_not_separate_carries_the_librarys_reason_when_it_declares_them(monkeypatch):
+    """``declare_confusable`` says why the library holds two forms as one physics (effects.CONFUSABLE)."""
+    from physmodel.estimation import signatures
+
+    sig = np.arange(1.0, 9.0).reshape(4, 2)          # a signature: (residuals, parameters)
+    confusable, separation = [], {}
+    conf = {"data": [{"top": "distributed_cpe", "other": "series_cpe", "z": 0.3, "separated": False},
+                     {"top": "distributed_cpe", "other": "leakage", "z": 0.2, "separated": False}],
+            "in_band": []}
+    sigs = {"distributed_cpe": sig, "series_cpe": sig, "leakage": sig}
+    monkeypatch.setattr(signatures, "separation_hint", lambda a, b, raw, data: "")
+    signatures.declare_confusable(confusable, separation, conf, sigs, sigs, None)
+    twin = separation["distributed_cpe~series_cpe"]
+    assert declared_confusable("series_cpe", "distributed_cpe") in twin and "two forms" in twin
+    assert "two forms" not in separation["distributed_cpe~leakage"]
