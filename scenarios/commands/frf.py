@@ -309,7 +309,7 @@ def run(args) -> int:
     ests = [_estimate(rec, p, args, kw) for rec, p in zip(records, args.records)]
     keep = {"min_coherence": args.min_coherence, "band_hz": tuple(args.band) if args.band else None,
                 "max_std_db": args.max_std_db}
-    written, lines = [], []
+    written, lines, jobs = [], [], []
     for o, path in zip(args.output, _out_paths(out, args.output)):
         sweeps, kept = [], []
         for T, e, src in zip(temps, ests, args.records):
@@ -327,7 +327,7 @@ def run(args) -> int:
                          f"of {c.frequency_hz.size} lines kept, median σ {np.median(sw.magnitude_std_db):.3g} dB / "
                          f"{np.median(sw.phase_std_deg):.3g}°")
         sweep = merge_sweeps(sweeps)
-        write_sweep(sweep, path)
+        jobs.append((write_sweep, (sweep,), path))
         written.append(path)
         if args.plot:
             from .. import plots
@@ -335,9 +335,14 @@ def run(args) -> int:
             ppath = Path(args.plot)
             if len(args.output) > 1:
                 ppath = ppath.with_name(f"{ppath.stem}_{o}{ppath.suffix}")
-            plots.frf_estimate(kept, ppath, title=f"{sweep.output_name} [{sweep.output_unit}] / "
-                                                  f"{sweep.input_name} [{sweep.input_unit}], {args.method}")
+            title = f"{sweep.output_name} [{sweep.output_unit}] / {sweep.input_name} [{sweep.input_unit}], {args.method}"
+            jobs.append((lambda p, kept=kept, title=title: plots.frf_estimate(kept, p, title=title), (), ppath))
             written.append(ppath)
+    from physmodel.data.results import files_together
+
+    with files_together([p for _, _, p in jobs]) as tmps:         # every sweep and figure, or none
+        for (write, head, _), tmp in zip(jobs, tmps):
+            write(*head, tmp)
     for e, src in zip(ests, args.records):
         for w in e.warnings:
             print(f"warning: {src}: {w}", file=sys.stderr)

@@ -240,10 +240,13 @@ def run(args: argparse.Namespace) -> int:
         fh.write(",".join(cols) + "\n")
         np.savetxt(fh, arr, delimiter=",", fmt="%.12g")
 
-    atomic_write(args.out, write_csv)
+    from physmodel.data.results import files_together
+
     prev = "infinite" if math.isinf(res.preview_s) else f"{res.preview_s:.4g} s"
-    if args.plot:
-        plots.inversion_traces(args.plot, t, u, y, ucol, ref, args.reference, f"stable inversion, preview {prev}")
+    with files_together([args.out, *([args.plot] if args.plot else [])]) as tmp:     # both or neither
+        atomic_write(tmp[0], write_csv)
+        if args.plot:
+            plots.inversion_traces(tmp[1], t, u, y, ucol, ref, args.reference, f"stable inversion, preview {prev}")
     if not args.quiet:
         print(f"ipmc invert: wrote {args.out} ({t.size} samples, preview {prev})")
     return status

@@ -21,8 +21,8 @@ estimates), :mod:`~scenarios.plots.canvas` (new figures and the writer they shar
 
 from __future__ import annotations
 
-from .frequency import bode, bode_overlay, compare_figure, plot_bode, plot_compare, save_bode
 from .chain import a0_series, effect_intervals
+from .frequency import bode, bode_overlay, compare_figure, plot_bode, plot_compare, save_bode
 from .residuals import calibration_figure, diagnosis_figures, frf_estimate, residual_bode
 from .roots import pole_zero_locus, pole_zero_maps, save_poles_zeros_vs_temperature
 from .timeseries import curves, feedforward_check, inversion_traces, plot_time, traces, tracking

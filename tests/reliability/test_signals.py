@@ -156,3 +156,16 @@ def test_an_interrupt_handled_in_one_block_does_not_stop_later_work():
         assert interrupts.requested() == signal.SIGTERM
     assert interrupts.requested() is None
     interrupts.check()                            # raises if the old interrupt were still recorded
+
+
+@pytest.mark.parametrize("sig,phase", [("SIGTERM", "temp:o"), ("SIGTERM", "write:o.csv")])
+def test_frf_writes_its_sweep_and_figure_together_or_not_at_all(work, sig, phase):
+    d = work / f"pair-frf-{phase.replace(':', '-')}"
+    d.mkdir()
+    made = ipmc(["simulate", "--out", "rec.csv", "--duration", "4", "--quiet"], d)
+    assert made.returncode == 0, made.stderr[-1500:]
+    p = ipmc(["frf", "rec.csv", "--input", "voltage", "--output", "tip_displacement", "--temperature", "25",
+              "--out", "o.csv", "--plot", "o.png", "--quiet"], d, signal=sig, phase=phase)
+    assert p.returncode == 130 and "Traceback" not in p.stderr, p.stderr[-1500:]
+    files = sorted(f.name for f in d.iterdir() if f.name != "rec.csv")
+    assert files == ([] if phase.startswith("temp") else ["o.csv", "o.png"]), files
