@@ -106,12 +106,66 @@ class CandidateResult:
 
 @dataclass
 class Diagnosis:
-    """Outcome of :func:`diagnose`.  ``verdict`` ∈ :data:`VERDICTS`; ``named``: effect names.
+    """Outcome of :func:`diagnose`.
 
-    ``laws``: the temperature laws used (stated choice); ``baseline_audit``: the baseline's
-    parameters at/near a bound, outside their plausible range, the multi-start spread and the
-    penalty; ``final_at_bound``/``final_implausible``: the same for the final fit;
-    ``cost_warning``: '' or why the weighted cost is inconsistent with the declared noise."""
+    Parameters
+    ----------
+    verdict : str
+        One of :data:`VERDICTS`.
+    named : list of str
+        The effects the verdict names (empty for ``none`` and ``unexplained``).
+    message : str
+        The verdict in words, as the report prints it.
+    kind, quantity : str
+        ``"actuator"``/``"sensor"`` and the measured quantity diagnosed.
+    alpha : float
+        Significance level of the tests. [-]
+    threshold, gap_threshold : float
+        Calibrated critical values of a candidate's likelihood-ratio statistic and of the gap test. [-]
+    baseline, final : CalibrationResult
+        The baseline fit, and the fit with the named effects (None when nothing is named).
+    final_effects : dict
+        Named effect → its fitted parameter values.
+    candidates, skipped : dict
+        Candidate name → its refit and statistics; candidate name → why it was not tried.
+    confusable : list
+        Declared-confusable pairs ``(a, b, cosine)``.
+    separation : dict
+        ``"a~b"`` → how the pair could be separated, and why it was declared.
+    localisation_before, localisation_after : list
+        Where (temperature, band, magnitude/phase) the residual gap lies before and after.
+    gap_before, gap_after : dict
+        The gap statistics before and after.
+    null : dict
+        How the null distribution was obtained and its figures.
+    noise_estimated : bool
+        The noise level was estimated from the residuals (the data declared none).
+    elapsed_s : float
+        Wall time of the diagnosis. [s]
+    data : FrequencySweep
+        The data diagnosed.
+    predicted_before, predicted_after : ndarray of complex
+        The baseline's and the final model's responses at the data's lines. [the data's output/input unit]
+    metadata : dict
+        Provenance.
+    laws : str
+        The temperature laws used (a stated choice).
+    baseline_audit : dict
+        The baseline's parameters at/near a bound or outside their plausible range, the
+        multi-start spread and the penalty.
+    final_at_bound, final_implausible : list
+        The same for the final fit.
+    cost_warning : str
+        '' or why the weighted cost is inconsistent with the declared noise.
+    confusability : dict
+        The cross-fit (Vuong) and in-band confusability records behind ``confusable``.
+    base_parameters : IPMCParameters
+        The base set with the laws used.
+    reduced : list
+        Named effects' parameters that ended at their off value (the simpler effect is meant).
+    sign_flip : dict
+        The costs of the baseline and of its sign reversal (the polarity check).
+    """
 
     verdict: str
     named: list
