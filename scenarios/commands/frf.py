@@ -51,6 +51,7 @@ import argparse
 import json
 import sys
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -309,7 +310,9 @@ def run(args) -> int:
     ests = [_estimate(rec, p, args, kw) for rec, p in zip(records, args.records)]
     keep = {"min_coherence": args.min_coherence, "band_hz": tuple(args.band) if args.band else None,
                 "max_std_db": args.max_std_db}
-    written, lines, jobs = [], [], []
+    written, lines = [], []
+    jobs: list[tuple[Callable[..., object], tuple, Path]] = []      # (writer, its leading arguments, final path)
+    titles: dict[Path, str] = {}
     for o, path in zip(args.output, _out_paths(out, args.output)):
         sweeps, kept = [], []
         for T, e, src in zip(temps, ests, args.records):
@@ -336,13 +339,14 @@ def run(args) -> int:
             if len(args.output) > 1:
                 ppath = ppath.with_name(f"{ppath.stem}_{o}{ppath.suffix}")
             title = f"{sweep.output_name} [{sweep.output_unit}] / {sweep.input_name} [{sweep.input_unit}], {args.method}"
-            jobs.append((lambda p, kept=kept, title=title: plots.frf_estimate(kept, p, title=title), (), ppath))
+            jobs.append((plots.frf_estimate, (kept,), ppath))
+            titles[ppath] = title
             written.append(ppath)
     from physmodel.data.results import files_together
 
     with files_together([p for _, _, p in jobs]) as tmps:         # every sweep and figure, or none
-        for (write, head, _), tmp in zip(jobs, tmps):
-            write(*head, tmp)
+        for (write, head, final), tmp in zip(jobs, tmps):
+            write(*head, tmp, **({"title": titles[final]} if final in titles else {}))
     for e, src in zip(ests, args.records):
         for w in e.warnings:
             print(f"warning: {src}: {w}", file=sys.stderr)
