@@ -13,6 +13,7 @@
     ipmc feedforward ...            actuator voltage for a reference, checked on the physics
     ipmc calibrate SWEEP            calibrate physical parameters to a measured sweep
     ipmc diagnose                   discrepancy workflow: locate, name, add, refit
+    ipmc compare MODEL DATA         a model against measured data: overlay and fit % per temperature
     ipmc validate                   every printed claim of the seed papers vs our number
 
 One module per subcommand in :mod:`scenarios.commands` (``add_parser(subparsers)`` and
