@@ -52,6 +52,7 @@ import json
 import sys
 import warnings
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -311,8 +312,7 @@ def run(args) -> int:
     keep = {"min_coherence": args.min_coherence, "band_hz": tuple(args.band) if args.band else None,
                 "max_std_db": args.max_std_db}
     written, lines = [], []
-    jobs: list[tuple[Callable[..., object], tuple, Path]] = []      # (writer, its leading arguments, final path)
-    titles: dict[Path, str] = {}
+    jobs: list[tuple[Callable[[Path], object], Path]] = []      # (write to a path, final path)
     for o, path in zip(args.output, _out_paths(out, args.output)):
         sweeps, kept = [], []
         for T, e, src in zip(temps, ests, args.records):
@@ -330,7 +330,7 @@ def run(args) -> int:
                          f"of {c.frequency_hz.size} lines kept, median σ {np.median(sw.magnitude_std_db):.3g} dB / "
                          f"{np.median(sw.phase_std_deg):.3g}°")
         sweep = merge_sweeps(sweeps)
-        jobs.append((write_sweep, (sweep,), path))
+        jobs.append((partial(write_sweep, sweep), path))
         written.append(path)
         if args.plot:
             from .. import plots
@@ -339,14 +339,13 @@ def run(args) -> int:
             if len(args.output) > 1:
                 ppath = ppath.with_name(f"{ppath.stem}_{o}{ppath.suffix}")
             title = f"{sweep.output_name} [{sweep.output_unit}] / {sweep.input_name} [{sweep.input_unit}], {args.method}"
-            jobs.append((plots.frf_estimate, (kept,), ppath))
-            titles[ppath] = title
+            jobs.append((partial(plots.frf_estimate, kept, title=title), ppath))
             written.append(ppath)
     from physmodel.data.results import files_together
 
-    with files_together([p for _, _, p in jobs]) as tmps:         # every sweep and figure, or none
-        for (write, head, final), tmp in zip(jobs, tmps):
-            write(*head, tmp, **({"title": titles[final]} if final in titles else {}))
+    with files_together([p for _, p in jobs]) as tmps:         # every sweep and figure, or none
+        for (write, _), tmp in zip(jobs, tmps):
+            write(tmp)
     for e, src in zip(ests, args.records):
         for w in e.warnings:
             print(f"warning: {src}: {w}", file=sys.stderr)
