@@ -33,13 +33,24 @@ Estimators
 Per-line uncertainty (σ of ln|H| in nepers and of the phase in radians, reported in dB and degrees
 via ×20/ln 10 and ×180/π):
 
-* Welch (Bendat & Piersol, *Random Data*, 4th ed., §9.2.3, eqs 9.73 and 9.90):
+* Welch (Bendat & Piersol, *Random Data*, 4th ed., §9.2.3, eqs 9.73 and 9.90): to first order
   ``σ_ln² = σ_φ² = (1 − γ²)/(2 ν γ²)`` with the sample coherence γ² and ``ν = n_eff − 1`` degrees
   of freedom; ``n_eff`` is the number of segments corrected for overlap (Welch 1967:
   ``K / (1 + 2 Σ_j (1 − j/K) ρ_j²)``, ρ_j the window's overlap correlation at a shift of j segments).
-  For H1 with output noise this is the conditional variance given the input spectra, estimated from
-  the residual ``S_yy(1 − γ²)``; for H2 it is the mirror case (input noise).  A line with γ² = 0 has
-  infinite σ.
+  For H1 with output noise the error ``Ĥ − H`` is, given the input spectra, circular complex
+  Gaussian with a variance estimated from the residual ``S_yy(1 − γ²)`` (Goodman 1957); σ is the
+  root-mean-square of ln|H/Ĥ| and of arg(H/Ĥ) over that exact distribution
+  (:func:`~physmodel.estimation.frf_estimate.sigma_exact`): the first-order value for small
+  errors, and not linearised where σ exceeds about 1 dB.  For H2 it is the mirror case (input
+  noise).  A line with γ² = 0 has infinite σ.
+* Which Welch lines stand out of noise: ``settings['coherence_threshold']`` is the coherence that
+  any of the estimate's ``coherence_lines`` noise-only lines exceeds with probability 1 %
+  (:func:`~physmodel.estimation.frf_estimate.coherence_threshold` with ``lines``).  A per-line
+  1 % (``settings['coherence_threshold_per_line']``, used for the low-coherence warning) would
+  keep about ten noise lines in an estimate of a thousand; the exact confidence disc of such a
+  line reaches H = 0, so its error of ln|H| is unbounded and no σ describes it
+  (``tests/benchmarks/bench_frf_excitation.py``: those lines made the error/σ RMS of a random
+  record 1.44 instead of 1.05).
 * Stepped sine: the scatter of the per-period phasors, ``δ ln H_k = (Y_k − H U_k)/Ȳ``; its real
   and imaginary parts give σ_ln and σ_φ (sample variance with P − 1 degrees of freedom, divided by P).
 
@@ -47,11 +58,12 @@ Both σ are estimates with few degrees of freedom when averages are few, so ±2�
 little less than 95 % of the time (Student t with ν degrees of freedom).  When the input repeats
 exactly in every segment (a multisine estimated over whole periods, P segments), the line's complex
 noise gives σ̂ two real degrees of freedom per period, ν = 2(P − 1)
-(``tests/scenarios/test_virtual_lab.py`` measures mean t² = 1.19 for P = 8, t₁₄: 1.17).  Both are first-order
-(small-error) results: as a standard deviation the Welch σ holds down to γ² ≈ 0.02, but once σ of
-the magnitude exceeds about 1 dB the error of ln|H| = ln|1 + ε| is visibly skewed (a long tail
-where |1 + ε| → 0), so its ±2σ interval covers less; :meth:`FRFEstimate.to_sweep` can drop such
-lines (``max_std_db``).  Leakage (resolution) bias is not in σ: choose ``nperseg`` so the bin width
+(``tests/scenarios/test_virtual_lab.py`` measures mean t² = 1.19 for P = 8, t₁₄: 1.17).  Once σ of
+the magnitude exceeds about 1 dB the error of ln|H| = ln|1 + ε| is skewed (a long tail where
+|1 + ε| → 0): the Welch σ is its exact RMS, but its ±2σ interval is not the Gaussian one, and a
+line kept because its sample coherence came out high has its |Ĥ| pushed up and its σ down (with
+fewer than about 16 segments this shows; ``tests/estimation/test_frf_sigma.py``);
+:meth:`FRFEstimate.to_sweep` can drop such lines (``max_std_db``).  Leakage (resolution) bias is not in σ: choose ``nperseg`` so the bin width
 is well below the half-power bandwidth of the sharpest resonance (the bias falls as Δf for a
 rectangular window, Δf² for Hann).  ``tests/benchmarks/bench_frf.py`` measures the coverage.
 """
@@ -76,7 +88,7 @@ from .frf_estimate import (
     channel_names,
     coherence_threshold,
     finite_block,
-    sigma_from_coherence,
+    sigma_exact,
 )
 
 __all__ = ["FRFEstimate", "effective_averages", "welch_frf", "h1", "h2", "estimate_frf", "estimate_record",
@@ -203,12 +215,14 @@ def welch_frf(t_or_fs, u, y, *, estimator: str = "h1", nperseg: int | None = Non
         coh = np.abs(Suy)**2 / (Suu * Syy)
     coh = np.where(np.isfinite(coh), coh, 0.0)
     n_eff = effective_averages(win, step, K)
-    sm, sp = sigma_from_coherence(coh, n_eff - 1.0)
+    sm, sp = sigma_exact(coh, n_eff - 1.0)
     names, units = channel_names(output_names, output_units, len(ys), "output")
     settings = {"fs_hz": fs, "nperseg": nperseg, "noverlap": int(noverlap),
                 "window": window if isinstance(window, (str, tuple)) else "custom", "detrend": detrend,
                 "discard_s": discard_s, "segments": K, "effective_averages": round(n_eff, 3),
-                "resolution_hz": fs / nperseg, "coherence_threshold": round(coherence_threshold(max(n_eff, 2.0)), 4)}
+                "resolution_hz": fs / nperseg, "coherence_lines": f.size,
+                "coherence_threshold": round(coherence_threshold(max(n_eff, 2.0), lines=f.size), 4),
+                "coherence_threshold_per_line": round(coherence_threshold(max(n_eff, 2.0)), 4)}
     return FRFEstimate(f, H, sm, sp, coh, np.full(f.size, K), estimator, input_name, input_unit, names, units, settings)
 
 
@@ -305,8 +319,9 @@ def estimate_frf(t_or_fs, u, y, *, estimator: str = "h1", excitation: str = "aut
        the longest power-of-two segment giving ≥ 16 segments, lengthened to resolve ``band_hz``.
     3. Lines outside ``band_hz`` (and the Nyquist line) are not estimated; a record too short for
        one line in the band is refused.  ``settings['excitation']`` says what was detected and
-       ``settings['coherence_threshold']`` what an unrelated output exceeds 1 % of the time; more
-       than half of a channel's lines below it is a low-coherence warning.  Warnings are in
+       ``settings['coherence_threshold']`` what an unrelated output exceeds 1 % of the time (at
+       any of the estimate's lines, for Welch; at a line, for the others); more than half of a
+       channel's lines below the per-line value is a low-coherence warning.  Warnings are in
        ``FRFEstimate.warnings`` and issued as :class:`~physmodel.estimation.frf_estimate.FRFWarning`.
 
     Parameters
@@ -394,7 +409,9 @@ def estimate_frf(t_or_fs, u, y, *, estimator: str = "h1", excitation: str = "aut
         est = replace(est, frequency_hz=est.frequency_hz[keep], response=est.response[:, keep],
                       magnitude_std_db=est.magnitude_std_db[:, keep], phase_std_deg=est.phase_std_deg[:, keep],
                       coherence=None if est.coherence is None else est.coherence[:, keep],
-                      n_averages=est.n_averages[keep])
+                      n_averages=est.n_averages[keep],
+                      settings={**est.settings, "coherence_lines": int(keep.sum()), "coherence_threshold": round(
+                          coherence_threshold(max(est.settings["effective_averages"], 2.0), lines=int(keep.sum())), 4)})
     low = low_coherence_warning(est)
     if low:
         notes.append(low)

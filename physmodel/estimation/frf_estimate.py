@@ -1,8 +1,9 @@
 """The result every FRF estimator returns (:class:`FRFEstimate`) and what the estimators share:
-checks of the input and output samples, the σ of a line from its coherence (Welch) or from the
-scatter of per-period phasors (periodic excitation, stepped sine), and the coherence a line needs to
-stand out of noise.  The estimators are :mod:`physmodel.estimation.frf` (Welch, and the front door
-that reads the excitation), :mod:`physmodel.estimation.periodic` and
+checks of the input and output samples, the σ of a line from its coherence (Welch, from the exact
+distribution of the estimate) or from the scatter of per-period phasors (periodic excitation,
+stepped sine), and the coherence a line needs to stand out of noise (per line, or for all lines of
+an estimate together).  The estimators are :mod:`physmodel.estimation.frf` (Welch, and the front
+door that reads the excitation), :mod:`physmodel.estimation.periodic` and
 :mod:`physmodel.estimation.stepped`; their statistics are described in
 :mod:`physmodel.estimation.frf`.
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import cache
 
 import numpy as np
 
@@ -112,7 +114,8 @@ class FRFEstimate:
     @property
     def coherence_threshold(self) -> float | None:
         """The coherence a line needs to stand out of noise (``settings['coherence_threshold']``, set
-        by the estimators from their number of averages; see :func:`coherence_threshold`)."""
+        by the estimators from their number of averages and, for Welch, of lines; see
+        :func:`coherence_threshold`)."""
         v = self.settings.get("coherence_threshold")
         return None if v is None else float(v)
 
@@ -208,36 +211,127 @@ class FRFEstimate:
 
 
 def sigma_from_coherence(coh: np.ndarray, dof: float) -> tuple[np.ndarray, np.ndarray]:
-    """σ [dB], σ [deg] of an FRF line from coherence and degrees of freedom (Bendat & Piersol 9.90)."""
+    """First-order σ [dB], σ [deg] of an FRF line from coherence and degrees of freedom
+    (Bendat & Piersol 9.90): ``σ_ln = σ_φ = sqrt((1 − γ²)/(2 ν γ²))``; see :func:`sigma_exact`."""
     with np.errstate(divide="ignore", invalid="ignore"):
         s = np.sqrt(np.clip(1.0 - coh, 0.0, None) / (2.0 * dof * coh))
     s = np.where(coh > 0, s, np.inf)
     return NEPER_TO_DB * s, np.degrees(s)
 
 
+#: Gauss–Legendre nodes and weights on (0, 1) for the expectation over |Z|² (:func:`sigma_exact`).
+_GL_T, _GL_W = np.polynomial.legendre.leggauss(96)
+_GL_T, _GL_W = 0.5 * (_GL_T + 1.0), 0.5 * _GL_W
 
 
-def coherence_threshold(averages: float, alpha: float = COHERENCE_ALPHA) -> float:
+@cache
+def _phase_beyond_table() -> tuple[np.ndarray, np.ndarray]:
+    """``u = 1/ρ`` and the mean over θ of arg²(1 − ρ e^{iθ}) for ρ ≥ 1 (no closed form; midpoint
+    rule on 8192 angles)."""
+    u = np.linspace(0.0, 1.0, 513)
+    th = (np.arange(8192) + 0.5) * (2 * np.pi / 8192)
+    z = 1.0 - np.exp(1j * th)[None] / u[1:, None]
+    h = np.concatenate([[np.pi**2 / 3.0], np.mean(np.angle(z)**2, axis=1)])
+    return u, h
+
+
+def circle_mean_squares(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Means over θ of ln²|1 − w| and arg²(1 − w) for ``w = ρ e^{iθ}``, ``y = ρ²`` (array).
+
+    For ρ < 1, ``ln(1 − w) = −Σ w^k/k`` gives both as ``Li₂(ρ²)/2``; for ρ > 1,
+    ``ln|1 − w| = ln ρ + ln|1 − 1/w|`` gives ``ln²ρ + Li₂(ρ⁻²)/2`` (the cross term has mean 0), and
+    the phase, which then winds once round the circle, is tabulated against 1/ρ.
+    """
+    # Li₂(y) = spence(1 − y)
+    from scipy.special import spence
+
+    y = np.asarray(y, dtype=float)
+    inside = y <= 1.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        li_in = 0.5 * spence(1.0 - np.where(inside, y, 0.0))
+        inv = np.where(inside, 1.0, 1.0 / y)
+        mag = np.where(inside, li_in, 0.25 * np.log(np.where(inside, 1.0, y))**2 + 0.5 * spence(1.0 - inv))
+        u_tab, h_tab = _phase_beyond_table()
+        ph = np.where(inside, li_in, np.interp(np.sqrt(inv), u_tab, h_tab))
+    return mag, ph
+
+
+def sigma_exact(coh: np.ndarray, dof: float) -> tuple[np.ndarray, np.ndarray]:
+    """σ [dB], σ [deg] of ln|H| and of the phase of a Welch H1 (or H2) line from the exact
+    distribution of the estimate, given the sample coherence γ̂² and ``dof`` = ν.
+
+    With Gaussian noise on the output and ν + 1 independent segments, conditional on the input
+    spectra, ``Ĥ − H`` is circular complex Gaussian with variance ``Ĝ_yy(1 − γ̂²)/(ν Ĝ_xx)``
+    estimated from the residual power, independent of ``Ĥ`` (Goodman 1957; Bendat & Piersol,
+    *Random Data*, 4th ed., ch. 9, whose confidence region (eq. 9.90)
+    ``|H − Ĥ|² ≤ (2/(n − 2)) F_{2,n−2;α} (1 − γ̂²)/γ̂² Ĝ_yy/Ĝ_xx``, n = 2(ν + 1), is the exact
+    form with that variance estimated; Carter, Knapp & Nuttall 1973).  Relative to the estimate,
+    ``H/Ĥ = 1 − w`` with ``w = r̂ Z``, ``r̂² = (1 − γ̂²)/(ν γ̂²)`` and Z standard circular complex
+    Gaussian (|Z|² ~ Exp(1), arg Z uniform).  The σ returned are the root-mean-square of
+    ``ln|1 − w|`` and ``arg(1 − w)`` over Z — what the residuals of a fit and the benchmarks divide
+    by σ: over arg Z in closed form (:func:`circle_mean_squares`), over |Z|² by Gauss–Legendre
+    quadrature of its quantile function ``x(s) = −ln s``.
+
+    For small r̂ this is the first-order σ (:func:`sigma_from_coherence`), ``r̂/√2``; beyond about
+    1 dB it departs from it, because ln|1 − w| and arg(1 − w) are not linear in w.  Like the σ of
+    the periodic and stepped-sine estimators it uses the estimated noise power as if known: the
+    standardised error then follows Student's t with 2ν degrees of freedom for small errors
+    (RMS ``sqrt(ν/(ν − 1))``; averaging |Z|² over F(2, 2ν) instead of Exp(1) would fold that in).
+    The probability that the exact confidence disc reaches H = 0, where |H| has no lower bound and
+    no σ describes the log-magnitude, is ``(1 − γ̂²)^ν`` — the line's coherence p-value
+    (:func:`coherence_threshold`): lines below the threshold are such lines.  A line with γ̂² = 0
+    has infinite σ.
+    """
+    coh = np.asarray(coh, dtype=float)
+    nu = float(dof)
+    if not nu > 0:
+        raise IPMCError(f"dof={dof!r}: σ needs more than one average (dof > 0)")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r2 = np.where(coh > 0, np.clip(1.0 - coh, 0.0, None) / (nu * coh), 0.0).reshape(-1)
+    x = -3.0 * np.log(_GL_T)                   # Exp(1) quantile at survival s = t³ (nodes crowd where |Z| → ∞)
+    w = _GL_W * 3 * _GL_T**2
+    sm, sp = np.empty(r2.size), np.empty(r2.size)
+    for a in range(0, r2.size, 4096):
+        mag, ph = circle_mean_squares(r2[a:a + 4096, None] * x[None])
+        sm[a:a + 4096], sp[a:a + 4096] = mag @ w, ph @ w
+    bad = ~(coh > 0)
+    sm = np.where(bad, np.inf, np.sqrt(sm).reshape(coh.shape))
+    sp = np.where(bad, np.inf, np.sqrt(sp).reshape(coh.shape))
+    return NEPER_TO_DB * sm, np.degrees(sp)
+
+
+def coherence_threshold(averages: float, alpha: float = COHERENCE_ALPHA, lines: int = 1) -> float:
     """Coherence that a line without any linear relation to the input exceeds with probability
-    ``alpha``: ``1 − alpha^(1/(n − 1))`` for ``n`` independent averages (segments or periods).
+    ``alpha``: ``1 − alpha^(1/(n − 1))`` for ``n`` independent averages (segments or periods);
+    with ``lines`` > 1, the probability that any of that many such lines exceeds it is ``alpha``.
 
     Under that null the sample coherence of ``n`` averages is Beta(1, n − 1) distributed
     (Carter, Knapp & Nuttall 1973), ``P(γ̂² > x) = (1 − x)^(n − 1)``, for Welch segments and for
-    whole periods of a periodic input alike.
+    whole periods of a periodic input alike.  The same number is the probability that the exact
+    confidence disc of the line (:func:`sigma_exact`) reaches H = 0, where the log-magnitude has no
+    lower bound.  A Welch estimate tests every bin, most of them often unexcited or buried in
+    noise: at a per-line ``alpha`` it would keep about ``alpha`` × (its noise-only bins) lines whose
+    response is noise, each with an error of ln|H| that no σ covers; ``lines`` makes ``alpha`` the
+    false-alarm probability of the whole estimate (Šidák: ``1 − (1 − alpha)^(1/lines)`` per line).
 
     Parameters
     ----------
     averages : float
         Independent averages (effective segments, or whole periods); at least 2.
     alpha : float
-        False-alarm probability per line, in (0, 1).
+        False-alarm probability (per line, or per estimate of ``lines`` lines), in (0, 1).
+    lines : int
+        Lines tested together (1: a per-line threshold).
     """
     n = float(averages)
     if not n >= 2:
         raise IPMCError(f"averages={averages!r}: a coherence needs at least 2 averages")
     if not 0 < alpha < 1:
         raise IPMCError(f"alpha={alpha!r} must lie in (0, 1)")
-    return float(1.0 - alpha ** (1.0 / (n - 1.0)))
+    if not (isinstance(lines, (int, np.integer)) and lines >= 1):
+        raise IPMCError(f"lines={lines!r} must be a positive integer")
+    per_line = -math.expm1(math.log1p(-alpha) / int(lines))
+    return float(-math.expm1(math.log(per_line) / (n - 1.0)))
 
 
 def phasor_scatter(U: np.ndarray, Y: np.ndarray, H: np.ndarray,
@@ -267,16 +361,19 @@ def phasor_scatter(U: np.ndarray, Y: np.ndarray, H: np.ndarray,
 
 
 def low_coherence_warning(est: FRFEstimate) -> str | None:
-    """A warning when more than half of an output channel's lines fall below the coherence
-    threshold (an output that does not follow the input: noise, a wrong or unplugged channel)."""
+    """A warning when more than half of an output channel's lines fall below the per-line
+    coherence threshold (``settings['coherence_threshold_per_line']`` when the estimate's threshold
+    is for all its lines together, as Welch's is): an output that does not follow the input —
+    noise, a wrong or unplugged channel."""
     if est.coherence is None or est.coherence_threshold is None:
         return None
+    thr = float(est.settings.get("coherence_threshold_per_line", est.coherence_threshold))
     out = []
     for i, name in enumerate(est.output_names):
-        low = int(np.sum(est.coherence[i] < est.coherence_threshold))
+        low = int(np.sum(est.coherence[i] < thr))
         if low > est.frequency_hz.size / 2:
             out.append(f"{name}: {low} of {est.frequency_hz.size} lines have coherence below "
-                       f"{est.coherence_threshold:.3g} (median {np.median(est.coherence[i]):.2g})")
+                       f"{thr:.3g} (median {np.median(est.coherence[i]):.2g})")
     if not out:
         return None
     return ("low coherence — the output barely follows the input (noise only? wrong or unplugged channel?): "
