@@ -245,3 +245,22 @@ def test_feedforward_reference_file_column_unit(surrogates, tmp_path, capsys):
 def test_invert_input_unit_must_agree_with_the_column_name(surrogates, tmp_path, capsys):
     rc, err = _invert(_signal(tmp_path, "tip_mm", 1.0), surrogates[0], tmp_path / "o.csv", capsys, "--input-unit", "m")
     assert rc == 2 and "--input-unit m" in err and "in mm by its name" in err
+
+
+def test_invert_mat_variable_with_a_stated_unit_is_converted(surrogates, tmp_path, capsys):
+    from scipy.io import savemat
+
+    act, _ = surrogates
+    rc, err = _invert(_signal(tmp_path, "tip_mm", 1.0), act, tmp_path / "mm.csv", capsys)
+    assert rc == 0, err
+    t = np.arange(0.0, 2.0, 1e-3)
+    x = 0.2 * np.sin(2 * np.pi * 2 * t) * np.sin(np.pi * t / 2) ** 2          # as _signal, in m below
+    savemat(tmp_path / "rec.mat", {"tt": t, "defl": x * 1e-3})
+    rc, err = _invert(str(tmp_path / "rec.mat"), act, tmp_path / "m.csv", capsys,
+                      "--time-column", "tt", "--input-column", "defl", "--input-unit", "m")
+    assert rc == 0 and "'defl' is in m; converted to the surrogate's mm" in err, err
+    a, b = _table(tmp_path / "mm.csv")[:, 2], _table(tmp_path / "m.csv")[:, 2]
+    np.testing.assert_allclose(b, a, rtol=0, atol=1e-8 * np.max(np.abs(a)))      # rounding only (see above)
+    rc, err = _invert(str(tmp_path / "rec.mat"), act, tmp_path / "uA.csv", capsys,
+                      "--time-column", "tt", "--input-column", "defl", "--input-unit", "uA")
+    assert rc == 2 and "current" in err and "--input-unit" in err
