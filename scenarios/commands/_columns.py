@@ -266,16 +266,17 @@ def signal_scale(column: str, unit: str | None, labels: dict, command: str, fix:
     return k
 
 
-def reference_column_unit(path, column) -> tuple[str, str | None]:
-    """(column, unit in its name or None) of the value column of a reference file (default: the
-    first column that is not ``time_s``); a missing file or column is left to the reader's message."""
-    from physmodel.data.columns import pick, read_table, suffix_unit
-    from physmodel.errors import IPMCError
+def reference_column_unit(path, column) -> tuple[str | None, str | None]:
+    """(column, unit in its name or None) of the value column of a reference file: ``column`` (a
+    name, the ``<name>`` of a ``<name>_<unit>`` column, or a 0-based index) or, when None, the
+    first column that is not ``time_s`` (None when there is none: the reader then says what is
+    missing).  A column that is not there is a CLIError naming ``--reference-column`` in the
+    wording of :func:`pick_column`; a missing file names ``--reference-file``."""
+    from physmodel.data.columns import suffix_unit
 
-    try:
-        table = read_table(path, "reference")
-        name = pick(table, column, "reference") if column is not None else \
-            next(n for n in table.names if n != "time_s")
-    except (IPMCError, StopIteration):
-        return str(column), None
-    return name, (suffix_unit(name) or (None, None))[1]
+    table = read_columns(path, "--reference-file")
+    if column is not None:
+        name = pick_column(table, column, "--reference-column", "reference")
+    else:
+        name = next((n for n in table.names if n != "time_s"), None)
+    return name, (suffix_unit(name) or (None, None))[1] if name is not None else None

@@ -67,7 +67,8 @@ def add_parser(sub):
     g = p.add_argument_group("reference (in the surrogate's output unit, e.g. mm)")
     g.add_argument("--reference", choices=("sine", "multitone", "steps"), default="sine")
     g.add_argument("--reference-file", help="CSV/NPZ with time_s and a value column (instead of --reference)")
-    g.add_argument("--reference-column", help="value column of --reference-file")
+    g.add_argument("--reference-column", metavar="NAME|INDEX",
+                   help="value column of --reference-file, by name or 0-based index (default: the first after time_s)")
     g.add_argument("--amplitude", default="0.3", help="amplitude(s), comma-separated for multitone")
     g.add_argument("--frequency", default="1", help="frequency(ies) [Hz], comma-separated for multitone")
     g.add_argument("--levels", default="0.2,-0.2", help="steps: plateau levels")
@@ -122,7 +123,9 @@ def build_reference(args, unit: str):
     lead, tail = args.lead, args.tail
     if args.reference_file:
         fade = 0.0 if args.fade is None else args.fade
-        return R.from_file(args.reference_file, column=args.reference_column, fade_in_s=fade,
+        column = None if args.reference_column is None else \
+            reference_column_unit(args.reference_file, args.reference_column)[0]     # an index → its name
+        return R.from_file(args.reference_file, column=column, fade_in_s=fade,
                            fade_out_s=fade, lead_s=lead, tail_s=tail, unit=unit)
     if args.reference == "steps":
         return R.smoothed_steps(floats(args.levels, "--levels"), args.hold, args.fs,
@@ -263,7 +266,7 @@ def run(args) -> int:
     ref_scale = signal_scale("reference", args.unit or out_unit, labels, "ipmc feedforward", "--unit")
     if args.reference_file:                             # a column with its own unit: its kind checked, a
         col, unit = reference_column_unit(args.reference_file, args.reference_column)   # conversion said
-        if unit is not None:
+        if col is not None and unit is not None:
             signal_scale(col, unit, labels, "ipmc feedforward", "--reference-column/--unit")
     if args.no_check and (args.model or args.set or args.params_json or args.param):
         raise CLIError("--no-check: no physics check is run, so --model/--set/--params-json/--param have nothing to do")
