@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFormatError
-from .fileio import by_extension, read_text
+from .fileio import by_extension, comment_header, read_text
 from .units import UNITS
 
 __all__ = ["ColumnMapError", "Table", "read_table", "pick", "suffix_unit", "time_column", "map_record", "TIME_UNITS"]
@@ -103,14 +103,8 @@ def _delimiter(line: str) -> str:
 def _csv_table(path) -> Table:
     where = str(path)
     lines = read_text(path, "data file").splitlines()
-    header: dict[str, str] = {}
-    i = 0
-    while i < len(lines) and (not lines[i].strip() or lines[i].lstrip().startswith("#")):
-        body = lines[i].strip().lstrip("#").strip()
-        if ":" in body:
-            k, v = body.split(":", 1)
-            header[k.strip()] = v.strip()
-        i += 1
+    head = comment_header(lines)
+    header, i = head.entries, head.end
     if i >= len(lines):
         raise DataFormatError(f"{where}: no column header line (expected one row of column names)")
     delim = _delimiter(lines[i])
