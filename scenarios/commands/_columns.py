@@ -275,8 +275,6 @@ def reference_column_unit(path, column) -> tuple[str | None, str | None]:
     from physmodel.data.columns import suffix_unit
 
     table = read_columns(path, "--reference-file")
-    if column is not None:
-        name = pick_column(table, column, "--reference-column", "reference")
-    else:
-        name = next((n for n in table.names if n != "time_s"), None)
+    name: str | None = pick_column(table, column, "--reference-column", "reference") if column is not None else \
+        next((n for n in table.names if n != "time_s"), None)
     return name, (suffix_unit(name) or (None, None))[1] if name is not None else None
