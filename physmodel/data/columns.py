@@ -23,10 +23,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataFormatError
-from .fileio import by_extension, read_text
+from .fileio import by_extension, comment_header, read_text
 from .units import UNITS
 
-__all__ = ["ColumnMapError", "Table", "read_table", "pick", "suffix_unit", "map_record", "TIME_UNITS"]
+__all__ = ["ColumnMapError", "Table", "read_table", "pick", "suffix_unit", "time_column", "map_record", "TIME_UNITS"]
 
 
 class ColumnMapError(DataFormatError):
@@ -103,14 +103,8 @@ def _delimiter(line: str) -> str:
 def _csv_table(path) -> Table:
     where = str(path)
     lines = read_text(path, "data file").splitlines()
-    header: dict[str, str] = {}
-    i = 0
-    while i < len(lines) and (not lines[i].strip() or lines[i].lstrip().startswith("#")):
-        body = lines[i].strip().lstrip("#").strip()
-        if ":" in body:
-            k, v = body.split(":", 1)
-            header[k.strip()] = v.strip()
-        i += 1
+    head = comment_header(lines)
+    header, i = head.entries, head.end
     if i >= len(lines):
         raise DataFormatError(f"{where}: no column header line (expected one row of column names)")
     delim = _delimiter(lines[i])
@@ -218,7 +212,10 @@ def read_table(path, what: str = "data") -> Table:
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "min": 60.0}
 
 
-def _time_column(table, columns: dict, units: dict) -> tuple[str, np.ndarray]:
+def time_column(table: Table, columns: dict, units: dict) -> tuple[str, np.ndarray]:
+    """``(column name, times [s])`` of ``table``: the column ``columns['time']`` (a name or 0-based
+    index; default ``time_s``) in ``units['time']`` (s, ms, us or min; default the column name's
+    ``_<unit>`` suffix, else s).  A ColumnMapError names ``columns['time']`` or ``units['time']``."""
     if "time" in columns:
         tcol = pick(table, columns["time"], "time")
     elif "time_s" in table.names:
@@ -257,7 +254,7 @@ def map_record(path, columns: dict | None = None, units: dict | None = None, tem
     columns, units = dict(columns or {}), dict(units or {})
     table = read_table(path, "time-record")
     where = table.where
-    tcol, t = _time_column(table, columns, units)
+    tcol, t = time_column(table, columns, units)
     chosen = {k: v for k, v in columns.items() if k != "time"}
     mapped = bool(chosen)
     if not mapped:

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import os
 import secrets
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -67,6 +68,53 @@ def read_text(path, what: str = "file") -> str:
         line = data[:exc.start].count(b"\n") + 1
         raise DataFormatError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
                               "save the file as UTF-8") from None
+
+
+@dataclass(frozen=True)
+class CommentHeader:
+    """The ``# key: value`` lines at the top of a text table (:func:`comment_header`).
+
+    Attributes
+    ----------
+    entries : dict[str, str]
+        Key → value of each ``# key: value`` line, in file order (a later line with the same key
+        wins); a format line ``# ipmc-<format> <version>`` is the entry ``{'ipmc-<format>': '<version>'}``.
+    end : int
+        Index (0-based) of the first line after the header: the column-name row, or ``len(lines)``
+        when the text holds nothing else.
+    """
+
+    entries: dict = field(default_factory=dict)
+    end: int = 0
+
+
+def comment_header(lines: Sequence[str]) -> CommentHeader:
+    """The comment header of a text table: the leading lines that are blank or start with ``#``
+    (after any indentation).
+
+    Each such line's text after the ``#`` signs is an entry when it holds a ``:`` (``# input:
+    voltage [V]`` → ``{'input': 'voltage [V]'}``, key and value stripped) or when its first word
+    names a library format (``# ipmc-sweep 1`` → ``{'ipmc-sweep': '1'}``); other comment lines
+    (free text) are skipped.  The one header scan of the library's CSV readers (the sweep CSV and
+    a user's own tables, :mod:`physmodel.data.columns`).
+
+    Parameters
+    ----------
+    lines : sequence of str
+        The text's lines, without line ends (``text.splitlines()``).
+    """
+    entries: dict[str, str] = {}
+    i = 0
+    while i < len(lines) and (not lines[i].strip() or lines[i].lstrip().startswith("#")):
+        body = lines[i].strip().lstrip("#").strip()
+        words = body.split(None, 1)
+        if words and words[0].startswith("ipmc-") and ":" not in words[0]:
+            entries[words[0]] = words[1] if len(words) > 1 else ""
+        elif ":" in body:
+            k, v = body.split(":", 1)
+            entries[k.strip()] = v.strip()
+        i += 1
+    return CommentHeader(entries, i)
 
 
 # the output-folder claim of the commands lives in physmodel.data.results (all or nothing, with a

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import DataFormatError, IPMCError
 from .columns import ColumnMapError, Table, pick, read_table
-from .fileio import atomic_write, by_extension, read_text
+from .fileio import atomic_write, by_extension, comment_header, read_text
 from .results import check_output_folder, folder_owner, output_folder
 from .sweep import (
     MAX_SWEEP_LINES,
@@ -67,7 +67,7 @@ def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], whe
     in_name, in_unit = unit_of("input")
     out_name, out_unit = unit_of("output")
     H = _response(cols["magnitude_db"], cols["phase_deg"], "dB", "deg", where)
-    meta = {k: v for k, v in header.items() if k not in ("input", "output", "ipmc-sweep")}
+    meta = {k: v for k, v in header.items() if k not in ("input", "output") and not k.startswith("ipmc-")}
     has_std = "magnitude_std_db" in cols
     return FrequencySweep(cols["temperature_c"], cols["frequency_hz"], H,
                           cols["magnitude_std_db"] if has_std else None,
@@ -79,18 +79,9 @@ def _from_columns(cols: Mapping[str, np.ndarray], header: Mapping[str, str], whe
 def read_csv(path) -> FrequencySweep:
     """Read the tidy CSV; a malformed file raises :class:`DataFormatError` naming the line."""
     path = Path(path)
-    text = read_text(path, "sweep file")
-    header: dict[str, str] = {}
-    lines = text.splitlines()
-    i = 0
-    while i < len(lines) and (lines[i].startswith("#") or not lines[i].strip()):
-        body = lines[i].lstrip("#").strip()
-        if body.startswith("ipmc-sweep"):
-            header["ipmc-sweep"] = body.split(None, 1)[1] if len(body.split()) > 1 else ""
-        elif ":" in body:
-            k, v = body.split(":", 1)
-            header[k.strip()] = v.strip()
-        i += 1
+    lines = read_text(path, "sweep file").splitlines()
+    head = comment_header(lines)
+    header, i = head.entries, head.end
     if i >= len(lines):
         raise DataFormatError(f"{path}: no column header line after the '#' header")
     colnames = [c.strip() for c in next(csv.reader([lines[i]]))]
@@ -419,7 +410,8 @@ def read_mapped_sweep(path, columns: Mapping | None = None, units: Mapping | Non
     if dup.size:
         k = order[dup[0]]
         raise DataFormatError(f"{where}: two lines at {f[k]:g} Hz and {T[k]:g} °C")
-    meta = {k: v for k, v in table.header.items() if k not in ("input", "output", "ipmc-sweep", "temperature_c")}
+    meta = {k: v for k, v in table.header.items()
+            if k not in ("input", "output", "temperature_c") and not k.startswith("ipmc-")}     # not format lines
     meta["columns"] = ", ".join(f"{r}={c}" for r, c in picked.items())
     try:
         return FrequencySweep(T[order], f[order], H[order], None if std is None else std[0][order],

@@ -24,7 +24,7 @@ from typing import Any
 from ._common import CLIError
 
 __all__ = ["add_record_options", "add_sweep_options", "record_mapping", "read_record_mapped", "sweep_mapping",
-           "read_sweep_mapped", "resolve_column"]
+           "read_sweep_mapped", "read_columns", "pick_column", "record_time", "column_values"]
 
 TIME_UNITS = ("s", "ms", "us", "min")
 
@@ -111,15 +111,56 @@ def read_record_mapped(path, args, channels: dict, option: str = "RECORD"):
         raise CLIError(f"{_record_option(exc, channels)}: {exc}") from None
 
 
-def resolve_column(header: list, spec, option: str, where: str, what: str = "column") -> str:
-    """The column of ``header`` named ``spec`` or at 0-based index ``spec``, else a CLIError naming ``option``."""
-    if spec in header:
-        return spec
-    s = _spec(spec)
-    if isinstance(s, int) and 0 <= s < len(header):
-        return header[s]
-    raise CLIError(f"{option} {spec}: no {what} {spec!r} in {where}; its columns are "
-                   f"{', '.join(f'{k}:{h}' for k, h in enumerate(header))} (a name or a 0-based index)")
+def read_columns(path, option: str):
+    """The named columns of ``path`` (CSV, NPZ or MAT: :func:`physmodel.data.columns.read_table`),
+    for a command that picks its columns itself (``--column``-style options, no channel units
+    needed); a missing file is a CLIError naming ``option``."""
+    from physmodel.data.columns import read_table
+
+    if not Path(path).exists():
+        raise CLIError(f"{option} {path}: no such file")
+    return read_table(path, "data")
+
+
+def pick_column(table, spec, option: str, key: str) -> str:
+    """The column of ``table`` that ``spec`` names (a name, the ``<name>`` of a ``<name>_<unit>``
+    column, or a 0-based index: :func:`physmodel.data.columns.pick`); a column that is not there is
+    a CLIError ``'<option>: <file>: columns[<key>] = <spec>: no such column; the file has 0:t, 1:...'``,
+    the wording of the record options of ``ipmc frf``."""
+    from physmodel.data.columns import ColumnMapError, pick
+
+    try:
+        return pick(table, spec, key)
+    except ColumnMapError as exc:
+        raise CLIError(f"{option}: {exc}") from None
+
+
+def record_time(table, args):
+    """``(time column, times [s])`` of ``table`` from ``--time-column``/``--time-unit`` (default
+    ``time_s``; the unit from the column name's suffix, else s); a problem names the option."""
+    from physmodel.data.columns import ColumnMapError, time_column
+
+    columns = {} if args.time_column is None else {"time": _spec(args.time_column)}
+    units = {} if args.time_unit is None else {"time": args.time_unit}
+    try:
+        return time_column(table, columns, units)
+    except ColumnMapError as exc:
+        raise CLIError(f"{'--time-unit' if exc.argument == 'units' else '--time-column'}: {exc}") from None
+
+
+def column_values(table, name: str, option: str, n: int):
+    """The samples of column ``name`` (chosen by ``option``), refused unless there are ``n`` of them
+    (the time column's) and every one is finite."""
+    import numpy as np
+
+    v = table.data[name]
+    if v.size != n:
+        raise CLIError(f"{option}: {table.where}: column {name!r} has {v.size} value(s); the time column has {n}")
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        raise CLIError(f"{option}: {table.where}: column {name!r} is not finite at sample(s) {bad[:5].tolist()} "
+                       "(0-based); expected finite numbers")
+    return v
 
 
 # ---------------------------------------------------------------------------- sweeps
@@ -225,16 +266,15 @@ def signal_scale(column: str, unit: str | None, labels: dict, command: str, fix:
     return k
 
 
-def reference_column_unit(path, column) -> tuple[str, str | None]:
-    """(column, unit in its name or None) of the value column of a reference file (default: the
-    first column that is not ``time_s``); a missing file or column is left to the reader's message."""
-    from physmodel.data.columns import pick, read_table, suffix_unit
-    from physmodel.errors import IPMCError
+def reference_column_unit(path, column) -> tuple[str | None, str | None]:
+    """(column, unit in its name or None) of the value column of a reference file: ``column`` (a
+    name, the ``<name>`` of a ``<name>_<unit>`` column, or a 0-based index) or, when None, the
+    first column that is not ``time_s`` (None when there is none: the reader then says what is
+    missing).  A column that is not there is a CLIError naming ``--reference-column`` in the
+    wording of :func:`pick_column`; a missing file names ``--reference-file``."""
+    from physmodel.data.columns import suffix_unit
 
-    try:
-        table = read_table(path, "reference")
-        name = pick(table, column, "reference") if column is not None else \
-            next(n for n in table.names if n != "time_s")
-    except (IPMCError, StopIteration):
-        return str(column), None
-    return name, (suffix_unit(name) or (None, None))[1]
+    table = read_columns(path, "--reference-file")
+    name: str | None = pick_column(table, column, "--reference-column", "reference") if column is not None else \
+        next((n for n in table.names if n != "time_s"), None)
+    return name, (suffix_unit(name) or (None, None))[1] if name is not None else None

@@ -35,7 +35,9 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -56,7 +58,7 @@ from ._common import (
     verdict_lines,
 )
 
-__all__ = ["add_parser", "run", "build_reference", "drive_limits"]
+__all__ = ["add_parser", "run", "build_reference", "drive_limits", "limit_flags"]
 
 
 def add_parser(sub):
@@ -67,7 +69,8 @@ def add_parser(sub):
     g = p.add_argument_group("reference (in the surrogate's output unit, e.g. mm)")
     g.add_argument("--reference", choices=("sine", "multitone", "steps"), default="sine")
     g.add_argument("--reference-file", help="CSV/NPZ with time_s and a value column (instead of --reference)")
-    g.add_argument("--reference-column", help="value column of --reference-file")
+    g.add_argument("--reference-column", metavar="NAME|INDEX",
+                   help="value column of --reference-file, by name or 0-based index (default: the first after time_s)")
     g.add_argument("--amplitude", default="0.3", help="amplitude(s), comma-separated for multitone")
     g.add_argument("--frequency", default="1", help="frequency(ies) [Hz], comma-separated for multitone")
     g.add_argument("--levels", default="0.2,-0.2", help="steps: plateau levels")
@@ -122,7 +125,9 @@ def build_reference(args, unit: str):
     lead, tail = args.lead, args.tail
     if args.reference_file:
         fade = 0.0 if args.fade is None else args.fade
-        return R.from_file(args.reference_file, column=args.reference_column, fade_in_s=fade,
+        column = None if args.reference_column is None else \
+            reference_column_unit(args.reference_file, args.reference_column)[0]     # an index → its name
+        return R.from_file(args.reference_file, column=column, fade_in_s=fade,
                            fade_out_s=fade, lead_s=lead, tail_s=tail, unit=unit)
     if args.reference == "steps":
         return R.smoothed_steps(floats(args.levels, "--levels"), args.hold, args.fs,
@@ -238,11 +243,28 @@ def drive_limits(args) -> tuple[float | None, float | None]:
     return (DEFAULT_MAX_VOLTAGE if args.max_voltage is None else args.max_voltage), args.max_rate
 
 
+def limit_flags(message: str, max_v: float | None, max_rate: float | None) -> str:
+    """A limit message of :func:`inversion.limits.check_limits` (Python names: ``max_voltage = ±…``,
+    ``max_rate = …``, ``action='warn'``, ``preview='inf'``) with the options of this command that set
+    them (``--max-voltage``, ``--max-rate``, ``--on-limit warn``, ``--preview inf``), so that the
+    message names what the user can type.  ``max_v`` [V] and ``max_rate`` [V/s] are the options'
+    values; the limit itself stays in the message's own unit."""
+    if max_v is not None:
+        message = re.sub(r"max_voltage = ±(\S+ \S+) \((\d+) samples violate it\)",
+                         rf"±\1 (--max-voltage {max_v:g}; \2 samples violate it)", message)
+    if max_rate is not None:
+        message = re.sub(r"max_rate = (\S+ \S+) \((\d+) samples violate it\)",
+                         rf"\1 (--max-rate {max_rate:g}; \2 samples violate it)", message)
+    message = message.replace("preview='inf'", "--preview inf").replace("action='warn'", "--on-limit warn")
+    return message.replace("relax the limits (--on-limit warn to proceed)",
+                           "relax --max-voltage/--max-rate (--on-limit warn to proceed)")
+
+
 def run(args) -> int:
     import json
 
     from inversion import InversionError, feedforward
-    from inversion.limits import LimitError, Limits
+    from inversion.limits import LimitError, Limits, LimitWarning
     from physmodel.data.files import atomic_write
     from physmodel.data.units import UNITS, unit_scale
 
@@ -263,7 +285,7 @@ def run(args) -> int:
     ref_scale = signal_scale("reference", args.unit or out_unit, labels, "ipmc feedforward", "--unit")
     if args.reference_file:                             # a column with its own unit: its kind checked, a
         col, unit = reference_column_unit(args.reference_file, args.reference_column)   # conversion said
-        if unit is not None:
+        if col is not None and unit is not None:
             signal_scale(col, unit, labels, "ipmc feedforward", "--reference-column/--unit")
     if args.no_check and (args.model or args.set or args.params_json or args.param):
         raise CLIError("--no-check: no physics check is run, so --model/--set/--params-json/--param have nothing to do")
@@ -292,14 +314,26 @@ def run(args) -> int:
     if max_v is None:
         print("ipmc feedforward: warning: --no-voltage-limit: the drive voltage is not limited; "
               "never play it on a real strip without checking its peak", file=sys.stderr)
-    try:
-        ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits,
-                         improper=args.improper, filter_bandwidth=args.filter_bandwidth)
-    except LimitError as exc:
-        print(f"ipmc feedforward: refused: {exc}", file=sys.stderr)
+    refused, error = None, None
+    with warnings.catch_warnings(record=True) as caught:       # a limit warning is re-said below with the options
+        warnings.simplefilter("always")
+        try:
+            ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits,
+                             improper=args.improper, filter_bandwidth=args.filter_bandwidth)
+        except LimitError as exc:
+            refused = limit_flags(str(exc), max_v, max_rate)
+        except InversionError as exc:        # the library's keywords, spelled as this command's flags
+            error = CLIError(f"{args.surrogate}: {as_flags(str(exc))}")
+    for w in caught:
+        if isinstance(w.message, LimitWarning):
+            warnings.warn(LimitWarning(limit_flags(str(w.message), max_v, max_rate)), stacklevel=1)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if error is not None:
+        raise error
+    if refused is not None:
+        print(f"ipmc feedforward: refused: {refused}", file=sys.stderr)
         return EXIT_FAILED
-    except InversionError as exc:            # the library's keywords, spelled as this command's flags
-        raise CLIError(f"{args.surrogate}: {as_flags(str(exc))}") from None
     volts = ff.output * v_scale
     from physmodel.data import results
 
@@ -389,8 +423,8 @@ def run(args) -> int:
                  if ff.preview_choice is not None else "")
               + f"; truncation error {ff.truncation_error * v_scale:.3g} V (bound {ff.truncation_bound * v_scale:.3g} V)",
               f"- peak voltage {ff.limit_report.peak * v_scale:.4g} V, peak rate {ff.limit_report.peak_rate * v_scale:.4g} V/s "
-              f"(limits: max_voltage {'**none (--no-voltage-limit)**' if max_v is None else f'{max_v:g} V'}, "
-              f"max_rate {'none' if max_rate is None else f'{max_rate:g} V/s'})"]
+              f"(limits: --max-voltage {'**none (--no-voltage-limit)**' if max_v is None else f'{max_v:g} V'}, "
+              f"--max-rate {'none' if max_rate is None else f'{max_rate:g} V/s'})"]
     trunc_rel = ff.truncation_error / max(ff.limit_report.peak, 1e-300)
     if trunc_rel > 0.01:
         lines.append(f"- **preview too short: it changes the voltage by {100 * trunc_rel:.0f} % of its peak "
@@ -404,7 +438,7 @@ def run(args) -> int:
     if jump > 0.01:
         lines.append(f"- **the reference ends away from rest ({100 * jump:.0f} % of its peak): expect spikes at the ends**")
     if not ff.limit_report.ok:
-        lines.append(f"- **LIMIT VIOLATED**: {ff.limit_report.message}")
+        lines.append(f"- **LIMIT VIOLATED**: {limit_flags(ff.limit_report.message, max_v, max_rate)}")
     status = EXIT_OK
 
     # ---- error against the physics model

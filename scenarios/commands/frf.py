@@ -24,11 +24,15 @@ Methods (physmodel.estimation.frf / .periodic / .stepped):
   what was detected and used.  ``--discard-s`` discards a leading time instead of finding it.
 * ``h1`` / ``h2``: the same with that ratio; with ``--nperseg``, ``--noverlap``, ``--window`` or
   ``--frequencies`` (with any method but stepped) the estimate is plain Welch-averaged spectra,
-  σ from the coherence.  ``--lines SIGNAL``
-  takes a multisine's lines from its signal file (``ipmc excite multisine``) and sets
-  ``--nperseg`` = one period, ``--noverlap 0``, ``--window boxcar`` and ``--discard-s`` = its
-  transient periods unless given; a record whose own header holds the multisine uses it without
-  ``--lines``.
+  σ from the coherence.
+* ``--lines SIGNAL`` takes a multisine's lines and period from its signal file (``ipmc excite
+  multisine``); a record whose own header holds the multisine uses it without ``--lines``.  A
+  record whose input is detected periodic with that period is estimated by the periodic
+  estimator at exactly those lines (H1/H2 over whole periods, σ from the period-to-period
+  scatter; discarded: ``--discard-s`` if given, else the design's transient periods or the
+  transient found from the period scatter, whichever is longer); any other record (a random
+  input) by Welch with one-period boxcar segments at the lines, as do ``--nperseg``,
+  ``--noverlap`` or ``--window`` given with it.  stderr says per record which estimator was used.
 * ``stepped``: per-period sine fits after each step's transient, σ from the scatter between
   periods; the schedule comes from ``--plan SIGNAL`` (``ipmc excite stepped``), the record's own
   header, or else is detected from the input; ``--settle-s``/``--settle-periods``/``--periods``
@@ -205,12 +209,16 @@ def _estimator_kwargs(args, records) -> tuple[dict, str]:
     how = "Welch"
     if found is not None:
         ms, tp = found
-        kw.update(nperseg=ms.n_samples, noverlap=0, window="boxcar", discard_s=tp * ms.period_s,
-                  frequencies_hz=ms.frequency_hz)
-        how = f"multisine lines ({ms.lines.size} lines, period {ms.period_s:g} s, {tp} transient period(s))"
         for rec, path in zip(records, args.records):
             if abs(rec.fs - ms.fs_hz) > 1e-9 * ms.fs_hz:
                 raise CLIError(f"{path}: sampled at {rec.fs:g} Hz but the multisine was designed at {ms.fs_hz:g} Hz")
+        how = f"multisine lines ({ms.lines.size} lines, period {ms.period_s:g} s, {tp} transient period(s))"
+        if all(getattr(args, o) is None for o in ("nperseg", "noverlap", "window")):
+            # periodic or not is read per record (_lines_estimate); Welch only for a record that is not
+            return {"method": "lines", "estimator": ratio, "multisine": ms, "transient_periods": tp,
+                    "where": f"--lines {args.lines}" if args.lines else "the record's multisine header"}, how
+        kw.update(nperseg=ms.n_samples, noverlap=0, window="boxcar", discard_s=tp * ms.period_s,
+                  frequencies_hz=ms.frequency_hz)
     elif args.frequencies is not None:
         kw["frequencies_hz"] = floats(args.frequencies, "--frequencies")
     for opt in ("nperseg", "noverlap", "window", "discard_s"):
@@ -224,13 +232,81 @@ def _band(args):
     return tuple(args.band) if args.band else None
 
 
-def _estimate(rec, path: str, args, kw: dict):
-    """The estimate of one record, with the warnings of every method (clipping, low coherence)."""
+def _checked(est, rec, args):
+    """``est`` with the clipping and low-coherence warnings the auto path gives (clipping above
+    ``--max-clipped-fraction`` refused)."""
     from dataclasses import replace
 
     from physmodel.estimation.clipping import check_clipping
+    from physmodel.estimation.frf_estimate import low_coherence_warning
+
+    inp = rec.resolve(args.input)
+    notes = check_clipping({inp: rec.channels[inp], **{rec.resolve(o): rec.channel(o) for o in args.output}},
+                           args.max_clipped_fraction)
+    low = low_coherence_warning(est)
+    return replace(est, warnings=tuple(notes + ([low] if low else [])))
+
+
+def _lines_estimate(rec, path: str, args, kw: dict):
+    """The estimate at a multisine's lines (``--lines`` or the record's header).
+
+    A record whose input the detector finds periodic with the multisine's period (or a divisor of
+    it) is estimated by :func:`~physmodel.estimation.periodic.periodic_frf` at those lines over
+    whole periods, σ from the scatter between periods; the leading periods discarded are
+    ``--discard-s`` when given, else the design's transient periods or the transient found from the
+    period scatter, whichever is longer.  Any other record (an input that is not periodic: noise on
+    the drive, another clock) is estimated by Welch with one-period boxcar segments at the lines.
+    Which one was used is said on stderr."""
+    import math
+
+    from physmodel.estimation.excitation_detection import detect_excitation
     from physmodel.estimation.frf import estimate_record
-    from physmodel.estimation.frf_estimate import FRFWarning, low_coherence_warning
+    from physmodel.estimation.periodic import periodic_frf
+
+    ms, tp, ratio = kw["multisine"], kw["transient_periods"], kw["estimator"]
+    N = ms.n_samples
+    inp, outs = rec.resolve(args.input), [rec.resolve(o) for o in args.output]
+    u = rec.channels[inp]
+    exc = detect_excitation(None, u, fs_hz=rec.fs)
+    what = f"{ms.lines.size} lines of {kw['where']}"
+    if exc.kind == "periodic" and exc.period_samples and N % exc.period_samples == 0:
+        common = dict(estimator=ratio, input_name=inp, input_unit=rec.units[inp], output_names=outs,
+                      output_units=[rec.units[o] for o in outs])
+        ys = [rec.channels[o] for o in outs]
+
+        def whole(seconds):                      # leading periods of the end-aligned grid in `seconds`
+            return max(0, int(math.ceil((seconds * rec.fs - u.size % N) / N - 1e-9)))
+
+        if args.discard_s is not None:
+            est = periodic_frf(rec.t, u, ys, N, ms.lines, discard_periods=whole(args.discard_s), **common)
+            why = f"--discard-s {args.discard_s:g}"
+        else:
+            est = periodic_frf(rec.t, u, ys, N, ms.lines, discard_periods=None, **common)
+            design = whole(tp * ms.period_s)
+            why = "found from the period scatter"
+            if est.settings["transient_periods"] < design:
+                est = periodic_frf(rec.t, u, ys, N, ms.lines, discard_periods=design, **common)
+                why = f"the design's {tp} transient period(s)"
+        st = est.settings
+        note = (f"periodic {ratio.upper()} at the {what} over {st['periods_used']} whole periods of {N} samples "
+                f"({st['transient_periods']} leading period(s) discarded: {why}), σ from the period-to-period "
+                f"scatter; input: {exc.describe()}")
+    else:
+        est = estimate_record(rec, args.input, args.output, method=ratio, nperseg=N, noverlap=0, window="boxcar",
+                              discard_s=args.discard_s if args.discard_s is not None else tp * ms.period_s,
+                              frequencies_hz=ms.frequency_hz)
+        note = (f"Welch {ratio.upper()} (boxcar segments of one period, {N} samples) at the {what}, σ from the "
+                f"coherence: the input is not periodic with the multisine's period ({exc.describe()})")
+    print(f"ipmc frf: {path}: estimator: {note}", file=sys.stderr)
+    from dataclasses import replace
+
+    return replace(est, settings={**est.settings, "excitation": exc.describe()})
+
+
+def _estimate(rec, path: str, args, kw: dict):
+    """The estimate of one record, with the warnings of every method (clipping, low coherence)."""
+    from physmodel.estimation.frf import estimate_record
+    from physmodel.estimation.frf_estimate import FRFWarning
 
     kw = dict(kw)
     plan = kw.pop("_plan", None)
@@ -242,13 +318,10 @@ def _estimate(rec, path: str, args, kw: dict):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FRFWarning)        # printed below from est.warnings
-            est = estimate_record(rec, args.input, args.output, **kw)
+            est = _lines_estimate(rec, path, args, kw) if kw["method"] == "lines" else \
+                estimate_record(rec, args.input, args.output, **kw)
         if kw["method"] != "auto":           # the auto path checks these itself
-            inp = rec.resolve(args.input)
-            notes = check_clipping({inp: rec.channels[inp], **{rec.resolve(o): rec.channel(o) for o in args.output}},
-                                   args.max_clipped_fraction)
-            low = low_coherence_warning(est)
-            est = replace(est, warnings=tuple(notes + ([low] if low else [])))
+            est = _checked(est, rec, args)
     except IPMCError as exc:
         text = str(exc)
         if kw.get("excitation") == "stepped_sine":

@@ -1,7 +1,11 @@
-"""``ipmc invert``: stable inversion of a CSV signal from the shell.
+"""``ipmc invert``: stable inversion of a recorded signal from the shell.
 
-Input CSV: a header row, a ``time_s`` column (uniform steps) and one or more signal columns
-(the first non-time column is inverted unless ``--column`` names another).  Output CSV:
+Input: a CSV (one header row of column names; ``,``, ``;`` or tab; ``#`` lines before it), an NPZ
+archive or a MATLAB ``.mat`` file (each numeric vector a column), read as ``ipmc frf`` reads a
+record (:func:`physmodel.data.columns.read_table`): a time column (``time_s`` unless
+``--time-column`` names another, by name or 0-based index, in ``--time-unit`` or the unit of its
+name's suffix; uniform steps) and one or more signal columns (the first numeric column other than
+the time is inverted unless ``--column``/``--input-column`` names another).  Output CSV:
 ``time_s, <input column>, reconstruction`` plus ``<reference>, error`` when ``--reference``
 names a column holding the true signal (error = reconstruction - reference).  Files are
 written atomically (:func:`physmodel.data.files.atomic_write`), so an interrupted run never
@@ -16,22 +20,22 @@ Examples::
 (Write coefficient lists with ``=`` and commas: argparse would read a separate token such as
 ``-1.0e7`` as an option.)
 
-Exit codes: 0 success, 2 bad input (unreadable/invalid CSV, invalid model or options).
+Exit codes: 0 success, 2 bad input (unreadable/invalid file, a column that is not there, invalid
+model or options; the message names the file and the option).
 
 A surrogate JSON (``--surrogate model.json --temperature T``, what ``ipmc fit`` writes) can
 replace ``--num``/``--den``.  The signal must be the surrogate's output quantity (a displacement
 for an actuator surrogate, a current for a sensor surrogate): its unit comes from the column name
 (``tip_mm``) or ``--input-unit``; another kind is refused (exit 2), another unit of the same kind
-(``tip_m`` for a mm surrogate) converted and said on stderr.  ``--column``/``--input-column`` and
-``--time-column`` take a name or a 0-based index.
+(``tip_m`` for a mm surrogate) converted and said on stderr.  ``--column``/``--input-column``,
+``--time-column`` and ``--reference`` take a name, the ``<name>`` of a ``<name>_<unit>`` column
+or a 0-based index.
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import math
-import os
 from typing import Any
 
 import numpy as np
@@ -40,10 +44,18 @@ from inversion import InversionError, invert
 from physmodel.data.files import atomic_write
 
 from .. import plots
-from ._columns import add_record_options, add_sweep_options, resolve_column, signal_scale
+from ._columns import (
+    add_record_options,
+    add_sweep_options,
+    column_values,
+    pick_column,
+    read_columns,
+    record_time,
+    signal_scale,
+)
 from ._common import EXIT_OK, check_plot_path
 
-__all__ = ["add_parser", "run", "model_from_surrogate", "read_csv"]
+__all__ = ["add_parser", "run", "model_from_surrogate"]
 
 
 def floats(tokens: list[str]) -> list[float]:
@@ -66,12 +78,12 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="stable (noncausal / finite-preview) inversion of a sampled signal in a CSV file",
         description=__doc__.split("\n\n")[0],
     )
-    p.add_argument("input", help="input CSV with a header, a time_s column and signal columns")
+    p.add_argument("input", help="signal file (.csv, .npz, .mat) with a time column and signal columns")
     p.add_argument("-o", "--out", required=True, help="output CSV path")
     p.add_argument("--quiet", action="store_true", help="no summary line")
     p.add_argument("--column", default=None, metavar="NAME|INDEX",
                    help="signal column to invert (default: first column other than time_s); same as --input-column")
-    p.add_argument("--reference", default=None,
+    p.add_argument("--reference", default=None, metavar="NAME|INDEX",
                    help="column with the true signal; adds reference and error columns/plot")
     p.add_argument("--num", nargs="+", default=None, metavar="C",
                    help="model numerator coefficients, descending powers of s (s in rad/s); "
@@ -125,38 +137,6 @@ def model_from_surrogate(path: str, temperature_c: float) -> Any:
     return model.at(float(temperature_c))
 
 
-def read_csv(path: str | os.PathLike[str]) -> tuple[list[str], np.ndarray]:
-    """Read a numeric CSV with a header row; return (column names, 2-D float array).
-
-    Lines starting with ``#`` (the ``# key: value`` header of ``ipmc simulate`` and of sweep
-    files) and blank lines are skipped; a UTF-8 byte-order mark is dropped; every value must be a
-    finite number."""
-    from physmodel.data.files import read_text
-
-    lines = [(i, ln) for i, ln in enumerate(read_text(path, "signal file").splitlines(), start=1)
-             if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
-        raise InversionError(f"{path}: empty file (expected a header row)")
-    parsed = csv.reader([ln for _, ln in lines])
-    header = [h.strip() for h in next(parsed)]
-    rows = []
-    for (lineno, _), row in zip(lines[1:], parsed):
-        if len(row) != len(header):
-            raise InversionError(f"{path}:{lineno}: expected {len(header)} fields like the header, got {len(row)}")
-        try:
-            vals = [float(c) for c in row]
-        except ValueError:
-            raise InversionError(f"{path}:{lineno}: non-numeric field in {row!r}") from None
-        bad = [h for h, v in zip(header, vals) if not math.isfinite(v)]
-        if bad:
-            raise InversionError(f"{path}:{lineno}: {bad[0]} = {row[header.index(bad[0])].strip()!r}; expected a finite number")
-        rows.append(vals)
-    if len(set(header)) != len(header):
-        raise InversionError(f"{path}: duplicate column names in header {header}")
-    data = np.array(rows, dtype=float).reshape(len(rows), len(header))
-    return header, data
-
-
 def run(args: argparse.Namespace) -> int:
     """Execute ``ipmc invert``; 0 on success (bad input raises and ``ipmc`` exits 2)."""
     from ._common import refuse_overwriting_inputs
@@ -182,19 +162,25 @@ def run(args: argparse.Namespace) -> int:
     preview: Any = args.preview
     if args.plot:
         check_plot_path(args.plot)
-    header, data = read_csv(args.input)
-    tcol = resolve_column(header, args.time_column, "--time-column", args.input, "time column")
+    table = read_columns(args.input, "INPUT")
+    tcol, t = record_time(table, args)
+    column_values(table, tcol, "--time-column", t.size)           # finite
     if args.column is not None and args.input_column is not None:
         raise InversionError("--column and --input-column name the same thing; give one of them")
     spec, opt = (args.column, "--column") if args.column is not None else (args.input_column, "--input-column")
-    others = [h for h in header if h != tcol]
-    if spec is None and not others:
-        raise InversionError(f"{args.input}: no signal column besides the time column in header {header}")
-    ucol = resolve_column(header, spec, opt, args.input, "signal column") if spec is not None else others[0]
-    if args.reference is not None and args.reference not in header:
-        raise InversionError(f"{args.input}: no reference column {args.reference!r} in header {header}")
-    t = data[:, header.index(tcol)] * {None: 1.0, "s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0}[args.time_unit]
-    u = data[:, header.index(ucol)]
+    if spec is None:          # the first column beside the time, not a scalar of a .mat/.npz file
+        others = [n for n in table.names if n != tcol and (n in table.text or table.data[n].size == t.size)]
+        if not others:
+            raise InversionError(f"{args.input}: no signal column besides the time column {tcol!r}; the file has "
+                                 f"{table.describe()} (choose one with --input-column NAME|INDEX)")
+        spec, opt = others[0], "--input-column"
+    ucol = pick_column(table, spec, opt, "input")          # a text column: its first line that is not a number
+    u = column_values(table, ucol, opt, t.size)
+    ref, rcol = None, None
+    if args.reference is not None:
+        rcol = pick_column(table, args.reference, "--reference", "reference")
+        ref = column_values(table, rcol, "--reference", t.size)
+    u_file = u
     if args.surrogate is not None:     # the signal must be what the surrogate outputs, in its unit
         from physmodel.data.columns import suffix_unit
 
@@ -219,13 +205,12 @@ def run(args: argparse.Namespace) -> int:
         raise InversionError(f"{args.input}: the inversion of column {ucol!r} overflows double precision "
                              f"({np.count_nonzero(~np.isfinite(y))} non-finite outputs from t = {t[k]:.6g} s; "
                              f"largest |input| {np.max(np.abs(u)):.3g}); scale the signal or check the model")
-    ref = data[:, header.index(args.reference)] if args.reference is not None else None
     cols = [tcol, ucol, "reconstruction"]
-    table = [data[:, header.index(tcol)], data[:, header.index(ucol)], y]      # the file's own columns
+    out_cols = [table.data[tcol], u_file, y]      # the file's own columns
     if ref is not None:
-        cols += [args.reference, "error"]
-        table += [ref, y - ref]
-    arr = np.column_stack(table)
+        cols += [str(rcol), "error"]
+        out_cols += [ref, y - ref]
+    arr = np.column_stack(out_cols)
 
     status = EXIT_OK
     notes: list[str] = []
@@ -246,7 +231,7 @@ def run(args: argparse.Namespace) -> int:
     with files_together([args.out, *([args.plot] if args.plot else [])]) as tmp:     # both or neither
         atomic_write(tmp[0], write_csv)
         if args.plot:
-            plots.inversion_traces(tmp[1], t, u, y, ucol, ref, args.reference, f"stable inversion, preview {prev}")
+            plots.inversion_traces(tmp[1], t, u, y, ucol, ref, rcol, f"stable inversion, preview {prev}")
     if not args.quiet:
         print(f"ipmc invert: wrote {args.out} ({t.size} samples, preview {prev})")
     return status

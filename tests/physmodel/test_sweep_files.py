@@ -154,3 +154,43 @@ def test_grid_refuses_ragged_and_to_frd_uses_rad_per_s(noisy):
     ragged = FrequencySweep(np.array([1.0, 1.0, 2.0]), np.array([1.0, 2.0, 1.0]), np.ones(3))
     with pytest.raises(IPMCError, match="differs"):
         ragged.grid()
+
+
+# ------------------------------------------------------------------ the one '# key: value' header scan
+HEADER_LINES = ["# ipmc-sweep 1", "", "   # input: tip_displacement [mm]", "\t## output: current [uA]",
+                "# a free comment without a colon", "#   note:  a: b  ", "# ipmc-timeseries", "# note: again",
+                "temperature_c,frequency_hz,magnitude_db,phase_deg", "# after the header: not read"]
+
+
+def test_comment_header_reads_entries_format_lines_and_indented_hashes():
+    from physmodel.data.fileio import comment_header
+
+    h = comment_header(HEADER_LINES)
+    # written out by hand: a later key wins, the value keeps its own colons, free text is no entry
+    assert h.entries == {"ipmc-sweep": "1", "input": "tip_displacement [mm]", "output": "current [uA]",
+                         "note": "again", "ipmc-timeseries": ""}
+    assert h.end == 8
+    assert comment_header([]).end == 0 and comment_header(["# only: header"]).end == 1
+    assert comment_header(["t,x", "# k: v"]).entries == {}
+
+
+def test_both_csv_readers_take_the_same_header(tmp_path):
+    """The sweep CSV and a user's own table read one header the same way: indented '#' lines are
+    header lines in both (the sweep reader took one for the column-name row and refused the file),
+    and the format line is no metadata."""
+    from physmodel.data.columns import read_table
+
+    text = "\n".join(HEADER_LINES[:-2] + HEADER_LINES[-2:-1]) + "\n25,10,1.0,80\n25,20,2.0,70\n"
+    p = _write(tmp_path, text)
+    sw = read_csv(p)
+    assert (sw.input_name, sw.input_unit, sw.output_name, sw.output_unit) == ("tip_displacement", "mm", "current", "uA")
+    assert sw.metadata == {"note": "again"}
+    np.testing.assert_allclose(sw.magnitude_db, [1.0, 2.0], rtol=1e-12)
+    table = read_table(p)
+    assert table.header == {"ipmc-sweep": "1", "input": "tip_displacement [mm]", "output": "current [uA]",
+                            "note": "again", "ipmc-timeseries": ""}
+    assert table.names == ["temperature_c", "frequency_hz", "magnitude_db", "phase_deg"]
+    mapped = read_sweep(p, columns={"temperature": 0, "frequency": 1, "magnitude": 2, "phase": 3})
+    assert mapped.metadata.get("note") == "again" and not any(k.startswith("ipmc-") for k in mapped.metadata)
+    # the library's own sweep file still reads as before (its format line is not metadata)
+    assert read_csv(_write(tmp_path, GOOD)).metadata == {}

@@ -245,3 +245,48 @@ def test_feedforward_reference_file_column_unit(surrogates, tmp_path, capsys):
 def test_invert_input_unit_must_agree_with_the_column_name(surrogates, tmp_path, capsys):
     rc, err = _invert(_signal(tmp_path, "tip_mm", 1.0), surrogates[0], tmp_path / "o.csv", capsys, "--input-unit", "m")
     assert rc == 2 and "--input-unit m" in err and "in mm by its name" in err
+
+
+def test_invert_mat_variable_with_a_stated_unit_is_converted(surrogates, tmp_path, capsys):
+    from scipy.io import savemat
+
+    act, _ = surrogates
+    rc, err = _invert(_signal(tmp_path, "tip_mm", 1.0), act, tmp_path / "mm.csv", capsys)
+    assert rc == 0, err
+    t = np.arange(0.0, 2.0, 1e-3)
+    x = 0.2 * np.sin(2 * np.pi * 2 * t) * np.sin(np.pi * t / 2) ** 2          # as _signal, in m below
+    savemat(tmp_path / "rec.mat", {"tt": t, "defl": x * 1e-3})
+    rc, err = _invert(str(tmp_path / "rec.mat"), act, tmp_path / "m.csv", capsys,
+                      "--time-column", "tt", "--input-column", "defl", "--input-unit", "m")
+    assert rc == 0 and "'defl' is in m; converted to the surrogate's mm" in err, err
+    a, b = _table(tmp_path / "mm.csv")[:, 2], _table(tmp_path / "m.csv")[:, 2]
+    np.testing.assert_allclose(b, a, rtol=0, atol=1e-8 * np.max(np.abs(a)))      # rounding only (see above)
+    rc, err = _invert(str(tmp_path / "rec.mat"), act, tmp_path / "uA.csv", capsys,
+                      "--time-column", "tt", "--input-column", "defl", "--input-unit", "uA")
+    assert rc == 2 and "current" in err and "--input-unit" in err
+
+
+def test_feedforward_reference_column_by_index_as_the_other_column_options(surrogates, tmp_path, capsys):
+    act, _ = surrogates
+    t = np.arange(0, 4, 1e-3)
+    x = 0.2 * np.sin(2 * np.pi * t) * np.sin(np.pi * t / 4) ** 2            # [mm], at rest at both ends
+    ref = _write(tmp_path / "r.csv", ["time_s", "other_mm", "target_m"], [t, 5 * x, x * 1e-3])
+    rc, err = _ff(act, tmp_path / "byname", capsys, "--reference-file", ref, "--reference-column", "target_m")
+    assert rc == 0, err
+    rc, err = _ff(act, tmp_path / "byindex", capsys, "--reference-file", ref, "--reference-column", "2")
+    assert rc == 0 and "'target_m' is in m; converted to the surrogate's mm" in err, err
+    a, b = (_table(tmp_path / k / "voltage.csv") for k in ("byname", "byindex"))
+    np.testing.assert_array_equal(b, a)                                  # the same column, read the same way
+    # the column really is column 2 (m → mm), not column 1 (5x in mm): the reference written is x
+    np.testing.assert_allclose(b[:, 2][1000:5000], x, rtol=0, atol=1e-9)
+    # a column that is not there: the wording of invert's --input-column, with this option's name
+    rc, err = _ff(act, tmp_path / "bad", capsys, "--reference-file", ref, "--reference-column", "9")
+    sig = _signal(tmp_path, "tip_mm", 1.0)
+    rc2, err2 = _invert(sig, act, tmp_path / "o.csv", capsys, "--input-column", "9")
+    assert rc == rc2 == 2 and not (tmp_path / "bad").exists()
+    assert f"error: --reference-column: {ref}: columns['reference'] = 9: no column 9 (0-based); the file has 3 " \
+           "column(s): 0:time_s, 1:other_mm, 2:target_m" in err, err
+    assert f"error: --input-column: {sig}: columns['input'] = 9: no column 9 (0-based); the file has 2 " \
+           "column(s): 0:time_s, 1:tip_mm" in err2, err2
+    rc, err = _ff(act, tmp_path / "bad", capsys, "--reference-file", ref, "--reference-column", "tip")
+    assert rc == 2 and "--reference-column: " in err and "'tip': no such column" in err, err

@@ -80,14 +80,33 @@ def test_feedforward_writes_voltage_checks_it_and_simulate_reproduces_it(model_j
     assert err == pytest.approx(0.3 * abs(P / G - 1), rel=0.15, abs=2e-4)
 
 
+def _sine():
+    from inversion.references import sine
+
+    ref = sine(0.3, 1.0, 8.0, 1000.0, fade_in_s=2.0, fade_out_s=2.0, lead_s=1.0, tail_s=1.0, unit="mm")
+    return ref.t, ref.y
+
+
 def test_voltage_over_the_limit_is_refused_with_the_first_sample(model_json, tmp_path, capsys):
-    path, _, _ = model_json
+    path, _, model = model_json
     out = tmp_path / "refused"
     rc = _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency", "1",
                "--max-voltage", "0.2", "--no-check", "--out", str(out)])
     assert rc == EXIT_FAILED and not out.exists()
     err = capsys.readouterr().err
-    assert "refused" in err and "max_voltage = ±0.2 V" in err
+    # the option that sets the limit is named, not the library's keyword (issue 26)
+    assert "refused" in err and "beyond ±0.2 V (--max-voltage 0.2; " in err and "max_voltage" not in err
+    assert "--on-limit warn to proceed" in err and "action=" not in err
+    # the Python API keeps its own names
+    import inversion
+    from inversion.limits import LimitError, Limits
+
+    with pytest.raises(LimitError, match="beyond max_voltage = ±0.2 V .*action='warn'"):
+        inversion.feedforward(model.at(37.0), *_sine(), limits=Limits(max_voltage=0.2))
+    rc = _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency", "1",
+               "--max-rate", "0.5", "--no-check", "--out", str(tmp_path / "rate")])
+    err_rate = capsys.readouterr().err
+    assert rc == EXIT_FAILED and "V/s (--max-rate 0.5; " in err_rate and "max_rate" not in err_rate, err_rate
     # the same sample, located independently on the unrestricted voltage
     ok = tmp_path / "ok"
     assert _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency", "1",
@@ -96,11 +115,12 @@ def test_voltage_over_the_limit_is_refused_with_the_first_sample(model_json, tmp
     first = int(np.flatnonzero(np.abs(v) > 0.2)[0])
     assert f"at sample {first} " in err
     warn = tmp_path / "warn"
-    with pytest.warns(UserWarning, match="beyond max_voltage"):
+    with pytest.warns(UserWarning, match=r"beyond ±0.2 V \(--max-voltage 0.2; "):
         assert _run(["feedforward", str(path), "--temperature", "37", "--amplitude", "0.3", "--frequency",
                      "1", "--max-voltage", "0.2", "--on-limit", "warn", "--no-check", "--quiet",
                      "--out", str(warn)]) == EXIT_OK
-    assert "LIMIT VIOLATED" in (warn / "report.md").read_text()
+    report = (warn / "report.md").read_text()
+    assert "LIMIT VIOLATED" in report and "(--max-voltage 0.2; " in report and "max_voltage =" not in report
 
 
 def test_reference_kinds_and_file(model_json, tmp_path, capsys):
@@ -126,7 +146,7 @@ def test_reference_kinds_and_file(model_json, tmp_path, capsys):
     assert _run(argv) == EXIT_FAILED
     err = capsys.readouterr().err
     assert "100 % of its peak at a record end" in err and "refused" in err
-    with pytest.warns(UserWarning, match="beyond max_voltage"):
+    with pytest.warns(UserWarning, match="--max-voltage"):
         assert _run([*argv, "--on-limit", "warn"]) == EXIT_OK
     assert "ends away from rest" in (tmp_path / "abrupt" / "report.md").read_text()
 
@@ -193,13 +213,13 @@ def test_no_voltage_limit_is_explicit_and_said(model_json, tmp_path, capsys):
     path, _, _ = model_json
     argv = ["feedforward", str(path), "--temperature", "37", "--preview", "4/r0", "--no-check", "--quiet"]
     assert _run([*argv, "--out", str(tmp_path / "default")]) == EXIT_FAILED
-    assert "beyond max_voltage = ±3 V" in capsys.readouterr().err
+    assert "beyond ±3 V (--max-voltage 3; " in capsys.readouterr().err
     out = tmp_path / "unlimited"
     assert _run([*argv, "--no-voltage-limit", "--out", str(out)]) == EXIT_OK
     assert "--no-voltage-limit: the drive voltage is not limited" in capsys.readouterr().err
     v = _cols(out / "voltage.csv")["voltage_V"]
     assert np.max(np.abs(v)) > 10.0
-    assert "max_voltage **none (--no-voltage-limit)**" in (out / "report.md").read_text()
+    assert "--max-voltage **none (--no-voltage-limit)**" in (out / "report.md").read_text()
     # the CLI default is the library's one constant
     from inversion.limits import DEFAULT_MAX_VOLTAGE
     from scenarios.commands.feedforward import drive_limits

@@ -87,13 +87,16 @@ def test_multisine_round_trip_agrees_with_the_physics_within_sigma(tmp_path, mul
     out, png = tmp_path / "sweep.csv", tmp_path / "frf.png"
     assert _run(["frf", *recs, "--lines", str(multisine_signal), "--input", "voltage", "--output",
                  "tip_displacement", "--out", str(out), "--plot", str(png)]) == 0
-    text = capsys.readouterr().out
+    cap = capsys.readouterr()
+    text = cap.out
     sw = read_sweep(out)
     assert (sw.input_unit, sw.output_unit) == ("V", "mm")
     np.testing.assert_array_equal(sw.temperatures(), [25.0, 45.0])
     n_lines = np.unique(np.maximum(np.round(np.geomspace(0.2, 9, 20) * 5), 1)).size
     assert sw.frequency_hz.size == 2 * n_lines
-    assert f"{n_lines} of {n_lines} lines kept" in text and "nperseg=1250" in text
+    # the input is periodic: the periodic estimator over whole 1250-sample periods, said on stderr
+    assert f"{n_lines} of {n_lines} lines kept" in text and "period_samples=1250" in text
+    assert cap.err.count("estimator: periodic H1") == 2 and sw.metadata["method"] == "periodic_h1"
     # errors over the stated σ: Student t with ν = 2(P − 1) for P = 8 whole periods
     t2 = _t2(sw)
     mean, band = _t2_mean_band(14, t2.size)

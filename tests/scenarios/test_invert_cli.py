@@ -70,9 +70,9 @@ def test_main_entry_point_and_preview_options(signal_csv, tmp_path):
     [
         ("time_s,x\n0,1\n0.001,nan\n0.002,1\n", [], "finite"),
         ("time_s,x\n0,1\n0.001,2\n0.003,1\n0.004,0\n", [], "uniformly"),
-        ("t,x\n0,1\n0.001,2\n", [], "time column"),
-        ("time_s,x\n0,1\n0.001,abc\n", [], "non-numeric"),
-        ("time_s,x\n0,1\n0.001,2\n", ["--column", "y"], "signal column"),
+        ("t,x\n0,1\n0.001,2\n", [], "--time-column"),          # the option that fixes it is named
+        ("time_s,x\n0,1\n0.001,abc\n", [], "bad.csv:3: x = 'abc' is not a number"),
+        ("time_s,x\n0,1\n0.001,2\n", ["--column", "y"], "--column: "),
         ("time_s,x\n" + "".join(f"{k * 1e-3},0\n" for k in range(50)), ["--preview", "1.0"], "longer than the record"),
     ],
 )
@@ -117,3 +117,86 @@ def test_interrupted_write_leaves_previous_file_intact(signal_csv, tmp_path, mon
     assert main(["invert", str(p), "-o", str(out), NUM, DEN]) == 2
     assert out.read_text() == "previous result\n"
     assert not list(tmp_path.glob(".*.part"))
+
+
+# ------------------------------------------------------------------ NPZ / MAT records (issue 26)
+# Files written here with numpy / scipy.io.savemat under a DAQ's or a MATLAB session's own names;
+# the oracle is inversion.invert on the same arrays, which never sees a file.
+def _expect(t, u, preview="inf"):
+    return invert((list(SEED000_NUM_35C), list(SEED000_DEN_35C)), t, u, preview=preview).output
+
+
+@pytest.fixture
+def own_names():
+    t = np.arange(0.0, 1.0, 1e-3)
+    cur = np.sin(2 * np.pi * 20 * t) * np.sin(np.pi * t) ** 2
+    return t, cur, 0.2 * cur
+
+
+def test_invert_reads_an_npz_by_name_and_by_index(own_names, tmp_path, capsys):
+    t, cur, disp = own_names
+    p = tmp_path / "daq.npz"
+    np.savez(p, t=t, cur=cur, disp=disp)
+    for spec in ("cur", "1"):
+        out = tmp_path / f"o{spec}.csv"
+        rc = main(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "inf", "--quiet",
+                   "--time-column", "t", "--input-column", spec, "--reference", "2"])
+        assert rc == 0, capsys.readouterr().err
+        header, data = _read(out)
+        assert header == ["t", "cur", "reconstruction", "disp", "error"]
+        np.testing.assert_array_equal(data[:, 1], np.array([float(f"{v:.12g}") for v in cur]))
+        np.testing.assert_allclose(data[:, 2], _expect(t, cur), rtol=1e-10, atol=1e-12)
+
+
+def test_invert_reads_mat_variables_in_their_time_unit(own_names, tmp_path, capsys):
+    from scipy.io import savemat
+
+    t, cur, _ = own_names
+    p = tmp_path / "session.mat"
+    # row vectors and a scalar and a string beside them, as a MATLAB session saves its workspace
+    savemat(p, {"t_ms": (t * 1e3)[None, :], "fs": 1000.0, "note": "bench 3", "i_meas": cur[None, :]})
+    out = tmp_path / "o.csv"
+    rc = main(["invert", str(p), "-o", str(out), NUM, DEN, "--preview", "inf", "--quiet", "--time-column", "t_ms"])
+    assert rc == 0, capsys.readouterr().err
+    header, data = _read(out)
+    assert header == ["t_ms", "i_meas", "reconstruction"]          # the scalar fs is not a signal
+    np.testing.assert_allclose(data[:, 2], _expect(t, cur), rtol=1e-10, atol=1e-12)
+    out2 = tmp_path / "o2.csv"                                       # the unit stated instead of named
+    savemat(tmp_path / "s2.mat", {"time": (t * 1e3)[:, None], "i_meas": cur[:, None]})
+    rc = main(["invert", str(tmp_path / "s2.mat"), "-o", str(out2), NUM, DEN, "--preview", "inf", "--quiet",
+               "--time-column", "0", "--time-unit", "ms", "--input-column", "i_meas"])
+    assert rc == 0, capsys.readouterr().err
+    np.testing.assert_allclose(_read(out2)[1][:, 2], _expect(t, cur), rtol=1e-10, atol=1e-12)
+
+
+def _bad_files(d, t, cur):
+    from scipy.io import savemat
+
+    np.savez(d / "ok.npz", t=t, cur=cur)
+    savemat(d / "ok.mat", {"t": t, "cur": cur, "fs": 1000.0})
+    (d / "junk.npz").write_bytes(b"not a zip archive")
+    (d / "junk.mat").write_bytes(b"MATLAB 5.0 MAT-file, truncated")
+    (d / "sig.txt").write_text("t,cur\n0,1\n")
+    np.savez(d / "nan.npz", t=t, cur=np.where(t > 0.5, np.nan, cur))
+
+
+@pytest.mark.parametrize("name, extra, needles", [
+    ("ok.npz", ["--time-column", "t", "--input-column", "volts"], ["--input-column: ", "ok.npz", "'volts'", "0:t, 1:cur"]),
+    ("ok.npz", ["--time-column", "t", "--input-column", "7"], ["--input-column: ", "ok.npz", "no column 7"]),
+    ("ok.npz", ["--time-column", "time_s"], ["--time-column: ", "ok.npz", "0:t, 1:cur"]),
+    ("ok.npz", ["--time-column", "t", "--reference", "truth"], ["--reference: ", "'truth'"]),
+    ("ok.mat", ["--time-column", "t", "--input-column", "fs"], ["--input-column: ", "'fs'", "1 value(s)"]),
+    ("junk.npz", ["--time-column", "t"], ["junk.npz", "not a readable NPZ"]),
+    ("junk.mat", ["--time-column", "t"], ["junk.mat", "not a readable MATLAB"]),
+    ("sig.txt", [], ["sig.txt", "'.txt'", ".csv, .npz, .mat"]),
+    ("missing.npz", [], ["INPUT", "missing.npz", "no such file"]),
+    ("nan.npz", ["--time-column", "t"], ["--input-column: ", "nan.npz", "'cur'", "not finite at sample(s) [501"]),
+])
+def test_invert_bad_record_files_exit_2_naming_file_or_option(own_names, tmp_path, capsys, name, extra, needles):
+    t, cur, _ = own_names
+    _bad_files(tmp_path, t, cur)
+    out = tmp_path / "o.csv"
+    rc = main(["invert", str(tmp_path / name), "-o", str(out), NUM, DEN, "--preview", "inf", *extra])
+    err = capsys.readouterr().err
+    assert rc == 2 and not out.exists()
+    assert "Traceback" not in err and all(n in err for n in needles), err
