@@ -37,7 +37,7 @@ import numpy as np
 
 from ..errors import DataFormatError, IPMCError
 from .columns import ColumnMapError, map_record
-from .fileio import atomic_write, by_extension, read_text
+from .fileio import atomic_write, by_extension, comment_header, read_text
 
 #: Samples read per block when checking long (memory-mapped) time bases.
 TIME_BLOCK_SAMPLES = 1 << 20
@@ -317,24 +317,15 @@ def read_csv(path, unitless: str | None = None) -> TimeRecord:
     path = Path(path)
     where = f"{path}: "
     text = read_text(path, "time-record")
-    header: dict[str, str] = {}
     lines = text.splitlines()
-    n_head = 0
-    for line in lines:
-        s = line.strip()
-        if s.startswith("#") or not s:
-            body = s.lstrip("#").strip()
-            if body.startswith(FORMAT):
-                _check_version(body, where)
-            elif ":" in body:
-                k, v = body.split(":", 1)
-                header[k.strip()] = v.strip()
-            n_head += 1
-            continue
-        names = [c.strip() for c in s.split(",")]
-        break
-    else:
+    head = comment_header(lines)
+    n_head = head.end
+    if FORMAT in head.entries:
+        _check_version(f"{FORMAT} {head.entries[FORMAT]}", where)
+    header = {k: v for k, v in head.entries.items() if not k.startswith("ipmc-")}   # format lines are not metadata
+    if n_head >= len(lines):
         raise DataFormatError(f"{where}no column header line after the '#' header")
+    names = [c.strip() for c in lines[n_head].strip().split(",")]
     if len(set(names)) != len(names):
         raise DataFormatError(f"{path}:{n_head + 1}: repeated column names in {names}")
     try:
