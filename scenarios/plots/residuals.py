@@ -27,8 +27,9 @@ def plot_calibration(data, result, axes=None, *, model=None):
     ----------
     data : FrequencySweep
         The sweep the model was calibrated to (with its per-line σ, which scale the residuals).
-    result : CalibrationResult
-        What :func:`physmodel.calibrate` returned (used to compute ``model`` when it is not given).
+    result : CalibrationResult or None
+        What :func:`physmodel.calibrate` returned; used only to compute ``model`` (None is
+        accepted when ``model`` is given).
     axes : 2 × 2 Axes or None
         ``((magnitude, magnitude residual), (phase, phase residual))``, nested or flat in that
         order; None: a new figure (its axes returned).
