@@ -259,3 +259,15 @@ def test_the_writers_are_still_there_and_write_through_the_plot_functions(tmp_pa
     monkeypatch.setattr(plots.roots, "plot_pole_zero_maps", lambda m, ax: seen.append(m) or real(m, ax))
     path = plots.pole_zero_maps({"a": ([1.0], [-1.0])}, tmp_path / "m.png")
     assert seen and path.stat().st_size > 0
+
+
+def test_without_axes_each_plot_function_makes_a_figure_of_its_own():
+    data, _, G = _pair()
+    col = plot_residual_bode(data, G)
+    assert len(col) == 3 and len(col[2].get_lines()) == 2 * len(TEMPS)
+    ax = plot_pole_zero_locus(_Scheduled(), [20.0, 30.0])
+    assert len(ax.collections) == 4 and len(ax.figure.axes) == 2
+    grid = plot_poles_zeros_vs_temperature(_Scheduled(), n_temperatures=3)
+    assert grid.shape == (2, 2) and grid[1, 1].get_lines()[0].get_ydata().size == 3
+    maps = plot_pole_zero_maps({"a": ([], [-1.0]), "b": ([1.0], [-2.0])})
+    assert maps.shape == (1, 2) and maps[0, 1].get_title() == "b\n1 RHP zero(s)"
