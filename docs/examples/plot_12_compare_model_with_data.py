@@ -8,7 +8,9 @@ error bars, a physics model at any temperatures, and a calibrated model with the
 parameters' 95 % intervals give.  ``scenarios.comparison.compare`` puts a model against data
 and gives, per temperature, the fit % of system-identification toolboxes,
 100·(1 − ‖H − Ĥ‖/‖H − mean H‖) on the complex response, and χ² against the data's σ with its
-verdict.  ``ipmc compare MODEL DATA -o FOLDER`` does the same from the command line.
+verdict.  ``ipmc compare MODEL DATA -o FOLDER`` does the same from the command line.  Every
+figure the commands write has such a ``plot_*`` form (``plot_calibration`` below, residuals and
+pole-zero maps too: :mod:`scenarios.plots`).
 
 The "measurement" here is a synthetic sweep of the seed 002 strip whose diffusion coefficient is
 30 % larger than the named set's, so the named set should misfit and a calibration should not.
@@ -22,7 +24,7 @@ import numpy as np
 
 from physmodel import ActuatorModel, MagnitudePhaseNoise, calibrate, get_parameter_set, load_model, synthesize_sweep
 from scenarios.comparison import compare
-from scenarios.plots import plot_bode, plot_compare
+from scenarios.plots import plot_bode, plot_calibration, plot_compare
 from scenarios.prediction import predict_sweep
 
 base = get_parameter_set("seed002_table3")
@@ -62,6 +64,18 @@ axes[0, 0].legend(fontsize=7)
 plot_compare(after, axes[:, 1])
 axes[0, 1].set_title("calibrated model vs data", fontsize=9)
 axes[0, 1].legend(fontsize=7)
+fig.tight_layout()
+
+# %%
+# The calibration's residuals
+# ---------------------------
+# ``plot_calibration`` draws what ``ipmc calibrate`` writes as ``bode.png``, on your Axes: the data
+# (markers) and the calibrated model (lines) beside their standardised residuals, which scatter
+# within the grey ±2 band when the model fits.
+fig, axes = plt.subplots(2, 2, figsize=(11, 6.5), sharex=True)
+plot_calibration(data, result, axes)
+axes[0, 0].legend(fontsize=7)
+axes[0, 1].set_title(f"cost {result.cost:.3g}, expected {result.expected_cost:.3g}", fontsize=9)
 fig.tight_layout()
 
 # %%

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["colormap", "new_figure", "normalize", "save_figure", "scalar_mappable", "temperature_colors"]
+__all__ = ["axes_grid", "colormap", "new_figure", "normalize", "save_figure", "scalar_mappable", "temperature_colors"]
 
 
 def new_figure(*args, figsize=None, **kw):
@@ -28,6 +28,44 @@ def new_figure(*args, figsize=None, **kw):
     fig = Figure(figsize=figsize)
     FigureCanvasAgg(fig)
     return fig, fig.subplots(*args, **kw)
+
+
+def axes_grid(axes, rows: int, cols: int, what: str, **figure_kw):
+    """The caller's axes as a ``rows`` × ``cols`` object array, and what a ``plot_*`` function
+    returns: ``axes`` as given, or a new figure's axes (``new_figure(rows, cols, **figure_kw)``)
+    when ``axes`` is None.
+
+    Parameters
+    ----------
+    axes : Axes, sequence of Axes, 2-D array of Axes or None
+        ``rows * cols`` Axes in row-major order (nested or flat), or None.
+    rows, cols : int
+        The panels' layout.
+    what : str
+        The panels, in order, for the error message (``"magnitude, phase, residuals"``).
+    **figure_kw
+        Passed to :func:`new_figure` when ``axes`` is None (``figsize``, ``sharex``, ...).
+
+    Raises
+    ------
+    ValueError
+        When the number of Axes given is not ``rows * cols``.
+    """
+    import numpy as np
+
+    given = axes
+    if axes is None:
+        _, given = new_figure(rows, cols, **figure_kw)
+
+    def flat(x):
+        return [a for item in x for a in flat(item)] if isinstance(x, (list, tuple, np.ndarray)) else [x]
+
+    items = flat(given)
+    if len(items) != rows * cols:
+        raise ValueError(f"axes: give {rows * cols} Axes ({what}), got {len(items)}")
+    grid = np.empty(len(items), dtype=object)
+    grid[:] = items
+    return given, grid.reshape(rows, cols)
 
 
 def colormap(name: str):

@@ -1,5 +1,8 @@
-"""Figures of fits against their data: the calibration overlay with standardised residuals, the
-diagnosis before/after bands, and an estimated frequency response with its σ and coherence."""
+"""Figures of fits against their data: the calibration overlay with standardised residuals
+(:func:`plot_calibration`), data with ±2σ bands against a model's response
+(:func:`plot_residual_bode`; the diagnosis before/after figures), and an estimated frequency
+response with its σ and coherence.  The ``plot_*`` functions draw on the ``Axes`` they are given
+and return them; the writers make a figure with them and write it."""
 
 from __future__ import annotations
 
@@ -9,25 +12,53 @@ import numpy as np
 
 from physmodel.errors import IPMCError
 
-from .canvas import colormap, new_figure, save_figure
+from .canvas import axes_grid, new_figure, save_figure, temperature_colors
 
-__all__ = ["calibration_figure", "diagnosis_figures", "frf_estimate", "residual_bode"]
+__all__ = ["calibration_figure", "diagnosis_figures", "frf_estimate", "plot_calibration", "plot_residual_bode",
+           "residual_bode"]
 
 
-def calibration_figure(data, model, res, path) -> Path:
-    """Bode overlay (data markers, model lines) and standardised residuals, one colour per temperature."""
+def plot_calibration(data, result, axes=None, *, model=None):
+    """A calibration against its data on the given axes: the data as markers and the calibrated
+    model as lines (magnitude and phase), and their standardised residuals beside them, one colour
+    per temperature (the ``viridis`` map); returns ``axes``.
+
+    Parameters
+    ----------
+    data : FrequencySweep
+        The sweep the model was calibrated to (with its per-line σ, which scale the residuals).
+    result : CalibrationResult or None
+        What :func:`physmodel.calibrate` returned; used only to compute ``model`` (None is
+        accepted when ``model`` is given).
+    axes : 2 × 2 Axes or None
+        ``((magnitude, magnitude residual), (phase, phase residual))``, nested or flat in that
+        order; None: a new figure (its axes returned).
+    model : FrequencySweep or None
+        The calibrated model on the data's lines; default
+        :func:`physmodel.estimation.calibration.model_sweep` of ``result`` and ``data``.
+
+    Returns
+    -------
+    Axes array
+        ``axes`` as given (the new 2 × 2 array when None).  The residual panels carry a grey ±2
+        band; titles and the legend (entries ``data <T> °C``) are left to the caller.
+    """
     from physmodel.estimation.residuals import residuals
 
-    fig, axes = new_figure(2, 2, sharex=True, figsize=(11, 6.5))
-    (ax_m, ax_rm), (ax_p, ax_rp) = axes
+    ret, grid = axes_grid(axes, 2, 2, "magnitude, magnitude residual, phase, phase residual",
+                          sharex=True, figsize=(11, 6.5))
+    (ax_m, ax_rm), (ax_p, ax_rp) = grid
+    if model is None:
+        from physmodel.estimation.calibration import model_sweep
+
+        model = model_sweep(result, data)
     r = residuals(model.response, data)
     n = data.frequency_hz.size
-    temps = data.temperatures()
-    cmap = colormap("viridis")
+    colors = temperature_colors(data.temperatures(), "viridis", 0.85)
     mag_d, ph_d, mag_m, ph_m = data.magnitude_db, data.phase_deg, model.magnitude_db, model.phase_deg
-    for t in temps:
+    for t in data.temperatures():
         m = data.temperature_c == t
-        c = cmap(0.0 if temps.size == 1 else 0.85 * (t - temps.min()) / (temps.max() - temps.min()))
+        c = colors[float(t)]
         f = data.frequency_hz[m]
         ax_m.semilogx(f, mag_d[m], "o", ms=3, color=c, label=f"data {t:g} °C")
         ax_m.semilogx(f, mag_m[m], "-", color=c)
@@ -46,8 +77,29 @@ def calibration_figure(data, model, res, path) -> Path:
     ax_rp.set_ylabel("phase residual / σ")
     for ax in (ax_p, ax_rp):
         ax.set_xlabel("frequency [Hz]")
-    for ax in axes.ravel():
+    for ax in grid.ravel():
         ax.grid(True, which="both", alpha=0.3)
+    return ret
+
+
+def calibration_figure(data, model, res, path) -> Path:
+    """Write :func:`plot_calibration`'s figure (its legend, and the cost against its expectation
+    in the title).
+
+    Parameters
+    ----------
+    data : FrequencySweep
+        The calibration data.
+    model : FrequencySweep
+        The calibrated model on the data's lines.
+    res : CalibrationResult
+        The calibration.
+    path : str or Path
+        The figure file.
+    """
+    fig, axes = new_figure(2, 2, sharex=True, figsize=(11, 6.5))
+    plot_calibration(data, res, axes, model=model)
+    (ax_m, ax_rm), _ = axes
     ax_m.legend(fontsize=7, ncol=2)
     ax_m.set_title("data (markers) and calibrated model (lines)")
     ax_rm.set_title(f"standardised residuals (band ±2); cost {res.cost:.4g}, expected {res.expected_cost:.4g}")
@@ -55,14 +107,45 @@ def calibration_figure(data, model, res, path) -> Path:
     return save_figure(fig, path)
 
 
-def residual_bode(path, data, G, title: str) -> Path:
-    """Data (±2σ bands) vs model and the standardised residuals, one colour per temperature."""
+def plot_residual_bode(data, model, axes=None):
+    """Data (±2σ bands) against a model's response and the standardised residuals, on the given
+    axes, one colour per temperature (``C0``, ``C1``, ...); returns ``axes``.
+
+    Parameters
+    ----------
+    data : FrequencySweep
+        The measured sweep (σ from its per-line values, or the noise floor
+        :func:`physmodel.estimation.residuals.noise_std` assumes without them).
+    model : array_like or FrequencySweep
+        The model's complex response at the data's lines (in the data's order and units), or a
+        sweep holding it on the same lines.
+    axes : three Axes or None
+        ``(magnitude, phase, residuals)``; None: a new figure (its axes returned).  The residual
+        panel holds the log-magnitude (solid) and phase (dashed) residuals over a grey ±2 band.
+
+    Returns
+    -------
+    Axes array
+        ``axes`` as given (the new three when None); titles and the legend are left to the caller.
+
+    Raises
+    ------
+    ValueError
+        When ``model`` is not on the data's lines.
+    """
     from physmodel.estimation.residuals import noise_std
 
+    G = np.asarray(getattr(model, "response", model), dtype=complex)
+    if G.shape != data.response.shape:
+        raise ValueError(f"model: expected the response at the data's {data.response.size} lines "
+                         f"(shape {data.response.shape}), got shape {G.shape}")
+    if hasattr(model, "frequency_hz") and not (np.array_equal(model.frequency_hz, data.frequency_hz)
+                                               and np.array_equal(model.temperature_c, data.temperature_c)):
+        raise ValueError("model: a sweep on other lines (frequencies or temperatures) than the data's")
+    ret, grid = axes_grid(axes, 3, 1, "magnitude, phase, residuals", figsize=(7, 9), sharex=True)
+    ax = grid[:, 0]
     s_ln, s_ph, _ = noise_std(data)
-    temps = data.temperatures()
-    fig, ax = new_figure(3, 1, figsize=(7, 9), sharex=True)
-    for i, t in enumerate(temps):
+    for i, t in enumerate(data.temperatures()):
         m = data.temperature_c == t
         f = data.frequency_hz[m]
         col = f"C{i % 10}"
@@ -86,10 +169,30 @@ def residual_bode(path, data, G, title: str) -> Path:
     ax[1].set_ylabel("phase [deg]")
     ax[2].set_ylabel("std. residual (— mag, -- phase)")
     ax[2].set_xlabel("frequency [Hz]")
+    return ret
+
+
+def residual_bode(path, data, G, title: str) -> Path:
+    """Write :func:`plot_residual_bode`'s figure with a legend and ``title``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The figure file.
+    data : FrequencySweep
+        The measured sweep.
+    G : array_like
+        The model's complex response at the data's lines.
+    title : str
+        Title (followed by "— data ±2σ bands, model lines").
+    """
+    fig, ax = new_figure(3, 1, figsize=(7, 9), sharex=True)
+    plot_residual_bode(data, G, ax)
     ax[0].legend(fontsize=7)
     ax[0].set_title(title + " — data ±2σ bands, model lines")
     fig.tight_layout()
     return save_figure(fig, path, dpi=90)
+
 
 def diagnosis_figures(diagnosis, folder) -> list[Path]:
     """bode_before.png and bode_after.png of a :class:`~physmodel.estimation.discrepancy.Diagnosis`."""
