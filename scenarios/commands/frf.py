@@ -41,7 +41,7 @@ Methods (physmodel.estimation.frf / .periodic / .stepped):
 Checks on every record: a channel with samples held at a rail (clipping) is refused when more than
 ``--max-clipped-fraction`` (default 0.01) of its samples are clipped, and warned about below that.
 ``--min-coherence`` (default ``auto``: the coherence an output unrelated to the input exceeds
-with probability 1 %, from the number of averages), ``--max-std-db`` and ``--band`` drop lines;
+with probability 1 %, from the number of averages; for a Welch estimate 1 % for any of its lines), ``--max-std-db`` and ``--band`` drop lines;
 more than half of a channel's lines below the coherence threshold is a low-coherence warning
 (noise only? wrong channel?).  Warnings go to stderr and into the sweep's ``warnings`` metadata.
 ``--reciprocal`` writes input/output (e.g. impedance V/A from a current channel).  ``--plot``
@@ -103,7 +103,7 @@ def add_parser(sub):
     s.add_argument("--periods", type=int, help="whole periods used per step (default: all whole periods)")
     k = p.add_argument_group("lines kept")
     k.add_argument("--min-coherence", default="auto",
-                   help="drop lines with coherence below this (default auto: the 1 %% level of an unrelated output)")
+                   help="drop lines with coherence below this (default auto: the 1 %% level of an unrelated output; Welch: for any of its lines)")
     k.add_argument("--max-clipped-fraction", type=float,
                    help="refuse a channel with more clipped samples than this fraction (default 0.01; 1 only warns)")
     k.add_argument("--max-std-db", type=float, help="drop lines whose magnitude σ exceeds this [dB]")
