@@ -29,7 +29,7 @@ Batch inversion (:mod:`inversion.batch`)
 
 Automatic preview (:mod:`inversion.preview`)
     choose_preview(split, dt, u, tol=1e-3, norm="linf") -> PreviewChoice (samples, seconds,
-        relative_error, max_error, tail_bound, error_bound, rule_4_over_r0_s);
+        relative_error, max_error, tail_bound, error_bound, reference_bound, rule_4_over_r0_s);
     truncation_error(split, dt, u, N) (exact e_N); discrete_tail_l1(split, dt, n) (the bound)
 
 Model split (:mod:`inversion.split`)

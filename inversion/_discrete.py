@@ -65,11 +65,14 @@ import scipy.signal as sig
 from ._sections import FusedPass, sos_sections
 from .split import InverseSplit
 
-__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan",
-           "central_difference_kernel", "left_powers", "FUSED_BLOCK"]
+__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan", "plan_for",
+           "central_difference_kernel", "left_powers", "FUSED_BLOCK", "PLAN_CACHE_SIZE"]
 
 #: Samples per block of the fused finite-preview backward pass (intermediates stay in cache).
 FUSED_BLOCK = 1 << 16
+
+#: Plans kept per split (the most recently built ones, by sampling interval and preview).
+PLAN_CACHE_SIZE = 8
 
 
 def expm_small(A: np.ndarray) -> np.ndarray:
@@ -367,6 +370,51 @@ class Plan:
                     tail = np.concatenate((o2, tail[:N - L]))
             sink(c0, c1, yu, x)
 
+    def causal(self, ua: np.ndarray, chunk: int) -> np.ndarray:
+        """The causal part (feedthrough, polynomial part, ``H_s``) of the in-memory record ``ua``
+        (the same for every preview), ``chunk`` samples at a time."""
+        n = ua.size
+        parts: dict[str, Any] = {}
+        if chunk >= n:
+            # single chunk: keep the filter output itself, no copy
+            def put_s(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+                parts["s"] = y
+        else:
+            parts["s"] = np.empty(n)
+
+            def put_s(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+                parts["s"][c0:c1] = y
+
+        self.forward(ua, n, chunk, put_s, check=False)
+        return parts["s"]
+
+    def run(self, ua: np.ndarray, chunk: int,
+            stable: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(stable, unstable, output)`` of this plan's inverse of the in-memory record ``ua``,
+        ``chunk`` samples at a time.  ``stable``: the causal part if it was already computed
+        (it does not depend on the preview), else computed here."""
+        n = ua.size
+        if stable is None:
+            stable = self.causal(ua, chunk)
+        if self.anti is None:
+            return stable, np.zeros(n), stable.copy()
+        if chunk >= n and self.fused is None:
+            # one whole-record backward pass: keep its output itself
+            whole: list[np.ndarray] = []
+            self.backward(ua, n, chunk, lambda c0, c1, y, _x: whole.append(y))
+            return stable, whole[0], stable + whole[0]
+        # block by block (chunked, or the fused finite-preview pass): write both results while
+        # the block is in cache
+        unstable = np.empty(n)
+        output = np.empty(n)
+
+        def put_b(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+            unstable[c0:c1] = y
+            np.add(stable[c0:c1], y, out=output[c0:c1])
+
+        self.backward(ua, n, chunk, put_b)
+        return stable, unstable, output
+
     def anticausal(self, u: np.ndarray) -> np.ndarray:
         """Anticausal part for the in-memory record ``u`` (zero beyond its end), as an array.
 
@@ -397,6 +445,30 @@ class Plan:
                 q -= fp.correlate(_read_padded(src, n, c0 + N, c1 + N + h2), fp.fir2)
             w, zi = fp.all_pole(q[::-1], zi)
             sink(c0, c1, w[::-1], seg[:c1 - c0])
+
+
+def plan_for(split: InverseSplit, dt: float, n_preview: int | None) -> Plan:
+    """The :class:`Plan` of ``split`` at ``dt`` and ``n_preview``, built once and kept on the split.
+
+    Building a plan (matrix exponentials, transfer-function and section realizations, their
+    accuracy checks) costs about a quarter of one ``lfilter`` pass over 2**21 samples; repeated
+    inversions with the same model, sampling interval and preview reuse it.  A plan holds no
+    state between passes (the filter states are local to :meth:`Plan.forward` and
+    :meth:`Plan.backward`), so sharing it is safe.  The split is immutable; the cache keeps the
+    :data:`PLAN_CACHE_SIZE` most recently built plans.
+    """
+    key = (float(dt), None if n_preview is None else int(n_preview))
+    cache = split.__dict__.get("_plan_cache")
+    if cache is None:
+        cache = {}
+        object.__setattr__(split, "_plan_cache", cache)
+    plan = cache.get(key)
+    if plan is None:
+        plan = Plan(split, key[0], key[1])
+        if len(cache) >= PLAN_CACHE_SIZE:
+            cache.pop(next(iter(cache)))
+        cache[key] = plan
+    return plan
 
 
 def _read_padded(src: Any, n: int, lo: int, hi: int) -> np.ndarray:

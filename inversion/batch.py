@@ -7,13 +7,14 @@ truncation; see :mod:`inversion.split` for the split of ``1/G``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from ._discrete import Plan
+from ._discrete import plan_for
 from ._errors import InversionError, NonFiniteSignalError
 from .preview import (
     DEFAULT_PREVIEW_TOL,
@@ -221,20 +222,21 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
     chunk = int(chunk_size)
     if rule == "auto":
-        # the choice runs the causal and the full anticausal pass and the truncation error of
-        # the preview it picks: their sums are the finite-preview inverse (to rounding)
-        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm)
+        # the causal pass, the preview certified from exact values of the full inverse at a few
+        # samples, then the finite-preview anticausal pass (see auto_preview_passes)
+        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk)
         choice = passes.choice
         n_prev, prev_s = choice.samples, choice.seconds
-        if chunk >= ua.size:
-            stable, unstable, output = passes.stable, passes.unstable, passes.output
-            finite = passes.finite
-        else:
-            stable, unstable, output = _passes(Plan(split, dt, n_prev), ua, chunk)
+        stable, unstable, output = passes.stable, passes.unstable, passes.output
+        finite = passes.finite
     else:
         n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
-        stable, unstable, output = _passes(Plan(split, dt, n_prev), ua, chunk)
-    bad = None if finite else ~np.isfinite(output)
+        stable, unstable, output = plan_for(split, dt, n_prev).run(ua, chunk)
+    # a finite sum proves every sample finite (as in as_signal); only a non-finite one (a bad
+    # sample, or an overflow of the sum) needs the element-wise check
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = float(np.add.reduce(output))
+    bad = None if (finite or math.isfinite(total)) else ~np.isfinite(output)
     if bad is not None and bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise NonFiniteSignalError(
@@ -245,44 +247,6 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
         time_stamps=ta, preview_rule=rule, preview_choice=choice)
-
-
-def _passes(plan: Plan, ua: np.ndarray, chunk: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(stable, unstable, output)`` of the plan's inverse of ``ua``, ``chunk`` samples at a time."""
-    n = ua.size
-    parts: dict[str, Any] = {}
-    if chunk >= n:
-        # single chunk: keep the filter output itself, no copy
-        def put_s(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            parts["s"] = y
-    else:
-        parts["s"] = np.empty(n)
-
-        def put_s(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            parts["s"][c0:c1] = y
-
-    plan.forward(ua, n, chunk, put_s, check=False)
-    stable = parts["s"]
-    if plan.anti is None:
-        return stable, np.zeros(n), stable.copy()
-    if chunk >= n and plan.fused is None:
-        # one whole-record backward pass: keep its output itself
-        def put_u(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            parts["u"] = y
-
-        plan.backward(ua, n, chunk, put_u)
-        return stable, parts["u"], stable + parts["u"]
-    # block by block (chunked, or the fused finite-preview pass): write both results while
-    # the block is in cache
-    unstable = np.empty(n)
-    output = np.empty(n)
-
-    def put_b(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-        unstable[c0:c1] = y
-        np.add(stable[c0:c1], y, out=output[c0:c1])
-
-    plan.backward(ua, n, chunk, put_b)
-    return stable, unstable, output
 
 
 @dataclass(frozen=True)
@@ -343,7 +307,7 @@ def invert_to(model: Any, dt: float, u: Any, out: Any, *, preview: Any = "auto",
     if not (isinstance(chunk_size, int | np.integer) and chunk_size > 0):
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
     n_prev, prev_s = resolve_preview(preview, split, dt, n)
-    plan = Plan(split, dt, n_prev)
+    plan = plan_for(split, dt, n_prev)
 
     def put_s(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
         out[c0:c1] = y

@@ -10,31 +10,40 @@ Truncating the anticausal part to ``N`` samples changes the output by exactly (s
 ``G`` the part of the sampled anticausal kernel beyond the preview.  Hence
 ``max|e_N| <= ||G||_1 max|u|`` and ``||e_N||_2 <= ||G||_1 ||u||_2``, with ``||G||_1`` (the tail
 of the kernel, :func:`discrete_tail_l1`) computed for every ``N`` at once from the powers
-``C_r Phi**j`` — no pass over the signal per candidate.  :func:`choose_preview` runs the full
-inverse once (for the reference ``y_inf``), takes the first ``N`` whose bound meets the
-tolerance, and computes the exact error of that ``N`` with one more pass of the anticausal
-recursion (:func:`truncation_error`); the three passes sum to the finite-preview inverse, so
-``invert(preview="auto")`` costs about one extra pass over inverting with the chosen preview.
+``C_r Phi**j`` — no pass over the signal per candidate.  :func:`choose_preview` takes the first
+``N`` whose bound is at most the tolerance times a certified size of the full inverse ``y_inf``:
+for the max norm a lower bound of ``max|y_inf|`` from the exact values of ``y_inf`` at a few
+samples (:func:`reference_lower_bound`, multiply-adds over the kernel, no pass), so
+``invert(preview="auto")`` costs the causal pass and the finite-preview anticausal pass of the
+chosen preview — what inverting with that preview given costs — and the exact error of ``N``
+(one more anticausal pass, plus the full inverse for the relative error) is computed only when
+it is read.  For the l2 norm ``||y_inf||_2`` itself is computed (the full inverse, then one more
+anticausal pass for the exact error; the three passes sum to the finite-preview inverse).
 The bound is tight for a signal that follows the sign pattern of the kernel's tail; for a
 sinusoid it gives away the ratio of the tail's l1 norm to its gain at that frequency, i.e. a
 preview one or two slowest-mode time constants longer than the shortest that meets the
-tolerance (a shorter error, never a larger one).
+tolerance (a shorter error, never a larger one).  A lower bound ``R`` of ``max|y_inf|`` in place
+of the peak itself lengthens the preview by ``ln(max|y_inf| / R)`` slowest time constants
+(``R`` is within a few per cent of the peak for the smooth and the noisy sines measured).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from ._discrete import FOHFilter, Plan, foh_matrices, left_powers
+from ._discrete import FOHFilter, Plan, foh_matrices, left_powers, plan_for
 from ._errors import InversionError, PreviewError
 from .signals import as_signal, sampling_interval
 from .split import InverseSplit
 
 __all__ = ["PreviewChoice", "AutoPreviewPasses", "auto_preview_passes", "choose_preview", "discrete_tail_l1",
+           "reference_lower_bound", "REFERENCE_PROBES",
            "frequency_preview", "preview_rule", "resolve_preview", "truncation_error", "RULE_4_OVER_R0",
            "DEFAULT_PREVIEW_TOL"]
 
@@ -225,24 +234,50 @@ def discrete_tail_l1(split: InverseSplit, dt: float, n: int) -> np.ndarray:
     bound of its 2-norm gain.  The kernel is summed up to ``K = min(n, 50 / -ln rho(Phi) + 10 m)``
     samples (beyond, it is below ``exp(-50)`` of its slowest mode); ``tail[K] = 0``.
     """
-    Phi, al, be = foh_matrices(-split.A_u, split.B_u, dt)
+    return _anti_kernel(split, dt, n)[1].copy()
+
+
+#: Sampled anticausal kernels kept per split (by sampling interval and length).
+_KERNEL_CACHE_SIZE = 8
+
+
+def _anti_kernel(split: InverseSplit, dt: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(h, tail)``: the sampled anticausal kernel ``h_j`` (``j < K``: ``h_0 = r_0 alpha``,
+    ``h_j = r_j alpha + r_{j-1} beta``) and :func:`discrete_tail_l1`, built once per ``(dt, K)``
+    and kept on the split (read-only)."""
+    plan = plan_for(split, dt, None)
+    Phi, al, be = plan.anti_phi, plan.anti_alpha, plan.anti_beta
     m = Phi.shape[0]
     rho = float(np.max(np.abs(np.linalg.eigvals(Phi)))) if m else 0.0
     K = n
     if 0.0 < rho < 1.0:
         K = min(n, int(math.ceil(50.0 / -math.log(rho))) + 10 * m)
     K = max(K, 1)
-    rows = left_powers(-split.C_u, Phi, K)
+    key = (float(dt), K)
+    cache = split.__dict__.get("_kernel_cache")
+    if cache is None:
+        cache = {}
+        object.__setattr__(split, "_kernel_cache", cache)
+    if key in cache:
+        return cache[key]
+    rows = left_powers(plan.anti_C, Phi, K) if m else np.zeros((K, 0))
     ra, rb = rows @ al, rows @ be
-    g = np.abs(ra[1:] + rb[:-1])                       # |G| at j = 1 .. K-1
+    h = ra.copy()
+    h[1:] += rb[:-1]                                   # h_j = r_j alpha + r_{j-1} beta
+    g = np.abs(h[1:])                                  # |G| at j = 1 .. K-1
     suffix = np.concatenate((np.cumsum(g[::-1])[::-1], [0.0]))   # sum over j >= N + 1
     tail = np.empty(K + 1)
     tail[:K] = np.abs(ra) + suffix
     tail[K] = 0.0
-    return tail
+    h.flags.writeable = False
+    tail.flags.writeable = False
+    if len(cache) >= _KERNEL_CACHE_SIZE:
+        cache.pop(next(iter(cache)))
+    cache[key] = (h, tail)
+    return h, tail
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PreviewChoice:
     """How an automatic preview was chosen for one signal (see :func:`choose_preview`).
 
@@ -256,28 +291,57 @@ class PreviewChoice:
         Requested bound on the truncation error relative to the full inverse.
     norm : str
         ``"linf"`` (max |e| / max |y_inf|) or ``"l2"`` (||e||_2 / ||y_inf||_2).
-    relative_error : float
-        Achieved truncation error in that norm (exact for the sampled signal).
-    max_error : float
-        Largest absolute truncation error [output units].
     tail_bound : float
         Signal-independent bound ``tail_l1_norm(T) * max|u|`` [output units].
     rule_4_over_r0_s : float
         What the 4/r0 rule would have chosen [s], for comparison.
+    reference_bound : float
+        The size of the full inverse the preview was certified against [output units]: for
+        ``"linf"`` a lower bound of ``max|y_inf|`` from the exact values of ``y_inf`` at a few
+        samples (:func:`reference_lower_bound`), for ``"l2"`` ``||y_inf||_2`` itself.
+    relative_error : float
+        Achieved truncation error in that norm (exact for the sampled signal).
+    max_error : float
+        Largest absolute truncation error [output units].
     error_bound : float
-        The bound the preview was chosen by: ``discrete_tail_l1[N]`` times ``max|u|`` (linf)
-        or ``||u||_2`` (l2), relative to the full inverse in that norm (<= ``tolerance``).
+        ``discrete_tail_l1[N]`` times ``max|u|`` (linf) or ``||u||_2`` (l2), relative to the full
+        inverse in that norm (<= ``tolerance``).
+
+    ``relative_error``, ``max_error`` and ``error_bound`` need the full inverse and the exact
+    truncation error of the signal (two more passes over it); for ``"linf"`` they are computed
+    when first read, from the signal, not when the preview is chosen.
     """
 
     samples: int
     seconds: float
     tolerance: float
     norm: str
-    relative_error: float
-    max_error: float
     tail_bound: float
     rule_4_over_r0_s: float
-    error_bound: float = 0.0
+    reference_bound: float = 0.0
+    _errors_of: Callable[[], tuple[float, float, float]] | None = field(default=None, repr=False)
+
+    @cached_property
+    def _errors(self) -> tuple[float, float, float]:
+        if self._errors_of is None:
+            return 0.0, 0.0, 0.0
+        rel, emax, bound = self._errors_of()
+        return float(rel), float(emax), float(bound)
+
+    @property
+    def relative_error(self) -> float:
+        """Achieved truncation error relative to the full inverse, in ``norm``."""
+        return self._errors[0]
+
+    @property
+    def max_error(self) -> float:
+        """Largest absolute truncation error [output units]."""
+        return self._errors[1]
+
+    @property
+    def error_bound(self) -> float:
+        """The kernel-tail bound of the chosen preview relative to the full inverse, in ``norm``."""
+        return self._errors[2]
 
 
 @dataclass(frozen=True, eq=False)
@@ -304,45 +368,128 @@ class AutoPreviewPasses:
     finite: bool = False
 
 
+#: Probes of the full inverse for the linf reference: equally spaced samples, plus the extremes
+#: of the signal and the last samples of the record (where the anticausal edge transient is).
+REFERENCE_PROBES = 64
+
+
+def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable: np.ndarray,
+                          umax: float, extremes: tuple[int, int] | None = None) -> float:
+    """A lower bound of ``max|y_inf|``, the peak of the full (infinite-preview) inverse of ``ua``.
+
+    ``y_inf[k] = stable[k] + sum_j h_j u[k+j]`` with ``h`` the sampled anticausal kernel
+    (:func:`discrete_tail_l1`'s ``G`` at ``N = 0``), evaluated exactly at the probe samples
+    (:data:`REFERENCE_PROBES` equally spaced, the extremes of ``u`` and the last 8 samples) with
+    the kernel cut where the rest of its l1 norm is below ``1e-6`` of the whole; that rest times
+    ``max|u|`` and a rounding margin of ``1e-12`` are subtracted.  ``stable`` is the causal part
+    (already computed, it does not depend on the preview).  Costs about
+    ``(REFERENCE_PROBES + 10) * 14`` slowest time constants of multiply-adds, not a pass.
+    ``extremes``: ``(argmax u, argmin u)`` if already known.
+    """
+    n = ua.size
+    if split.n_unstable == 0 or umax == 0.0:
+        return _peak(stable)
+    h, _ = _anti_kernel(split, dt, n)
+    suffix = np.cumsum(np.abs(h)[::-1])[::-1]
+    l1 = float(suffix[0])
+    cut = np.flatnonzero(suffix <= 1e-6 * l1)
+    M = int(cut[0]) if cut.size else h.size
+    rest = float(suffix[M]) if M < h.size else 0.0
+    hk = h[:M]
+    probes = np.unique(np.concatenate((
+        np.linspace(0, n - 1, REFERENCE_PROBES).astype(np.intp),
+        extremes or (int(np.argmax(ua)), int(np.argmin(ua))), np.arange(max(0, n - 8), n))))
+    best = 0.0
+    for k in probes:
+        seg = ua[k:k + M]
+        y = float(stable[k]) + float(np.dot(seg, hk[:seg.size]))
+        slack = rest * umax + 1e-12 * (abs(float(stable[k])) + l1 * umax)
+        best = max(best, abs(y) - slack)
+    return best
+
+
 def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: float = DEFAULT_PREVIEW_TOL,
-                        norm: str = "linf") -> AutoPreviewPasses:
+                        norm: str = "linf", chunk: int | None = None) -> AutoPreviewPasses:
     """Choose the automatic preview for the validated signal ``ua`` and invert it (see
-    :func:`choose_preview`): three passes over the record — the causal part, the full anticausal
-    part, and the truncation error of the chosen preview — whose sums are the inverse."""
+    :func:`choose_preview`).
+
+    ``"linf"``: the causal pass, the preview from :func:`reference_lower_bound` (no pass), then
+    the finite-preview anticausal pass of :class:`~inversion._discrete.Plan` — the cost of
+    inverting with that preview given; the exact truncation error is computed when the choice's
+    ``relative_error``/``max_error``/``error_bound`` is first read.  ``"l2"``: the causal pass,
+    the full anticausal pass (for ``||y_inf||_2``) and the truncation error of the chosen
+    preview, whose sums are the inverse.  ``chunk``: samples per pass block (default: whole).
+    """
     _check_tolerance(tol, norm)
     n = ua.size
-    plan = Plan(split, dt, None)
-    parts: dict[str, np.ndarray] = {}
-    plan.forward(ua, n, n, lambda c0, c1, y, _x: parts.__setitem__("s", y), check=False)
-    stable = parts["s"]
+    chunk = n if chunk is None else int(chunk)
+    plan0 = plan_for(split, dt, None)
+    if norm == "l2" and chunk >= n:
+        return _auto_l2(split, dt, ua, plan0, tol)
+    stable = plan0.causal(ua, chunk)
+    extremes = (int(np.argmax(ua)), int(np.argmin(ua)))
+    umax = max(float(ua[extremes[0]]), -float(ua[extremes[1]]))
+    size_u = umax if norm == "linf" else float(np.sqrt(np.dot(ua, ua)))
+    if norm == "linf":
+        ref = reference_lower_bound(split, dt, ua, stable, umax, extremes)
+    else:     # chunked l2: the full inverse once for its norm
+        y_inf = plan0.run(ua, chunk, stable)[2]
+        ref = float(np.sqrt(np.dot(y_inf, y_inf)))
     if split.n_unstable == 0:
-        return AutoPreviewPasses(PreviewChoice(0, 0.0, float(tol), norm, 0.0, 0.0, 0.0, 0.0),
-                                 stable, np.zeros(n), stable.copy())
-    plan.backward(ua, n, n, lambda c0, c1, y, _x: parts.__setitem__("u", y))
-    y_u = parts["u"]                                   # the full anticausal part
-    output = stable + y_u                              # y_inf, made the output below
+        N = 0
+        tail_n = 0.0
+    else:
+        tail = _anti_kernel(split, dt, n)[1] * size_u
+        ok = np.flatnonzero(tail <= tol * ref)          # tail is non-increasing: the first index
+        N = min(int(ok[0]) if ok.size else n - 1, n - 1)
+        tail_n = float(tail[min(N, tail.size - 1)])
+    stable, unstable, output = plan_for(split, dt, N).run(ua, chunk, stable)
+
+    def errors() -> tuple[float, float, float]:
+        # from the signal alone (the result's arrays may have been changed since)
+        minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
+        y_inf = plan0.run(ua, ua.size)[2]
+        size = _peak if norm == "linf" else (lambda e: float(np.sqrt(np.dot(e, e))))
+        r = size(y_inf)
+        emax = _peak(minus_e) if minus_e.size else 0.0
+        e = emax if norm == "linf" else (size(minus_e) if minus_e.size else 0.0)
+        return (e / r, emax, tail_n / r) if r > 0 else (0.0, emax, 0.0)
+
+    choice = PreviewChoice(
+        samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
+        tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
+        reference_bound=ref, _errors_of=errors)
+    return AutoPreviewPasses(choice, stable, unstable, output)
+
+
+def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float) -> AutoPreviewPasses:
+    """The l2 choice: ``||y_inf||_2`` needs the full inverse, so three passes whose sums are the
+    inverse with the chosen preview (the causal part, the full anticausal part, the truncation error)."""
+    n = ua.size
+    stable, y_u, output = plan0.run(ua, n)
+    y_u = y_u.copy() if y_u is stable else y_u
 
     def size(e: np.ndarray) -> float:
-        return _peak(e) if norm == "linf" else float(np.sqrt(np.dot(e, e)))
+        return float(np.sqrt(np.dot(e, e)))
 
     ref = size(output)
-    if ref == 0.0:
-        zero = PreviewChoice(0, 0.0, float(tol), norm, 0.0, 0.0, 0.0, split.auto_preview_s)
-        return AutoPreviewPasses(zero, stable, np.zeros(n), stable.copy())
     umax = _peak(ua)
-    tail = discrete_tail_l1(split, dt, n) * (umax if norm == "linf" else size(ua))
-    ok = np.flatnonzero(tail <= tol * ref)          # tail is non-increasing: the first index
+    if split.n_unstable == 0 or ref == 0.0:
+        zero = PreviewChoice(0, 0.0, float(tol), "l2", 0.0, split.auto_preview_s if split.n_unstable else 0.0,
+                             ref)
+        return AutoPreviewPasses(zero, stable, np.zeros(n), stable.copy())
+    tail = _anti_kernel(split, dt, n)[1] * size(ua)
+    ok = np.flatnonzero(tail <= tol * ref)
     N = min(int(ok[0]) if ok.size else n - 1, n - 1)
-    minus_e = _truncation_head(split, dt, ua, N)      # -e_N[:n - N]; e_N is zero beyond
+    minus_e = _truncation_head(split, dt, ua, N)
     y_u[:minus_e.size] -= minus_e
     output[:minus_e.size] -= minus_e
     emax = _peak(minus_e) if minus_e.size else 0.0
+    errs = ((size(minus_e) if minus_e.size else 0.0) / ref, emax, float(tail[min(N, tail.size - 1)]) / ref)
     choice = PreviewChoice(
-        samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
-        relative_error=(emax if norm == "linf" else size(minus_e)) / ref, max_error=emax,
+        samples=N, seconds=N * dt, tolerance=float(tol), norm="l2",
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
-        error_bound=float(tail[min(N, tail.size - 1)]) / ref)
-    # |output| <= max|y_inf| + max|e_N| <= ref + max|e_N| (in both norms, max|.| <= ||.||_2)
+        reference_bound=ref, _errors_of=lambda: errs)
     return AutoPreviewPasses(choice, stable, y_u, output, finite=math.isfinite(ref + emax))
 
 
@@ -366,12 +513,16 @@ def choose_preview(split: InverseSplit, dt: float, u: Any, *, tol: float = DEFAU
     relative to the full (infinite-preview) inverse ``y_inf`` in the chosen norm.  ``N`` is the
     first preview at which the l1 norm of the discarded sampled kernel
     (:func:`discrete_tail_l1`) times ``max|u|`` (linf) or ``||u||_2`` (l2) is at most ``tol``
-    times that of ``y_inf``: a bound, so the exact error of ``N`` (reported) meets the tolerance.
-    It costs no search over previews (one full inverse, then one pass for the exact error of
-    ``N``); ``N`` is longer than the smallest preview meeting the tolerance by what the bound
-    gives away, typically one to two time constants ``1/r0`` of the slowest anticausal mode
-    (10–25 % on the seed 000 sensor and the toy actuator with sines, measured).  A record too
-    short for any shorter preview gets ``N = len(u) - 1``, which equals the infinite preview.
+    times that of ``y_inf`` — for ``"linf"`` times a certified lower bound of ``max|y_inf|``
+    (:func:`reference_lower_bound`, reported as ``reference_bound``), for ``"l2"`` times
+    ``||y_inf||_2``: a bound, so the exact error of ``N`` (reported) meets the tolerance.
+    It costs no search over previews and, for ``"linf"``, no pass beyond the inverse with the
+    chosen preview (the exact error is computed when first read); ``N`` is longer than the
+    smallest preview meeting the tolerance by what the bound gives away, typically one to two
+    time constants ``1/r0`` of the slowest anticausal mode (10–25 % on the seed 000 sensor and
+    the toy actuator with sines, measured), plus ``ln(max|y_inf|/reference_bound)`` of them.  A
+    record too short for any shorter preview gets ``N = len(u) - 1``, which equals the infinite
+    preview.
 
     Parameters
     ----------

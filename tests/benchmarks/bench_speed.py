@@ -46,7 +46,14 @@ stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilte
         inverting with the preview it chooses (issue 29: ≤ 1.5).  Measured 2026-11-26 against
         d968249 (``--root``): auto ÷ chosen 8.45 / 9.01 / 10.19 before, 1.30 / 1.23 / 1.37 after
         (1 / 5 / 20 kHz); the preview chosen is 243 / 1203 / 4849 samples instead of the
-        smallest, 203 / 1009 / 4043 (a bound instead of a search).
+        smallest, 203 / 1009 / 4043 (a bound instead of a search).  2026-11-26, later (ff1ca1d vs
+        e6a666c, 3 alternating runs each, load 5-7 on 2 cores, medians [min-max] at 1 / 5 / 20 kHz):
+        lfilter ÷ auto 0.19 [0.19-0.24] / 0.20 [0.16-0.21] / 0.16 [0.16-0.17] -> 0.26 [0.24-0.27] /
+        0.19 [0.18-0.23] / 0.23 [0.23-0.25]; auto ÷ chosen 1.26 / 1.20 / 1.33 -> 1.07 / 1.08 / 1.08;
+        lfilter ÷ given 0.26 / 0.28 / 0.20 -> 0.31 / 0.23 / 0.25 (within the noise, spread ±0.05).
+        The given-preview floor with scipy's filters: a causal and an anticausal recursion (each
+        about one lfilter pass, latency-bound, whatever the order) and two 4-tap correlations
+        (~0.4 pass each) for the finite preview, plus the three result arrays: <= ~0.33.
 """
 
 from __future__ import annotations

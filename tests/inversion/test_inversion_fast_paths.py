@@ -124,3 +124,20 @@ def test_long_preview_switches_between_kernel_block_sums_and_batch_pass():
     outs.append(inv.push(u[i:]))
     outs.append(inv.flush())
     np.testing.assert_allclose(np.concatenate(outs), ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+def test_plans_are_built_once_per_split_interval_and_preview():
+    """Repeated inversions reuse the plan kept on the split; another interval or preview gets
+    its own, and the cached plan's result equals a freshly built plan's (oracle: Plan itself)."""
+    from inversion._discrete import PLAN_CACHE_SIZE, plan_for
+
+    split = split_inverse(G35)
+    p1 = plan_for(split, 1e-3, 113)
+    assert plan_for(split, 1e-3, 113) is p1
+    assert plan_for(split, 1e-3, 114) is not p1 and plan_for(split, 2e-3, 113) is not p1
+    u = np.random.default_rng(6).standard_normal(2000)
+    fresh = Plan(split, 1e-3, 113).run(u, u.size)[2]
+    np.testing.assert_array_equal(invert(split, 1e-3, u, preview=0.113).output, fresh)
+    for k in range(PLAN_CACHE_SIZE + 2):                     # the cache stays bounded
+        plan_for(split, 1e-3, 200 + k)
+    assert len(split.__dict__["_plan_cache"]) <= PLAN_CACHE_SIZE

@@ -102,10 +102,12 @@ def test_auto_preview_meets_the_tolerance_and_is_the_first_the_kernel_tail_certi
     assert ch.max_error == pytest.approx(err, rel=1e-6, abs=1e-14)
     assert err <= tol * ref * (1 + 1e-9)
     assert err <= r.truncation_bound * (1 + 1e-9)
-    # the preview is the first whose kernel tail times max|u| meets the tolerance
-    N, umax = ch.samples, np.max(np.abs(d))
-    assert _kernel_tail_by_impulse(G, d.size, N) * umax <= tol * ref * (1 + 1e-9)
-    assert _kernel_tail_by_impulse(G, d.size, N - 1) * umax > tol * ref
+    # the preview is the first whose kernel tail times max|u| meets the tolerance of the
+    # certified size of the full inverse: a lower bound of its peak, and close to it here
+    N, umax, R = ch.samples, np.max(np.abs(d)), ch.reference_bound
+    assert 0.95 * ref <= R <= ref
+    assert _kernel_tail_by_impulse(G, d.size, N) * umax <= tol * R * (1 + 1e-9)
+    assert _kernel_tail_by_impulse(G, d.size, N - 1) * umax > tol * R
     assert ch.error_bound == pytest.approx(_kernel_tail_by_impulse(G, d.size, N) * umax / ref, rel=1e-6)
     # and not much longer than the shortest preview from which on every preview meets it
     # (scanned here in steps of 10 samples with the finite-preview inverses): the bound gives
@@ -115,6 +117,47 @@ def test_auto_preview_meets_the_tolerance_and_is_the_first_the_kernel_tail_certi
     errs = np.array([np.max(np.abs(invert(G, t, d, preview=m * DT).output - y_inf)) for m in scan])
     last_fail = int(scan[np.flatnonzero(errs > tol * ref)[-1]])
     assert last_fail < N <= last_fail + 10 + 2.5 / (sp.r0 * DT)
+
+
+def _signals(n, rng):
+    k = np.arange(n)
+    imp = np.zeros(n)
+    imp[n // 3] = 1.0                                        # one impulse, far from every probe
+    step = (k > n // 2).astype(float)                        # a jump to the record's end
+    return {"noise": rng.standard_normal(n), "impulse": imp, "step": step,
+            "sine+noise": np.sin(2 * np.pi * 0.02 * k) + 0.1 * rng.standard_normal(n)}
+
+
+@pytest.mark.parametrize("model", [toy_actuator(), NMP], ids=["toy-actuator", "seed000-sensor"])
+def test_reference_lower_bound_never_exceeds_the_peak_of_the_full_inverse(model):
+    """The certified size is a lower bound of max|y_inf| (oracle: the infinite-preview inverse)
+    on signals chosen to defeat the probes, so the chosen preview always meets the tolerance."""
+    from inversion.preview import reference_lower_bound
+
+    sp = split_inverse(model)
+    for name, u in _signals(3001, np.random.default_rng(5)).items():
+        y = invert(sp, DT, u, preview="inf")
+        peak = np.max(np.abs(y.output))
+        R = reference_lower_bound(sp, DT, u, y.stable_part, float(np.max(np.abs(u))))
+        assert 0.0 <= R <= peak * (1 + 1e-12), name
+        r = invert(sp, DT, u, preview_tol=1e-3)
+        assert r.preview_choice.reference_bound == pytest.approx(R, rel=1e-12)
+        err = np.max(np.abs(r.output - y.output))
+        assert err <= 1e-3 * peak * (1 + 1e-9), name
+        # (rounding: the finite-preview and the infinite-preview passes are different filters)
+        assert r.preview_choice.max_error == pytest.approx(err, rel=1e-6, abs=1e-12 * peak), name
+
+
+def test_auto_preview_errors_are_computed_from_the_signal_when_read():
+    G = toy_actuator()
+    t, d = _faded_sine(1.0)
+    y_inf = invert(G, t, d, preview="inf").output
+    r = invert(G, t, d)
+    err = np.max(np.abs(r.output - y_inf))
+    r.output[:] = 0.0                          # the result's arrays are not what the errors use
+    assert r.preview_choice.max_error == pytest.approx(err, rel=1e-6)
+    assert r.truncation_error == pytest.approx(err, rel=1e-6)
+    assert r.preview_choice.relative_error == pytest.approx(err / np.max(np.abs(y_inf)), rel=1e-6)
 
 
 def test_auto_preview_grows_with_tighter_tolerance_and_l2_norm_is_available():
