@@ -349,12 +349,12 @@ def joint_section(args):
 def _zpk_breakdown(res) -> dict:
     """Where a joint zpk fit's time went, from its history: the per-temperature stage, the
     coefficient-form solve that gives its start, and the joint Levenberg–Marquardt race
-    (lockstep time, the winning start's iterations with its resumes, every start's ending)."""
+    (lockstep time, the iterations of the start that reached the lowest cost, with its resumes,
+    and how every start's first run ended)."""
     h = res.history
     joint = [e for e in h if e["stage"].startswith("joint") and "coefficient form" not in e["stage"]]
     first = [e for e in joint if e["stage"] == "joint"]
-    won = [e for e in first if e["converged"]] or first[-1:]
-    best = min(won, key=lambda e: e["cost"])["start"]
+    best = min(joint, key=lambda e: e["cost"] if np.isfinite(e["cost"]) else np.inf)["start"]
     cstart = [e for e in h if "coefficient form" in e["stage"]]
     return {"per_t_s": sum(e["time_s"] for e in h if e["stage"].startswith("per-T")),
             "cstart_its": sum(e["iterations"] for e in cstart), "cstart_s": sum(e["time_s"] for e in cstart),
