@@ -2,7 +2,7 @@
 
 Run (from the repository root; a script, not collected by pytest):
 
-    python tests/benchmarks/bench_speed.py [--sections fit,build,joint,stream] [--quick]
+    python tests/benchmarks/bench_speed.py [--sections fit,build,joint,zpk,stream] [--quick]
     python tests/benchmarks/bench_speed.py --root /path/to/other/checkout ...
 
 ``--root`` imports ``surrogate``, ``inversion`` and ``physmodel`` from another checkout (e.g.
@@ -40,6 +40,13 @@ zpk     Joint zpk ÷ coefficient schedule on seed001_actuator and seed002_table3
         0.1–9 Hz, 4/4 cubic): time ratio per noise seed and the joint iterations (issue 29).
         Measured 2026-11-26 against d968249: seed 001 median 3.1 (max 6.6) -> 2.9 (3.7);
         seed 002 median 4.0 (max 10.2, 1,227 iterations) -> 4.0 (5.4; 68 iterations on that draw).
+        Later (trailing start stopped, against 89bf8cb via ``--root``, two runs each, load ~8 on
+        2 cores): seed 002 per draw 2.2/5.0/3.8/1.7/4.2 and 2.2/6.4/4.0/1.9/4.0 -> 2.2/3.1/2.5/2.0/3.9
+        and 2.4/3.1/2.4/2.0/3.8, seed 001 max 4.7/4.4 -> 3.0/2.9, final costs unchanged.  Fresh
+        draws (``--zpk-seeds 301,302,303,304,305 --zpk-physics seed002_table3``): 3.6/4.8/3.1/2.4/17.2
+        -> 2.3/3.0/2.2/2.3/12.9; draw 305 (and 101, 102, 104) stays above 5: there the zpk optimum
+        has a zero at infinity, which a monic zero section reaches only by crawling (k -> 0 with
+        c0 -> inf), about 1,200 iterations on draw 305.  ``--zpk-seeds``/``--zpk-physics`` choose the draws.
 stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilter`` with
         carried state and against the batch inverse; finite-preview batch throughput as a
         ratio to ``scipy.signal.lfilter`` at 1, 5 and 20 kHz, and ``preview='auto'`` against
