@@ -366,7 +366,13 @@ def _zpk_breakdown(res) -> dict:
     return {"per_t_s": sum(e["time_s"] for e in h if e["stage"].startswith("per-T")),
             "cstart_its": sum(e["iterations"] for e in cstart), "cstart_s": sum(e["time_s"] for e in cstart),
             "joint_s": sum(e["time_s"] for e in joint), "winner": best,
-            "its_won": sum(e["iterations"] for e in joint if e["start"] == best),
+            # a resumed or continued Levenberg–Marquardt solve counts its iterations from the start;
+            # a constrained (IPOPT) re-solve counts its own
+            "its_won": max([e["iterations"] for e in joint if e["start"] == best
+                            and ("resumed" in e["stage"] or "continued" in e["stage"] or e["stage"] == "joint")]
+                           or [0])
+            + sum(e["iterations"] for e in joint if e["start"] == best and ("constraints" in e["stage"]
+                                                                             or "bounds" in e["stage"])),
             "ends": ", ".join(f"{e['start']} {e['iterations']} {e['status']}" for e in first)}
 
 
