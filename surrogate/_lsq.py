@@ -299,7 +299,7 @@ class LevenbergMarquardt:
         and is stopped whatever its margin.  Default 0 for every start.
     trailing_ratio : float, optional
         Also stop a running start while no start has converged yet, when its cost is more
-        than ``trailing_ratio`` times the lowest cost of the other starts and, at the rates both
+        than ``trailing_ratio`` times the lowest cost of the other running starts and, at the rates both
         fell over their last ``CATCH_UP_WINDOW`` accepted steps, it would need more than
         ``CATCH_UP_ITERATIONS`` iterations to close the gap (status ``Stopped_Early``).  A
         start caught in a poor basin then no longer doubles the cost of every iteration of a
