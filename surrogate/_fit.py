@@ -311,15 +311,19 @@ def _outcome(lm: LevenbergMarquardt, i: int, time_s: float) -> SolveOutcome:
                         int(lm.iterations[i]), time_s, list(lm.traces[i]), resume)
 
 
-def race_starts(evaluator, starts, max_iter: int, tol: float, lb, ub, prefer: str | None = "warm") -> list:
+def race_starts(evaluator, starts, max_iter: int, tol: float, lb, ub, prefer: str | None = "warm",
+                trailing_ratio: float | None = None) -> list:
     """Levenberg–Marquardt from every start in lockstep (one batched evaluation per
     iteration serves them all); when one converges, the starts whose cost is higher are
     stopped (status ``Stopped_Early``), except the start named ``prefer`` (a warm start),
-    which keeps running while within ``WARM_MARGIN`` of it.  Returns ``[(name, SolveOutcome)]``
+    which keeps running while within ``WARM_MARGIN`` of it; with ``trailing_ratio``, a start
+    that trails another running one by more than that factor and is not catching up is
+    stopped before any has converged (``LevenbergMarquardt``).  Returns ``[(name, SolveOutcome)]``
     (the time of the lockstep run is shared equally among the starts)."""
     names = [name for name, _ in starts]
     margins = [WARM_MARGIN if name == prefer else 0.0 for name in names]
-    lm = LevenbergMarquardt(evaluator, np.array([th for _, th in starts]), lb, ub, tol, margins)
+    lm = LevenbergMarquardt(evaluator, np.array([th for _, th in starts]), lb, ub, tol, margins,
+                            trailing_ratio)
     lm.run(max_iter)
     share = lm.time_s / len(names)
     return [(name, _outcome(lm, i, share)) for i, name in enumerate(names)]

@@ -297,6 +297,13 @@ class LevenbergMarquardt:
         reach c at its recent rate: a losing start ends early, one still falling fast towards
         c is let through.  A start within ``SAME_ANSWER`` above c has reached the same answer
         and is stopped whatever its margin.  Default 0 for every start.
+    trailing_ratio : float, optional
+        Also stop a running start while no start has converged yet, when its cost is more
+        than ``trailing_ratio`` times the lowest cost of the other running starts and, at the rates both
+        fell over their last ``CATCH_UP_WINDOW`` accepted steps, it would need more than
+        ``CATCH_UP_ITERATIONS`` iterations to close the gap (status ``Stopped_Early``).  A
+        start caught in a poor basin then no longer doubles the cost of every iteration of a
+        long race it cannot win.  None (default): starts are compared with converged ones only.
 
     ``run(k)`` takes at most ``k`` more iterations (every running start advances by one
     trial step per iteration); ``theta``, ``cost``, ``status``, ``converged``,
@@ -310,8 +317,10 @@ class LevenbergMarquardt:
     BEATEN_RATIO = 0.2
     SAME_ANSWER = 1e-6
 
-    def __init__(self, evaluator: Evaluator, starts, lb, ub, tol: float = 1e-10, margins=None):
+    def __init__(self, evaluator: Evaluator, starts, lb, ub, tol: float = 1e-10, margins=None,
+                 trailing_ratio: float | None = None):
         t0 = time.perf_counter()
+        self.trailing_ratio = trailing_ratio
         self.ev, self.tol = evaluator, float(tol)
         x = np.atleast_2d(np.asarray(starts, float))
         S, p = x.shape
@@ -463,11 +472,37 @@ class LevenbergMarquardt:
             if ended or self.converged.any():
                 self.cost[act] = 0.5 * rr / self._m
                 ended = self._stop_losers() or ended
+            elif self.trailing_ratio is not None and act.size > 1:
+                self.cost[act] = 0.5 * rr / self._m
+                ended = self._stop_trailing()
         self.theta[act], self._r[act], self._J[act], self._rr[act] = x, r, J, rr
         self._scale[act], self._mu[act], self._nu[act] = scale, mu, nu
         self.cost[act] = 0.5 * rr / self._m
         self.iterations[act] += done
         return done
+
+    def _stop_trailing(self) -> bool:
+        """Stop every running start whose cost exceeds ``trailing_ratio`` times the lowest
+        cost of the running starts and which, at the rates both fell over their last
+        ``CATCH_UP_WINDOW`` accepted steps, would need more than ``CATCH_UP_ITERATIONS``
+        iterations to reach it (see ``trailing_ratio``)."""
+        run = np.flatnonzero(self.running)
+        if run.size < 2:
+            return False
+        lead = run[np.argmin(self.cost[run])]
+        c, w = self.cost[lead], self.CATCH_UP_WINDOW
+        tl = self.traces[lead]
+        rate_lead = (tl[-1 - w] - tl[-1]) / w if len(tl) > w else 0.0
+        stopped = False
+        for i in run:
+            tr = self.traces[i]
+            if i == lead or not self.cost[i] > self.trailing_ratio * c or len(tr) <= w:
+                continue
+            closing = (tr[-1 - w] - tr[-1]) / w - rate_lead
+            if closing <= 0 or self.cost[i] - c > self.CATCH_UP_ITERATIONS * closing:
+                self._end(i, STATUS_STOPPED, False)
+                stopped = True
+        return stopped
 
     def _stop_losers(self) -> bool:
         """Stop every running start that another start has beaten: one has converged with a

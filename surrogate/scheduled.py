@@ -33,6 +33,14 @@ __all__ = ["ScheduledFit"]
 _METHODS = ("joint", "two-stage")
 _DENSE_CHECK = 501   # temperatures of the final stability check (FitResult.stability)
 _MAX_REFINE = 4      # rounds of adding unstable temperatures to the Hurwitz constraint grid
+#: forms 'zpk' and 'sections': a joint start whose cost stays above this multiple of the other
+#: start's, without closing the gap, is stopped before either converges (see
+#: ``LevenbergMarquardt.trailing_ratio``): on the seed 002 sample a coefficient-schedule start
+#: caught in a poor basin (cost 10-240 after 10 iterations; the optimum: 0.5) otherwise ran the
+#: whole 150-230 iteration race in lockstep, at about twice the cost per iteration of the winner
+#: alone.  (The coefficient form's races end within ~10 iterations, and its stability handling
+#: re-solves from every start: not used there.)
+_TRAILING_RATIO = 2.0
 
 
 class ScheduledFit:
@@ -198,7 +206,11 @@ class ScheduledFit:
         iterations; its schedule carries the far-out, weakly determined zeros smoothly across
         temperatures, which the pole-zero form otherwise has to crawl to (seed 002 sample, 4/4
         cubic on 0.1–9 Hz: 1,200 joint iterations from the two-stage and constant starts, 68
-        from this one, at a lower cost).  None when that solve gives no finite start."""
+        from this one, at a lower cost).  Where the coefficient form's leading numerator
+        coefficient changes sign inside the range (a far zero passes through infinity, seed 002
+        noise draws 2 and 3), no polynomial zpk schedule follows it and this start lands in a
+        poor basin (cost 10-240 against 0.5); the race then stops it early (``_TRAILING_RATIO``)
+        and the constant start wins.  None when that solve gives no finite start."""
         st_c = Structure("coefficients", self.n_zeros, self.n_poles, self.degree)
         problem_c, _ = F.make_problem(st_c, data, scaling, self.weighting)
         theta_c = self._two_stage_params(per_t, scaling, st_c)
@@ -229,7 +241,9 @@ class ScheduledFit:
 
         * Levenberg–Marquardt runs both starts in lockstep (``_fit.race_starts``); a start
           is stopped when the other has converged to a lower cost (a converged two-stage
-          start can be a poor local minimum: sensor zpk 2/2, cost 112 vs 0.49);
+          start can be a poor local minimum: sensor zpk 2/2, cost 112 vs 0.49); forms 'zpk'
+          and 'sections': also before either has converged, when it trails the other by more
+          than ``_TRAILING_RATIO`` and is not closing the gap;
         * if the lowest cost belongs to a solve that ran out of iterations (slow, not
           failed: far-out zeros are weakly determined), it is resumed once with
           ``RESUME_FACTOR × max_iter`` iterations (``_fit.resume_slowest``); if it still
@@ -294,7 +308,8 @@ class ScheduledFit:
                 del starts["two-stage"]
                 starts["coefficient schedule"] = np.clip(theta_c, *st.bounds())
         outcomes = F.race_starts(evaluator, list(starts.items()), self.max_iter, self.tol, lb, ub,
-                                 prefer=None)
+                                 prefer=None,
+                                 trailing_ratio=None if st.form == "coefficients" else _TRAILING_RATIO)
         history += [F.history_entry("joint", name, out) for name, out in outcomes]
         F.resume_slowest(outcomes, None, history, "joint", self.max_iter)
         final, setups = [], {}

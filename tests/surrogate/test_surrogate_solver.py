@@ -187,3 +187,47 @@ def test_reported_errors_equal_the_saved_models_own_response():
     one = RationalFit(2, 3).fit(f[k], None, h[k])
     assert one.per_temperature[0].relative_rms_error == pytest.approx(
         relative_rms_error(one.model.frequency_response(f[k]), h[k]), rel=1e-12)
+
+
+def _noisy_sections_problem():
+    from surrogate._structure import response
+
+    st = Structure("sections", 2, 3, 0)
+    truth = np.array([1.0, 0.5, 0.2, np.log(0.3), np.log(1.0), np.log(2.0)])
+    n_lines = 60
+    w = np.geomspace(0.05, 20.0, n_lines)
+    tau = np.zeros(n_lines)
+    rng = np.random.default_rng(1)
+    h = response(st, truth, w, tau) * np.exp(0.01 * (rng.normal(size=n_lines) + 1j * rng.normal(size=n_lines)))
+    return st, truth, Problem(st, w, tau, h, "log", np.ones(n_lines), np.ones(n_lines))
+
+
+def test_a_trailing_start_is_stopped_before_the_leader_converges_and_the_leader_is_unchanged():
+    st, truth, pr = _noisy_sections_problem()
+    ev = Evaluator(pr)
+    lb, ub = st.bounds(float(pr.w.min()), float(pr.w.max()))
+    # the leader needs 15 iterations; the other start (poles far above the band) trails it
+    starts = np.stack([truth + 0.5, np.array([1.0, 0.0, 0.0, np.log(40.0), np.log(400.0), np.log(20.0)])])
+    plain = LevenbergMarquardt(ev, starts, lb, ub, 1e-12).run(500)
+    lm = LevenbergMarquardt(ev, starts, lb, ub, 1e-12, trailing_ratio=2.0).run(500)
+    assert plain.converged[0] and lm.converged[0] and lm.status[1] == STATUS_STOPPED
+    assert lm.iterations[1] < lm.iterations[0] == plain.iterations[0]     # stopped before the end
+    assert lm.cost[1] > 2.0 * lm.cost[0]
+    # the starts advance independently in lockstep: stopping one leaves the other's path (up to
+    # the summation order of a stack of one instead of two)
+    np.testing.assert_allclose(lm.theta[0], plain.theta[0], rtol=1e-12, atol=0)
+    assert lm.cost[0] == pytest.approx(plain.cost[0], rel=1e-13)
+
+
+@pytest.mark.parametrize("rate, stopped", [(0.0, True), (0.1, True), (0.5, False)])
+def test_the_trailing_rule_lets_a_start_through_that_closes_the_gap_in_time(rate, stopped):
+    """Leader at cost 1 (flat), the other at 3: gap 2; closing at ``rate`` per accepted step it
+    needs 2/rate iterations, stopped above CATCH_UP_ITERATIONS (10)."""
+    st, truth, pr = _noisy_sections_problem()
+    lm = LevenbergMarquardt(Evaluator(pr), np.stack([truth, truth + 0.1]), *st.bounds(0.05, 20.0), 1e-12,
+                            trailing_ratio=2.0)
+    w = lm.CATCH_UP_WINDOW
+    lm.cost[:] = [1.0, 3.0]
+    lm.traces = [[1.0] * (w + 1), [3.0 + rate * (w - k) for k in range(w + 1)]]
+    assert lm._stop_trailing() is stopped
+    assert (lm.status[1] == STATUS_STOPPED) is stopped and lm.running[0]
