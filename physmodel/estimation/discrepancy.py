@@ -238,7 +238,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     Ep = project_out(Q0, E)
     lin = {c: constrained_lr(S, sided[c], Ep) for c, S in sigs.items()}
     for c in [c for c in sigs if c in degenerate]:      # look-elsewhere over parameters without a first-order signature
-        lin[c] = np.maximum(lin[c], scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep))
+        lin[c] = np.maximum(lin[c], scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep,
+                                            is_off=LIBRARY[c].is_off))
     lin_max = np.max(np.vstack(list(lin.values())), axis=0) if lin else np.zeros(E.shape[1])
     cost2_null = np.sum(Ep * Ep, axis=0)
     T_lin = float(np.quantile(lin_max, 1 - alpha))

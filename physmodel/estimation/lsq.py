@@ -240,7 +240,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
             return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c
         for opt in optima:
             if opt.status > 0 and opt.cost <= c <= opt.cost + JOIN_COST * s2:
-                d = np.clip(z + step, lo, hi) - opt.z          # the step kept in the box
+                d = z + step - opt.z
                 if float(d @ (opt.J.T @ opt.J) @ d) <= JOIN_DISTANCE**2 * s2:
                     return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
                                 f"errors of {_JOINED}{opt.index}'s optimum"), step, c
