@@ -204,6 +204,33 @@ def joined_start(record: StartRecord) -> int | None:
     return int(digits) if digits.isdigit() else None
 
 
+#: A coordinate of an optimum within this fraction of its range from a bound sits at that bound.
+AT_BOUND = 1e-6
+
+
+def _landing(z, r, J, step, z_opt, lo, hi) -> np.ndarray:
+    """Where the Gauss–Newton model from ``z`` lands, as seen from an earlier optimum ``z_opt``:
+    ``z + step`` — unless ``z_opt`` sits at bounds (an effect at its off value): then the model's
+    minimum on that face (those coordinates held at the optimum's bound, the others solved), if it
+    is the minimum over the box too (each held coordinate's gradient there points out of the box,
+    the Karush–Kuhn–Tucker sign); else ``z + step`` (no join on a face the model would leave)."""
+    span = hi - lo
+    low, high = z_opt - lo <= AT_BOUND * span, hi - z_opt <= AT_BOUND * span
+    held = low | high
+    if not held.any():
+        return z + step
+    d = np.zeros_like(z)
+    d[held] = z_opt[held] - z[held]
+    free = ~held
+    rr = r + J[:, held] @ d[held]
+    if free.any():
+        d[free] = np.linalg.lstsq(J[:, free], -rr, rcond=None)[0]
+    g = J.T @ (r + J @ d)                      # the model's gradient at the landing point
+    if np.all(g[low] >= 0) and np.all(g[high] <= 0):
+        return z + d
+    return z + step
+
+
 class _Stop(Exception):
     """Ends scipy's search from inside the residual function."""
 
@@ -240,7 +267,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
             return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c
         for opt in optima:
             if opt.status > 0 and opt.cost <= c <= opt.cost + JOIN_COST * s2:
-                d = z + step - opt.z
+                d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
                 if float(d @ (opt.J.T @ opt.J) @ d) <= JOIN_DISTANCE**2 * s2:
                     return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
                                 f"errors of {_JOINED}{opt.index}'s optimum"), step, c
