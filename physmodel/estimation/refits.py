@@ -28,22 +28,24 @@ __all__ = ["StageCounter", "Refitter"]
 class StageCounter:
     """Model evaluations per stage of a diagnosis: parameter sets predicted (``sets``), batched
     model calls (``calls``), least-squares fits (``fits``) and their points (``points``: each one
-    residuals and Jacobian in one model call) and wall seconds (``seconds``).  ``predict_many``
+    residuals and Jacobian in one model call), wall seconds (``seconds``) and the process's CPU
+    seconds (``cpu_s``).  ``predict_many``
     is the counted predictor; :meth:`enter` switches the stage."""
 
     def __init__(self, predict_many: Callable):
         self._pm = predict_many
         self.stages: dict[str, dict] = {}
         self.stage = ""
-        self._t = time.perf_counter()
+        self._t, self._c = time.perf_counter(), time.process_time()
         self.enter("setup")
 
     def enter(self, stage: str) -> None:
-        now = time.perf_counter()
+        now, cpu = time.perf_counter(), time.process_time()
         if self.stage:
             self.stages[self.stage]["seconds"] += now - self._t
-        self._t, self.stage = now, stage
-        self.stages.setdefault(stage, {"sets": 0, "calls": 0, "fits": 0, "points": 0, "seconds": 0.0})
+            self.stages[self.stage]["cpu_s"] += cpu - self._c
+        self._t, self._c, self.stage = now, cpu, stage
+        self.stages.setdefault(stage, {"sets": 0, "calls": 0, "fits": 0, "points": 0, "seconds": 0.0, "cpu_s": 0.0})
 
     def predict_many(self, values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
         row = self.stages[self.stage]

@@ -15,7 +15,7 @@ alpha0, d, kappa_e, xi, omega_n, default starts and bounds — what ``ipmc calib
 4 null refits).  Printed: median wall and CPU seconds of each, their ratio, the verdict (the same in
 every round, else flagged), and the diagnosis's own account (``metadata["profile"]``) per stage —
 parameter sets predicted, batched model calls, least-squares fits, fit points (each one residual
-vector and Jacobian in one batched model call) and wall seconds.  Each process is single-threaded
+vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 """
 
@@ -74,7 +74,7 @@ def run(cases: str, rounds: int) -> list[dict]:
             dia["wall"].append(w)
             dia["cpu"].append(p)
             verdicts.add((d.verdict, tuple(sorted(d.named))))
-            profile = d.metadata["profile"]
+            profile = d.metadata.get("profile", {})       # absent before issue 27 item 6
         med = {k: {q: float(np.median(v)) for q, v in x.items()} for k, x in (("calibrate", cal), ("diagnose", dia))}
         row = dict(seed=seed, label=label, expected=expected, verdicts=sorted(verdicts), profile=profile,
                    calibrate_evaluations=c.n_evaluations, calibrate_calls=c.n_model_calls, **med)
@@ -93,11 +93,12 @@ def _print(r: dict) -> None:
           f"{r['calibrate_calls']} model calls)")
     print(f"   diagnose:  {dw:.2f} s wall, {dc:.2f} s CPU")
     print(f"   ratio diagnose/calibrate: {dw / cw:.0f}x wall, {dc / cc:.0f}x CPU")
-    print("   stage        sets   calls  fits  points   wall s")
+    print("   stage        sets   calls  fits  points   wall s    CPU s")
     for s in STAGES:
         x = r["profile"].get(s)
         if x:
-            print(f"   {s:<10} {x['sets']:>7} {x['calls']:>6} {x['fits']:>5} {x['points']:>7} {x['seconds']:>8.2f}")
+            print(f"   {s:<10} {x['sets']:>7} {x['calls']:>6} {x['fits']:>5} {x['points']:>7} {x['seconds']:>8.2f} "
+                  f"{x['cpu_s']:>8.2f}")
 
 
 def main(argv=None) -> int:
