@@ -116,7 +116,8 @@ class Refitter:
                 origins.append(origin)
                 points.append(fr)
         res = self.fit(points[0], sim=sim, identify=identify,
-                       initials=[{fp.name: fp.initial for fp in fr} for fr in points[1:]])
+                       initials=[{fp.name: fp.midpoint() if fp.initial is None else fp.initial for fp in fr}
+                                 for fr in points[1:]])
         res.metadata["refit_multistart"] = refit_spread(res, origins)
         return res
 
