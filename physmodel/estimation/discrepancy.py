@@ -23,7 +23,8 @@ user's free parameters, and:
    of a resonance, a fluid's viscosity — the supremum over a grid of them, Davies' look-elsewhere
    correction, :func:`~physmodel.estimation.nullstats.scan_lr`), ``null_draws`` draws, scaled by
    the ratio of full-refit to linearised LR on ``null_refits`` parametric-bootstrap draws
-   (clipped to [1, 3]);
+   (clipped to [1, 3]; each candidate refitted warm from the draw's baseline refit with the effect
+   starts of the data, :meth:`~physmodel.estimation.refits.Refitter.null_max_lr`);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
    baseline Jacobian projected out; the secant to the typical size where the tangent at off carries
    < :data:`~physmodel.estimation.nullstats.SECANT_RATIO` of it) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`,
