@@ -17,6 +17,39 @@ every round, else flagged), and the diagnosis's own account (``metadata["profile
 parameter sets predicted, batched model calls, least-squares fits, fit points (each one residual
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
+
+Measured 2026-11-26 (2 cores shared by ~6 sessions, load 4-9: wall times are 3-6× the CPU times
+and mean little).  "Before" = e6a666c (main at the start of this work), one round; "after" = this
+branch, three rounds (median)::
+
+    python3 tests/benchmarks/bench_diagnosis_speed.py --rounds 3       # after
+    python3 tests/benchmarks/bench_diagnosis_speed.py --rounds 1       # before (run in a copy of e6a666c)
+
+    case                                  diagnose CPU s     calibrate   diagnose / calibrate (CPU)
+                                          before   after     CPU s       before   after
+    41000 none                            30.4     11.65     0.017       1563x    683x
+    41009 water_uptake                    32.0     13.12     0.016       2070x    835x
+    41038 contact_resistance+time_delay   37.6     12.32     0.059        630x    209x
+
+Verdicts identical before and after (none; named water_uptake; ambiguous among the declared
+twins), as are the messages and the null thresholds (9.916, 11.823, 8.749).  The library's
+``calibrate`` is 16-60 ms here (one model class evaluated on states built as arrays, 24-88 batched
+calls), so no diagnosis — at least 16 candidate refits, each a fit of a different model — comes
+within 5× of it.  What the issue measured (31.7 s vs 2.0 s) were the commands, whose calibrate is
+mostly start-up, report and figure; on seed 41009 (CPU, ``/usr/bin/time``)::
+
+    ipmc calibrate sweep.csv --set base.json --kind actuator --free alpha0 --free d --free kappa_e \
+        --free xi --free omega_n --out cal --force --quiet --accept-misfit                 2.0 s
+    ipmc diagnose --data sweep.csv --set base.json --kind actuator --free alpha0 --free d \
+        --free kappa_e --free xi --free omega_n --seed 41009 --out dia --force --quiet    before 32.5 s (16×)
+                                                                                         after  15.8 s (7.9×)
+
+Where the time goes now (seed 41009, after): the null refits 6.2 s CPU (72 fits, 1767 points),
+the single-candidate refits 3.5 s (19 fits, 1032 points), signatures and the look-elsewhere scan
+1.9 s, pairs and verdicts 1.2 s.  Under cProfile 80 % of a diagnosis is inside the effect model's
+``predict_many`` (physmodel/effects/library.py): 3.65 ``frequency_response`` calls per batched
+call (one per distinct set of effect values, so a Jacobian of a k-parameter candidate costs 1 + k
+of them) and 24 % in ``apply_values``, one validated ``IPMCParameters`` per parameter set.
 """
 
 from __future__ import annotations
