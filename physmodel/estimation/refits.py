@@ -40,6 +40,7 @@ class StageCounter:
         self.enter("setup")
 
     def enter(self, stage: str) -> None:
+        """Book the wall and CPU time since the last switch to the current stage; count in ``stage`` from now."""
         now, cpu = time.perf_counter(), time.process_time()
         if self.stage:
             self.stages[self.stage]["seconds"] += now - self._t
@@ -48,17 +49,20 @@ class StageCounter:
         self.stages.setdefault(stage, {"sets": 0, "calls": 0, "fits": 0, "points": 0, "seconds": 0.0, "cpu_s": 0.0})
 
     def predict_many(self, values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
+        """The wrapped predictor (n_sets, N), its sets and call counted in the current stage."""
         row = self.stages[self.stage]
         row["sets"] += len(values_list)
         row["calls"] += 1
         return self._pm(values_list)
 
     def fitted(self, res: CalibrationResult) -> None:
+        """Count the fit ``res`` and its points (its starts' evaluations) in the current stage."""
         row = self.stages[self.stage]
         row["fits"] += 1
         row["points"] += sum(int(s.nfev) for s in res.starts)
 
     def as_dict(self) -> dict:
+        """``{stage: {sets, calls, fits, points, seconds, cpu_s}}``, the current stage booked up to now."""
         self.enter(self.stage)          # book the time of the current stage so far
         return {k: dict(v) for k, v in self.stages.items()}
 
@@ -85,6 +89,8 @@ class Refitter:
 
     def fit(self, free_list, sim: FrequencySweep | None = None, starts: int = 1, identify: bool = True,
             initials: Sequence[Mapping[str, float]] = ()):
+        """One fit of ``free_list`` on the data (or on ``sim``, a simulated sweep, with the same soft
+        walls), ``starts`` multi-starts plus the warm ``initials``; nothing held; counted."""
         pr = self.prob if sim is None else PenalisedProblem(sim, self.prob.predict_many, self.prob.penalties)
         res = pr.fit(free_list, starts=starts, seed=self.seed, max_nfev=self.max_nfev, identify=identify,
                      hold_undetermined=False, initials=initials, damped=not initials)
