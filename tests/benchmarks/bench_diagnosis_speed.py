@@ -32,7 +32,10 @@ branch, three rounds (median)::
     41038 contact_resistance+time_delay   37.6     12.32     0.059        630x    209x
 
 Verdicts identical before and after (none; named water_uptake; ambiguous among the declared
-twins), as are the messages and the null thresholds (9.916, 11.823, 8.749).  The library's
+twins), as are the messages and the null thresholds (9.916, 11.823, 8.749); two more strips checked
+the same way (``--cases 41003:leakage,41005:added_fluid_mass``: none, and ambiguous viscous_fluid /
+distributed_cpe) keep their thresholds (9.8103, 10.4189), nonlinearity ratios and top-3 LRs to the
+printed digits, at 21.8 → 8.6 s and 31.5 → 17.5 s CPU.  The library's
 ``calibrate`` is 16-60 ms here (one model class evaluated on states built as arrays, 24-88 batched
 calls), so no diagnosis — at least 16 candidate refits, each a fit of a different model — comes
 within 5× of it.  What the issue measured (31.7 s vs 2.0 s) were the commands, whose calibrate is
