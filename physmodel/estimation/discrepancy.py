@@ -23,7 +23,8 @@ user's free parameters, and:
    of a resonance, a fluid's viscosity — the supremum over a grid of them, Davies' look-elsewhere
    correction, :func:`~physmodel.estimation.nullstats.scan_lr`), ``null_draws`` draws, scaled by
    the ratio of full-refit to linearised LR on ``null_refits`` parametric-bootstrap draws
-   (clipped to [1, 3]);
+   (clipped to [1, 3]; each candidate refitted warm from the draw's baseline refit with the effect
+   starts of the data, :meth:`~physmodel.estimation.refits.Refitter.null_max_lr`);
 4. reports as *confusable* the candidate pairs whose signatures (Jacobian columns with the
    baseline Jacobian projected out; the secant to the typical size where the tangent at off carries
    < :data:`~physmodel.estimation.nullstats.SECANT_RATIO` of it) have a largest canonical correlation ≥ :data:`CONFUSABLE_COSINE`,
@@ -66,6 +67,7 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
+from functools import partial
 from itertools import combinations
 
 import numpy as np
@@ -102,6 +104,7 @@ from .priors import (
     plausible_audit,
 )
 from .records import CalibrationResult, FreeParameter
+from .refits import Refitter, StageCounter
 from .residuals import standardised_residuals
 from .signatures import (
     declare_confusable,
@@ -110,7 +113,6 @@ from .signatures import (
     orth,
     pair_members,
     project_out,
-    refit_spread,
     vuong_confusability,
     vuong_critical,
     vuong_z,
@@ -184,7 +186,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         extra_free = [f"{n}.{p.name}" for n in beff for p in get_effect(n).parameters]
     cbounds, cstarts = _candidate_overrides(candidate_bounds, candidate_starts)
     model0 = EffectModel(base, kind, beff, kernel=kernel)
-    pm = model0.predictor(data, q).many
+    counter = StageCounter(model0.predictor(data, q).many)
+    pm = counter.predict_many
     free0 = free_parameters_for(base, list(free) + [f for f in extra_free if f not in free], beff)
     names0 = [fp.name for fp in free0]
     ranges = plausible_ranges(base, plausible)
@@ -193,16 +196,13 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     N = data.frequency_hz.size
     n_temps = data.temperatures().size
 
-    def from_(values):
-        """The base free parameters started at ``values`` (clipped to their bounds)."""
-        return [fp.with_initial(min(max(values[fp.name], fp.lower), fp.upper)) for fp in free0]
-
-    def fit(free_list, sim=None, starts=1, identify=True):
-        pr = prob if sim is None else PenalisedProblem(sim, pm, prob.penalties)
-        return pr.fit(free_list, starts=starts, seed=seed, max_nfev=max_nfev, identify=identify,
-                      hold_undetermined=False)
+    cpars: dict = {}       # {candidate: its parameters with candidate bounds}, filled below
+    rf = Refitter(prob, free0, cpars, cstarts, seed=seed, max_nfev=max_nfev, baseline_starts=baseline_starts,
+                  counter=counter)
+    from_, fit = rf.from_, rf.fit
 
     # ---- 1. baseline
+    counter.enter("baseline")
     res0 = fit(free0, starts=int(baseline_starts))
     if _restart is not None:
         res0 = min(res0, fit(from_(_restart)), key=lambda x: x.cost)
@@ -226,7 +226,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     bad = sorted(set(cbounds) - set(cand)) + sorted(set(cstarts) - set(cand))
     if bad:
         raise ParameterError(f"candidate bounds/starts given for {bad}, which are not candidates here ({cand})")
-    cpars = {c: LIBRARY[c].candidate_parameters(base, cbounds.get(c)) for c in cand}
+    counter.enter("signatures")
+    cpars.update({c: LIBRARY[c].candidate_parameters(base, cbounds.get(c)) for c in cand})
     hard = _hard_sides(cpars)
     J0, Q0, sigs, sided, skipped, first_order, raw_sigs, degenerate, confusable, separation = signature_stage(
         pm, v0, free0, cand, cpars, r0, data, s_ln, s_ph)
@@ -238,7 +239,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     Ep = project_out(Q0, E)
     lin = {c: constrained_lr(S, sided[c], Ep) for c, S in sigs.items()}
     for c in [c for c in sigs if c in degenerate]:      # look-elsewhere over parameters without a first-order signature
-        lin[c] = np.maximum(lin[c], scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep))
+        lin[c] = np.maximum(lin[c], scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep,
+                                            is_off=LIBRARY[c].is_off))
     lin_max = np.max(np.vstack(list(lin.values())), axis=0) if lin else np.zeros(E.shape[1])
     cost2_null = np.sum(Ep * Ep, axis=0)
     T_lin = float(np.quantile(lin_max, 1 - alpha))
@@ -247,45 +249,9 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     say("signatures", f"linearised null: LR threshold {T_lin:.3g} from {E.shape[1]} draws")
 
     # ---- 4. candidate refits
-    def eff_free(c, start=None):
-        out = []
-        for p in cpars[c]:
-            v = p.off if start is None else float(np.clip(start.get(p.name, p.off), p.lower, p.upper))
-            out.append(FreeParameter(f"{c}.{p.name}", p.lower, p.upper, "linear", v))
-        return out
-
-    user0 = {fp.name: fp.initial for fp in free0}
-
-    def refit(effects_on: Sequence[str], start_vals: dict, eff_starts: list, sim=None, identify=True,
-              from_user=False):
-        """Best of the refits from ``start_vals`` (and, ``from_user``, the user's start) × ``eff_starts``."""
-        best, runs = None, []
-        for origin, sv in [("baseline optimum", start_vals)] + ([("user start", user0)] if from_user else []):
-            for starts in eff_starts:
-                fr = from_(sv)
-                for c in effects_on:
-                    st = None if starts is None else starts.get(c)
-                    if st is None and any(k.startswith(c + ".") for k in sv):
-                        st = {k.split(".", 1)[1]: v for k, v in sv.items() if k.startswith(c + ".")}
-                    fr += eff_free(c, st)
-                res = fit(fr, sim=sim, identify=identify)
-                runs.append((origin, res))
-                if best is None or res.cost < best.cost:
-                    best, best_origin = res, origin
-        best.metadata["refit_multistart"] = refit_spread(runs, best, best_origin)
-        return best
-
-    def lin_start(c, r_now, Qb):
-        """Linearised estimate of the effect's values from the current residual."""
-        S = project_out(Qb, sigs[c])
-        d, *_ = np.linalg.lstsq(S, -r_now, rcond=None)
-        return {p.name: p.off + d[j] * (p.typical - p.off) for j, p in enumerate(cpars[c])}
-
-    def starts_for(c, r_now, Qb):
-        out = [None, {c: lin_start(c, r_now, Qb)}, {c: {p.name: p.typical for p in cpars[c]}}]
-        if c in cstarts:
-            out.append({c: {**{p.name: p.typical for p in cpars[c]}, **cstarts[c]}})
-        return out
+    counter.enter("singles")
+    rf.sigs = sigs
+    eff_free, refit, lin_start, starts_for = rf.eff_free, rf.refit, rf.lin_start, rf.starts_for
 
     def audit(res, extra_free):
         fl = free0 + extra_free
@@ -322,24 +288,18 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             out.metadata["baseline_restart"] = {"from_candidate": c, "cost_before": res0.cost, "cost_after": rb.cost}
             return out
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
-    def fit_null(sim):       # the same search as on the data (both base starts, candidates from the user's too)
-        return min((fit(from_(v0), sim=sim, identify=False),
-                    fit(free0, sim=sim, starts=int(baseline_starts), identify=False)), key=lambda x: x.cost)
-
+    counter.enter("null")
     n_boot = int(null_refits) * (len(sigs) + 1)
     boot_done = [0]
 
     def refit_max(sim, rb):
-        r_b = standardised_residuals(pm([rb.values])[0], sim, s_ln, s_ph)
-        best = 0.0
-        boot_done[0] += 1
-        for c in sigs:
+        def say_c(c):
             say("null", f"null refit {boot_done[0] // (len(sigs) + 1) + 1}/{int(null_refits)}: {c}", boot_done[0], n_boot)
-            best = max(best, 2 * (rb.cost - refit([c], rb.values, starts_for(c, r_b, Q0), sim=sim, identify=False,
-                                                   from_user=True).cost))
             boot_done[0] += 1
-        return best
+        boot_done[0] += 1
+        return rf.null_max_lr(sim, rb, Q0, say_c)
 
+    fit_null = partial(rf.fit_null, v0)
     ratio, full_max, lin_used = bootstrap_ratio(E, lin_max, G0, data, s_ln, s_ph, int(null_refits), fit_null, refit_max)
     T = T_lin * ratio
     say("null", f"null threshold {T:.3g} (linearised {T_lin:.3g} × nonlinearity ratio {ratio:.3g})")
@@ -351,6 +311,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         v_steps[0] += 1
         say("verdict", msg, v_steps[0], v_steps[0] + 4)
 
+    counter.enter("verdicts")
     say_v("testing significance and the gap")
     def gap_thr(effs: Sequence[str]) -> float:
         if not effs:
@@ -442,6 +403,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
             joint linearised estimate at the baseline."""
             key = frozenset((a, b))
             if key not in fitted_pairs:
+                was = counter.stage
+                counter.enter("pairs")
                 own = {**fits[a].values, **{k: v for k, v in fits[b].values.items() if k.startswith(b + ".")}}
                 own_b = {**fits[b].values, **{k: v for k, v in fits[a].values.items() if k.startswith(a + ".")}}
                 _, r_a, Qa = explain_scores(a)
@@ -450,6 +413,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
                         refit([a, b], own_b, [{a: lin_start(a, r_b, Qb)}]),
                         refit([a, b], v0, [joint_start(a, b)])]
                 fitted_pairs[key] = min(runs, key=lambda x: x.cost)
+                counter.enter(was)
             return fitted_pairs[key]
 
         def pair_fits(pairs):
@@ -696,7 +660,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
         metadata={"base": base.name, "kernel": kernel, "free": names0, "baseline_effects": beff, "candidates": cand,
-                  "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried,
+                  "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried, "profile": counter.as_dict(),
                   "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,

@@ -192,18 +192,58 @@ def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[
     return _residuals_and_jacobian(batch, ScaledRows(free, x, range(len(free))), z, hi, fd_step, res)
 
 
+_JOINED = "start "
+
+
+def joined_start(record: StartRecord) -> int | None:
+    """The index of the earlier start whose optimum ``record``'s start joined (status −2), else None."""
+    if record.status != -2:
+        return None
+    tail = record.message.rsplit(_JOINED, 1)[-1]
+    digits = tail.split("'", 1)[0]
+    return int(digits) if digits.isdigit() else None
+
+
+#: A coordinate of an optimum within this fraction of its range from a bound sits at that bound.
+AT_BOUND = 1e-6
+
+
+def _landing(z, r, J, step, z_opt, lo, hi) -> np.ndarray:
+    """Where the Gauss–Newton model from ``z`` lands, as seen from an earlier optimum ``z_opt``:
+    ``z + step`` — unless ``z_opt`` sits at bounds (an effect at its off value): then the model's
+    minimum on that face (those coordinates held at the optimum's bound, the others solved), if it
+    is the minimum over the box too (each held coordinate's gradient there points out of the box,
+    the Karush–Kuhn–Tucker sign); else ``z + step`` (no join on a face the model would leave)."""
+    span = hi - lo
+    low, high = z_opt - lo <= AT_BOUND * span, hi - z_opt <= AT_BOUND * span
+    held = low | high
+    if not held.any():
+        return z + step
+    d = np.zeros_like(z)
+    d[held] = z_opt[held] - z[held]
+    free = ~held
+    rr = r + J[:, held] @ d[held]
+    if free.any():
+        d[free] = np.linalg.lstsq(J[:, free], -rr, rcond=None)[0]
+    g = J.T @ (r + J @ d)                      # the model's gradient at the landing point
+    if np.all(g[low] >= 0) and np.all(g[high] <= 0):
+        return z + d
+    return z + step
+
+
 class _Stop(Exception):
     """Ends scipy's search from inside the residual function."""
 
 
 def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatch, res, max_nfev, ftol,
-           fd_step, optima: Sequence[_Fit] = (), first: tuple | None = None) -> _Fit:
+           fd_step, optima: Sequence[_Fit] = (), first: tuple | None = None, damped: bool = True) -> _Fit:
     """Least squares over the ``active`` parameters of ``free`` in their scaled space (the others
     at ``x_full``); search and stopping in the module doc.  A point costs one batched model call,
     residuals and Jacobian together (a Broyden-updated Jacobian needed three times the points).
     Plain Gauss–Newton steps converge in 6–7 points on the benchmark where scipy's trust region,
     which starts small, needs 9–10.  s² = 2·cost/dof scales the tests to standard errors.
-    ``first``: the residuals and Jacobian at the (clipped) start, already computed.
+    ``first``: the residuals and Jacobian at the (clipped) start, already computed.  ``damped``
+    False: a later start goes straight to the trust region, as start 0 does.
     """
     act = [free[k] for k in active]
     lo = np.array([fp.z_bounds[0] for fp in act])
@@ -227,10 +267,10 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
             return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c
         for opt in optima:
             if opt.status > 0 and opt.cost <= c <= opt.cost + JOIN_COST * s2:
-                d = z + step - opt.z
+                d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
                 if float(d @ (opt.J.T @ opt.J) @ d) <= JOIN_DISTANCE**2 * s2:
                     return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
-                                f"errors of start {opt.index}'s optimum"), step, c
+                                f"errors of {_JOINED}{opt.index}'s optimum"), step, c
         return None, "", step, c
 
     def evaluate(z):
@@ -266,7 +306,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         if not new[6] < pt[6]:
             break
         pt = new
-    if pt[3] is None and optima and not stopped_at_budget():
+    if pt[3] is None and optima and damped and not stopped_at_budget():
         # a later start: damped Gauss-Newton (Levenberg-Marquardt) steps kept in the box until it
         # converges or reaches an earlier optimum; scipy's trust region (below) only if it stalls
         pt = damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget)
@@ -297,7 +337,8 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
                    identify: bool = True, hold_undetermined: bool | str = True,
                    probe: SensitivityProbe | None = None, fd_step: float = FD_STEP,
                    progress: Callable[[int], None] | None = None,
-                   predict_array: Callable[[np.ndarray], np.ndarray] | None = None) -> CalibrationResult:
+                   predict_array: Callable[[np.ndarray], np.ndarray] | None = None,
+                   initials: Sequence[Values] = (), damped: bool = True) -> CalibrationResult:
     """Fit ``free`` parameters of a generic predictor to ``data`` by weighted least squares.
 
     Parameters
@@ -335,6 +376,15 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         Wide-band evaluation locating where each parameter acts.
     progress : callable or None
         ``progress(1)`` after each start.
+    initials : sequence of mappings
+        Further start points, physical values of every free parameter (clipped to the bounds),
+        taken after start 0 and before the Latin-hypercube ones: several warm starts searched
+        as one multi-start, so a later one that reaches an earlier optimum stops there (status
+        −2, :func:`joined_start`).
+    damped : bool
+        The later starts take Levenberg–Marquardt steps before scipy's trust region (module doc);
+        False: they go to the trust region at once, as start 0 does (for starts whose optimum
+        lies at a bound, where the damped steps crawl along it).
 
     Returns
     -------
@@ -374,7 +424,9 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         if len(held) == len(free):
             raise IPMCError(f"the data depend on none of the free parameters {list(held)} (zero sensitivity)")
     active = [k for k, fp in enumerate(free) if fp.name not in held]
-    z_starts = np.vstack([z_init[None, :], lhs_starts(free, int(starts) - 1, seed)])
+    z_given = [[fp.to_z(min(max(float(v[fp.name]), fp.lower), fp.upper)) for fp in free] for v in initials]
+    z_starts = np.vstack([z_init[None, :], np.array(z_given, float).reshape(-1, len(free)),
+                          lhs_starts(free, int(starts) - 1, seed)])
     z_starts[:, [k for k in range(len(free)) if k not in active]] = z_init[[k for k in range(len(free)) if k not in active]]
     records, fits, ends = [], [], []
     firsts: dict = {}
@@ -386,7 +438,8 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
             pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[1:]]
             firsts = dict(enumerate(_residuals_and_jacobians(batch, ScaledRows(free, x_full, active), pts, hi_a,
                                                              fd_step, res), start=1))
-        fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits, firsts.get(i))
+        fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits, firsts.get(i),
+                     damped)
         fit.index = i
         fits.append(fit)
         ends.append(z0.copy())

@@ -112,7 +112,7 @@ def _scan_axis(p, n: int) -> np.ndarray:
 
 
 def scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, data, s_ln, s_ph, Q0, E,
-             h: float = 1e-3, max_points: int = SCAN_POINTS) -> np.ndarray:
+             h: float = 1e-3, max_points: int = SCAN_POINTS, is_off=None) -> np.ndarray:
     """Linearised null LR of a candidate whose parameters include *degenerate* ones (no first-order
     signature at off: a shape that only exists once the effect is on, e.g. the frequency and damping
     of a resonance, the viscosity of a fluid load), with the look-elsewhere effect over them.
@@ -125,7 +125,9 @@ def scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, dat
     whose time constant and damping are both degenerate, the sizes between grid points are covered
     by the ray, a slight over-cover, i.e. conservative).  Columns are projected off the baseline
     Jacobian (``Q0``); returns the max over the grid of the constrained LR for every column of ``E``
-    (the null draws, already projected)."""
+    (the null draws, already projected).  ``is_off(effect values)`` (the effect's
+    :meth:`~physmodel.effects.base.Effect.is_off`): grid points where the effect is off (its
+    amplitudes off) predict the baseline itself, so their residuals are ``r0``, not evaluated again."""
     from itertools import product
 
     deg = [i for i, x in enumerate(degenerate) if x]
@@ -144,7 +146,12 @@ def scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, dat
             w = dict(v)
             w[f"{effect}.{params[i].name}"] = params[i].off + h * (params[i].typical - params[i].off)
             pts.append(w)
-    R = standardised_residuals(predict_many(pts), data, s_ln, s_ph)        # (points, 2N)
+    # a point where the effect is off (amplitudes off at a grid point of its shape) predicts the
+    # baseline itself: its residuals are r0, not evaluated again
+    on = np.array([is_off is None or not is_off({p.name: v[f"{effect}.{p.name}"] for p in params}) for v in pts])
+    R = np.repeat(r0[None, :], len(pts), axis=0)                           # (points, 2N)
+    if on.any():
+        R[on] = standardised_residuals(predict_many([v for v, x in zip(pts, on) if x]), data, s_ln, s_ph)
     stride = 1 + len(amp)
     base = R[0::stride]                                                    # each grid point, amplitudes off
     tang = [(R[1 + j::stride] - base) / h for j in range(len(amp))]       # (G, 2N) each
@@ -156,7 +163,7 @@ def scan_lr(predict_many, values: dict, effect: str, params, degenerate, r0, dat
     one = [params[i].off in (params[i].lower, params[i].upper) for i in amp] + [True]
     cols[~use_ray, len(amp)] = 0.0                                         # no ray where the point alone is off
     cols[~np.all(np.isfinite(cols), axis=(1, 2))] = 0.0                    # a grid point the model cannot evaluate
-    B = np.einsum("gkn,nd->gkd", cols, E)                                  # (G, k + 1, draws)
+    B = (cols.reshape(-1, cols.shape[2]) @ E).reshape(cols.shape[0], cols.shape[1], -1)   # (G, k + 1, draws), BLAS
     return _constrained_lr_gram(cols @ cols.transpose(0, 2, 1), B, one).max(axis=0)
 
 

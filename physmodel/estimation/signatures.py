@@ -280,16 +280,29 @@ def declare_confusable(confusable: list, separation: dict, confusability: dict, 
             separation[key] += f" The library holds them as one physics in two forms: {same_physics}."
 
 
-def refit_spread(runs: list, best, best_origin: str, tol: float = 1.0) -> dict:
-    """Multi-start record of a candidate refit: ``runs`` = [(origin, CalibrationResult)]; the costs,
-    origins, the best's origin, how many reach the best cost within ``tol`` (½Δχ²), the cost spread
-    and each parameter's range over the starts that reach it."""
-    costs = [float(r.cost) for _, r in runs]
-    near = [r for _, r in runs if r.cost <= best.cost + tol]
-    return {"n_starts": len(runs), "costs": costs, "origins": [o for o, _ in runs], "best_origin": best_origin,
-            "n_at_best": len(near), "cost_spread": max(costs) - min(costs),
-            "ranges": {n: [float(min(r.values[n] for r in near)), float(max(r.values[n] for r in near))]
-                       for n in best.names}}
+def refit_spread(res, origins: Sequence[str], tol: float = 1.0) -> dict:
+    """Multi-start record of a candidate refit ``res`` (one multi-start search, start k from
+    ``origins[k]``): the costs, origins, the best's origin, how many reach the best cost within
+    ``tol`` (½Δχ²) — a start that stopped early in the basin of one that did (status −2,
+    :func:`~physmodel.estimation.lsq.joined_start`) counts as reaching it — the cost spread of the
+    starts that ran to their end and each parameter's range over the starts that reach the best."""
+    from .lsq import joined_start
+
+    st = res.starts
+    ran = [x for x in st if x.status != -2]
+    best = min(ran, key=lambda x: x.cost)
+    near = [x for x in ran if x.cost <= best.cost + tol]
+    at_best = {x.index for x in near}
+    for x in st:                 # joined starts follow the start they joined (an earlier one)
+        j = joined_start(x)
+        if j is not None and j in at_best:
+            at_best.add(x.index)
+    costs = [float(x.cost) for x in st]
+    return {"n_starts": len(st), "costs": costs, "origins": list(origins), "best_origin": origins[best.index],
+            "n_at_best": len(at_best), "n_joined": sum(x.status == -2 for x in st),
+            "cost_spread": max(float(x.cost) for x in ran) - float(best.cost),
+            "ranges": {n: [float(min(x.final[n] for x in near)), float(max(x.final[n] for x in near))]
+                       for n in res.names}}
 
 
 def pair_members(best: Sequence[str], other: Sequence[str], sigs: dict) -> list:
