@@ -55,7 +55,8 @@ from physmodel.errors import IPMCError
 from surrogate import FORMS
 
 #: The order in which the runner executes the step tables.
-STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy", "chain", "fixtures")
+STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy",
+              "next_measurement", "chain", "fixtures")
 
 
 class ScenarioError(IPMCError):
@@ -125,8 +126,16 @@ CHAIN_SCHEMA = {"temperature_c": NUM, "fmin_hz": NUM, "fmax_hz": NUM, "points": 
                 "preview": NUM_OR_STR, "decode_frequencies_hz": NUMS, "amplitude_mm": NUM, "fs_hz": NUM,
                 "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM, "d_profile": NUMS}
 
+#: [next_measurement]: ambiguous → the recommended measurement → named (scenarios/steps_next_measurement.py).
+NEXT_MEASUREMENT_SCHEMA = {"effects": _Map(_Map(NUM)), "temperatures_c": NUMS, **_SWEEP_GRID, "fs_hz": NUM, "period_s": NUM,
+                           "periods": INT, "transient_periods": INT, "rms": NUM, "oversample": INT, "output_noise_rms": NUM,
+                           "noise_seed": INT, "next_noise_seed": INT, "free": STRS, "candidates": STRS, "null_draws": INT,
+                           "null_refits": INT, "alpha": NUM, "seed": INT, "laws": STR, "baseline_starts": INT,
+                           "band_limits_hz": NUMS, "temperature_limits_c": NUMS, "levels": NUMS, "power": NUM}
+
 SECTIONS = {
     "chain": CHAIN_SCHEMA,
+    "next_measurement": NEXT_MEASUREMENT_SCHEMA,
     "control_route": CONTROL_ROUTE_SCHEMA,
     "scenario": {"name": STR, "title": STR, "description": STR, "source": STR},
     "model": {"kind": _choice("actuator", "sensor"), "set": STR, "quantity": STR,
