@@ -44,7 +44,8 @@ result.
 Decision: the separation needed is λ* with Vuong power ``power`` at the diagnosis's α
 (:func:`~physmodel.estimation.signatures.vuong_power`: z ~ N(√λ/2, 1), so λ* = 4(z_crit + Φ⁻¹(power))²).
 Among the experiments reaching λ* and taking no longer than the diagnosed record did (duration ≈
-number of temperatures × :data:`PERIODS` / lowest frequency; or than the quickest that reaches λ*),
+number of temperatures × :data:`PERIODS` / lowest frequency, plus :data:`BATH_SETTLE_S` per new
+bath temperature; or than the quickest that reaches λ*),
 the recommendation is the one at the lowest drive level, then of the largest λ (the safest margin);
 when none reaches λ*, the one of largest λ, with ``separates = False`` and the sentence saying so.  The linearised λ of the
 recommendation (and of the next ones when it falls short) is then checked by a full nonlinear refit
@@ -74,6 +75,9 @@ DEFAULT_BAND_LIMITS_HZ = (0.01, 1000.0)
 DEFAULT_LEVELS = (1.0, 2.0)
 #: Measured periods per temperature assumed for a measurement's duration.
 PERIODS = 10
+#: Time a water bath takes to settle at a temperature the record was not measured at (a stated
+#: choice: minutes for a stirred bath and a 0.2 mm strip), added to a measurement's duration. [s]
+BATH_SETTLE_S = 600.0
 #: Relative step of the central differences of the Jacobians.
 FD_RELATIVE_STEP = 1e-5
 #: A pair whose linearised separation stays below this in every experiment is the same response in
@@ -109,7 +113,8 @@ class CandidateMeasurement:
     joint : bool
         Evaluated together with the diagnosed record (same quantity: merge and diagnose both).
     duration_s : float
-        Measurement time estimate: temperatures × :data:`PERIODS` / lowest frequency. [s]
+        Measurement time estimate: temperatures × :data:`PERIODS` / lowest frequency, plus
+        :data:`BATH_SETTLE_S` per temperature the record was not measured at. [s]
     power : float
         Probability that Vuong's test separates them at the diagnosis's α (normal approximation).
     separation_refit : float
@@ -117,6 +122,9 @@ class CandidateMeasurement:
         response in another form left out. [-]
     refit_by_pair : dict
         ``"A vs B"`` → λ after the refits, the least over the two directions (checked experiments). [-]
+    line_temperatures_c, line_frequencies_hz : ndarray
+        Every line of the new record (a joint record leaves out the diagnosed record's band at its
+        temperatures). [°C], [Hz]
     """
 
     quantity: str
@@ -132,18 +140,24 @@ class CandidateMeasurement:
     power: float
     separation_refit: float = float("nan")
     refit_by_pair: dict = field(default_factory=dict)
+    line_temperatures_c: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    line_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
     def describe(self) -> str:
         """The experiment in words."""
         T = ", ".join(f"{t:g}" for t in self.temperatures_c)
         return (f"{self.quantity} at {T} °C, {self.band_hz[0]:.3g}–{self.band_hz[1]:.3g} Hz "
-                f"({self.frequencies_hz.size} lines per temperature), drive ×{self.level:g}"
+                f"({self.n_lines} lines"
+                + (", none inside the record's band at its temperatures" if self.joint else "")
+                + f"), drive ×{self.level:g}"
                 + (" (merged with the diagnosed record)" if self.joint else " (a record of its own)"))
 
     def to_dict(self) -> dict:
         """JSON-ready form."""
         return {"quantity": self.quantity, "band_hz": list(self.band_hz), "temperatures_c": list(self.temperatures_c),
                 "level": self.level, "n_lines": self.n_lines, "frequencies_hz": self.frequencies_hz.tolist(),
+                "lines": {"temperature_c": self.line_temperatures_c.tolist(),
+                          "frequency_hz": self.line_frequencies_hz.tolist()},
                 "separation": self.separation, "separation_by_pair": self.separation_by_pair, "joint": self.joint,
                 "duration_s": self.duration_s, "power": self.power, "separation_refit": self.separation_refit,
                 "refit_by_pair": self.refit_by_pair,
@@ -179,6 +193,8 @@ class NextMeasurement:
     inseparable : list of str
         ``"A vs B"`` pairs no experiment within the limits separates (the same response in another
         form: linearised, or after the refits of every checked experiment).
+    best_by_quantity : dict
+        Quantity → the largest linearised separation any experiment of it reaches. [-]
     """
 
     models: list
@@ -192,6 +208,7 @@ class NextMeasurement:
     fitted: dict
     message: str
     inseparable: list = field(default_factory=list)
+    best_by_quantity: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready form (finite floats; NaN as None)."""
@@ -210,7 +227,7 @@ class NextMeasurement:
                       "separates": self.separates, "target": self.target, "current": self.current,
                       "evaluated": self.evaluated, "ranking": [r.to_dict() for r in self.ranking],
                       "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
-                      "inseparable": list(self.inseparable)})
+                      "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity})
 
 
 # =============================================================================== competing models
@@ -556,10 +573,14 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                         f"{label(a)} true": float(la[e]), f"{label(b)} true": float(lb[e])}
         for i, level in enumerate(lv):
             for e, (_, ts) in enumerate(meta):
-                fl = np.unique(sk.frequency_hz[M[e] > 0])
+                on = M[e] > 0
+                fl = np.unique(sk.frequency_hz[on])
                 rows.append(CandidateMeasurement(q, (float(fl.min()), float(fl.max())), tuple(ts), float(level),
                                                  int(M[e].sum()), fl, math.inf, by_pair[i * M.shape[0] + e],
-                                                 same, len(ts) * PERIODS / float(fl.min()), 0.0))
+                                                 same, len(ts) * PERIODS / float(fl.min())
+                                                 + BATH_SETTLE_S * int(np.sum(~np.isin(ts, T_data))), 0.0,
+                                                 line_temperatures_c=sk.temperature_c[on],
+                                                 line_frequencies_hz=sk.frequency_hz[on]))
     if not rows:
         raise IPMCError("next_measurement: no candidate experiment within the limits")
     # a pair that no experiment separates even linearised (the same response in another form) is
@@ -614,7 +635,9 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                f"best, {chosen.describe()}, gives λ = {lam_said:.3g} < {target:.3g} needed (the record alone "
                f"{current:.3g}); lower the noise (more periods), widen the limits, or accept the ambiguity.{alike}")
     return NextMeasurement([tuple(m) for m in mods], chosen, bool(sep_ok), target, float(current), len(rows),
-                           ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form)
+                           ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form,
+                           {q: max(r.separation for r in rows if r.quantity == q) for q in qs
+                            if any(r.quantity == q for r in rows)})
 
 
 def merge_records(record: FrequencySweep, new: FrequencySweep) -> FrequencySweep:
@@ -661,8 +684,9 @@ def _refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: in
     least over the two directions}`` for each of ``pairs``."""
     from .lsq import fit_parameters
 
-    T = np.asarray(r.temperatures_c, float)
-    sk = _skeleton(d.kind, r.quantity, r.frequencies_hz, T)
+    in_name, unit_in, out_name, unit_out = QUANTITY_UNITS[(d.kind, r.quantity)]
+    sk = FrequencySweep(r.line_temperatures_c, r.line_frequencies_hz, np.ones(r.n_lines, complex), None, None,
+                        in_name, unit_in, out_name, unit_out)
     cb = d.metadata.get("candidate_bounds", {})
     out = {}
     for a, b in pairs:
@@ -701,5 +725,5 @@ def _refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: in
 
 
 __all__ = ["CandidateMeasurement", "NextMeasurement", "competing_models", "merge_records", "next_measurement",
-           "PERIODS", "SAME_FORM_LAMBDA", "REFIT_STARTS", "FD_RELATIVE_STEP",
+           "PERIODS", "BATH_SETTLE_S", "SAME_FORM_LAMBDA", "REFIT_STARTS", "FD_RELATIVE_STEP",
            "DEFAULT_BAND_LIMITS_HZ", "DEFAULT_LEVELS", "DEFAULT_TEMPERATURE_LIMITS_C"]

@@ -178,3 +178,21 @@ def test_the_scenario_records_carry_the_hidden_pole(tmp_path):
     assert np.max(np.abs(np.log(droop / expect))) < 0.02
     assert math.isclose(float(np.median(np.angle(rec2.response / P) / np.angle(1 / (1 + 2j * np.pi * rec2.frequency_hz * TAU)))),
                         1.0, rel_tol=0.02)
+
+
+def test_default_search_spans_quantities_temperatures_and_levels(ambiguous):
+    """Without restrictions the search covers S and Z (Z a record of its own), temperatures across the
+    default range and both drive levels; a new bath temperature costs its settling time, so the
+    recommendation stays at the record's 35 °C when that suffices."""
+    nm = next_measurement(ambiguous.d)
+    qs = {r.quantity: r for r in nm.ranking}
+    assert nm.evaluated > 100 and nm.separates
+    r = nm.recommended
+    assert r.temperatures_c == (35.0,) and r.duration_s < nmod.BATH_SETTLE_S
+    rows = {(x["quantity"], x["joint"]) for x in nm.to_dict()["ranking"]}
+    assert ("S", True) in rows and "S" in qs
+    assert set(nm.best_by_quantity) == {"S", "Z"}      # Z evaluated too (a record of its own)
+    assert nm.best_by_quantity["S"] >= max(nm.best_by_quantity.values())
+    temps = {t for x in nm.to_dict()["ranking"] for t in x["temperatures_c"]}
+    assert json.dumps(nm.to_dict(), allow_nan=False)        # the report can hold it
+    assert temps <= set(np.linspace(*nmod.DEFAULT_TEMPERATURE_LIMITS_C, 5)) | {35.0}
