@@ -6,7 +6,7 @@ except ``[scenario]``, ``[model]`` and ``[checks]``; the steps run in this order
 table is present:
 
 ``[sweep]`` → ``[surrogate]`` → ``[inversion]`` → ``[widths]`` → ``[taylor]`` → ``[blackbox]``
-→ ``[discrepancy]`` → ``[fixtures]``.
+→ ``[discrepancy]`` → ``[next_measurement]`` → ``[fixtures]``.
 
 Schema (units in the key names; SI otherwise)::
 
@@ -34,6 +34,12 @@ Schema (units in the key names; SI otherwise)::
     [blackbox]   orders = [[n_zeros, n_poles], ...], temperature_c (one of the sweep's)
     [discrepancy] effects = { name = { param = value } } (physmodel.effects), free (list),
                  null_draws, null_refits, alpha, seed  (physmodel.estimation.discrepancy.diagnose)
+    [next_measurement] effects = { name = { param = value } } (a hidden instrument element), the first
+                 virtual-lab record's design (temperatures_c, fmin_hz, fmax_hz, points, fs_hz, period_s,
+                 periods, transient_periods, rms, oversample), output_noise_rms, noise_seed,
+                 next_noise_seed, the diagnosis's free, candidates, null_draws, null_refits, alpha, seed,
+                 laws, baseline_starts and the search's band_limits_hz, temperature_limits_c, levels, power
+                 (scenarios/steps_next_measurement.py)
     [fixtures]   count, seed, formats (subset of ["csv", "npz", "mat"]), temperatures_c,
                  fmin_hz, fmax_hz, points, step_duration_s, fs_hz, noise_rms_mm
     [checks.NAME] metric = "section.metric" or "a / b", min, max, description

@@ -196,3 +196,20 @@ def test_default_search_spans_quantities_temperatures_and_levels(ambiguous):
     temps = {t for x in nm.to_dict()["ranking"] for t in x["temperatures_c"]}
     assert json.dumps(nm.to_dict(), allow_nan=False)        # the report can hold it
     assert temps <= set(np.linspace(*nmod.DEFAULT_TEMPERATURE_LIMITS_C, 5)) | {35.0}
+
+
+def test_experiment_file_next_measurement_table(ambiguous, tmp_path, capsys):
+    from scenarios.cli import main
+
+    ambiguous.rec.to_csv(tmp_path / "record.csv")
+    base = ('data = "record.csv"\nkind = "sensor"\nset = "seed000_sensor_dev"\nfree = ["a0", "d", "kappa_e"]\n'
+            'candidates = ["time_delay", "amplifier_bandwidth"]\nnull_draws = 400\nnull_refits = 0\n'
+            '[parameters]\nT_ref = 308.15\n')
+    (tmp_path / "bad.toml").write_text(base + '[next_measurement]\nband = [0.1, 1000.0]\n')
+    assert main(["diagnose", str(tmp_path / "bad.toml"), "--out", str(tmp_path / "b"), "--quiet"]) == 2
+    assert "next_measurement" in capsys.readouterr().err
+    (tmp_path / "ok.toml").write_text(base + '[next_measurement]\nquantities = ["S"]\nband_limits_hz = [0.1, 300.0]\n'
+                                      'temperature_limits_c = [35.0, 35.0]\nlevels = [1.0]\n')
+    assert main(["diagnose", str(tmp_path / "ok.toml"), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    rec = json.loads((tmp_path / "o" / "report.json").read_text())["next_measurement"]["recommended"]
+    assert rec["quantity"] == "S" and rec["band_hz"][1] <= 300.0 and rec["level"] == 1.0
