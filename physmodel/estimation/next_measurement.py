@@ -532,7 +532,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         sk = _skeleton(d.kind, q, f_grid, T_grid)
         resp = {id(m): m.log_response(sk, q) for m in fitted}
         same = q == d.quantity
-        logabs = resp[id(fitted[0])][0].real
+        logabs = resp[id(fitted[0])][0].real + _log_unit_factor(d, sk)      # in the record's units
         sl, sp = _sigma(nm, logabs, lv, same)                   # (n_levels, N)
         # masks: experiment e = (window, temperature set) × level
         masks, meta, seen = [], [], set()
@@ -677,6 +677,20 @@ def _law_range(base) -> tuple:
     return lo, hi
 
 
+def _log_unit_factor(d, sk: FrequencySweep) -> float:
+    """ln of the factor from ``sk``'s response units to the diagnosed record's (same dimensions)."""
+    from ..data.units import unit_scale
+
+    if (d.data.input_unit, d.data.output_unit) == (sk.input_unit, sk.output_unit):
+        return 0.0
+    try:
+        f = (unit_scale(sk.output_unit) / unit_scale(sk.input_unit)) / (unit_scale(d.data.output_unit)
+                                                                        / unit_scale(d.data.input_unit))
+    except (KeyError, IPMCError):
+        return 0.0
+    return float(np.log(abs(f)))
+
+
 def _refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int, label) -> dict:
     """λ of experiment ``r`` by full refits: each rival refitted to the other's noiseless predictions
     on the new lines (with the record's lines when joint) from its own fit, from its effect at its
@@ -694,7 +708,7 @@ def _refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: in
         for truth, rival in ((a, b), (b, a)):
             G = np.asarray(truth.model.predictor(sk, r.quantity).many([truth.values])[0])
             if r.joint:
-                s_ln, s_ph = _sigma(nm, np.log(np.abs(G)), np.array([r.level]), True)
+                s_ln, s_ph = _sigma(nm, np.log(np.abs(G)) + _log_unit_factor(d, sk), np.array([r.level]), True)
                 G0 = np.asarray(truth.model.predictor(d.data, d.quantity).many([truth.values])[0])
                 rec = FrequencySweep(d.data.temperature_c, d.data.frequency_hz, G0, d.data.magnitude_std_db,
                                      d.data.phase_std_deg, d.data.input_name, d.data.input_unit, d.data.output_name,

@@ -213,3 +213,17 @@ def test_experiment_file_next_measurement_table(ambiguous, tmp_path, capsys):
     assert main(["diagnose", str(tmp_path / "ok.toml"), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     rec = json.loads((tmp_path / "o" / "report.json").read_text())["next_measurement"]["recommended"]
     assert rec["quantity"] == "S" and rec["band_hz"][1] <= 300.0 and rec["level"] == 1.0
+
+
+def test_the_record_units_do_not_change_the_recommendation(ambiguous):
+    """The same record in A/m instead of µA/mm (the noise model regresses σ on |G| in the record's units)."""
+    from dataclasses import replace
+
+    kw = dict(quantities=["S"], temperature_limits_c=(35.0, 35.0), band_limits_hz=(0.1, 1000.0), check_refit=0)
+    a = next_measurement(ambiguous.d, **kw)
+    b = next_measurement(replace(ambiguous.d, data=ambiguous.d.data.in_units("m", "A")), **kw)
+    assert b.recommended.describe() == a.recommended.describe()
+    # the rival is refitted to the record in each unit system: its optimiser stops within its own
+    # tolerance (measured 4e-4 relative in λ), which a units bug (a factor of 1e3 in |G|^b) would dwarf
+    assert b.recommended.separation == pytest.approx(a.recommended.separation, rel=1e-2)
+    assert b.noise_model["slope"] == pytest.approx(a.noise_model["slope"], abs=1e-9)
