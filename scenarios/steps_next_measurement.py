@@ -169,7 +169,7 @@ def step_next_measurement(ctx: RunContext):
                == hidden)
     ctx.metric("next_measurement.second_n_named", len(d2.named) if d2 is not None else 0)
     ctx.section("The next measurement",
-                f"Hidden in the virtual lab's physics: {effects}. The first record (the [sweep] design) is "
+                f"Hidden in the virtual lab's physics: {effects}. The first record (the table's design) is "
                 f"diagnosed: **{d1.verdict}** ({', '.join(d1.named) or 'nothing named'}).", "",
                 (nm.message if nm is not None else "No recommendation: the first verdict leaves no competing models."),
                 "", md_table(["records diagnosed", "verdict", "named", "expected λ of the added record"], rows), "",
