@@ -25,18 +25,18 @@ called ``none``, are listed and not counted.
 Measured 2026-11-26 (seeds the helper did not develop on; development used 900-905 and the
 scenario's virtual-lab record), 2 shared cores:
 
-================================================  =====================  =========================
-                                                  the pair only          all seven candidates
-                                                  (7000-7015)            (7100-7105)
-================================================  =====================  =========================
-ambiguous after one 10-100 Hz record              11/32                  5/12 (7 'none': λ < 4)
-named exactly after the recommended measurement   **11/11** [0.74, 1]   2/5 [0.12, 0.77]
-expected to separate (λ after refits ≥ target)    9/11 (2 named anyway)  2/5 (both named; the 3
-                                                                         others stayed ambiguous,
-                                                                         as forecast)
-recommended                                       S 108-1000 Hz (9),     S 108-1000 Hz (5)
-                                                  S 2.3-210 Hz (2)
-================================================  =====================  =========================
+===============================================  =====================  ========================
+                                                 the pair only          all seven candidates
+                                                 (7000-7015)            (7100-7105)
+===============================================  =====================  ========================
+ambiguous after one 10-100 Hz record             11/32                  5/12 (7 'none': λ < 4)
+named exactly after the recommended measurement  **11/11** [0.74, 1]    2/5 [0.12, 0.77]
+expected to separate (λ after refits ≥ target)   9/11 (2 named anyway)  2/5 (both named; the 3
+                                                                        others stayed ambiguous,
+                                                                        as forecast)
+recommended                                      S 108-1000 Hz (9),     S 108-1000 Hz (5)
+                                                 S 2.3-210 Hz (2)
+===============================================  =====================  ========================
 
 The three misses with all candidates are amplifier cases left ambiguous between amplifier_bandwidth
 and transimpedance, which the recommendation h  ad said no experiment up to 1 kHz separates (the two
