@@ -633,7 +633,10 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     else:
         msg = (f"No experiment within the limits is expected to separate {who} at the noise of this record: the "
                f"best, {chosen.describe()}, gives λ = {lam_said:.3g} < {target:.3g} needed (the record alone "
-               f"{current:.3g}); lower the noise (more periods), widen the limits, or accept the ambiguity.{alike}")
+               f"{current:.3g}); lower the noise (more periods"
+               + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_said)}× "
+                  "as many" if 0 < lam_said < target else "")
+               + f"), widen the limits, or accept the ambiguity.{alike}")
     return NextMeasurement([tuple(m) for m in mods], chosen, bool(sep_ok), target, float(current), len(rows),
                            ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form,
                            {q: max(r.separation for r in rows if r.quantity == q) for q in qs
