@@ -110,6 +110,8 @@ def test_says_honestly_when_the_limits_leave_no_separating_experiment(ambiguous)
     assert not nm.separates
     assert nm.recommended.band_hz[1] <= 10.0 + 1e-9       # only bands below the record remain (its own is measured)
     assert "No experiment within the limits" in nm.message
+    lam = nm.recommended.separation_refit
+    assert 0 < lam < nm.target and f"about {math.ceil(nm.target / lam)}× as many" in nm.message
 
 
 def test_diagnosis_carries_the_recommendation_into_report_and_model_file(ambiguous, tmp_path):
