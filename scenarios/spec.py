@@ -6,7 +6,7 @@ except ``[scenario]``, ``[model]`` and ``[checks]``; the steps run in this order
 table is present:
 
 ``[sweep]`` → ``[surrogate]`` → ``[inversion]`` → ``[widths]`` → ``[taylor]`` → ``[blackbox]``
-→ ``[discrepancy]`` → ``[fixtures]``.
+→ ``[discrepancy]`` → ``[next_measurement]`` → ``[fixtures]``.
 
 Schema (units in the key names; SI otherwise)::
 
@@ -34,6 +34,12 @@ Schema (units in the key names; SI otherwise)::
     [blackbox]   orders = [[n_zeros, n_poles], ...], temperature_c (one of the sweep's)
     [discrepancy] effects = { name = { param = value } } (physmodel.effects), free (list),
                  null_draws, null_refits, alpha, seed  (physmodel.estimation.discrepancy.diagnose)
+    [next_measurement] effects = { name = { param = value } } (a hidden instrument element), the first
+                 virtual-lab record's design (temperatures_c, fmin_hz, fmax_hz, points, fs_hz, period_s,
+                 periods, transient_periods, rms, oversample), output_noise_rms, noise_seed,
+                 next_noise_seed, the diagnosis's free, candidates, null_draws, null_refits, alpha, seed,
+                 laws, baseline_starts and the search's band_limits_hz, temperature_limits_c, levels, power
+                 (scenarios/steps_next_measurement.py)
     [fixtures]   count, seed, formats (subset of ["csv", "npz", "mat"]), temperatures_c,
                  fmin_hz, fmax_hz, points, step_duration_s, fs_hz, noise_rms_mm
     [checks.NAME] metric = "section.metric" or "a / b", min, max, description
@@ -55,7 +61,8 @@ from physmodel.errors import IPMCError
 from surrogate import FORMS
 
 #: The order in which the runner executes the step tables.
-STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy", "chain", "fixtures")
+STEP_ORDER = ("sweep", "surrogate", "control_route", "inversion", "widths", "taylor", "blackbox", "discrepancy",
+              "next_measurement", "chain", "fixtures")
 
 
 class ScenarioError(IPMCError):
@@ -125,8 +132,16 @@ CHAIN_SCHEMA = {"temperature_c": NUM, "fmin_hz": NUM, "fmax_hz": NUM, "points": 
                 "preview": NUM_OR_STR, "decode_frequencies_hz": NUMS, "amplitude_mm": NUM, "fs_hz": NUM,
                 "duration_s": NUM, "settle_s": NUM, "end_margin_s": NUM, "d_profile": NUMS}
 
+#: [next_measurement]: ambiguous → the recommended measurement → named (scenarios/steps_next_measurement.py).
+NEXT_MEASUREMENT_SCHEMA = {"effects": _Map(_Map(NUM)), "temperatures_c": NUMS, **_SWEEP_GRID, "fs_hz": NUM, "period_s": NUM,
+                           "periods": INT, "transient_periods": INT, "rms": NUM, "oversample": INT, "output_noise_rms": NUM,
+                           "noise_seed": INT, "next_noise_seed": INT, "free": STRS, "candidates": STRS, "null_draws": INT,
+                           "null_refits": INT, "alpha": NUM, "seed": INT, "laws": STR, "baseline_starts": INT,
+                           "band_limits_hz": NUMS, "temperature_limits_c": NUMS, "levels": NUMS, "power": NUM}
+
 SECTIONS = {
     "chain": CHAIN_SCHEMA,
+    "next_measurement": NEXT_MEASUREMENT_SCHEMA,
     "control_route": CONTROL_ROUTE_SCHEMA,
     "scenario": {"name": STR, "title": STR, "description": STR, "source": STR},
     "model": {"kind": _choice("actuator", "sensor"), "set": STR, "quantity": STR,

@@ -18,6 +18,7 @@ from .context import RunContext, md_table
 from .spec import ScenarioError
 from .steps_chain import step_chain
 from .steps_control import step_control_route
+from .steps_next_measurement import step_next_measurement
 
 
 def _slug(text: str) -> str:
@@ -482,4 +483,5 @@ def step_fixtures(ctx: RunContext):
 
 STEPS = {"sweep": step_sweep, "surrogate": step_surrogate, "control_route": step_control_route,
          "inversion": step_inversion, "widths": step_widths, "taylor": step_taylor, "blackbox": step_blackbox,
-         "discrepancy": step_discrepancy, "chain": step_chain, "fixtures": step_fixtures}
+         "discrepancy": step_discrepancy, "next_measurement": step_next_measurement, "chain": step_chain,
+         "fixtures": step_fixtures}

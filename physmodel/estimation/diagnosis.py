@@ -15,6 +15,7 @@ from ..data.files import atomic_write
 from ..data.sweep import FrequencySweep
 from ..effects import LIBRARY, get_effect
 from ..errors import ParameterError
+from .next_measurement import NextMeasurement
 from .records import CalibrationResult
 
 VERDICTS = ("none", "named", "ambiguous", "at_bound", "unexplained")
@@ -165,6 +166,11 @@ class Diagnosis:
         Named effects' parameters that ended at their off value (the simpler effect is meant).
     sign_flip : dict
         The costs of the baseline and of its sign reversal (the polarity check).
+    next_measurement : NextMeasurement or None
+        For an ``ambiguous`` or ``at_bound`` verdict, the experiment expected to separate the
+        competing models and its expected separation at this record's noise
+        (:func:`physmodel.estimation.next_measurement.next_measurement`; set by
+        :meth:`recommend_next_measurement`, which ``ipmc diagnose`` calls); None otherwise.
     """
 
     verdict: str
@@ -202,6 +208,27 @@ class Diagnosis:
     base_parameters: object = field(default=None, repr=False)    # the base set with the laws used (IPMCParameters)
     reduced: list = field(default_factory=list)      # named effects' parameters at their off value (simpler form)
     sign_flip: dict = field(default_factory=dict)    # costs of the baseline and of its sign reversal
+    next_measurement: NextMeasurement | None = field(default=None, repr=False)   # ambiguous / at_bound
+
+    # ---------------------------------------------------------------- the next measurement
+    def recommend_next_measurement(self, **kw):
+        """For an ``ambiguous`` or ``at_bound`` verdict, search the experiment that would separate the
+        competing models (:func:`physmodel.estimation.next_measurement.next_measurement`, keywords
+        passed on), keep it in :attr:`next_measurement` (the report and model file carry it) and
+        return it; None for other verdicts.
+
+        Parameters
+        ----------
+        **kw
+            Keywords of :func:`~physmodel.estimation.next_measurement.next_measurement`
+            (``quantities``, ``band_limits_hz``, ``temperature_limits_c``, ``levels``, ``power``, ...).
+        """
+        from .next_measurement import next_measurement
+
+        if self.verdict not in ("ambiguous", "at_bound"):
+            return None
+        self.next_measurement = next_measurement(self, **kw)
+        return self.next_measurement
 
     # ---------------------------------------------------------------- views
     def named_effect(self) -> dict | None:
@@ -255,6 +282,8 @@ class Diagnosis:
         N = self.data.frequency_hz.size
         gof = goodness_of_fit(gap["cost"], 2 * N, int(gap["n_free"]), self.noise_estimated)
         verdict = FitVerdict.from_goodness(gof, self.verdict, self.named)
+        if self.next_measurement is not None:         # the later commands that read the file say it too
+            verdict = _replace(verdict, reason=f"{verdict.reason.rstrip('.')}. {self.next_measurement.message}")
         if provenance is None:
             provenance = Provenance("physmodel.diagnose", data_fingerprint=self.metadata.get("data_fingerprint"),
                                     temperatures_c=tuple(self.data.temperatures().tolist()),
@@ -299,6 +328,7 @@ class Diagnosis:
             "final_outside_plausible_range": self.final_implausible, "cost_warning": self.cost_warning,
             "confusability": self.confusability, "reduced_to_simpler_form": self.reduced,
             "sign_flip": self.sign_flip,
+            "next_measurement": self.next_measurement.to_dict() if self.next_measurement is not None else None,
         })
 
     def _baseline_rows(self) -> list:
@@ -319,6 +349,18 @@ class Diagnosis:
     def summary(self) -> str:
         """A readable Markdown summary."""
         L = [f"# Discrepancy diagnosis: {self.verdict.upper()}", "", self.message, ""]
+        nm = self.next_measurement
+        if nm is not None:
+            L += ["## Next measurement", "", f"**{nm.message}**", ""]
+            if nm.ranking:
+                L += [f"Method: linearised T-optimal discrimination (Atkinson & Fedorov 1975) of "
+                      f"{' vs '.join(' + '.join(m) for m in nm.models)}; {nm.evaluated} experiments evaluated, "
+                      f"separation needed λ ≥ {nm.target:.3g}. Best by expected separation:", "",
+                      "| quantity | band [Hz] | T [°C] | drive | lines | λ (linearised) | power |", "|---|---|---|---|---|---|---|"]
+                L += [f"| {r.quantity} | {r.band_hz[0]:.3g}–{r.band_hz[1]:.3g} | "
+                      f"{', '.join(f'{t:g}' for t in r.temperatures_c)} | ×{r.level:g} | {r.n_lines} | "
+                      f"{r.separation:.3g} | {r.power:.2f} |" for r in nm.ranking[:5]]
+                L += [""]
         if self.noise_estimated:
             L += ["*The data carry no per-line uncertainty: 1 % per line was assumed; absolute gap "
                   "tests are relative to that assumption.*", ""]

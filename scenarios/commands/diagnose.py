@@ -36,6 +36,15 @@ EXPERIMENT.toml (paths relative to the TOML file; SI units for parameters)::
     kappa_e = [1e-7, 1e-5]
     prior = true                       # hold the free base parameters to their plausible ranges
     baseline_starts = 3                # multi-start count of the baseline fit
+    [next_measurement]                 # an ambiguous / at-bound verdict's recommended next measurement
+    quantities = ["S"]                 # what the lab can measure (default every quantity the kind has)
+    band_limits_hz = [0.1, 1000.0]     # the band it may reach [Hz]; temperature_limits_c = [LO, HI] [°C]
+    levels = [1.0, 2.0]                # drive levels, multiples of the record's (cap at what the strip takes)
+
+When the verdict is ambiguous or at bound, it also searches the measurement that would separate
+the competing models (physmodel.estimation.next_measurement: quantity, band, temperatures, drive
+level, with the separation expected at this record's noise) and says it on stderr, in summary.md,
+report.json ("next_measurement") and model.json's verdict reason.
 
 Writes model.json (the model it ends with — the baseline plus the named effect(s), refitted, with the
 goodness-of-fit verdict and the data's provenance: what ``--model`` takes in every later command),
@@ -44,7 +53,8 @@ value and interval, every candidate's statistics, localisation tables, gap befor
 pairs, null calibration), summary.md, bode_before.png and bode_after.png.
 
 Flags: --laws NAME, --law QUANTITY=LAW[:P=V,...] (repeatable), --candidate-bound EFFECT.PARAM=LO:HI,
---candidate-start EFFECT.PARAM=V, --plausible NAME=LO:HI, --no-prior, --baseline-starts N.
+--candidate-start EFFECT.PARAM=V, --plausible NAME=LO:HI, --no-prior, --baseline-starts N,
+--next-quantities Q,Q --next-band-hz LO,HI --next-temperatures-c LO,HI --next-levels A,B.
 
 Exit codes: 0 when the model it ends with fits the data (any verdict), 3 when it does not (the verdict
 ``unexplained``, or a named model still outside the noise; ``--accept-misfit`` to exit 0 — model.json
@@ -108,6 +118,11 @@ def add_parser(subparsers):
                    help="write into a folder that holds another run's results")
     p.add_argument("--accept-misfit", action="store_true",
                    help="exit 0 even when the model diagnose ends with does not fit the data (model.json says so)")
+    p.add_argument("--next-quantities", metavar="Q[,Q]",
+                   help="an ambiguous verdict's next measurement: quantities the lab can measure (default all)")
+    p.add_argument("--next-band-hz", metavar="LO,HI", help="... lowest and highest frequency it may reach [Hz]")
+    p.add_argument("--next-temperatures-c", metavar="LO,HI", help="... bath temperatures allowed [°C]")
+    p.add_argument("--next-levels", metavar="A[,B...]", help="... drive levels, multiples of the record's")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     add_sweep_options(p, "--data")
     p.set_defaults(func=run)
@@ -127,7 +142,7 @@ def _load_toml(path: Path) -> dict:
         raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
     known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
              "geometry", "parameters", "baseline_effects", "null_draws", "null_refits", "laws",
-             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts"}
+             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts", "next_measurement"}
     unknown = set(spec) - known
     if unknown:
         raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
@@ -177,7 +192,10 @@ _TYPES = {"data": (lambda v: isinstance(v, str), "a file name"), "kind": (lambda
                                "a table of NAME = number"),
           "plausible": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
           "prior": (lambda v: isinstance(v, bool), "true or false"),
-          "baseline_starts": (lambda v: _is_int(v) and v >= 1, "a positive integer")}
+          "baseline_starts": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
+          "next_measurement": (lambda v: isinstance(v, dict) and set(v) <= {"quantities", "band_limits_hz",
+                                                                            "temperature_limits_c", "levels", "power"},
+                               "a table of quantities, band_limits_hz, temperature_limits_c, levels, power")}
 
 
 def _check_types(spec: dict, path: Path) -> None:
@@ -329,6 +347,37 @@ def build(args):
     return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
 
 
+def spec_of(args) -> dict:
+    """The experiment file's ``[next_measurement]`` table (empty without a file or table)."""
+    if not args.experiment:
+        return {}
+    return dict(_load_toml(Path(args.experiment)).get("next_measurement", {}))
+
+
+def _next_kw(args, table: dict) -> dict:
+    """Keywords of :meth:`Diagnosis.recommend_next_measurement` from ``[next_measurement]`` and the
+    flags: ``quantities`` (what the lab measures), ``band_limits_hz``, ``temperature_limits_c``,
+    ``levels`` (drive multiples; cap them at what the strip takes), ``power``."""
+    kw = {}
+    for key, flag, n in (("quantities", "next_quantities", None), ("band_limits_hz", "next_band_hz", 2),
+                         ("temperature_limits_c", "next_temperatures_c", 2), ("levels", "next_levels", None)):
+        v = getattr(args, flag, None)
+        v = [x.strip() for x in v.split(",")] if isinstance(v, str) else table.get(key)
+        if v is None:
+            continue
+        if not isinstance(v, list) or not v or (n is not None and len(v) != n):
+            raise IPMCError(f"next_measurement {key} = {v!r}: expected a list" + (f" of {n} values" if n else ""))
+        if key != "quantities":
+            try:
+                v = [float(x) for x in v]
+            except (TypeError, ValueError):
+                raise IPMCError(f"next_measurement {key} = {v!r}: expected numbers") from None
+        kw[key] = tuple(v)
+    if "power" in table:
+        kw["power"] = table["power"]
+    return kw
+
+
 def run(args) -> int:
     """Execute ``ipmc diagnose``: 0 when the final model fits the data, 3 when not (unless
     ``--accept-misfit``); bad input raises IPMCError (exit 2)."""
@@ -355,6 +404,10 @@ def run(args) -> int:
 
     try:
         d = diagnose(data, base, progress=progress, **kw)
+        if d.verdict in ("ambiguous", "at_bound"):       # which measurement would separate the rivals
+            if bar is not None:
+                bar.set_postfix_str("searching the next measurement", refresh=True)
+            d.recommend_next_measurement(**_next_kw(args, spec_of(args)))
     finally:
         if bar is not None:
             bar.close()
@@ -371,6 +424,8 @@ def run(args) -> int:
               f"{d.elapsed_s:.1f} s")
         print(f"report: {out}/report.json, summary.md, bode_before.png, bode_after.png")
         print(f"model: {out}/model.json — {mf.describe()}; use it downstream with --model {out}/model.json")
+    if d.next_measurement is not None:               # said whether or not --quiet: it is the verdict's advice
+        print(f"ipmc diagnose: {d.verdict}; {d.next_measurement.message}", file=sys.stderr)
     if not mf.adequate:
         print(f"ipmc diagnose: the diagnosed model does not fit the data ({mf.verdict.reason}); model.json says so "
               "and every command that reads it will too"

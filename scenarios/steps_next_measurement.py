@@ -1,0 +1,186 @@
+"""The ``[next_measurement]`` step: a virtual-lab record leaves two effects ambiguous, the
+diagnosis recommends the measurement that separates them, the virtual lab takes it, and the two
+records diagnosed together name the hidden effect (issue 27, item 3).
+
+The hidden effect is an instrument element between the strip and the DAQ (a response-level
+library effect written with the Laplace variable only: amplifier poles, a delay, a laser lag, AC
+coupling), put into the transfer function the virtual lab realises and simulates, so both records
+are time-domain experiments measured like a DAQ (:mod:`scenarios.virtual_lab`): the first with the
+table's design (``temperatures_c``, ``fmin_hz`` … ``rms``, ``output_noise_rms``, ``noise_seed``),
+the second with the same design moved to the recommended band, temperatures and drive level, and
+a new noise seed.  The virtual lab records the model's main quantity only (actuator M, sensor S), so the
+search is restricted to it; the two records are then of the same quantity and are merged
+(:func:`physmodel.estimation.next_measurement.merge_records`, lines the first record already holds
+left out of the second) and diagnosed jointly.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .context import RunContext, md_table
+from .spec import ScenarioError
+
+#: Keys of the first record's design (virtual-lab [sweep] keys) and of its DAQ noise.
+DESIGN = ("temperatures_c", "fmin_hz", "fmax_hz", "points", "fs_hz", "period_s", "periods", "transient_periods",
+          "rms", "oversample")
+
+
+class InstrumentModel:
+    """A physics model with a hidden instrument element on its main quantity: ``evaluate`` (what the
+    virtual lab realises) multiplies M or S by the library effect's factor at the Laplace points;
+    everything else is the wrapped model's."""
+
+    def __init__(self, model, effects: dict):
+        from types import SimpleNamespace
+
+        from physmodel.effects import LIBRARY
+
+        self._model, self._effects = model, {}
+        for name, vals in effects.items():
+            e = LIBRARY.get(name)
+            if e is None or e.level != "response":
+                raise ScenarioError(f"[next_measurement] effects.{name}: the virtual lab can hide an instrument "
+                                    "element only (a response-level library effect, e.g. amplifier_bandwidth)")
+            full = {**e.off, **vals}
+            try:       # the factor must be a function of s alone (no state of the strip)
+                e.apply("S", SimpleNamespace(s=np.array([1j])), full)
+            except AttributeError:
+                raise ScenarioError(f"[next_measurement] effects.{name}: its factor needs the strip's state; "
+                                    "hide an instrument element (amplifier_bandwidth, time_delay, ...)") from None
+            self._effects[name] = (e, full)
+
+    def __getattr__(self, name):
+        return getattr(self._model, name)
+
+    def evaluate(self, s, temperature_c, quantities=None, **kw):
+        """The wrapped model's quantities with the hidden factor on M (actuator) or S (sensor)."""
+        from types import SimpleNamespace
+
+        out = dict(self._model.evaluate(s, temperature_c, quantities=quantities, **kw))
+        q = "M" if self._model.kind == "actuator" else "S"
+        if q in out:
+            ctx = SimpleNamespace(s=np.asarray(s, dtype=complex))
+            for e, v in self._effects.values():
+                out[q] = out[q] * e.apply(q, ctx, v)
+        return out
+
+
+def _diagnose(ctx, data, cfg):
+    from physmodel.estimation.discrepancy import diagnose
+
+    m = ctx.spec.section("model")
+    kw = {k: cfg[k] for k in ("null_draws", "null_refits", "alpha", "seed", "laws", "baseline_starts") if k in cfg}
+    if "free" in cfg:
+        kw["free"] = tuple(cfg["free"])
+    if "candidates" in cfg:
+        kw["candidates"] = list(cfg["candidates"])
+    if m["kind"] == "sensor":
+        kw["kernel"] = m.get("kernel", "boundary_charge")
+    return diagnose(data, ctx.base_params, kind=m["kind"], quantity="M" if m["kind"] == "actuator" else "S", **kw)
+
+
+def _new_lines(record, new):
+    """``new`` without the lines ``record`` already holds (same temperature and frequency)."""
+    from dataclasses import replace
+
+    have = {(float(t), float(f)) for t, f in zip(record.temperature_c, record.frequency_hz)}
+    keep = np.array([(float(t), float(f)) not in have for t, f in zip(new.temperature_c, new.frequency_hz)])
+    if keep.all():
+        return new
+    if not keep.any():
+        raise ScenarioError("the recommended measurement holds only lines the first record already has")
+    pick = lambda a: None if a is None else np.asarray(a)[keep]  # noqa: E731
+    return replace(new, temperature_c=new.temperature_c[keep], frequency_hz=new.frequency_hz[keep],
+                   response=new.response[keep], magnitude_std_db=pick(new.magnitude_std_db),
+                   phase_std_deg=pick(new.phase_std_deg))
+
+
+def step_next_measurement(ctx: RunContext):
+    """Ambiguous on one virtual-lab record → the recommended measurement → named on both."""
+    from physmodel.estimation.next_measurement import merge_records
+
+    from . import plots
+    from .virtual_lab import from_config
+
+    cfg = ctx.spec.section("next_measurement")
+    m = ctx.spec.section("model")
+    where = f"{ctx.spec.path}: "
+    effects = cfg.get("effects", {})
+    if not effects:
+        raise ScenarioError(f"{where}[next_measurement] effects: give the hidden instrument element")
+    missing = [k for k in ("temperatures_c", "fs_hz", "output_noise_rms", "noise_seed") if k not in cfg]
+    if missing:
+        raise ScenarioError(f"{where}[next_measurement] {missing[0]}: required (the first record's design)")
+    truth = InstrumentModel(ctx.model, effects)
+    sweep_cfg = {"source": "virtual_lab", "excitation": "multisine",
+                 **{k: cfg[k] for k in DESIGN if k in cfg}}
+    noise_cfg = {"kind": "time", "output_noise_rms": cfg["output_noise_rms"], "seed": int(cfg["noise_seed"])}
+    lab1 = from_config(truth, sweep_cfg, noise_cfg, where=where)
+    rec1 = lab1.sweep
+    ctx.file(rec1.to_csv(ctx.out / "next_measurement" / "record1.csv"))
+    d1 = _diagnose(ctx, rec1, cfg)
+    q = "M" if m["kind"] == "actuator" else "S"
+    T = np.asarray(sweep_cfg["temperatures_c"], float)
+    nm_kw = {"quantities": [q], "temperature_limits_c": tuple(cfg.get("temperature_limits_c", (T.min(), T.max())))}
+    for k in ("band_limits_hz", "levels", "power"):
+        if k in cfg:
+            nm_kw[k] = tuple(cfg[k]) if isinstance(cfg[k], list) else cfg[k]
+    nm = d1.recommend_next_measurement(**nm_kw) if d1.verdict in ("ambiguous", "at_bound") else None
+    folder = d1.write_report(ctx.out / "next_measurement" / "diagnosis1")
+    plots.diagnosis_figures(d1, folder)
+    hidden = sorted(effects)
+    ctx.metric("next_measurement.first_ambiguous", d1.verdict in ("ambiguous", "at_bound"))
+    ctx.metric("next_measurement.first_n_named", len(d1.named))
+    rows = [("1: " + f"{rec1.frequency_hz.min():.3g}–{rec1.frequency_hz.max():.3g} Hz", d1.verdict,
+             ", ".join(d1.named) or "–", "–")]
+    d2 = None
+    if nm is not None and nm.recommended is not None:
+        r = nm.recommended
+        ctx.metric("next_measurement.expected_separation", r.separation_refit if np.isfinite(r.separation_refit)
+                   else r.separation)
+        ctx.metric("next_measurement.target", nm.target)
+        ctx.metric("next_measurement.expected_to_separate", nm.separates)
+        sw2 = dict(sweep_cfg, fmin_hz=float(r.band_hz[0]), fmax_hz=float(r.band_hz[1]),
+                   points=int(r.frequencies_hz.size), temperatures_c=[float(t) for t in r.temperatures_c])
+        for k in ("rms", "amplitude"):
+            sw2[k] = float(sweep_cfg.get(k, 1.0)) * r.level
+        if "period_s" in sw2:            # the design's period: whole periods of the new lowest line
+            sw2["period_s"] = max(float(sweep_cfg["period_s"]), 1.0 / r.band_hz[0])
+        fs = float(sweep_cfg["fs_hz"])
+        if r.band_hz[1] >= 0.4 * fs:
+            raise ScenarioError(f"{where}the recommended band reaches {r.band_hz[1]:g} Hz, beyond the virtual lab's "
+                                f"fs_hz = {fs:g} (set [next_measurement] band_limits_hz below 0.4·fs_hz)")
+        nz2 = dict(noise_cfg, seed=int(cfg.get("next_noise_seed", int(cfg["noise_seed"]) + 1)))
+        rec2 = _new_lines(rec1, from_config(truth, sw2, nz2, where=where).sweep)
+        ctx.file(rec2.to_csv(ctx.out / "next_measurement" / "record2.csv"))
+        both = merge_records(rec1, rec2)
+        d2 = _diagnose(ctx, both, cfg)
+        folder2 = d2.write_report(ctx.out / "next_measurement" / "diagnosis2")
+        plots.diagnosis_figures(d2, folder2)
+        rows.append((f"1 + 2: adds {r.describe()}", d2.verdict, ", ".join(d2.named) or "–",
+                     f"{ctx.metrics['next_measurement.expected_separation']:.3g}"))
+    for p in sorted((ctx.out / "next_measurement").rglob("*")):
+        if p.is_file() and not p.name.startswith(".") and p.suffix != ".csv":
+            ctx.file(Path(p))
+    ctx.metric("next_measurement.second_named_truth", d2 is not None and d2.verdict == "named" and sorted(d2.named)
+               == hidden)
+    ctx.metric("next_measurement.second_n_named", len(d2.named) if d2 is not None else 0)
+    ctx.section("The next measurement",
+                f"Hidden in the virtual lab's physics: {effects}. The first record (the table's design) is "
+                f"diagnosed: **{d1.verdict}** ({', '.join(d1.named) or 'nothing named'}).", "",
+                (nm.message if nm is not None else "No recommendation: the first verdict leaves no competing models."),
+                "", md_table(["records diagnosed", "verdict", "named", "expected λ of the added record"], rows), "",
+                "Diagnoses: `next_measurement/diagnosis1/summary.md` (with the recommendation) and "
+                "`next_measurement/diagnosis2/summary.md` (both records).")
+
+
+#: [next_measurement] (scenarios.spec checks the types): the hidden element, the first record's
+#: design and noise, the diagnosis's settings and the search's limits.
+SCHEMA_KEYS = ("effects", *DESIGN, "output_noise_rms", "noise_seed", "next_noise_seed", "free", "candidates",
+               "null_draws", "null_refits", "alpha", "seed", "laws", "baseline_starts", "band_limits_hz",
+               "temperature_limits_c", "levels", "power")
+
+__all__ = ["DESIGN", "InstrumentModel", "SCHEMA_KEYS", "step_next_measurement"]
