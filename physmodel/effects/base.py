@@ -75,7 +75,7 @@ class Effect:
     changes.  ``needs_temperatures``: it only shows in data at two or more temperatures.
     ``batchable``: ``apply`` takes its values as arrays over parameter sets, shaped (n_sets, 1, 1)
     to broadcast against the model's (n_sets, n_T, n_f) arrays, so one model call evaluates sets
-    with different values of it (:meth:`~physmodel.effects.library.EffectModel.predictor`); a
+    with different values of it (``EffectModel(...).predictor(...).many``); a
     ``kernel`` effect is not (the charge dynamics are evaluated on one ŝ grid per call).
     """
 

@@ -38,7 +38,15 @@ from ..actuator import ActuatorModel
 from ..beam import first_mode
 from ..errors import IPMCError, ParameterError
 from ..model import DEFAULT_CHUNK, FrequencyResponse, check_frequencies, evaluate_grid
-from ..params import STATE_FIELDS, IPMCParameters, State, first_mode_omega
+from ..params import (
+    STATE_FIELDS,
+    IPMCParameters,
+    ParameterTable,
+    State,
+    check_field_values,
+    density_for_mode,
+    first_mode_omega,
+)
 from ..sensor import SensorModel
 from ..transport import debye_rate
 from . import chain, forms, physical, sensing
@@ -154,6 +162,39 @@ def _apply(p: IPMCParameters, base_vals: Mapping[str, float], paths: dict | None
     return apply_values(p, base_vals, paths)
 
 
+def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], paths: dict) -> ParameterTable | None:
+    """The :class:`ParameterTable` of ``base`` with ``base_vals[i]`` in set i, built as arrays (no
+    record per set; values checked as :class:`IPMCParameters` checks them, ``omega_n`` set through
+    the density as :meth:`IPMCParameters.replace` does).  None when a name addresses a temperature
+    law or ``T_ref`` (the table's sets would not share one laws group): the caller then builds one
+    record per set.  ``paths``: names resolved against ``base`` (kept across calls)."""
+    from ..parameter_paths import resolve_path
+
+    names: dict = {}
+    for bv in base_vals:
+        names.update(dict.fromkeys(bv))
+    table = ParameterTable.of(base)
+    for name in names:
+        path = paths.get(name)
+        if path is None:
+            path = paths[name] = resolve_path(base, name)
+        if path.is_law or (path.target == "field" and (name == "T_ref" or name not in table.columns)):
+            return None
+    n = len(base_vals)
+    cols = {k: np.repeat(v, n, axis=0) for k, v in table.columns.items()}
+    for name in names:
+        if name != "omega_n":
+            a = np.array([bv.get(name, np.nan) for bv in base_vals], dtype=float)
+            given = np.array([name in bv for bv in base_vals])
+            cols[name] = np.where(given, check_field_values(name, np.where(given, a, 1.0)), cols[name][:, 0])[:, None]
+    if "omega_n" in names:
+        given = np.array(["omega_n" in bv for bv in base_vals])
+        wn = np.array([bv.get("omega_n", 1.0) for bv in base_vals], dtype=float)
+        rho = density_for_mode(wn, cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
+        cols["rho"] = np.where(given, check_field_values("rho", np.where(given, rho, 1.0)), cols["rho"][:, 0])[:, None]
+    return ParameterTable(cols, table.groups, n)
+
+
 class _EffectMixin:
     """Shared by the actuator and sensor flavours of :class:`EffectModel`."""
 
@@ -170,6 +211,14 @@ class _EffectMixin:
         # array, the values arrays over the sets (see _batch_effects)
         self._active: list = [(get_effect(n), v, None) for n, v in self.effects.items()
                               if not get_effect(n).is_off(v)]
+        self._batch_table: ParameterTable | None = None
+
+    def _use_table(self, table: ParameterTable) -> None:
+        """Evaluate the parameter sets of ``table`` (built as arrays by :func:`_table_of`, one row
+        per set of ``self.params``, which then only carry the names and ``T_ref``)."""
+        if table.n != len(self.params):
+            raise IPMCError(f"a table of {table.n} sets for {len(self.params)} parameter sets")
+        self._batch_table = table
 
     def _batch_effects(self, values_per_set: Sequence[Mapping[str, Mapping[str, float]]]) -> None:
         """Switch this model's batchable effects to per-set values: ``values_per_set[i]`` =
@@ -225,7 +274,7 @@ class _EffectMixin:
         self._active = active
 
     def state(self, temperature_c) -> State:
-        st = super().state(temperature_c)
+        st = super().state(temperature_c) if self._batch_table is None else self._batch_table.state(temperature_c)
         acts = [(e, v, m) for e, v, m in self._active if e.level == "parameter"]
         if not acts:
             return st
@@ -368,8 +417,14 @@ class _EffectMixin:
                 for n, pv in split[rows[0]][1].items():    # the non-batchable values (all the same here)
                     if not get_effect(n).batchable:
                         effects.setdefault(n, {}).update(pv)
-                plist = [_apply(self.params[0], split[i][0], paths) for i in rows]
+                # the base values as arrays (no record per set), or a record per set when a name
+                # addresses a temperature law or T_ref
+                table = _table_of(self.params[0], [split[i][0] for i in rows], paths)
+                plist = ([self.params[0]] * len(rows) if table is not None
+                         else [_apply(self.params[0], split[i][0], paths) for i in rows])
                 m = make_effect_model(plist, self.kind, effects, **self._extra())
+                if table is not None:
+                    m._use_table(table)
                 m._batch_effects([split[i][1] for i in rows])
                 r = m.frequency_response(freqs, temps, quantities=(q,))[q]
                 out[rows] = r[:, ti, fi] * scale

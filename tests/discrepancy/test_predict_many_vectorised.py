@@ -158,3 +158,32 @@ def test_bad_effect_values_are_named():
         pred.many([{}, {"coupling_compliance.compliance_ratio": 0.1}])
     with pytest.raises(ParameterError, match="unknown effect"):
         pred.many([{"warp_drive.speed": 1.0}])
+
+
+def test_base_values_built_as_arrays_match_records_and_laws_fall_back(monkeypatch):
+    """Base values go into one table of arrays (no record per set); a temperature-law name or T_ref
+    makes one record per set (apply_values), and both agree with the grouped form."""
+    import physmodel.effects.library as lib
+
+    pred = _predictor("actuator", "M", P_ACT)
+    built = []
+    orig = lib._table_of
+    monkeypatch.setattr(lib, "_table_of", lambda *a: built.append(orig(*a)) or built[-1])
+    sets = [{"d": P_ACT.d * 1.3, "omega_n": P_ACT.omega_n * 2, "E": P_ACT.E * 0.7, "time_delay.delay": 1e-3},
+            {"E": P_ACT.E * 1.5, "h": P_ACT.h * 1.1}, {"omega_n": P_ACT.omega_n * 0.5, "r1_sheet": 0.0}, {}]
+    np.testing.assert_allclose(pred.many(sets), pred.many_grouped(sets), rtol=1e-12, atol=0)
+    assert built[-1] is not None and built[-1].n == len(sets)
+    for extra in ({"laws.d.activation_energy": 25e3}, {"T_ref": 310.0}):
+        law_sets = [dict(v, **extra) if k % 2 else v for k, v in enumerate(sets)]
+        np.testing.assert_allclose(pred.many(law_sets), pred.many_grouped(law_sets), rtol=1e-12, atol=0)
+        assert built[-1] is None
+
+
+def test_bad_base_values_are_named_as_the_record_names_them():
+    pred = _predictor("actuator", "M", P_ACT)
+    for bad, pattern in (({"d": -1.0}, r"d=-1\.0 \[m\^2/s\]"), ({"kappa_e": float("nan")}, "kappa_e is NaN"),
+                         ({"omega_n": 0.0}, r"omega_n=0\.0 rad/s must be a positive finite number"),
+                         ({"E": float("inf")}, r"E=inf .* must be finite")):
+        for form in (pred.many, pred.many_grouped):
+            with pytest.raises(ParameterError, match=pattern):
+                form([{}, bad])
