@@ -3,10 +3,10 @@ as arrays over the sets (physmodel/effects/library.py).  The oracle is the group
 ``predict.many_grouped`` — one model call per distinct set of effect values, each effect switched on
 only where it is on, scalar values — which the effect tests check against independent physics.
 
-For every library effect alone and every pair, for actuators (M and Z) and sensors (S): random
-in-range base parameters and effect values over several sets, some sets at the effect's off value,
-some with its switch off and the other parameters anywhere, some without it; the two forms agree
-to rtol 1e-12.
+For every library effect (and out-of-library effect) alone and every pair of library effects, for
+actuators (M and Z) and sensors (S): random in-range base parameters and effect values over several
+sets, some sets at the effect's off value, some with its switch off and the other parameters
+anywhere, some without it; the two forms agree to rtol 1e-12.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pytest
 
 from physmodel import get_parameter_set
 from physmodel.data.sweep import synthesize_sweep
-from physmodel.effects import LIBRARY, EffectModel
+from physmodel.effects import LIBRARY, OUT_OF_LIBRARY, EffectModel, get_effect
 from physmodel.effects.library import EffectActuatorModel, EffectSensorModel
 from physmodel.errors import IPMCError, ParameterError
 
@@ -38,14 +38,14 @@ def _predictor(kind, q, p, baseline=None):
     return EffectModel(p, kind, baseline or {}).predictor(sweep, q)
 
 
-def _effects_for(kind, q):
-    return [n for n, e in LIBRARY.items() if kind in e.kinds and q in e.quantities]
+def _effects_for(kind, q, library=LIBRARY):
+    return [n for n, e in library.items() if kind in e.kinds and q in e.quantities]
 
 
 def _draw_effect(rng, name, p, mode):
     """Values of effect ``name``: ``mode`` "on" (random in its candidate bounds), "off" (all at off),
     "switch_off" (the switch at off, the others random), "absent" (not given)."""
-    e = LIBRARY[name]
+    e = get_effect(name)
     if mode == "absent":
         return {}
     pars = e.candidate_parameters(p)
@@ -87,7 +87,7 @@ def test_every_effect_alone(kind, q, p, gain, baseline):
     rng = np.random.default_rng(27)
     names = _effects_for(kind, q)
     assert len(names) >= 8
-    for n in names:
+    for n in names + _effects_for(kind, q, OUT_OF_LIBRARY):     # the blind generators' effects too
         _check(pred, _draw_sets(rng, [n], p, gain))
 
 
