@@ -166,10 +166,35 @@ def first_mode_omega(E, rho, L, h):
     return BETA1L_SQ / L**2 * np.sqrt(E * h**2 / (3.0 * rho))
 
 
+def check_field_values(name: str, values) -> np.ndarray:
+    """The checks :class:`IPMCParameters` makes of numeric field ``name``, over an array of values
+    (one per parameter set, e.g. a batch built without a record per set); returns them as floats.
+    A bad value is a :class:`ParameterError` worded as the record's own."""
+    m = _FIELD_META[name]
+    v = np.asarray(values, dtype=float)
+    bad = np.isnan(v)
+    if not m["allow_inf"]:
+        bad |= np.isinf(v)
+    if m["positive"]:
+        bad |= (v < 0) | ((v == 0) & (not m["allow_zero"]))
+    if np.any(bad):
+        x = float(v[bad].ravel()[0])
+        if math.isnan(x):
+            raise ParameterError(f"{name} is NaN; expected a number [{m['unit']}]")
+        if math.isinf(x) and not m["allow_inf"]:
+            raise ParameterError(f"{name}={x!r} [{m['unit']}] must be finite")
+        need = ">= 0" if m["allow_zero"] else "> 0"
+        raise ParameterError(f"{name}={x!r} [{m['unit']}] ({m['doc']}) must be {need}")
+    return v
+
+
 def density_for_mode(omega_n, E, L, h):
-    """Effective density [kg/m³] that puts the first mode at ``omega_n`` [rad/s]."""
-    if not (np.isfinite(omega_n) and omega_n > 0):
-        raise ParameterError(f"omega_n={omega_n!r} rad/s must be a positive finite number")
+    """Effective density [kg/m³] that puts the first mode at ``omega_n`` [rad/s] (arrays broadcast)."""
+    w = np.asarray(omega_n, dtype=float)
+    bad = ~(np.isfinite(w) & (w > 0))
+    if np.any(bad):
+        raise ParameterError(f"omega_n={float(w[bad].ravel()[0]) if w.ndim else omega_n!r} rad/s must be a positive "
+                             "finite number")
     return E * h**2 / 3.0 * (BETA1L_SQ / (L**2 * omega_n)) ** 2
 
 
@@ -215,6 +240,9 @@ class State:
     def take(self, i_set: int, i_T: int) -> State:
         """The state of one parameter set at one temperature (arrays of shape (1, 1, 1))."""
         return State(**{k: getattr(self, k)[i_set:i_set + 1, i_T:i_T + 1] for k in STATE_FIELDS})
+
+
+_FIELD_META = {f.name: f.metadata for f in fields(IPMCParameters) if f.name not in ("laws", "name", "source")}
 
 
 def as_parameter_list(params) -> list[IPMCParameters]:
@@ -340,4 +368,5 @@ def describe(p: IPMCParameters) -> str:
 
 
 __all__ = ["IPMCParameters", "State", "ParameterTable", "state_at", "first_mode_omega", "density_for_mode", "describe",
+           "check_field_values",
            "as_parameter_list"]

@@ -15,7 +15,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from types import SimpleNamespace
 
+import numpy as np
+
+from .. import beam
 from ..errors import ParameterError
 
 KINDS = ("actuator", "sensor")
@@ -69,6 +73,10 @@ class Effect:
     strip ``params`` (:class:`~physmodel.params.IPMCParameters`), with their rationale in
     ``bounds_doc``.  ``kinds``/``quantities``: the model kinds and response quantities it
     changes.  ``needs_temperatures``: it only shows in data at two or more temperatures.
+    ``batchable``: ``apply`` takes its values as arrays over parameter sets, shaped (n_sets, 1, 1)
+    to broadcast against the model's (n_sets, n_T, n_f) arrays, so one model call evaluates sets
+    with different values of it (``EffectModel(...).predictor(...).many``); a
+    ``kernel`` effect is not (the charge dynamics are evaluated on one ŝ grid per call).
     """
 
     name: str
@@ -84,10 +92,13 @@ class Effect:
     switch: str | None = None
     fit_bounds: Callable | None = field(default=None, repr=False, compare=False)
     bounds_doc: str = ""
+    batchable: bool = True
 
     def __post_init__(self):
         if self.level not in LEVELS:
             raise ParameterError(f"effect {self.name}: level {self.level!r} not in {LEVELS}")
+        if self.level == "kernel" and self.batchable:
+            raise ParameterError(f"effect {self.name}: a kernel effect cannot be batchable (one ŝ grid per model call)")
         if self.switch is not None:
             self.parameter(self.switch)
 
@@ -110,6 +121,12 @@ class Effect:
         if self.switch is not None:
             return values[self.switch] == self.parameter(self.switch).off
         return all(values[p.name] == p.off for p in self.parameters)
+
+    def on_mask(self, values: Mapping[str, np.ndarray]) -> np.ndarray:
+        """:meth:`is_off` negated, elementwise over arrays of values (one entry per parameter set)."""
+        if self.switch is not None:
+            return np.asarray(values[self.switch]) != self.parameter(self.switch).off
+        return np.logical_or.reduce([np.asarray(values[p.name]) != p.off for p in self.parameters])
 
     def applies_to(self, kind: str, quantity: str) -> bool:
         return kind in self.kinds and quantity in self.quantities
@@ -147,9 +164,50 @@ class Effect:
         return f"{self.name}: {self.title}. {self.description} Parameters: {pars}.{extra} Ref: {self.reference}"
 
 
+def law_factor(law: type, field_name: str, value, T, T_ref):
+    """``law(field_name=value).factor(T, T_ref)`` of a temperature law of :mod:`physmodel.temperature`
+    whose parameter ``value`` may be an array over parameter sets (shaped to broadcast against ``T``).
+
+    The laws' constructors check a scalar; an array of effect values has been checked against the
+    effect parameter's bounds (finite, in range) where the values were gathered, so the law's own
+    ``factor`` is evaluated on them directly (one formula, the law's)."""
+    if np.ndim(value) == 0:
+        return law(**{field_name: float(value)}).factor(T, T_ref)
+    holder = SimpleNamespace(**{field_name: np.asarray(value, dtype=float)})
+    return law.factor(holder, T, T_ref)
+
+
+def rows_of(a, rows):
+    """``a`` restricted to the parameter sets ``rows`` (first axis), unless it broadcasts over them."""
+    return a if np.ndim(a) == 0 or np.shape(a)[0] == 1 else np.asarray(a)[rows]
+
+
+def by_mode_count(ctx, modal):
+    """A modal response with each parameter set's own number of modes.
+
+    ``modal(rows, n_modes)`` evaluates the response of the parameter sets ``rows`` (an index into
+    the first axis; :func:`rows_of` restricts arrays to them) with ``n_modes`` modes.  The count is
+    :func:`physmodel.beam.modes_for_band` of each set's own ωn over the band, so a set's response
+    does not depend on which other sets share its model call (the count of the whole batch is
+    set by its softest strip)."""
+    wmax = float(np.max(np.abs(ctx.s)))
+    wn = np.asarray(ctx.st.omega_n)
+    counts = np.array([beam.modes_for_band(w, wmax) for w in wn])
+    if np.all(counts == counts[0]):
+        return modal(slice(None), int(counts[0]))
+    out = None
+    for n in np.unique(counts):
+        rows = np.flatnonzero(counts == n)
+        r = modal(rows, int(n))
+        if out is None:
+            out = np.empty((wn.shape[0],) + np.shape(r)[1:], dtype=complex)
+        out[rows] = r
+    return out
+
+
 def P(*args, **kw) -> EffectParameter:
     """Short constructor used by the declaring modules."""
     return EffectParameter(*args, **kw)
 
 
-__all__ = ["EffectParameter", "Effect", "KINDS", "LEVELS", "P"]
+__all__ = ["EffectParameter", "Effect", "KINDS", "LEVELS", "P", "by_mode_count", "law_factor", "rows_of"]

@@ -55,6 +55,7 @@ from scipy import special
 
 from .. import beam
 from ..temperature import Arrhenius
+from .base import law_factor
 
 # Sader (1998) eq. (21): Ω_r and Ω_i as rational functions of τ = log10 Re (coefficients of
 # τ⁰, τ¹, …).
@@ -97,13 +98,13 @@ def gamma_rectangular(reynolds):
 def kinematic_viscosity(v, T, T_ref):
     """ν(T) [m²/s] from the effect values ``v`` (``log10_viscosity`` at ``T_ref``, Andrade energy
     ``viscosity_energy`` [J/mol]); ``T``, ``T_ref`` [K]."""
-    return 10.0 ** v["log10_viscosity"] / Arrhenius(activation_energy=v["viscosity_energy"]).factor(T, T_ref)
+    return 10.0 ** v["log10_viscosity"] / law_factor(Arrhenius, "activation_energy", v["viscosity_energy"], T, T_ref)
 
 
 def fluid_density(v):
     """ρ_f = √(ρ_f η)/√ν [kg/m³] at T_ref from the effect values ``v`` (``viscous_load`` √(ρ_f η)
     [kg m⁻² s^-½], ``log10_viscosity``)."""
-    return v["viscous_load"] / math.sqrt(10.0 ** v["log10_viscosity"])
+    return v["viscous_load"] / np.sqrt(10.0 ** np.asarray(v["log10_viscosity"], dtype=float))
 
 
 def mass_factor(s, st, T_ref, v):

@@ -58,7 +58,7 @@ import numpy as np
 from .. import beam, electrode, transport
 from ..numerics import line_kernels
 from ..params import STATE_FIELDS
-from .base import Effect, P
+from .base import Effect, P, by_mode_count, rows_of
 from .chain import double_layer_area_impedance
 
 #: Pairs of effects the band may not separate, with the reason (declared with the effects; the
@@ -76,11 +76,15 @@ CONFUSABLE = {
 # --------------------------------------------------------------------------- higher modes
 def _r_higher_modes(q, ctx, v):
     """1 + c (T/g1 − 1) on M (module doc)."""
-    st = ctx.st
-    g1 = beam.first_mode(ctx.s, st.omega_n, st.xi)
-    n = beam.modes_for_band(st.omega_n, float(np.max(np.abs(ctx.s))))
-    full = beam.modal_damping_response(ctx.s, st.omega_n, st.xi, v["damping"], ctx.x, n)
-    return 1.0 + v["weight"] * (full / g1 - 1.0)
+    st, x = ctx.st, ctx.x
+
+    def modal(rows, n):
+        wn, xi = rows_of(st.omega_n, rows), rows_of(st.xi, rows)
+        g1 = beam.first_mode(ctx.s, wn, xi)
+        full = beam.modal_damping_response(ctx.s, wn, xi, rows_of(v["damping"], rows), rows_of(x, rows), n)
+        return 1.0 + rows_of(v["weight"], rows) * (full / g1 - 1.0)
+
+    return by_mode_count(ctx, modal)
 
 
 # --------------------------------------------------------------------------- distributed CPE

@@ -38,7 +38,15 @@ from ..actuator import ActuatorModel
 from ..beam import first_mode
 from ..errors import IPMCError, ParameterError
 from ..model import DEFAULT_CHUNK, FrequencyResponse, check_frequencies, evaluate_grid
-from ..params import STATE_FIELDS, IPMCParameters, State, first_mode_omega
+from ..params import (
+    STATE_FIELDS,
+    IPMCParameters,
+    ParameterTable,
+    State,
+    check_field_values,
+    density_for_mode,
+    first_mode_omega,
+)
 from ..sensor import SensorModel
 from ..transport import debye_rate
 from . import chain, forms, physical, sensing
@@ -75,6 +83,11 @@ class _Context:
             A = electrode.strip_terms(p, self.s_kernel, want_xcoth=False).A
             self._x = electrode.line_argument(A, p["r1"], p["L"])
         return self._x
+
+
+def _where_on(on, value, off_value):
+    """``value`` in the parameter sets where an effect is on, ``off_value`` elsewhere (``on`` None: all)."""
+    return value if on is None else np.where(on, value, off_value)
 
 
 def candidate_free_parameters(effect: str, params: IPMCParameters | None = None,
@@ -149,6 +162,39 @@ def _apply(p: IPMCParameters, base_vals: Mapping[str, float], paths: dict | None
     return apply_values(p, base_vals, paths)
 
 
+def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], paths: dict) -> ParameterTable | None:
+    """The :class:`ParameterTable` of ``base`` with ``base_vals[i]`` in set i, built as arrays (no
+    record per set; values checked as :class:`IPMCParameters` checks them, ``omega_n`` set through
+    the density as :meth:`IPMCParameters.replace` does).  None when a name addresses a temperature
+    law or ``T_ref`` (the table's sets would not share one laws group): the caller then builds one
+    record per set.  ``paths``: names resolved against ``base`` (kept across calls)."""
+    from ..parameter_paths import resolve_path
+
+    names: dict = {}
+    for bv in base_vals:
+        names.update(dict.fromkeys(bv))
+    table = ParameterTable.of(base)
+    for name in names:
+        path = paths.get(name)
+        if path is None:
+            path = paths[name] = resolve_path(base, name)
+        if path.is_law or (path.target == "field" and (name == "T_ref" or name not in table.columns)):
+            return None
+    n = len(base_vals)
+    cols = {k: np.repeat(v, n, axis=0) for k, v in table.columns.items()}
+    for name in names:
+        if name != "omega_n":
+            a = np.array([bv.get(name, np.nan) for bv in base_vals], dtype=float)
+            given = np.array([name in bv for bv in base_vals])
+            cols[name] = np.where(given, check_field_values(name, np.where(given, a, 1.0)), cols[name][:, 0])[:, None]
+    if "omega_n" in names:
+        given = np.array(["omega_n" in bv for bv in base_vals])
+        wn = np.array([bv.get("omega_n", 1.0) for bv in base_vals], dtype=float)
+        rho = density_for_mode(wn, cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
+        cols["rho"] = np.where(given, check_field_values("rho", np.where(given, rho, 1.0)), cols["rho"][:, 0])[:, None]
+    return ParameterTable(cols, table.groups, n)
+
+
 class _EffectMixin:
     """Shared by the actuator and sensor flavours of :class:`EffectModel`."""
 
@@ -161,19 +207,89 @@ class _EffectMixin:
             if self.kind not in e.kinds:
                 raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model "
                                 f"(it applies to {e.kinds})")
-        self._active = [(get_effect(n), v) for n, v in self.effects.items() if not get_effect(n).is_off(v)]
+        # (effect, values, on): ``on`` None = on in every parameter set; else a boolean (n_sets, 1, 1)
+        # array, the values arrays over the sets (see _batch_effects)
+        self._active: list = [(get_effect(n), v, None) for n, v in self.effects.items()
+                              if not get_effect(n).is_off(v)]
+        self._batch_table: ParameterTable | None = None
+
+    def _use_table(self, table: ParameterTable) -> None:
+        """Evaluate the parameter sets of ``table`` (built as arrays by :func:`_table_of`, one row
+        per set of ``self.params``, which then only carry the names and ``T_ref``)."""
+        if table.n != len(self.params):
+            raise IPMCError(f"a table of {table.n} sets for {len(self.params)} parameter sets")
+        self._batch_table = table
+
+    def _batch_effects(self, values_per_set: Sequence[Mapping[str, Mapping[str, float]]]) -> None:
+        """Switch this model's batchable effects to per-set values: ``values_per_set[i]`` =
+        ``{effect: {param: value}}`` of parameter set i on top of ``self.effects`` (missing: this
+        model's value, else off).  Values are checked as :func:`normalize_effects` does; a set where
+        an effect is off gets its off values and the effect's result is replaced by the base's
+        exactly there.  Non-batchable effects must be given the same values in every set (they
+        stay as built)."""
+        n = len(self.params)
+        if len(values_per_set) != n:
+            raise IPMCError(f"{len(values_per_set)} sets of effect values for {n} parameter sets")
+        names = list(self.effects)
+        canon = []
+        for ev in values_per_set:
+            canon.append({get_effect(k).name: pv for k, pv in ev.items()})
+            for k in canon[-1]:
+                if k not in names:
+                    names.append(k)
+        active = []
+        for name in names:
+            e = get_effect(name)
+            if self.kind not in e.kinds:
+                raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model (it applies to {e.kinds})")
+            own = self.effects.get(name, e.off)
+            if not e.batchable:
+                if any(ev.get(name, {}) != canon[0].get(name, {}) for ev in canon):
+                    raise IPMCError(f"effect {name!r} is not batchable: one model call needs one set of its values")
+                if name in self.effects and not e.is_off(own):
+                    active.append((e, own, None))
+                continue
+            for ev in canon:
+                bad = set(ev.get(name, {})) - set(own)
+                if bad:
+                    e.parameter(sorted(bad)[0])                 # raises: no such parameter
+            vals = {}
+            for p in e.parameters:
+                a = np.array([ev.get(name, {}).get(p.name, own[p.name]) for ev in canon], dtype=float)
+                ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
+                if not np.all(ok):
+                    v = float(a[~ok][0])
+                    raise ParameterError(f"{name}.{p.name}={v!r} [{p.unit}] must lie in [{p.lower:g}, {p.upper:g}]")
+                vals[p.name] = a
+            on = e.on_mask(vals)
+            if not np.any(on):
+                continue
+            if np.all(on):
+                mask = None
+            else:            # off sets take the off values: the effect sees no switched-off mixture
+                mask = on[:, None, None]
+                for p in e.parameters:
+                    vals[p.name] = np.where(on, vals[p.name], p.off)
+            active.append((e, {k: a[:, None, None] for k, a in vals.items()}, mask))
+        self._active = active
 
     def state(self, temperature_c) -> State:
-        st = super().state(temperature_c)
-        acts = [(e, v) for e, v in self._active if e.level == "parameter"]
+        st = super().state(temperature_c) if self._batch_table is None else self._batch_table.state(temperature_c)
+        acts = [(e, v, m) for e, v, m in self._active if e.level == "parameter"]
         if not acts:
             return st
-        d = {k: np.array(getattr(st, k), dtype=float) for k in STATE_FIELDS}
+        d0 = {k: np.array(getattr(st, k), dtype=float) for k in STATE_FIELDS}
+        d = dict(d0)
         T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
-        for e, v in acts:
-            d = e.apply(d, T_ref, v)
+        for e, v, m in acts:
+            new = e.apply(dict(d), T_ref, v)
+            d = new if m is None else {k: np.where(m, new[k], d[k]) for k in d}
         d["K"] = debye_rate(d["d"], d["C_minus"], d["kappa_e"], d["T"])
         d["omega_n"] = first_mode_omega(d["E"], d["rho"], d["L"], d["h"])
+        if all(m is not None for _, _, m in acts):      # sets with every parameter effect off: the base state
+            changed = np.logical_or.reduce([m for _, _, m in acts])
+            for k in ("K", "omega_n"):
+                d[k] = np.where(changed, d[k], d0[k])
         return State(**d)
 
     def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
@@ -184,13 +300,13 @@ class _EffectMixin:
         T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
         s = 2j * np.pi * f
         st = self.state(T)
-        resp = [(e, v) for e, v in self._active if e.level == "response"]
-        series = [(e, v) for e, v in self._active if e.level == "series"]
+        resp = [(e, v, m) for e, v, m in self._active if e.level == "response"]
+        series = [(e, v, m) for e, v, m in self._active if e.level == "series"]
         need = set(qs)
         if series:
             need.add("Z")
         need = tuple(q for q in self.quantities if q in need)
-        kern = next(((e, v) for e, v in self._active if e.level == "kernel"), None)
+        kern = next(((e, v) for e, v, _ in self._active if e.level == "kernel"), None)
         s_kernel = s if kern is None else kern[0].apply(s, kern[1])
         if kern is None:
             vals = evaluate_grid(st, s, self._kernel, need, self.chunk_size, None, progress)
@@ -208,15 +324,19 @@ class _EffectMixin:
                     vals["M"] = vals["H"] * G
         T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
         ctx = _Context(s[None, None, :], s_kernel[None, None, :], st, dict(vals), T_ref)
-        strip = [(e, v) for e, v in self._active if e.level == "strip"]
+        strip = [(e, v, m) for e, v, m in self._active if e.level == "strip"]
         if strip:                           # the strip itself: every quantity computed, Z included
+            partly = [m for _, _, m in strip if m is not None]
+            x0 = ctx.x if partly else None  # the line without them, for the sets where they are off
             for q in need:
-                for e, ev in strip:
+                for e, ev, m in strip:
                     if q in e.quantities:
-                        vals[q] = vals[q] * e.apply(q, ctx, ev)
+                        vals[q] = vals[q] * _where_on(m, e.apply(q, ctx, ev), 1.0)
+            if partly and len(partly) == len(strip) and ctx._x is not x0:
+                ctx._x = np.where(np.logical_or.reduce(partly), ctx._x, x0)
             ctx.base = dict(vals)
         for q in qs:
-            fac = [e.apply(q, ctx, ev) for e, ev in resp if q in e.quantities]
+            fac = [_where_on(m, e.apply(q, ctx, ev), 1.0) for e, ev, m in resp if q in e.quantities]
             if fac:
                 v = vals[q].copy()
                 for x in fac:
@@ -224,12 +344,14 @@ class _EffectMixin:
                 vals[q] = v
         if series:
             Z0 = ctx.base["Z"]
-            zs = sum(e.apply(ctx, ev) for e, ev in series)
+            zs = sum(_where_on(m, e.apply(ctx, ev), 0.0) for e, ev, m in series)
+            masks = [m for _, _, m in series]
+            on = None if any(m is None for m in masks) else np.logical_or.reduce(masks)
             for q in qs:
                 if q == "Z":
                     vals[q] = vals[q] + zs
                 elif q != "G":                 # voltage divider (actuator) / current divider (sensor)
-                    vals[q] = vals[q] * (Z0 / (Z0 + zs))
+                    vals[q] = _where_on(on, vals[q] * (Z0 / (Z0 + zs)), vals[q])
         res = {}
         for q in qs:
             if out is not None and q in out:
@@ -262,7 +384,10 @@ class _EffectMixin:
         numbers; anything not given keeps this model's value.  One vectorised model call per
         prediction (unique temperatures × union of frequencies).  ``predict.many(list_of_values)``
         is the batched form (n_sets, N) for ``fit_parameters(predict_many=...)``; it uses the first
-        parameter set of this model as the base.
+        parameter set of this model as the base and evaluates every set in one model call, the
+        values of the batchable effects (:attr:`Effect.batchable`) as arrays over the sets (one call
+        per distinct set of values of the others).  ``predict.many_grouped`` is the same with one
+        model call per distinct set of effect values.
         """
         from ..data.sweep import sweep_layout
 
@@ -278,7 +403,36 @@ class _EffectMixin:
         paths: dict = {}        # the base names, each resolved once against self.params[0]
 
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
-            # one batched model call per distinct set of effect values (base values vary freely)
+            # one batched model call for every set (effect values as arrays over the sets), or one
+            # per distinct set of values of the non-batchable effects (Effect.batchable)
+            out = np.empty((len(values_list), data.response.size), dtype=complex)
+            split = [split_values(v) for v in values_list]
+            groups: dict = {}
+            for i, (_, e) in enumerate(split):
+                key = tuple(sorted((get_effect(n).name, tuple(sorted(pv.items()))) for n, pv in e.items()
+                                   if not get_effect(n).batchable))
+                groups.setdefault(key, []).append(i)
+            for rows in groups.values():
+                effects = {n: dict(v) for n, v in self.effects.items()}
+                for n, pv in split[rows[0]][1].items():    # the non-batchable values (all the same here)
+                    if not get_effect(n).batchable:
+                        effects.setdefault(n, {}).update(pv)
+                # the base values as arrays (no record per set), or a record per set when a name
+                # addresses a temperature law or T_ref
+                table = _table_of(self.params[0], [split[i][0] for i in rows], paths)
+                plist = ([self.params[0]] * len(rows) if table is not None
+                         else [_apply(self.params[0], split[i][0], paths) for i in rows])
+                m = make_effect_model(plist, self.kind, effects, **self._extra())
+                if table is not None:
+                    m._use_table(table)
+                m._batch_effects([split[i][1] for i in rows])
+                r = m.frequency_response(freqs, temps, quantities=(q,))[q]
+                out[rows] = r[:, ti, fi] * scale
+            return out
+
+        def predict_many_grouped(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
+            # one batched model call per distinct set of effect values (base values vary freely): the
+            # reference the batched form is tested against
             out = np.empty((len(values_list), data.response.size), dtype=complex)
             groups: dict = {}
             for i, v in enumerate(values_list):
@@ -298,6 +452,7 @@ class _EffectMixin:
             return out
 
         predict.many = predict_many
+        predict.many_grouped = predict_many_grouped
         return predict
 
     def _extra(self) -> dict:

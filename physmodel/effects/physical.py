@@ -33,7 +33,7 @@ from .. import beam
 from ..temperature import Arrhenius, LogLinear
 from ..transport import debye_rate
 from . import fluid
-from .base import Effect, P
+from .base import Effect, P, by_mode_count, law_factor, rows_of
 
 #: Frequency [Hz] at which |ŝ| = |s| for the fractional transport (ŝ = ω_c (s/ω_c)^β).
 CPE_REFERENCE_HZ = 10.0
@@ -80,19 +80,19 @@ def _curved(st, T_ref, v):
 
 
 def _p_modulus_T(st, T_ref, v):
-    st["E"] = st["E"] * LogLinear(slope=v["slope"]).factor(st["T"], T_ref) * _curved(st, T_ref, v)
+    st["E"] = st["E"] * law_factor(LogLinear, "slope", v["slope"], st["T"], T_ref) * _curved(st, T_ref, v)
     return st
 
 
 def _p_diffusivity_T(st, T_ref, v):
-    fac = Arrhenius(activation_energy=v["activation_energy"]).factor(st["T"], T_ref) * _curved(st, T_ref, v)
+    fac = law_factor(Arrhenius, "activation_energy", v["activation_energy"], st["T"], T_ref) * _curved(st, T_ref, v)
     st["d"] = st["d"] * fac
     st["Rp"] = st["Rp"] / fac            # Nernst-Einstein: ionic resistance ∝ T/d (T part in the base law)
     return st
 
 
 def _p_permittivity_T(st, T_ref, v):
-    st["kappa_e"] = st["kappa_e"] * LogLinear(slope=v["slope"]).factor(st["T"], T_ref) * _curved(st, T_ref, v)
+    st["kappa_e"] = st["kappa_e"] * law_factor(LogLinear, "slope", v["slope"], st["T"], T_ref) * _curved(st, T_ref, v)
     return st
 
 
@@ -115,11 +115,15 @@ def _p_water_uptake(st, T_ref, v):
 # --------------------------------------------------------------------------- response / kernel level
 def _r_second_mode(q, ctx, v):
     """M = H_qs·[g1 + c (T_modal − g1)]: c = 1 is the Euler–Bernoulli modal sum, c = 0 the base."""
-    st = ctx.st
-    g1 = beam.first_mode(ctx.s, st.omega_n, st.xi)
-    n = beam.modes_for_band(st.omega_n, float(np.max(np.abs(ctx.s))))
-    full = beam.modal_tip_response(ctx.s, st.omega_n, st.xi, ctx.x, n, v["viscous_share"])
-    return 1.0 + v["weight"] * (full / g1 - 1.0)
+    st, x = ctx.st, ctx.x
+
+    def modal(rows, n):
+        wn, xi = rows_of(st.omega_n, rows), rows_of(st.xi, rows)
+        g1 = beam.first_mode(ctx.s, wn, xi)
+        full = beam.modal_tip_response(ctx.s, wn, xi, rows_of(x, rows), n, rows_of(v["viscous_share"], rows))
+        return 1.0 + rows_of(v["weight"], rows) * (full / g1 - 1.0)
+
+    return by_mode_count(ctx, modal)
 
 
 def fractional_s(s, v):
@@ -240,7 +244,7 @@ EFFECTS = [
            "transport (see module docstring; not the series interface CPE).",
            "Macdonald (Impedance Spectroscopy); Evangelista & Lenzi, fractional PNP models", "kernel",
            (P("beta", "1", 1.0, 0.5, 1.0, 0.85, "fractional order β", limits=("upper",)),), quantities=("M", "H", "Z", "I", "S"),
-           apply=fractional_s),
+           apply=fractional_s, batchable=False),
 ]
 
 __all__ = ["EFFECTS", "CPE_REFERENCE_HZ", "SECOND_MODE_RATIO", "polymer_area_resistance", "fractional_s"]

@@ -1,0 +1,189 @@
+"""``EffectModel.predictor(...).many`` evaluates every parameter set in one model call, effect values
+as arrays over the sets (physmodel/effects/library.py).  The oracle is the grouped form
+``predict.many_grouped`` — one model call per distinct set of effect values, each effect switched on
+only where it is on, scalar values — which the effect tests check against independent physics.
+
+For every library effect (and out-of-library effect) alone and every pair of library effects, for
+actuators (M and Z) and sensors (S): random in-range base parameters and effect values over several
+sets, some sets at the effect's off value, some with its switch off and the other parameters
+anywhere, some without it; the two forms agree to rtol 1e-12.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from physmodel import get_parameter_set
+from physmodel.data.sweep import synthesize_sweep
+from physmodel.effects import LIBRARY, OUT_OF_LIBRARY, EffectModel, get_effect
+from physmodel.effects.library import EffectActuatorModel, EffectSensorModel
+from physmodel.errors import IPMCError, ParameterError
+
+P_ACT = get_parameter_set("seed002_table3").replace(r1_sheet=300.0)
+P_SEN = get_parameter_set("seed000_sensor_dev")
+FREQS = np.geomspace(0.05, 300.0, 13)
+TEMPS = [18.0, 37.0, 55.0]
+CASES = [("actuator", "M", P_ACT, "alpha0"), ("actuator", "Z", P_ACT, "alpha0"), ("sensor", "S", P_SEN, "a0")]
+
+
+#: Effects already on in the model the predictor comes from (sets that do not name them keep these values).
+BASELINE = {"time_delay": {"delay": 2e-3}, "leakage": {"conductance": 20.0, "tcr": 2e-3}}
+
+
+def _predictor(kind, q, p, baseline=None):
+    sweep = synthesize_sweep(EffectModel(p, kind, {}), q, FREQS, TEMPS)
+    return EffectModel(p, kind, baseline or {}).predictor(sweep, q)
+
+
+def _effects_for(kind, q, library=LIBRARY):
+    return [n for n, e in library.items() if kind in e.kinds and q in e.quantities]
+
+
+def _draw_effect(rng, name, p, mode):
+    """Values of effect ``name``: ``mode`` "on" (random in its candidate bounds), "off" (all at off),
+    "switch_off" (the switch at off, the others random), "absent" (not given)."""
+    e = get_effect(name)
+    if mode == "absent":
+        return {}
+    pars = e.candidate_parameters(p)
+    v = {q.name: float(rng.uniform(q.lower, q.upper)) for q in pars}
+    if mode == "off":
+        v = {q.name: q.off for q in pars}
+    elif mode == "switch_off":
+        v[e.switch or pars[0].name] = e.parameter(e.switch or pars[0].name).off
+        if e.switch is None:
+            v = {q.name: q.off for q in pars}
+    return {f"{name}.{k}": x for k, x in v.items()}
+
+
+def _draw_sets(rng, names, p, gain):
+    modes = ("on", "on", "off", "switch_off", "absent", "on", "on")
+    sets = []
+    for k, mode in enumerate(modes):
+        v = {"d": p.d * rng.uniform(0.6, 1.6), "kappa_e": p.kappa_e * rng.uniform(0.7, 1.4),
+             "xi": float(rng.uniform(0.05, 0.4)), "omega_n": p.omega_n * rng.uniform(0.4, 3.0),
+             gain: getattr(p, gain) * rng.uniform(0.8, 1.2)}
+        for j, n in enumerate(names):
+            # the second effect of a pair takes its modes in another order
+            v.update(_draw_effect(rng, n, p, mode if j == 0 else modes[(k + 3) % len(modes)]))
+        sets.append(v)
+    return sets
+
+
+def _check(pred, sets):
+    grouped = pred.many_grouped(sets)
+    batched = pred.many(sets)
+    assert np.all(np.isfinite(grouped))
+    np.testing.assert_allclose(batched, grouped, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("baseline", [None, BASELINE], ids=["plain", "with-baseline-effects"])
+@pytest.mark.parametrize("kind, q, p, gain", CASES, ids=[f"{c[0]}-{c[1]}" for c in CASES])
+def test_every_effect_alone(kind, q, p, gain, baseline):
+    pred = _predictor(kind, q, p, baseline)
+    rng = np.random.default_rng(27)
+    names = _effects_for(kind, q)
+    assert len(names) >= 8
+    for n in names + _effects_for(kind, q, OUT_OF_LIBRARY):     # the blind generators' effects too
+        _check(pred, _draw_sets(rng, [n], p, gain))
+
+
+@pytest.mark.parametrize("kind, q, p, gain", CASES, ids=[f"{c[0]}-{c[1]}" for c in CASES])
+def test_every_pair_of_effects(kind, q, p, gain):
+    pred = _predictor(kind, q, p)
+    rng = np.random.default_rng(2706)
+    for a, b in itertools.combinations(_effects_for(kind, q), 2):
+        _check(pred, _draw_sets(rng, [a, b], p, gain))
+
+
+def _count_calls(monkeypatch):
+    calls = []
+    for cls in (EffectActuatorModel, EffectSensorModel):
+        orig = cls.frequency_response
+
+        def counted(self, *a, _orig=orig, **k):
+            calls.append(len(self.params))
+            return _orig(self, *a, **k)
+
+        monkeypatch.setattr(cls, "frequency_response", counted)
+    return calls
+
+
+def test_batchable_effects_take_one_model_call(monkeypatch):
+    pred = _predictor("actuator", "M", P_ACT)
+    rng = np.random.default_rng(5)
+    sets = _draw_sets(rng, ["contact_resistance", "time_delay"], P_ACT, "alpha0")
+    calls = _count_calls(monkeypatch)
+    pred.many(sets)
+    assert calls == [len(sets)]
+    calls.clear()
+    pred.many_grouped(sets)
+    assert len(calls) > 1
+
+
+def test_a_non_batchable_effect_is_grouped_by_its_values(monkeypatch):
+    assert not LIBRARY["fractional_transport"].batchable
+    pred = _predictor("actuator", "M", P_ACT)
+    sets = [{"fractional_transport.beta": b, "time_delay.delay": t}
+            for b, t in ((0.8, 1e-3), (0.9, 2e-3), (0.8, 3e-3), (1.0, 0.0), (0.9, 0.0))]
+    calls = _count_calls(monkeypatch)
+    out = pred.many(sets)
+    assert sorted(calls) == [1, 2, 2]          # beta 0.8, 0.9 (two sets each) and 1.0
+    calls.clear()
+    np.testing.assert_allclose(out, pred.many_grouped(sets), rtol=1e-12, atol=0)
+
+
+def test_a_set_does_not_depend_on_its_batch_mates():
+    """The modal effects' mode count is each set's own, not that of the softest strip in the call."""
+    pred = _predictor("actuator", "M", P_ACT)
+    stiff = {"omega_n": P_ACT.omega_n * 3.0, "second_mode.weight": 1.0, "higher_modes.weight": 0.8}
+    soft = {"omega_n": P_ACT.omega_n * 0.2, "second_mode.weight": 0.5, "higher_modes.weight": 1.0}
+    both = pred.many([soft, stiff])
+    np.testing.assert_array_equal(both[1], pred.many([stiff])[0])
+    np.testing.assert_array_equal(both[0], pred.many([soft])[0])
+
+
+def test_bad_effect_values_are_named():
+    pred = _predictor("actuator", "M", P_ACT)
+    with pytest.raises(ParameterError, match=r"time_delay\.delay=-1\.0"):
+        pred.many([{"time_delay.delay": 1e-3}, {"time_delay.delay": -1.0}])
+    with pytest.raises(ParameterError, match=r"time_delay\.delay=nan"):
+        pred.many([{"time_delay.delay": float("nan")}])
+    with pytest.raises(ParameterError, match="no parameter"):
+        pred.many([{"time_delay.delay": 1e-3}, {"time_delay.tau": 1e-3}])
+    with pytest.raises(IPMCError, match="does not apply"):
+        pred.many([{}, {"coupling_compliance.compliance_ratio": 0.1}])
+    with pytest.raises(ParameterError, match="unknown effect"):
+        pred.many([{"warp_drive.speed": 1.0}])
+
+
+def test_base_values_built_as_arrays_match_records_and_laws_fall_back(monkeypatch):
+    """Base values go into one table of arrays (no record per set); a temperature-law name or T_ref
+    makes one record per set (apply_values), and both agree with the grouped form."""
+    import physmodel.effects.library as lib
+
+    pred = _predictor("actuator", "M", P_ACT)
+    built = []
+    orig = lib._table_of
+    monkeypatch.setattr(lib, "_table_of", lambda *a: built.append(orig(*a)) or built[-1])
+    sets = [{"d": P_ACT.d * 1.3, "omega_n": P_ACT.omega_n * 2, "E": P_ACT.E * 0.7, "time_delay.delay": 1e-3},
+            {"E": P_ACT.E * 1.5, "h": P_ACT.h * 1.1}, {"omega_n": P_ACT.omega_n * 0.5, "r1_sheet": 0.0}, {}]
+    np.testing.assert_allclose(pred.many(sets), pred.many_grouped(sets), rtol=1e-12, atol=0)
+    assert built[-1] is not None and built[-1].n == len(sets)
+    for extra in ({"laws.d.activation_energy": 25e3}, {"T_ref": 310.0}):
+        law_sets = [dict(v, **extra) if k % 2 else v for k, v in enumerate(sets)]
+        np.testing.assert_allclose(pred.many(law_sets), pred.many_grouped(law_sets), rtol=1e-12, atol=0)
+        assert built[-1] is None
+
+
+def test_bad_base_values_are_named_as_the_record_names_them():
+    pred = _predictor("actuator", "M", P_ACT)
+    for bad, pattern in (({"d": -1.0}, r"d=-1\.0 \[m\^2/s\]"), ({"kappa_e": float("nan")}, "kappa_e is NaN"),
+                         ({"omega_n": 0.0}, r"omega_n=0\.0 rad/s must be a positive finite number"),
+                         ({"E": float("inf")}, r"E=inf .* must be finite")):
+        for form in (pred.many, pred.many_grouped):
+            with pytest.raises(ParameterError, match=pattern):
+                form([{}, bad])
