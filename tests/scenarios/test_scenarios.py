@@ -26,10 +26,13 @@ _RUNS: dict = {}
 
 
 @pytest.fixture(scope="module")
-def quick_run(tmp_path_factory):
-    """Run a bundled scenario in quick mode once per module (name -> RunResult)."""
+def quick_run(tmp_path_factory, request):
+    """Run a bundled scenario in quick mode once per module (name -> RunResult); seed000_chain's run is
+    the session's (tests/conftest.py), shared with test_seed000_chain.py."""
 
     def get(name):
+        if name == "seed000_chain":
+            return request.getfixturevalue("seed000_chain_quick")[0]
         if name not in _RUNS:
             spec = load_scenario(_path(name), quick=True)
             _RUNS[name] = run_scenario(spec, tmp_path_factory.mktemp(name), quiet=True)

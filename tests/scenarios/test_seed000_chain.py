@@ -43,16 +43,19 @@ SMALL = {"points": 16, "candidates": ["tip_driven_beam"], "documented": ["tip_dr
 @pytest.fixture(scope="module", params=[pytest.param("small", id="small"),
                                         pytest.param("quick", id="quick", marks=pytest.mark.slow)])
 def quick_result(request, tmp_path_factory):
+    """The small run, or the bundled quick run (the session's, tests/conftest.py: test_scenarios.py
+    asserts on the same run)."""
     import tomllib
 
+    if request.param == "quick":
+        return request.getfixturevalue("seed000_chain_quick")
     mp = pytest.MonkeyPatch()
     _register(mp)
     out = tmp_path_factory.mktemp(f"chain_{request.param}")
     try:
         path = spec.bundled_scenarios()[0].parent / "seed000_chain.toml"
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
-        if request.param == "small":
-            raw["quick"]["chain"] = {**raw["quick"]["chain"], **SMALL}
+        raw["quick"]["chain"] = {**raw["quick"]["chain"], **SMALL}
         res = runner.run_scenario(spec.parse_scenario(raw, str(path), quick=True), out, quiet=True)
     finally:
         mp.undo()
