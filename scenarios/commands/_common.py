@@ -284,6 +284,18 @@ def model_metadata(mf, overridden: bool = False) -> dict[str, str]:
     return meta
 
 
+def surrogate_misfit(info: dict) -> str | None:
+    """The surrogate's own verdict on the sweep it was fitted to, as ``ipmc fit`` recorded it in
+    ``model.json`` (``info["adequacy"]``): a sentence when it does not fit that sweep, else None
+    (also for surrogates written before the verdict was recorded)."""
+    a = info.get("adequacy") or {}
+    if a.get("adequate") is False:
+        data = (info.get("data") or {}).get("file", "its sweep")
+        return (f"the surrogate does not fit the sweep it was fitted to ({data}): {a.get('reason', '')}"
+                + (" (accepted with ipmc fit --accept-misfit)" if a.get("accepted") else ""))
+    return None
+
+
 def provenance_data(mf, info: dict) -> tuple:
     """The measured sweep a model or a surrogate names as its data, when it is still that file:
     the physics model's provenance first, then the surrogate's source model, then — for a surrogate

@@ -354,6 +354,11 @@ def run(args) -> int:
     if mf is not None and mf.verdict is not None and not mf.verdict.adequate and \
             not (src.get("sha256") and src.get("sha256") == mf.fingerprint()):
         upstream.append(f"the physics model {mf.path or mf.name} does not fit its data: {mf.verdict.reason}")
+    from ._common import surrogate_misfit
+
+    own = surrogate_misfit(model.info)
+    if own is not None:
+        upstream.append(own)
     summary["upstream_misfit"] = upstream
     lo_hi = model.temperature_range_c
     range_notes = []

@@ -219,6 +219,8 @@ def run(args) -> int:
     if not verdict.adequate:
         print(f"ipmc fit: the model does not fit the data: {verdict.reason}"
               + ("" if args.accept_misfit else " (--accept-misfit to exit 0)"), file=sys.stderr)
+        print("ipmc fit: model.json records this verdict; ipmc feedforward/invert will say it and refuse the "
+              "surrogate without --accept-misfit", file=sys.stderr)
         return EXIT_OK if args.accept_misfit else EXIT_NOT_CONVERGED
     return EXIT_OK
 
@@ -245,6 +247,8 @@ def _write(args, data, fit_data, res, excl, temps, fit_temps, out, verdict, sche
                                         res.per_temperature_models)
         figures.append("poles_zeros_vs_temperature.png")
     model.info.update(provenance(args, data, fit_data))
+    model.info["adequacy"] = {"adequate": bool(verdict.adequate), "test": verdict.test, "reason": verdict.reason,
+                              "p_value": verdict.p_value, "accepted": bool(args.accept_misfit)}   # read by feedforward/invert
     model.to_json(out / "model.json")
     report = _report(args, data, fit_data, res, held, figures, verdict)
     report += upstream_lines(model.info)

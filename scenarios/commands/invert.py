@@ -257,7 +257,14 @@ def _verdicts(args: argparse.Namespace, smodel: Any, t: np.ndarray, y: np.ndarra
         print(f"ipmc invert: {msg}" + ("" if args.accept_misfit else " (exit 3; --accept-misfit to accept)"),
               file=sys.stderr)
         status = EXIT_OK if args.accept_misfit else 3
-    from ._common import provenance_data
+    from ._common import provenance_data, surrogate_misfit
+
+    own = surrogate_misfit(smodel.info)
+    if own is not None:
+        notes.append(f"surrogate_misfit: {own}")
+        print(f"ipmc invert: surrogate_misfit: {own}" + ("" if args.accept_misfit else " (exit 3; --accept-misfit to accept)"),
+              file=sys.stderr)
+        status = EXIT_OK if args.accept_misfit else 3
 
     if args.data is not None:
         if not Path(args.data).is_file():
