@@ -466,7 +466,7 @@ def plan_for(split: InverseSplit, dt: float, n_preview: int | None) -> Plan:
     if plan is None:
         plan = Plan(split, key[0], key[1])
         if len(cache) >= PLAN_CACHE_SIZE:
-            cache.pop(next(iter(cache)))
+            cache.pop(next(iter(cache)), None)
         cache[key] = plan
     return plan
 

@@ -272,7 +272,7 @@ def _anti_kernel(split: InverseSplit, dt: float, n: int) -> tuple[np.ndarray, np
     h.flags.writeable = False
     tail.flags.writeable = False
     if len(cache) >= _KERNEL_CACHE_SIZE:
-        cache.pop(next(iter(cache)))
+        cache.pop(next(iter(cache)), None)
     cache[key] = (h, tail)
     return h, tail
 
@@ -444,9 +444,10 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         N = min(int(ok[0]) if ok.size else n - 1, n - 1)
         tail_n = float(tail[min(N, tail.size - 1)])
     stable, unstable, output = plan_for(split, dt, N).run(ua, chunk, stable)
+    ua = ua.copy()      # ua may be the caller's own array: the errors are of the signal inverted now
 
     def errors() -> tuple[float, float, float]:
-        # from the signal alone (the result's arrays may have been changed since)
+        # from the signal alone (the result's arrays, or the caller's input, may have been changed since)
         minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
         y_inf = plan0.run(ua, ua.size)[2]
         size = _peak if norm == "linf" else (lambda e: float(np.sqrt(np.dot(e, e))))

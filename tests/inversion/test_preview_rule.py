@@ -160,6 +160,20 @@ def test_auto_preview_errors_are_computed_from_the_signal_when_read():
     assert r.preview_choice.relative_error == pytest.approx(err / np.max(np.abs(y_inf)), rel=1e-6)
 
 
+def test_auto_preview_errors_are_of_the_signal_inverted_even_if_the_caller_reuses_its_array():
+    # the caller's own float64 array may be what the inversion holds: changing it afterwards must
+    # not change the error reported for the inversion already done (review finding: 100x once)
+    G = toy_actuator()
+    t, d = _faded_sine(1.0)
+    d = np.ascontiguousarray(d, dtype=float)
+    y_inf = invert(G, t, d.copy(), preview="inf").output
+    r = invert(G, t, d)
+    err = float(np.max(np.abs(r.output - y_inf)))
+    d *= 100.0
+    assert r.preview_choice.max_error == pytest.approx(err, rel=1e-6)
+    assert r.truncation_error == pytest.approx(err, rel=1e-6)
+
+
 def test_auto_preview_grows_with_tighter_tolerance_and_l2_norm_is_available():
     G = toy_actuator()
     t, d = _faded_sine(2.0)
