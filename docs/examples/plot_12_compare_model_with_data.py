@@ -8,9 +8,9 @@ error bars, a physics model at any temperatures, and a calibrated model with the
 parameters' 95 % intervals give.  ``scenarios.comparison.compare`` puts a model against data
 and gives, per temperature, the fit % of system-identification toolboxes,
 100·(1 − ‖H − Ĥ‖/‖H − mean H‖) on the complex response, and χ² against the data's σ with its
-verdict.  ``ipmc compare MODEL DATA -o FOLDER`` does the same from the command line.  Every
-figure the commands write has such a ``plot_*`` form (``plot_calibration`` below, residuals and
-pole-zero maps too: :mod:`scenarios.plots`).
+verdict.  ``ipmc compare MODEL DATA -o FOLDER`` does the same from the command line.  The
+Bode, time, calibration, residual and pole-zero figures have such a ``plot_*`` form
+(``plot_calibration`` below; the list is in :mod:`scenarios.plots`).
 
 The "measurement" here is a synthetic sweep of the seed 002 strip whose diffusion coefficient is
 30 % larger than the named set's, so the named set should misfit and a calibration should not.

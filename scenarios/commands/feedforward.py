@@ -68,7 +68,7 @@ def add_parser(sub):
     p.add_argument("--temperature", type=float, required=True, help="operating temperature [°C]")
     g = p.add_argument_group("reference (in the surrogate's output unit, e.g. mm)")
     g.add_argument("--reference", choices=("sine", "multitone", "steps"), default="sine")
-    g.add_argument("--reference-file", help="CSV/NPZ with time_s and a value column (instead of --reference)")
+    g.add_argument("--reference-file", help="CSV/NPZ/MAT with a time column and a value column (instead of --reference)")
     g.add_argument("--reference-column", metavar="NAME|INDEX",
                    help="value column of --reference-file, by name or 0-based index (default: the first after time_s)")
     g.add_argument("--amplitude", default="0.3", help="amplitude(s), comma-separated for multitone")

@@ -75,7 +75,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     """Add the ``invert`` subcommand to an ``argparse`` subparsers object and return it."""
     p = subparsers.add_parser(
         "invert",
-        help="stable (noncausal / finite-preview) inversion of a sampled signal in a CSV file",
+        help="stable (noncausal / finite-preview) inversion of a sampled signal in a .csv, .npz or .mat file",
         description=__doc__.split("\n\n")[0],
     )
     p.add_argument("input", help="signal file (.csv, .npz, .mat) with a time column and signal columns")
@@ -171,7 +171,9 @@ def run(args: argparse.Namespace) -> int:
     if spec is None:          # the first column beside the time, not a scalar of a .mat/.npz file
         others = [n for n in table.names if n != tcol and (n in table.text or table.data[n].size == t.size)]
         if not others:
-            raise InversionError(f"{args.input}: no signal column besides the time column {tcol!r}; the file has "
+            sizes = ", ".join(f"{n} has {table.data[n].size}" for n in table.names if n != tcol and n in table.data)
+            raise InversionError(f"{args.input}: no signal column besides the time column {tcol!r} with its "
+                                 f"{t.size} values" + (f" ({sizes})" if sizes else "") + f"; the file has "
                                  f"{table.describe()} (choose one with --input-column NAME|INDEX)")
         spec, opt = others[0], "--input-column"
     ucol = pick_column(table, spec, opt, "input")          # a text column: its first line that is not a number

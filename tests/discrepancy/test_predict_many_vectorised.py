@@ -6,7 +6,7 @@ only where it is on, scalar values — which the effect tests check against inde
 For every library effect (and out-of-library effect) alone and every pair of library effects, for
 actuators (M and Z) and sensors (S): random in-range base parameters and effect values over several
 sets, some sets at the effect's off value, some with its switch off and the other parameters
-anywhere, some without it; the two forms agree to rtol 1e-12.
+anywhere, some without it; the two forms agree to rtol 1e-10 (1e-12 here; the margin is for other BLAS builds).
 """
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ def _check(pred, sets):
     grouped = pred.many_grouped(sets)
     batched = pred.many(sets)
     assert np.all(np.isfinite(grouped))
-    np.testing.assert_allclose(batched, grouped, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(batched, grouped, rtol=1e-10, atol=0)
 
 
 @pytest.mark.parametrize("baseline", [None, BASELINE], ids=["plain", "with-baseline-effects"])
@@ -133,7 +133,7 @@ def test_a_non_batchable_effect_is_grouped_by_its_values(monkeypatch):
     out = pred.many(sets)
     assert sorted(calls) == [1, 2, 2]          # beta 0.8, 0.9 (two sets each) and 1.0
     calls.clear()
-    np.testing.assert_allclose(out, pred.many_grouped(sets), rtol=1e-12, atol=0)
+    np.testing.assert_allclose(out, pred.many_grouped(sets), rtol=1e-10, atol=0)
 
 
 def test_a_set_does_not_depend_on_its_batch_mates():
@@ -171,11 +171,11 @@ def test_base_values_built_as_arrays_match_records_and_laws_fall_back(monkeypatc
     monkeypatch.setattr(lib, "_table_of", lambda *a: built.append(orig(*a)) or built[-1])
     sets = [{"d": P_ACT.d * 1.3, "omega_n": P_ACT.omega_n * 2, "E": P_ACT.E * 0.7, "time_delay.delay": 1e-3},
             {"E": P_ACT.E * 1.5, "h": P_ACT.h * 1.1}, {"omega_n": P_ACT.omega_n * 0.5, "r1_sheet": 0.0}, {}]
-    np.testing.assert_allclose(pred.many(sets), pred.many_grouped(sets), rtol=1e-12, atol=0)
+    np.testing.assert_allclose(pred.many(sets), pred.many_grouped(sets), rtol=1e-10, atol=0)
     assert built[-1] is not None and built[-1].n == len(sets)
     for extra in ({"laws.d.activation_energy": 25e3}, {"T_ref": 310.0}):
         law_sets = [dict(v, **extra) if k % 2 else v for k, v in enumerate(sets)]
-        np.testing.assert_allclose(pred.many(law_sets), pred.many_grouped(law_sets), rtol=1e-12, atol=0)
+        np.testing.assert_allclose(pred.many(law_sets), pred.many_grouped(law_sets), rtol=1e-10, atol=0)
         assert built[-1] is None
 
 

@@ -66,7 +66,18 @@ def blind():
     workers = min(2, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
     if workers < 2:
         return dict(map(_blind_diagnosis, BLIND_CASES))
-    with multiprocessing.get_context("spawn").Pool(workers) as pool:
+    threads = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+    saved = {k: os.environ.get(k) for k in threads}
+    os.environ.update({k: "1" for k in threads})      # two workers x one BLAS thread on two cores
+    try:
+        pool = multiprocessing.get_context("spawn").Pool(workers)      # the workers start here, with that env
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    with pool:
         return dict(pool.map(_blind_diagnosis, BLIND_CASES, chunksize=1))
 
 
