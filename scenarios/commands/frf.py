@@ -300,7 +300,7 @@ def _lines_estimate(rec, path: str, args, kw: dict):
     print(f"ipmc frf: {path}: estimator: {note}", file=sys.stderr)
     from dataclasses import replace
 
-    return replace(est, settings={**est.settings, "excitation": exc.describe()})
+    return replace(est, settings={**est.settings, "excitation": exc.describe(), "estimator_note": note})
 
 
 def _estimate(rec, path: str, args, kw: dict):

@@ -147,4 +147,5 @@ def test_lines_on_a_random_record_is_welch_and_said(tmp_path, capsys):
     r = read_sweep(tmp_path / "r.csv")
     assert r.metadata["method"] == "h1" and "random" in r.metadata["excitation"]
     assert "estimator: Welch H1 (boxcar segments of one period, 1000 samples)" in err and "not periodic" in err
+    assert "not periodic" in r.metadata["estimator_note"]          # and in the sweep a later command reads
     np.testing.assert_allclose(r.frequency_hz, LINES * FS / N, rtol=1e-12)
