@@ -229,3 +229,41 @@ def test_the_record_units_do_not_change_the_recommendation(ambiguous):
     # tolerance (measured 4e-4 relative in λ), which a units bug (a factor of 1e3 in |G|^b) would dwarf
     assert b.recommended.separation == pytest.approx(a.recommended.separation, rel=1e-2)
     assert b.noise_model["slope"] == pytest.approx(a.noise_model["slope"], abs=1e-9)
+
+
+# ------------------------------------------------------------------ review fixes
+def test_library_refuses_a_non_numeric_power(ambiguous):
+    for bad in ("0.9", None, True):
+        with pytest.raises(IPMCError, match="power"):
+            next_measurement(ambiguous.d, power=bad)
+
+
+def test_given_temperature_limits_meet_the_laws_valid_range(ambiguous):
+    """Kelvin typed as °C is refused; limits beyond the laws' valid range (0–100 °C for this set) are
+    clipped to it and the message says so (no bath is proposed where the laws are not trusted)."""
+    from dataclasses import fields
+
+    laws = ambiguous.d.base_parameters.laws         # the set's Arrhenius / water-permittivity laws: 0–100 °C
+    assert {tuple(getattr(laws, f.name).valid_c) for f in fields(laws)
+            if type(getattr(laws, f.name)).__name__ != "Constant"} == {(0.0, 100.0)}
+    for bad in ((278.0, 338.0), (0.0, 151.0)):
+        with pytest.raises(IPMCError, match="kelvin"):
+            next_measurement(ambiguous.d, temperature_limits_c=bad)
+    nm = next_measurement(ambiguous.d, quantities=["S"], band_limits_hz=(0.1, 1000.0), temperature_limits_c=(-20.0, 35.0),
+                          check_refit=0)
+    temps = {t for r in nm.ranking for t in r.temperatures_c}
+    assert min(temps) >= 0.0
+    assert "clipped to 0–35 °C" in nm.message
+    with pytest.raises(IPMCError, match="valid range"):
+        next_measurement(ambiguous.d, temperature_limits_c=(-30.0, -10.0))
+
+
+def test_one_json_sanitiser_for_both_reports():
+    from physmodel.estimation import diagnosis
+    from physmodel.estimation.next_measurement import NextMeasurement, json_ready
+
+    assert json_ready({1: (np.float64("nan"), np.bool_(True), np.int64(3), math.inf, "s")}) == {
+        "1": [None, True, 3, None, "s"]}
+    assert diagnosis.json_ready is json_ready
+    nm = NextMeasurement.unavailable("why", [("a",), ("b",)])
+    assert json.loads(json.dumps(nm.to_dict(), allow_nan=False))["message"] == "no recommendation: why"
