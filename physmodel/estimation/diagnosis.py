@@ -15,7 +15,7 @@ from ..data.files import atomic_write
 from ..data.sweep import FrequencySweep
 from ..effects import LIBRARY, get_effect
 from ..errors import ParameterError
-from .next_measurement import NextMeasurement
+from .next_measurement import NextMeasurement, json_ready
 from .records import CalibrationResult
 
 VERDICTS = ("none", "named", "ambiguous", "at_bound", "unexplained")
@@ -292,20 +292,7 @@ class Diagnosis:
                          verdict, tuple(fit.estimates()), provenance)
 
     def to_dict(self) -> dict:
-        def clean(o):
-            if isinstance(o, dict):
-                return {str(k): clean(v) for k, v in o.items()}
-            if isinstance(o, (list, tuple)):
-                return [clean(v) for v in o]
-            if isinstance(o, (np.floating, float)):
-                return float(o) if math.isfinite(o) else None
-            if isinstance(o, (np.integer,)):
-                return int(o)
-            if isinstance(o, np.bool_):
-                return bool(o)
-            return o
-
-        return clean({
+        return json_ready({
             "format": "ipmc-diagnosis", "version": 1,
             "verdict": self.verdict, "named": list(self.named), "message": self.message,
             "named_effect": self.named_effect(),

@@ -68,6 +68,8 @@ from .residuals import noise_std
 #: Temperature range [°C] a hydrated strip is measured in by default (above freezing of the bath,
 #: below where Nafion's water content falls off), intersected with the laws' own valid ranges.
 DEFAULT_TEMPERATURE_LIMITS_C = (5.0, 65.0)
+#: Bath limits above this are refused as kelvin typed for °C (the CLI's ``check_celsius`` bound). [°C]
+MAX_BATH_C = 150.0
 #: Frequency limits [Hz] of a candidate band by default (a 0.01 Hz line takes 100 s a period; the
 #: single-mode beam and the DAQs of the scenarios end well below 1 kHz).
 DEFAULT_BAND_LIMITS_HZ = (0.01, 1000.0)
@@ -210,19 +212,16 @@ class NextMeasurement:
     inseparable: list = field(default_factory=list)
     best_by_quantity: dict = field(default_factory=dict)
 
+    @classmethod
+    def unavailable(cls, reason: str, models=()) -> NextMeasurement:
+        """The record of a search that gave no recommendation (``reason``: why), so that a finished
+        diagnosis still carries, reports and says it instead of losing it."""
+        return cls([tuple(m) for m in models], None, False, math.nan, math.nan, 0, [], {}, {},
+                   f"no recommendation: {reason}")
+
     def to_dict(self) -> dict:
         """JSON-ready form (finite floats; NaN as None)."""
-        def clean(o):
-            if isinstance(o, dict):
-                return {str(k): clean(v) for k, v in o.items()}
-            if isinstance(o, (list, tuple)):
-                return [clean(v) for v in o]
-            if isinstance(o, (float, np.floating)):
-                return float(o) if math.isfinite(o) else None
-            if isinstance(o, np.integer):
-                return int(o)
-            return o
-        return clean({"models": [list(m) for m in self.models],
+        return json_ready({"models": [list(m) for m in self.models],
                       "recommended": self.recommended.to_dict() if self.recommended else None,
                       "separates": self.separates, "target": self.target, "current": self.current,
                       "evaluated": self.evaluated, "ranking": [r.to_dict() for r in self.ranking],
@@ -231,6 +230,22 @@ class NextMeasurement:
 
 
 # =============================================================================== competing models
+def json_ready(o):
+    """``o`` with dict keys as str, tuples as lists, numpy scalars as Python ones and non-finite floats
+    as None: what ``json.dumps(..., allow_nan=False)`` accepts (the reports' one sanitiser)."""
+    if isinstance(o, dict):
+        return {str(k): json_ready(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [json_ready(v) for v in o]
+    if isinstance(o, (float, np.floating)):
+        return float(o) if math.isfinite(o) else None
+    if isinstance(o, np.bool_):
+        return bool(o)
+    if isinstance(o, np.integer):
+        return int(o)
+    return o
+
+
 def competing_models(d) -> list[tuple]:
     """The models an ``ambiguous`` / ``at_bound`` diagnosis ``d`` leaves competing: the best (its
     final effects) first, then each alternative — another named single effect, a pair with one member
@@ -450,7 +465,8 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         below and above the record's.
     temperature_limits_c : (float, float) or None
         Bath temperatures allowed. [°C]  Default :data:`DEFAULT_TEMPERATURE_LIMITS_C` intersected
-        with the laws' valid ranges.
+        with the laws' valid ranges; given limits are clipped to the laws' valid ranges (the message
+        says so) and refused above :data:`MAX_BATH_C` (kelvin typed as °C).
     levels : sequence of float
         Excitation levels, multiples of the record's drive (cap them at what the strip takes). [-]
     lines_per_decade : float or None
@@ -474,8 +490,9 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                         "verdict leaves models to separate")
     if d.base_parameters is None:
         raise IPMCError("next_measurement: the diagnosis does not carry its base parameters; rerun diagnose")
-    if not 0.5 <= power < 1:
-        raise IPMCError(f"power={power!r} must lie in [0.5, 1)")
+    if isinstance(power, bool) or not isinstance(power, (int, float, np.integer, np.floating)) \
+            or not 0.5 <= power < 1:
+        raise IPMCError(f"power={power!r}: expected a number in [0.5, 1)")
     lv = np.asarray(sorted(set(float(x) for x in levels)), float)
     if lv.size == 0 or np.any(~np.isfinite(lv)) or np.any(lv <= 0):
         raise IPMCError(f"levels={list(levels)!r}: give positive multiples of the record's drive")
@@ -510,9 +527,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     f_hi = min(band_limits_hz[1], fmax * 10.0)
     if not f_lo < f_hi:
         raise IPMCError(f"band_limits_hz={band_limits_hz!r} leave no band near the record's {fmin:g}–{fmax:g} Hz")
-    t_lo, t_hi = temperature_limits_c if temperature_limits_c is not None else _law_range(d.base_parameters)
-    if t_lo > t_hi:
-        raise IPMCError(f"temperature_limits_c={temperature_limits_c!r}: lower above upper")
+    t_lo, t_hi, t_note = _temperature_limits(temperature_limits_c, d.base_parameters)
     f_grid = np.geomspace(f_lo, f_hi, max(int(round(lpd * math.log10(f_hi / f_lo))) + 1, 2))
     windows = _band_windows(f_lo, f_hi, (fmin, fmax))
     tsets = _temperature_sets(T_data, t_lo, t_hi)
@@ -637,6 +652,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_said)}× "
                   "as many" if 0 < lam_said < target else "")
                + f"), widen the limits, or accept the ambiguity.{alike}")
+    msg += t_note
     return NextMeasurement([tuple(m) for m in mods], chosen, bool(sep_ok), target, float(current), len(rows),
                            ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form,
                            {q: max(r.separation for r in rows if r.quantity == q) for q in qs
@@ -667,17 +683,52 @@ def merge_records(record: FrequencySweep, new: FrequencySweep) -> FrequencySweep
                           {**dict(record.metadata or {}), "merged_with": dict(b.metadata or {})})
 
 
-def _law_range(base) -> tuple:
-    """:data:`DEFAULT_TEMPERATURE_LIMITS_C` intersected with every non-constant law's valid range."""
+def _laws_valid_range(base) -> tuple:
+    """The intersection of every non-constant temperature law's valid range. [°C]"""
     from dataclasses import fields
 
-    lo, hi = DEFAULT_TEMPERATURE_LIMITS_C
+    lo, hi = -273.15, math.inf
     laws = getattr(base, "laws", None)
     for f in fields(laws) if laws is not None else ():
         law = getattr(laws, f.name)
         if type(law).__name__ != "Constant" and hasattr(law, "valid_c"):
-            lo, hi = max(lo, law.valid_c[0]), min(hi, law.valid_c[1])
+            lo, hi = max(lo, float(law.valid_c[0])), min(hi, float(law.valid_c[1]))
     return lo, hi
+
+
+def _law_range(base) -> tuple:
+    """:data:`DEFAULT_TEMPERATURE_LIMITS_C` intersected with every non-constant law's valid range."""
+    lo, hi = _laws_valid_range(base)
+    return max(DEFAULT_TEMPERATURE_LIMITS_C[0], lo), min(DEFAULT_TEMPERATURE_LIMITS_C[1], hi)
+
+
+def _temperature_limits(limits, base) -> tuple[float, float, str]:
+    """The bath limits searched (default :func:`_law_range`) and a note for the message: given limits
+    above :data:`MAX_BATH_C` are refused (kelvin typed as °C); limits outside the laws' valid range are
+    clipped to it (the models are not trusted beyond it) and the note says so."""
+    if limits is None:
+        lo, hi = _law_range(base)
+        return lo, hi, ""
+    try:
+        t_lo, t_hi = (float(x) for x in limits)
+    except (TypeError, ValueError):
+        raise IPMCError(f"temperature_limits_c={limits!r}: expected two numbers (lower, upper) in °C") from None
+    if not (math.isfinite(t_lo) and math.isfinite(t_hi)):
+        raise IPMCError(f"temperature_limits_c={limits!r}: expected finite temperatures in °C")
+    if t_lo > t_hi:
+        raise IPMCError(f"temperature_limits_c={limits!r}: lower above upper")
+    if t_hi > MAX_BATH_C or t_lo <= -273.15:
+        raise IPMCError(f"temperature_limits_c={limits!r}: outside (-273.15, {MAX_BATH_C:g}] °C where a hydrated "
+                        "IPMC works — kelvin? Temperatures are in °C (subtract 273.15)")
+    v_lo, v_hi = _laws_valid_range(base)
+    c_lo, c_hi = max(t_lo, v_lo), min(t_hi, v_hi)
+    if c_lo > c_hi:
+        raise IPMCError(f"temperature_limits_c={limits!r}: no temperature within the temperature laws' valid "
+                        f"range {v_lo:g}–{v_hi:g} °C")
+    if (c_lo, c_hi) == (t_lo, t_hi):
+        return t_lo, t_hi, ""
+    return c_lo, c_hi, (f" Bath limits {t_lo:g}–{t_hi:g} °C clipped to {c_lo:g}–{c_hi:g} °C, the temperature "
+                        "laws' valid range.")
 
 
 def _log_unit_factor(d, sk: FrequencySweep) -> float:
@@ -741,6 +792,7 @@ def _refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: in
     return out
 
 
-__all__ = ["CandidateMeasurement", "NextMeasurement", "competing_models", "merge_records", "next_measurement",
+__all__ = ["CandidateMeasurement", "NextMeasurement", "competing_models", "json_ready", "merge_records",
+           "next_measurement", "MAX_BATH_C",
            "PERIODS", "BATH_SETTLE_S", "SAME_FORM_LAMBDA", "REFIT_STARTS", "FD_RELATIVE_STEP",
            "DEFAULT_BAND_LIMITS_HZ", "DEFAULT_LEVELS", "DEFAULT_TEMPERATURE_LIMITS_C"]

@@ -44,7 +44,11 @@ EXPERIMENT.toml (paths relative to the TOML file; SI units for parameters)::
 When the verdict is ambiguous or at bound, it also searches the measurement that would separate
 the competing models (physmodel.estimation.next_measurement: quantity, band, temperatures, drive
 level, with the separation expected at this record's noise) and says it on stderr, in summary.md,
-report.json ("next_measurement") and model.json's verdict reason.
+report.json ("next_measurement") and model.json's verdict reason. Its options are checked before the
+diagnosis runs (exit 2, whatever the verdict); bath limits are in °C (above 150 refused as kelvin) and
+clipped to the temperature laws' valid range. When no recommendation can be made (e.g. no candidate
+experiment within the limits) the diagnosis is still written, with "no recommendation: <reason>" in
+the same places.
 
 Writes model.json (the model it ends with — the baseline plus the named effect(s), refitted, with the
 goodness-of-fit verdict and the data's provenance: what ``--model`` takes in every later command),
@@ -344,38 +348,72 @@ def build(args):
     bound_count(kw["null_draws"], "--null-draws" if args.null_draws is not None else f"null_draws (in {args.experiment})",
                 8 * (4 * data.frequency_hz.size + 16), what="draws")
     args.data_path = data_path
+    args.next_table = dict(spec.get("next_measurement", {}))
     return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
 
 
-def spec_of(args) -> dict:
-    """The experiment file's ``[next_measurement]`` table (empty without a file or table)."""
-    if not args.experiment:
-        return {}
-    return dict(_load_toml(Path(args.experiment)).get("next_measurement", {}))
+def _next_kw(args, table: dict, kind: str) -> dict:
+    """Keywords of :meth:`Diagnosis.recommend_next_measurement` from ``[next_measurement]`` (``table``,
+    as :func:`build` read it) and the flags: ``quantities`` (what the lab measures), ``band_limits_hz``,
+    ``temperature_limits_c``, ``levels`` (drive multiples; cap them at what the strip takes), ``power``.
+    Checked before the diagnosis runs, whatever its verdict: bad input raises IPMCError (exit 2)
+    naming the flag or key."""
+    import math
 
+    from physmodel.data.units import QUANTITY_UNITS
 
-def _next_kw(args, table: dict) -> dict:
-    """Keywords of :meth:`Diagnosis.recommend_next_measurement` from ``[next_measurement]`` and the
-    flags: ``quantities`` (what the lab measures), ``band_limits_hz``, ``temperature_limits_c``,
-    ``levels`` (drive multiples; cap them at what the strip takes), ``power``."""
-    kw = {}
+    from ._common import check_celsius
+
+    where = f" (in {args.experiment})" if args.experiment else ""
+    kw: dict = {}
     for key, flag, n in (("quantities", "next_quantities", None), ("band_limits_hz", "next_band_hz", 2),
                          ("temperature_limits_c", "next_temperatures_c", 2), ("levels", "next_levels", None)):
         v = getattr(args, flag, None)
+        name = f"--{flag.replace('_', '-')}" if isinstance(v, str) else f"next_measurement.{key}{where}"
         v = [x.strip() for x in v.split(",")] if isinstance(v, str) else table.get(key)
         if v is None:
             continue
         if not isinstance(v, list) or not v or (n is not None and len(v) != n):
-            raise IPMCError(f"next_measurement {key} = {v!r}: expected a list" + (f" of {n} values" if n else ""))
-        if key != "quantities":
+            raise IPMCError(f"{name} = {v!r}: expected a list" + (f" of {n} values" if n else "") + f" ({key})")
+        if key == "quantities":
+            kinds = [q for k, q in QUANTITY_UNITS if k == kind and q != "G"]
+            bad = [q for q in v if q not in kinds]
+            if bad:
+                raise IPMCError(f"{name} = {v!r}: {bad} not measurable on a {kind}; expected some of {kinds}")
+        else:
             try:
+                if any(isinstance(x, bool) for x in v):
+                    raise TypeError
                 v = [float(x) for x in v]
             except (TypeError, ValueError):
-                raise IPMCError(f"next_measurement {key} = {v!r}: expected numbers") from None
+                raise IPMCError(f"{name} = {v!r}: expected numbers ({key})") from None
+            if not all(math.isfinite(x) for x in v):
+                raise IPMCError(f"{name} = {v!r}: expected finite numbers ({key})")
+            if key in ("band_limits_hz", "levels") and min(v) <= 0:
+                raise IPMCError(f"{name} = {v!r}: expected positive numbers ({key})")
+            if n == 2 and v[0] > v[1] or key == "band_limits_hz" and v[0] == v[1]:
+                raise IPMCError(f"{name} = {v!r}: expected lower, upper with lower below upper ({key})")
+            if key == "temperature_limits_c":
+                check_celsius(v, name)
         kw[key] = tuple(v)
     if "power" in table:
-        kw["power"] = table["power"]
+        pw = table["power"]
+        if isinstance(pw, bool) or not isinstance(pw, (int, float)) or not 0.5 <= pw < 1:
+            raise IPMCError(f"next_measurement.power{where} = {pw!r}: expected a number in [0.5, 1)")
+        kw["power"] = float(pw)
     return kw
+
+
+def recommend(d, kw: dict) -> None:
+    """Search an ambiguous / at-bound diagnosis's next measurement into ``d.next_measurement``; when the
+    search cannot give one (IPMCError: e.g. no candidate experiment within the limits) the reason is
+    recorded there instead ("no recommendation: ..."), so the finished diagnosis is still written."""
+    from physmodel.estimation.next_measurement import NextMeasurement
+
+    try:
+        d.recommend_next_measurement(**kw)
+    except IPMCError as exc:
+        d.next_measurement = NextMeasurement.unavailable(str(exc))
 
 
 def run(args) -> int:
@@ -385,6 +423,7 @@ def run(args) -> int:
     from physmodel.estimation.discrepancy import diagnose, gap_shrink
 
     data, base, kw, out = build(args)
+    next_kw = _next_kw(args, args.next_table, kw["kind"])      # before the diagnosis, whatever its verdict
     check_output_folder(out, "ipmc diagnose", force=args.force)
     bar = None
     if not args.quiet:
@@ -407,7 +446,7 @@ def run(args) -> int:
         if d.verdict in ("ambiguous", "at_bound"):       # which measurement would separate the rivals
             if bar is not None:
                 bar.set_postfix_str("searching the next measurement", refresh=True)
-            d.recommend_next_measurement(**_next_kw(args, spec_of(args)))
+            recommend(d, next_kw)
     finally:
         if bar is not None:
             bar.close()

@@ -229,3 +229,106 @@ def test_the_record_units_do_not_change_the_recommendation(ambiguous):
     # tolerance (measured 4e-4 relative in λ), which a units bug (a factor of 1e3 in |G|^b) would dwarf
     assert b.recommended.separation == pytest.approx(a.recommended.separation, rel=1e-2)
     assert b.noise_model["slope"] == pytest.approx(a.noise_model["slope"], abs=1e-9)
+
+
+# ------------------------------------------------------------------ review fixes
+def _cli(ambiguous, tmp_path, *extra, toml=None):
+    from scenarios.cli import main
+
+    ambiguous.rec.to_csv(tmp_path / "record.csv")
+    if toml is not None:
+        (tmp_path / "exp.toml").write_text(
+            'data = "record.csv"\nkind = "sensor"\nset = "seed000_sensor_dev"\nfree = ["a0", "d", "kappa_e"]\n'
+            'candidates = ["time_delay", "amplifier_bandwidth"]\nnull_draws = 400\nnull_refits = 0\n'
+            '[parameters]\nT_ref = 308.15\n[next_measurement]\n' + toml)
+        return main(["diagnose", str(tmp_path / "exp.toml"), "--out", str(tmp_path / "out"), "--quiet", *extra])
+    return main(["diagnose", "--data", str(tmp_path / "record.csv"), "--kind", "sensor", "--set", "seed000_sensor_dev",
+                 "--param", "T_ref=308.15", "--free", "a0", "--free", "d", "--free", "kappa_e",
+                 "--candidates", "time_delay,amplifier_bandwidth", "--null-draws", "400", "--null-refits", "0",
+                 "--out", str(tmp_path / "out"), "--quiet", *extra])
+
+
+@pytest.mark.parametrize("extra, toml, named", [
+    (["--next-band-hz", "0.1"], None, "--next-band-hz"),
+    (["--next-quantities", "M"], None, "--next-quantities"),           # an actuator's quantity on a sensor
+    (["--next-temperatures-c", "278,338"], None, "kelvin"),
+    (["--next-levels", "0,1"], None, "--next-levels"),
+    ([], 'power = "high"\n', "next_measurement.power"),
+    ([], "power = true\n", "next_measurement.power"),
+    ([], "temperature_limits_c = [278.15, 338.15]\n", "next_measurement.temperature_limits_c"),
+    ([], 'levels = ["x"]\n', "next_measurement.levels"),
+])
+def test_cli_checks_the_next_measurement_options_before_diagnosing(ambiguous, tmp_path, capsys, monkeypatch,
+                                                                    extra, toml, named):
+    """Bad next-measurement input exits 2 naming the option or key before the (long) diagnosis runs,
+    whatever its verdict would be: the diagnosis is replaced by one that fails the test if called."""
+    from physmodel.estimation import discrepancy
+
+    def never(*a, **k):
+        raise AssertionError("diagnose ran before the next-measurement options were checked")
+
+    monkeypatch.setattr(discrepancy, "diagnose", never)
+    assert _cli(ambiguous, tmp_path, *extra, toml=toml) == 2
+    assert named in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_keeps_the_diagnosis_when_no_experiment_is_left(ambiguous, tmp_path, capsys, monkeypatch):
+    """Limits that leave no candidate experiment (the record's own band at its own temperature, merged
+    with it: every line already measured) make the search raise; the finished diagnosis is still
+    written, with "no recommendation: <reason>" in its report, model file and on stderr."""
+    from dataclasses import replace
+
+    from physmodel.estimation import discrepancy
+
+    with pytest.raises(IPMCError, match="no candidate experiment"):          # the library still raises
+        next_measurement(ambiguous.d, quantities=["S"], band_limits_hz=(10.0, 100.0), temperature_limits_c=(35.0, 35.0))
+    monkeypatch.setattr(discrepancy, "diagnose", lambda *a, **k: replace(ambiguous.d))
+    rc = _cli(ambiguous, tmp_path, "--next-quantities", "S", "--next-band-hz", "10,100", "--next-temperatures-c",
+              "35,35")
+    err = capsys.readouterr().err
+    assert rc == (0 if ambiguous.d.to_model_file().adequate else 3)
+    assert "ipmc diagnose: ambiguous; no recommendation: next_measurement: no candidate experiment" in err
+    rep = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert rep["verdict"] == "ambiguous"
+    assert rep["next_measurement"]["message"].startswith("no recommendation: ")
+    assert rep["next_measurement"]["recommended"] is None
+    assert "no recommendation" in (tmp_path / "out" / "summary.md").read_text()
+    assert "no recommendation" in json.loads((tmp_path / "out" / "model.json").read_text())["verdict"]["reason"]
+
+
+def test_library_refuses_a_non_numeric_power(ambiguous):
+    for bad in ("0.9", None, True):
+        with pytest.raises(IPMCError, match="power"):
+            next_measurement(ambiguous.d, power=bad)
+
+
+def test_given_temperature_limits_meet_the_laws_valid_range(ambiguous):
+    """Kelvin typed as °C is refused; limits beyond the laws' valid range (0–100 °C for this set) are
+    clipped to it and the message says so (no bath is proposed where the laws are not trusted)."""
+    from dataclasses import fields
+
+    laws = ambiguous.d.base_parameters.laws         # the set's Arrhenius / water-permittivity laws: 0–100 °C
+    assert {tuple(getattr(laws, f.name).valid_c) for f in fields(laws)
+            if type(getattr(laws, f.name)).__name__ != "Constant"} == {(0.0, 100.0)}
+    for bad in ((278.0, 338.0), (0.0, 151.0)):
+        with pytest.raises(IPMCError, match="kelvin"):
+            next_measurement(ambiguous.d, temperature_limits_c=bad)
+    nm = next_measurement(ambiguous.d, quantities=["S"], band_limits_hz=(0.1, 1000.0), temperature_limits_c=(-20.0, 35.0),
+                          check_refit=0)
+    temps = {t for r in nm.ranking for t in r.temperatures_c}
+    assert min(temps) >= 0.0
+    assert "clipped to 0–35 °C" in nm.message
+    with pytest.raises(IPMCError, match="valid range"):
+        next_measurement(ambiguous.d, temperature_limits_c=(-30.0, -10.0))
+
+
+def test_one_json_sanitiser_for_both_reports():
+    from physmodel.estimation import diagnosis
+    from physmodel.estimation.next_measurement import NextMeasurement, json_ready
+
+    assert json_ready({1: (np.float64("nan"), np.bool_(True), np.int64(3), math.inf, "s")}) == {
+        "1": [None, True, 3, None, "s"]}
+    assert diagnosis.json_ready is json_ready
+    nm = NextMeasurement.unavailable("why", [("a",), ("b",)])
+    assert json.loads(json.dumps(nm.to_dict(), allow_nan=False))["message"] == "no recommendation: why"
