@@ -47,7 +47,7 @@ COMMANDS = (
     ("run", "run a scenario file (scenarios/*.toml) into a report folder"),
     ("study", "Monte Carlo / grid parameter study on local processes or a Dask cluster"),
     ("fit", "fit a temperature-scheduled rational transfer function to a sweep CSV"),
-    ("invert", "stable (noncausal / finite-preview) inversion of a sampled signal in a CSV file"),
+    ("invert", "stable (noncausal / finite-preview) inversion of a sampled signal in a .csv, .npz or .mat file"),
     ("feedforward", "feedforward voltage of a surrogate, checked on the physics"),
     ("calibrate", "calibrate physical parameters to a measured sweep (estimates, intervals, identifiability)"),
     ("diagnose", "locate a model/data discrepancy, name the missing effect, refit, show the gap shrink"),
