@@ -14,7 +14,7 @@ LM_STEPS = 30
 
 def damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
     """Levenberg-Marquardt from the point ``pt``, a tuple ``(z, r, J, status, message, step,
-    cost)`` as the engine's ``evaluate(z)`` returns it (cached and counted in ``count``).
+    cost, joined)`` as the engine's ``evaluate(z)`` returns it (cached and counted in ``count``).
 
     Steps ``(JᵀJ + λ diag JᵀJ) d = -Jᵀr`` clipped to just inside the box [lo, hi]; λ is divided by 3 after a
     decrease and multiplied by 4 after an increase.  Ends at a point with a status (converged, or

@@ -131,6 +131,7 @@ class _Fit:
     nfev: int
     status: int
     message: str
+    joined: int | None = None       # the earlier start whose optimum this one reached (status -2)
 
 
 def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step, res):
@@ -192,16 +193,9 @@ def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[
     return _residuals_and_jacobian(batch, ScaledRows(free, x, range(len(free))), z, hi, fd_step, res)
 
 
-_JOINED = "start "
-
-
 def joined_start(record: StartRecord) -> int | None:
     """The index of the earlier start whose optimum ``record``'s start joined (status −2), else None."""
-    if record.status != -2:
-        return None
-    tail = record.message.rsplit(_JOINED, 1)[-1]
-    digits = tail.split("'", 1)[0]
-    return int(digits) if digits.isdigit() else None
+    return record.joined if record.status == -2 else None
 
 
 #: A coordinate of an optimum within this fraction of its range from a bound sits at that bound.
@@ -254,7 +248,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     count, last = [0], [None]
 
     def assess(z, r, J):
-        """(status or None, message, Gauss–Newton step, cost) of a point."""
+        """(status or None, message, Gauss–Newton step, cost, the start joined or None) of a point."""
         c = 0.5 * float(r @ r)
         s2 = 2.0 * c / dof if dof > 0 else 1.0
         g = J.T @ r
@@ -264,17 +258,17 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
             step = np.linalg.lstsq(J, -r, rcond=None)[0]
         decrement = -0.5 * float(g @ step)
         if 0 <= decrement < GN_DECREMENT * s2:
-            return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c
+            return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c, None
         for opt in optima:
             if opt.status > 0 and opt.cost <= c <= opt.cost + JOIN_COST * s2:
                 d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
                 if float(d @ (opt.J.T @ opt.J) @ d) <= JOIN_DISTANCE**2 * s2:
                     return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
-                                f"errors of {_JOINED}{opt.index}'s optimum"), step, c
-        return None, "", step, c
+                                f"errors of start {opt.index}'s optimum"), step, c, opt.index
+        return None, "", step, c, None
 
     def evaluate(z):
-        """(z, r, J, status, message, step, cost) at ``z``, cached for the last two points."""
+        """(z, r, J, status, message, step, cost, joined) at ``z``, cached for the last two points."""
         key = z.tobytes()
         if key not in cache:
             if len(cache) > 1:
@@ -327,7 +321,8 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
             pt = last[0]
             status, msg = pt[3], pt[4]
     z, r, J = pt[0], pt[1], pt[2]
-    return _Fit(index=-1, z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=count[0], status=status, message=msg)
+    return _Fit(index=-1, z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=count[0], status=status, message=msg,
+                joined=pt[7] if status == -2 else None)
 
 
 def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[[Values], np.ndarray] | None,
@@ -447,7 +442,7 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
         records.append(StartRecord(i, initial,
                                    {fp.name: float(fp.from_z(v)) for fp, v in zip(free, ends[-1])},
-                                   fit.cost, fit.nfev, fit.status, fit.message))
+                                   fit.cost, fit.nfev, fit.status, fit.message, fit.joined))
         if progress:
             progress(1)
     best = min((k for k in range(len(fits)) if fits[k].status != -2), key=lambda k: fits[k].cost)

@@ -173,6 +173,7 @@ class StartRecord:
     nfev: int
     status: int
     message: str
+    joined: int | None = None       # status -2: the earlier start whose optimum it reached
 
 
 @dataclass
