@@ -315,20 +315,23 @@ def run(args) -> int:
         print("ipmc feedforward: warning: --no-voltage-limit: the drive voltage is not limited; "
               "never play it on a real strip without checking its peak", file=sys.stderr)
     refused, error = None, None
-    with warnings.catch_warnings(record=True) as caught:       # a limit warning is re-said below with the options
-        warnings.simplefilter("always")
-        try:
-            ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits,
-                             improper=args.improper, filter_bandwidth=args.filter_bandwidth)
-        except LimitError as exc:
-            refused = limit_flags(str(exc), max_v, max_rate)
-        except InversionError as exc:        # the library's keywords, spelled as this command's flags
-            error = CLIError(f"{args.surrogate}: {as_flags(str(exc))}")
-    for w in caught:
-        if isinstance(w.message, LimitWarning):
-            warnings.warn(LimitWarning(limit_flags(str(w.message), max_v, max_rate)), stacklevel=1)
-        else:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    caught: list = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:   # a limit warning is re-said below with the options
+            warnings.simplefilter("always")
+            try:
+                ff = feedforward(G, ref.t, ref.y, preview=args.preview, preview_tol=args.preview_tol, limits=limits,
+                                 improper=args.improper, filter_bandwidth=args.filter_bandwidth)
+            except LimitError as exc:
+                refused = limit_flags(str(exc), max_v, max_rate)
+            except InversionError as exc:        # the library's keywords, spelled as this command's flags
+                error = CLIError(f"{args.surrogate}: {as_flags(str(exc))}")
+    finally:        # said even when something unexpected (or Ctrl-C) ends the inversion
+        for w in caught:
+            if isinstance(w.message, LimitWarning):
+                warnings.warn(LimitWarning(limit_flags(str(w.message), max_v, max_rate)), stacklevel=1)
+            else:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if error is not None:
         raise error
     if refused is not None:

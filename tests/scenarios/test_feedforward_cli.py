@@ -228,3 +228,22 @@ def test_no_voltage_limit_is_explicit_and_said(model_json, tmp_path, capsys):
     feedforward.add_parser(ap.add_subparsers())
     args = ap.parse_args(["feedforward", "m.json", "--temperature", "30", "--out", "o"])
     assert drive_limits(args) == (DEFAULT_MAX_VOLTAGE, None)
+
+
+def test_limit_flags_follow_the_library_wording():
+    """``limit_flags`` rewrites the library's limit messages into this command's options; it is
+    applied to messages the library itself produced, so a change of their wording fails here
+    instead of silently leaving Python keywords in what the user reads."""
+    from inversion.limits import LimitError, Limits, check_limits
+    from scenarios.commands.feedforward import limit_flags
+
+    t = np.arange(200) * 1e-3
+    y = 3.0 * np.sin(2 * np.pi * 20 * t)           # peak 3 V, peak rate 2π·20·3 ≈ 377 V/s
+    for limits, option, keyword in ((Limits(max_voltage=2.0), "--max-voltage 2", "max_voltage"),
+                                    (Limits(max_rate=100.0), "--max-rate 100", "max_rate")):
+        with pytest.raises(LimitError) as exc:
+            check_limits(y, 1e-3, limits, what="feedforward voltage", unit="V")
+        said = limit_flags(str(exc.value), 2.0, 100.0)
+        assert option in said, said
+        assert keyword + " =" not in said, said
+        assert "samples violate it" in said
