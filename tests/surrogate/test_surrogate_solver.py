@@ -18,12 +18,17 @@ from surrogate._structure import CasadiBackend, denominators, polynomials
 
 CASES = [("coefficients", 2, 3, 0), ("coefficients", 3, 3, 2), ("sections", 4, 4, 0),
          ("sections", 1, 2, 3), ("sections", 2, 5, 0), ("zpk", 3, 3, 2), ("zpk", 4, 4, 1),
-         ("zpk", 2, 3, 0), ("zpk", 0, 1, 0)]
+         ("zpk", 2, 3, 0), ("zpk", 0, 1, 0), ("zpk:monic", 3, 3, 2), ("zpk:monic", 2, 3, 0)]
+
+
+def _structure(form, m, n, deg):
+    """``Structure``; "zpk:monic": the zpk zero sections of schema 1 (s̃² + c1 s̃ + c0)."""
+    return Structure(*form.split(":")[:1], m, n, deg, *form.split(":")[1:])
 
 
 def _problem(form, m, n, deg, kind, n_lines=37, seed=0):
     rng = np.random.default_rng(seed)
-    st = Structure(form, m, n, deg)
+    st = _structure(form, m, n, deg)
     w = np.geomspace(0.1, 10.0, n_lines)
     tau = rng.uniform(-1, 1, n_lines) if deg else np.zeros(n_lines)
     h = (1 + 0.3 * rng.normal(size=n_lines)) * np.exp(1j * rng.normal(size=n_lines))
@@ -142,7 +147,7 @@ def test_covariance_from_the_r_factor_equals_the_svd_of_the_jacobian(shape, spre
 
 @pytest.mark.parametrize("form, m, n, deg", CASES)
 def test_vectorised_denominators_equal_polynomials_per_temperature(form, m, n, deg):
-    st = Structure(form, m, n, deg)
+    st = _structure(form, m, n, deg)
     theta = np.random.default_rng(2).normal(scale=0.5, size=st.n_params)
     taus = np.linspace(-1.2, 1.2, 9)
     ref = np.array([polynomials(st, theta, t)[1] for t in taus])
