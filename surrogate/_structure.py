@@ -50,7 +50,20 @@ _LOG_BOUND = 30.0  # |log a| ≤ 30 keeps scaled section coefficients within e^�
 
 @dataclass(frozen=True)
 class Structure:
-    """Which parametrisation, which orders, which polynomial degree in temperature."""
+    """Which parametrisation, which orders, which polynomial degree in temperature.
+
+    Parameters
+    ----------
+    form : {'zpk', 'coefficients', 'sections'}
+        The parametrisation (module docstring).
+    n_zeros, n_poles : int
+        Orders of the numerator and denominator in s (``n_zeros <= n_poles``, ``n_poles >= 1``).
+    degree : int
+        Polynomial degree of every slot in the scaled temperature τ (0: one temperature).
+    zero_sections : {'unit', 'monic'}
+        'zpk' only: zero factors 1 + β1 s̃ + β2 s̃² and 1 + β s̃ ('unit', what fits produce), or
+        the former s̃² + c1 s̃ + c0 and s̃ + e ('monic', models saved with schema version 1).
+    """
 
     form: str
     n_zeros: int
@@ -191,7 +204,13 @@ class Structure:
         return _structure(self.form, self.n_zeros, self.n_poles, degree, self.zero_sections)
 
     def with_form(self, form: str) -> Structure:
-        """The same orders and degree in ``form`` ('zpk': 'unit' zero sections)."""
+        """The same orders and degree in another parametrisation.
+
+        Parameters
+        ----------
+        form : {'zpk', 'coefficients', 'sections'}
+            The target form ('zpk': with 'unit' zero sections, whatever this structure's).
+        """
         return _structure(form, self.n_zeros, self.n_poles, self.degree)
 
     def to_dict(self) -> dict:
