@@ -8,7 +8,7 @@ import itertools
 
 import numpy as np
 
-from ._structure import Structure, factor_roots, polynomials, roots, section_polys, slot_values
+from ._structure import Structure, factor_roots, polynomials, roots, section_polys, slot_values, zero_section_polys
 
 
 # --------------------------------------------------- grouping roots into factors
@@ -111,6 +111,11 @@ def pole_slots_from_groups(quads, single) -> list[float]:
 
 
 def zero_slots_from_groups(gain, quads, single) -> list[float]:
+    """'zpk' zero slots, gain first, from grouped roots ρ: a factor's coefficients are those of
+    (ρ-polynomial) ρ² − (ρ1 + ρ2) ρ + ρ1ρ2 and ρ − ρ0.  'monic' sections: ρ are the zeros,
+    (c1, c0) and e, gain the leading coefficient; 'unit' sections: ρ are the *inverse* zeros
+    μ = 1/z (a zero at infinity is μ = 0), (β1, β2) = (−(μ1 + μ2), μ1μ2) and β = −μ0, since
+    (1 − μ1 s̃)(1 − μ2 s̃) = 1 + β1 s̃ + β2 s̃², gain the numerator's value at s̃ = 0."""
     out = [gain]
     for q in quads:
         out += list(quad_coefficients(q))
@@ -119,17 +124,39 @@ def zero_slots_from_groups(gain, quads, single) -> list[float]:
     return out
 
 
+_FAR_INVERSE = 1e12  # an inverse zero standing in for a zero at the origin (which has no β)
+
+
+def inverse_zeros(num_asc, m: int) -> tuple[float, np.ndarray]:
+    """(gain, μ): N(s̃) = gain · Π (1 − μ_i s̃) for a numerator of degree ≤ m (ascending);
+    μ = 1/z are the roots of the reversed polynomial (a zero at infinity, a missing leading
+    coefficient, is μ = 0).  A zero at the origin (N(0) = 0) has no such factor: μ = 1e12
+    stands in for it and the gain is scaled to keep N."""
+    num = np.zeros(m + 1)
+    num[:min(len(num_asc), m + 1)] = np.asarray(num_asc, float)[:m + 1]
+    nz = np.flatnonzero(num)
+    if not nz.size:
+        return 0.0, np.zeros(m, complex)
+    j = int(nz[0])                                   # zeros at the origin
+    mu = np.roots(num[j:])                           # num[j:] ascending in s = descending in μ
+    gain = float(num[j]) * (-1.0 / _FAR_INVERSE) ** j
+    mu = np.concatenate([np.asarray(mu, complex), np.full(j, _FAR_INVERSE + 0j)])
+    return gain, mu
+
+
 def groups_from_theta(structure: Structure, theta, which: str):
-    """Root groups of a degree-0 sections/zpk parameter vector, in slot order."""
+    """Root groups of a degree-0 sections/zpk parameter vector, in slot order ('zpk' zeros
+    with 'unit' sections: the inverse zeros, as ``zero_slots_from_groups`` reads them)."""
     v = slot_values(structure, theta, 0.0)
     if which == "poles":
         n = structure.n_poles
         secs = section_polys(v, "log_a1", "log_a0", n // 2, "log_c" if n % 2 else None, True)
         odd = n % 2 == 1
     else:
-        m = structure.n_zeros
-        secs = section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
-        odd = m % 2 == 1
+        secs = zero_section_polys(structure, v)
+        odd = structure.n_zeros % 2 == 1
+        if structure.zero_sections == "unit":        # inverse zeros: roots of the reversed factors
+            secs = [sec[::-1] for sec in secs]
     rts = [factor_roots(s) for s in secs]
     if odd:
         return rts[:-1], rts[-1]
@@ -160,6 +187,9 @@ def convert(structure: Structure, theta, form: str, reference_theta=None) -> np.
     pole_part = pole_slots_from_groups(pq, ps)
     if form == "sections":
         return np.concatenate([num, pole_part])
-    gain = float(num[m]) if len(num) > m else 0.0
-    zq, zs = group_roots(zeros, ref_z) if m else ([], None)
+    if target.zero_sections == "unit":
+        gain, rho = inverse_zeros(num, m)
+    else:
+        gain, rho = (float(num[m]) if len(num) > m else 0.0), zeros
+    zq, zs = group_roots(rho, ref_z) if m else ([], None)
     return np.concatenate([zero_slots_from_groups(gain, zq, zs), pole_part])

@@ -69,10 +69,12 @@ def _layout(structure: Structure) -> dict:
 
     lay = {"form": structure.form, "m": m, "n": n, "n_slots": len(ix)}
     if structure.form == "zpk":
+        p1, p2, single = structure.zero_section_slots
         lay["k"] = ix["k"]
-        lay["z1"] = span([f"zc1_{k}" for k in range(m // 2)], 2)
-        lay["z0"] = span([f"zc0_{k}" for k in range(m // 2)], 2)
-        lay["ze"] = ix["ze"] if m % 2 else None
+        lay["unit"] = structure.zero_sections == "unit"
+        lay["z1"] = span([f"{p1}_{k}" for k in range(m // 2)], 2)
+        lay["z0"] = span([f"{p2}_{k}" for k in range(m // 2)], 2)     # c0 ('monic') or β2 ('unit')
+        lay["ze"] = ix[single] if m % 2 else None
     else:
         lay["b"] = span([f"b{i}" for i in range(m + 1)])
     if structure.form == "coefficients":
@@ -138,20 +140,22 @@ class Evaluator:
         if lay["form"] == "zpk":
             k = v[..., lay["k"]]
             num = k
+            unit = lay["unit"]
             if m > 1:
-                sec = s2 + v[..., lay["z1"]] * s + v[..., lay["z0"]]
+                z1s = v[..., lay["z1"]] * s
+                sec = (1.0 + z1s + v[..., lay["z0"]] * s2) if unit else (s2 + z1s + v[..., lay["z0"]])
                 num = num * (sec[..., 0] if m < 4 else np.prod(sec, axis=-1))
                 if grad:
                     inv = 1.0 / sec
                     g[..., lay["z1"]] = s * inv
-                    g[..., lay["z0"]] = inv
+                    g[..., lay["z0"]] = s2 * inv if unit else inv
             if grad:
                 g[..., lay["k"]] = 1.0 / k
             if lay["ze"] is not None:
-                e = s[:, 0] + v[..., lay["ze"]]
+                e = (1.0 + v[..., lay["ze"]] * s[:, 0]) if unit else (s[:, 0] + v[..., lay["ze"]])
                 num = num * e
                 if grad:
-                    g[..., lay["ze"]] = 1.0 / e
+                    g[..., lay["ze"]] = (s[:, 0] if unit else 1.0) / e
         elif v.shape[1] == 1:                     # one temperature: a matrix product
             num = v[:, 0, lay["b"]] @ self._sp_num_t
             if grad:

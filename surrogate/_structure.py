@@ -18,11 +18,18 @@ Forms
     is stable for every parameter value; a section holds a complex pair (a1² < 4a0) or two
     real poles (a1² ≥ 4a0) and moves continuously between the two.
 ``zpk`` (paper (ii), seed 001)
-    N = k · Π_k (s̃² + c1_k s̃ + c0_k) · (s̃ + e) with free c1, c0, e (non-minimum phase allowed)
-    and D as in ``sections``.  Gain, zero sections and log pole-section coefficients are
-    polynomials in T, so a zero or pole pair may turn from complex to real and back at some
-    temperature (the discriminant changes sign) without any change of parametrisation, and
-    the poles are stable at *every* temperature, not only on a grid.
+    N = k · Π_k (1 + β1_k s̃ + β2_k s̃²) · (1 + β s̃) with free β1, β2, β (slots zb1_k, zb2_k,
+    zb; non-minimum phase allowed; k is the numerator's value at s̃ = 0) and D as in
+    ``sections``.  Gain, zero sections and log pole-section coefficients are polynomials in
+    T, so a zero or pole pair may turn from complex to real and back at some temperature
+    (the discriminant changes sign) without any change of parametrisation, and the poles are
+    stable at *every* temperature, not only on a grid.  A zero at infinity is a finite point
+    (β2 = 0, or β = 0) reached continuously, with the gain unchanged: the seed 002 optima
+    that send a zero out of the band took the former monic sections (s̃² + c1 s̃ + c0), where
+    that needs k → 0 with c0 → ∞, 400–1,200 iterations.
+    ``zero_sections='monic'``: those former sections, N = k · Π_k (s̃² + c1_k s̃ + c0_k) ·
+    (s̃ + e) (slots zc1_k, zc0_k, ze) — models saved with schema version 1 are read in it;
+    fits always use ``'unit'``.
 """
 
 from __future__ import annotations
@@ -35,21 +42,42 @@ from numpy.polynomial import polynomial as P
 
 #: The fitter forms, declared once (scheduled fits, the CLI and the scenario schema read this).
 FORMS = ("zpk", "coefficients", "sections")
+#: 'zpk' zero-section parametrisations: 'unit' (1 + β1 s̃ + β2 s̃², fitted) and 'monic'
+#: (s̃² + c1 s̃ + c0, models saved with schema version 1).
+ZERO_SECTIONS = ("unit", "monic")
 _LOG_BOUND = 30.0  # |log a| ≤ 30 keeps scaled section coefficients within e^±30
 
 
 @dataclass(frozen=True)
 class Structure:
-    """Which parametrisation, which orders, which polynomial degree in temperature."""
+    """Which parametrisation, which orders, which polynomial degree in temperature.
+
+    Parameters
+    ----------
+    form : {'zpk', 'coefficients', 'sections'}
+        The parametrisation (module docstring).
+    n_zeros, n_poles : int
+        Orders of the numerator and denominator in s (``n_zeros <= n_poles``, ``n_poles >= 1``).
+    degree : int
+        Polynomial degree of every slot in the scaled temperature τ (0: one temperature).
+    zero_sections : {'unit', 'monic'}
+        'zpk' only: zero factors 1 + β1 s̃ + β2 s̃² and 1 + β s̃ ('unit', what fits produce), or
+        the former s̃² + c1 s̃ + c0 and s̃ + e ('monic', models saved with schema version 1).
+    """
 
     form: str
     n_zeros: int
     n_poles: int
     degree: int = 0
+    zero_sections: str = "unit"
 
     def __post_init__(self):
         if self.form not in FORMS:
             raise ValueError(f"form must be one of {FORMS}, got {self.form!r}")
+        if self.zero_sections not in ZERO_SECTIONS:
+            raise ValueError(f"zero_sections must be one of {ZERO_SECTIONS}, got {self.zero_sections!r}")
+        if self.form != "zpk" and self.zero_sections != "unit":
+            raise ValueError(f"zero_sections={self.zero_sections!r} applies to form 'zpk' only, not {self.form!r}")
         for name in ("n_zeros", "n_poles", "degree"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
@@ -74,7 +102,7 @@ class Structure:
 
     @property
     def slots(self) -> list[str]:
-        return list(_slots(self.form, self.n_zeros, self.n_poles))
+        return list(_slots(self.form, self.n_zeros, self.n_poles, self.zero_sections))
 
     def _slot_names(self) -> list[str]:
         m, n = self.n_zeros, self.n_poles
@@ -84,11 +112,18 @@ class Structure:
         if self.form == "sections":
             return num + self.pole_slots
         zs = ["k"]
+        p1, p2, single = self.zero_section_slots
         for k in range(m // 2):
-            zs += [f"zc1_{k}", f"zc0_{k}"]
+            zs += [f"{p1}_{k}", f"{p2}_{k}"]
         if m % 2:
-            zs.append("ze")
+            zs.append(single)
         return zs + self.pole_slots
+
+    @property
+    def zero_section_slots(self) -> tuple[str, str, str]:
+        """'zpk': the slot prefixes of a zero section's s̃¹ and other coefficient, and the real
+        zero's slot: ('zb1', 'zb2', 'zb') for 'unit' sections, ('zc1', 'zc0', 'ze') for 'monic'."""
+        return ("zb1", "zb2", "zb") if self.zero_sections == "unit" else ("zc1", "zc0", "ze")
 
     @property
     def n_coef(self) -> int:
@@ -112,19 +147,21 @@ class Structure:
         """The 'zpk' zero-section slots (empty for the other forms)."""
         if self.form != "zpk":
             return []
-        return [s for s in self.slots if s.startswith(("zc1_", "zc0_")) or s == "ze"]
+        p1, p2, single = self.zero_section_slots
+        return [s for s in self.slots if s.startswith((f"{p1}_", f"{p2}_")) or s == single]
 
     def slot_bounds(self, w_min: float = None, w_max: float = None, window: float = 1e3) -> dict:
         """Bounds on the values of the log-slots (pole-section coefficients) and, with a band,
         of the 'zpk' zero-section slots.
 
         With the scaled band [w_min, w_max], poles are kept within [w_min/window,
-        w_max·window] in magnitude and section damping above 1e-4, and zero sections
-        (s̃² + c1 s̃ + c0), (s̃ + e) within |c0| ≤ Z², |c1| ≤ 2Z, |e| ≤ Z, Z = w_max·window
-        (zeros within about 2Z): poles and zeros far outside the data band are not
-        identifiable and would only drift towards 0 or ∞ (a monic zero section cannot reach
-        a zero at infinity, so without a bound the gain and the section drift together and
-        the solver runs out of iterations).
+        w_max·window] in magnitude and section damping above 1e-4.  Zero sections
+        (1 + β1 s̃ + β2 s̃²), (1 + β s̃): |β2| ≤ 1/z², |β1| ≤ 2/z, |β| ≤ 1/z with
+        z = w_min/window (zeros at least about z/2 from the origin; a zero at infinity is
+        β = 0, inside); 'monic' sections (s̃² + c1 s̃ + c0), (s̃ + e): |c0| ≤ Z², |c1| ≤ 2Z,
+        |e| ≤ Z, Z = w_max·window.  Poles and zeros far outside the data band are not
+        identifiable and would only drift (a 'unit' section's zero towards the origin needs
+        the gain → 0 with β → ∞, as a 'monic' one's towards infinity needs c0 → ∞).
         """
         out = {}
         if w_min is None:
@@ -139,9 +176,10 @@ class Structure:
                 out[s] = (lo_p + np.log(2e-4), np.log(2.0) + hi_p)
             else:
                 out[s] = (lo_p, hi_p)
-        z = w_max * window
+        p1, p2, _ = self.zero_section_slots
+        z = w_max * window if self.zero_sections == "monic" else window / w_min
         for s in self.zero_slots:
-            lim = z * z if s.startswith("zc0") else (2 * z if s.startswith("zc1") else z)
+            lim = z * z if s.startswith(p2) else (2 * z if s.startswith(p1) else z)
             out[s] = (-lim, lim)
         return out
 
@@ -163,14 +201,23 @@ class Structure:
         return lo, hi
 
     def with_degree(self, degree: int) -> Structure:
-        return _structure(self.form, self.n_zeros, self.n_poles, degree)
+        return _structure(self.form, self.n_zeros, self.n_poles, degree, self.zero_sections)
 
     def with_form(self, form: str) -> Structure:
+        """The same orders and degree in another parametrisation.
+
+        Parameters
+        ----------
+        form : {'zpk', 'coefficients', 'sections'}
+            The target form ('zpk': with 'unit' zero sections, whatever this structure's).
+        """
         return _structure(form, self.n_zeros, self.n_poles, self.degree)
 
     def to_dict(self) -> dict:
-        return {"form": self.form, "n_zeros": self.n_zeros, "n_poles": self.n_poles,
-                "degree": self.degree}
+        d = {"form": self.form, "n_zeros": self.n_zeros, "n_poles": self.n_poles, "degree": self.degree}
+        if self.form == "zpk":
+            d["zero_sections"] = self.zero_sections
+        return d
 
     # ----------------------------------------------------- slot matrices
     def slot_matrix(self, theta) -> np.ndarray:
@@ -179,15 +226,15 @@ class Structure:
 
 
 @functools.lru_cache(maxsize=256)
-def _slots(form, n_zeros, n_poles) -> tuple:
+def _slots(form, n_zeros, n_poles, zero_sections="unit") -> tuple:
     """Slot names of a form and orders (computed once)."""
-    return tuple(Structure(form, n_zeros, n_poles, 0)._slot_names())
+    return tuple(Structure(form, n_zeros, n_poles, 0, zero_sections)._slot_names())
 
 
 @functools.lru_cache(maxsize=256)
-def _structure(form, n_zeros, n_poles, degree) -> Structure:
+def _structure(form, n_zeros, n_poles, degree, zero_sections="unit") -> Structure:
     """A (frozen, hence shareable) ``Structure``, built and validated once per value."""
-    return Structure(form, n_zeros, n_poles, degree)
+    return Structure(form, n_zeros, n_poles, degree, zero_sections)
 
 
 @functools.lru_cache(maxsize=256)
@@ -288,8 +335,20 @@ def evaluate(structure: Structure, theta, w, tau, be=NumpyBackend):
             re, im = _cmul(re, im, f(slot(single)), w)
         return re, im
 
+    def unit_sections(prefix1, prefix2, count, single):
+        re, im = ones, be.zeros_like(w)
+        for k in range(count):        # 1 + β1 jw + β2 (jw)²
+            re, im = _cmul(re, im, ones - slot(f"{prefix2}_{k}") * w2, slot(f"{prefix1}_{k}") * w)
+        if single is not None:
+            re, im = _cmul(re, im, ones, slot(single) * w)
+        return re, im
+
     if structure.form == "zpk":
-        zr, zi = sections("zc1", "zc0", m // 2, "ze" if m % 2 else None, log=False)
+        p1, p2, single = structure.zero_section_slots
+        if structure.zero_sections == "unit":
+            zr, zi = unit_sections(p1, p2, m // 2, single if m % 2 else None)
+        else:
+            zr, zi = sections(p1, p2, m // 2, single if m % 2 else None, log=False)
         k = slot("k")
         nr, ni = k * zr, k * zi
     else:
@@ -326,14 +385,28 @@ def section_polys(vals, p1, p0, count, single, log):
     return out
 
 
+def zero_section_polys(structure: Structure, vals) -> list:
+    """'zpk': the zero factors' coefficients in s̃ (ascending) from slot values: [1, β1, β2]
+    and [1, β] ('unit'), [c0, c1, 1] and [e, 1] ('monic')."""
+    m = structure.n_zeros
+    p1, p2, single = structure.zero_section_slots
+    if structure.zero_sections == "monic":
+        return section_polys(vals, p1, p2, m // 2, single if m % 2 else None, False)
+    out = [np.array([1.0, vals[f"{p1}_{k}"], vals[f"{p2}_{k}"]]) for k in range(m // 2)]
+    if m % 2:
+        out.append(np.array([1.0, vals[single]]))
+    return out
+
+
 def polynomials(structure: Structure, theta, tau: float = 0.0):
     """Numerator and monic denominator coefficients in s̃, ascending powers, at τ."""
     v = slot_values(structure, theta, tau)
     m, n = structure.n_zeros, structure.n_poles
     if structure.form == "zpk":
         num = np.array([v["k"]])
-        for sec in section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False):
+        for sec in zero_section_polys(structure, v):
             num = P.polymul(num, sec)
+        num = np.pad(num, (0, m + 1 - num.size))      # polymul trims a zero leading β
     else:
         num = np.array([v[f"b{i}"] for i in range(m + 1)])
     if structure.form == "coefficients":
@@ -409,14 +482,35 @@ def factor_roots(poly_asc) -> np.ndarray:
     return np.array([-poly_asc[0] + 0j])
 
 
+def finite_roots(poly_asc) -> np.ndarray:
+    """Finite roots of a0 + a1 s + a2 s² (or a0 + a1 s) whose leading coefficient may be 0
+    (a root at infinity, left out), cancellation-free like ``factor_roots``: for real roots,
+    q = −(a1 + sign(a1)·√disc)/2 and the roots q/a2 and a0/q."""
+    a = [float(c) for c in poly_asc]
+    if len(a) == 2:
+        return np.array([complex(-a[0] / a[1])]) if a[1] != 0.0 else np.array([], complex)
+    a0, a1, a2 = a
+    if a2 == 0.0:
+        return finite_roots([a0, a1])
+    disc = a1 * a1 - 4 * a0 * a2
+    if disc < 0:
+        im = np.sqrt(-disc) / (2 * abs(a2))
+        return np.array([complex(-a1 / (2 * a2), im), complex(-a1 / (2 * a2), -im)])
+    q = -(a1 + np.copysign(np.sqrt(disc), a1)) / 2
+    if q == 0.0:
+        return np.zeros(2, complex)
+    return np.array([complex(q / a2), complex(a0 / q)])
+
+
 def roots(structure: Structure, theta, tau: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """(zeros, poles) in s̃ at τ; sections are solved in closed form."""
+    """(zeros, poles) in s̃ at τ; sections are solved in closed form ('zpk': a zero at
+    infinity, β2 = 0 or β = 0, is left out)."""
     v = slot_values(structure, theta, tau)
-    m, n = structure.n_zeros, structure.n_poles
+    n = structure.n_poles
     num, den = polynomials(structure, theta, tau)
     if structure.form == "zpk":
-        secs = section_polys(v, "zc1", "zc0", m // 2, "ze" if m % 2 else None, False)
-        zeros = np.concatenate([factor_roots(s) for s in secs]) if secs else np.array([], complex)
+        secs = zero_section_polys(structure, v)
+        zeros = np.concatenate([finite_roots(s) for s in secs]) if secs else np.array([], complex)
     else:
         zeros = np.roots(num[::-1]) if np.any(num) else np.array([], complex)
     if structure.form == "coefficients":

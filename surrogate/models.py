@@ -20,7 +20,12 @@ from . import _structure as S
 __all__ = ["Scaling", "StabilityCheck", "RationalModel", "load", "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "ipmc.surrogate.rational_model"
-SCHEMA_VERSION = 1
+#: 2: 'zpk' zero sections 1 + β1 s̃ + β2 s̃² (slots zb1_k, zb2_k, zb; ``structure.zero_sections``
+#: says which).  1: 'zpk' zero sections s̃² + c1 s̃ + c0 (slots zc1_k, zc0_k, ze); still read, as
+#: a model with ``zero_sections='monic'`` (its numbers unchanged: a polynomial schedule of one
+#: kind is not one of the other).
+SCHEMA_VERSION = 2
+_READABLE_VERSIONS = (1, 2)
 
 
 @dataclass(frozen=True)
@@ -453,21 +458,27 @@ class RationalModel:
         """
         if not isinstance(d, dict) or d.get("schema") != SCHEMA:
             raise IPMCError(f"not a {SCHEMA} document (schema={d.get('schema') if isinstance(d, dict) else None!r})")
-        if d.get("schema_version") != SCHEMA_VERSION:
-            raise IPMCError(
-                f"unsupported schema_version {d.get('schema_version')!r}; this code reads {SCHEMA_VERSION}"
-            )
+        version = d.get("schema_version")
+        if isinstance(version, bool) or version not in _READABLE_VERSIONS:
+            raise IPMCError(f"unsupported schema_version {version!r}; this code reads "
+                            f"{', '.join(map(str, _READABLE_VERSIONS))}")
         for key, kind in (("structure", dict), ("params", dict), ("scaling", dict)):
             if not isinstance(d.get(key), kind):
                 raise IPMCError(f"key {key!r}: expected an object, got {type(d.get(key)).__name__}")
+        structure = dict(d["structure"])
+        if version == 1:
+            if "zero_sections" in structure:
+                raise IPMCError("key 'structure.zero_sections': not part of schema_version 1")
+            if structure.get("form") == "zpk":
+                structure["zero_sections"] = "monic"
         params = d["params"]
         for key in ("names", "values"):
             if not isinstance(params.get(key), list):
                 raise IPMCError(f"key 'params.{key}': expected a list, got {type(params.get(key)).__name__}")
         try:
-            st = S.Structure(**d["structure"])
+            st = S.Structure(**structure)
             scaling = Scaling(**d["scaling"])
-        except TypeError as exc:
+        except (TypeError, ValueError) as exc:
             raise IPMCError(f"key 'structure' or 'scaling': {exc}") from None
         if params["names"] != st.param_names():
             raise IPMCError("key 'params.names': the parameter names do not match the structure "

@@ -54,9 +54,11 @@ class ScheduledFit:
         a dense temperature grid, the fit is repeated with Liénard–Chipart constraints on
         ``stability_grid`` temperatures (``enforce_stability``), and re-checked on the dense
         grid (``result.stability``): the answer is stable there, whatever the solvers' exit
-        status, or flagged not converged with status ``Unstable_Solution``.  'zpk': gain, zero sections (s̃² + c1 s̃ + c0) and log pole-section
-        coefficients are polynomials in T (seed 001's gain/zeros/poles, in a form that
-        survives real↔complex transitions); stable at every temperature by construction.
+        status, or flagged not converged with status ``Unstable_Solution``.  'zpk': gain, zero
+        sections (1 + β1 s̃ + β2 s̃², and 1 + β s̃) and log pole-section coefficients are
+        polynomials in T (seed 001's gain/zeros/poles, in a form that survives real↔complex
+        transitions and takes a zero through infinity as β2 or β through 0); stable at every
+        temperature by construction.
         'sections': free numerator coefficients with the 'zpk' denominator.
     n_zeros, n_poles : int
         Orders (``n_zeros <= n_poles``).
@@ -204,12 +206,12 @@ class ScheduledFit:
 
         The coefficient form's problem is nearly linear in its unknowns and converges in a few
         iterations; its schedule carries the far-out, weakly determined zeros smoothly across
-        temperatures, which the pole-zero form otherwise has to crawl to (seed 002 sample, 4/4
-        cubic on 0.1–9 Hz: 1,200 joint iterations from the two-stage and constant starts, 68
-        from this one, at a lower cost).  Where the coefficient form's leading numerator
-        coefficient changes sign inside the range (a far zero passes through infinity, seed 002
-        noise draws 2 and 3), no polynomial zpk schedule follows it and this start lands in a
-        poor basin (cost 10-240 against 0.5); the race then stops it early (``_TRAILING_RATIO``)
+        temperatures (seed 002 sample, 4/4 cubic on 0.1–9 Hz, with the former monic zero
+        sections s̃² + c1 s̃ + c0: 1,200 joint iterations from the two-stage and constant starts,
+        68 from this one).  A far zero passing through infinity (the coefficient form's leading
+        numerator coefficient changes sign) is β2 or β passing through 0 in the 'zpk' form's
+        zero sections, so the converted per-temperature values lie on a smooth curve; where
+        this start still lands in a poorer basin the race stops it early (``_TRAILING_RATIO``)
         and the constant start wins.  None when that solve gives no finite start."""
         st_c = Structure("coefficients", self.n_zeros, self.n_poles, self.degree)
         problem_c, _ = F.make_problem(st_c, data, scaling, self.weighting)

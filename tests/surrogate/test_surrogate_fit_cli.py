@@ -22,7 +22,7 @@ def test_json_round_trip(fitted, tmp_path):
     path = tmp_path / "m.json"
     fitted.model.to_json(path)
     doc = json.loads(path.read_text())
-    assert doc["schema"] == "ipmc.surrogate.rational_model" and doc["schema_version"] == 1
+    assert doc["schema"] == "ipmc.surrogate.rational_model" and doc["schema_version"] == 2
     assert doc["info"]["data_fingerprint"] == fitted.data_fingerprint
     assert doc["info"]["settings"]["form"] == "zpk" and doc["info"]["settings"]["degree"] == 2
     back = load(path)

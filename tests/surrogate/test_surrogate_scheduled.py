@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from surrogate_fixtures import FIT_TEMPS, TRUE_SCALING, TRUE_THETA, noisy_sweep
 
-from surrogate import ConvergenceError, RationalModel, ScheduledFit, Structure, relative_rms_error
+from surrogate import ConvergenceError, RationalModel, Scaling, ScheduledFit, Structure, relative_rms_error
 
 SCALES = dict(omega_ref_rad_s=TRUE_SCALING.omega_ref_rad_s, gain_ref=TRUE_SCALING.gain_ref,
               temperature_center_c=TRUE_SCALING.temperature_center_c,
@@ -23,19 +23,28 @@ def test_true_model_has_a_real_to_complex_zero_transition(true_model):
     assert np.all(z_cold.real > 0) and np.all(z_hot.real > 0)  # non-minimum phase throughout
 
 
-def test_synthetic_scheduled_recovery_within_confidence_intervals(joint_zpk):
-    res = joint_zpk
-    assert res.converged and res.method == "joint"
-    assert np.all(res.ci95_low < res.ci95_high)
-    z = (res.params - TRUE_THETA) / res.stderr
+def test_synthetic_scheduled_recovery_within_confidence_intervals(joint_zpk, true_model):
+    # pooled over five noise draws (seed 3, the module's fit, and 4-7): 18 coefficients of one
+    # draw are too few for a coverage claim (one draw, seed 3, has 4 of 18 outside their 95 %
+    # intervals; P ≈ 1-2 % for honest intervals)
+    fits = [joint_zpk] + [
+        ScheduledFit("zpk", 2, 3, 2, **SCALES).fit(*noisy_sweep(true_model, FIT_TEMPS, np.geomspace(0.1, 30, 40),
+                                                                seed=seed))
+        for seed in (4, 5, 6, 7)]
+    z, inside = [], []
+    for res in fits:
+        assert res.converged and res.method == "joint"
+        assert np.all(res.ci95_low < res.ci95_high)
+        z.append((res.params - TRUE_THETA) / res.stderr)
+        inside.append((TRUE_THETA >= res.ci95_low) & (TRUE_THETA <= res.ci95_high))
+        # correct uncertainties: weighted residual RMS close to 1
+        assert 0.85 < res.weighted_rms < 1.15
+    z, inside = np.concatenate(z), np.concatenate(inside)
     # every coefficient within 3.5 standard errors …
     assert np.max(np.abs(z)) < 3.5, z
     # … and the intervals are honest, neither inflated nor too narrow
     assert 0.5 < np.sqrt(np.mean(z ** 2)) < 1.6, z
-    inside = (TRUE_THETA >= res.ci95_low) & (TRUE_THETA <= res.ci95_high)
     assert inside.mean() >= 0.8
-    # correct uncertainties: weighted residual RMS close to 1
-    assert 0.85 < res.weighted_rms < 1.15
 
 
 def test_joint_fit_reproduces_the_response_at_unseen_temperatures(joint_zpk, true_model):
@@ -115,6 +124,32 @@ def test_structure_conversion_preserves_the_response():
         for form in ("coefficients", "zpk"):
             th2 = convert(st, theta, form)
             np.testing.assert_allclose(response(st.with_form(form), th2, w, 0.0), ref, rtol=1e-8)
+
+
+@pytest.mark.parametrize("num, zeros", [
+    ([0.6, -0.5, 0.0, 0.0], [1.2]),                       # two zeros at infinity: β2 = β = 0
+    ([0.0, 0.6, -0.5, 0.2], [0.0, 1.25 + 1.19896j, 1.25 - 1.19896j]),   # a zero at the origin
+    ([-0.3, 0.1, 0.4, -0.2], None),                       # three finite zeros, one in the RHP
+])
+def test_unit_zero_sections_carry_zeros_at_infinity_and_near_the_origin(num, zeros):
+    """The 'zpk' numerator k·(1 + β1 s̃ + β2 s̃²)(1 + β s̃): a zero at infinity is β = 0, a finite
+    point; a zero at the origin has no β and is moved to |s̃| = 1e-12 (the response is kept to
+    ~1e-12·|s̃| relative).  Oracle: numpy's polyval of the numerator written here."""
+    from surrogate._convert import convert
+    from surrogate._structure import response
+
+    w = np.geomspace(0.05, 20, 30)
+    st = Structure("coefficients", 3, 4, 0)
+    den = [2.0, 1.5, 3.0, 0.8]
+    theta = np.array(num + den)
+    s = 1j * w
+    ref = np.polyval(num[::-1], s) / np.polyval((den + [1.0])[::-1], s)
+    th2 = convert(st, theta, "zpk")
+    np.testing.assert_allclose(response(st.with_form("zpk"), th2, w, 0.0), ref, rtol=1e-9)
+    assert th2[0] == pytest.approx(num[0] if num[0] else -1e-12 * num[1])      # k: the numerator at 0
+    if zeros is not None:        # the finite zeros (a zero at infinity is not listed)
+        z = RationalModel(st.with_form("zpk"), th2, Scaling(1.0, 1.0)).zeros()
+        np.testing.assert_allclose(np.sort_complex(z), np.sort_complex(zeros), atol=1e-4)
 
 
 def test_hurwitz_constraints_keep_the_coefficients_form_stable():

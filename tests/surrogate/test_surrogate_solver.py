@@ -11,19 +11,24 @@ model (recovered parameters).
 import numpy as np
 import pytest
 
-from surrogate import Structure
+from surrogate import RationalModel, Scaling, Structure
 from surrogate._lsq import STATUS_STOPPED, Evaluator, LevenbergMarquardt
 from surrogate._nlp import BLOCK_LINES, Problem, Solver, covariance, residual
 from surrogate._structure import CasadiBackend, denominators, polynomials
 
 CASES = [("coefficients", 2, 3, 0), ("coefficients", 3, 3, 2), ("sections", 4, 4, 0),
          ("sections", 1, 2, 3), ("sections", 2, 5, 0), ("zpk", 3, 3, 2), ("zpk", 4, 4, 1),
-         ("zpk", 2, 3, 0), ("zpk", 0, 1, 0)]
+         ("zpk", 2, 3, 0), ("zpk", 0, 1, 0), ("zpk:monic", 3, 3, 2), ("zpk:monic", 2, 3, 0)]
+
+
+def _structure(form, m, n, deg):
+    """``Structure``; "zpk:monic": the zpk zero sections of schema 1 (s̃² + c1 s̃ + c0)."""
+    return Structure(*form.split(":")[:1], m, n, deg, *form.split(":")[1:])
 
 
 def _problem(form, m, n, deg, kind, n_lines=37, seed=0):
     rng = np.random.default_rng(seed)
-    st = Structure(form, m, n, deg)
+    st = _structure(form, m, n, deg)
     w = np.geomspace(0.1, 10.0, n_lines)
     tau = rng.uniform(-1, 1, n_lines) if deg else np.zeros(n_lines)
     h = (1 + 0.3 * rng.normal(size=n_lines)) * np.exp(1j * rng.normal(size=n_lines))
@@ -142,7 +147,7 @@ def test_covariance_from_the_r_factor_equals_the_svd_of_the_jacobian(shape, spre
 
 @pytest.mark.parametrize("form, m, n, deg", CASES)
 def test_vectorised_denominators_equal_polynomials_per_temperature(form, m, n, deg):
-    st = Structure(form, m, n, deg)
+    st = _structure(form, m, n, deg)
     theta = np.random.default_rng(2).normal(scale=0.5, size=st.n_params)
     taus = np.linspace(-1.2, 1.2, 9)
     ref = np.array([polynomials(st, theta, t)[1] for t in taus])
@@ -231,3 +236,23 @@ def test_the_trailing_rule_lets_a_start_through_that_closes_the_gap_in_time(rate
     lm.traces = [[1.0] * (w + 1), [3.0 + rate * (w - k) for k in range(w + 1)]]
     assert lm._stop_trailing() is stopped
     assert (lm.status[1] == STATUS_STOPPED) is stopped and lm.running[0]
+
+
+def test_unit_zero_section_bounds_keep_zeros_away_from_the_origin():
+    """'zpk' slot bounds with a band: |β2| ≤ 1/z², |β1| ≤ 2/z, |β| ≤ 1/z (z = w_min/1000) keep every
+    zero at |s̃| ≥ z/(1 + √2) (roots of μ² + β1 μ + β2 have |μ| ≤ |β1|/2 + √(β1²/4 + |β2|)), and
+    a zero at infinity (β = 0) inside them."""
+    st = Structure("zpk", 3, 3, 0)
+    w_min, w_max = 0.1, 10.0
+    b = st.slot_bounds(w_min, w_max)
+    z = w_min / 1e3
+    assert b["zb2_0"] == pytest.approx((-1 / z ** 2, 1 / z ** 2)) and b["zb1_0"] == pytest.approx((-2 / z, 2 / z))
+    assert b["zb"] == pytest.approx((-1 / z, 1 / z)) and b["zb"][0] < 0.0 < b["zb"][1]
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        theta = np.concatenate([[1.0], rng.uniform(*zip(b["zb1_0"], b["zb2_0"], b["zb"])), np.zeros(3)])
+        theta[1:4] *= rng.choice([1.0, 1e-3, 1e-9])              # also zeros far out
+        zeros = RationalModel(st, theta, Scaling(1.0, 1.0)).zeros()
+        assert np.all(np.abs(zeros) >= z / (1 + np.sqrt(2)) * (1 - 1e-12))
+    monic = Structure("zpk", 3, 3, 0, "monic").slot_bounds(w_min, w_max)      # schema-1 sections
+    assert monic["zc0_0"] == pytest.approx((-(w_max * 1e3) ** 2, (w_max * 1e3) ** 2))
