@@ -256,12 +256,13 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
         plan = plan_for(split, dt, n_prev)
         # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
-        stable, unstable, output = plan.run(ua, chunk, keep_unstable=False)
-    # a finite sum proves every sample finite (as in as_signal); only a non-finite one (a bad
-    # sample, or an overflow of the sum) needs the element-wise check
-    with np.errstate(over="ignore", invalid="ignore"):
-        total = float(np.add.reduce(output))
-    bad = None if (finite or math.isfinite(total)) else ~np.isfinite(output)
+        sums: list[float] = []
+        stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums)
+        finite = math.isfinite(sums[0])
+    # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
+    # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
+    # element-wise check
+    bad = None if finite else ~np.isfinite(output)
     if bad is not None and bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise NonFiniteSignalError(
@@ -269,7 +270,8 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             "scale the signal to the model's units")
     return InversionResult(
         input=ua, output=output, stable_part=stable,
-        unstable_source=unstable if unstable is not None else (plan, chunk), preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
+        unstable_source=unstable if unstable is not None else (plan, chunk),
+        preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
         time_stamps=ta, preview_rule=rule, preview_choice=choice)
 

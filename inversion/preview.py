@@ -359,7 +359,8 @@ class AutoPreviewPasses:
     output : ndarray
         The inverse with that preview, ``stable + unstable``.
     finite : bool
-        Every output sample is finite (proved from the peaks; False: not proved).
+        Every output sample is finite (proved from the peaks, or from a finite sum of the
+        output; False: not proved).
     plan : Plan or None
         The plan of the chosen preview that produced ``unstable``/``output`` (None on the
         ``"l2"`` path, whose ``unstable`` is always kept).
@@ -451,7 +452,8 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         N = min(int(ok[0]) if ok.size else n - 1, n - 1)
         tail_n = float(tail[min(N, tail.size - 1)])
     plan = plan_for(split, dt, N)
-    stable, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable)
+    sums: list[float] = []
+    stable, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums)
     ua = ua.copy()      # ua may be the caller's own array: the errors are of the signal inverted now
 
     def errors() -> tuple[float, float, float]:
@@ -468,7 +470,7 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
-    return AutoPreviewPasses(choice, stable, unstable, output, plan=plan)
+    return AutoPreviewPasses(choice, stable, unstable, output, finite=math.isfinite(sums[0]), plan=plan)
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float) -> AutoPreviewPasses:

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from inversion import InversionError, invert, split_inverse
+from inversion import InversionError, NonFiniteSignalError, invert, split_inverse
 from inversion._discrete import plan_for
 from inversion.examples import seed000_sensor_35c
 
@@ -119,3 +119,15 @@ def test_whole_record_infinite_preview_keeps_its_unstable_part():
     res = invert(split, 1e-3, u, preview="inf")
     assert isinstance(res.unstable_source, np.ndarray)
     np.testing.assert_array_equal(res.stable_part + res.unstable_part, res.output)
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")     # numpy's overflow warnings on the way
+@pytest.mark.parametrize("preview", [0.3, "auto", "inf"])
+@pytest.mark.parametrize("chunk", [None, 700])
+def test_an_overflowing_inverse_is_refused_on_every_path(preview, chunk):
+    # the output's finiteness is proved from its sum taken block by block during the pass: an
+    # inverse gain of 1e10 on a 1e300 signal must still be caught, and named
+    G = ([1e-10, -5e-10], [1.0, 10.0])
+    u = np.random.default_rng(0).standard_normal(5000) * 1e300
+    with pytest.raises(NonFiniteSignalError, match="the inverse overflowed: output sample"):
+        invert(G, 1e-3, u, preview=preview, chunk_size=chunk)
