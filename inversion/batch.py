@@ -8,7 +8,7 @@ truncation; see :mod:`inversion.split` for the split of ``1/G``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
@@ -74,6 +74,11 @@ class InversionResult(SampledRecord):
         Causal contribution: feedthrough, polynomial (derivative) part and ``H_s[u]``.
     unstable_part : ndarray
         Anticausal contribution ``H_u[u]`` (truncated to the preview when it is finite).
+        When the anticausal pass ran block by block (a finite preview, or ``chunk_size``) it
+        is not stored but recomputed from ``input`` when first read — one more anticausal
+        pass, the same values bit for bit, checked to give ``stable_part + unstable_part ==
+        output`` exactly (:class:`InversionError` if ``input`` was modified in place since).
+        Keeping it would cost a record-sized array that nothing but this attribute reads.
     preview_s : float
         Preview actually used, ``preview_samples * dt`` [s]; ``inf`` for infinite preview.
     preview_samples : int or None
@@ -99,7 +104,6 @@ class InversionResult(SampledRecord):
     input: np.ndarray
     output: np.ndarray
     stable_part: np.ndarray
-    unstable_part: np.ndarray
     preview_s: float
     preview_samples: int | None
     r0: float
@@ -111,6 +115,23 @@ class InversionResult(SampledRecord):
     preview_rule: str = "fixed"
     preview_choice: PreviewChoice | None = None
     limit_report: Any = None
+    #: the anticausal part, or ``(plan, chunk)`` that recomputes it (see ``unstable_part``)
+    unstable_source: Any = field(default=None, repr=False)
+
+    @cached_property
+    def unstable_part(self) -> np.ndarray:
+        """Anticausal contribution ``H_u[u]`` (see the class doc)."""
+        src = self.unstable_source
+        if isinstance(src, np.ndarray):
+            return src
+        plan, chunk = src
+        unstable = plan.anticausal(self.input, chunk)
+        if not np.array_equal(self.stable_part + unstable, self.output):
+            raise InversionError(
+                "unstable_part is recomputed from result.input when first read, and that input no "
+                "longer gives result.output: the input array was modified in place after the "
+                "inversion; invert a copy (or read unstable_part before modifying it)")
+        return unstable
 
     @cached_property
     def truncation_error(self) -> float:
@@ -224,26 +245,32 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     if rule == "auto":
         # the causal pass, the preview certified from exact values of the full inverse at a few
         # samples, then the finite-preview anticausal pass (see auto_preview_passes)
-        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk)
+        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
+                                     keep_unstable=False)
         choice = passes.choice
         n_prev, prev_s = choice.samples, choice.seconds
         stable, unstable, output = passes.stable, passes.unstable, passes.output
         finite = passes.finite
+        plan = passes.plan
     else:
         n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
-        stable, unstable, output = plan_for(split, dt, n_prev).run(ua, chunk)
-    # a finite sum proves every sample finite (as in as_signal); only a non-finite one (a bad
-    # sample, or an overflow of the sum) needs the element-wise check
-    with np.errstate(over="ignore", invalid="ignore"):
-        total = float(np.add.reduce(output))
-    bad = None if (finite or math.isfinite(total)) else ~np.isfinite(output)
+        plan = plan_for(split, dt, n_prev)
+        # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
+        sums: list[float] = []
+        stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums)
+        finite = math.isfinite(sums[0])
+    # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
+    # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
+    # element-wise check
+    bad = None if finite else ~np.isfinite(output)
     if bad is not None and bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise NonFiniteSignalError(
             f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
             "scale the signal to the model's units")
     return InversionResult(
-        input=ua, output=output, stable_part=stable, unstable_part=unstable,
+        input=ua, output=output, stable_part=stable,
+        unstable_source=unstable if unstable is not None else (plan, chunk),
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),
         time_stamps=ta, preview_rule=rule, preview_choice=choice)

@@ -353,19 +353,25 @@ class AutoPreviewPasses:
     choice : PreviewChoice
     stable : ndarray
         Causal part (feedthrough, polynomial part and ``H_s[u]``).
-    unstable : ndarray
-        Anticausal part truncated to the chosen preview.
+    unstable : ndarray or None
+        Anticausal part truncated to the chosen preview; None when it was not kept
+        (``keep_unstable=False``): ``plan.anticausal(ua, chunk)`` recomputes it exactly.
     output : ndarray
         The inverse with that preview, ``stable + unstable``.
     finite : bool
-        Every output sample is finite (proved from the peaks; False: not proved).
+        Every output sample is finite (proved from the peaks, or from a finite sum of the
+        output; False: not proved).
+    plan : Plan or None
+        The plan of the chosen preview that produced ``unstable``/``output`` (None on the
+        ``"l2"`` path, whose ``unstable`` is always kept).
     """
 
     choice: PreviewChoice
     stable: np.ndarray
-    unstable: np.ndarray
+    unstable: np.ndarray | None
     output: np.ndarray
     finite: bool = False
+    plan: Plan | None = None
 
 
 #: Probes of the full inverse for the linf reference: equally spaced samples, plus the extremes
@@ -409,7 +415,8 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
 
 
 def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: float = DEFAULT_PREVIEW_TOL,
-                        norm: str = "linf", chunk: int | None = None) -> AutoPreviewPasses:
+                        norm: str = "linf", chunk: int | None = None,
+                        keep_unstable: bool = True) -> AutoPreviewPasses:
     """Choose the automatic preview for the validated signal ``ua`` and invert it (see
     :func:`choose_preview`).
 
@@ -419,6 +426,7 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     ``relative_error``/``max_error``/``error_bound`` is first read.  ``"l2"``: the causal pass,
     the full anticausal pass (for ``||y_inf||_2``) and the truncation error of the chosen
     preview, whose sums are the inverse.  ``chunk``: samples per pass block (default: whole).
+    ``keep_unstable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
     """
     _check_tolerance(tol, norm)
     n = ua.size
@@ -443,7 +451,9 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         ok = np.flatnonzero(tail <= tol * ref)          # tail is non-increasing: the first index
         N = min(int(ok[0]) if ok.size else n - 1, n - 1)
         tail_n = float(tail[min(N, tail.size - 1)])
-    stable, unstable, output = plan_for(split, dt, N).run(ua, chunk, stable)
+    plan = plan_for(split, dt, N)
+    sums: list[float] = []
+    stable, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums)
     ua = ua.copy()      # ua may be the caller's own array: the errors are of the signal inverted now
 
     def errors() -> tuple[float, float, float]:
@@ -460,7 +470,7 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
-    return AutoPreviewPasses(choice, stable, unstable, output)
+    return AutoPreviewPasses(choice, stable, unstable, output, finite=math.isfinite(sums[0]), plan=plan)
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float) -> AutoPreviewPasses:

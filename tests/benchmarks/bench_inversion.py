@@ -6,6 +6,9 @@ Prints
   1. batch throughput of ``invert`` on the 4th-order 35 degC sensor model, as a ratio to
      ``scipy.signal.lfilter`` running a 4th-order filter over the same samples in the same
      run (interleaved repetitions, best of N; goal >= 0.3);
+  1b. the floor of the finite-preview inverse with scipy's filters (``--only floor``): the two
+     recursions alone, then the two correlations of the finite preview, then the output
+     array, then ``invert`` itself, each as a ratio to that ``lfilter`` (thread CPU time);
   2. streaming cost per sample for several chunk sizes;
   3. a 10-hour, 1 kHz record (3.6e7 samples) inverted from and to memory-mapped files:
      wall time, peak Python heap (tracemalloc) and peak RSS;
@@ -73,6 +76,76 @@ def bench_batch(n: int, reps: int) -> None:
     for k, v in best.items():
         print(f"   {k:22s} {v / n * 1e9:7.2f} ns/sample  {n / v / 1e6:7.1f} Msample/s  "
               f"ratio to lfilter {base / v:5.2f}")
+
+
+def _thread_medians(fns: dict, reps: int) -> dict:
+    """Median thread CPU time [s] of each callable over ``reps`` interleaved rounds (CPU time of
+    this thread: on a shared machine the wall time also counts the time other processes run)."""
+    import gc
+
+    times: dict = {k: [] for k in fns}
+    for _ in range(reps):
+        for k, f in fns.items():
+            gc.collect()
+            t0 = time.thread_time()
+            f()
+            times[k].append(time.thread_time() - t0)
+    return {k: float(np.median(v)) for k, v in times.items()}
+
+
+def bench_floor(n: int, reps: int) -> None:
+    """Where the finite-preview inverse's time goes, against scipy's filters (issue 29).
+
+    The given-preview inverse needs a causal recursion (the stable part, order 1 here) and an
+    anticausal one (all-pole, order 3, or two second-order sections at 20 kHz), two short
+    correlations for the finite preview (the numerators of the full and of the truncated
+    anticausal filter, seed 000 eq. (6): they share the denominator, so one recursion), and the
+    output written block by block.  Each row adds one of these to the previous one, built from
+    the same plan as ``invert`` (same filters, same blocks); the last is ``invert`` itself.
+    """
+    from inversion._discrete import FUSED_BLOCK, plan_for
+
+    print(f"\n1b. floor of the finite-preview inverse with scipy's filters, n = {n:,} samples, "
+          f"median thread CPU time of {reps} interleaved rounds, ratio = lfilter / row")
+    sp = split_inverse(G35)
+    b4, a4 = ss.butter(4, 0.1)
+    rng = np.random.default_rng(0)
+
+    def pieces(plan, u, stage):
+        S = plan.stable.run(u, plan.stable.zi0())[0]           # causal recursion, whole record
+        fp, N = plan.fused, plan.n_preview
+        h1, h2 = fp.reach(fp.fir1), fp.reach(fp.fir2)
+        up = np.concatenate((u, np.zeros(N + max(h1, h2) + 1)))  # zero beyond the record
+        zi = fp.zi0()
+        out = np.empty(n) if stage >= 3 else None
+        for c1 in range(n, 0, -FUSED_BLOCK):
+            c0 = max(0, c1 - FUSED_BLOCK)
+            if stage >= 2:                                     # the two correlations
+                q = fp.correlate(up[c0:c1 + h1], fp.fir1)
+                if c0 + N < n:
+                    q -= fp.correlate(up[c0 + N:c1 + N + h2], fp.fir2)
+            else:
+                q = u[c0:c1]
+            w, zi = fp.all_pole(q[::-1], zi)                    # anticausal recursion
+            if stage >= 3:
+                np.add(S[c0:c1], w[::-1], out=out[c0:c1])       # the output, block by block
+
+    print("   rate    | anticausal | lfilter 4th order | 2 recursions | + 2 correlations | "
+          "+ output array | invert (given preview)")
+    for fs in (1e3, 5e3, 20e3):
+        dt = 1.0 / fs
+        u = np.sin(2 * np.pi * 20 * dt * np.arange(n)) + 0.1 * rng.standard_normal(n)
+        N = round(sp.auto_preview_s / dt)
+        plan = plan_for(sp, dt, N)
+        fns = {"lfilter": lambda: ss.lfilter(b4, a4, u),
+               "rec": lambda: pieces(plan, u, 1), "corr": lambda: pieces(plan, u, 2),
+               "out": lambda: pieces(plan, u, 3),
+               "invert": lambda: invert(sp, dt, u, preview=N * dt)}
+        m = _thread_medians(fns, reps)
+        ref = m["lfilter"]
+        cells = [f"{1e9 * m[k] / n:5.1f} ns ({ref / m[k]:.2f})" for k in ("rec", "corr", "out", "invert")]
+        kind = "ba" if plan.fused.sos is None else "sos"
+        print(f"   {fs / 1e3:3g} kHz  | {kind:10s} | {1e9 * ref / n:5.1f} ns         | " + " | ".join(cells))
 
 
 def bench_streaming(n: int) -> None:
@@ -327,8 +400,9 @@ def main() -> None:
     ap.add_argument("--skip-10h", action="store_true", help="skip the long-record test")
     ap.add_argument("--skip-seed001", action="store_true",
                     help="skip the seed 001 tracking figures (physmodel + surrogate fits, ~10 s)")
-    ap.add_argument("--only", choices=["batch", "seed001"],
-                    help="run only the batch-throughput section or only the seed 001 figures")
+    ap.add_argument("--only", choices=["batch", "floor", "seed001"],
+                    help="run only the batch-throughput section, only the floor of the finite-preview "
+                         "inverse (1b), or only the seed 001 figures")
     args = ap.parse_args()
     n = 1 << (20 if args.quick else 22)
     print(f"python {sys.version.split()[0]}, numpy {np.__version__}, scipy {__import__('scipy').__version__}, "
@@ -336,10 +410,14 @@ def main() -> None:
     if args.only == "batch":
         bench_batch(n, 3 if args.quick else 7)
         return
+    if args.only == "floor":
+        bench_floor(1 << (19 if args.quick else 21), 5 if args.quick else 11)
+        return
     if args.only == "seed001":
         figures_seed001()
         return
     bench_batch(n, 3 if args.quick else 7)
+    bench_floor(1 << (19 if args.quick else 21), 5 if args.quick else 11)
     bench_streaming(1 << (17 if args.quick else 19))
     if not args.skip_10h:
         bench_10h(1.0 if args.quick else 10.0, 1 << 20)

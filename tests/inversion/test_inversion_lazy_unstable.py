@@ -1,0 +1,133 @@
+"""``InversionResult.unstable_part`` is recomputed when first read whenever the anticausal pass
+ran block by block (issue 29: not writing it saves a record-sized array on every inversion).
+
+Oracles: the plan run with the anticausal part kept (the code path as it was before), and, for
+the output itself, the explicit state recursions of the FOH discretisation (forward for the
+stable part, the finite-preview window sum of seed 000 eq. (6) backward for the anticausal
+part) with ``scipy.linalg.expm`` — independent of the filters, of ``expm_small`` and of the
+block structure.
+"""
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+from inversion import InversionError, NonFiniteSignalError, invert, split_inverse
+from inversion._discrete import plan_for
+from inversion.examples import seed000_sensor_35c
+
+G35 = seed000_sensor_35c("coefficients")
+
+
+def _foh(M, B, dt):
+    m = M.shape[0]
+    big = np.zeros((m + 2, m + 2))
+    big[:m, :m], big[:m, m], big[m, m + 1] = M * dt, B * dt, 1.0
+    E = sla.expm(big)
+    alpha = E[:m, m + 1]
+    return E[:m, :m], alpha, E[:m, m] - alpha
+
+
+def _explicit_inverse(split, dt, n_prev, u):
+    """stable + anticausal parts by explicit state recursions (u = 0 outside the record)."""
+    n = u.size
+    Phi, al, be = _foh(split.A_s, split.B_s, dt)
+    x = np.zeros(split.n_stable)
+    up = np.concatenate(([0.0], u))
+    ys = np.empty(n)
+    for k in range(n):
+        x = Phi @ x + al * up[k + 1] + be * up[k]
+        ys[k] = split.C_s @ x + split.feedthrough * u[k]
+    Phi, al, be = _foh(-split.A_u, split.B_u, dt)
+    m = Phi.shape[0]
+    un = np.append(u, 0.0)
+    xs = np.zeros((n + n_prev + 1, m))
+    for k in range(n - 1, -1, -1):
+        xs[k] = Phi @ xs[k + 1] + al * un[k] + be * un[k + 1]
+    xbar = xs[:n] - xs[n_prev:n_prev + n] @ np.linalg.matrix_power(Phi, n_prev).T
+    return ys, xbar @ (-split.C_u)
+
+
+def _signal(n, seed):
+    rng = np.random.default_rng(seed)
+    return np.sin(2 * np.pi * 20e-3 * np.arange(n)) + 0.1 * rng.standard_normal(n)
+
+
+@pytest.mark.parametrize("fs, chunk", [(1e3, None), (20e3, None), (1e3, 700)])
+def test_recomputed_unstable_part_is_the_kept_one_bit_for_bit(fs, chunk):
+    split = split_inverse(G35)
+    dt = 1.0 / fs
+    n_prev = round(split.auto_preview_s / dt)
+    u = _signal(3 * n_prev + 1234, 5)
+    res = invert(split, dt, u, preview=n_prev * dt, chunk_size=chunk)
+    assert not isinstance(res.unstable_source, np.ndarray)     # not stored: recomputed below
+    stable, unstable, output = plan_for(split, dt, n_prev).run(u, chunk or u.size, keep_unstable=True)
+    np.testing.assert_array_equal(res.output, output)
+    np.testing.assert_array_equal(res.stable_part, stable)
+    np.testing.assert_array_equal(res.unstable_part, unstable)
+    np.testing.assert_array_equal(res.stable_part + res.unstable_part, res.output)
+
+
+def test_automatic_preview_recomputes_the_same_unstable_part():
+    split = split_inverse(G35)
+    u = _signal(6000, 6)
+    res = invert(split, 1e-3, u, preview="auto")
+    N = res.preview_samples
+    kept = plan_for(split, 1e-3, N).run(u, u.size, keep_unstable=True)
+    np.testing.assert_array_equal(res.unstable_part, kept[1])
+    np.testing.assert_array_equal(res.output, kept[2])
+
+
+def test_output_equals_the_explicit_state_recursions():
+    split = split_inverse(G35)
+    dt, n_prev = 1e-3, 113
+    u = _signal(2500, 7)
+    ys, yu = _explicit_inverse(split, dt, n_prev, u)
+    res = invert(split, dt, u, preview=n_prev * dt)
+    scale = np.max(np.abs(ys + yu))
+    np.testing.assert_allclose(res.output, ys + yu, rtol=0, atol=1e-11 * scale)
+    np.testing.assert_allclose(res.unstable_part, yu, rtol=0, atol=1e-11 * scale)
+
+
+def test_modifying_the_input_before_reading_the_unstable_part_is_refused():
+    split = split_inverse(G35)
+    u = _signal(2000, 8)
+    res = invert(split, 1e-3, u, preview=0.113)
+    assert res.input is u                     # the caller's own array, not a copy
+    u[1500] += 1.0
+    with pytest.raises(InversionError, match="modified in place"):
+        _ = res.unstable_part
+
+
+def test_chunked_infinite_preview_recomputes_the_same_unstable_part():
+    split = split_inverse(G35)
+    u = _signal(2000, 10)
+    res = invert(split, 1e-3, u, preview="inf", chunk_size=300)
+    assert not isinstance(res.unstable_source, np.ndarray)
+    kept = plan_for(split, 1e-3, None).run(u, 300, keep_unstable=True)
+    np.testing.assert_array_equal(res.unstable_part, kept[1])
+    np.testing.assert_array_equal(res.output, kept[2])
+    whole = invert(split, 1e-3, u, preview="inf")
+    np.testing.assert_allclose(res.unstable_part, whole.unstable_part, rtol=0,
+                               atol=1e-13 * np.max(np.abs(whole.output)))
+
+
+def test_whole_record_infinite_preview_keeps_its_unstable_part():
+    # one whole-record backward pass: its output is the anticausal part, kept as it is
+    split = split_inverse(G35)
+    u = _signal(2000, 9)
+    res = invert(split, 1e-3, u, preview="inf")
+    assert isinstance(res.unstable_source, np.ndarray)
+    np.testing.assert_array_equal(res.stable_part + res.unstable_part, res.output)
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")     # numpy's overflow warnings on the way
+@pytest.mark.parametrize("preview", [0.3, "auto", "inf"])
+@pytest.mark.parametrize("chunk", [None, 700])
+def test_an_overflowing_inverse_is_refused_on_every_path(preview, chunk):
+    # the output's finiteness is proved from its sum taken block by block during the pass: an
+    # inverse gain of 1e10 on a 1e300 signal must still be caught, and named
+    G = ([1e-10, -5e-10], [1.0, 10.0])
+    u = np.random.default_rng(0).standard_normal(5000) * 1e300
+    with pytest.raises(NonFiniteSignalError, match="the inverse overflowed: output sample"):
+        invert(G, 1e-3, u, preview=preview, chunk_size=chunk)
