@@ -9,7 +9,7 @@ log-magnitude and phase over each line's own σ) are unit-free once each quantit
 own sweep's units, so the baseline, every candidate refit, the linearised null and the bootstrap
 refits of the diagnosis run unchanged on the stacked lines — one data path.  The predictor
 (:meth:`JointData.predictor`) evaluates each quantity at its own sweep's lines with
-:meth:`physmodel.effects.EffectModel.predictor` and concatenates them; an effect that acts on one
+the model's ``predictor(sweep, quantity)`` and concatenates them; an effect that acts on one
 quantity only leaves the other unchanged (the library's ``quantities``), so it is still fitted
 jointly.
 
@@ -22,7 +22,7 @@ absorbed into the noise; the provisional baseline is weighted with the same esti
 data themselves (third differences of ln G, which a smooth response hardly moves), so a noisy
 quantity does not dominate it.  Each quantity's σ is one number for magnitude and one for phase.
 
-The report (:attr:`~physmodel.estimation.diagnosis.Diagnosis.per_quantity`) gives each quantity's
+The report (``Diagnosis.per_quantity``) gives each quantity's
 lines, noise (declared or estimated) and its cost before and after against its expectation, so a
 misfit left in one quantity is visible.  With estimated noise that cost is not a test (the
 estimate has a relative spread of about 1/√(lines); the same rule as for one quantity, whose
@@ -93,7 +93,7 @@ def quantity_of(sweep: FrequencySweep, kind: str, given: str | None = None, wher
     fits = [q for q in qs if (UNITS[QUANTITY_UNITS[(kind, q)][1]][0], UNITS[QUANTITY_UNITS[(kind, q)][3]][0]) == dims]
     if given is not None:
         if given not in qs:
-            raise IPMCError(f"{where}: quantity {given!r} is not a {kind} quantity; expected one of {qs}")
+            raise IPMCError(f"{where}: quantity {given!r} is not one of the {kind} quantities {qs}")
         if given not in fits:
             raise DataFormatError(f"{where}: {sweep.output_name} [{sweep.output_unit}] per {sweep.input_name} "
                                   f"[{sweep.input_unit}] cannot be the {kind} quantity {given} "
@@ -122,19 +122,23 @@ class JointData:
 
     @property
     def sizes(self) -> list[int]:
+        """Lines per quantity."""
         return [s.frequency_hz.size for s in self.sweeps]
 
     @property
     def slices(self) -> list[slice]:
+        """Each quantity's lines in the stacked record."""
         e = np.cumsum([0] + self.sizes)
         return [slice(int(a), int(b)) for a, b in zip(e[:-1], e[1:])]
 
     @property
     def label(self) -> str:
+        """The quantities joined by "+" (e.g. ``"M+Z"``): the diagnosis's ``quantity``."""
         return "+".join(self.quantities)
 
     @property
     def any_estimated(self) -> bool:
+        """Some quantity's σ is estimated (its sweep declared none)."""
         return "estimated" in self.noise
 
     def split(self, G) -> list[np.ndarray]:
@@ -291,5 +295,5 @@ def estimate_noise(sweep: FrequencySweep, G) -> tuple[float, float]:
     return _robust_sigma(sweep, a, 2), _robust_sigma(sweep, p, 2)
 
 
-__all__ = ["JointData", "StackedSweep", "joint_data", "quantity_of", "estimate_noise", "data_noise", "MAD_SCALE",
+__all__ = ["JointData", "StackedSweep", "joint_data", "quantity_of", "estimate_noise", "data_noise", "MAD_SCALE", "TRIM",
            "per_quantity_sentence"]
