@@ -92,7 +92,7 @@ from .diagnosis import (
     stage_progress,
     worst_cells,
 )
-from .joint import joint_data, per_quantity_sentence
+from .joint import check_acts_on, joint_data, per_quantity_sentence
 from .nullstats import bootstrap_ratio, constrained_lr, scan_lr, signature_stage
 from .priors import (
     WALL_DECADES,
@@ -137,13 +137,16 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
              null_refits: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int = 200,
              laws=None, candidate_bounds: Mapping | None = None, candidate_starts: Mapping | None = None,
              plausible: Mapping | None = None, prior: bool = True, baseline_starts: int = 3,
-             progress: Callable[[str], None] | None = None, _restart: Mapping | None = None) -> Diagnosis:
+             progress: Callable[[str], None] | None = None, acts_on: Mapping[str, Sequence[str]] | None = None,
+             _restart: Mapping | None = None) -> Diagnosis:
     """Diagnose the discrepancy between ``data`` and the ``base`` model (see module docstring).
 
     ``data``: one sweep (one measured quantity, ``quantity``, default M / S), or a sequence of
     sweeps of the same strip, one per quantity (``quantity``: their names, or None to take each from
     its sweep's metadata/units), diagnosed jointly — baseline, candidates and null over all their
-    lines, each quantity with its own noise (:mod:`~physmodel.estimation.joint`).
+    lines, each quantity with its own noise (:mod:`~physmodel.estimation.joint`); ``acts_on``
+    (several quantities only) narrows where an effect acts, ``{effect: [quantities]}`` — e.g. a
+    current amplifier on S but not on Z measured by another instrument.
 
     ``free``: the user's calibration parameters (names with default bounds, ``"effect.param"`` of a
     baseline effect, or :class:`FreeParameter`).  ``baseline_effects``: effects already in the model
@@ -167,7 +170,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
     args = dict(kind=kind, quantity=quantity, free=free, baseline_effects=baseline_effects, candidates=candidates,
                 alpha=alpha, null_draws=null_draws, null_refits=null_refits, seed=seed, kernel=kernel,
                 max_nfev=max_nfev, laws=laws, candidate_bounds=candidate_bounds, candidate_starts=candidate_starts,
-                plausible=plausible, prior=prior, baseline_starts=baseline_starts, progress=progress)
+                plausible=plausible, prior=prior, baseline_starts=baseline_starts, progress=progress, acts_on=acts_on)
     base_in, data_in = base, data
     t0 = time.perf_counter()
     jd = None                                   # several quantities: their stacked lines (joint.py)
@@ -200,7 +203,10 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         extra_free = [f"{n}.{p.name}" for n in beff for p in get_effect(n).parameters]
     cbounds, cstarts = _candidate_overrides(candidate_bounds, candidate_starts)
     model0 = EffectModel(base, kind, beff, kernel=kernel)
-    counter = StageCounter(jd.predictor(model0) if jd is not None else model0.predictor(data, q).many)
+    if acts_on and jd is None:
+        raise IPMCError("acts_on narrows where effects act among several measured quantities; this diagnosis has one")
+    scope = check_acts_on(acts_on, kind, qs)
+    counter = StageCounter(jd.predictor(model0, scope) if jd is not None else model0.predictor(data, q).many)
     pm = counter.predict_many
     free0 = free_parameters_for(base, list(free) + [f for f in extra_free if f not in free], beff)
     names0 = [fp.name for fp in free0]
@@ -242,7 +248,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
     for c in cand:
         if c not in LIBRARY:
             raise ParameterError(f"unknown candidate effect {c!r}; expected library names {sorted(LIBRARY)}")
-        if not any(LIBRARY[c].applies_to(kind, qq) for qq in qs):
+        if not any(LIBRARY[c].applies_to(kind, qq) and qq in scope.get(c, qs) for qq in qs):
             raise ParameterError(f"candidate {c!r} does not apply to {kind} quantity {q}")
     bad = sorted(set(cbounds) - set(cand)) + sorted(set(cstarts) - set(cand))
     if bad:
@@ -683,6 +689,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
         metadata={"base": base.name, "kernel": kernel, "free": names0, "baseline_effects": beff, "candidates": cand,
+                  "quantities": list(qs), "acts_on": {k: list(v) for k, v in scope.items()},
                   "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried, "profile": counter.as_dict(),
                   "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},

@@ -11,7 +11,10 @@ refits of the diagnosis run unchanged on the stacked lines — one data path.  T
 (:meth:`JointData.predictor`) evaluates each quantity at its own sweep's lines with
 the model's ``predictor(sweep, quantity)`` and concatenates them; an effect that acts on one
 quantity only leaves the other unchanged (the library's ``quantities``), so it is still fitted
-jointly.
+jointly.  Where the quantities come from different instruments, ``acts_on`` narrows where an
+effect acts (``{"amplifier_bandwidth": ["S"], "time_delay": ["S"]}``: the current amplifier and
+the acquisition of S do not carry an impedance analyser's Z): on the other quantities it is held
+at its off values.
 
 Noise, per quantity: a sweep that declares per-line standard deviations keeps them; one that does
 not gets its own estimate (:func:`estimate_noise`): the RMS of the second differences along
@@ -32,14 +35,14 @@ estimated-noise cost is not checked either), so ``misfit`` is then None.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..data.sweep import FrequencySweep
 from ..data.units import QUANTITY_UNITS, UNITS
-from ..effects import DEFAULT_QUANTITY
+from ..effects import DEFAULT_QUANTITY, get_effect
 from ..errors import DataFormatError, IPMCError
 from .residuals import noise_std, standardised_residuals
 
@@ -146,12 +149,25 @@ class JointData:
         G = np.asarray(G)
         return [G[..., s] for s in self.slices]
 
-    def predictor(self, model) -> Callable:
-        """``many(values_list) -> (n_sets, N)``: each quantity at its own sweep's lines, in its units."""
-        parts = [model.predictor(s, q).many for s, q in zip(self.sweeps, self.quantities)]
+    def predictor(self, model, acts_on: Mapping[str, Sequence[str]] | None = None) -> Callable:
+        """``many(values_list) -> (n_sets, N)``: each quantity at its own sweep's lines, in its units.
+
+        ``acts_on``: ``{effect: quantities}`` narrowing where an effect acts (e.g. a current
+        amplifier's pole on S only, when Z is measured by another instrument); on the other
+        quantities the effect is held at its off values."""
+        parts = []
+        for s, q in zip(self.sweeps, self.quantities):
+            off = {f"{e}.{k}": v for e, qs in (acts_on or {}).items() if q not in qs for k, v in get_effect(e).off.items()}
+            present = {k.split(".", 1)[0] for k in off} & set(getattr(model, "effects", {}) or {})
+            parts.append((model.predictor(s, q).many, off, present))
 
         def many(values_list):
-            return np.hstack([np.asarray(p(values_list), dtype=complex) for p in parts])
+            out = []
+            for pm, off, present in parts:
+                vals = values_list if not off else [
+                    {**v, **{k: o for k, o in off.items() if k in v or k.split(".", 1)[0] in present}} for v in values_list]
+                out.append(np.asarray(pm(vals), dtype=complex))
+            return np.hstack(out)
         return many
 
     def with_sigma(self, sigmas: Sequence[tuple[float, float] | None], noise: Sequence[str]) -> JointData:
@@ -210,6 +226,23 @@ def _build(sweeps: tuple, quantities: tuple, noise: tuple) -> JointData:
                            {"quantities": list(quantities), "block_sizes": [s.frequency_hz.size for s in sweeps],
                             "noise": list(noise), "units": [f"{s.output_unit}/{s.input_unit}" for s in sweeps]})
     return JointData(sweeps, quantities, noise, stacked)
+
+
+def check_acts_on(acts_on: Mapping | None, kind: str, quantities: Sequence[str]) -> dict:
+    """``acts_on`` validated: ``{effect name: tuple of quantities}``, each quantity among ``quantities``
+    and applicable to the effect; a ParameterError naming the entry otherwise."""
+    from ..errors import ParameterError
+
+    out: dict = {}
+    for e, qs in (acts_on or {}).items():
+        eff = get_effect(e)
+        qs = (qs,) if isinstance(qs, str) else tuple(qs)
+        bad = [q for q in qs if q not in quantities or not eff.applies_to(kind, q)]
+        if bad or not qs:
+            raise ParameterError(f"acts_on[{e!r}] = {list(qs)}: expected some of the quantities diagnosed "
+                                 f"{list(quantities)} that the effect acts on ({list(eff.quantities)})")
+        out[eff.name] = qs
+    return out
 
 
 def joint_data(data: Sequence[FrequencySweep], kind: str, quantity: str | Sequence[str] | None = None) -> JointData:
@@ -295,5 +328,5 @@ def estimate_noise(sweep: FrequencySweep, G) -> tuple[float, float]:
     return _robust_sigma(sweep, a, 2), _robust_sigma(sweep, p, 2)
 
 
-__all__ = ["JointData", "StackedSweep", "joint_data", "quantity_of", "estimate_noise", "data_noise", "MAD_SCALE", "TRIM",
+__all__ = ["check_acts_on", "JointData", "StackedSweep", "joint_data", "quantity_of", "estimate_noise", "data_noise", "MAD_SCALE", "TRIM",
            "per_quantity_sentence"]

@@ -13,6 +13,9 @@ EXPERIMENT.toml (paths relative to the TOML file; SI units for parameters)::
     kind = "actuator"                  # or "sensor"
     quantity = "M"                     # optional (actuator M/H/Z/I, sensor S/Z); several files:
                                        # quantity = ["M", "Z"] (default: from each file's units)
+    [acts_on]                          # several quantities from different instruments: where an
+    amplifier_bandwidth = ["S"]        # effect acts (here the current amplifier and acquisition of
+    time_delay = ["S"]                 # S, not an impedance analyser's Z; default: every quantity)
     set = "seed002_table3"             # named set or parameter JSON file
     free = ["alpha0", "d", "xi", "omega_n", "kappa_e:1e-7:1e-5"]   # NAME[:LOWER:UPPER[:SCALE[:INITIAL]]]
     candidates = ["time_delay", "amplifier_bandwidth"]             # optional (default: all that apply)
@@ -105,6 +108,9 @@ def add_parser(subparsers):
     p.add_argument("--kind", choices=("actuator", "sensor"), help="model kind (default actuator)")
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z; several files: "
                                       "one per file, comma-separated (default: from each file's units)")
+    p.add_argument("--acts-on", action="append", metavar="EFFECT=Q[,Q]",
+                   help="several quantities: the quantities an effect acts on (e.g. amplifier_bandwidth=S when Z "
+                        "is measured by another instrument; repeatable; default every quantity it applies to)")
     p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), help="sensing kernel")
     p.add_argument("--set", "--model", dest="base_set",
                    help="start: a named parameter set or a JSON model/parameter file (a model file's effects are "
@@ -161,7 +167,8 @@ def _load_toml(path: Path) -> dict:
         raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
     known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
              "geometry", "parameters", "baseline_effects", "null_draws", "null_refits", "laws",
-             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts", "next_measurement"}
+             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts", "next_measurement",
+             "acts_on"}
     unknown = set(spec) - known
     if unknown:
         raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
@@ -216,6 +223,8 @@ _TYPES = {"data": (lambda v: isinstance(v, str) or _is_strs(v) and len(v) > 0,
           "plausible": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
           "prior": (lambda v: isinstance(v, bool), "true or false"),
           "baseline_starts": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
+          "acts_on": (lambda v: isinstance(v, dict) and all(_is_strs(x) and x for x in v.values()),
+                      "a table of EFFECT = [quantities], e.g. amplifier_bandwidth = [\"S\"]"),
           "next_measurement": (lambda v: isinstance(v, dict) and set(v) <= {"quantities", "band_limits_hz",
                                                                             "temperature_limits_c", "levels", "power"},
                                "a table of quantities, band_limits_hz, temperature_limits_c, levels, power")}
@@ -359,7 +368,16 @@ def build(args):
         raise IPMCError(f"kind = {kind!r}; expected 'actuator' or 'sensor'")
     data, quantity = _quantities(sweeps, paths, kind, pick(args.quantity, "quantity"),
                                  "--quantity" if args.quantity is not None else f"quantity (in {args.experiment})")
-    kw = dict(kind=kind, quantity=quantity,
+    acts_on = {k: list(v) for k, v in dict(spec.get("acts_on", {})).items()}
+    for item in args.acts_on or []:
+        e, sep, qs = item.partition("=")
+        if not sep or not e.strip() or not [q for q in qs.split(",") if q.strip()]:
+            raise IPMCError(f"--acts-on {item!r}: expected EFFECT=Q[,Q], e.g. amplifier_bandwidth=S")
+        acts_on[e.strip()] = [q.strip() for q in qs.split(",") if q.strip()]
+    if acts_on and not isinstance(quantity, tuple):
+        raise IPMCError(f"{'--acts-on' if args.acts_on else 'acts_on'}: says where effects act among several "
+                        "measured quantities; give one data file per quantity (--data repeated)")
+    kw = dict(kind=kind, quantity=quantity, acts_on=acts_on or None,
               laws=_laws(spec, args, set_name), candidate_bounds=cb or None, candidate_starts=cs or None,
               plausible=pl or None, prior=prior, baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
               free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),

@@ -20,9 +20,11 @@ from physmodel.data.sweep import FrequencySweep
 try:                                      # imported as tests/discrepancy/joint_cases
     from . import independent_generator as ig
     from . import independent_physics as ip
+    from . import independent_sensor as isn
 except ImportError:                       # imported with tests/discrepancy on sys.path
     import independent_generator as ig
     import independent_physics as ip
+    import independent_sensor as isn
 
 #: Seed root of the Z records' noise (not the generator's).
 Z_NOISE = 0x27_0002
@@ -53,4 +55,22 @@ def make_joint_case(seed: int, label: str, z_noise: float = 1.0, declare: bool =
     return M, Zs, truth
 
 
-__all__ = ["make_joint_case", "z_record", "Z_NOISE"]
+def make_joint_sensor_case(seed: int, label: str, z_noise: float = 1.0, **kw):
+    """``(S sweep [uA/mm], Z sweep [V/A], truth)`` of one independent sensor case
+    (:func:`independent_sensor.make_case`): Z is the strip's own terminal impedance
+    (:func:`independent_sensor.strip_sensor`) at the same lines, as an impedance analyser on the
+    strip measures it — not through the current amplifier or the acquisition, so the hidden chain
+    element does not act on it — with relative noise sigma_rel·``z_noise``, seeded apart."""
+    S, truth = isn.make_case(seed, label, **kw)
+    f = S.frequency_hz
+    Z = isn.strip_sensor(truth["base"], 2j * np.pi * f)[1]
+    sig = truth["sigma_rel"] * float(z_noise) / math.sqrt(2.0)
+    rng = np.random.default_rng([Z_NOISE + 1, int(seed)])
+    noisy = Z * (1 + sig * (rng.standard_normal(Z.size) + 1j * rng.standard_normal(Z.size)))
+    Zs = FrequencySweep(S.temperature_c, f, noisy, np.full(f.size, 20 / math.log(10) * sig),
+                        np.full(f.size, math.degrees(sig)), "current", "A", "voltage", "V",
+                        {"source": "independent sensor's strip impedance (tests/discrepancy/joint_cases.py)"})
+    return S, Zs, truth
+
+
+__all__ = ["make_joint_case", "make_joint_sensor_case", "z_record", "Z_NOISE"]
