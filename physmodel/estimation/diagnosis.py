@@ -15,6 +15,7 @@ from ..data.files import atomic_write
 from ..data.sweep import FrequencySweep
 from ..effects import LIBRARY, get_effect
 from ..errors import IPMCError, ParameterError
+from .joint import JointData
 from .next_measurement import NextMeasurement, json_ready
 from .records import CalibrationResult
 
@@ -216,7 +217,7 @@ class Diagnosis:
     sign_flip: dict = field(default_factory=dict)    # costs of the baseline and of its sign reversal
     next_measurement: NextMeasurement | None = field(default=None, repr=False)   # ambiguous / at_bound
     per_quantity: list = field(default_factory=list)   # several quantities: each one's lines, noise, costs
-    joint: object = field(default=None, repr=False)    # several quantities: their JointData (estimation.joint)
+    joint: JointData | None = field(default=None, repr=False)   # several quantities: their JointData
 
     # ---------------------------------------------------------------- the next measurement
     def recommend_next_measurement(self, **kw):

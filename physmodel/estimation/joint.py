@@ -300,10 +300,11 @@ def _log_parts(sweep: FrequencySweep, G=None) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _robust_sigma(sweep: FrequencySweep, x: np.ndarray, order: int) -> float:
-    """σ of white noise on ``x`` from the MAD of its ``order``-th differences along frequency within
-    each temperature (variance of the k-th difference: C(2k, k)·σ²)."""
-    d = [np.diff(x[sweep.temperature_c == t], n=order) for t in sweep.temperatures()]
-    d = np.concatenate([v for v in d if v.size]) if any(v.size for v in d) else np.zeros(0)
+    """σ of white noise on ``x`` from the RMS of its ``order``-th differences along frequency within
+    each temperature (those beyond :data:`TRIM` robust σ left out; variance of the k-th
+    difference: C(2k, k)·σ²)."""
+    per_t = [np.diff(x[sweep.temperature_c == t], n=order) for t in sweep.temperatures()]
+    d = np.concatenate([v for v in per_t if v.size]) if any(v.size for v in per_t) else np.zeros(0)
     if d.size < 3:
         raise IPMCError(f"cannot estimate the noise of a {sweep.output_name} sweep from {sweep.frequency_hz.size} "
                         f"lines: give at least {order + 3} frequencies per temperature, or declare per-line "
