@@ -133,7 +133,7 @@ def main(argv=None):
     for key, what in (("single_ok", "one quantity"), ("joint_ok", "joint")):
         k = sum(r[key] for r in rows)
         lo, hi = wilson(k, n)
-        print(f"{what:13s}: {'none (no false positive)' if args.set == 'null' else 'named exactly'} {k}/{n}"
+        print(f"{what:13s}: {'none (no false positive)' if all(not r['expected'] for r in rows) else 'named exactly'} {k}/{n}"
               f" [{lo:.2f}, {hi:.2f}]")
     for lab in labels:
         sub = [r for r in rows if r["label"] == lab]
