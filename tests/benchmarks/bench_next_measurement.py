@@ -48,7 +48,23 @@ recommended                                      S 108-1000 Hz (9),     S 108-10
                                                                                                   5, 35, 65 °C (5)
 ===============================================  =====================  ========================  =======================
 
-The actuator's four misses are weak contact resistances (λ 14-37 in the record) that the recommendation
+With the Z record diagnosed jointly with the M record (2026-11-26, the same commands, this file;
+the earlier Z-alone figure re-measured on the same seeds with the main branch's copy):
+
+=========================================  ==========================  ==========================
+actuator, the pair                         7200-7209                   7300-7309 (fresh)
+=========================================  ==========================  ==========================
+ambiguous after one record                 9/20                        9/20
+named exactly, Z record diagnosed alone    7/9                         9/9
+named exactly, Z jointly with M            7/9 [0.45, 0.94]            8/9 [0.56, 0.98]
+=========================================  ==========================  ==========================
+
+Together 15/18 (83 %) jointly vs 16/18 alone.  The misses are the weak contact resistances that
+the recommendation forecast it would not separate (λ expected 5-14 < the target): 7203, 7204
+(both set-ups) and 7307 (named by Z alone, left ambiguous jointly: the joint refits must fit M,
+where the two are confusable, with the same base values).
+
+The actuator's four misses (Z alone, 7200-7219) are weak contact resistances (λ 14-37 in the record) that the recommendation
 forecast it would not separate at the record's noise (λ 5-14 < 42).  The three misses with all
 sensor candidates are amplifier cases left ambiguous between amplifier_bandwidth
 and transimpedance, which the recommendation had said no experiment up to 1 kHz separates (the two
