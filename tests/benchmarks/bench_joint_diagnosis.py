@@ -48,8 +48,8 @@ sensor lag vs amplifier pole (8500-8507)               3/16                    3
 sensor null strips (8600-8607)                         8/8                     8/8
 =====================================================  ======================  ======================
 
-Time per diagnosis: joint 1.0-1.6× one quantity (every candidate: 22 s vs 19 s; the pair: 0.8 s
-vs 0.5 s).  What the figures say:
+Time per diagnosis, joint vs one quantity: every candidate 22 s vs 19 s (contact), 11-14 s vs
+9-10 s (null); the pair 0.8 s vs 0.5 s; sensor 2.0 s vs 4.5 s.  What the figures say:
 
 * Z separates the contact resistance from the diffusivity law where M cannot: 0/10 → 6/10 with
   the pair as candidates.  The four left are weak (λ 1.5 → ``none`` in both; λ 20, 49, 277 →
@@ -70,7 +70,7 @@ vs 0.5 s).  What the figures say:
 * Sensor: Z does not separate a lag from an amplifier pole — neither acts on the strip's own
   impedance, and with the library's default (chain effects on every quantity, i.e. Z measured
   through S's amplifier) they act identically on both.  Without ``acts_on`` every sensor S+Z case
-  with a hidden element was ``unexplained`` (development seeds 900-904); with it, Z pins d and κe,
+  with a hidden element but one was ``unexplained`` (development seeds 900-903: 7 of 8); with it, Z pins d and κe,
   so three tiny elements that S alone called ``none`` (λ 0.1-0.6 after the generator's own
   baseline refit) become significant (``ambiguous`` between the two), while the sensor null
   strips stay ``none`` 8/8.
