@@ -49,7 +49,8 @@ sensor null strips (8600-8607)                         8/8                     8
 =====================================================  ======================  ======================
 
 Time per diagnosis, joint vs one quantity: every candidate 22 s vs 19 s (contact), 11-14 s vs
-9-10 s (null); the pair 0.8 s vs 0.5 s; sensor 2.0 s vs 4.5 s.  What the figures say:
+9-10 s (null), 18 s vs 11 s (thermal); the pair 0.8 s vs 0.5 s; sensor 2.0 s vs 4.5 s.  What the
+figures say:
 
 * Z separates the contact resistance from the diffusivity law where M cannot: 0/10 → 6/10 with
   the pair as candidates.  The four left are weak (λ 1.5 → ``none`` in both; λ 20, 49, 277 →
