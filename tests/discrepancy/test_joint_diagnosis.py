@@ -178,3 +178,18 @@ def test_cli_diagnoses_several_files_and_names_a_bad_one(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "Z.csv" in err and "cannot be the actuator quantity M" in err, err
     assert "Traceback" not in err
+
+
+def test_the_next_measurement_search_says_it_takes_one_quantity():
+    # the search (next_measurement.py) works on one quantity's record; for a joint diagnosis it
+    # refuses with the reason, which ipmc diagnose records as "no recommendation: ..."
+    from dataclasses import replace
+
+    from scenarios.commands.diagnose import recommend
+
+    M, Z, truth = make_joint_case(902, "contact_resistance")
+    d = replace(_diag([M, Z], truth, 902), verdict="ambiguous")
+    with pytest.raises(IPMCError, match="takes a diagnosis of one quantity; this one is joint over M\\+Z"):
+        d.recommend_next_measurement()
+    recommend(d, {})
+    assert d.next_measurement is not None and "one quantity" in d.next_measurement.message
