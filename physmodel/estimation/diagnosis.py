@@ -14,7 +14,8 @@ import numpy as np
 from ..data.files import atomic_write
 from ..data.sweep import FrequencySweep
 from ..effects import LIBRARY, get_effect
-from ..errors import ParameterError
+from ..errors import IPMCError, ParameterError
+from .joint import JointData
 from .next_measurement import NextMeasurement, json_ready
 from .records import CalibrationResult
 
@@ -166,6 +167,12 @@ class Diagnosis:
         Named effects' parameters that ended at their off value (the simpler effect is meant).
     sign_flip : dict
         The costs of the baseline and of its sign reversal (the polarity check).
+    per_quantity : list
+        Diagnosed over several quantities (``quantity`` is then e.g. ``"M+Z"`` and ``data`` their
+        stacked lines): per quantity its lines, unit, noise (declared or estimated, median σ), weighted
+        cost before/after against its expectation and whether a misfit remains; [] for one quantity.
+    joint : JointData or None
+        The sweeps of those quantities and the σ used (:class:`~physmodel.estimation.joint.JointData`).
     next_measurement : NextMeasurement or None
         For an ``ambiguous`` or ``at_bound`` verdict, the experiment expected to separate the
         competing models and its expected separation at this record's noise
@@ -209,6 +216,8 @@ class Diagnosis:
     reduced: list = field(default_factory=list)      # named effects' parameters at their off value (simpler form)
     sign_flip: dict = field(default_factory=dict)    # costs of the baseline and of its sign reversal
     next_measurement: NextMeasurement | None = field(default=None, repr=False)   # ambiguous / at_bound
+    per_quantity: list = field(default_factory=list)   # several quantities: each one's lines, noise, costs
+    joint: JointData | None = field(default=None, repr=False)   # several quantities: their JointData
 
     # ---------------------------------------------------------------- the next measurement
     def recommend_next_measurement(self, **kw):
@@ -227,6 +236,9 @@ class Diagnosis:
 
         if self.verdict not in ("ambiguous", "at_bound"):
             return None
+        if self.joint is not None:
+            raise IPMCError(f"the next-measurement search takes a diagnosis of one quantity; this one is joint over "
+                            f"{self.quantity}: diagnose the quantity to extend on its own first")
         self.next_measurement = next_measurement(self, **kw)
         return self.next_measurement
 
@@ -288,7 +300,8 @@ class Diagnosis:
             provenance = Provenance("physmodel.diagnose", data_fingerprint=self.metadata.get("data_fingerprint"),
                                     temperatures_c=tuple(self.data.temperatures().tolist()),
                                     band_hz=(float(self.data.frequency_hz.min()), float(self.data.frequency_hz.max())))
-        return ModelFile(self.kind, params, effects, self.quantity, self.metadata.get("kernel", "boundary_charge"),
+        # several quantities: the model is the strip's; the file names the first quantity as its own
+        return ModelFile(self.kind, params, effects, self.quantity.split("+")[0], self.metadata.get("kernel", "boundary_charge"),
                          verdict, tuple(fit.estimates()), provenance)
 
     def to_dict(self) -> dict:
@@ -297,6 +310,7 @@ class Diagnosis:
             "verdict": self.verdict, "named": list(self.named), "message": self.message,
             "named_effect": self.named_effect(),
             "kind": self.kind, "quantity": self.quantity, "alpha": self.alpha,
+            "quantities": self.quantity.split("+"), "per_quantity": self.per_quantity,
             "lr_threshold": self.threshold, "gap_threshold_2cost": self.gap_threshold,
             "noise_estimated": self.noise_estimated,
             "baseline": self.baseline.to_dict(),
@@ -354,6 +368,14 @@ class Diagnosis:
         if self.cost_warning:
             L += [f"**Cost vs declared noise — {self.cost_warning}.**", ""]
         L += [f"Temperature laws: {self.laws}", ""]
+        if self.per_quantity:
+            L += ["## Per quantity (diagnosed jointly)", "", "| quantity | lines | unit | noise | σ dB / deg (median) | "
+                  "cost before | cost after | expected | misfit left |", "|---|---|---|---|---|---|---|---|---|"]
+            L += [f"| {r['quantity']} | {r['lines']} | {r['unit']} | {r['noise']} | {r['sigma_db_median']:.3g} / "
+                  f"{r['sigma_deg_median']:.3g} | {r['cost_before']:.4g} | {r['cost_after']:.4g} | "
+                  f"{r['expected_after']:.4g} | {'not tested (estimated noise)' if r['misfit'] is None else 'yes' if r['misfit'] else 'no'} |"
+                  for r in self.per_quantity]
+            L += [""]
         L += ["## Baseline parameters", "", "| parameter | value | 95 % CI | fit bounds | plausible range | flag | "
               "multi-start range |", "|---|---|---|---|---|---|---|"]
         for r in self._baseline_rows():

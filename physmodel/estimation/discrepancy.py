@@ -92,6 +92,7 @@ from .diagnosis import (
     stage_progress,
     worst_cells,
 )
+from .joint import check_acts_on, joint_data, per_quantity_sentence
 from .nullstats import bootstrap_ratio, constrained_lr, scan_lr, signature_stage
 from .priors import (
     WALL_DECADES,
@@ -128,15 +129,24 @@ PAIR_FITS = 6
 
 
 # =============================================================================== main entry
-def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuator", quantity: str | None = None,
+def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParameters, *, kind: str = "actuator",
+             quantity: str | Sequence[str] | None = None,
              free: Sequence[str | FreeParameter] = ("alpha0",),
              baseline_effects: Mapping[str, Mapping[str, float]] | Sequence[str] = (),
              candidates: Sequence[str] | None = None, alpha: float = 0.05, null_draws: int = 4000,
              null_refits: int = 4, seed: int = 0, kernel: str = "boundary_charge", max_nfev: int = 200,
              laws=None, candidate_bounds: Mapping | None = None, candidate_starts: Mapping | None = None,
              plausible: Mapping | None = None, prior: bool = True, baseline_starts: int = 3,
-             progress: Callable[[str], None] | None = None, _restart: Mapping | None = None) -> Diagnosis:
+             progress: Callable[[str], None] | None = None, acts_on: Mapping[str, Sequence[str]] | None = None,
+             _restart: Mapping | None = None) -> Diagnosis:
     """Diagnose the discrepancy between ``data`` and the ``base`` model (see module docstring).
+
+    ``data``: one sweep (one measured quantity, ``quantity``, default M / S), or a sequence of
+    sweeps of the same strip, one per quantity (``quantity``: their names, or None to take each from
+    its sweep's metadata/units), diagnosed jointly — baseline, candidates and null over all their
+    lines, each quantity with its own noise (:mod:`~physmodel.estimation.joint`); ``acts_on``
+    (several quantities only) narrows where an effect acts, ``{effect: [quantities]}`` — e.g. a
+    current amplifier on S but not on Z measured by another instrument.
 
     ``free``: the user's calibration parameters (names with default bounds, ``"effect.param"`` of a
     baseline effect, or :class:`FreeParameter`).  ``baseline_effects``: effects already in the model
@@ -160,11 +170,17 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     args = dict(kind=kind, quantity=quantity, free=free, baseline_effects=baseline_effects, candidates=candidates,
                 alpha=alpha, null_draws=null_draws, null_refits=null_refits, seed=seed, kernel=kernel,
                 max_nfev=max_nfev, laws=laws, candidate_bounds=candidate_bounds, candidate_starts=candidate_starts,
-                plausible=plausible, prior=prior, baseline_starts=baseline_starts, progress=progress)
-    base_in = base
+                plausible=plausible, prior=prior, baseline_starts=baseline_starts, progress=progress, acts_on=acts_on)
+    base_in, data_in = base, data
     t0 = time.perf_counter()
+    jd = None                                   # several quantities: their stacked lines (joint.py)
     if not isinstance(data, FrequencySweep):
-        raise IPMCError(f"data must be a FrequencySweep, got {type(data).__name__}")
+        if isinstance(data, (str, bytes)) or not isinstance(data, Sequence):
+            raise IPMCError(f"data must be a FrequencySweep or a sequence of them (one per quantity), "
+                            f"got {type(data).__name__}")
+        jd = joint_data(data, kind, quantity)
+        if len(jd.quantities) == 1:             # one quantity: today's path
+            data, quantity, jd = jd.sweeps[0], jd.quantities[0], None
     if not isinstance(base, IPMCParameters):
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
     if not (0 < alpha < 0.5):
@@ -176,7 +192,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     if int(baseline_starts) < 1:
         raise IPMCError(f"baseline_starts={baseline_starts!r} must be >= 1")
     base, laws_note = resolve_laws(base, laws)
-    q = quantity or DEFAULT_QUANTITY.get(kind, "")
+    q = jd.label if jd is not None else (quantity or DEFAULT_QUANTITY.get(kind, ""))
+    qs = jd.quantities if jd is not None else (q,)
     say = stage_progress(progress)
     if isinstance(baseline_effects, Mapping):
         beff = normalize_effects(baseline_effects)
@@ -186,13 +203,22 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         extra_free = [f"{n}.{p.name}" for n in beff for p in get_effect(n).parameters]
     cbounds, cstarts = _candidate_overrides(candidate_bounds, candidate_starts)
     model0 = EffectModel(base, kind, beff, kernel=kernel)
-    counter = StageCounter(model0.predictor(data, q).many)
+    if acts_on and jd is None:
+        raise IPMCError("acts_on narrows where effects act among several measured quantities; this diagnosis has one")
+    scope = check_acts_on(acts_on, kind, qs)
+    counter = StageCounter(jd.predictor(model0, scope) if jd is not None else model0.predictor(data, q).many)
     pm = counter.predict_many
     free0 = free_parameters_for(base, list(free) + [f for f in extra_free if f not in free], beff)
     names0 = [fp.name for fp in free0]
     ranges = plausible_ranges(base, plausible)
-    prob = PenalisedProblem(data, pm, penalties_for(free0, ranges) if prior else [])
-    s_ln, s_ph, estimated = prob.s_ln, prob.s_ph, prob.estimated
+    pens = penalties_for(free0, ranges) if prior else []
+    if jd is not None:                          # each quantity's own σ where its sweep declares none
+        counter.enter("baseline")
+        jd = jd.resolve_noise(lambda d: pm([PenalisedProblem(d, pm, pens).fit(
+            free0, seed=seed, max_nfev=max_nfev, identify=False, hold_undetermined=False).values])[0])
+        data = jd.stacked
+    prob = PenalisedProblem(data, pm, pens)
+    s_ln, s_ph, estimated = prob.s_ln, prob.s_ph, prob.estimated or (jd is not None and jd.any_estimated)
     N = data.frequency_hz.size
     n_temps = data.temperatures().size
 
@@ -216,12 +242,13 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     say("baseline", f"baseline fitted: cost {cost0:.4g} (expected {res0.expected_cost:.4g})")
 
     # ---- 2. signatures, confusability
+    applies = {c for qq in qs for c in candidates_for(kind, qq, n_temps)}      # to any of the quantities
     cand = [get_effect(c).name for c in candidates] if candidates is not None else [
-        c for c in candidates_for(kind, q, n_temps) if c not in beff]
+        c for c in LIBRARY if c in applies and c not in beff]
     for c in cand:
         if c not in LIBRARY:
             raise ParameterError(f"unknown candidate effect {c!r}; expected library names {sorted(LIBRARY)}")
-        if not LIBRARY[c].applies_to(kind, q):
+        if not any(LIBRARY[c].applies_to(kind, qq) and qq in scope.get(c, qs) for qq in qs):
             raise ParameterError(f"candidate {c!r} does not apply to {kind} quantity {q}")
     bad = sorted(set(cbounds) - set(cand)) + sorted(set(cstarts) - set(cand))
     if bad:
@@ -284,7 +311,7 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         rb = fit(from_(fits[c].values))
         if rb.cost < res0.cost - 0.5:       # ½Δχ² > ½: a better baseline basin, not the effect
             say("candidates", f"baseline basin from the {c} refit: cost {rb.cost:.4g} < {res0.cost:.4g}; restarting")
-            out = diagnose(data, base_in, **args, _restart=rb.values)
+            out = diagnose(data_in, base_in, **args, _restart=rb.values)
             out.metadata["baseline_restart"] = {"from_candidate": c, "cost_before": res0.cost, "cost_after": rb.cost}
             return out
     # ---- 5. bootstrap refits under the null (nonlinearity correction of the threshold)
@@ -642,6 +669,8 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
     warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
     if warn:
         message += f" Cost vs declared noise: {warn}."
+    per_q = jd.per_quantity(G0, Gf, k0, n_free_after, alpha) if jd is not None else []
+    message += per_quantity_sentence(per_q)
     declare_confusable(confusable, separation, confusability, sigs, raw_sigs, data)
     say("audit", f"verdict {verdict}" + (f": {', '.join(named)}" if named else ""))
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
@@ -660,12 +689,13 @@ def diagnose(data: FrequencySweep, base: IPMCParameters, *, kind: str = "actuato
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
         metadata={"base": base.name, "kernel": kernel, "free": names0, "baseline_effects": beff, "candidates": cand,
+                  "quantities": list(qs), "acts_on": {k: list(v) for k, v in scope.items()},
                   "data_fingerprint": data.fingerprint(), "pairs_tried": pair_tried, "profile": counter.as_dict(),
                   "candidate_bounds": {c: {p.name: [p.lower, p.upper, p.typical] for p in cpars[c]} for c in cpars},
                   "prior": f"soft walls of {WALL_DECADES:g} decade outside the plausible ranges" if prior else "none"},
         laws=laws_note, baseline_audit=audit0, final_at_bound=at_bound, final_implausible=final_implausible,
         cost_warning=warn, confusability=confusability, base_parameters=base,
-        reduced=reduced, sign_flip=flip,
+        reduced=reduced, sign_flip=flip, per_quantity=per_q, joint=jd,
     )
 
 

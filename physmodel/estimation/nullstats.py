@@ -6,11 +6,11 @@ scan over parameters that are not identified under the null (Davies 1987)."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from itertools import combinations
 
 import numpy as np
 
-from ..data.sweep import FrequencySweep
 from .diagnosis import CONFUSABLE_COSINE, MIN_SIGNATURE_LR
 from .residuals import standardised_residuals
 from .signatures import effect_signature, orth, project_out, separation_hint, with_noise, z_jacobian
@@ -195,9 +195,8 @@ def bootstrap_ratio(E, lin_max, G0, data, s_ln, s_ph, n_refits: int, fit_null, r
     Returns ``(ratio, full_max, lin_used)``."""
     full_max, lin_used = [], []
     for b in range(n_refits):
-        sim = FrequencySweep(data.temperature_c, data.frequency_hz, with_noise(G0, E[:, b], s_ln, s_ph),
-                             np.asarray(s_ln) * 20 / math.log(10), np.degrees(s_ph), data.input_name,
-                             data.input_unit, data.output_name, data.output_unit)
+        sim = replace(data, response=with_noise(G0, E[:, b], s_ln, s_ph),     # keeps a stacked sweep's type
+                      magnitude_std_db=np.asarray(s_ln) * 20 / math.log(10), phase_std_deg=np.degrees(s_ph))
         full_max.append(float(refit_max(sim, fit_null(sim))))
         lin_used.append(float(lin_max[b]))
     ratio = 1.0

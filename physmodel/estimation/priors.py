@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -74,11 +74,11 @@ class PenalisedProblem:
         # pseudo-lines after the last line, above its frequency (a sweep's frequencies increase per
         # temperature); the predictor never sees them (it answers for the data lines only)
         t_last, f_last = data.temperature_c[-1], data.frequency_hz[data.temperature_c == data.temperature_c[-1]].max()
-        self.data_aug = FrequencySweep(
-            np.concatenate([data.temperature_c, np.full(k, t_last)]),
-            np.concatenate([data.frequency_hz, f_last * (2.0 + np.arange(k))]),
-            np.concatenate([data.response, np.ones(k, dtype=complex)]), db, deg,
-            data.input_name, data.input_unit, data.output_name, data.output_unit, dict(data.metadata or {}))
+        self.data_aug = replace(        # keeps the record's type (a stacked sweep of several quantities)
+            data, temperature_c=np.concatenate([data.temperature_c, np.full(k, t_last)]),
+            frequency_hz=np.concatenate([data.frequency_hz, f_last * (2.0 + np.arange(k))]),
+            response=np.concatenate([data.response, np.ones(k, dtype=complex)]), magnitude_std_db=db,
+            phase_std_deg=deg, metadata=dict(data.metadata or {}))
 
         def pm_aug(values_list):
             G = np.asarray(predict_many(values_list), dtype=complex)

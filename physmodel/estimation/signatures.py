@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 from itertools import combinations
 
 import numpy as np
@@ -212,8 +213,8 @@ def vuong_power(lam: float, z_crit: float) -> float:
 
 def _noiseless(data: FrequencySweep, G, s_ln, s_ph) -> FrequencySweep:
     """``data`` with response ``G`` and the same per-line σ."""
-    return FrequencySweep(data.temperature_c, data.frequency_hz, G, np.asarray(s_ln) * 20 / math.log(10),
-                          np.degrees(s_ph), data.input_name, data.input_unit, data.output_name, data.output_unit)
+    return replace(data, response=G, magnitude_std_db=np.asarray(s_ln) * 20 / math.log(10),
+                   phase_std_deg=np.degrees(s_ph))
 
 
 def vuong_confusability(top: str, sig: Sequence[str], fits: dict, cres: dict, pm, data: FrequencySweep, s_ln, s_ph,

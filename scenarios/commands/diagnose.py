@@ -3,12 +3,19 @@
     ipmc diagnose EXPERIMENT.toml [--out FOLDER] [--seed N] [--quiet]
     ipmc diagnose --data sweep.csv --kind actuator --set seed002_table3 \\
                   --free alpha0 --free d --free xi --free omega_n --out diagnosis
+    ipmc diagnose --data M.csv --data Z.csv --quantity M,Z ...     # several quantities, jointly
 
 EXPERIMENT.toml (paths relative to the TOML file; SI units for parameters)::
 
     data = "sweep.csv"                 # .csv / .npz / .mat in the physmodel sweep format
+                                       # or several files of one strip, one per quantity:
+                                       # data = ["M.csv", "Z.csv"]
     kind = "actuator"                  # or "sensor"
-    quantity = "M"                     # optional (actuator M/H/Z/I, sensor S/Z)
+    quantity = "M"                     # optional (actuator M/H/Z/I, sensor S/Z); several files:
+                                       # quantity = ["M", "Z"] (default: from each file's units)
+    [acts_on]                          # several quantities from different instruments: where an
+    amplifier_bandwidth = ["S"]        # effect acts (here the current amplifier and acquisition of
+    time_delay = ["S"]                 # S, not an impedance analyser's Z; default: every quantity)
     set = "seed002_table3"             # named set or parameter JSON file
     free = ["alpha0", "d", "xi", "omega_n", "kappa_e:1e-7:1e-5"]   # NAME[:LOWER:UPPER[:SCALE[:INITIAL]]]
     candidates = ["time_delay", "amplifier_bandwidth"]             # optional (default: all that apply)
@@ -50,6 +57,15 @@ clipped to the temperature laws' valid range. When no recommendation can be made
 experiment within the limits) the diagnosis is still written, with "no recommendation: <reason>" in
 the same places.
 
+Several measured quantities of the same strip (actuator M and Z, sensor S and Z; one file per
+quantity, ``--data`` repeated or a list): the baseline, the candidates and the null are fitted to
+all their lines together, each quantity with its own noise (its per-line σ, or estimated per
+quantity when the file has none); report.json ("per_quantity") and summary.md give each quantity's
+cost before/after against its expectation, and the figures are drawn per quantity
+(bode_before_M.png, bode_after_Z.png, ...). model.json names the first quantity and the first file
+in its provenance (the command line, kept there, lists every file). The next-measurement search
+takes a diagnosis of one quantity: for a joint one it says "no recommendation" and why.
+
 Writes model.json (the model it ends with — the baseline plus the named effect(s), refitted, with the
 goodness-of-fit verdict and the data's provenance: what ``--model`` takes in every later command),
 report.json (verdict none / named / ambiguous / unexplained, the named effect with its fitted
@@ -87,9 +103,14 @@ def add_parser(subparsers):
         "diagnose", help="locate a model/data discrepancy, name the missing effect, refit, show the gap shrink",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("experiment", nargs="?", help="experiment description (TOML); flags override its entries")
-    p.add_argument("--data", help="sweep file (.csv/.npz/.mat)")
+    p.add_argument("--data", action="append",
+                   help="sweep file (.csv/.npz/.mat); repeat it for several quantities of the strip (one file each)")
     p.add_argument("--kind", choices=("actuator", "sensor"), help="model kind (default actuator)")
-    p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z")
+    p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z; several files: "
+                                      "one per file, comma-separated (default: from each file's units)")
+    p.add_argument("--acts-on", action="append", metavar="EFFECT=Q[,Q]",
+                   help="several quantities: the quantities an effect acts on (e.g. amplifier_bandwidth=S when Z "
+                        "is measured by another instrument; repeatable; default every quantity it applies to)")
     p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), help="sensing kernel")
     p.add_argument("--set", "--model", dest="base_set",
                    help="start: a named parameter set or a JSON model/parameter file (a model file's effects are "
@@ -146,7 +167,8 @@ def _load_toml(path: Path) -> dict:
         raise IPMCError(f"experiment file {str(path)!r} is not valid TOML: {exc}") from None
     known = {"data", "kind", "quantity", "kernel", "set", "free", "candidates", "alpha", "seed", "out",
              "geometry", "parameters", "baseline_effects", "null_draws", "null_refits", "laws",
-             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts", "next_measurement"}
+             "candidate_bounds", "candidate_starts", "plausible", "prior", "baseline_starts", "next_measurement",
+             "acts_on"}
     unknown = set(spec) - known
     if unknown:
         raise IPMCError(f"experiment file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected {sorted(known)}")
@@ -156,6 +178,8 @@ def _load_toml(path: Path) -> dict:
             cand = path.parent / spec[key]
             if key == "data" or cand.suffix.lower() == ".json":
                 spec[key] = str(cand) if not Path(spec[key]).is_absolute() else spec[key]
+    if isinstance(spec.get("data"), list):
+        spec["data"] = [x if Path(x).is_absolute() else str(path.parent / x) for x in spec["data"]]
     return spec
 
 
@@ -174,8 +198,10 @@ def _is_strs(v):
 
 
 #: Experiment-file keys: (check, what is expected).
-_TYPES = {"data": (lambda v: isinstance(v, str), "a file name"), "kind": (lambda v: v in ("actuator", "sensor"), "'actuator' or 'sensor'"),
-          "quantity": (lambda v: isinstance(v, str), "a quantity name (M, H, Z, I, S)"),
+_TYPES = {"data": (lambda v: isinstance(v, str) or _is_strs(v) and len(v) > 0,
+                   "a file name or a non-empty list of file names (one per quantity)"), "kind": (lambda v: v in ("actuator", "sensor"), "'actuator' or 'sensor'"),
+          "quantity": (lambda v: isinstance(v, str) or _is_strs(v) and len(v) > 0,
+                       "a quantity name (M, H, Z, I, S) or a list of them (one per data file)"),
           "kernel": (lambda v: v in ("boundary_charge", "reciprocal"), "'boundary_charge' or 'reciprocal'"),
           "set": (lambda v: isinstance(v, str), "a parameter-set name or JSON file"),
           "free": (lambda v: _is_strs(v) and len(v) > 0, "a non-empty list of strings NAME[:LOWER:UPPER...]"),
@@ -197,6 +223,8 @@ _TYPES = {"data": (lambda v: isinstance(v, str), "a file name"), "kind": (lambda
           "plausible": (lambda v: isinstance(v, dict), "a table of NAME = [LOWER, UPPER]"),
           "prior": (lambda v: isinstance(v, bool), "true or false"),
           "baseline_starts": (lambda v: _is_int(v) and v >= 1, "a positive integer"),
+          "acts_on": (lambda v: isinstance(v, dict) and all(_is_strs(x) and x for x in v.values()),
+                      "a table of EFFECT = [quantities], e.g. amplifier_bandwidth = [\"S\"]"),
           "next_measurement": (lambda v: isinstance(v, dict) and set(v) <= {"quantities", "band_limits_hz",
                                                                             "temperature_limits_c", "levels", "power"},
                                "a table of quantities, band_limits_hz, temperature_limits_c, levels, power")}
@@ -280,6 +308,7 @@ def build(args):
     data_path = pick(args.data, "data")
     if not data_path:
         raise IPMCError("no data: give --data FILE or 'data = ...' in the experiment file")
+    paths = [data_path] if isinstance(data_path, str) else list(data_path)
     set_name = pick(args.base_set, "set")
     if not set_name:
         raise IPMCError("no starting parameter set: give --set NAME_OR_JSON or 'set = ...'")
@@ -294,8 +323,9 @@ def build(args):
     over.update(parse_assignments(args.param))
     start = start_model(set_name, pick(args.kind, "kind"), over)
     base = start.parameters
-    data = read_sweep_mapped(data_path, args, "--data")
-    check_celsius(data.temperatures(), f"{data_path}: temperature_c")
+    sweeps = [read_sweep_mapped(x, args, "--data") for x in paths]
+    for x, sw in zip(paths, sweeps):
+        check_celsius(sw.temperatures(), f"{x}: temperature_c")
     # the start model's effects are in the model (fixed at their values) unless the TOML/flags say otherwise
     effects_spec = {**start.effects, **dict(spec.get("baseline_effects", {}))}
     for item in args.baseline_effect or []:
@@ -333,23 +363,62 @@ def build(args):
     prior = False if args.no_prior else spec.get("prior", True)
     if not isinstance(prior, bool):
         raise IPMCError(f"prior = {prior!r}: expected true or false")
-    kw = dict(kind=pick(args.kind, "kind", start.kind), quantity=pick(args.quantity, "quantity"),
+    kind = pick(args.kind, "kind", start.kind)
+    if kind not in ("actuator", "sensor"):
+        raise IPMCError(f"kind = {kind!r}; expected 'actuator' or 'sensor'")
+    data, quantity = _quantities(sweeps, paths, kind, pick(args.quantity, "quantity"),
+                                 "--quantity" if args.quantity is not None else f"quantity (in {args.experiment})")
+    acts_on = {k: list(v) for k, v in dict(spec.get("acts_on", {})).items()}
+    for item in args.acts_on or []:
+        e, sep, qs = item.partition("=")
+        if not sep or not e.strip() or not [q for q in qs.split(",") if q.strip()]:
+            raise IPMCError(f"--acts-on {item!r}: expected EFFECT=Q[,Q], e.g. amplifier_bandwidth=S")
+        acts_on[e.strip()] = [q.strip() for q in qs.split(",") if q.strip()]
+    if acts_on and not isinstance(quantity, tuple):
+        raise IPMCError(f"{'--acts-on' if args.acts_on else 'acts_on'}: says where effects act among several "
+                        "measured quantities; give one data file per quantity (--data repeated)")
+    kw = dict(kind=kind, quantity=quantity, acts_on=acts_on or None,
               laws=_laws(spec, args, set_name), candidate_bounds=cb or None, candidate_starts=cs or None,
               plausible=pl or None, prior=prior, baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
               free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
               null_draws=int(pick(args.null_draws, "null_draws", 4000)),
               null_refits=int(pick(args.null_refits, "null_refits", 4)), seed=int(pick(args.seed, "seed", 0)),
               kernel=pick(args.kernel, "kernel", "boundary_charge"))
-    if kw["kind"] not in ("actuator", "sensor"):
-        raise IPMCError(f"kind = {kw['kind']!r}; expected 'actuator' or 'sensor'")
     from ._common import bound_count
 
     # the null Monte Carlo holds two (2·lines × draws) float64 arrays and a few rows per candidate
     bound_count(kw["null_draws"], "--null-draws" if args.null_draws is not None else f"null_draws (in {args.experiment})",
-                8 * (4 * data.frequency_hz.size + 16), what="draws")
-    args.data_path = data_path
+                8 * (4 * sum(sw.frequency_hz.size for sw in sweeps) + 16), what="draws")
+    args.data_path = paths[0]
     args.next_table = dict(spec.get("next_measurement", {}))
     return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
+
+
+def _quantities(sweeps: list, paths: list, kind: str, given, option: str):
+    """``(data, quantity)`` for :func:`diagnose`: one sweep and its quantity as given, or the sweeps
+    of several files with one quantity each (``given``: a list, ``"M,Z"``, or None to take each from
+    its file's units); a quantity that does not fit its file, or two files of one quantity, is an
+    IPMCError naming the file (exit 2)."""
+    from physmodel.estimation.joint import quantity_of
+
+    if isinstance(given, str):
+        given = [q.strip() for q in given.split(",")] if "," in given or len(sweeps) > 1 else given
+    if len(sweeps) == 1:
+        if isinstance(given, list):
+            if len(given) != 1:
+                raise IPMCError(f"{option} = {given!r}: {len(given)} quantities for one data file ({paths[0]})")
+            given = given[0]
+        return sweeps[0], given
+    if given is not None and len(given) != len(sweeps):
+        raise IPMCError(f"{option} = {given!r}: {len(given)} quantities for {len(sweeps)} data files {paths}; "
+                        "give one per file, in order (or none: each from its file's units)")
+    qs = [quantity_of(sw, kind, None if given is None else given[i], f"data file {paths[i]}")
+          for i, sw in enumerate(sweeps)]
+    for i, q in enumerate(qs):
+        if q in qs[:i]:
+            raise IPMCError(f"data files {paths[qs.index(q)]} and {paths[i]} are both quantity {q}: give one file "
+                            "per quantity (merge the records of one quantity into one sweep file first)")
+    return sweeps, tuple(qs)
 
 
 def _next_kw(args, table: dict, kind: str) -> dict:
@@ -450,18 +519,27 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    mf = d.to_model_file(provenance_of(args.data_path, data, "ipmc diagnose"))
+    mf = d.to_model_file(provenance_of(args.data_path, d.data, "ipmc diagnose"))
     with output_folder(out, "ipmc diagnose", force=args.force) as stage:     # all or nothing
         d.write_report(stage)
         mf.save(stage / "model.json")
-        plots.diagnosis_figures(d, stage)
+        if d.joint is None:
+            plots.diagnosis_figures(d, stage)
+        else:                                   # one pair of figures per quantity, in its own units
+            after = "after: + " + (", ".join(d.final_effects) or "nothing")
+            for sw, q, gb, ga in zip(d.joint.sweeps, d.joint.quantities, d.joint.split(d.predicted_before),
+                                     d.joint.split(d.predicted_after)):
+                plots.residual_bode(stage / f"bode_before_{q}.png", sw, gb, f"{q}: baseline (before)")
+                plots.residual_bode(stage / f"bode_after_{q}.png", sw, ga, f"{q}: {after}")
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)
         print(f"weighted cost {d.gap_before['cost']:.4g} -> {d.gap_after['cost']:.4g} "
               f"(expected {d.gap_after['expected_cost']:.4g}); gap shrink {gap_shrink(d):.3g}x; "
               f"{d.elapsed_s:.1f} s")
-        print(f"report: {out}/report.json, summary.md, bode_before.png, bode_after.png")
+        figs = ("bode_before.png, bode_after.png" if d.joint is None else
+                ", ".join(f"bode_before_{q}.png, bode_after_{q}.png" for q in d.joint.quantities))
+        print(f"report: {out}/report.json, summary.md, {figs}")
         print(f"model: {out}/model.json — {mf.describe()}; use it downstream with --model {out}/model.json")
     if d.next_measurement is not None:               # said whether or not --quiet: it is the verdict's advice
         print(f"ipmc diagnose: {d.verdict}; {d.next_measurement.message}", file=sys.stderr)
