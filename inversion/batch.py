@@ -99,6 +99,16 @@ class InversionResult(SampledRecord):
     truncation_error, truncation_bound : float
         Largest error the preview causes on this signal (exact) and its signal-independent
         bound [output units].
+    t0 : float
+        Time of sample 0 [s].
+    time_stamps : ndarray or None
+        The caller's own sample times [s] when they were given (else ``t`` is built from
+        ``t0`` and ``dt``).
+    limit_report : LimitReport or None
+        The drive-limit check of ``output`` (:func:`~inversion.limits.check_limits`).
+    unstable_source : ndarray or tuple
+        Where ``unstable_part`` comes from: the array itself, or the ``(plan, chunk)`` that
+        recomputes it from ``input`` (internal; read ``unstable_part``) [model input units].
     """
 
     input: np.ndarray
