@@ -294,15 +294,42 @@ class Diagnosis:
         N = self.data.frequency_hz.size
         gof = goodness_of_fit(gap["cost"], 2 * N, int(gap["n_free"]), self.noise_estimated)
         verdict = FitVerdict.from_goodness(gof, self.verdict, self.named)
+        # several quantities: the file is the model of one of them (model_quantity); an effect the
+        # diagnosis held off on that quantity (acts_on) is not part of its model
+        q_model = self.model_quantity
+        held_off = sorted(e for e, on in (self.metadata.get("acts_on") or {}).items() if q_model not in on)
+        effects = {e: v for e, v in effects.items() if e not in held_off}
+        estimates = [r for r in fit.estimates() if r["name"].split(".", 1)[0] not in held_off]
+        notes = []
+        if held_off:
+            notes.append(f"this file is the model of {q_model}; {', '.join(held_off)} acted only on "
+                         + "; ".join(f"{e}: {', '.join(self.metadata['acts_on'][e])}" for e in held_off)
+                         + " in the diagnosis and is left out")
+        bad = [r for r in self.per_quantity if r.get("misfit")]
+        if bad:                             # a misfit in one quantity is a misfit of the model
+            notes.append("a misfit remains in " + "; ".join(
+                f"{r['quantity']} (cost {r['cost_after']:.4g}, expected {r['expected_after']:.4g}, above its χ² band)"
+                for r in bad))
+            verdict = _replace(verdict, adequate=False)
+        if notes:
+            verdict = _replace(verdict, reason=f"{verdict.reason.rstrip('.')}; " + "; ".join(notes))
         if self.next_measurement is not None:         # the later commands that read the file say it too
             verdict = _replace(verdict, reason=f"{verdict.reason.rstrip('.')}. {self.next_measurement.message}")
         if provenance is None:
             provenance = Provenance("physmodel.diagnose", data_fingerprint=self.metadata.get("data_fingerprint"),
                                     temperatures_c=tuple(self.data.temperatures().tolist()),
                                     band_hz=(float(self.data.frequency_hz.min()), float(self.data.frequency_hz.max())))
-        # several quantities: the model is the strip's; the file names the first quantity as its own
-        return ModelFile(self.kind, params, effects, self.quantity.split("+")[0], self.metadata.get("kernel", "boundary_charge"),
-                         verdict, tuple(fit.estimates()), provenance)
+        return ModelFile(self.kind, params, effects, q_model, self.metadata.get("kernel", "boundary_charge"),
+                         verdict, tuple(estimates), provenance)
+
+    @property
+    def model_quantity(self) -> str:
+        """The quantity :meth:`to_model_file` writes the model of: the diagnosed one, or of several
+        the kind's default (M for an actuator, S for a sensor) when it was among them, else the first."""
+        from ..effects import DEFAULT_QUANTITY
+
+        qs = self.quantity.split("+")
+        return DEFAULT_QUANTITY.get(self.kind, qs[0]) if DEFAULT_QUANTITY.get(self.kind) in qs else qs[0]
 
     def to_dict(self) -> dict:
         return json_ready({

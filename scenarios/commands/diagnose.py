@@ -62,8 +62,11 @@ quantity, ``--data`` repeated or a list): the baseline, the candidates and the n
 all their lines together, each quantity with its own noise (its per-line σ, or estimated per
 quantity when the file has none); report.json ("per_quantity") and summary.md give each quantity's
 cost before/after against its expectation, and the figures are drawn per quantity
-(bode_before_M.png, bode_after_Z.png, ...). model.json names the first quantity and the first file
-in its provenance (the command line, kept there, lists every file). The next-measurement search
+(bode_before_M.png, bode_after_Z.png, ...). model.json is the model of one quantity — M for an
+actuator, S for a sensor when diagnosed, else the first — with that quantity's file, lines and hash
+in its provenance (the command line, kept there, lists every file); an effect held off on it
+(--acts-on) is left out of it, and a misfit left in ANY quantity makes it say "does not fit" (exit 3
+unless --accept-misfit), as every later command that reads it will. The next-measurement search
 takes a diagnosis of one quantity: for a joint one it says "no recommendation" and why.
 
 Writes model.json (the model it ends with — the baseline plus the named effect(s), refitted, with the
@@ -389,7 +392,7 @@ def build(args):
     # the null Monte Carlo holds two (2·lines × draws) float64 arrays and a few rows per candidate
     bound_count(kw["null_draws"], "--null-draws" if args.null_draws is not None else f"null_draws (in {args.experiment})",
                 8 * (4 * sum(sw.frequency_hz.size for sw in sweeps) + 16), what="draws")
-    args.data_path = paths[0]
+    args.data_path, args.data_paths = paths[0], paths
     args.next_table = dict(spec.get("next_measurement", {}))
     return data, base, kw, Path(pick(args.out, "out", "diagnosis"))
 
@@ -519,7 +522,11 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    mf = d.to_model_file(provenance_of(args.data_path, d.data, "ipmc diagnose"))
+    if d.joint is None:
+        mf = d.to_model_file(provenance_of(args.data_path, d.data, "ipmc diagnose"))
+    else:               # the file is the model of one quantity: its own data file, lines and hash
+        i = d.joint.quantities.index(d.model_quantity)
+        mf = d.to_model_file(provenance_of(args.data_paths[i], d.joint.sweeps[i], "ipmc diagnose"))
     with output_folder(out, "ipmc diagnose", force=args.force) as stage:     # all or nothing
         d.write_report(stage)
         mf.save(stage / "model.json")

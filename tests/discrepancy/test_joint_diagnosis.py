@@ -154,6 +154,22 @@ def test_a_misfit_left_in_one_quantity_is_said():
     rows = {r["quantity"]: r for r in d.per_quantity}
     assert rows["Z"]["misfit"] is True, rows
     assert "A misfit remains in" in d.message and "Z" in d.message.split("A misfit remains in")[1]
+    # ... and travels: the model file (what every later command reads) says it does not fit, naming Z
+    mf = d.to_model_file()
+    assert mf.quantity == "M" and not mf.adequate, mf.verdict
+    assert "misfit remains in Z" in mf.verdict.reason, mf.verdict.reason
+
+
+def test_the_model_file_leaves_out_an_effect_held_off_on_its_quantity():
+    # the diagnosis held contact resistance off on M (acts_on Z only): M's model has none of it
+    M, Z, truth = make_joint_case(902, "contact_resistance")
+    d = _diag([M, Z], truth, 902, candidates=["contact_resistance"], acts_on={"contact_resistance": ["Z"]})
+    mf = d.to_model_file()
+    assert d.model_quantity == mf.quantity == "M"
+    assert "contact_resistance" not in mf.effects
+    assert not any(r["name"].startswith("contact_resistance.") for r in mf.estimates)
+    if "contact_resistance" in d.final_effects:
+        assert "left out" in mf.verdict.reason
 
 
 def test_cli_diagnoses_several_files_and_names_a_bad_one(tmp_path, capsys):
@@ -172,6 +188,14 @@ def test_cli_diagnoses_several_files_and_names_a_bad_one(tmp_path, capsys):
     assert rep["verdict"] == "named" and rep["named"] == ["contact_resistance"] and rep["quantities"] == ["M", "Z"]
     assert {p.name for p in (tmp_path / "out").glob("bode_*.png")} == {
         "bode_before_M.png", "bode_after_M.png", "bode_before_Z.png", "bode_after_Z.png"}
+    # the model file is M's, with M's own file, lines and band in its provenance
+    mj = json.loads((tmp_path / "out" / "model.json").read_text())
+    assert mj["quantity"] == "M"
+    prov = mj["provenance"]
+    from physmodel.data.files import read_sweep
+
+    assert prov["data_file"].endswith("M.csv") and prov["data_fingerprint"] == read_sweep(tmp_path / "M.csv").fingerprint()
+    assert prov["band_hz"] == [float(M.frequency_hz.min()), float(M.frequency_hz.max())]
     capsys.readouterr()
     rc = main(["diagnose", "--data", str(tmp_path / "M.csv"), "--data", str(tmp_path / "Z.csv"), "--quantity", "M,M",
                *common, "--out", str(tmp_path / "bad")])
@@ -193,3 +217,20 @@ def test_the_next_measurement_search_says_it_takes_one_quantity():
         d.recommend_next_measurement()
     recommend(d, {})
     assert d.next_measurement is not None and "one quantity" in d.next_measurement.message
+
+
+def test_cli_says_a_misfit_left_in_one_quantity_and_exits_3(tmp_path, capsys):
+    from scenarios.cli import main
+
+    M, Z, truth = make_joint_case(900, "contact_resistance")
+    M.to_csv(tmp_path / "M.csv")
+    Z.to_csv(tmp_path / "Z.csv")
+    (tmp_path / "start.json").write_text(json.dumps(_base(truth).to_dict()))
+    argv = ["diagnose", "--data", str(tmp_path / "M.csv"), "--data", str(tmp_path / "Z.csv"), "--set",
+            str(tmp_path / "start.json"), "--candidates", "diffusivity_temperature", "--null-draws", "1000",
+            "--null-refits", "2", "--quiet", *[x for f in FREE for x in ("--free", f)], "--out", str(tmp_path / "out")]
+    rc = main(argv)
+    err = capsys.readouterr().err
+    assert rc == 3 and "does not fit" in err and "misfit remains in Z" in err, err
+    mj = json.loads((tmp_path / "out" / "model.json").read_text())
+    assert mj["verdict"]["adequate"] is False and "misfit remains in Z" in mj["verdict"]["reason"]
