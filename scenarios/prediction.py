@@ -236,12 +236,32 @@ def _band_model_file(model, rows, quantity, correlation, notes) -> tuple[np.ndar
         log, sign, _, _ = c
         return sign * 10.0 ** z if log else z
 
+    def steps(n, c):
+        """z ± σ_z, an effect parameter's kept within the values its model accepts (a one-sided
+        difference at a bound: the interval of an estimate at 0 reaches below it)."""
+        zs = [c[2] + c[3], c[2] - c[3]]
+        if is_effect_parameter(n):
+            e, p = n.split(".", 1)
+            par = get_effect(e).parameter(p)
+            for i, z in enumerate(zs):
+                v = min(max(value(c, z), par.lower), par.upper)
+                if not c[0]:
+                    zs[i] = v
+                elif v * c[1] > 0:          # log coordinates: a clipped value of the same sign
+                    zs[i] = math.log10(v * c[1])
+        return zs
+
+    from physmodel.effects import get_effect
+    from physmodel.parameter_paths import is_effect_parameter
+
+    zsteps = [steps(n, c) for n, c in coords]
     rows_v: list[dict] = [{}]
-    for n, c in coords:
-        rows_v += [{n: value(c, c[2] + c[3])}, {n: value(c, c[2] - c[3])}]
+    for (n, c), (zp, zm) in zip(coords, zsteps):
+        rows_v += [{n: value(c, zp)}, {n: value(c, zm)}]
     R = many(rows_v)
+    dz = np.array([(zp - zm) / c[3] for (_, c), (zp, zm) in zip(coords, zsteps)])   # in units of σ_z
     with np.errstate(all="ignore"):
-        J = np.log(R[1::2] / R[2::2]) / 2.0          # per 1σ of each parameter: (p, N)
+        J = np.log(R[1::2] / R[2::2]) / np.where(dz > 0, dz, np.inf)[:, None]   # per 1σ: (p, N)
     if correlation is None:
         correlation = _correlation_beside(model, names)
         src = "their correlation from calibration.json" if correlation is not None else \

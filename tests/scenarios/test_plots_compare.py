@@ -271,3 +271,15 @@ def test_cli_compare_bad_input_is_exit_2_with_a_message(tmp_path, capsys, case, 
     assert main(["compare", *args]) == 2
     err = capsys.readouterr().err
     assert needle in err and "Traceback" not in err
+
+
+def test_a_model_file_band_at_an_effect_bound_takes_a_one_sided_step():
+    """An effect parameter estimated at its bound (a delay of ~0 s, interval ±0.1 ms reaching below
+    0) gave a band draw outside the values the effect accepts (exit 2 in ``ipmc compare``).  The
+    step is kept inside; for e^{-sτ} the band is analytic: phase σ = ω σ_τ, magnitude σ = 0."""
+    sd = 1e-4 / Z95
+    est = ({"name": "time_delay.delay", "value": 1e-25, "ci95": [-1e-4, 1e-4], "status": "determined"},)
+    mf = ModelFile("actuator", BASE, {"time_delay": {"delay": 1e-25}}, estimates=est)
+    s = predict_sweep(mf, F, [30.0])
+    np.testing.assert_allclose(s.phase_std_deg, np.degrees(2 * np.pi * F * sd), rtol=1e-6)
+    np.testing.assert_allclose(s.magnitude_std_db, 0.0, atol=1e-9)
