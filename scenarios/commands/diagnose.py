@@ -327,8 +327,15 @@ def build(args):
     start = start_model(set_name, pick(args.kind, "kind"), over)
     base = start.parameters
     sweeps = [read_sweep_mapped(x, args, "--data") for x in paths]
+    from physmodel.errors import DataFormatError
+    from physmodel.estimation.residuals import noise_std
+
     for x, sw in zip(paths, sweeps):
         check_celsius(sw.temperatures(), f"{x}: temperature_c")
+        try:                            # its per-line σ, checked here so that the message names the file
+            noise_std(sw)
+        except DataFormatError as exc:
+            raise DataFormatError(f"data file {x}: {exc}") from None
     # the start model's effects are in the model (fixed at their values) unless the TOML/flags say otherwise
     effects_spec = {**start.effects, **dict(spec.get("baseline_effects", {}))}
     for item in args.baseline_effect or []:

@@ -234,3 +234,21 @@ def test_cli_says_a_misfit_left_in_one_quantity_and_exits_3(tmp_path, capsys):
     assert rc == 3 and "does not fit" in err and "misfit remains in Z" in err, err
     mj = json.loads((tmp_path / "out" / "model.json").read_text())
     assert mj["verdict"]["adequate"] is False and "misfit remains in Z" in mj["verdict"]["reason"]
+
+
+def test_cli_names_the_file_whose_noise_cannot_weight_a_fit(tmp_path, capsys):
+    from dataclasses import replace
+
+    from scenarios.cli import main
+
+    M, Z, truth = make_joint_case(900, "none")
+    zero = np.array(Z.magnitude_std_db, float)
+    zero[:5] = 0.0
+    M.to_csv(tmp_path / "M.csv")
+    replace(Z, magnitude_std_db=zero).to_csv(tmp_path / "Zzero.csv")
+    (tmp_path / "start.json").write_text(json.dumps(_base(truth).to_dict()))
+    rc = main(["diagnose", "--data", str(tmp_path / "M.csv"), "--data", str(tmp_path / "Zzero.csv"), "--set",
+               str(tmp_path / "start.json"), "--quiet", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "Zzero.csv" in err and "standard deviations must be > 0" in err, err
+    assert not (tmp_path / "out").exists()
