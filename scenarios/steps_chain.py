@@ -47,7 +47,7 @@ import numpy as np
 from .context import md_table as _table
 from .spec import ScenarioError
 
-__all__ = ["misfit", "printed_sweep", "step_chain"]
+__all__ = ["misfit", "physics_free", "printed_sweep", "step_chain"]
 
 CANDIDATES = ("time_delay", "amplifier_bandwidth", "laser_lag", "ac_coupling", "fixture_joint", "tip_driven_beam",
               "transimpedance")
@@ -107,7 +107,10 @@ def misfit(G, H) -> dict:
 
 
 # ----------------------------------------------------------------------------- model pieces
-def _physics_free(base, names, sign, start=None):
+def physics_free(base, names, sign, start=None):
+    """The sensor chain's physical free parameters ``names`` of ``base`` as
+    :class:`~physmodel.estimation.records.FreeParameter` within ``PHYS_BOUNDS`` (log scale);
+    ``a0`` on the side of ``sign`` (the strip's polarity); started at ``start``'s values, else base's."""
     from physmodel.estimation.records import FreeParameter
 
     out = []
@@ -143,7 +146,7 @@ def _greedy(data, base, cfg, say):
               baseline_starts=cfg.get("baseline_starts", 3), alpha=cfg.get("alpha", 0.05), seed=cfg.get("seed", 0))
     first = {}
     for sign in (-1.0, 1.0):
-        first[sign] = diagnose(data, base, free=_physics_free(base, names, sign), candidates=cands, **kw)
+        first[sign] = diagnose(data, base, free=physics_free(base, names, sign), candidates=cands, **kw)
     sign = min(first, key=lambda k: first[k].baseline.cost)
     say(f"[chain] a0 sign {sign:+g} (baseline 2·cost {2 * first[sign].baseline.cost:.4g} vs "
         f"{2 * first[-sign].baseline.cost:.4g})")
@@ -170,7 +173,7 @@ def _greedy(data, base, cfg, say):
         if dg.verdict in ("named", "at_bound", "ambiguous") or not [c for c in cands if c not in chosen]:
             return sign, steps, chosen, vals, dg.verdict, dg
         start = {n: vals[n] for n in names}
-        free = _physics_free(base, names, sign, start) + [f"{c}.{p}" for c, v in chosen.items() for p in v]
+        free = physics_free(base, names, sign, start) + [f"{c}.{p}" for c, v in chosen.items() for p in v]
         dg = diagnose(data, base, free=free, baseline_effects={c: {p: vals[f"{c}.{p}"] for p in v}
                                                                 for c, v in chosen.items()},
                       candidates=[c for c in cands if c not in chosen], **kw)
@@ -190,7 +193,7 @@ def _documented_fit(data, base, sign, effects, start, cfg):
             lo, hi, _ = PHYS_SOURCED[n]
             free.append(FreeParameter(n, lo, hi, "log", min(max(start.get(n, math.sqrt(lo * hi)), lo), hi)))
         else:
-            free += _physics_free(base, [n], sign, start)
+            free += physics_free(base, [n], sign, start)
     fixed = {}
     for e in effects:
         for p in get_effect(e).parameters:
@@ -370,7 +373,7 @@ def _profile_d(data, base, vals, effects, cfg):
 
     sign = math.copysign(1.0, vals["a0"])
     names = [n for n in cfg.get("free", ["a0", "d", "kappa_e"]) if n != "d"]
-    free = _physics_free(base, names, sign, vals)
+    free = physics_free(base, names, sign, vals)
     for e in effects:
         for p in get_effect(e).parameters:
             free.append(FreeParameter(f"{e}.{p.name}", p.lower, p.upper, "linear",

@@ -121,6 +121,7 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):     # 
     os.environ.setdefault(_v, "1")
 
 import numpy as np  # noqa: E402
+from _stats import wilson_text  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "discrepancy")]
@@ -132,7 +133,7 @@ from physmodel.data.sweep import FrequencySweep
 from physmodel.effects import EffectModel
 from physmodel.estimation.discrepancy import diagnose
 from physmodel.estimation.lsq import fit_parameters
-from scenarios.steps_chain import CANDIDATES, _physics_free
+from scenarios.steps_chain import CANDIDATES, physics_free
 
 DETECTABLE = 25.0
 #: A detectable case is distinguishable when the truth beats every other candidate by this much
@@ -187,7 +188,7 @@ def library_case(seed: int, label: str):
     if eff:
         exact = mk(H1)
         pm = EffectModel(p0, "sensor", {}).predictor(exact, "S").many
-        r = fit_parameters(exact, None, _physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
+        r = fit_parameters(exact, None, physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
                            predict_many=pm, starts=2, seed=0, max_nfev=400, identify=False)
         lam = 2 * r.cost
     exp = [] if label == "none" or LIB_OF[label] is None else [LIB_OF[label]]
@@ -234,7 +235,7 @@ def oracle(truth, candidates):
         best = math.inf
         for bs in base_starts:
             for es, n in eff_starts:
-                fr = _physics_free(p0, ["a0", "d", "kappa_e"], sign, bs)
+                fr = physics_free(p0, ["a0", "d", "kappa_e"], sign, bs)
                 fr += [FreeParameter(f"{c}.{p.name}", p.lower, p.upper, "linear",
                                      float(np.clip(es[p.name], p.lower, p.upper))) for p in cp]
                 r = fit_parameters(data, None, fr, predict_many=pm, starts=n, seed=0, max_nfev=400, identify=False)
@@ -251,22 +252,12 @@ def run_case(sweep, truth, args):
     orc = oracle(truth, cands) if (truth["expected"] and det and not args.no_oracle) else None   # before diagnose
     p0 = start_set()
     t = time.perf_counter()
-    d = diagnose(sweep, p0, kind="sensor", free=_physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
+    d = diagnose(sweep, p0, kind="sensor", free=physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
                  candidates=cands, null_draws=args.null_draws, null_refits=args.null_refits, baseline_starts=2, seed=1)
     return {"label": truth["label"], "expected": truth["expected"], "lam": truth["lam_baseline"],
             "detectable": det, "oo": truth["out_of_library"], "oracle": orc,
             "declared": {frozenset(x[:2]) for x in d.confusable},
             "verdict": d.verdict, "named": sorted(d.named), "dt": time.perf_counter() - t}
-
-
-def wilson(k, n, z=1.96):
-    if n == 0:
-        return "n = 0"
-    p = k / n
-    den = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / den
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return f"{k}/{n} = {100 * p:.0f} % (95 %: {100 * max(0, c - h):.0f}-{100 * min(1, c + h):.0f} %)"
 
 
 def outcome(r) -> str:
@@ -295,15 +286,15 @@ def report(rows, name):
     print(f"  detectable (λ ≥ {DETECTABLE:g}), {n} cases:")
     for k in ("exact", "ambiguous_with_truth", "at_bound_truth", "at_bound_other", "wrong_name",
               "ambiguous_without_truth", "unexplained", "none"):
-        print(f"    {k:24s} {wilson(oc.get(k, 0), n)}")
+        print(f"    {k:24s} {wilson_text(oc.get(k, 0), n)}")
     amb_decl = sum(outcome(r) == "ambiguous_with_truth" and all(
         frozenset((r["expected"][0], o)) in r["declared"] for o in r["named"] if o != r["expected"][0]) for r in det)
     print(f"    exact or ambiguous-with-truth among declared-confusable pairs (issue goal): "
-          f"{wilson(oc.get('exact', 0) + amb_decl, n)}")
+          f"{wilson_text(oc.get('exact', 0) + amb_decl, n)}")
     dist = [r for r in det if r["oracle"] is not None and r["oracle"]["distinguishable"]]
     print(f"  distinguishable by the oracle (noiseless Δλ ≥ {DISTINGUISHABLE:g} to every other candidate): "
           f"{len(dist)} of {sum(r['oracle'] is not None for r in det)}; named exactly: "
-          f"{wilson(sum(outcome(r) == 'exact' for r in dist), len(dist))}; wrong confident names: "
+          f"{wilson_text(sum(outcome(r) == 'exact' for r in dist), len(dist))}; wrong confident names: "
           f"{sum(outcome(r) == 'wrong_name' for r in dist)}")
     for r in det:
         if outcome(r) != "exact":
@@ -319,14 +310,14 @@ def report(rows, name):
           f"{sum(r['named'] == r['expected'] and r['verdict'] == 'named' for r in und)}; wrong confident names "
           f"{sum(outcome(r) == 'wrong_name' for r in und)}")
     print(f"  FPR on null data (anything named, any verdict naming an effect): "
-          f"{wilson(sum(bool(r['named']) for r in nul), len(nul))}; any verdict but 'none': "
-          f"{wilson(sum(r['verdict'] != 'none' for r in nul), len(nul))}")
-    print(f"  out of library -> unexplained: {wilson(sum(r['verdict'] == 'unexplained' for r in oo), len(oo))}; "
+          f"{wilson_text(sum(bool(r['named']) for r in nul), len(nul))}; any verdict but 'none': "
+          f"{wilson_text(sum(r['verdict'] != 'none' for r in nul), len(nul))}")
+    print(f"  out of library -> unexplained: {wilson_text(sum(r['verdict'] == 'unexplained' for r in oo), len(oo))}; "
           f"-> none: {sum(r['verdict'] == 'none' for r in oo)}; confident name: "
           f"{sum(r['verdict'] == 'named' for r in oo)}; ambiguous/at bound: "
           f"{sum(r['verdict'] in ('ambiguous', 'at_bound') for r in oo)}")
     print(f"  wrong confident names over all {len(rows)} cases (detectable, undetectable, null, out of library): "
-          f"{wilson(len(wrong_all), len(rows))}")
+          f"{wilson_text(len(wrong_all), len(rows))}")
     return {"outcomes": dict(oc), "n_detectable": n, "exact": (oc.get("exact", 0), n),
             "distinguishable_exact": (sum(outcome(r) == "exact" for r in dist), len(dist)),
             "wrong": (len(wrong_all), len(rows)), "fpr": (sum(bool(r["named"]) for r in nul), len(nul)),

@@ -149,6 +149,7 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_v, "1")
 
 import numpy as np  # noqa: E402
+from _stats import wilson  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
@@ -361,15 +362,6 @@ def correct(r, confident_only=True):
         return all(t in r["named"] for t in truth) and all(
             any(frozenset((t, o)) in r["declared"] for t in truth) for o in r["named"] if o not in truth)
     return False
-
-
-def wilson(k, n, z=1.96):
-    if n == 0:
-        return float("nan"), float("nan")
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return c - h, c + h
 
 
 def _rate(k, n):

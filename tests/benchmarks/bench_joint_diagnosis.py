@@ -94,6 +94,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "discrepancy")]
 
 import independent_sensor as isn  # noqa: E402
 import joint_cases as jc  # noqa: E402
+from _stats import wilson  # noqa: E402
 
 from physmodel import IPMCParameters, get_parameter_set  # noqa: E402
 from physmodel.estimation.discrepancy import diagnose  # noqa: E402
@@ -121,13 +122,13 @@ def run_case(seed: int, label: str, kind: str, args) -> dict:
         acts_on = None
         lam = truth["lam_baseline"]
     else:
-        from scenarios.steps_chain import CANDIDATES, _physics_free
+        from scenarios.steps_chain import CANDIDATES, physics_free
 
         first, Z, truth = jc.make_joint_sensor_case(seed, label)
         expected = truth["expected"]
         base = get_parameter_set("seed000_sensor_dev", T_ref=isn.TEMPERATURE_C + 273.15)
         cands = list(CANDIDATES) if args.candidates == "all" else ["time_delay", "amplifier_bandwidth"]
-        kw.update(kind="sensor", free=_physics_free(base, ["a0", "d", "kappa_e"], math.copysign(1, base.a0)),
+        kw.update(kind="sensor", free=physics_free(base, ["a0", "d", "kappa_e"], math.copysign(1, base.a0)),
                   candidates=cands, baseline_starts=2, seed=1)
         acts_on = {k: v for k, v in SENSOR_ACTS_ON.items() if k in cands}
         lam = truth["lam_baseline"]
@@ -141,16 +142,6 @@ def run_case(seed: int, label: str, kind: str, args) -> dict:
             "single": (d1.verdict, sorted(d1.named)), "joint": (d2.verdict, sorted(d2.named)),
             "single_ok": ok(d1), "joint_ok": ok(d2), "t_single": t1 - t0, "t_joint": t2 - t1,
             "misfit": [r["quantity"] for r in d2.per_quantity if r["misfit"]]}
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple:
-    """Wilson 95 % interval of k/n."""
-    if n == 0:
-        return (float("nan"), float("nan"))
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return (c - h, c + h)
 
 
 def main(argv=None):

@@ -95,6 +95,7 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_v, "1")
 
 import numpy as np  # noqa: E402
+from _stats import wilson  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "discrepancy")]
@@ -213,16 +214,6 @@ def run_case(seed: int, label: str, args) -> dict:
     row["dt"] = time.perf_counter() - t0
     row["success"] = row["second"] == "named" and row["second_named"] == [expected]
     return row
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple:
-    """Wilson 95 % interval of k/n."""
-    if n == 0:
-        return (float("nan"), float("nan"))
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return (c - h, c + h)
 
 
 def main(argv=None):

@@ -128,13 +128,13 @@ def run_case(item):
         d = diagnose(sweep, base, kind="actuator", free=FREE_ACT, alpha=0.05, seed=seed)
         lam = truth["lam_baseline"] or 0.0
     else:
-        from scenarios.steps_chain import CANDIDATES, _physics_free
+        from scenarios.steps_chain import CANDIDATES, physics_free
 
         sweep, truth = isn.make_case(seed, name)
         p0 = get_parameter_set("seed000_sensor_dev", T_ref=isn.TEMPERATURE_C + 273.15)
         cands = list(CANDIDATES) + [c for c in ("mount_resonance",) if c in LIBRARY and c not in CANDIDATES]
         t0 = time.perf_counter()
-        d = diagnose(sweep, p0, kind="sensor", free=_physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
+        d = diagnose(sweep, p0, kind="sensor", free=physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
                      candidates=cands, null_draws=1000, null_refits=2, baseline_starts=2, seed=1)
         lam = truth["lam_baseline"]
     dt = time.perf_counter() - t0
