@@ -278,14 +278,13 @@ def step_inversion(ctx: RunContext):
             # steady-state oracle from the physics frequency response: |error| = A |P(jω)/G(jω) − 1|
             P = _plant_response(ctx, freqs[0], T)
             g = complex(G(2j * np.pi * freqs[0]))
-            pred = ctx.metric(f"{key}.predicted_error_mm", exp["amplitude_mm"] * abs(P / g - 1))
+            ctx.metric(f"{key}.predicted_error_mm", exp["amplitude_mm"] * abs(P / g - 1))
             if is_act:
-                # the prediction holds up to what the inversion reports it adds itself: the preview's
-                # truncation error and its sampling (discretisation) bound, both through |P| — once the
-                # surrogate is within 0.1 % of the plant these are of the same size as the model error
-                bound = ctx.metric(f"{key}.inversion_error_bound_mm",
-                                   abs(P) * (ff.truncation_error + ff.discretisation_error_estimate))
-                ctx.metric(f"{key}.prediction_gap_over_allowance", abs(emax - pred) / (bound + 0.05 * pred))
+                # the prediction is the model's error alone; what the inversion adds itself (the
+                # preview's truncation error and its sampling bound, through |P|) must be small beside
+                # it for the prediction to hold: said, so a scenario can check that premise
+                ctx.metric(f"{key}.inversion_error_bound_mm",
+                           abs(P) * (ff.truncation_error + ff.discretisation_error_estimate))
         png = f"inversion_{_slug(exp['name'])}.png"
         if "highpass_hz" in exp:
             labels = tuple(f"{lab}, high-passed at {exp['highpass_hz']:g} Hz" for lab in labels)

@@ -109,11 +109,10 @@ def test_demo_tracking_error_matches_the_steady_state_oracle(quick_run):
     P = physmodel.ActuatorModel(physmodel.get_parameter_set(spec.section("model")["set"])).frequency_response(
         [2.0], [45.0])["M"][0, 0, 0] * 1e3
     pred = 0.65 * abs(P / G.frequency_response([2.0], 45.0)[0] - 1)
-    # up to what the inversion reports it adds itself (its sampling and truncation bounds through |P|)
-    # plus 5 %: with a surrogate within 0.1 % of the plant those are of the model error's size
-    bound = res.metrics["inversion.2_hz_sine_at_45_c.inversion_error_bound_mm"]
-    assert bound < pred                 # the model error still dominates: the check can fail
-    assert abs(res.metrics["inversion.2_hz_sine_at_45_c.error_max_mm"] - pred) <= bound + 0.05 * pred
+    # the premise: what the inversion adds itself (its sampling and truncation bounds through |P|)
+    # is small beside the model's error
+    assert res.metrics["inversion.2_hz_sine_at_45_c.inversion_error_bound_mm"] < 0.05 * pred
+    assert res.metrics["inversion.2_hz_sine_at_45_c.error_max_mm"] == pytest.approx(pred, rel=0.15)
 
 
 def test_fixture_files_regenerate_from_their_seeds(quick_run):
