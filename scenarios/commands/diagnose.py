@@ -427,7 +427,9 @@ def _quantities(sweeps: list, paths: list, kind: str, given, option: str):
     for i, q in enumerate(qs):
         if q in qs[:i]:
             raise IPMCError(f"data files {paths[qs.index(q)]} and {paths[i]} are both quantity {q}: give one file "
-                            "per quantity (merge the records of one quantity into one sweep file first)")
+                            "per quantity (merge the records of one quantity into one sweep file first), or, "
+                            "where one unit serves two quantities (mm/V: M or H), say which with --quantity, "
+                            "e.g. --quantity M,H")
     return sweeps, tuple(qs)
 
 
