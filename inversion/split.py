@@ -101,7 +101,8 @@ class InverseSplit:
     ----------
     num, den : ndarray
         Coefficients of the model ``G`` that was inverted (descending powers of s), after
-        the ``"filter"`` augmentation if it was used.
+        the zeros at infinity were divided out and after the ``"filter"`` augmentation if it
+        was used.
     zeros : ndarray
         Zeros of ``num`` = poles of ``H`` [rad/s].
     relative_degree : int

@@ -242,3 +242,11 @@ def test_cli_refuses_or_says_it(tmp_path, capsys):
     assert proc.returncode == 0, proc.stderr
     assert "ipmc invert: warning: the model's zero at s = -1e+13" in proc.stderr
     assert "treated as at infinity" in proc.stderr
+
+
+def test_choose_preview_checks_the_split_too():
+    from inversion import choose_preview
+
+    t, u = _signal()
+    with pytest.raises(InversionError, match=r"split_inverse\(model, dt=0.001\)"):
+        choose_preview(split_inverse((_num(-1e13), DEN)), DT, u)
