@@ -150,6 +150,9 @@ class ScheduledInversionResult(SampledRecord):
     dt : float
         [s]
     splits : list of InverseSplit
+    notes : tuple of str
+        What the inversion changed in the grid models: each zero treated as at infinity because
+        the sampling cannot represent it, prefixed with the node's temperature (:mod:`inversion.split`).
     """
 
     input: np.ndarray
@@ -166,6 +169,11 @@ class ScheduledInversionResult(SampledRecord):
     t0: float = 0.0
     time_stamps: np.ndarray | None = None
 
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the inversion changed in the grid models (see the class doc)."""
+        return tuple(f"{float(T):.6g} degC: {n}" for T, sp in zip(self.grid_c, self.splits, strict=True)
+                     for n in sp.notes)
 
 
 def _run_scheduled(splits: list[InverseSplit], grid: np.ndarray, dt: float, n_prev: int | None,

@@ -172,6 +172,7 @@ def test_streaming_scheduled_and_chunked_paths_drop_it_too():
     sched = invert_scheduled(model_at, DT, u, temp, preview=0.5, **kw)
     assert all(sp.num.size == sched.splits[1].num.size for sp in sched.splits)   # same path for all
     assert [sp.zeros_at_infinity.size for sp in sched.splits] == [1, 0, 1]
+    assert [n.split(":")[0] for n in sched.notes] == ["-1 degC", "1 degC"]
     assert np.max(np.abs(sched.output - ref)) <= 1e-9 * float(np.max(np.abs(ref)))
 
 
