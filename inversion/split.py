@@ -55,8 +55,14 @@ sends the zero through infinity from one half-plane to the other, so that withou
 answer jumps from "refused" (coefficient exactly 0) to "wrong".  The tolerance is the default
 accuracy the inversion promises anyway (:data:`inversion.preview.DEFAULT_PREVIEW_TOL`, the part
 of the inverse the automatic preview may discard): the dropped factor is below it at every
-representable frequency, and in band (``omega << omega_N``) far below it.  The dropped zeros
-are recorded (:attr:`InverseSplit.zeros_at_infinity`, :attr:`InverseSplit.notes`).
+representable frequency, and in band (``omega << omega_N``) far below it.  It also keeps the
+zeros that are kept inside the range where keeping them is measured to be accurate: with a right
+half-plane pair at 0.75 +- 2.1j rad/s and a third zero at +-|z|, a 1 Hz sine inverted at dt = 1 ms
+matched the mpmath steady state as well for |z| dt = 1e5 as for 1e2 in either half-plane, and
+degraded from |z| dt = 1e6 in the right half-plane (relative error 3.9e-2, then 61 at 1e7); the
+rule drops every zero from |z| dt = pi/1e-3 = 3142 on.  The dropped zeros are recorded
+(:attr:`InverseSplit.zeros_at_infinity`, :attr:`InverseSplit.notes`) and warned about
+(:class:`~inversion.ZeroAtInfinityWarning`).
 """
 
 from __future__ import annotations
