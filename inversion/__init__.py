@@ -53,7 +53,8 @@ Time-varying temperature (:mod:`inversion.scheduled`)
 
 Errors (:mod:`inversion._errors`, all ``ValueError`` subclasses)
     InversionError, NonHyperbolicModelError, ImproperInverseError, NonUniformSamplingError,
-    NonFiniteSignalError, PreviewError
+    NonFiniteSignalError, PreviewError; ZeroAtInfinityWarning (a zero the sampling cannot
+    represent was treated as at infinity: ``split_inverse(..., dt=)``, ``result.notes``)
 
 Examples and toy models (:mod:`inversion.examples`)
     seed000_sensor_35c(form="coefficients" | "zeros"), toy_scheduled_sensor(T),
@@ -80,6 +81,7 @@ from ._errors import (
     NonHyperbolicModelError,
     NonUniformSamplingError,
     PreviewError,
+    ZeroAtInfinityWarning,
 )
 from .batch import (
     ChunkedInversionSummary,
@@ -125,6 +127,7 @@ __all__ = [
     "NonHyperbolicModelError",
     "NonUniformSamplingError",
     "PreviewError",
+    "ZeroAtInfinityWarning",
     "ScheduledInversionResult",
     "ScheduledStreamingInverter",
     "StreamingInverter",

@@ -15,6 +15,7 @@ __all__ = [
     "NonUniformSamplingError",
     "NonFiniteSignalError",
     "PreviewError",
+    "ZeroAtInfinityWarning",
 ]
 
 
@@ -45,3 +46,9 @@ class NonFiniteSignalError(InversionError):
 class PreviewError(InversionError):
     """The preview time is invalid (negative, NaN, longer than the record, or infinite where
     a finite preview is required)."""
+
+
+class ZeroAtInfinityWarning(UserWarning):
+    """A model zero beyond what the sampling represents was treated as at infinity (the inverse
+    is that of the model without it; :mod:`inversion.split`, "Zeros at infinity").  The same
+    words are in ``InverseSplit.notes`` and ``InversionResult.notes``."""

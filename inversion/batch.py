@@ -106,6 +106,9 @@ class InversionResult(SampledRecord):
         ``t0`` and ``dt``).
     limit_report : LimitReport or None
         The drive-limit check of ``output`` (:func:`~inversion.limits.check_limits`).
+    notes : tuple of str
+        What the inversion changed in the model (``split.notes``): each zero treated as at
+        infinity because the sampling cannot represent it (:mod:`inversion.split`).
     unstable_source : ndarray or tuple
         Where ``unstable_part`` comes from: the array itself, or the ``(plan, chunk)`` that
         recomputes it from ``input`` (internal; read ``unstable_part``) [model input units].
@@ -127,6 +130,11 @@ class InversionResult(SampledRecord):
     limit_report: Any = None
     #: the anticausal part, or ``(plan, chunk)`` that recomputes it (see ``unstable_part``)
     unstable_source: Any = field(default=None, repr=False)
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the inversion changed in the model (see the class doc)."""
+        return self.split.notes
 
     @cached_property
     def unstable_part(self) -> np.ndarray:
@@ -241,9 +249,9 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     :func:`feedforward` (3 V limit by default); for decoding, :func:`decode_sensor` (limits on
     request); or :func:`inversion.limits.check_limits` on ``result.output``.
     """
-    split = as_split(model, improper, filter_bandwidth)
     ua = as_signal(u)
     ta, dt = time_base(t, ua)
+    split = as_split(model, improper, filter_bandwidth, dt)
     rule = preview_rule(preview)
     choice = None
     finite = False
@@ -334,8 +342,8 @@ def invert_to(model: Any, dt: float, u: Any, out: Any, *, preview: Any = "auto",
     preview, improper, filter_bandwidth, chunk_size
         As in :func:`invert`.
     """
-    split = as_split(model, improper, filter_bandwidth)
     dt = sampling_interval(dt)
+    split = as_split(model, improper, filter_bandwidth, dt)
     n = len(u)
     if len(out) != n:
         raise InversionError(f"out must have the same length as u ({n}); got {len(out)}")

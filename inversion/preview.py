@@ -40,7 +40,7 @@ import numpy as np
 from ._discrete import FOHFilter, Plan, foh_matrices, left_powers, plan_for
 from ._errors import InversionError, PreviewError
 from .signals import as_signal, sampling_interval
-from .split import InverseSplit
+from .split import InverseSplit, check_split_for
 
 __all__ = ["PreviewChoice", "AutoPreviewPasses", "auto_preview_passes", "choose_preview", "discrete_tail_l1",
            "reference_lower_bound", "REFERENCE_PROBES",
@@ -552,4 +552,5 @@ def choose_preview(split: InverseSplit, dt: float, u: Any, *, tol: float = DEFAU
     if not checked:
         u = as_signal(u)
         dt = sampling_interval(dt)
+        check_split_for(split, dt)      # its zeros judged for this dt (inversion.split)
     return auto_preview_passes(split, dt, np.asarray(u, dtype=float), tol=tol, norm=norm).choice

@@ -102,12 +102,14 @@ def _check_temperature(temperature: Any, n: int) -> np.ndarray:
 
 
 def _splits(model_at: Callable[[float], Any], grid: np.ndarray, improper: str,
-            filter_bandwidth: float | None) -> list[InverseSplit]:
+            filter_bandwidth: float | None, dt: float) -> list[InverseSplit]:
+    """The split of every grid model at sampling interval ``dt`` [s] (zeros the sampling cannot
+    represent treated as at infinity: :mod:`inversion.split`)."""
     out = []
     for T in grid:
         try:
             out.append(split_inverse(model_at(float(T)), improper=improper,
-                                     filter_bandwidth=filter_bandwidth))
+                                     filter_bandwidth=filter_bandwidth, dt=dt))
         except InversionError as exc:
             raise type(exc)(f"model_at({float(T):.6g} degC): {exc}") from exc
     return out
@@ -148,6 +150,9 @@ class ScheduledInversionResult(SampledRecord):
     dt : float
         [s]
     splits : list of InverseSplit
+    notes : tuple of str
+        What the inversion changed in the grid models: each zero treated as at infinity because
+        the sampling cannot represent it, prefixed with the node's temperature (:mod:`inversion.split`).
     """
 
     input: np.ndarray
@@ -164,6 +169,11 @@ class ScheduledInversionResult(SampledRecord):
     t0: float = 0.0
     time_stamps: np.ndarray | None = None
 
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the inversion changed in the grid models (see the class doc)."""
+        return tuple(f"{float(T):.6g} degC: {n}" for T, sp in zip(self.grid_c, self.splits, strict=True)
+                     for n in sp.notes)
 
 
 def _run_scheduled(splits: list[InverseSplit], grid: np.ndarray, dt: float, n_prev: int | None,
@@ -225,7 +235,7 @@ def invert_scheduled(model_at: Callable[[float], Any], t: Any, u: Any, temperatu
     Ta = _check_temperature(temperature, n)
     ta, dt = time_base(t, ua)
     g = _grid(grid, Ta, grid_step)
-    splits = _splits(model_at, g, improper, filter_bandwidth)
+    splits = _splits(model_at, g, improper, filter_bandwidth, dt)
     n_prev, prev_s = resolve_preview(preview, _auto(splits, preview, dt), dt, n)
     chunk = n if chunk_size is None else int(chunk_size)
     if chunk <= 0:
@@ -281,7 +291,7 @@ def invert_scheduled_to(model_at: Callable[[float], Any], dt: float, u: Any, tem
         g = temperature_grid(lo, hi, grid_step)
     else:
         g = _grid(grid, np.array([lo, hi]), grid_step)
-    splits = _splits(model_at, g, improper, filter_bandwidth)
+    splits = _splits(model_at, g, improper, filter_bandwidth, dt)
     n_prev, _ = resolve_preview(preview, _auto(splits, preview, dt), dt, n)
     for c0 in range(0, n, chunk_size):
         out[c0:c0 + chunk_size] = 0.0
@@ -316,8 +326,8 @@ class ScheduledStreamingInverter:
                  filter_bandwidth: float | None = None):
         self.grid_c = temperature_grid(float(temperature_range[0]), float(temperature_range[1]),
                                        grid_step)
-        splits = _splits(model_at, self.grid_c, improper, filter_bandwidth)
         dt = sampling_interval(dt)
+        splits = _splits(model_at, self.grid_c, improper, filter_bandwidth, dt)
         n_prev, prev_s = resolve_preview(preview, _auto(splits, preview, dt), dt)
         if n_prev is None:
             raise PreviewError(

@@ -16,7 +16,7 @@ from physmodel.data.timerecord import UNIFORM_RTOL, uniform_interval
 from physmodel.errors import IPMCError
 
 from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
-from .split import InverseSplit, split_inverse
+from .split import InverseSplit, check_split_for, split_inverse
 
 __all__ = ["UNIFORM_RTOL", "as_signal", "as_split", "sampling_interval", "time_base"]
 
@@ -47,11 +47,13 @@ def time_base(t: Any, u: np.ndarray) -> tuple[np.ndarray | None, float]:
     return ta, sampling_interval(ta)
 
 
-def as_split(model: Any, improper: str, filter_bandwidth: float | None) -> InverseSplit:
-    """The model's :class:`InverseSplit` (a split is returned as it is)."""
+def as_split(model: Any, improper: str, filter_bandwidth: float | None, dt: float) -> InverseSplit:
+    """The model's :class:`InverseSplit` for sampling interval ``dt`` [s]: zeros the sampling cannot
+    represent are treated as at infinity (:mod:`inversion.split`, "Zeros at infinity"); a split is
+    returned as it is after checking that its zeros were judged right for ``dt``."""
     if isinstance(model, InverseSplit):
-        return model
-    return split_inverse(model, improper=improper, filter_bandwidth=filter_bandwidth)
+        return check_split_for(model, dt)
+    return split_inverse(model, improper=improper, filter_bandwidth=filter_bandwidth, dt=dt)
 
 
 def as_signal(u: Any) -> np.ndarray:

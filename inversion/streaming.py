@@ -94,8 +94,8 @@ class StreamingInverter:
 
     def __init__(self, model: Any, dt: float, preview: Any = "auto", *, improper: str = "error",
                  filter_bandwidth: float | None = None):
-        self.split = as_split(model, improper, filter_bandwidth)
         self.dt = sampling_interval(dt)
+        self.split = as_split(model, improper, filter_bandwidth, self.dt)
         n_prev, prev_s = resolve_preview(preview, self.split, self.dt)
         if n_prev is None:
             raise PreviewError(
