@@ -447,6 +447,9 @@ def run(args) -> int:
         lines.append(f"- **the reference ends away from rest ({100 * jump:.0f} % of its peak): expect spikes at the ends**")
     if not ff.limit_report.ok:
         lines.append(f"- **LIMIT VIOLATED**: {limit_flags(ff.limit_report.message, max_v, max_rate)}")
+    for n in ff.notes:                  # what the inversion changed in the model (a zero treated as at infinity)
+        lines.append(f"- inversion: {n}")
+    summary["inversion_notes"] = list(ff.notes)
     status = EXIT_OK
 
     # ---- error against the physics model
@@ -505,6 +508,8 @@ def run(args) -> int:
                                                    else "unchecked against measurement") + "\n")
         if upstream:
             fh.write(f"# upstream_misfit: {'; '.join(upstream)}\n")
+        for n in ff.notes:
+            fh.write(f"# inversion_note: {n}\n")
         fh.write(",".join(cols) + "\n")
         np.savetxt(fh, arr, delimiter=",", fmt="%.12g")
 

@@ -220,6 +220,7 @@ def run(args: argparse.Namespace) -> int:
         notes, status = _verdicts(args, smodel, t, y)
     elif args.data is not None:
         raise InversionError("--data needs --surrogate and --temperature (a coefficient model has no temperature)")
+    notes += [f"inversion_note: {n}" for n in res.notes]     # e.g. a zero treated as at infinity
 
     def write_csv(fh: Any) -> None:
         for n in notes:

@@ -230,7 +230,10 @@ def test_cli_refuses_or_says_it(tmp_path, capsys):
         assert "|z| = 1e+13 rad/s" in err and "--improper filter" in err and not out.exists()
         with pytest.warns(ZeroAtInfinityWarning, match=re.escape("|z| = 1e+13 rad/s")):
             assert main([*argv, "--improper", "filter", "--filter-bandwidth", str(WF)]) == 0
-        y = np.loadtxt(out, delimiter=",", comments="#", skiprows=2)[:, 2]
+        lines = out.read_text().splitlines()
+        assert any(ln.startswith("# inversion_note:") and "treated as at infinity" in ln for ln in lines), lines[:5]
+        body = [ln for ln in lines if not ln.startswith("#")][1:]          # below the column names
+        y = np.loadtxt(body, delimiter=",")[:, 2]
         assert 1.5 < np.max(np.abs(y)) < 2.5
         out.unlink()
     # as a user sees it (pytest records warnings instead of printing them): one line on stderr
