@@ -91,8 +91,17 @@ def rectangular_correction(reynolds):
 
 
 def gamma_rectangular(reynolds):
-    """Sader's Γ_rect(Re) = Ω(Re) Γ_circ(Re) of a thin rectangular beam [-] (e^{−iωt} convention)."""
-    return rectangular_correction(reynolds) * gamma_circular(reynolds)
+    """Sader's Γ_rect(Re) = Ω(Re) Γ_circ(Re) of a thin rectangular beam [-] (e^{−iωt} convention).
+
+    Evaluated once per distinct Reynolds number: a batch of parameter sets repeats the same Re
+    wherever the sets share the width and the viscosity at a temperature (the finite-difference sets
+    of every parameter but the viscosity's own), and the Bessel functions are the costly part."""
+    re = np.asarray(reynolds, dtype=float)
+    if re.size > 1:
+        u, inv = np.unique(re, return_inverse=True)
+        if u.size < re.size:
+            return (rectangular_correction(u) * gamma_circular(u))[inv.reshape(re.shape)]
+    return rectangular_correction(re) * gamma_circular(re)
 
 
 def kinematic_viscosity(v, T, T_ref):

@@ -28,6 +28,7 @@ inviscid limit) (:data:`ALIASES`).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 
@@ -140,16 +141,22 @@ def split_values(values: Mapping[str, float]) -> tuple[dict, dict]:
 
     Base names are IPMCParameters fields, ``omega_n`` or ``laws.<quantity>.<attribute>``
     (see :func:`physmodel.parameter_paths.apply_values`)."""
-    from ..parameter_paths import is_effect_parameter
-
     base, eff = {}, {}
     for k, v in values.items():
-        if is_effect_parameter(k):
-            e, p = k.split(".", 1)
-            eff.setdefault(e, {})[p] = float(v)
-        else:
+        ep = _effect_parameter(k)
+        if ep is None:
             base[k] = float(v)
+        else:
+            eff.setdefault(ep[0], {})[ep[1]] = float(v)
     return base, eff
+
+
+@functools.lru_cache(maxsize=4096)
+def _effect_parameter(name: str) -> tuple | None:
+    """``(effect, param)`` of an effect parameter's name, None for a base name (read once per name)."""
+    from ..parameter_paths import is_effect_parameter
+
+    return tuple(name.split(".", 1)) if is_effect_parameter(name) else None
 
 
 # --------------------------------------------------------------------------- the model
@@ -162,18 +169,20 @@ def _apply(p: IPMCParameters, base_vals: Mapping[str, float], paths: dict | None
     return apply_values(p, base_vals, paths)
 
 
-def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], paths: dict) -> ParameterTable | None:
+def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], paths: dict,
+              table: ParameterTable | None = None) -> ParameterTable | None:
     """The :class:`ParameterTable` of ``base`` with ``base_vals[i]`` in set i, built as arrays (no
     record per set; values checked as :class:`IPMCParameters` checks them, ``omega_n`` set through
     the density as :meth:`IPMCParameters.replace` does).  None when a name addresses a temperature
     law or ``T_ref`` (the table's sets would not share one laws group): the caller then builds one
-    record per set.  ``paths``: names resolved against ``base`` (kept across calls)."""
+    record per set.  ``paths``: names resolved against ``base`` (kept across calls); ``table``: the
+    table of ``base`` if the caller keeps it."""
     from ..parameter_paths import resolve_path
 
     names: dict = {}
     for bv in base_vals:
         names.update(dict.fromkeys(bv))
-    table = ParameterTable.of(base)
+    table = ParameterTable.of(base) if table is None else table
     for name in names:
         path = paths.get(name)
         if path is None:
@@ -181,17 +190,21 @@ def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], pa
         if path.is_law or (path.target == "field" and (name == "T_ref" or name not in table.columns)):
             return None
     n = len(base_vals)
-    cols = {k: np.repeat(v, n, axis=0) for k, v in table.columns.items()}
-    for name in names:
-        if name != "omega_n":
-            a = np.array([bv.get(name, np.nan) for bv in base_vals], dtype=float)
-            given = np.array([name in bv for bv in base_vals])
-            cols[name] = np.where(given, check_field_values(name, np.where(given, a, 1.0)), cols[name][:, 0])[:, None]
-    if "omega_n" in names:
-        given = np.array(["omega_n" in bv for bv in base_vals])
-        wn = np.array([bv.get("omega_n", 1.0) for bv in base_vals], dtype=float)
-        rho = density_for_mode(wn, cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
-        cols["rho"] = np.where(given, check_field_values("rho", np.where(given, rho, 1.0)), cols["rho"][:, 0])[:, None]
+    cols = dict(table.columns)          # the base's (1, 1) columns, repeated over the sets at the end
+    for name in (*(k for k in names if k != "omega_n"), *(("rho",) if "omega_n" in names else ())):
+        src = "omega_n" if name == "rho" else name
+        given = [src in bv for bv in base_vals]
+        if name == "rho":
+            wn = np.array([bv.get("omega_n", 1.0) for bv in base_vals], dtype=float)
+            a = density_for_mode(wn, cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
+        else:
+            a = np.array([bv.get(name, 1.0) for bv in base_vals], dtype=float)
+        if all(given):
+            cols[name] = check_field_values(name, a)[:, None]
+        else:
+            g = np.array(given)
+            cols[name] = np.where(g, check_field_values(name, np.where(g, a, 1.0)), cols[name][:, 0])[:, None]
+    cols = {k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()}
     return ParameterTable(cols, table.groups, n)
 
 
@@ -308,7 +321,12 @@ class _EffectMixin:
         need = tuple(q for q in self.quantities if q in need)
         kern = next(((e, v) for e, v, _ in self._active if e.level == "kernel"), None)
         s_kernel = s if kern is None else kern[0].apply(s, kern[1])
-        if kern is None:
+        if kern is None and progress is None:
+            # the model's own evaluation of a state: an actuator batch whose sets repeat an
+            # electrode line or slice (finite-difference sets of the gain, the mode, a response or
+            # series effect) evaluates those terms once (ActuatorModel.evaluate_state)
+            vals = self.evaluate_state(st, s, need)
+        elif kern is None:
             vals = evaluate_grid(st, s, self._kernel, need, self.chunk_size, None, progress)
         else:
             # the charge dynamics at ŝ, the mechanics at s
@@ -401,6 +419,10 @@ class _EffectMixin:
             return r[ti, fi] * scale
 
         paths: dict = {}        # the base names, each resolved once against self.params[0]
+        table0 = ParameterTable.of(self.params[0])
+        # the models of the batched calls, by (values of the non-batchable effects, number of sets):
+        # each call gives them its own table and effect values (_use_table, _batch_effects)
+        models: dict = {}
 
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
             # one batched model call for every set (effect values as arrays over the sets), or one
@@ -412,19 +434,25 @@ class _EffectMixin:
                 key = tuple(sorted((get_effect(n).name, tuple(sorted(pv.items()))) for n, pv in e.items()
                                    if not get_effect(n).batchable))
                 groups.setdefault(key, []).append(i)
-            for rows in groups.values():
+            for key, rows in groups.items():
                 effects = {n: dict(v) for n, v in self.effects.items()}
                 for n, pv in split[rows[0]][1].items():    # the non-batchable values (all the same here)
                     if not get_effect(n).batchable:
                         effects.setdefault(n, {}).update(pv)
                 # the base values as arrays (no record per set), or a record per set when a name
                 # addresses a temperature law or T_ref
-                table = _table_of(self.params[0], [split[i][0] for i in rows], paths)
-                plist = ([self.params[0]] * len(rows) if table is not None
-                         else [_apply(self.params[0], split[i][0], paths) for i in rows])
-                m = make_effect_model(plist, self.kind, effects, **self._extra())
+                table = _table_of(self.params[0], [split[i][0] for i in rows], paths, table0)
                 if table is not None:
+                    m = models.get((key, len(rows)))
+                    if m is None:
+                        if len(models) >= 64:
+                            models.pop(next(iter(models)))
+                        m = models[key, len(rows)] = make_effect_model([self.params[0]] * len(rows), self.kind,
+                                                                       effects, **self._extra())
                     m._use_table(table)
+                else:
+                    m = make_effect_model([_apply(self.params[0], split[i][0], paths) for i in rows], self.kind,
+                                          effects, **self._extra())
                 m._batch_effects([split[i][1] for i in rows])
                 r = m.frequency_response(freqs, temps, quantities=(q,))[q]
                 out[rows] = r[:, ti, fi] * scale
