@@ -208,6 +208,27 @@ def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], pa
     return ParameterTable(cols, table.groups, n)
 
 
+def _batched_entry(e: Effect, vals: dict):
+    """The ``_active`` entry ``(effect, {param: (n_sets, 1, 1)}, on mask or None)`` of a batchable
+    effect with values ``vals = {param: (n_sets,) array}`` (checked against its bounds), None where it
+    is off in every set; sets where it is off take its off values."""
+    for p in e.parameters:
+        a = vals[p.name]
+        ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
+        if not np.all(ok):
+            v = float(a[~ok][0])
+            raise ParameterError(f"{e.name}.{p.name}={v!r} [{p.unit}] must lie in [{p.lower:g}, {p.upper:g}]")
+    on = e.on_mask(vals)
+    if not np.any(on):
+        return None
+    if np.all(on):
+        mask = None
+    else:            # off sets take the off values: the effect sees no switched-off mixture
+        mask = on[:, None, None]
+        vals = {p.name: np.where(on, vals[p.name], p.off) for p in e.parameters}
+    return e, {k: a[:, None, None] for k, a in vals.items()}, mask
+
+
 class _EffectMixin:
     """Shared by the actuator and sensor flavours of :class:`EffectModel`."""
 
@@ -266,24 +287,36 @@ class _EffectMixin:
                 bad = set(ev.get(name, {})) - set(own)
                 if bad:
                     e.parameter(sorted(bad)[0])                 # raises: no such parameter
-            vals = {}
-            for p in e.parameters:
-                a = np.array([ev.get(name, {}).get(p.name, own[p.name]) for ev in canon], dtype=float)
-                ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
-                if not np.all(ok):
-                    v = float(a[~ok][0])
-                    raise ParameterError(f"{name}.{p.name}={v!r} [{p.unit}] must lie in [{p.lower:g}, {p.upper:g}]")
-                vals[p.name] = a
-            on = e.on_mask(vals)
-            if not np.any(on):
+            vals = {p.name: np.array([ev.get(name, {}).get(p.name, own[p.name]) for ev in canon], dtype=float)
+                    for p in e.parameters}
+            entry = _batched_entry(e, vals)
+            if entry is not None:
+                active.append(entry)
+        self._active = active
+
+    def _batch_effect_arrays(self, given: Mapping[str, Mapping[str, np.ndarray]]) -> None:
+        """:meth:`_batch_effects` with the values already as arrays over the sets: ``given`` =
+        ``{effect: {param: (n_sets,) array}}``, canonical names of batchable effects with known
+        parameters (missing parameters: this model's value, else off)."""
+        n = len(self.params)
+        active = []
+        for name in (*self.effects, *(k for k in given if k not in self.effects)):
+            e = get_effect(name)
+            if self.kind not in e.kinds:
+                raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model (it applies to {e.kinds})")
+            own = self.effects.get(name, e.off)
+            if not e.batchable:
+                if name in given:
+                    raise IPMCError(f"effect {name!r} is not batchable: give its values through _batch_effects")
+                if not e.is_off(own):
+                    active.append((e, own, None))
                 continue
-            if np.all(on):
-                mask = None
-            else:            # off sets take the off values: the effect sees no switched-off mixture
-                mask = on[:, None, None]
-                for p in e.parameters:
-                    vals[p.name] = np.where(on, vals[p.name], p.off)
-            active.append((e, {k: a[:, None, None] for k, a in vals.items()}, mask))
+            g = given.get(name, {})
+            vals = {p.name: np.asarray(g[p.name], dtype=float) if p.name in g else np.full(n, float(own[p.name]))
+                    for p in e.parameters}
+            entry = _batched_entry(e, vals)
+            if entry is not None:
+                active.append(entry)
         self._active = active
 
     def state(self, temperature_c) -> State:
@@ -424,9 +457,80 @@ class _EffectMixin:
         # each call gives them its own table and effect values (_use_table, _batch_effects)
         models: dict = {}
 
+        plans: dict = {}        # the fast path's plan of each tuple of names (None: the general path)
+
+        def plan_of(keys: tuple):
+            """Where the names ``keys`` go when every set gives exactly these: ``(base, omega,
+            effects)`` = ([(field, column)], column of omega_n or None, {effect: {param: column}}),
+            or None (a temperature law, T_ref, a non-batchable effect or an error: the general path
+            handles and words them)."""
+            from ..parameter_paths import resolve_path
+
+            base, omega, effects = [], None, {}
+            for j, k in enumerate(keys):
+                ep = _effect_parameter(k)
+                try:
+                    if ep is None:
+                        path = paths.get(k)
+                        if path is None:
+                            path = paths[k] = resolve_path(self.params[0], k)
+                        if path.target == "omega_n":
+                            omega = j
+                        elif path.is_law or k == "T_ref" or k not in table0.columns:
+                            return None
+                        else:
+                            base.append((k, j))
+                        continue
+                    e = get_effect(ep[0])
+                    e.parameter(ep[1])
+                except IPMCError:
+                    return None
+                if not e.batchable or self.kind not in e.kinds or ep[1] in effects.get(e.name, {}):
+                    return None
+                effects.setdefault(e.name, {})[ep[1]] = j
+            return base, omega, effects
+
+        def predict_fast(values_list, plan, n_names: int) -> np.ndarray | None:
+            # every set names the same parameters: one array of values, columns by name; the same
+            # numbers and checks as the general path below (the table of _table_of, _batch_effects)
+            n = len(values_list)
+            X = np.array([list(v.values()) for v in values_list], dtype=float)
+            if X.shape != (n, n_names):
+                return None
+            base, omega, effects = plan
+            cols = dict(table0.columns)
+            for name, j in base:
+                cols[name] = check_field_values(name, X[:, j])[:, None]
+            if omega is not None:
+                rho = density_for_mode(X[:, omega], cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
+                cols["rho"] = check_field_values("rho", rho)[:, None]
+            table = ParameterTable({k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()},
+                                   table0.groups, n)
+            m = models.get(((), n))
+            if m is None:
+                if len(models) >= 64:
+                    models.pop(next(iter(models)))
+                m = models[(), n] = make_effect_model([self.params[0]] * n, self.kind, self.effects, **self._extra())
+            m._use_table(table)
+            m._batch_effect_arrays({e: {p: X[:, j] for p, j in pj.items()} for e, pj in effects.items()})
+            r = m.frequency_response(freqs, temps, quantities=(q,))[q]
+            return r[:, ti, fi] * scale
+
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
             # one batched model call for every set (effect values as arrays over the sets), or one
             # per distinct set of values of the non-batchable effects (Effect.batchable)
+            if values_list:
+                keys = tuple(values_list[0])
+                if all(tuple(v) == keys for v in values_list):
+                    plan = plans.get(keys, False)
+                    if plan is False:
+                        if len(plans) >= 256:
+                            plans.pop(next(iter(plans)))
+                        plan = plans[keys] = plan_of(keys)
+                    if plan is not None:
+                        r = predict_fast(values_list, plan, len(keys))
+                        if r is not None:
+                            return r
             out = np.empty((len(values_list), data.response.size), dtype=complex)
             split = [split_values(v) for v in values_list]
             groups: dict = {}
