@@ -514,7 +514,11 @@ class _EffectMixin:
             m._use_table(table)
             m._batch_effect_arrays({e: {p: X[:, j] for p, j in pj.items()} for e, pj in effects.items()})
             r = m.frequency_response(freqs, temps, quantities=(q,))[q]
-            return r[:, ti, fi] * scale
+            # C order, as the general path's: r[:, ti, fi] alone comes out in Fortran order, and the
+            # estimation layer's reductions and products over it then round differently
+            out = np.empty((n, data.response.size), dtype=complex)
+            np.multiply(r[:, ti, fi], scale, out=out)
+            return out
 
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
             # one batched model call for every set (effect values as arrays over the sets), or one
