@@ -172,6 +172,11 @@ def check_field_values(name: str, values) -> np.ndarray:
     A bad value is a :class:`ParameterError` worded as the record's own."""
     m = _FIELD_META[name]
     v = np.asarray(values, dtype=float)
+    if v.size:                  # the usual case, all good, from two reductions (NaN propagates into both)
+        lo, hi = float(v.min()), float(v.max())
+        if (lo == lo and hi == hi and (m["allow_inf"] or (hi < math.inf and lo > -math.inf))
+                and (not m["positive"] or lo > 0 or (lo == 0 and m["allow_zero"]))):
+            return v
     bad = np.isnan(v)
     if not m["allow_inf"]:
         bad |= np.isinf(v)
@@ -327,23 +332,18 @@ class ParameterTable:
                 f = p.laws.factors(T, p.T_ref)
                 for name in LAW_PARAMETERS:
                     fac[name][idx] = f[name]
-        shape = (n, T.size, 1)
-        vals = {name: np.broadcast_to(col[name][:, :, None], shape) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
+        # the fields constant along T repeated over it (fresh arrays, as the products below are)
+        vals = {name: np.repeat(col[name][:, :, None], T.size, axis=1) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
         for name in LAW_PARAMETERS:
             vals[name] = (col[name] * fac[name])[:, :, None]
         W = vals["W"]
-        vals["T"] = np.broadcast_to(T[None, :, None], shape)
+        vals["T"] = np.repeat(T[None, :, None], n, axis=0)
         vals["r1"] = vals.pop("r1_sheet") / W
         vals["r2"] = vals.pop("r2_specific") / W
         vals["Rp"] = vals.pop("Rp_specific") / W
         vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * vals["T"])
         vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
-        # fresh arrays as they are; the broadcast views (constant along T) copied
-        return State(**{k: np.array(v, dtype=float) if k in _BROADCAST else v
-                        for k, v in ((k, vals[k]) for k in STATE_FIELDS)})
-
-
-_BROADCAST = frozenset({"L", "W", "alpha0", "a0", "rho", "xi", "T"})
+        return State(**{k: vals[k] for k in STATE_FIELDS})
 
 
 def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -> State:

@@ -156,6 +156,11 @@ class IonicResistance(_Law):
 LAW_PARAMETERS = ("d", "E", "kappa_e", "Rp_specific", "r1_sheet", "r2_specific", "C_minus", "h")
 
 
+#: :meth:`TemperatureLaws.factors` kept per (laws, temperatures, T_ref), oldest dropped first.
+_FACTORS_CACHE: dict = {}
+_FACTORS_CACHE_SIZE = 64
+
+
 @dataclass(frozen=True)
 class TemperatureLaws:
     """One law per temperature-dependent parameter (physics.md §7 defaults).
@@ -175,14 +180,32 @@ class TemperatureLaws:
     h: _Law = field(default_factory=Constant)
 
     def factors(self, T_K, T_ref_K) -> dict[str, np.ndarray]:
-        """Multiplicative factors for every law parameter at temperatures ``T_K`` [K]."""
+        """Multiplicative factors for every law parameter at temperatures ``T_K`` [K].
+
+        The laws are frozen values, so the factors at the same temperatures and ``T_ref`` are kept
+        (a fit evaluates one laws object at one temperature grid thousands of times): the arrays
+        returned are read-only and shared between calls."""
+        key = None
+        if np.ndim(T_ref_K) == 0:
+            T = np.asarray(T_K, dtype=float)
+            key = (self, T.shape, T.tobytes(), float(T_ref_K))
+            hit = _FACTORS_CACHE.get(key)
+            if hit is not None:
+                return dict(hit)
         out: dict[str, np.ndarray] = {}
         for name in LAW_PARAMETERS:
             getattr(self, name).check(T_K, name)
         out["d"] = self.d.factor(T_K, T_ref_K)
         for name in LAW_PARAMETERS[1:]:
             out[name] = getattr(self, name).factor(T_K, T_ref_K, diffusivity_factor=out["d"])
-        return out
+        if key is not None:
+            for name, v in out.items():         # own copies (a law may hand back its input)
+                out[name] = v = np.array(v)
+                v.flags.writeable = False
+            if len(_FACTORS_CACHE) >= _FACTORS_CACHE_SIZE:
+                _FACTORS_CACHE.pop(next(iter(_FACTORS_CACHE)))
+            _FACTORS_CACHE[key] = out
+        return dict(out)
 
     def with_(self, **laws: _Law) -> TemperatureLaws:
         """A copy with some laws replaced, e.g. ``laws.with_(E=Constant())``."""

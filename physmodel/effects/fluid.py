@@ -86,13 +86,31 @@ def gamma_circular(reynolds):
 def rectangular_correction(reynolds):
     """Sader's Ω(Re) = Γ_rect/Γ_circ [-] (eq. 21), τ = log10 Re held to :data:`OMEGA_LOG10_RE_RANGE`."""
     tau = np.clip(np.log10(np.asarray(reynolds, dtype=float)), *OMEGA_LOG10_RE_RANGE)
-    pv = np.polynomial.polynomial.polyval
+    pv = _polyval
     return (pv(tau, _OMEGA_R_NUM) / pv(tau, _OMEGA_R_DEN)) + 1j * (pv(tau, _OMEGA_I_NUM) / pv(tau, _OMEGA_I_DEN))
 
 
+def _polyval(x, c):
+    """``numpy.polynomial.polynomial.polyval(x, c)`` for a float array ``x`` and a tuple ``c``: the
+    same Horner steps in the same order, without its argument handling (four per evaluation)."""
+    acc = c[-1] + x * 0
+    for k in range(2, len(c) + 1):
+        acc = c[-k] + acc * x
+    return acc
+
+
 def gamma_rectangular(reynolds):
-    """Sader's Γ_rect(Re) = Ω(Re) Γ_circ(Re) of a thin rectangular beam [-] (e^{−iωt} convention)."""
-    return rectangular_correction(reynolds) * gamma_circular(reynolds)
+    """Sader's Γ_rect(Re) = Ω(Re) Γ_circ(Re) of a thin rectangular beam [-] (e^{−iωt} convention).
+
+    Evaluated once per distinct Reynolds number: a batch of parameter sets repeats the same Re
+    wherever the sets share the width and the viscosity at a temperature (the finite-difference sets
+    of every parameter but the viscosity's own), and the Bessel functions are the costly part."""
+    re = np.asarray(reynolds, dtype=float)
+    if re.size > 1:
+        u, inv = np.unique(re, return_inverse=True)
+        if u.size < re.size:
+            return (rectangular_correction(u) * gamma_circular(u))[inv.reshape(re.shape)]
+    return rectangular_correction(re) * gamma_circular(re)
 
 
 def kinematic_viscosity(v, T, T_ref):

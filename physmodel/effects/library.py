@@ -28,6 +28,7 @@ inviscid limit) (:data:`ALIASES`).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 
@@ -140,16 +141,22 @@ def split_values(values: Mapping[str, float]) -> tuple[dict, dict]:
 
     Base names are IPMCParameters fields, ``omega_n`` or ``laws.<quantity>.<attribute>``
     (see :func:`physmodel.parameter_paths.apply_values`)."""
-    from ..parameter_paths import is_effect_parameter
-
     base, eff = {}, {}
     for k, v in values.items():
-        if is_effect_parameter(k):
-            e, p = k.split(".", 1)
-            eff.setdefault(e, {})[p] = float(v)
-        else:
+        ep = _effect_parameter(k)
+        if ep is None:
             base[k] = float(v)
+        else:
+            eff.setdefault(ep[0], {})[ep[1]] = float(v)
     return base, eff
+
+
+@functools.lru_cache(maxsize=4096)
+def _effect_parameter(name: str) -> tuple | None:
+    """``(effect, param)`` of an effect parameter's name, None for a base name (read once per name)."""
+    from ..parameter_paths import is_effect_parameter
+
+    return tuple(name.split(".", 1)) if is_effect_parameter(name) else None
 
 
 # --------------------------------------------------------------------------- the model
@@ -162,18 +169,20 @@ def _apply(p: IPMCParameters, base_vals: Mapping[str, float], paths: dict | None
     return apply_values(p, base_vals, paths)
 
 
-def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], paths: dict) -> ParameterTable | None:
+def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], paths: dict,
+              table: ParameterTable | None = None) -> ParameterTable | None:
     """The :class:`ParameterTable` of ``base`` with ``base_vals[i]`` in set i, built as arrays (no
     record per set; values checked as :class:`IPMCParameters` checks them, ``omega_n`` set through
     the density as :meth:`IPMCParameters.replace` does).  None when a name addresses a temperature
     law or ``T_ref`` (the table's sets would not share one laws group): the caller then builds one
-    record per set.  ``paths``: names resolved against ``base`` (kept across calls)."""
+    record per set.  ``paths``: names resolved against ``base`` (kept across calls); ``table``: the
+    table of ``base`` if the caller keeps it."""
     from ..parameter_paths import resolve_path
 
     names: dict = {}
     for bv in base_vals:
         names.update(dict.fromkeys(bv))
-    table = ParameterTable.of(base)
+    table = ParameterTable.of(base) if table is None else table
     for name in names:
         path = paths.get(name)
         if path is None:
@@ -181,18 +190,43 @@ def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], pa
         if path.is_law or (path.target == "field" and (name == "T_ref" or name not in table.columns)):
             return None
     n = len(base_vals)
-    cols = {k: np.repeat(v, n, axis=0) for k, v in table.columns.items()}
-    for name in names:
-        if name != "omega_n":
-            a = np.array([bv.get(name, np.nan) for bv in base_vals], dtype=float)
-            given = np.array([name in bv for bv in base_vals])
-            cols[name] = np.where(given, check_field_values(name, np.where(given, a, 1.0)), cols[name][:, 0])[:, None]
-    if "omega_n" in names:
-        given = np.array(["omega_n" in bv for bv in base_vals])
-        wn = np.array([bv.get("omega_n", 1.0) for bv in base_vals], dtype=float)
-        rho = density_for_mode(wn, cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
-        cols["rho"] = np.where(given, check_field_values("rho", np.where(given, rho, 1.0)), cols["rho"][:, 0])[:, None]
+    cols = dict(table.columns)          # the base's (1, 1) columns, repeated over the sets at the end
+    for name in (*(k for k in names if k != "omega_n"), *(("rho",) if "omega_n" in names else ())):
+        src = "omega_n" if name == "rho" else name
+        given = [src in bv for bv in base_vals]
+        if name == "rho":
+            wn = np.array([bv.get("omega_n", 1.0) for bv in base_vals], dtype=float)
+            a = density_for_mode(wn, cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
+        else:
+            a = np.array([bv.get(name, 1.0) for bv in base_vals], dtype=float)
+        if all(given):
+            cols[name] = check_field_values(name, a)[:, None]
+        else:
+            g = np.array(given)
+            cols[name] = np.where(g, check_field_values(name, np.where(g, a, 1.0)), cols[name][:, 0])[:, None]
+    cols = {k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()}
     return ParameterTable(cols, table.groups, n)
+
+
+def _batched_entry(e: Effect, vals: dict):
+    """The ``_active`` entry ``(effect, {param: (n_sets, 1, 1)}, on mask or None)`` of a batchable
+    effect with values ``vals = {param: (n_sets,) array}`` (checked against its bounds), None where it
+    is off in every set; sets where it is off take its off values."""
+    for p in e.parameters:
+        a = vals[p.name]
+        ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
+        if not np.all(ok):
+            v = float(a[~ok][0])
+            raise ParameterError(f"{e.name}.{p.name}={v!r} [{p.unit}] must lie in [{p.lower:g}, {p.upper:g}]")
+    on = e.on_mask(vals)
+    if not np.any(on):
+        return None
+    if np.all(on):
+        mask = None
+    else:            # off sets take the off values: the effect sees no switched-off mixture
+        mask = on[:, None, None]
+        vals = {p.name: np.where(on, vals[p.name], p.off) for p in e.parameters}
+    return e, {k: a[:, None, None] for k, a in vals.items()}, mask
 
 
 class _EffectMixin:
@@ -253,24 +287,36 @@ class _EffectMixin:
                 bad = set(ev.get(name, {})) - set(own)
                 if bad:
                     e.parameter(sorted(bad)[0])                 # raises: no such parameter
-            vals = {}
-            for p in e.parameters:
-                a = np.array([ev.get(name, {}).get(p.name, own[p.name]) for ev in canon], dtype=float)
-                ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
-                if not np.all(ok):
-                    v = float(a[~ok][0])
-                    raise ParameterError(f"{name}.{p.name}={v!r} [{p.unit}] must lie in [{p.lower:g}, {p.upper:g}]")
-                vals[p.name] = a
-            on = e.on_mask(vals)
-            if not np.any(on):
+            vals = {p.name: np.array([ev.get(name, {}).get(p.name, own[p.name]) for ev in canon], dtype=float)
+                    for p in e.parameters}
+            entry = _batched_entry(e, vals)
+            if entry is not None:
+                active.append(entry)
+        self._active = active
+
+    def _batch_effect_arrays(self, given: Mapping[str, Mapping[str, np.ndarray]]) -> None:
+        """:meth:`_batch_effects` with the values already as arrays over the sets: ``given`` =
+        ``{effect: {param: (n_sets,) array}}``, canonical names of batchable effects with known
+        parameters (missing parameters: this model's value, else off)."""
+        n = len(self.params)
+        active = []
+        for name in (*self.effects, *(k for k in given if k not in self.effects)):
+            e = get_effect(name)
+            if self.kind not in e.kinds:
+                raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model (it applies to {e.kinds})")
+            own = self.effects.get(name, e.off)
+            if not e.batchable:
+                if name in given:
+                    raise IPMCError(f"effect {name!r} is not batchable: give its values through _batch_effects")
+                if not e.is_off(own):
+                    active.append((e, own, None))
                 continue
-            if np.all(on):
-                mask = None
-            else:            # off sets take the off values: the effect sees no switched-off mixture
-                mask = on[:, None, None]
-                for p in e.parameters:
-                    vals[p.name] = np.where(on, vals[p.name], p.off)
-            active.append((e, {k: a[:, None, None] for k, a in vals.items()}, mask))
+            g = given.get(name, {})
+            vals = {p.name: np.asarray(g[p.name], dtype=float) if p.name in g else np.full(n, float(own[p.name]))
+                    for p in e.parameters}
+            entry = _batched_entry(e, vals)
+            if entry is not None:
+                active.append(entry)
         self._active = active
 
     def state(self, temperature_c) -> State:
@@ -308,7 +354,12 @@ class _EffectMixin:
         need = tuple(q for q in self.quantities if q in need)
         kern = next(((e, v) for e, v, _ in self._active if e.level == "kernel"), None)
         s_kernel = s if kern is None else kern[0].apply(s, kern[1])
-        if kern is None:
+        if kern is None and progress is None:
+            # the model's own evaluation of a state: an actuator batch whose sets repeat an
+            # electrode line or slice (finite-difference sets of the gain, the mode, a response or
+            # series effect) evaluates those terms once (ActuatorModel.evaluate_state)
+            vals = self.evaluate_state(st, s, need)
+        elif kern is None:
             vals = evaluate_grid(st, s, self._kernel, need, self.chunk_size, None, progress)
         else:
             # the charge dynamics at ŝ, the mechanics at s
@@ -401,10 +452,89 @@ class _EffectMixin:
             return r[ti, fi] * scale
 
         paths: dict = {}        # the base names, each resolved once against self.params[0]
+        table0 = ParameterTable.of(self.params[0])
+        # the models of the batched calls, by (values of the non-batchable effects, number of sets):
+        # each call gives them its own table and effect values (_use_table, _batch_effects)
+        models: dict = {}
+
+        plans: dict = {}        # the fast path's plan of each tuple of names (None: the general path)
+
+        def plan_of(keys: tuple):
+            """Where the names ``keys`` go when every set gives exactly these: ``(base, omega,
+            effects)`` = ([(field, column)], column of omega_n or None, {effect: {param: column}}),
+            or None (a temperature law, T_ref, a non-batchable effect or an error: the general path
+            handles and words them)."""
+            from ..parameter_paths import resolve_path
+
+            base, omega, effects = [], None, {}
+            for j, k in enumerate(keys):
+                ep = _effect_parameter(k)
+                try:
+                    if ep is None:
+                        path = paths.get(k)
+                        if path is None:
+                            path = paths[k] = resolve_path(self.params[0], k)
+                        if path.target == "omega_n":
+                            omega = j
+                        elif path.is_law or k == "T_ref" or k not in table0.columns:
+                            return None
+                        else:
+                            base.append((k, j))
+                        continue
+                    e = get_effect(ep[0])
+                    e.parameter(ep[1])
+                except IPMCError:
+                    return None
+                if not e.batchable or self.kind not in e.kinds or ep[1] in effects.get(e.name, {}):
+                    return None
+                effects.setdefault(e.name, {})[ep[1]] = j
+            return base, omega, effects
+
+        def predict_fast(values_list, plan, n_names: int) -> np.ndarray | None:
+            # every set names the same parameters: one array of values, columns by name; the same
+            # numbers and checks as the general path below (the table of _table_of, _batch_effects)
+            n = len(values_list)
+            X = np.array([list(v.values()) for v in values_list], dtype=float)
+            if X.shape != (n, n_names):
+                return None
+            base, omega, effects = plan
+            cols = dict(table0.columns)
+            for name, j in base:
+                cols[name] = check_field_values(name, X[:, j])[:, None]
+            if omega is not None:
+                rho = density_for_mode(X[:, omega], cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
+                cols["rho"] = check_field_values("rho", rho)[:, None]
+            table = ParameterTable({k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()},
+                                   table0.groups, n)
+            m = models.get(((), n))
+            if m is None:
+                if len(models) >= 64:
+                    models.pop(next(iter(models)))
+                m = models[(), n] = make_effect_model([self.params[0]] * n, self.kind, self.effects, **self._extra())
+            m._use_table(table)
+            m._batch_effect_arrays({e: {p: X[:, j] for p, j in pj.items()} for e, pj in effects.items()})
+            r = m.frequency_response(freqs, temps, quantities=(q,))[q]
+            # C order, as the general path's: r[:, ti, fi] alone comes out in Fortran order, and the
+            # estimation layer's reductions and products over it then round differently
+            out = np.empty((n, data.response.size), dtype=complex)
+            np.multiply(r[:, ti, fi], scale, out=out)
+            return out
 
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
             # one batched model call for every set (effect values as arrays over the sets), or one
             # per distinct set of values of the non-batchable effects (Effect.batchable)
+            if values_list:
+                keys = tuple(values_list[0])
+                if all(tuple(v) == keys for v in values_list):
+                    plan = plans.get(keys, False)
+                    if plan is False:
+                        if len(plans) >= 256:
+                            plans.pop(next(iter(plans)))
+                        plan = plans[keys] = plan_of(keys)
+                    if plan is not None:
+                        r = predict_fast(values_list, plan, len(keys))
+                        if r is not None:
+                            return r
             out = np.empty((len(values_list), data.response.size), dtype=complex)
             split = [split_values(v) for v in values_list]
             groups: dict = {}
@@ -412,19 +542,25 @@ class _EffectMixin:
                 key = tuple(sorted((get_effect(n).name, tuple(sorted(pv.items()))) for n, pv in e.items()
                                    if not get_effect(n).batchable))
                 groups.setdefault(key, []).append(i)
-            for rows in groups.values():
+            for key, rows in groups.items():
                 effects = {n: dict(v) for n, v in self.effects.items()}
                 for n, pv in split[rows[0]][1].items():    # the non-batchable values (all the same here)
                     if not get_effect(n).batchable:
                         effects.setdefault(n, {}).update(pv)
                 # the base values as arrays (no record per set), or a record per set when a name
                 # addresses a temperature law or T_ref
-                table = _table_of(self.params[0], [split[i][0] for i in rows], paths)
-                plist = ([self.params[0]] * len(rows) if table is not None
-                         else [_apply(self.params[0], split[i][0], paths) for i in rows])
-                m = make_effect_model(plist, self.kind, effects, **self._extra())
+                table = _table_of(self.params[0], [split[i][0] for i in rows], paths, table0)
                 if table is not None:
+                    m = models.get((key, len(rows)))
+                    if m is None:
+                        if len(models) >= 64:
+                            models.pop(next(iter(models)))
+                        m = models[key, len(rows)] = make_effect_model([self.params[0]] * len(rows), self.kind,
+                                                                       effects, **self._extra())
                     m._use_table(table)
+                else:
+                    m = make_effect_model([_apply(self.params[0], split[i][0], paths) for i in rows], self.kind,
+                                          effects, **self._extra())
                 m._batch_effects([split[i][1] for i in rows])
                 r = m.frequency_response(freqs, temps, quantities=(q,))[q]
                 out[rows] = r[:, ti, fi] * scale

@@ -1,13 +1,14 @@
 """Speed of a diagnosis against one calibration of the same data (issue 27 item 6).
 
-    python3 tests/benchmarks/bench_diagnosis_speed.py                      # 3 cases, 3 rounds
+    python3 tests/benchmarks/bench_diagnosis_speed.py                      # 5 cases, 3 rounds
     python3 tests/benchmarks/bench_diagnosis_speed.py --rounds 5 --cases 41000:none,41009:water_uptake
 
 Cases come from the independent generator (tests/discrepancy/independent_generator.py: its own
 actuator physics and its own parametrisation of every effect; no data written by the library's
 effect code), each seed a different strip (the base drawn ±30–40 % from the user's start), 0.5–2 %
 noise, 5 temperatures 19–55 °C, 31 lines 0.05–50 Hz.  Default cases: a null case (41000), one
-effect (41009, water uptake) and two effects (41038, contact resistance + time delay).
+effect (41009, water uptake), two effects (41038, contact resistance + time delay), a leakage the
+band cannot see (41003) and a fluid load (41005, the slowest: Sader's Bessel functions).
 
 Per case and round, interleaved: ``calibrate`` of the baseline (the user's free parameters
 alpha0, d, kappa_e, xi, omega_n, default starts and bounds — what ``ipmc calibrate`` runs) and
@@ -18,9 +19,51 @@ parameter sets predicted, batched model calls, least-squares fits, fit points (e
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 
-Measured 2026-11-26 (2 cores shared by ~6 sessions, load 4-9: wall times are 3-6× the CPU times
-and mean little).  "Before" = e6a666c (main at the start of this work), one round; "after" = this
-branch, three rounds (median)::
+Measured 2026-11-26, second round (the model layer; 2 cores shared by ~6 sessions, load 2-4): the
+commands as the issue measures them, child-process CPU.  "Before" = main at 795c454, "after" = the
+same plus this work (h-dspeed), interleaved per case and round (before/after order alternating);
+the reports (report.json) compared number by number::
+
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2             # after: 3.5x median, 5.2x max
+    # before/after interleaved: the same two commands run from /work/main and from this branch
+    case                                  ipmc calibrate   ipmc diagnose CPU s   diagnose / calibrate
+                                          CPU s            before    after        before   after
+    41000 none                            2.07 / 2.18      8.25      7.10         4.0x     3.3x
+    41009 water_uptake                    2.03 / 1.88      8.94      7.26         4.4x     3.9x
+    41038 contact_resistance+time_delay   2.06 / 1.96     11.98      9.50         5.8x     4.8x
+    41003 leakage                         2.02 / 2.19      6.98      6.26         3.4x     2.9x
+    41005 added_fluid_mass                2.03 / 2.03     13.71     10.85         6.8x     5.4x
+    fresh strips, one round (--cases 43101:none,43102:contact_resistance,43103:added_fluid_mass,
+    43104:leakage,43105:water_uptake):
+    43101 none                            2.05 / 2.09      9.39      7.43         4.6x     3.6x
+    43102 contact_resistance              2.04 / 2.06      9.41      8.73         4.6x     4.2x
+    43103 added_fluid_mass                2.10 / 2.11     18.53     13.93         8.8x     6.6x
+    43104 leakage                         2.06 / 2.12      7.44      6.74         3.6x     3.2x
+    43105 water_uptake                    2.23 / 2.15      9.32      7.76         4.2x     3.6x
+
+Every report is the same before and after, number for number (verdicts, names, costs, null
+thresholds, candidate LRs, the next-measurement search).  The model's outputs are the same bit for
+bit: every ``predict_many`` call of a diagnosis, recorded on main and replayed on this branch, gives
+the same array (41000, 41005, 41038 with the next-measurement search, 43103; max relative
+difference 0).  That replay times the model layer alone (CPU s, main → this branch): 41005 7.4 →
+3.9, 41038 4.2 → 2.5, 41000 3.7 → 2.2, 43103 9.6 → 5.8.  Where it went: Sader's Bessel functions
+evaluated once per distinct Reynolds number (the finite-difference sets of every parameter but the
+viscosity's repeat the point's), an actuator batch's shared electrode lines evaluated once
+(``ActuatorModel.evaluate_state``), the temperature-law factors kept per (laws, T, T_ref), and
+sets that name the same parameters — a fit's points and Jacobian columns — read into one array
+instead of a dict, a table and a model per call.
+
+Still above 5x: the fluid-load strips (41005, 43103).  ``ipmc diagnose`` on 41005 is now
+(CPU s) start-up 0.8, ``diagnose()`` 7.5, the next-measurement search 1.5 (ambiguous verdicts
+only), the two figures 1.4; ``ipmc calibrate`` is 2.1, of which 1.35 is importing scenarios.cli,
+the estimation package and matplotlib.  Inside ``diagnose()`` the model is now about half (3.9 s);
+the rest is the estimation layer (least squares, the null statistics: ``_constrained_lr_gram`` alone
+is 0.85 s of 7.1 on 41038).  On 43103 the model is 5.8 s of 10 (Bessel functions ~0.6 s for 1.27
+million Reynolds numbers, the modal sums of the higher-mode candidates, the non-batchable
+fractional_transport in the pairs).
+
+Earlier round (the estimation layer).  "Before" = e6a666c (main at the start of that work), one
+round; "after" = that branch, three rounds (median)::
 
     python3 tests/benchmarks/bench_diagnosis_speed.py --rounds 3       # after
     python3 tests/benchmarks/bench_diagnosis_speed.py --rounds 1       # before (run in a copy of e6a666c)
@@ -47,7 +90,7 @@ mostly start-up, report and figure; on seed 41009 (CPU, ``/usr/bin/time``)::
         --free kappa_e --free xi --free omega_n --seed 41009 --out dia --force --quiet    before 32.5 s (16×)
                                                                                          after  15.8 s (7.9×)
 
-Where the time goes now (seed 41009, after): the null refits 6.2 s CPU (72 fits, 1767 points),
+Where the time went then (seed 41009): the null refits 6.2 s CPU (72 fits, 1767 points),
 the single-candidate refits 3.5 s (19 fits, 1032 points), signatures and the look-elsewhere scan
 1.9 s, pairs and verdicts 1.2 s.  Under cProfile 80 % of a diagnosis is inside the effect model's
 ``predict_many`` (physmodel/effects/library.py): 3.65 ``frequency_response`` calls per batched
@@ -81,7 +124,7 @@ from physmodel.estimation.calibration import calibrate  # noqa: E402
 from physmodel.estimation.discrepancy import diagnose  # noqa: E402
 
 FREE = ("alpha0", "d", "kappa_e", "xi", "omega_n")
-CASES = "41000:none,41009:water_uptake,41038:contact_resistance+time_delay"
+CASES = "41000:none,41009:water_uptake,41038:contact_resistance+time_delay,41003:leakage,41005:added_fluid_mass"
 STAGES = ("baseline", "signatures", "singles", "null", "pairs", "verdicts")
 
 

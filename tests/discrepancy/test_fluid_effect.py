@@ -117,3 +117,27 @@ def test_off_switch_and_declaration():
     with pytest.raises(ParameterError, match="viscous_load"):
         EffectModel(P, "actuator", {"viscous_fluid": {"viscous_load": 500.0}})
     assert fl.fluid_density({"viscous_load": math.sqrt(1000 * 1e-3), "log10_viscosity": -6.0}) == pytest.approx(1000.0)
+
+
+def test_gamma_rectangular_is_evaluated_once_per_reynolds_number_with_the_same_values():
+    """A batch repeats Reynolds numbers (sets sharing the width and viscosity): Γ_rect is computed on
+    the distinct ones and spread back, the same numbers bit for bit as each value on its own (and
+    the mpmath value of Γ_circ times Sader's Ω)."""
+    rng = np.random.default_rng(3)
+    distinct = 10.0 ** rng.uniform(-4, 5, 7)
+    re = distinct[rng.integers(0, 7, (3, 4, 5))]
+    got = fl.gamma_rectangular(re)
+    assert got.shape == re.shape
+    alone = np.array([fl.gamma_rectangular(np.array([x]))[0] for x in re.ravel()]).reshape(re.shape)
+    np.testing.assert_array_equal(got, alone)
+    for x in distinct[:3]:
+        want = fl.rectangular_correction(x) * _gamma_circ_mp(x)
+        assert complex(got[re == x][0]) == pytest.approx(want, rel=1e-12)
+    assert fl.gamma_rectangular(7.5) == pytest.approx(fl.rectangular_correction(7.5) * _gamma_circ_mp(7.5), rel=1e-12)
+
+
+def test_rectangular_correction_is_numpys_polyval_of_sader_coefficients():
+    tau = np.linspace(-6.0, 4.0, 41)
+    pv = np.polynomial.polynomial.polyval
+    want = (pv(tau, fl._OMEGA_R_NUM) / pv(tau, fl._OMEGA_R_DEN)) + 1j * (pv(tau, fl._OMEGA_I_NUM) / pv(tau, fl._OMEGA_I_DEN))
+    np.testing.assert_array_equal(fl.rectangular_correction(10.0 ** tau), want)

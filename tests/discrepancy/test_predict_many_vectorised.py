@@ -187,3 +187,87 @@ def test_bad_base_values_are_named_as_the_record_names_them():
         for form in (pred.many, pred.many_grouped):
             with pytest.raises(ParameterError, match=pattern):
                 form([{}, bad])
+
+
+def _same_names(rng, names, p, gain, n_sets=6):
+    """Sets that all name the same parameters, as a fit's points and Jacobian columns do: each effect
+    on, at its off values or with its switch off in turn."""
+    sets = []
+    for k in range(n_sets):
+        v = {gain: getattr(p, gain) * rng.uniform(0.8, 1.2), "d": p.d * rng.uniform(0.6, 1.6),
+             "kappa_e": p.kappa_e * rng.uniform(0.7, 1.4), "xi": float(rng.uniform(0.05, 0.4)),
+             "omega_n": p.omega_n * rng.uniform(0.4, 3.0)}
+        for j, n in enumerate(names):
+            v.update(_draw_effect(rng, n, p, ("on", "on", "off", "switch_off")[(k + j) % 4]))
+        sets.append(v)
+    return sets
+
+
+def _array_path(monkeypatch):
+    """Count the general path's tables: the array path of sets naming the same parameters builds none."""
+    import physmodel.effects.library as lib
+
+    built = []
+    orig = lib._table_of
+    monkeypatch.setattr(lib, "_table_of", lambda *a: built.append(1) or orig(*a))
+    return built
+
+
+@pytest.mark.parametrize("kind, q, p, gain", CASES, ids=[f"{c[0]}-{c[1]}" for c in CASES])
+def test_sets_naming_the_same_parameters_take_the_array_path(kind, q, p, gain, monkeypatch):
+    """Sets with one tuple of names go through one array of values (no per-set dicts or table) and
+    agree with the grouped form, every batchable effect alone and with a neighbour, with baseline
+    effects in the model; a non-batchable effect or a law name takes the general path."""
+    rng = np.random.default_rng(2727)
+    built = _array_path(monkeypatch)
+    names = [n for n in _effects_for(kind, q) if get_effect(n).batchable]
+    for baseline in (None, BASELINE if kind == "actuator" else None):
+        pred = _predictor(kind, q, p, baseline)
+        for i, n in enumerate(names):
+            _check(pred, _same_names(rng, [n], p, gain))
+            _check(pred, _same_names(rng, [n, names[(i + 1) % len(names)]], p, gain))
+        _check(pred, _same_names(rng, [], p, gain))
+        # C order as the general path's (an F-ordered result rounds differently in the fits' products)
+        assert pred.many(_same_names(rng, names[:1], p, gain)).flags.c_contiguous
+    assert built == []
+    if kind == "actuator":
+        pred = _predictor(kind, q, p)
+        _check(pred, [dict(v, **{"fractional_transport.beta": 0.85}) for v in _same_names(rng, ["time_delay"], p, gain)])
+        _check(pred, [dict(v, **{"laws.d.activation_energy": 20e3 + 1e3 * k})
+                      for k, v in enumerate(_same_names(rng, ["time_delay"], p, gain))])
+        assert built
+
+
+def test_the_array_path_words_bad_values_as_the_general_path(monkeypatch):
+    pred = _predictor("actuator", "M", P_ACT)
+    built = _array_path(monkeypatch)
+    for bad, pattern in (([{"time_delay.delay": 1e-3}, {"time_delay.delay": -1.0}], r"time_delay\.delay=-1\.0"),
+                         ([{"time_delay.delay": float("nan")}] * 2, r"time_delay\.delay=nan"),
+                         ([{"d": P_ACT.d}, {"d": -1.0}], r"d=-1\.0 \[m\^2/s\]"),
+                         ([{"kappa_e": float("nan")}], "kappa_e is NaN"),
+                         ([{"omega_n": 1.0}, {"omega_n": 0.0}], r"omega_n=0\.0 rad/s must be a positive finite number"),
+                         ([{"E": float("inf")}], r"E=inf .* must be finite")):
+        with pytest.raises(ParameterError, match=pattern):
+            pred.many(bad)
+    assert built == []
+    with pytest.raises(ParameterError, match="no parameter"):           # refused names: the general path says so
+        pred.many([{"time_delay.tau": 1e-3}] * 2)
+    with pytest.raises(IPMCError, match="does not apply"):
+        pred.many([{"coupling_compliance.compliance_ratio": 0.1}] * 2)
+    with pytest.raises(ParameterError, match="unknown effect"):
+        pred.many([{"warp_drive.speed": 1.0}])
+    with pytest.raises(ParameterError, match="unknown parameter 'dd'"):
+        pred.many([{"dd": 1.0}])
+
+
+def test_sets_sharing_an_electrode_line_give_what_each_gives_alone():
+    """The finite-difference sets of the gain, the mode and response/series effects repeat the
+    point's electrode line and slice, evaluated once for them: each set's response is bit for bit
+    what it gives alone."""
+    pred = _predictor("actuator", "M", P_ACT)
+    point = {"alpha0": P_ACT.alpha0, "d": P_ACT.d, "xi": 0.2, "omega_n": P_ACT.omega_n,
+             "time_delay.delay": 1e-3, "series_resistance.resistance": 2.0}
+    sets = [point] + [dict(point, **{k: v * 1.01}) for k, v in point.items()]
+    both = pred.many(sets)
+    for i, v in enumerate(sets):
+        np.testing.assert_array_equal(both[i], pred.many([v])[0])

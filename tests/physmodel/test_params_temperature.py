@@ -208,3 +208,31 @@ def test_batch_checks_every_sets_law_ranges():
         state_at([base, base.replace(d=2 * base.d), narrow], [60.0])
     with pytest.raises(TemperatureRangeError):
         ActuatorModel([base, narrow]).frequency_response([1.0], [60.0])
+
+
+def test_law_factors_are_kept_per_laws_temperatures_and_reference():
+    """TemperatureLaws.factors keeps its result for (laws, T, T_ref): the same numbers as each law's
+    own factor(), shared read-only; another T, T_ref or law is evaluated afresh."""
+    laws = TemperatureLaws().with_(r1_sheet=Linear(2e-3))
+    T = np.array([290.0, 310.0, 330.0])
+    first = laws.factors(T, 298.15)
+    again = laws.factors(T.copy(), 298.15)
+    for k in first:
+        assert again[k] is first[k]
+        assert not first[k].flags.writeable
+    with pytest.raises(ValueError):
+        first["d"][0] = 1.0
+    np.testing.assert_array_equal(first["d"], Arrhenius().factor(T, 298.15))
+    np.testing.assert_array_equal(first["r1_sheet"], Linear(2e-3).factor(T, 298.15))
+    np.testing.assert_array_equal(first["Rp_specific"], (T / 298.15) / Arrhenius().factor(T, 298.15))
+    other_ref = laws.factors(T, 310.0)
+    np.testing.assert_array_equal(other_ref["d"], Arrhenius().factor(T, 310.0))
+    assert other_ref["d"][1] == 1.0
+    other_T = laws.factors(T[:2], 298.15)
+    np.testing.assert_array_equal(other_T["d"], first["d"][:2])
+    hot = laws.with_(d=Arrhenius(40e3)).factors(T, 298.15)
+    np.testing.assert_array_equal(hot["d"], Arrhenius(40e3).factor(T, 298.15))
+    narrow = laws.with_(d=Arrhenius(valid_c=(0.0, 40.0)))
+    for _ in range(2):                       # a refused temperature is refused every time
+        with pytest.raises(TemperatureRangeError, match="for d"):
+            narrow.factors(T, 298.15)
