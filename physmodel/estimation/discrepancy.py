@@ -141,31 +141,69 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
              _restart: Mapping | None = None) -> Diagnosis:
     """Diagnose the discrepancy between ``data`` and the ``base`` model (see module docstring).
 
-    ``data``: one sweep (one measured quantity, ``quantity``, default M / S), or a sequence of
-    sweeps of the same strip, one per quantity (``quantity``: their names, or None to take each from
-    its sweep's metadata/units), diagnosed jointly — baseline, candidates and null over all their
-    lines, each quantity with its own noise (:mod:`~physmodel.estimation.joint`); ``acts_on``
-    (several quantities only) narrows where an effect acts, ``{effect: [quantities]}`` — e.g. a
-    current amplifier on S but not on Z measured by another instrument.
-
-    ``free``: the user's calibration parameters (names with default bounds, ``"effect.param"`` of a
-    baseline effect, or :class:`FreeParameter`).  ``baseline_effects``: effects already in the model
-    (``{name: {param: value}}``; a bare name means all its parameters free from their off value).
-    ``candidates``: library names to test (default: all that apply to ``kind``/``quantity`` and are
-    not in the baseline).  ``alpha``: family-wise false-positive rate.  ``null_draws``/``null_refits``:
-    linearised null draws and full bootstrap refits.  ``laws``: temperature laws —
-    None/``"set"`` (those of ``base``), ``"isothermal"``, ``"default"`` (physics.md §7), a
-    :class:`~physmodel.temperature.TemperatureLaws` or a mapping (see
-    :func:`~physmodel.estimation.diagnosis.resolve_laws`); the report states the choice.
-    ``candidate_bounds``: ``{"effect.param": (lower, upper) or {"lower", "upper", "typical"}}``
-    replacing the strip-scaled candidate bounds; ``candidate_starts``: ``{"effect.param": value}``
-    extra start values.  ``plausible``: ``{field: (lower, upper)}`` replacing default plausible
-    ranges; ``prior``: hold the free base parameters to them (soft walls).  ``baseline_starts``:
-    multi-start count of the baseline fit.  ``progress(message)`` is called after each stage.
     A candidate refit that beats the baseline may have found a better basin of the baseline itself:
     for the three best candidates above the linearised threshold, the baseline is refitted from
     their base values and, if lower by more than ½ in cost, the diagnosis restarts once with it
     (``metadata["baseline_restart"]``; ``_restart`` is that internal start).
+
+    Parameters
+    ----------
+    data : FrequencySweep or sequence of FrequencySweep
+        One sweep (one measured quantity), or sweeps of the same strip, one per quantity (e.g. an
+        actuator's M and Z), diagnosed jointly: baseline, candidates and null over all their lines,
+        each quantity with its own noise (:mod:`~physmodel.estimation.joint`).
+    base : IPMCParameters
+        The user's starting parameter set.
+    kind : {"actuator", "sensor"}
+        The physics.
+    quantity : str, sequence of str or None
+        The measured quantity (default M for an actuator, S for a sensor), or one name per sweep
+        (None: each taken from its sweep's metadata and units).
+    free : sequence of str or FreeParameter
+        The user's calibration parameters: names with default bounds, ``"effect.param"`` of a
+        baseline effect, or :class:`~physmodel.estimation.records.FreeParameter` records.
+    baseline_effects : mapping or sequence of str
+        Effects already in the model, ``{name: {param: value}}`` (SI); a bare name means all its
+        parameters free from their off value.
+    candidates : sequence of str or None
+        Library effect names to test (default: all that apply to ``kind`` and the quantities and
+        are not in the baseline).
+    alpha : float
+        Family-wise false-positive rate of the verdict [-].
+    null_draws, null_refits : int
+        Linearised null Monte-Carlo draws, and full bootstrap refits that correct its threshold.
+    seed : int
+        Seed of the null draws and multi-starts.
+    kernel : str
+        The sensor's collection kernel (see :func:`~physmodel.estimation.calibration.calibrate`).
+    max_nfev : int
+        Residual evaluations per fit start.
+    laws : None, str, TemperatureLaws or mapping
+        Temperature laws: None/``"set"`` (those of ``base``), ``"isothermal"``, ``"default"``
+        (physics.md §7), a :class:`~physmodel.temperature.TemperatureLaws` or a mapping (see
+        :func:`~physmodel.estimation.diagnosis.resolve_laws`); the report states the choice.
+    candidate_bounds : mapping or None
+        ``{"effect.param": (lower, upper) or {"lower", "upper", "typical"}}`` replacing the
+        strip-scaled candidate bounds (SI).
+    candidate_starts : mapping or None
+        ``{"effect.param": value}``: extra start values (SI).
+    plausible : mapping or None
+        ``{field: (lower, upper)}`` replacing the default plausible ranges (SI).
+    prior : bool
+        Hold the free base parameters to their plausible ranges (soft walls).
+    baseline_starts : int
+        Multi-start count of the baseline fit.
+    progress : callable or None
+        ``progress(message)``, called within every stage.
+    acts_on : mapping or None
+        Several quantities only: ``{effect: [quantities]}`` narrowing where an effect acts (e.g.
+        a current amplifier on S, not on Z measured by another instrument); elsewhere it is held
+        at its off values.
+
+    Returns
+    -------
+    Diagnosis
+        The verdict, the named effect(s), every candidate's statistics and the refitted models.
     """
     args = dict(kind=kind, quantity=quantity, free=free, baseline_effects=baseline_effects, candidates=candidates,
                 alpha=alpha, null_draws=null_draws, null_refits=null_refits, seed=seed, kernel=kernel,
