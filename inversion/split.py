@@ -69,7 +69,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -163,6 +163,16 @@ class InverseSplit:
     zeros_at_infinity: np.ndarray = field(default_factory=lambda: np.zeros(0, complex))
     model_zeros: np.ndarray = field(default_factory=lambda: np.zeros(0, complex))
     sampling_interval: float | None = None
+
+    def __post_init__(self):
+        # plans built from the split are cached on it (inversion._discrete.plan_for), so its arrays
+        # are read-only copies: changing one in place would leave stale plans behind
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, np.ndarray):
+                v = v.copy()
+                v.setflags(write=False)
+                object.__setattr__(self, f.name, v)
 
     @property
     def notes(self) -> tuple[str, ...]:
