@@ -300,19 +300,19 @@ class Diagnosis:
         held_off = sorted(e for e, on in (self.metadata.get("acts_on") or {}).items() if q_model not in on)
         effects = {e: v for e, v in effects.items() if e not in held_off}
         estimates = [r for r in fit.estimates() if r["name"].split(".", 1)[0] not in held_off]
-        notes = []
+        notes, lead = [], []
         if held_off:
             notes.append(f"this file is the model of {q_model}; {', '.join(held_off)} acted only on "
                          + "; ".join(f"{e}: {', '.join(self.metadata['acts_on'][e])}" for e in held_off)
                          + " in the diagnosis and is left out")
         bad = [r for r in self.per_quantity if r.get("misfit")]
-        if bad:                             # a misfit in one quantity is a misfit of the model
-            notes.append("a misfit remains in " + "; ".join(
+        if bad:                             # a misfit in one quantity is a misfit of the model, said first
+            lead.append("a misfit remains in " + "; ".join(
                 f"{r['quantity']} (cost {r['cost_after']:.4g}, expected {r['expected_after']:.4g}, above its χ² band)"
-                for r in bad))
+                for r in bad) + "; pooled over every quantity")
             verdict = _replace(verdict, adequate=False)
-        if notes:
-            verdict = _replace(verdict, reason=f"{verdict.reason.rstrip('.')}; " + "; ".join(notes))
+        if notes or lead:
+            verdict = _replace(verdict, reason="; ".join([": ".join(lead + [verdict.reason.rstrip(".")])] + notes))
         if self.next_measurement is not None:         # the later commands that read the file say it too
             verdict = _replace(verdict, reason=f"{verdict.reason.rstrip('.')}. {self.next_measurement.message}")
         if provenance is None:
