@@ -44,9 +44,9 @@ from ..data.sweep import FrequencySweep
 from ..data.units import QUANTITY_UNITS, UNITS
 from ..effects import DEFAULT_QUANTITY, get_effect
 from ..errors import DataFormatError, IPMCError
+from .frf_estimate import NEPER_TO_DB
 from .residuals import noise_std, standardised_residuals
 
-_DB_PER_NP = 20.0 / math.log(10.0)
 #: Robust spread: σ ≈ MAD_SCALE · median |x − median| of Gaussian x; here of differences with median 0.
 MAD_SCALE = 1.4826
 #: Differences beyond this many robust σ are left out of the (otherwise RMS) estimate: the RMS is
@@ -176,7 +176,7 @@ class JointData:
         for s, sg in zip(self.sweeps, sigmas):
             if sg is not None:
                 n = s.frequency_hz.size
-                s = replace(s, magnitude_std_db=np.full(n, sg[0] * _DB_PER_NP), phase_std_deg=np.full(n, math.degrees(sg[1])))
+                s = replace(s, magnitude_std_db=np.full(n, sg[0] * NEPER_TO_DB), phase_std_deg=np.full(n, math.degrees(sg[1])))
             out.append(s)
         return _build(tuple(out), self.quantities, tuple(noise))
 
@@ -208,7 +208,7 @@ class JointData:
             exp_b, exp_a = n - 0.5 * n_free_before * n / N, n - 0.5 * n_free_after * n / N
             dof = max(2 * exp_a, 1.0)
             rows.append({"quantity": q, "lines": int(n), "unit": f"{s.output_unit}/{s.input_unit}", "noise": nz,
-                         "sigma_db_median": float(np.median(s_ln) * _DB_PER_NP),
+                         "sigma_db_median": float(np.median(s_ln) * NEPER_TO_DB),
                          "sigma_deg_median": float(np.degrees(np.median(s_ph))),
                          "cost_before": cb, "expected_before": exp_b, "cost_after": ca, "expected_after": exp_a,
                          "z_after": (ca - exp_a) / math.sqrt(max(exp_a, 1e-12)),
@@ -221,7 +221,7 @@ def _build(sweeps: tuple, quantities: tuple, noise: tuple) -> JointData:
     cat = lambda name: np.concatenate([getattr(s, name) for s in sweeps])  # noqa: E731
     sd = [noise_std(s) for s in sweeps]
     stacked = StackedSweep(cat("temperature_c"), cat("frequency_hz"), cat("response"),
-                           np.concatenate([x[0] for x in sd]) * _DB_PER_NP, np.degrees(np.concatenate([x[1] for x in sd])),
+                           np.concatenate([x[0] for x in sd]) * NEPER_TO_DB, np.degrees(np.concatenate([x[1] for x in sd])),
                            "+".join(s.input_name for s in sweeps), "1", "+".join(s.output_name for s in sweeps), "1",
                            {"quantities": list(quantities), "block_sizes": [s.frequency_hz.size for s in sweeps],
                             "noise": list(noise), "units": [f"{s.output_unit}/{s.input_unit}" for s in sweeps]})
