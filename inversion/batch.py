@@ -249,10 +249,11 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     :func:`feedforward` (3 V limit by default); for decoding, :func:`decode_sensor` (limits on
     request); or :func:`inversion.limits.check_limits` on ``result.output``.
     """
-    ua = as_signal(u)
+    rule = preview_rule(preview)
+    # preview="auto" checks the signal finite in the pass that copies it (auto_preview_passes)
+    ua = as_signal(u, finite=rule != "auto")
     ta, dt = time_base(t, ua)
     split = as_split(model, improper, filter_bandwidth, dt)
-    rule = preview_rule(preview)
     choice = None
     finite = False
     if chunk_size is None:
@@ -264,7 +265,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         # the causal pass, the preview certified from exact values of the full inverse at a few
         # samples, then the finite-preview anticausal pass (see auto_preview_passes)
         passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
-                                     keep_unstable=False)
+                                     keep_unstable=False, finite_checked=False)
         choice = passes.choice
         n_prev, prev_s = choice.samples, choice.seconds
         stable, unstable, output = passes.stable, passes.unstable, passes.output

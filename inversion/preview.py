@@ -39,7 +39,7 @@ import numpy as np
 
 from ._discrete import FOHFilter, Plan, foh_matrices, left_powers, plan_for
 from ._errors import InversionError, PreviewError
-from .signals import as_signal, sampling_interval
+from .signals import as_signal, check_finite, sampling_interval, signal_snapshot
 from .split import InverseSplit, check_split_for
 
 __all__ = ["PreviewChoice", "AutoPreviewPasses", "auto_preview_passes", "choose_preview", "discrete_tail_l1",
@@ -245,21 +245,32 @@ def _anti_kernel(split: InverseSplit, dt: float, n: int) -> tuple[np.ndarray, np
     """``(h, tail)``: the sampled anticausal kernel ``h_j`` (``j < K``: ``h_0 = r_0 alpha``,
     ``h_j = r_j alpha + r_{j-1} beta``) and :func:`discrete_tail_l1`, built once per ``(dt, K)``
     and kept on the split (read-only)."""
+    return _kernel_entry(split, dt, n)[:2]
+
+
+def _kernel_entry(split: InverseSplit, dt: float, n: int) -> tuple[Any, ...]:
+    """``(h, tail, hk, rest, l1)`` for ``(dt, K)``: :func:`_anti_kernel`'s pair and the cut kernel of
+    :func:`reference_lower_bound` (the first ``M`` samples of ``h``, the l1 norm of the rest, and
+    of the whole), so that a call with a cached entry costs no pass over the kernel."""
+    cache = split.__dict__.get("_kernel_cache")
+    lengths = split.__dict__.get("_kernel_lengths")
+    if cache is None or lengths is None:
+        cache, lengths = {}, {}
+        object.__setattr__(split, "_kernel_cache", cache)
+        object.__setattr__(split, "_kernel_lengths", lengths)
     plan = plan_for(split, dt, None)
     Phi, al, be = plan.anti_phi, plan.anti_alpha, plan.anti_beta
     m = Phi.shape[0]
-    rho = float(np.max(np.abs(np.linalg.eigvals(Phi)))) if m else 0.0
-    K = n
-    if 0.0 < rho < 1.0:
-        K = min(n, int(math.ceil(50.0 / -math.log(rho))) + 10 * m)
-    K = max(K, 1)
+    kmax = lengths.get(float(dt))
+    if kmax is None:            # the kernel's length at dt, whatever the record's (-1: unbounded)
+        rho = float(np.max(np.abs(np.linalg.eigvals(Phi)))) if m else 0.0
+        kmax = int(math.ceil(50.0 / -math.log(rho))) + 10 * m if 0.0 < rho < 1.0 else -1
+        lengths[float(dt)] = kmax
+    K = max(min(n, kmax) if kmax >= 0 else n, 1)
     key = (float(dt), K)
-    cache = split.__dict__.get("_kernel_cache")
-    if cache is None:
-        cache = {}
-        object.__setattr__(split, "_kernel_cache", cache)
-    if key in cache:
-        return cache[key]
+    entry = cache.get(key)
+    if entry is not None:
+        return entry
     rows = left_powers(plan.anti_C, Phi, K) if m else np.zeros((K, 0))
     ra, rb = rows @ al, rows @ be
     h = ra.copy()
@@ -269,12 +280,20 @@ def _anti_kernel(split: InverseSplit, dt: float, n: int) -> tuple[np.ndarray, np
     tail = np.empty(K + 1)
     tail[:K] = np.abs(ra) + suffix
     tail[K] = 0.0
-    h.flags.writeable = False
-    tail.flags.writeable = False
+    # the kernel of the reference, cut where the rest of its l1 norm is below 1e-6 of the whole
+    full = np.cumsum(np.abs(h)[::-1])[::-1]
+    l1 = float(full[0])
+    cut = np.flatnonzero(full <= 1e-6 * l1)
+    M = int(cut[0]) if cut.size else h.size
+    rest = float(full[M]) if M < h.size else 0.0
+    hk = h[:M].copy()
+    for a in (h, tail, hk):
+        a.flags.writeable = False
+    entry = (h, tail, hk, rest, l1)
     if len(cache) >= _KERNEL_CACHE_SIZE:
-        cache.pop(next(iter(cache)), None)
-    cache[key] = (h, tail)
-    return h, tail
+        cache.pop(next(iter(cache), None), None)
+    cache[key] = entry
+    return entry
 
 
 @dataclass(frozen=True, eq=False)
@@ -395,13 +414,8 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
     n = ua.size
     if split.n_unstable == 0 or umax == 0.0:
         return _peak(stable)
-    h, _ = _anti_kernel(split, dt, n)
-    suffix = np.cumsum(np.abs(h)[::-1])[::-1]
-    l1 = float(suffix[0])
-    cut = np.flatnonzero(suffix <= 1e-6 * l1)
-    M = int(cut[0]) if cut.size else h.size
-    rest = float(suffix[M]) if M < h.size else 0.0
-    hk = h[:M]
+    _, _, hk, rest, l1 = _kernel_entry(split, dt, n)
+    M = hk.size
     probes = np.unique(np.concatenate((
         np.linspace(0, n - 1, REFERENCE_PROBES).astype(np.intp),
         extremes or (int(np.argmax(ua)), int(np.argmin(ua))), np.arange(max(0, n - 8), n))))
@@ -416,7 +430,7 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
 
 def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: float = DEFAULT_PREVIEW_TOL,
                         norm: str = "linf", chunk: int | None = None,
-                        keep_unstable: bool = True) -> AutoPreviewPasses:
+                        keep_unstable: bool = True, finite_checked: bool = True) -> AutoPreviewPasses:
     """Choose the automatic preview for the validated signal ``ua`` and invert it (see
     :func:`choose_preview`).
 
@@ -427,16 +441,24 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     the full anticausal pass (for ``||y_inf||_2``) and the truncation error of the chosen
     preview, whose sums are the inverse.  ``chunk``: samples per pass block (default: whole).
     ``keep_unstable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
+    ``finite_checked=False``: ``ua`` was not yet checked finite (it is checked here, on the
+    ``"linf"`` path in the pass that copies it, see below).
+
+    The errors read later are those of the signal inverted now, whatever happens to the caller's
+    array or to the result's afterwards, so the ``"linf"`` path keeps a copy of ``ua``; it is made
+    by :func:`~inversion.signals.signal_snapshot` in the same pass that finds the peak of ``ua``
+    (for the bound) and its extremes (probes of the reference) and checks it finite.
     """
     _check_tolerance(tol, norm)
     n = ua.size
     chunk = n if chunk is None else int(chunk)
     plan0 = plan_for(split, dt, None)
     if norm == "l2" and chunk >= n:
-        return _auto_l2(split, dt, ua, plan0, tol)
+        return _auto_l2(split, dt, ua if finite_checked else check_finite(ua), plan0, tol)
+    ua_copy, imax, imin = signal_snapshot(ua)
+    extremes = (imax, imin)
     stable = plan0.causal(ua, chunk)
-    extremes = (int(np.argmax(ua)), int(np.argmin(ua)))
-    umax = max(float(ua[extremes[0]]), -float(ua[extremes[1]]))
+    umax = max(float(ua_copy[imax]), -float(ua_copy[imin]))
     size_u = umax if norm == "linf" else float(np.sqrt(np.dot(ua, ua)))
     if norm == "linf":
         ref = reference_lower_bound(split, dt, ua, stable, umax, extremes)
@@ -454,12 +476,12 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     plan = plan_for(split, dt, N)
     sums: list[float] = []
     stable, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums)
-    ua = ua.copy()      # ua may be the caller's own array: the errors are of the signal inverted now
 
     def errors() -> tuple[float, float, float]:
-        # from the signal alone (the result's arrays, or the caller's input, may have been changed since)
-        minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
-        y_inf = plan0.run(ua, ua.size)[2]
+        # from the copy of the signal inverted (the result's arrays, or the caller's input, may have
+        # been changed since)
+        minus_e = _truncation_head(split, dt, ua_copy, N)     # -e_N[:n - N]; e_N is zero beyond
+        y_inf = plan0.run(ua_copy, ua_copy.size)[2]
         size = _peak if norm == "linf" else (lambda e: float(np.sqrt(np.dot(e, e))))
         r = size(y_inf)
         emax = _peak(minus_e) if minus_e.size else 0.0
