@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import FOHFilter, Plan, foh_matrices, left_powers, plan_for
+from ._discrete import Plan, left_powers, plan_for
 from ._errors import InversionError, PreviewError
 from .signals import as_signal, check_finite, sampling_interval, signal_snapshot
 from .split import InverseSplit, check_split_for
@@ -214,11 +214,11 @@ def _truncation_head(split: InverseSplit, dt: float, u: np.ndarray, N: int) -> n
     n = u.size
     if split.n_unstable == 0 or N >= n:
         return np.zeros(0)
-    Phi, al, be = foh_matrices(-split.A_u, split.B_u, dt)
-    C2 = -split.C_u @ np.linalg.matrix_power(Phi, N)
+    anti = plan_for(split, dt, None).anti
+    C2 = anti.C @ np.linalg.matrix_power(anti.Phi, N)
     if not np.any(C2):
         return np.zeros(n - N)
-    f = FOHFilter.build(Phi, al, be, C2)
+    f = anti.with_row(C2)
     return f.run(u[N:][::-1], f.zi0())[0][::-1]
 
 
