@@ -268,3 +268,27 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
     # the 4/r0 rule asks for tens of volts and misses by more than the reference itself
     assert vr > 10 * vi and er > 0.3
     assert ffa.preview_s > 2.5 * ffa.auto_preview_s                   # measured 0.124 vs 0.034 s
+
+
+def test_signal_snapshot_is_a_copy_with_numpys_extremes_and_refuses_non_finite_samples():
+    # oracle: np.argmax / np.argmin of the whole record (first occurrence) and np.isfinite
+    from inversion import NonFiniteSignalError
+    from inversion.signals import SNAPSHOT_BLOCK, signal_snapshot
+
+    rng = np.random.default_rng(8)
+    n = 3 * SNAPSHOT_BLOCK + 17
+    u = rng.standard_normal(n)
+    # ties across blocks: the first occurrence wins, as for np.argmax
+    u[[5, SNAPSHOT_BLOCK + 3, 2 * SNAPSHOT_BLOCK + 1]] = 9.0
+    u[[SNAPSHOT_BLOCK - 1, 3 * SNAPSHOT_BLOCK + 2]] = -9.0
+    c, i, j = signal_snapshot(u)
+    assert c is not u and np.array_equal(c, u)
+    assert (i, j) == (int(np.argmax(u)), int(np.argmin(u))) == (5, SNAPSHOT_BLOCK - 1)
+    for bad in (np.nan, np.inf, -np.inf):
+        v = u.copy()
+        v[2 * SNAPSHOT_BLOCK + 40] = bad
+        v[3 * SNAPSHOT_BLOCK + 1] = np.nan
+        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * SNAPSHOT_BLOCK + 40} is"):
+            signal_snapshot(v)
+        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * SNAPSHOT_BLOCK + 40} is"):
+            invert(toy_actuator(), DT, v)            # preview='auto' checks in the snapshot
