@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 import scipy.signal as sig
 
+from ._norms import expm_small
 from ._sections import FusedPass, sos_sections
 from .split import InverseSplit
 
@@ -73,35 +74,6 @@ FUSED_BLOCK = 1 << 16
 
 #: Plans kept per split (the most recently built ones, by sampling interval and preview).
 PLAN_CACHE_SIZE = 8
-
-
-def expm_small(A: np.ndarray) -> np.ndarray:
-    """Matrix exponential of a small dense matrix: Taylor scaling and squaring, matmuls only.
-
-    ``A`` is scaled by ``2**-s`` to 1-norm <= 1, the degree-20 Taylor polynomial is
-    evaluated by Horner's rule (truncation error <= e/21! ~ 5e-20 relative) and squared ``s``
-    times.  Against 40-digit ``mpmath.expm`` it is as accurate as ``scipy.linalg.expm`` on the
-    FOH matrices of the inverses and on random 2x2..5x5 matrices (largest error 7e-14 of the
-    largest entry, vs 2e-11 for scipy's Pade).  It is used instead of ``scipy.linalg.expm``
-    because it calls no LAPACK routine: with a threaded OpenBLAS, the LU factorisation inside
-    the Pade step wakes the BLAS worker threads, which then busy-wait and, on a machine whose
-    other cores are busy, halve the speed of the filtering that follows (measured: the whole
-    inversion ran 2x slower).
-    """
-    A = np.asarray(A, dtype=float)
-    n = A.shape[0]
-    eye = np.eye(n)
-    if n == 0:
-        return eye
-    norm = float(np.max(np.sum(np.abs(A), axis=0)))
-    s = int(np.ceil(np.log2(norm))) if norm > 1.0 else 0
-    X = A / 2.0 ** s
-    E = eye.copy()
-    for k in range(20, 0, -1):
-        E = eye + (X @ E) / k
-    for _ in range(s):
-        E = E @ E
-    return E
 
 
 def foh_matrices(M: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
