@@ -15,9 +15,10 @@ of the kernel, :func:`discrete_tail_l1`) computed for every ``N`` at once from t
 for the max norm a lower bound of ``max|y_inf|`` from the exact values of ``y_inf`` at a few
 samples (:func:`reference_lower_bound`, multiply-adds over the kernel, no pass), so
 ``invert(preview="auto")`` costs the causal pass and the finite-preview anticausal pass of the
-chosen preview — what inverting with that preview given costs — and the exact error of ``N``
-(one more anticausal pass, plus the full inverse for the relative error) is computed only when
-it is read.  For the l2 norm ``||y_inf||_2`` itself is computed (the full inverse, then one more
+chosen preview — what inverting with that preview given costs — plus one copy of the signal
+(:func:`~inversion.signals.signal_snapshot`, which also finds its peak and checks it finite), and
+the exact error of ``N`` (one more anticausal pass, plus the full inverse for the relative error)
+is computed from that copy only when it is read.  For the l2 norm ``||y_inf||_2`` itself is computed (the full inverse, then one more
 anticausal pass for the exact error; the three passes sum to the finite-preview inverse).
 The bound is tight for a signal that follows the sign pattern of the kernel's tail; for a
 sinusoid it gives away the ratio of the tail's l1 norm to its gain at that frequency, i.e. a
