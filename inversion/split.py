@@ -346,8 +346,22 @@ class InverseSplit:
         return V @ R.T
 
     def truncation_factors(self, T: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(V, R)`` with :meth:`truncation_terms` ``= V @ R.T``: the rows ``V[i] = exp(-A_u T_i) B_u``
-        (real, shape (m, n_u)) and ``R[k] = C_u (j w_k I - A_u)^{-1}`` (complex, shape (k, n_u))."""
+        """``(V, R)`` with :meth:`truncation_terms` ``= V @ R.T`` (for an anticausal part).
+
+        Parameters
+        ----------
+        T : ndarray, shape (m,)
+            Previews [s] (``inf`` gives 0).
+        w : ndarray, shape (k,)
+            Angular frequencies [rad/s].
+
+        Returns
+        -------
+        V : ndarray, shape (m, n_u)
+            Rows ``exp(-A_u T_i) B_u`` (real).
+        R : ndarray of complex, shape (k, n_u)
+            Rows ``C_u (j w_k I - A_u)^{-1}``.
+        """
         n = self.n_unstable
         # rows R(w) = C_u (j w I - A_u)^{-1}, one batched solve (transpose system)
         lhs = (1j * w)[:, None, None] * np.eye(n) - self.A_u
