@@ -25,7 +25,7 @@ from .preview import (
     resolve_preview,
     truncation_error,
 )
-from .signals import as_signal, as_split, sampling_interval, time_base
+from .signals import as_signal, as_split, check_finite, sampling_interval, time_base
 from .split import InverseSplit
 
 __all__ = [
@@ -250,37 +250,44 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     request); or :func:`inversion.limits.check_limits` on ``result.output``.
     """
     rule = preview_rule(preview)
-    # preview="auto" checks the signal finite in the pass that copies it (auto_preview_passes)
-    ua = as_signal(u, finite=rule != "auto")
+    # the signal is proved finite in a pass made anyway: preview="auto" in the one that copies it
+    # (auto_preview_passes), any other preview by the sum of the output (below): every input sample
+    # reaches its own output sample through the causal pass's b0 * u[k] (computed even for b0 = 0,
+    # and 0 * NaN, 0 * inf are NaN), so a finite output proves a finite input
+    ua = as_signal(u, finite=False)
     ta, dt = time_base(t, ua)
     split = as_split(model, improper, filter_bandwidth, dt)
-    choice = None
-    finite = False
     if chunk_size is None:
         chunk_size = ua.size
     if not (isinstance(chunk_size, int | np.integer) and chunk_size > 0):
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
     chunk = int(chunk_size)
-    if rule == "auto":
-        # the causal pass, the preview certified from exact values of the full inverse at a few
-        # samples, then the finite-preview anticausal pass (see auto_preview_passes)
-        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
-                                     keep_unstable=False, finite_checked=False)
-        choice = passes.choice
-        n_prev, prev_s = choice.samples, choice.seconds
-        stable, unstable, output = passes.stable, passes.unstable, passes.output
-        finite = passes.finite
-        plan = passes.plan
-    else:
-        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
-        plan = plan_for(split, dt, n_prev)
-        # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
-        sums: list[float] = []
-        stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums)
-        finite = math.isfinite(sums[0])
+    choice = None
+    # a non-finite input sample, or an overflow, is refused below with its index (numpy's warnings
+    # on the way, e.g. inf - inf in the output's sum, would only announce it)
+    with np.errstate(invalid="ignore", over="ignore"):
+        if rule == "auto":
+            # the causal pass, the preview certified from exact values of the full inverse at a
+            # few samples, then the finite-preview anticausal pass (see auto_preview_passes)
+            passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
+                                         keep_unstable=False, finite_checked=False)
+            choice = passes.choice
+            n_prev, prev_s = choice.samples, choice.seconds
+            stable, unstable, output = passes.stable, passes.unstable, passes.output
+            finite = passes.finite
+            plan = passes.plan
+        else:
+            n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
+            plan = plan_for(split, dt, n_prev)
+            # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
+            sums: list[float] = []
+            stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums)
+            finite = math.isfinite(sums[0])
     # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
     # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
-    # element-wise check
+    # element-wise check, of the input first (a bad input sample is named as as_signal names it)
+    if not finite:
+        check_finite(ua)
     bad = None if finite else ~np.isfinite(output)
     if bad is not None and bad.any():
         i = int(np.flatnonzero(bad)[0])

@@ -606,14 +606,19 @@ def stream_section(args):
         S = plan.stable.run(u, plan.stable.zi0())[0]
         fp, N, n = plan.fused, plan.n_preview, u.size
         h1, h2 = fp.reach(fp.fir1), fp.reach(fp.fir2)
-        up = np.concatenate((u, np.zeros(N + max(h1, h2) + 1)))
+
+        def seg(lo, hi):          # u[lo:hi], zero beyond the record (no padded copy of the record)
+            if hi <= n:
+                return u[lo:hi]
+            return np.concatenate((u[min(lo, n):n], np.zeros(hi - max(lo, n))))
+
         zi = fp.zi0()
         out = np.empty(n)
         for c1 in range(n, 0, -FB):
             c0 = max(0, c1 - FB)
-            q = fp.correlate(up[c0:c1 + h1], fp.fir1)
+            q = fp.correlate(seg(c0, c1 + h1), fp.fir1)
             if c0 + N < n:
-                q -= fp.correlate(up[c0 + N:c1 + N + h2], fp.fir2)
+                q -= fp.correlate(seg(c0 + N, c1 + N + h2), fp.fir2)
             w, zi = fp.all_pole(q[::-1], zi)
             np.add(S[c0:c1], w[::-1], out=out[c0:c1])
         return out
