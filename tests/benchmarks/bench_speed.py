@@ -89,7 +89,7 @@ stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilte
         issue-29 goal of 0.3 for auto is out of reach with scipy's filters.  Streaming chunk 4096 ÷
         batch went 1.48 -> 1.63 (NOT met, ≤ 1.5): the streaming inverter's ns/sample is unchanged,
         the batch it is compared with got faster.
-        2026-11-26, issue 29 (branch h-auto 46e9eb9 against main f5fe250 via ``--root``, ``--clock
+        2026-11-26, issue 29 (branch h-auto 46e9eb9 against main e3c9b1d, inversion as at f5fe250, via ``--root``, ``--clock
         thread``, 3 alternating runs, load ~2 on 2 cores; per run at 1 / 5 / 20 kHz):
         ``preview='auto'`` 20.4/20.7/22.2, 18.3/17.8/18.9, 16.9/17.8/20.2 -> 17.5/18.5/18.5,
         16.3/16.5/16.4, 16.0/16.6/16.3 ns/sample; lfilter ÷ auto 0.27/0.28/0.27 (main's lfilter ran at
