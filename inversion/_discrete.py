@@ -399,8 +399,8 @@ class Plan:
         return parts["s"]
 
     def run(self, ua: np.ndarray, chunk: int, stable: np.ndarray | None = None,
-            keep_unstable: bool = True,
-            output_sum: list[float] | None = None) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
+            keep_unstable: bool = True, output_sum: list[float] | None = None,
+            keep_stable: bool = True) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
         """``(stable, unstable, output)`` of this plan's inverse of the in-memory record ``ua``,
         ``chunk`` samples at a time.  ``stable``: the causal part if it was already computed
         (it does not depend on the preview), else computed here.
@@ -414,6 +414,12 @@ class Plan:
         ``output_sum``: a list to which the sum of ``output`` is appended (a finite sum proves
         every sample finite); on the block-wise path it is summed block by block while each
         block is in cache, instead of reading the whole output once more.
+
+        ``keep_stable=False`` (with ``keep_unstable=False``): on the block-wise path the output is
+        written over the causal part's array (``stable``, the caller's if given), which is then
+        not returned (None): one record-sized array fewer, and no fresh memory to fault in for
+        it.  :meth:`run` with ``keep_unstable=True`` and the same ``chunk`` recomputes both parts
+        bit for bit (``stable + unstable`` is what was written).
         """
         n = ua.size
         if stable is None:
@@ -427,7 +433,8 @@ class Plan:
             return stable, whole[0], _summed(stable + whole[0], output_sum)
         # block by block (chunked, or the fused finite-preview pass): write the results while
         # the block is in cache
-        output = np.empty(n)
+        in_place = not (keep_unstable or keep_stable)
+        output = stable if in_place else np.empty(n)
         if not keep_unstable:
             total = [0.0]
 
@@ -441,7 +448,7 @@ class Plan:
             self.backward(ua, n, chunk, put_o)
             if output_sum is not None:
                 output_sum.append(total[0])
-            return stable, None, output
+            return (None if in_place else stable), None, output
         unstable = np.empty(n)
 
         def put_b(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:

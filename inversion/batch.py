@@ -71,7 +71,9 @@ class InversionResult(SampledRecord):
         The reconstruction ``H[u]`` = ``stable_part + unstable_part`` [model input units,
         e.g. mm for a sensor, V for an actuator].
     stable_part : ndarray
-        Causal contribution: feedthrough, polynomial (derivative) part and ``H_s[u]``.
+        Causal contribution: feedthrough, polynomial (derivative) part and ``H_s[u]``.  When the
+        anticausal pass ran block by block the output was written over it, and it is recomputed
+        when first read, as ``unstable_part`` is (below; both in the same passes).
     unstable_part : ndarray
         Anticausal contribution ``H_u[u]`` (truncated to the preview when it is finite).
         When the anticausal pass ran block by block (a finite preview, or ``chunk_size``) it
@@ -112,11 +114,17 @@ class InversionResult(SampledRecord):
     unstable_source : ndarray or tuple
         Where ``unstable_part`` comes from: the array itself, or the ``(plan, chunk)`` that
         recomputes it from ``input`` (internal; read ``unstable_part``) [model input units].
+    stable_source : ndarray or None
+        The causal part itself, or None when it is recomputed with ``unstable_part``
+        (internal; read ``stable_part``) [model input units].
+    signal_copy : ndarray or None
+        The copy of the input that ``preview="auto"`` keeps (internal): the parts are then
+        recomputed from it, so that they are those of the signal inverted even if the caller
+        reuses its array [model output units].
     """
 
     input: np.ndarray
     output: np.ndarray
-    stable_part: np.ndarray
     preview_s: float
     preview_samples: int | None
     r0: float
@@ -130,11 +138,22 @@ class InversionResult(SampledRecord):
     limit_report: Any = None
     #: the anticausal part, or ``(plan, chunk)`` that recomputes it (see ``unstable_part``)
     unstable_source: Any = field(default=None, repr=False)
+    #: the causal part, or None: recomputed with the anticausal part (see ``stable_part``)
+    stable_source: np.ndarray | None = field(default=None, repr=False)
+    #: preview="auto"'s copy of the input, which the parts are recomputed from (see ``stable_part``)
+    signal_copy: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def notes(self) -> tuple[str, ...]:
         """What the inversion changed in the model (see the class doc)."""
         return self.split.notes
+
+    @property
+    def stable_part(self) -> np.ndarray:
+        """Causal contribution (see the class doc)."""
+        if self.stable_source is not None:
+            return self.stable_source
+        return self._parts[0]
 
     @cached_property
     def unstable_part(self) -> np.ndarray:
@@ -142,14 +161,29 @@ class InversionResult(SampledRecord):
         src = self.unstable_source
         if isinstance(src, np.ndarray):
             return src
+        return self._parts[1]
+
+    @cached_property
+    def _parts(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(stable_part, unstable_part)`` recomputed from the input (the copy ``preview="auto"``
+        keeps, else ``input``) by the passes that made ``output``, checked to sum to it bit for bit."""
+        src = self.unstable_source
+        if isinstance(src, np.ndarray):        # only the causal part was not kept
+            raise InversionError("internal: a kept anticausal part without its causal part")  # pragma: no cover
         plan, chunk = src
-        unstable = plan.anticausal(self.input, chunk)
-        if not np.array_equal(self.stable_part + unstable, self.output):
+        u = self.signal_copy if self.signal_copy is not None else self.input
+        stable = self.stable_source
+        if stable is None:
+            stable, unstable, _ = plan.run(u, chunk)
+        else:
+            unstable = plan.anticausal(u, chunk)
+        if not np.array_equal(stable + unstable, self.output):
             raise InversionError(
-                "unstable_part is recomputed from result.input when first read, and that input no "
-                "longer gives result.output: the input array was modified in place after the "
-                "inversion; invert a copy (or read unstable_part before modifying it)")
-        return unstable
+                "the stable and unstable parts are recomputed from result.input when first read, and "
+                "that input no longer gives result.output: the input array (or result.output) was "
+                "modified in place after the inversion; invert a copy (or read stable_part and "
+                "unstable_part before modifying them)")
+        return stable, unstable
 
     @cached_property
     def truncation_error(self) -> float:
@@ -270,10 +304,11 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             # the causal pass, the preview certified from exact values of the full inverse at a
             # few samples, then the finite-preview anticausal pass (see auto_preview_passes)
             passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
-                                         keep_unstable=False, finite_checked=False)
+                                         keep_unstable=False, finite_checked=False, keep_stable=False)
             choice = passes.choice
             n_prev, prev_s = choice.samples, choice.seconds
             stable, unstable, output = passes.stable, passes.unstable, passes.output
+            signal_copy = passes.signal
             finite = passes.finite
             plan = passes.plan
         else:
@@ -281,8 +316,10 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             plan = plan_for(split, dt, n_prev)
             # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
             sums: list[float] = []
-            stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums)
+            stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums,
+                                                keep_stable=False)
             finite = math.isfinite(sums[0])
+            signal_copy = None
     # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
     # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
     # element-wise check, of the input first (a bad input sample is named as as_signal names it)
@@ -295,7 +332,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
             "scale the signal to the model's units")
     return InversionResult(
-        input=ua, output=output, stable_part=stable,
+        input=ua, output=output, stable_source=stable, signal_copy=signal_copy,
         unstable_source=unstable if unstable is not None else (plan, chunk),
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),

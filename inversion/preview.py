@@ -405,8 +405,9 @@ class AutoPreviewPasses:
     Attributes
     ----------
     choice : PreviewChoice
-    stable : ndarray
-        Causal part (feedthrough, polynomial part and ``H_s[u]``).
+    stable : ndarray or None
+        Causal part (feedthrough, polynomial part and ``H_s[u]``); None when the output was
+        written over it (``keep_stable=False``): ``plan.run(signal, chunk)`` recomputes it exactly.
     unstable : ndarray or None
         Anticausal part truncated to the chosen preview; None when it was not kept
         (``keep_unstable=False``): ``plan.anticausal(ua, chunk)`` recomputes it exactly.
@@ -418,14 +419,17 @@ class AutoPreviewPasses:
     plan : Plan or None
         The plan of the chosen preview that produced ``unstable``/``output`` (None on the
         ``"l2"`` path, whose ``unstable`` is always kept).
+    signal : ndarray or None
+        The copy of the signal the errors are computed from (the ``"linf"`` and chunked paths).
     """
 
     choice: PreviewChoice
-    stable: np.ndarray
+    stable: np.ndarray | None
     unstable: np.ndarray | None
     output: np.ndarray
     finite: bool = False
     plan: Plan | None = None
+    signal: np.ndarray | None = None
 
 
 #: Probes of the full inverse for the linf reference: equally spaced samples, plus the extremes
@@ -465,7 +469,8 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
 
 def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: float = DEFAULT_PREVIEW_TOL,
                         norm: str = "linf", chunk: int | None = None,
-                        keep_unstable: bool = True, finite_checked: bool = True) -> AutoPreviewPasses:
+                        keep_unstable: bool = True, finite_checked: bool = True,
+                        keep_stable: bool = True) -> AutoPreviewPasses:
     """Choose the automatic preview for the validated signal ``ua`` and invert it (see
     :func:`choose_preview`).
 
@@ -476,6 +481,7 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     the full anticausal pass (for ``||y_inf||_2``) and the truncation error of the chosen
     preview, whose sums are the inverse.  ``chunk``: samples per pass block (default: whole).
     ``keep_unstable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
+    ``keep_stable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
     ``finite_checked=False``: ``ua`` was not yet checked finite (it is checked here, on the
     ``"linf"`` path in the pass that copies it, see below).
 
@@ -510,7 +516,8 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         tail_n = float(tail[min(N, tail.size - 1)])
     plan = plan_for(split, dt, N)
     sums: list[float] = []
-    stable, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums)
+    stable_kept, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums,
+                                             keep_stable=keep_stable)
 
     def errors() -> tuple[float, float, float]:
         # from the copy of the signal inverted (the result's arrays, or the caller's input, may have
@@ -527,7 +534,8 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
-    return AutoPreviewPasses(choice, stable, unstable, output, finite=math.isfinite(sums[0]), plan=plan)
+    return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(sums[0]), plan=plan,
+                             signal=ua_copy)
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float) -> AutoPreviewPasses:
