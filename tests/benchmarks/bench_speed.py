@@ -89,25 +89,27 @@ stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilte
         issue-29 goal of 0.3 for auto is out of reach with scipy's filters.  Streaming chunk 4096 ÷
         batch went 1.48 -> 1.63 (NOT met, ≤ 1.5): the streaming inverter's ns/sample is unchanged,
         the batch it is compared with got faster.
-        2026-11-26, issue 29 (branch h-auto 46e9eb9 against main e3c9b1d, inversion as at f5fe250, via ``--root``, ``--clock
-        thread``, 3 alternating runs, load ~2 on 2 cores; per run at 1 / 5 / 20 kHz):
-        ``preview='auto'`` 20.4/20.7/22.2, 18.3/17.8/18.9, 16.9/17.8/20.2 -> 17.5/18.5/18.5,
-        16.3/16.5/16.4, 16.0/16.6/16.3 ns/sample; lfilter ÷ auto 0.27/0.28/0.27 (main's lfilter ran at
-        5.5-5.9 ns there, 4.5-4.7 elsewhere), 0.24/0.25/0.24, 0.27/0.26/0.24 -> 0.26/0.25/0.24,
-        0.28/0.28/0.27, 0.28/0.28/0.29 (goal 0.3 NOT met); auto ÷ chosen 1.19/1.14/1.18 ->
-        1.17/1.17/1.18 at 1 kHz, 1.10-1.26 overall (the chosen preview got faster too: its own
-        filters' floor 15.0-16.4 -> 13.6-14.1 ns, lfilter ÷ floor 0.32-0.34).  What went: at 1 and
-        5 kHz the automatic preview's fused pass ran ``sosfilt`` (the truncated kernel's numerator
-        from ``ss2tf`` of a row 1.6e-3 of the full one failed the accuracy check; now built from the
-        unit rows, ``FOHFilter.with_row``), a sum pass and argmax/argmin passes over the input
-        (now one block-wise pass that also makes the copy the errors need), a sum pass for the
-        given previews (the output's sum proves the input finite).  What stays: the copy of the
-        signal, 1-3 ns/sample with its fresh memory (the errors read later must be those of the
-        signal inverted even if the caller reuses its array, a tested promise), and the reference's
-        probes (0.2-0.4 ns).  Streaming chunk 4096 ÷ batch 1.46/1.45/1.47 -> 0.90/0.86/0.91
-        (35.4-37.9 -> 20.2-21.2 ns/sample; goal ≤ 1.5 met): a third of a 2^20-sample stream was
-        building the inverter, 9 ms of it the signal-independent automatic preview (now 0.8 ms);
-        chunk 1: 2590-2855 -> 2134-2350 ns/sample.
+        2026-11-26, issue 29 (branch h-auto 2b91f15 against main e3c9b1d, inversion as at f5fe250,
+        via ``--root``, ``--clock thread``, 3 alternating runs, load ~2.5 on 2 cores; per run at
+        1 / 5 / 20 kHz): ``preview='auto'`` 19.7/19.2/21.0, 17.2/17.0/17.5, 17.3/16.4/17.9 ->
+        14.0/13.2/14.6, 13.9/13.1/14.2, 15.1/14.5/15.9 ns/sample; lfilter ÷ auto 0.29/0.28/0.27
+        (main's lfilter ran at 5.4-5.7 ns there, 4.3-4.8 elsewhere), 0.26/0.26/0.26, 0.27/0.28/0.27
+        -> 0.30/0.33/0.30, 0.31/0.33/0.31, 0.29/0.30/0.28 (goal 0.3: met at 1 and 5 kHz, not
+        robustly at 20 kHz, whose anticausal poles cluster near z = 1 and need second-order
+        sections: sosfilt is ~1.3 ns/sample slower than lfilter); auto ÷ chosen 1.12-1.20 ->
+        1.07-1.18; lfilter ÷ given 0.31-0.35 -> 0.31-0.37.  What went: at 1 and 5 kHz the automatic
+        preview's fused pass ran ``sosfilt`` (the truncated kernel's numerator from ``ss2tf`` of a
+        row 1.6e-3 of the full one failed the accuracy check; now built from the unit rows,
+        ``FOHFilter.with_row``); a sum pass and argmax/argmin passes over the input (now one
+        block-wise pass that also makes the copy the errors need); for every preview a sum pass
+        over the input (the output's sum proves it finite) and the separate output array (written
+        over the causal part, which is recomputed when read).  What stays for auto: the copy of the
+        signal (the errors read later must be those of the signal inverted even if the caller
+        reuses its array, a tested promise) and the reference's probes (0.2-0.4 ns/sample).
+        Streaming chunk 4096 ÷ batch 1.47/1.53/1.50 -> 0.99/1.02/1.01 (36.5/35.7/38.7 ->
+        20.9/19.7/19.9 ns/sample, while the batch got faster too; goal ≤ 1.5 met): a third of a
+        2^20-sample stream was building the inverter, 9 ms of it the signal-independent automatic
+        preview (now 0.8 ms); chunk 1: 2474-2586 -> 2071-2123 ns/sample.
 """
 
 from __future__ import annotations
