@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 import scipy.signal as sig
 
+from ._norms import expm_small
 from ._sections import FusedPass, sos_sections
 from .split import InverseSplit
 
@@ -73,35 +74,6 @@ FUSED_BLOCK = 1 << 16
 
 #: Plans kept per split (the most recently built ones, by sampling interval and preview).
 PLAN_CACHE_SIZE = 8
-
-
-def expm_small(A: np.ndarray) -> np.ndarray:
-    """Matrix exponential of a small dense matrix: Taylor scaling and squaring, matmuls only.
-
-    ``A`` is scaled by ``2**-s`` to 1-norm <= 1, the degree-20 Taylor polynomial is
-    evaluated by Horner's rule (truncation error <= e/21! ~ 5e-20 relative) and squared ``s``
-    times.  Against 40-digit ``mpmath.expm`` it is as accurate as ``scipy.linalg.expm`` on the
-    FOH matrices of the inverses and on random 2x2..5x5 matrices (largest error 7e-14 of the
-    largest entry, vs 2e-11 for scipy's Pade).  It is used instead of ``scipy.linalg.expm``
-    because it calls no LAPACK routine: with a threaded OpenBLAS, the LU factorisation inside
-    the Pade step wakes the BLAS worker threads, which then busy-wait and, on a machine whose
-    other cores are busy, halve the speed of the filtering that follows (measured: the whole
-    inversion ran 2x slower).
-    """
-    A = np.asarray(A, dtype=float)
-    n = A.shape[0]
-    eye = np.eye(n)
-    if n == 0:
-        return eye
-    norm = float(np.max(np.sum(np.abs(A), axis=0)))
-    s = int(np.ceil(np.log2(norm))) if norm > 1.0 else 0
-    X = A / 2.0 ** s
-    E = eye.copy()
-    for k in range(20, 0, -1):
-        E = eye + (X @ E) / k
-    for _ in range(s):
-        E = E @ E
-    return E
 
 
 def foh_matrices(M: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -161,24 +133,43 @@ class FOHFilter:
         n = Phi.shape[0]
         Bd = Phi @ alpha + beta
         Dd = float(C @ alpha) + float(D_extra)
-        theta = np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0]))
-        zs = np.exp(1j * theta)
-        eye = np.eye(n)
-        # (zI - Phi)^-1 Bd at all test points with one batched solve
-        rhs = np.broadcast_to(Bd.astype(complex)[:, None], (zs.size, n, 1))
-        exact = np.linalg.solve(zs[:, None, None] * eye - Phi, rhs)[..., 0] @ C + Dd
-        ref = np.maximum(np.abs(exact), 1e-300)
+        zs = _TEST_POINTS
+        exact = _exact_response(Phi, Bd, C, Dd, zs)
         bb, aa = sig.ss2tf(Phi, Bd.reshape(n, 1), C.reshape(1, n), np.array([[Dd]]))
         b = np.atleast_1d(np.asarray(bb, float)[0])
         a = np.asarray(aa, float)
-        zinv = 1.0 / zs
-        tf_val = np.polyval(b[::-1], zinv) / np.polyval(a[::-1], zinv)
-        # relative to the largest response: deviations far below it do not matter
-        scale = float(np.max(np.abs(exact)))
-        if np.all(np.abs(tf_val - exact) <= 1e-10 * np.maximum(ref, 1e-3 * scale)):
+        if _tf_accurate(b, a, zs, exact):
             return cls(Phi=Phi, alpha=alpha, beta=beta, C=C, D=Dd, b=b, a=a, sos=None)
         sos = sos_sections(Phi, Bd, C, Dd, zs, exact)
         return cls(Phi=Phi, alpha=alpha, beta=beta, C=C, D=Dd, b=None, a=None, sos=sos)
+
+    def with_row(self, C2: np.ndarray) -> FOHFilter:
+        """The filter of the same recursion with the output row ``C2`` (no extra feedthrough).
+
+        The transfer-function numerator is linear in the output row, so it is formed as
+        ``sum_i C2[i] b_i`` from the numerators ``b_i`` of the unit rows (one ``ss2tf`` with
+        ``C = I``), over this filter's denominator: its error scales with ``C2``.  ``ss2tf`` of
+        ``C2`` itself subtracts polynomials of order one to get a numerator of the size of
+        ``C2``; for the truncated kernel's row ``C_r Phi**N`` of a long preview (``|C2|`` 1.6e-3
+        of ``|C_r|``) that lost the 1e-10 accuracy checked here, and the filter fell back to
+        second-order sections: the fused finite-preview pass then ran ``sosfilt`` instead of
+        ``lfilter`` (the automatic previews at 1 and 5 kHz of the seed 000 sensor).  The result is
+        checked as in :meth:`build` and built by :meth:`build` if it fails.
+        """
+        n = self.order
+        C2 = np.asarray(C2, dtype=float)
+        if self.sos is None and n:
+            Bd = self.Phi @ self.alpha + self.beta
+            D2 = float(C2 @ self.alpha)
+            zs = _TEST_POINTS
+            exact = _exact_response(self.Phi, Bd, C2, D2, zs)
+            basis = np.asarray(sig.ss2tf(self.Phi, Bd.reshape(n, 1), np.eye(n), self.alpha.reshape(n, 1))[0],
+                               float)
+            b = C2 @ basis
+            if _tf_accurate(b, self.a, zs, exact):
+                return FOHFilter(Phi=self.Phi, alpha=self.alpha, beta=self.beta, C=C2, D=D2, b=b, a=self.a,
+                                 sos=None)
+        return FOHFilter.build(self.Phi, self.alpha, self.beta, C2)
 
     @property
     def order(self) -> int:
@@ -186,10 +177,7 @@ class FOHFilter:
 
     def response(self, zs: np.ndarray) -> np.ndarray:
         """Exact frequency response ``C (zI - Phi)^-1 Bd + Dd`` at the points ``zs``."""
-        n = self.order
-        rhs = np.broadcast_to((self.Phi @ self.alpha + self.beta).astype(complex)[:, None],
-                              (zs.size, n, 1))
-        return np.linalg.solve(zs[:, None, None] * np.eye(n) - self.Phi, rhs)[..., 0] @ self.C + self.D
+        return _exact_response(self.Phi, self.Phi @ self.alpha + self.beta, self.C, self.D, zs)
 
     @property
     def kind(self) -> str:
@@ -211,6 +199,28 @@ class FOHFilter:
         if self.sos is None:
             return sig.lfilter(self.b, self.a, X, axis=1)
         return sig.sosfilt(self.sos, X, axis=1)
+
+
+#: Points of the unit circle where a realization is checked against the exact response: a
+#: logarithmic grid down to 1e-7 of the Nyquist frequency, and z = 1.
+_TEST_POINTS = np.exp(1j * np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0])))
+
+
+def _exact_response(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray) -> np.ndarray:
+    """``C (zI - Phi)^-1 Bd + Dd`` at the points ``zs`` (one batched solve)."""
+    n = Phi.shape[0]
+    rhs = np.broadcast_to(Bd.astype(complex)[:, None], (zs.size, n, 1))
+    return np.linalg.solve(zs[:, None, None] * np.eye(n) - Phi, rhs)[..., 0] @ C + Dd
+
+
+def _tf_accurate(b: np.ndarray, a: np.ndarray, zs: np.ndarray, exact: np.ndarray) -> bool:
+    """The transfer function ``b/a`` (ascending powers of 1/z) is within 1e-10 of ``exact`` at ``zs``,
+    relative to each value or, where it is far below the largest, to 1e-3 of the largest."""
+    zinv = 1.0 / zs
+    tf_val = np.polyval(b[::-1], zinv) / np.polyval(a[::-1], zinv)
+    ref = np.maximum(np.abs(exact), 1e-300)
+    scale = float(np.max(np.abs(exact)))
+    return bool(np.all(np.abs(tf_val - exact) <= 1e-10 * np.maximum(ref, 1e-3 * scale)))
 
 
 def left_powers(row: np.ndarray, Phi: np.ndarray, count: int) -> np.ndarray:
@@ -297,7 +307,7 @@ class Plan:
             if n_preview is not None:
                 C2 = Cr @ np.linalg.matrix_power(Phi, n_preview)
                 if np.any(C2 != 0):
-                    self.anti_tail = FOHFilter.build(Phi, al, be, C2)
+                    self.anti_tail = self.anti.with_row(C2)
         #: the fused finite-preview backward pass (:class:`FusedPass`), or None (module doc)
         self.fused: FusedPass | None = None
         t1, t2 = self.anti, self.anti_tail
@@ -389,8 +399,8 @@ class Plan:
         return parts["s"]
 
     def run(self, ua: np.ndarray, chunk: int, stable: np.ndarray | None = None,
-            keep_unstable: bool = True,
-            output_sum: list[float] | None = None) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
+            keep_unstable: bool = True, output_sum: list[float] | None = None,
+            keep_stable: bool = True) -> tuple[np.ndarray | None, np.ndarray | None, np.ndarray]:
         """``(stable, unstable, output)`` of this plan's inverse of the in-memory record ``ua``,
         ``chunk`` samples at a time.  ``stable``: the causal part if it was already computed
         (it does not depend on the preview), else computed here.
@@ -404,6 +414,12 @@ class Plan:
         ``output_sum``: a list to which the sum of ``output`` is appended (a finite sum proves
         every sample finite); on the block-wise path it is summed block by block while each
         block is in cache, instead of reading the whole output once more.
+
+        ``keep_stable=False`` (with ``keep_unstable=False``): on the block-wise path the output is
+        written over the causal part's array (``stable``, the caller's if given), which is then
+        not returned (None): one record-sized array fewer, and no fresh memory to fault in for
+        it.  :meth:`run` with ``keep_unstable=True`` and the same ``chunk`` recomputes both parts
+        bit for bit (``stable + unstable`` is what was written).
         """
         n = ua.size
         if stable is None:
@@ -417,7 +433,8 @@ class Plan:
             return stable, whole[0], _summed(stable + whole[0], output_sum)
         # block by block (chunked, or the fused finite-preview pass): write the results while
         # the block is in cache
-        output = np.empty(n)
+        in_place = not (keep_unstable or keep_stable)
+        output = stable if in_place else np.empty(n)
         if not keep_unstable:
             total = [0.0]
 
@@ -431,7 +448,7 @@ class Plan:
             self.backward(ua, n, chunk, put_o)
             if output_sum is not None:
                 output_sum.append(total[0])
-            return stable, None, output
+            return (None if in_place else stable), None, output
         unstable = np.empty(n)
 
         def put_b(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:

@@ -25,7 +25,7 @@ from .preview import (
     resolve_preview,
     truncation_error,
 )
-from .signals import as_signal, as_split, sampling_interval, time_base
+from .signals import as_signal, as_split, check_finite, sampling_interval, time_base
 from .split import InverseSplit
 
 __all__ = [
@@ -71,7 +71,9 @@ class InversionResult(SampledRecord):
         The reconstruction ``H[u]`` = ``stable_part + unstable_part`` [model input units,
         e.g. mm for a sensor, V for an actuator].
     stable_part : ndarray
-        Causal contribution: feedthrough, polynomial (derivative) part and ``H_s[u]``.
+        Causal contribution: feedthrough, polynomial (derivative) part and ``H_s[u]``.  When the
+        anticausal pass ran block by block the output was written over it, and it is recomputed
+        when first read, as ``unstable_part`` is (below; both in the same passes).
     unstable_part : ndarray
         Anticausal contribution ``H_u[u]`` (truncated to the preview when it is finite).
         When the anticausal pass ran block by block (a finite preview, or ``chunk_size``) it
@@ -112,11 +114,17 @@ class InversionResult(SampledRecord):
     unstable_source : ndarray or tuple
         Where ``unstable_part`` comes from: the array itself, or the ``(plan, chunk)`` that
         recomputes it from ``input`` (internal; read ``unstable_part``) [model input units].
+    stable_source : ndarray or None
+        The causal part itself, or None when it is recomputed with ``unstable_part``
+        (internal; read ``stable_part``) [model input units].
+    signal_copy : ndarray or None
+        The copy of the input that ``preview="auto"`` keeps (internal): the parts are then
+        recomputed from it, so that they are those of the signal inverted even if the caller
+        reuses its array [model output units].
     """
 
     input: np.ndarray
     output: np.ndarray
-    stable_part: np.ndarray
     preview_s: float
     preview_samples: int | None
     r0: float
@@ -130,11 +138,22 @@ class InversionResult(SampledRecord):
     limit_report: Any = None
     #: the anticausal part, or ``(plan, chunk)`` that recomputes it (see ``unstable_part``)
     unstable_source: Any = field(default=None, repr=False)
+    #: the causal part, or None: recomputed with the anticausal part (see ``stable_part``)
+    stable_source: np.ndarray | None = field(default=None, repr=False)
+    #: preview="auto"'s copy of the input, which the parts are recomputed from (see ``stable_part``)
+    signal_copy: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def notes(self) -> tuple[str, ...]:
         """What the inversion changed in the model (see the class doc)."""
         return self.split.notes
+
+    @property
+    def stable_part(self) -> np.ndarray:
+        """Causal contribution (see the class doc)."""
+        if self.stable_source is not None:
+            return self.stable_source
+        return self._parts[0]
 
     @cached_property
     def unstable_part(self) -> np.ndarray:
@@ -142,14 +161,29 @@ class InversionResult(SampledRecord):
         src = self.unstable_source
         if isinstance(src, np.ndarray):
             return src
+        return self._parts[1]
+
+    @cached_property
+    def _parts(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(stable_part, unstable_part)`` recomputed from the input (the copy ``preview="auto"``
+        keeps, else ``input``) by the passes that made ``output``, checked to sum to it bit for bit."""
+        src = self.unstable_source
+        if isinstance(src, np.ndarray):        # only the causal part was not kept
+            raise InversionError("internal: a kept anticausal part without its causal part")  # pragma: no cover
         plan, chunk = src
-        unstable = plan.anticausal(self.input, chunk)
-        if not np.array_equal(self.stable_part + unstable, self.output):
+        u = self.signal_copy if self.signal_copy is not None else self.input
+        stable = self.stable_source
+        if stable is None:
+            stable, unstable, _ = plan.run(u, chunk)
+        else:
+            unstable = plan.anticausal(u, chunk)
+        if not np.array_equal(stable + unstable, self.output):
             raise InversionError(
-                "unstable_part is recomputed from result.input when first read, and that input no "
-                "longer gives result.output: the input array was modified in place after the "
-                "inversion; invert a copy (or read unstable_part before modifying it)")
-        return unstable
+                "the stable and unstable parts are recomputed from result.input when first read, and "
+                "that input no longer gives result.output: the input array (or result.output) was "
+                "modified in place after the inversion; invert a copy (or read stable_part and "
+                "unstable_part before modifying them)")
+        return stable, unstable
 
     @cached_property
     def truncation_error(self) -> float:
@@ -249,37 +283,48 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     :func:`feedforward` (3 V limit by default); for decoding, :func:`decode_sensor` (limits on
     request); or :func:`inversion.limits.check_limits` on ``result.output``.
     """
-    ua = as_signal(u)
+    rule = preview_rule(preview)
+    # the signal is proved finite in a pass made anyway: preview="auto" in the one that copies it
+    # (auto_preview_passes), any other preview by the sum of the output (below): every input sample
+    # reaches its own output sample through the causal pass's b0 * u[k] (computed even for b0 = 0,
+    # and 0 * NaN, 0 * inf are NaN), so a finite output proves a finite input
+    ua = as_signal(u, finite=False)
     ta, dt = time_base(t, ua)
     split = as_split(model, improper, filter_bandwidth, dt)
-    rule = preview_rule(preview)
-    choice = None
-    finite = False
     if chunk_size is None:
         chunk_size = ua.size
     if not (isinstance(chunk_size, int | np.integer) and chunk_size > 0):
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
     chunk = int(chunk_size)
-    if rule == "auto":
-        # the causal pass, the preview certified from exact values of the full inverse at a few
-        # samples, then the finite-preview anticausal pass (see auto_preview_passes)
-        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
-                                     keep_unstable=False)
-        choice = passes.choice
-        n_prev, prev_s = choice.samples, choice.seconds
-        stable, unstable, output = passes.stable, passes.unstable, passes.output
-        finite = passes.finite
-        plan = passes.plan
-    else:
-        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
-        plan = plan_for(split, dt, n_prev)
-        # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
-        sums: list[float] = []
-        stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums)
-        finite = math.isfinite(sums[0])
+    choice = None
+    # a non-finite input sample, or an overflow, is refused below with its index (numpy's warnings
+    # on the way, e.g. inf - inf in the output's sum, would only announce it)
+    with np.errstate(invalid="ignore", over="ignore"):
+        if rule == "auto":
+            # the causal pass, the preview certified from exact values of the full inverse at a
+            # few samples, then the finite-preview anticausal pass (see auto_preview_passes)
+            passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
+                                         keep_unstable=False, finite_checked=False, keep_stable=False)
+            choice = passes.choice
+            n_prev, prev_s = choice.samples, choice.seconds
+            stable, unstable, output = passes.stable, passes.unstable, passes.output
+            signal_copy = passes.signal
+            finite = passes.finite
+            plan = passes.plan
+        else:
+            n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
+            plan = plan_for(split, dt, n_prev)
+            # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
+            sums: list[float] = []
+            stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums,
+                                                keep_stable=False)
+            finite = math.isfinite(sums[0])
+            signal_copy = None
     # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
     # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
-    # element-wise check
+    # element-wise check, of the input first (a bad input sample is named as as_signal names it)
+    if not finite:
+        check_finite(ua)
     bad = None if finite else ~np.isfinite(output)
     if bad is not None and bad.any():
         i = int(np.flatnonzero(bad)[0])
@@ -287,7 +332,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
             "scale the signal to the model's units")
     return InversionResult(
-        input=ua, output=output, stable_part=stable,
+        input=ua, output=output, stable_source=stable, signal_copy=signal_copy,
         unstable_source=unstable if unstable is not None else (plan, chunk),
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),

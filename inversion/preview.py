@@ -15,9 +15,10 @@ of the kernel, :func:`discrete_tail_l1`) computed for every ``N`` at once from t
 for the max norm a lower bound of ``max|y_inf|`` from the exact values of ``y_inf`` at a few
 samples (:func:`reference_lower_bound`, multiply-adds over the kernel, no pass), so
 ``invert(preview="auto")`` costs the causal pass and the finite-preview anticausal pass of the
-chosen preview — what inverting with that preview given costs — and the exact error of ``N``
-(one more anticausal pass, plus the full inverse for the relative error) is computed only when
-it is read.  For the l2 norm ``||y_inf||_2`` itself is computed (the full inverse, then one more
+chosen preview — what inverting with that preview given costs — plus one copy of the signal
+(:func:`~inversion.signals.signal_snapshot`, which also finds its peak and checks it finite), and
+the exact error of ``N`` (one more anticausal pass, plus the full inverse for the relative error)
+is computed from that copy only when it is read.  For the l2 norm ``||y_inf||_2`` itself is computed (the full inverse, then one more
 anticausal pass for the exact error; the three passes sum to the finite-preview inverse).
 The bound is tight for a signal that follows the sign pattern of the kernel's tail; for a
 sinusoid it gives away the ratio of the tail's l1 norm to its gain at that frequency, i.e. a
@@ -37,9 +38,9 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import FOHFilter, Plan, foh_matrices, left_powers, plan_for
+from ._discrete import Plan, left_powers, plan_for
 from ._errors import InversionError, PreviewError
-from .signals import as_signal, sampling_interval
+from .signals import as_signal, check_finite, sampling_interval, signal_snapshot
 from .split import InverseSplit, check_split_for
 
 __all__ = ["PreviewChoice", "AutoPreviewPasses", "auto_preview_passes", "choose_preview", "discrete_tail_l1",
@@ -99,7 +100,7 @@ def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
     w, H = w[keep], H[keep]
     step = 0.05 / split.r0
     T = step * np.arange(2001)                    # up to 100/r0 (exp(-100) of the kernel)
-    ratio = np.max(np.abs(split.truncation_terms(T, w)) / H, axis=1)
+    ratio = _preview_ratios(split, T, w, H, tol)
     bad = np.flatnonzero(ratio > tol)
     if bad.size == 0:
         return 0.0, float(ratio[0])
@@ -109,6 +110,40 @@ def frequency_preview(split: InverseSplit, tol: float = DEFAULT_PREVIEW_TOL, *,
             f"no finite preview up to 100/r0 = {T[-1]:.4g} s brings the truncation error below "
             f"{tol:g} of the inverse (best {ratio[-1]:.3g}); use preview='inf'")
     return float(T[i]), float(np.max(ratio[i:]))
+
+
+def _preview_ratios(split: InverseSplit, T: np.ndarray, w: np.ndarray, H: np.ndarray, tol: float) -> np.ndarray:
+    """``max_w |E_T(j w)| / |H(j w)|`` for each ``T``, exactly wherever it can exceed ``tol`` and
+    wherever it can be the largest of the previews at and after the first that meets ``tol``;
+    elsewhere an upper bound that is at most ``tol`` and at most that largest value, so that
+    :func:`frequency_preview` answers as from the exact ratios everywhere.
+
+    ``E_T(j w) = R(w) . V_T`` (:meth:`InverseSplit.truncation_factors`), so by Cauchy-Schwarz
+    ``ratio(T) <= c ||V_T||`` with ``c = max_w ||R(w)|| / |H(w)|``: the exact ratio (a row of the
+    (previews x frequencies) product) is needed only where that bound exceeds ``tol`` and, after the
+    last preview that fails, where it exceeds the largest exact ratio found there (a few hundred of
+    the 2001 previews instead of all of them: the product was most of the cost of the automatic
+    streaming preview).
+    """
+    V, R = split.truncation_factors(T, w)
+
+    def exact(rows: np.ndarray) -> np.ndarray:
+        return np.max(np.abs(V[rows] @ R.T) / H, axis=1)
+
+    upper = float(np.max(np.linalg.norm(R, axis=1) / H)) * np.linalg.norm(V, axis=1)
+    ratio = upper.copy()
+    done = upper > tol
+    done[0] = True                  # the no-preview ratio is reported when no preview is needed
+    rows = np.flatnonzero(done)
+    ratio[rows] = exact(rows)
+    fail = rows[ratio[rows] > tol]
+    first_ok = int(fail[-1]) + 1 if fail.size else 0
+    if first_ok < T.size:
+        top = float(np.max(ratio[first_ok:], where=done[first_ok:], initial=0.0))
+        more = first_ok + np.flatnonzero(~done[first_ok:] & (upper[first_ok:] > top))
+        if more.size:
+            ratio[more] = exact(more)
+    return ratio
 
 
 
@@ -214,11 +249,11 @@ def _truncation_head(split: InverseSplit, dt: float, u: np.ndarray, N: int) -> n
     n = u.size
     if split.n_unstable == 0 or N >= n:
         return np.zeros(0)
-    Phi, al, be = foh_matrices(-split.A_u, split.B_u, dt)
-    C2 = -split.C_u @ np.linalg.matrix_power(Phi, N)
+    anti = plan_for(split, dt, None).anti
+    C2 = anti.C @ np.linalg.matrix_power(anti.Phi, N)
     if not np.any(C2):
         return np.zeros(n - N)
-    f = FOHFilter.build(Phi, al, be, C2)
+    f = anti.with_row(C2)
     return f.run(u[N:][::-1], f.zi0())[0][::-1]
 
 
@@ -245,21 +280,32 @@ def _anti_kernel(split: InverseSplit, dt: float, n: int) -> tuple[np.ndarray, np
     """``(h, tail)``: the sampled anticausal kernel ``h_j`` (``j < K``: ``h_0 = r_0 alpha``,
     ``h_j = r_j alpha + r_{j-1} beta``) and :func:`discrete_tail_l1`, built once per ``(dt, K)``
     and kept on the split (read-only)."""
+    return _kernel_entry(split, dt, n)[:2]
+
+
+def _kernel_entry(split: InverseSplit, dt: float, n: int) -> tuple[Any, ...]:
+    """``(h, tail, hk, rest, l1)`` for ``(dt, K)``: :func:`_anti_kernel`'s pair and the cut kernel of
+    :func:`reference_lower_bound` (the first ``M`` samples of ``h``, the l1 norm of the rest, and
+    of the whole), so that a call with a cached entry costs no pass over the kernel."""
+    cache = split.__dict__.get("_kernel_cache")
+    lengths = split.__dict__.get("_kernel_lengths")
+    if cache is None or lengths is None:
+        cache, lengths = {}, {}
+        object.__setattr__(split, "_kernel_cache", cache)
+        object.__setattr__(split, "_kernel_lengths", lengths)
     plan = plan_for(split, dt, None)
     Phi, al, be = plan.anti_phi, plan.anti_alpha, plan.anti_beta
     m = Phi.shape[0]
-    rho = float(np.max(np.abs(np.linalg.eigvals(Phi)))) if m else 0.0
-    K = n
-    if 0.0 < rho < 1.0:
-        K = min(n, int(math.ceil(50.0 / -math.log(rho))) + 10 * m)
-    K = max(K, 1)
+    kmax = lengths.get(float(dt))
+    if kmax is None:            # the kernel's length at dt, whatever the record's (-1: unbounded)
+        rho = float(np.max(np.abs(np.linalg.eigvals(Phi)))) if m else 0.0
+        kmax = int(math.ceil(50.0 / -math.log(rho))) + 10 * m if 0.0 < rho < 1.0 else -1
+        lengths[float(dt)] = kmax
+    K = max(min(n, kmax) if kmax >= 0 else n, 1)
     key = (float(dt), K)
-    cache = split.__dict__.get("_kernel_cache")
-    if cache is None:
-        cache = {}
-        object.__setattr__(split, "_kernel_cache", cache)
-    if key in cache:
-        return cache[key]
+    entry = cache.get(key)
+    if entry is not None:
+        return entry
     rows = left_powers(plan.anti_C, Phi, K) if m else np.zeros((K, 0))
     ra, rb = rows @ al, rows @ be
     h = ra.copy()
@@ -269,12 +315,20 @@ def _anti_kernel(split: InverseSplit, dt: float, n: int) -> tuple[np.ndarray, np
     tail = np.empty(K + 1)
     tail[:K] = np.abs(ra) + suffix
     tail[K] = 0.0
-    h.flags.writeable = False
-    tail.flags.writeable = False
+    # the kernel of the reference, cut where the rest of its l1 norm is below 1e-6 of the whole
+    full = np.cumsum(np.abs(h)[::-1])[::-1]
+    l1 = float(full[0])
+    cut = np.flatnonzero(full <= 1e-6 * l1)
+    M = int(cut[0]) if cut.size else h.size
+    rest = float(full[M]) if M < h.size else 0.0
+    hk = h[:M].copy()
+    for a in (h, tail, hk):
+        a.flags.writeable = False
+    entry = (h, tail, hk, rest, l1)
     if len(cache) >= _KERNEL_CACHE_SIZE:
-        cache.pop(next(iter(cache)), None)
-    cache[key] = (h, tail)
-    return h, tail
+        cache.pop(next(iter(cache), None), None)
+    cache[key] = entry
+    return entry
 
 
 @dataclass(frozen=True, eq=False)
@@ -351,8 +405,9 @@ class AutoPreviewPasses:
     Attributes
     ----------
     choice : PreviewChoice
-    stable : ndarray
-        Causal part (feedthrough, polynomial part and ``H_s[u]``).
+    stable : ndarray or None
+        Causal part (feedthrough, polynomial part and ``H_s[u]``); None when the output was
+        written over it (``keep_stable=False``): ``plan.run(signal, chunk)`` recomputes it exactly.
     unstable : ndarray or None
         Anticausal part truncated to the chosen preview; None when it was not kept
         (``keep_unstable=False``): ``plan.anticausal(ua, chunk)`` recomputes it exactly.
@@ -364,14 +419,17 @@ class AutoPreviewPasses:
     plan : Plan or None
         The plan of the chosen preview that produced ``unstable``/``output`` (None on the
         ``"l2"`` path, whose ``unstable`` is always kept).
+    signal : ndarray or None
+        The copy of the signal the errors are computed from (the ``"linf"`` and chunked paths).
     """
 
     choice: PreviewChoice
-    stable: np.ndarray
+    stable: np.ndarray | None
     unstable: np.ndarray | None
     output: np.ndarray
     finite: bool = False
     plan: Plan | None = None
+    signal: np.ndarray | None = None
 
 
 #: Probes of the full inverse for the linf reference: equally spaced samples, plus the extremes
@@ -395,13 +453,8 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
     n = ua.size
     if split.n_unstable == 0 or umax == 0.0:
         return _peak(stable)
-    h, _ = _anti_kernel(split, dt, n)
-    suffix = np.cumsum(np.abs(h)[::-1])[::-1]
-    l1 = float(suffix[0])
-    cut = np.flatnonzero(suffix <= 1e-6 * l1)
-    M = int(cut[0]) if cut.size else h.size
-    rest = float(suffix[M]) if M < h.size else 0.0
-    hk = h[:M]
+    _, _, hk, rest, l1 = _kernel_entry(split, dt, n)
+    M = hk.size
     probes = np.unique(np.concatenate((
         np.linspace(0, n - 1, REFERENCE_PROBES).astype(np.intp),
         extremes or (int(np.argmax(ua)), int(np.argmin(ua))), np.arange(max(0, n - 8), n))))
@@ -416,7 +469,8 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
 
 def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: float = DEFAULT_PREVIEW_TOL,
                         norm: str = "linf", chunk: int | None = None,
-                        keep_unstable: bool = True) -> AutoPreviewPasses:
+                        keep_unstable: bool = True, finite_checked: bool = True,
+                        keep_stable: bool = True) -> AutoPreviewPasses:
     """Choose the automatic preview for the validated signal ``ua`` and invert it (see
     :func:`choose_preview`).
 
@@ -427,16 +481,25 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     the full anticausal pass (for ``||y_inf||_2``) and the truncation error of the chosen
     preview, whose sums are the inverse.  ``chunk``: samples per pass block (default: whole).
     ``keep_unstable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
+    ``keep_stable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
+    ``finite_checked=False``: ``ua`` was not yet checked finite (it is checked here, on the
+    ``"linf"`` path in the pass that copies it, see below).
+
+    The errors read later are those of the signal inverted now, whatever happens to the caller's
+    array or to the result's afterwards, so the ``"linf"`` path keeps a copy of ``ua``; it is made
+    by :func:`~inversion.signals.signal_snapshot` in the same pass that finds the peak of ``ua``
+    (for the bound) and its extremes (probes of the reference) and checks it finite.
     """
     _check_tolerance(tol, norm)
     n = ua.size
     chunk = n if chunk is None else int(chunk)
     plan0 = plan_for(split, dt, None)
     if norm == "l2" and chunk >= n:
-        return _auto_l2(split, dt, ua, plan0, tol)
+        return _auto_l2(split, dt, ua if finite_checked else check_finite(ua), plan0, tol)
+    ua_copy, imax, imin = signal_snapshot(ua)
+    extremes = (imax, imin)
     stable = plan0.causal(ua, chunk)
-    extremes = (int(np.argmax(ua)), int(np.argmin(ua)))
-    umax = max(float(ua[extremes[0]]), -float(ua[extremes[1]]))
+    umax = max(float(ua_copy[imax]), -float(ua_copy[imin]))
     size_u = umax if norm == "linf" else float(np.sqrt(np.dot(ua, ua)))
     if norm == "linf":
         ref = reference_lower_bound(split, dt, ua, stable, umax, extremes)
@@ -453,13 +516,14 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         tail_n = float(tail[min(N, tail.size - 1)])
     plan = plan_for(split, dt, N)
     sums: list[float] = []
-    stable, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums)
-    ua = ua.copy()      # ua may be the caller's own array: the errors are of the signal inverted now
+    stable_kept, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums,
+                                             keep_stable=keep_stable)
 
     def errors() -> tuple[float, float, float]:
-        # from the signal alone (the result's arrays, or the caller's input, may have been changed since)
-        minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
-        y_inf = plan0.run(ua, ua.size)[2]
+        # from the copy of the signal inverted (the result's arrays, or the caller's input, may have
+        # been changed since)
+        minus_e = _truncation_head(split, dt, ua_copy, N)     # -e_N[:n - N]; e_N is zero beyond
+        y_inf = plan0.run(ua_copy, ua_copy.size)[2]
         size = _peak if norm == "linf" else (lambda e: float(np.sqrt(np.dot(e, e))))
         r = size(y_inf)
         emax = _peak(minus_e) if minus_e.size else 0.0
@@ -470,7 +534,8 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
-    return AutoPreviewPasses(choice, stable, unstable, output, finite=math.isfinite(sums[0]), plan=plan)
+    return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(sums[0]), plan=plan,
+                             signal=ua_copy)
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float) -> AutoPreviewPasses:

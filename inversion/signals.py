@@ -18,7 +18,8 @@ from physmodel.errors import IPMCError
 from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
 from .split import InverseSplit, check_split_for, split_inverse
 
-__all__ = ["UNIFORM_RTOL", "as_signal", "as_split", "sampling_interval", "time_base"]
+__all__ = ["UNIFORM_RTOL", "as_signal", "as_split", "check_finite", "sampling_interval", "signal_snapshot",
+           "time_base", "SNAPSHOT_BLOCK"]
 
 def sampling_interval(t: Any) -> float:
     """Return the sampling interval [s] of uniformly spaced time stamps ``t`` [s] (or of a scalar
@@ -56,23 +57,68 @@ def as_split(model: Any, improper: str, filter_bandwidth: float | None, dt: floa
     return split_inverse(model, improper=improper, filter_bandwidth=filter_bandwidth, dt=dt)
 
 
-def as_signal(u: Any) -> np.ndarray:
-    """The signal as a finite 1-D float array of at least 2 samples (else a message naming the sample)."""
+def as_signal(u: Any, *, finite: bool = True) -> np.ndarray:
+    """The signal as a finite 1-D float array of at least 2 samples (else a message naming the sample).
+
+    ``finite=False`` skips the finiteness check (:func:`check_finite`) for a caller that proves it
+    otherwise in a pass it makes anyway (:func:`signal_snapshot`).
+    """
     ua = np.asarray(u, dtype=float)
     if ua.ndim != 1:
         raise InversionError(f"the signal must be 1-D; got shape {ua.shape}")
     if ua.size < 2:
         raise InversionError(f"the signal must have at least 2 samples; got {ua.size}")
+    return check_finite(ua) if finite else ua
+
+
+def check_finite(ua: np.ndarray) -> np.ndarray:
+    """``ua`` if every sample is finite, else :class:`NonFiniteSignalError` naming the first bad one."""
     # a finite sum proves every sample finite (NaN/inf propagate) without an n-sized mask;
     # only a non-finite sum (a bad sample, or overflow) needs the element-wise check
     with np.errstate(over="ignore", invalid="ignore"):
         total = float(np.add.reduce(ua))
     if math.isfinite(total):
         return ua
+    _refuse_non_finite(ua)
+    return ua
+
+
+def _refuse_non_finite(ua: np.ndarray) -> None:
     finite = np.isfinite(ua)
     if not finite.all():
         i = int(np.flatnonzero(~finite)[0])
         raise NonFiniteSignalError(
             f"the signal must be finite; sample {i} is {ua[i]!r} (NaN/inf are not allowed: "
             "fill or interpolate gaps before inverting)")
-    return ua
+
+
+#: Samples per block of :func:`signal_snapshot` (a block's extremes are found while it is in cache).
+SNAPSHOT_BLOCK = 1 << 15
+
+
+def signal_snapshot(ua: np.ndarray) -> tuple[np.ndarray, int, int]:
+    """``(copy, argmax, argmin)`` of the 1-D float signal ``ua``, checked finite, in one pass.
+
+    The copy is written block by block and each block's extremes are searched while it is in
+    cache, instead of a copy and two more passes over the record (``np.argmax``/``np.argmin``
+    treat NaN as the extreme, so finite extremes of every block prove every sample finite:
+    the check of :func:`check_finite` comes with it).  The positions are those ``np.argmax`` and
+    ``np.argmin`` of the whole record give (the first occurrence).  Raises
+    :class:`NonFiniteSignalError` as :func:`as_signal` does.
+    """
+    n = ua.size
+    out = np.empty(n)
+    imax = imin = 0
+    vmax, vmin = -math.inf, math.inf
+    for c0 in range(0, n, SNAPSHOT_BLOCK):
+        o = out[c0:c0 + SNAPSHOT_BLOCK]
+        np.copyto(o, ua[c0:c0 + SNAPSHOT_BLOCK])
+        i, j = int(np.argmax(o)), int(np.argmin(o))
+        hi, lo = float(o[i]), float(o[j])
+        if not (math.isfinite(hi) and math.isfinite(lo)):
+            _refuse_non_finite(ua)
+        if hi > vmax:
+            vmax, imax = hi, c0 + i
+        if lo < vmin:
+            vmin, imin = lo, c0 + j
+    return out, imax, imin

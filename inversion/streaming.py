@@ -333,10 +333,22 @@ class StreamingInverter:
             elif self._blocks_ok and taps.size - 1 > BLOCK_RATIO * n_out:
                 out += self._blocks(k_lo, k_hi)
             else:
-                out += p.anticausal(seg)[:n_out]
+                self._add_anticausal(seg, out)
                 self._reset_blocks()
         self._n_out = k_hi
         return out
+
+    def _add_anticausal(self, seg: np.ndarray, out: np.ndarray) -> None:
+        """``out += plan.anticausal(seg)[:out.size]`` (the same values), added block by block as the
+        backward pass makes them, without the segment-sized array of the anticausal part."""
+        n_out = out.size
+
+        def add(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+            if c0 < n_out:
+                hi = min(c1, n_out)
+                out[c0:hi] += y[:hi - c0]
+
+        self._plan.backward(seg, seg.size, max(seg.size, 1), add)
 
     # -- the two-stack block sums ---------------------------------------------------------
     def _ur(self, lo: int, hi: int) -> np.ndarray:

@@ -115,15 +115,20 @@ def bench_floor(n: int, reps: int) -> None:
         S = plan.stable.run(u, plan.stable.zi0())[0]           # causal recursion, whole record
         fp, N = plan.fused, plan.n_preview
         h1, h2 = fp.reach(fp.fir1), fp.reach(fp.fir2)
-        up = np.concatenate((u, np.zeros(N + max(h1, h2) + 1)))  # zero beyond the record
+
+        def seg(lo, hi):          # u[lo:hi], zero beyond the record (no padded copy of the record)
+            if hi <= n:
+                return u[lo:hi]
+            return np.concatenate((u[min(lo, n):n], np.zeros(hi - max(lo, n))))
+
         zi = fp.zi0()
         out = np.empty(n) if stage >= 3 else None
         for c1 in range(n, 0, -FUSED_BLOCK):
             c0 = max(0, c1 - FUSED_BLOCK)
             if stage >= 2:                                     # the two correlations
-                q = fp.correlate(up[c0:c1 + h1], fp.fir1)
+                q = fp.correlate(seg(c0, c1 + h1), fp.fir1)
                 if c0 + N < n:
-                    q -= fp.correlate(up[c0 + N:c1 + N + h2], fp.fir2)
+                    q -= fp.correlate(seg(c0 + N, c1 + N + h2), fp.fir2)
             else:
                 q = u[c0:c1]
             w, zi = fp.all_pole(q[::-1], zi)                    # anticausal recursion

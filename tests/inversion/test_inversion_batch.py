@@ -286,3 +286,25 @@ def test_control_transfer_function_and_split_inputs_agree():
     c = invert(control.ss(seed000_sensor_35c()), 1e-3, u)
     np.testing.assert_array_equal(a.output, b.output)
     np.testing.assert_allclose(c.output, a.output, rtol=0, atol=1e-7 * np.max(np.abs(a.output)))
+
+
+@pytest.mark.parametrize("model, kwargs", [
+    (NMP, dict(preview="4/r0")),                                     # fused finite-preview pass
+    (NMP, dict(preview="inf")),                                      # whole-record passes
+    (NMP, dict(preview=0.05, chunk_size=700)),                       # block by block
+    (NMP, dict(preview="auto")),                                     # the snapshot's check
+    ((np.poly([-50.0, -500.0]), np.poly([-10.0, -100.0])), dict(preview="inf")),   # causal only
+    (([100.0], [1.0, 14.0, 100.0]), dict(improper="differentiate")),               # stencil, D = 0
+    ((np.array([1.0, -30.0]), np.array([1.0, 40.0])), dict(preview=0.05)),          # no stable part
+])
+@pytest.mark.parametrize("where", [0, 777, 2999])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_a_non_finite_input_sample_is_named_whatever_the_path(model, kwargs, where, bad):
+    # the input is proved finite by the output's sum (or the auto preview's snapshot), not by a
+    # pass of its own: every path must still refuse a bad sample and name it (oracle: its index)
+    u = np.sin(2 * np.pi * 5e-3 * np.arange(3000))
+    u[where] = bad
+    if where < 2500:
+        u[2500] = np.nan                    # a later bad sample: the first is the one named
+    with pytest.raises(NonFiniteSignalError, match=f"the signal must be finite; sample {where} is"):
+        invert(model, 1e-3, u, **kwargs)

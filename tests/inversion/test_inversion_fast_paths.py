@@ -66,6 +66,51 @@ def test_fused_pass_transfer_function_form_at_1khz_equals_the_window_sum():
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-11 * np.max(np.abs(ref)))
 
 
+@pytest.mark.parametrize("dt, n_prev", [(1e-3, 246), (1e-3, 452), (2e-4, 1240), (2e-4, 2256)])
+def test_long_previews_keep_the_transfer_function_fused_pass_and_equal_the_window_sum(dt, n_prev):
+    # the truncated kernel's row C_r Phi**N is 1.6e-3 .. 1.2e-6 of C_r here (2.2 and 4 times the
+    # 4/r0 preview, as preview='auto' picks at 1 and 5 kHz): its transfer-function numerator must
+    # keep its accuracy relative to that row (FOHFilter.with_row), so that the fused pass stays
+    # one lfilter recursion instead of falling back to second-order sections
+    split = split_inverse(G35)
+    plan = Plan(split, dt, n_prev)
+    assert plan.anti.kind == "ba" and plan.anti_tail.kind == "ba"
+    assert plan.fused is not None and plan.fused.sos is None
+    row = np.linalg.norm(plan.anti_tail.C) / np.linalg.norm(plan.anti.C)
+    assert row < 2e-3
+    rng = np.random.default_rng(6)
+    n = n_prev + 3000
+    u = rng.standard_normal(n) + np.sin(2 * np.pi * 20 * dt * np.arange(n))
+    ref = _window_sum_oracle(split, dt, n_prev, u)
+    got = invert(split, dt, u, preview=n_prev * dt).unstable_part
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-11 * np.max(np.abs(ref)))
+    # and the truncation error alone (the tail filter's own output, preview_choice's max_error
+    # uses it) against the oracle's difference from the infinite preview
+    from inversion.preview import truncation_error
+
+    e = truncation_error(split, dt, u, n_prev)
+    e_ref = _truncation_oracle(split, dt, n_prev, u)
+    np.testing.assert_allclose(e, e_ref, rtol=0, atol=1e-11 * np.max(np.abs(e_ref)))
+
+
+def _truncation_oracle(split, dt, n_prev, u):
+    """e_N[k] = -(C_r Phi**N) x[k+N] from the explicit backward recursion (as in _window_sum_oracle,
+    without its difference of two O(1) sums, which would bury an error of 1e-8 of them)."""
+    M, B, Cr = -split.A_u, split.B_u, -split.C_u
+    m = M.shape[0]
+    big = np.zeros((m + 2, m + 2))
+    big[:m, :m], big[:m, m], big[m, m + 1] = M * dt, B * dt, 1.0
+    E = sla.expm(big)
+    Phi, alpha = E[:m, :m], E[:m, m + 1]
+    beta = E[:m, m] - alpha
+    n = u.size
+    up = np.append(u, 0.0)
+    x = np.zeros((n + n_prev + 1, m))
+    for k in range(n - 1, -1, -1):
+        x[k] = Phi @ x[k + 1] + alpha * up[k] + beta * up[k + 1]
+    return -(x[n_prev:n_prev + n] @ (Cr @ np.linalg.matrix_power(Phi, n_prev)))
+
+
 def _stream(inv, u, size):
     outs = [inv.push(u[i:i + size]) for i in range(0, u.size, size)]
     outs.append(inv.flush())

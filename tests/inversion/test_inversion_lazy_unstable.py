@@ -1,5 +1,6 @@
 """``InversionResult.unstable_part`` is recomputed when first read whenever the anticausal pass
-ran block by block (issue 29: not writing it saves a record-sized array on every inversion).
+ran block by block (issue 29: not writing it saves a record-sized array on every inversion), and
+so is ``stable_part``, over which the output is then written (one more array saved).
 
 Oracles: the plan run with the anticausal part kept (the code path as it was before), and, for
 the output itself, the explicit state recursions of the FOH discretisation (forward for the
@@ -131,3 +132,41 @@ def test_an_overflowing_inverse_is_refused_on_every_path(preview, chunk):
     u = np.random.default_rng(0).standard_normal(5000) * 1e300
     with pytest.raises(NonFiniteSignalError, match="the inverse overflowed: output sample"):
         invert(G, 1e-3, u, preview=preview, chunk_size=chunk)
+
+
+@pytest.mark.parametrize("preview", [0.113, "auto"])
+@pytest.mark.parametrize("chunk", [None, 700])
+def test_the_output_is_written_over_the_causal_part_which_is_recomputed_when_read(preview, chunk):
+    # block by block the output is written over the causal part's array (one record-sized array
+    # fewer); both parts are recomputed when read.  Oracle: the explicit state recursions.
+    split = split_inverse(G35)
+    dt = 1e-3
+    u = _signal(2600, 11)
+    res = invert(split, dt, u, preview=preview, chunk_size=chunk)
+    assert res.stable_source is None and not isinstance(res.unstable_source, np.ndarray)
+    ys, yu = _explicit_inverse(split, dt, res.preview_samples, u)
+    scale = np.max(np.abs(ys + yu))
+    np.testing.assert_allclose(res.stable_part, ys, rtol=0, atol=1e-11 * scale)
+    np.testing.assert_allclose(res.unstable_part, yu, rtol=0, atol=1e-11 * scale)
+    np.testing.assert_array_equal(res.stable_part + res.unstable_part, res.output)
+
+
+def test_automatic_preview_recomputes_the_parts_of_the_signal_inverted():
+    # preview='auto' keeps a copy of the signal (for its errors): the parts come from it, so a
+    # caller reusing its array still reads the parts of what was inverted
+    split = split_inverse(G35)
+    u = _signal(2600, 12)
+    ref = invert(split, 1e-3, u.copy())
+    res = invert(split, 1e-3, u)
+    u *= 100.0
+    np.testing.assert_array_equal(res.stable_part, ref.stable_part)
+    np.testing.assert_array_equal(res.unstable_part, ref.unstable_part)
+
+
+@pytest.mark.parametrize("preview", [0.113, "auto"])
+def test_modifying_the_output_before_reading_the_parts_is_refused(preview):
+    split = split_inverse(G35)
+    res = invert(split, 1e-3, _signal(2000, 13), preview=preview)
+    res.output[10] += 1.0
+    with pytest.raises(InversionError, match="modified in place"):
+        _ = res.stable_part

@@ -225,6 +225,30 @@ def test_frequency_rule_bounds_every_sinusoid_in_the_band():
     assert inv.preview_samples == n and s == pytest.approx(T, abs=DT / 2)
 
 
+@pytest.mark.parametrize("model", [toy_actuator(), NMP], ids=["toy-actuator", "seed000-sensor"])
+@pytest.mark.parametrize("tol", [1e-1, 1e-3, 1e-6])
+@pytest.mark.parametrize("dt", [1e-3, 5e-5])
+def test_frequency_rule_is_the_grid_rule_evaluated_everywhere(model, tol, dt):
+    # the rule skips the previews whose Cauchy-Schwarz bound already meets the tolerance; oracle:
+    # the rule's definition evaluated at every grid preview and frequency from the residues of
+    # den/num (scipy.signal.residue) and H = den/num by polyval, not from the split's realization
+    sp, r, p = _rhp_residues(model)
+    T_got, bound_got = frequency_preview(sp, tol, omega_max=math.pi / dt)
+    zmag = np.abs(sp.zeros[np.abs(sp.zeros) > 0])
+    w = np.concatenate(([0.0], np.logspace(math.log10(1e-3 * np.min(zmag)), math.log10(math.pi / dt), 256)))
+    H = np.abs(np.polyval(sp.den, 1j * w) / np.polyval(sp.num, 1j * w))
+    keep = H > 1e-12 * np.max(H)
+    w, H = w[keep], H[keep]
+    T = 0.05 / sp.r0 * np.arange(2001)
+    E = np.abs(np.sum(r[None, None, :] * np.exp(-p[None, None, :] * T[:, None, None])
+                      / (1j * w[None, :, None] - p[None, None, :]), axis=2))
+    ratio = np.max(E / H, axis=1)
+    bad = np.flatnonzero(ratio > tol)
+    i = int(bad[-1]) + 1 if bad.size else 0
+    assert T_got == pytest.approx(T[i], rel=1e-12, abs=0.0)
+    assert bound_got == pytest.approx(np.max(ratio[i:]) if bad.size else ratio[0], rel=1e-6)
+
+
 def test_minimum_phase_model_needs_no_preview():
     mp = (np.poly([-50.0, -500.0]).tolist(), np.poly([-10.0, -100.0]).tolist())
     t, d = _faded_sine(3.0)
@@ -268,3 +292,27 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
     # the 4/r0 rule asks for tens of volts and misses by more than the reference itself
     assert vr > 10 * vi and er > 0.3
     assert ffa.preview_s > 2.5 * ffa.auto_preview_s                   # measured 0.124 vs 0.034 s
+
+
+def test_signal_snapshot_is_a_copy_with_numpys_extremes_and_refuses_non_finite_samples():
+    # oracle: np.argmax / np.argmin of the whole record (first occurrence) and np.isfinite
+    from inversion import NonFiniteSignalError
+    from inversion.signals import SNAPSHOT_BLOCK, signal_snapshot
+
+    rng = np.random.default_rng(8)
+    n = 3 * SNAPSHOT_BLOCK + 17
+    u = rng.standard_normal(n)
+    # ties across blocks: the first occurrence wins, as for np.argmax
+    u[[5, SNAPSHOT_BLOCK + 3, 2 * SNAPSHOT_BLOCK + 1]] = 9.0
+    u[[SNAPSHOT_BLOCK - 1, 3 * SNAPSHOT_BLOCK + 2]] = -9.0
+    c, i, j = signal_snapshot(u)
+    assert c is not u and np.array_equal(c, u)
+    assert (i, j) == (int(np.argmax(u)), int(np.argmin(u))) == (5, SNAPSHOT_BLOCK - 1)
+    for bad in (np.nan, np.inf, -np.inf):
+        v = u.copy()
+        v[2 * SNAPSHOT_BLOCK + 40] = bad
+        v[3 * SNAPSHOT_BLOCK + 1] = np.nan
+        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * SNAPSHOT_BLOCK + 40} is"):
+            signal_snapshot(v)
+        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * SNAPSHOT_BLOCK + 40} is"):
+            invert(toy_actuator(), DT, v)            # preview='auto' checks in the snapshot
