@@ -108,7 +108,7 @@ from physmodel import get_parameter_set  # noqa: E402
 from physmodel.data.sweep import FrequencySweep  # noqa: E402
 from physmodel.estimation.discrepancy import diagnose  # noqa: E402
 from physmodel.estimation.next_measurement import merge_records, next_measurement  # noqa: E402
-from scenarios.steps_chain import CANDIDATES, _physics_free  # noqa: E402
+from scenarios.steps_chain import CANDIDATES, physics_free  # noqa: E402
 
 T_C = isn.TEMPERATURE_C
 #: Seed root of the new records' noise (not the generator's: a fresh measurement).
@@ -123,19 +123,21 @@ def start_set():
 
 def run_diagnosis(sweep, args):
     p0 = start_set()
-    return diagnose(sweep, p0, kind="sensor", free=_physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
+    return diagnose(sweep, p0, kind="sensor", free=physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)),
                     candidates=list(args.candidates), null_draws=args.null_draws, null_refits=args.null_refits,
                     baseline_starts=2, seed=1)
 
 
 def measure(truth, rec, seed: int) -> FrequencySweep:
-    """The independent sensor at the recommended lines, with its own (relative) noise, a fresh seed."""
-    f = np.asarray(rec.frequencies_hz, float)
-    H1 = isn.response(truth["base"], truth["effects"], f) * 1e3            # A/m -> uA/mm
+    """The independent sensor at the recommended lines (bath temperatures included), with its own
+    (relative) noise, a fresh seed."""
+    f = np.asarray(rec.line_frequencies_hz, float)
+    T = np.asarray(rec.line_temperatures_c, float)
+    H1 = isn.response(truth["base"], truth["effects"], f, temperature_c=T) * 1e3     # A/m -> uA/mm
     sig = truth["sigma_rel"] / math.sqrt(2.0)
     rng = np.random.default_rng([NEW_NOISE, seed])
     noisy = H1 * (1 + sig * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)))
-    return FrequencySweep(np.full(f.size, T_C), f, noisy, np.full(f.size, 20 / math.log(10) * sig),
+    return FrequencySweep(T, f, noisy, np.full(f.size, 20 / math.log(10) * sig),
                           np.full(f.size, math.degrees(sig)), "tip_displacement", "mm", "current", "uA",
                           {"source": "independent sensor generator, the recommended next measurement"})
 
@@ -202,7 +204,7 @@ def run_case(seed: int, label: str, args) -> dict:
            "first": d1.verdict, "first_named": sorted(d1.named), "second": None, "second_named": [],
            "recommended": None, "separates": None, "lam_expected": float("nan")}
     if d1.verdict in ("ambiguous", "at_bound"):
-        nm = next_measurement(d1, quantities=["S"], temperature_limits_c=(T_C, T_C),
+        nm = next_measurement(d1, quantities=["S"], temperature_limits_c=args.bath_limits_c,
                               band_limits_hz=(0.1, args.fmax_hz))
         row.update(recommended=nm.recommended.describe() if nm.recommended else None, separates=nm.separates,
                    lam_expected=nm.recommended.separation_refit if nm.recommended else float("nan"),
@@ -229,6 +231,10 @@ def main(argv=None):
                     help="library candidates (default: the sensing chain's seven, as bench_chain_detection; "
                          "actuator: contact_resistance and diffusivity_temperature)")
     ap.add_argument("--fmax-hz", type=float, default=1000.0, help="highest line the lab can measure")
+    ap.add_argument("--bath-limits-c", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                    help="sensor: bath temperatures [°C] the lab can hold for the next measurement (default: "
+                         "the library's default range, 5-65 °C within the laws' ranges; 35 35: the bath fixed "
+                         "at the record's temperature, the set-up before 2026-11-26 evening)")
     ap.add_argument("--min-ambiguous", type=int, default=0,
                     help="stop once this many ambiguous cases are scored (0: run every seed)")
     args = ap.parse_args(argv)
