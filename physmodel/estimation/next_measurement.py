@@ -322,45 +322,65 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         raise IPMCError("next_measurement: no candidate experiment within the limits")
     # a pair that no experiment separates even linearised (the same response in another form) is
     # said, and left out of the criterion: the others can still be told apart
+    key = lambda a, b: f"{label(a)} vs {label(b)}"  # noqa: E731
     best_pair = {k: max(min(r.separation_by_pair[k].values()) for r in rows) for k in rows[0].separation_by_pair}
     same_form = [k for k, v in best_pair.items() if v < SAME_FORM_LAMBDA]
-    for r in rows:
-        vals = [min(v.values()) for k, v in r.separation_by_pair.items() if k not in same_form]
-        r.separation = float(min(vals)) if vals else 0.0
-        r.power = vuong_power(r.separation, z_crit)
-    live = [(a, b) for a, b in pairs if f"{label(a)} vs {label(b)}" not in same_form]
-    ranking = sorted(rows, key=lambda r: -r.separation)
-    # among those reaching the target: within the time budget (the record's own duration, or the
-    # quickest that reaches it), the lowest drive, then the largest separation (the safest margin)
-    ok = [r for r in rows if r.separation >= target]
-    budget = max(T_data.size * PERIODS / fmin, min((r.duration_s for r in ok), default=0.0))
-    ok = sorted((r for r in ok if r.duration_s <= budget * (1 + 1e-9)), key=lambda r: (r.level, -r.separation))
-    order = ok or ranking
-    # the nonlinear check (the linearised λ overstates what a rival can reach after a full refit):
-    # the preferred experiment, then the one of largest linearised λ, then the next preferred ones
-    to_check = list(dict.fromkeys([id(r) for r in order[:1] + ranking[:1] + order[1:]]))
     by_id = {id(r): r for r in rows}
     checked: list = []
-    for rid in to_check[:max(check_refit, 0) if live else 0]:
-        r = by_id[rid]
-        r.refit_by_pair = refit_check(d, live, r, nm, max_nfev, label)
-        checked.append(r)
-    # a pair no checked experiment separates after refits is the same response in another form here
-    same_refit = [k for k in (checked[0].refit_by_pair if checked else {})
-                  if all(r.refit_by_pair[k] < SAME_FORM_LAMBDA for r in checked)]
+    same_refit: list = []
+    # the nonlinear check (the linearised λ overstates what a rival can reach after a full refit), in
+    # rounds: a pair the refits show to be the same response in another form leaves the criterion,
+    # the experiments are ranked again without it and the new preferred ones checked (otherwise one
+    # such pair — two nested forms, or a linearisation error on a quantity that cannot see the
+    # effects — ranks every experiment near 0 and the check lands on one that separates nothing)
+    for _ in range(max(len(pairs), 1)):
+        gone = same_form + same_refit
+        for r in rows:
+            vals = [min(v.values()) for k, v in r.separation_by_pair.items() if k not in gone]
+            r.separation = float(min(vals)) if vals else 0.0
+            r.power = vuong_power(r.separation, z_crit)
+        live = [(a, b) for a, b in pairs if key(a, b) not in gone]
+        ranking = sorted(rows, key=lambda r: -r.separation)
+        # among those reaching the target: within the time budget (the record's own duration, or the
+        # quickest that reaches it), the lowest drive, then the largest separation (the safest margin)
+        ok = [r for r in rows if r.separation >= target]
+        budget = max(T_data.size * PERIODS / fmin, min((r.duration_s for r in ok), default=0.0))
+        ok = sorted((r for r in ok if r.duration_s <= budget * (1 + 1e-9)), key=lambda r: (r.level, -r.separation))
+        order = ok or ranking
+        # the preferred experiment, then the one of largest linearised λ, then the next preferred ones
+        to_check = [rid for rid in dict.fromkeys([id(r) for r in order[:1] + ranking[:1] + order[1:]])
+                    if not any(id(c) == rid for c in checked)]
+        for rid in to_check[:max(check_refit, 0) if live else 0]:
+            r = by_id[rid]
+            r.refit_by_pair = refit_check(d, live, r, nm, max_nfev, label)
+            checked.append(r)
+        # a pair is the same response in another form here when every checked experiment expected
+        # (linearised) to separate it does not after the refits — one that was not expected to says nothing
+        new_same = []
+        for a, b in live:
+            k = key(a, b)
+            judged = [r for r in checked if k in r.refit_by_pair
+                      and min(r.separation_by_pair[k].values()) >= SAME_FORM_LAMBDA]
+            if judged and all(r.refit_by_pair[k] < SAME_FORM_LAMBDA for r in judged):
+                new_same.append(k)
+        same_refit += new_same
+        if not new_same:
+            break
+    live = [(a, b) for a, b in pairs if key(a, b) not in same_form + same_refit]
     for r in checked:
         vals = [v for k, v in r.refit_by_pair.items() if k not in same_refit]
         r.separation_refit = float(min(vals)) if vals else 0.0
-    good = [r for r in checked if r.separation_refit >= target]
+    done = {id(r) for r in checked}
+    good = [r for r in order if id(r) in done and r.separation_refit >= target] \
+        or [r for r in checked if r.separation_refit >= target]
     chosen = good[0] if good else (max(checked, key=lambda r: r.separation_refit) if checked else order[0])
     same_form = same_form + same_refit
-    sep_ok = bool(live) and len(same_refit) < len(live) and chosen.separation >= target \
-        and (not checked or chosen.separation_refit >= target)
+    sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
     who = " vs ".join(" + ".join(m) for m in mods)
     alike = (" Not separable within the limits (the same response in another form; best λ after refits "
              "below " f"{SAME_FORM_LAMBDA:g}): " + "; ".join(same_form) + "." if same_form else "")
-    if not live or len(same_refit) == len(live):
+    if not live:
         sep_ok = False
         msg = f"No experiment within the limits can separate {who}.{alike}"
     elif sep_ok:
