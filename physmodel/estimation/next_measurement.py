@@ -26,11 +26,17 @@ J_B the Jacobian of ln G_B in B's free parameters (the user's base parameters an
 parameters, central differences), λ_A = ‖(I − P_{J_B}) Δ‖²_W, W the diagonal weights 1/σ² of the
 stacked lines.  A measurement of the diagnosed quantity is evaluated *together with* the diagnosed
 record (the two are merged and diagnosed jointly; the rival refits to both); one of another
-quantity alone (the diagnosis takes one quantity).  Since either model may be the true one the
+quantity alone.  A joint diagnosis (several quantities of one strip, :mod:`~physmodel.estimation.joint`)
+is searched the same way with every experiment evaluated together with its whole record: a
+measurement of one of its quantities is merged into that quantity's record, one of another
+quantity is one more quantity diagnosed jointly; each keeps its own σ and the diagnosis's
+``acts_on`` (:class:`~physmodel.estimation.next_measurement_design.RecordView`).  Since either model may be the true one the
 criterion is min(λ_A, λ_B), and with several rivals the least over every pair of them (the
 experiment must leave one standing, whichever is true).  A pair that no experiment separates even
 linearised (λ < :data:`SAME_FORM_LAMBDA` everywhere: the same response in two forms) is said and
-left out.  All candidate experiments are evaluated at once: the
+left out; so is one the nonlinear check below shows no experiment expected to separate it does
+(nested forms: a single amplifier pole is an op-amp stage with a feedback capacitor), after which
+the experiments are ranked again without it.  All candidate experiments are evaluated at once: the
 responses and Jacobians are computed once on the union grid of each quantity, and each experiment
 is a weight mask over it (batched normal equations).
 
@@ -39,7 +45,8 @@ one slope b clipped to [−1, 0]: b = 0 is noise proportional to the signal, b =
 instrument floor, as the virtual lab's DAQ noise is); at a line where the model predicts |G| and at
 excitation level a (a multiple of the record's drive) σ = σ_ref (|G|/|G_ref|)^b a^b.  Another
 quantity is given the record's median relative σ (its instrument is not known): stated in the
-result.
+result.  A joint record has one such noise model per quantity, and another quantity the median
+over them.
 
 Decision: the separation needed is λ* with Vuong power ``power`` at the diagnosis's α
 (:func:`~physmodel.estimation.signatures.vuong_power`: z ~ N(√λ/2, 1), so λ* = 4(z_crit + Φ⁻¹(power))²).
@@ -49,7 +56,18 @@ bath temperature; or than the quickest that reaches λ*),
 the recommendation is the one at the lowest drive level, then of the largest λ (the safest margin);
 when none reaches λ*, the one of largest λ, with ``separates = False`` and the sentence saying so.  The linearised λ of the
 recommendation (and of the next ones when it falls short) is then checked by a full nonlinear refit
-of the rival to the true model's noiseless predictions (``separation_refit``).
+of the rival to the true model's noiseless predictions (``separation_refit``), in rounds: a pair that
+the refits show to be inseparable in every checked experiment expected to separate it leaves the
+criterion and the experiments are ranked and checked again (at most one round per pair).
+
+Temperatures: the search offers bath steps (a 5-point grid of the allowed range and its ends with
+the middle) for every quantity the models predict at other temperatures through the parameter set's
+laws — for a sensor the strip's Z moves with d(T), κe(T) and T, so an op-amp stage loaded by the
+strip (``transimpedance``) moves with the bath while an amplifier pole does not.  The linearisation
+is at the competing models' fits to the record: a model whose fit took a nested form of itself (an
+op-amp stage fitted as ideal op-amps with a feedback capacitor, i.e. one pole) is searched in that
+form, and the search may then call the pair inseparable although the truth's own form would move
+with the bath.
 """
 
 from __future__ import annotations
@@ -65,6 +83,7 @@ from ..errors import IPMCError
 from .next_measurement_design import (
     FD_RELATIVE_STEP,
     REFIT_STARTS,
+    RecordView,
     fit_competing_models,
     line_sigma,
     log_ratio,
@@ -227,6 +246,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     target = 4.0 * (z_crit + float(norm.ppf(power))) ** 2
     mods = list(models) if models is not None else competing_models(d)
     nm = noise_model(d)
+    view = RecordView(d)
     if len(mods) < 2:
         return NextMeasurement([tuple(m) for m in mods], None, False, target, 0.0, 0, [], nm, {},
                                "No competing model to separate: the diagnosis names no rival "
@@ -238,12 +258,12 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     w0 = np.concatenate([1 / s_ln0 ** 2, 1 / s_ph0 ** 2])
     rec = {}
     for m in fitted:
-        rec[id(m)] = m.log_response(d.data, d.quantity)
+        rec[id(m)] = m.log_response_of(view.record_many(m.model))
     # ---- candidate grids
     f_data = d.data.frequency_hz
     T_data = d.data.temperatures()
     fmin, fmax = float(f_data.min()), float(f_data.max())
-    n_per_T = f_data.size / max(T_data.size, 1)
+    n_per_T = f_data.size / max(T_data.size, 1) / len(view.sweeps)
     lpd = lines_per_decade or max(n_per_T / max(math.log10(fmax / fmin), 0.5), 5.0)
     f_lo = max(band_limits_hz[0], fmin / 10.0)
     f_hi = min(band_limits_hz[1], fmax * 10.0)
@@ -267,10 +287,14 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         current = min(current, lam_a, lam_b)
     for q in qs:
         sk = _skeleton(d.kind, q, f_grid, T_grid)
-        resp = {id(m): m.log_response(sk, q) for m in fitted}
-        same = q == d.quantity
-        logabs = resp[id(fitted[0])][0].real + log_unit_factor(d, sk)      # in the record's units
-        sl, sp = line_sigma(nm, logabs, lv, same)                   # (n_levels, N)
+        resp = {id(m): m.log_response_of(view.many(m.model, sk, q)) for m in fitted}
+        rs = view.sweeps.get(q)               # the record of this quantity, if any: the new lines merge with it
+        same = rs is not None
+        together = same or view.joint         # evaluated with the record (merged, or one more quantity of a joint one)
+        logabs = resp[id(fitted[0])][0].real + (log_unit_factor(rs, sk) if same else 0.0)   # in the record's units
+        sl, sp = line_sigma(nm["by_quantity"][q] if view.joint and same else nm, logabs, lv, same)   # (n_levels, N)
+        if same:
+            T_q, fmin_q, fmax_q = rs.temperatures(), float(rs.frequency_hz.min()), float(rs.frequency_hz.max())
         # masks: experiment e = (window, temperature set) × level
         masks, meta, seen = [], [], set()
         for (a, b) in windows:
@@ -278,8 +302,8 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
             for ts in tsets:
                 m_ = fm & np.isin(sk.temperature_c, ts)
                 if same:        # merged with the record: no line inside its band at its temperatures
-                    m_ &= ~(np.isin(sk.temperature_c, T_data) & (sk.frequency_hz >= fmin * (1 - 1e-9))
-                            & (sk.frequency_hz <= fmax * (1 + 1e-9)))
+                    m_ &= ~(np.isin(sk.temperature_c, T_q) & (sk.frequency_hz >= fmin_q * (1 - 1e-9))
+                            & (sk.frequency_hz <= fmax_q * (1 + 1e-9)))
                 key = m_.tobytes()
                 if m_.sum() < 2 or key in seen:      # bands clipped to the same lines are one experiment
                     continue
@@ -295,7 +319,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
             Lb, Jb = resp[id(b)]
             D = stack_real(log_ratio(La, Lb))
             base_ab = base_ba = None
-            if same:
+            if together:
                 Ra, RJa = rec[id(a)]
                 Rb, RJb = rec[id(b)]
                 D0, JB0, JA0 = stack_real(log_ratio(Ra, Rb)), stack_real(RJb), stack_real(RJa)
@@ -314,10 +338,11 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                 fl = np.unique(sk.frequency_hz[on])
                 rows.append(CandidateMeasurement(q, (float(fl.min()), float(fl.max())), tuple(ts), float(level),
                                                  int(M[e].sum()), fl, math.inf, by_pair[i * M.shape[0] + e],
-                                                 same, len(ts) * PERIODS / float(fl.min())
+                                                 together, len(ts) * PERIODS / float(fl.min())
                                                  + BATH_SETTLE_S * int(np.sum(~np.isin(ts, T_data))), 0.0,
                                                  line_temperatures_c=sk.temperature_c[on],
-                                                 line_frequencies_hz=sk.frequency_hz[on]))
+                                                 line_frequencies_hz=sk.frequency_hz[on],
+                                                 added_quantity=together and not same))
     if not rows:
         raise IPMCError("next_measurement: no candidate experiment within the limits")
     # a pair that no experiment separates even linearised (the same response in another form) is

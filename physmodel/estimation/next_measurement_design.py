@@ -41,7 +41,10 @@ class CompetingModel:
 
     def log_response(self, sweep: FrequencySweep, q: str) -> tuple[np.ndarray, np.ndarray]:
         """(ln G at θ (N,), ∂ ln G/∂θ (N, k)) on ``sweep``'s lines (central differences in θ)."""
-        pm = self.model.predictor(sweep, q).many
+        return self.log_response_of(self.model.predictor(sweep, q).many)
+
+    def log_response_of(self, pm) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`log_response` of a predictor ``pm(values_list) -> (n_sets, N)`` of this model's lines."""
         sets, steps = [self.values], []
         for fp in self.free:
             v = self.values[fp.name]
@@ -55,6 +58,47 @@ class CompetingModel:
             J = np.stack([np.log(G[1 + 2 * j] / G[2 + 2 * j]) / steps[j] for j in range(len(self.free))], axis=-1) \
                 if self.free else np.zeros((G.shape[1], 0), complex)
         return L0, J
+
+
+class RecordView:
+    """The diagnosed record as the search sees it: one quantity's sweep, or the sweeps of a joint
+    diagnosis (:mod:`~physmodel.estimation.joint`, one per quantity, effects narrowed by its
+    ``acts_on``), each a quantity a new measurement of it is merged with."""
+
+    def __init__(self, d):
+        jd = getattr(d, "joint", None)
+        self.kind, self.joint, self._d, self._jd = d.kind, jd is not None, d, jd
+        self.acts_on = {k: tuple(v) for k, v in ((d.metadata or {}).get("acts_on") or {}).items()} if self.joint else {}
+        self.sweeps = dict(zip(jd.quantities, jd.sweeps)) if jd is not None else {d.quantity: d.data}
+
+    def record_many(self, model):
+        """The predictor of ``model`` on the whole diagnosed record (stacked when joint)."""
+        if self._jd is not None:
+            return self._jd.predictor(model, self.acts_on)
+        return model.predictor(self._d.data, self._d.quantity).many
+
+    def many(self, model, sweep: FrequencySweep, q: str):
+        """The predictor of ``model`` on ``sweep``'s lines of quantity ``q`` (``acts_on`` applied when joint)."""
+        if not self.joint:
+            return model.predictor(sweep, q).many
+        from .joint import joint_data
+
+        if sweep.magnitude_std_db is None:        # σ does not enter a prediction; the stacking wants one
+            n = sweep.frequency_hz.size
+            sweep = FrequencySweep(sweep.temperature_c, sweep.frequency_hz, sweep.response, np.ones(n), np.ones(n),
+                                   sweep.input_name, sweep.input_unit, sweep.output_name, sweep.output_unit)
+        return joint_data([sweep], self.kind, (q,)).predictor(model, self.acts_on)
+
+    def restacked(self, sweeps: dict) -> tuple:
+        """(record, predictor factory ``model -> many``) of ``{quantity: sweep}`` diagnosed as the
+        record is (jointly when it is joint)."""
+        if not self.joint:
+            (q, sw), = sweeps.items()
+            return sw, lambda model: model.predictor(sw, q).many
+        from .joint import joint_data
+
+        jd = joint_data(list(sweeps.values()), self.kind, tuple(sweeps))
+        return jd.stacked, lambda model: jd.predictor(model, self.acts_on)
 
 
 def refit_model(d, effects: tuple, start: dict, max_nfev: int):
@@ -72,7 +116,7 @@ def refit_model(d, effects: tuple, start: dict, max_nfev: int):
             v = start.get(name, typ)
             free.append(FreeParameter(name, lo, hi, "linear", float(min(max(v, lo), hi))))
     m = CompetingModel(d, effects, {fp.name: fp.initial for fp in free}, free)
-    pm = m.model.predictor(d.data, d.quantity).many
+    pm = RecordView(d).record_many(m.model)
     # the effects' values ride in the predictor's base model; the fit varies them through the names
     res = fit_parameters(d.data, None, free, predict_many=pm, starts=1, seed=0, max_nfev=max_nfev, identify=False,
                          hold_undetermined=False)
@@ -104,9 +148,24 @@ def fit_competing_models(d, models: Sequence[tuple], max_nfev: int) -> list[Comp
 
 def noise_model(d) -> dict:
     """σ_ln, σ_φ of the record against |G| (:mod:`~physmodel.estimation.next_measurement`, "Noise at
-    the new lines"): slope b ∈ [−1, 0] and the references."""
-    s_ln, s_ph, estimated = noise_std(d.data)
-    a = np.log(np.abs(d.data.response))
+    the new lines"): slope b ∈ [−1, 0] and the references; a joint record's per quantity
+    (``by_quantity``), with the median relative σ over its quantities for another one."""
+    view = RecordView(d)
+    if not view.joint:
+        return sweep_noise_model(d.data)
+    by_q = {q: sweep_noise_model(s) for q, s in view.sweeps.items()}
+    return {"by_quantity": by_q, "median_ln": float(np.median([v["median_ln"] for v in by_q.values()])),
+            "median_ph": float(np.median([v["median_ph"] for v in by_q.values()])),
+            "estimated": any(v["estimated"] for v in by_q.values()),
+            "rule": next(iter(by_q.values()))["rule"].replace("the diagnosed quantity", "each diagnosed quantity")
+            .replace("the record's median relative σ", "the median over the diagnosed quantities of their median "
+                     "relative σ")}
+
+
+def sweep_noise_model(sweep: FrequencySweep) -> dict:
+    """:func:`noise_model` of one quantity's sweep."""
+    s_ln, s_ph, estimated = noise_std(sweep)
+    a = np.log(np.abs(sweep.response))
     b = 0.0
     if not estimated and a.size > 2 and np.ptp(a) > 0.1:
         y = np.log(np.concatenate([s_ln, s_ph]))
@@ -161,15 +220,15 @@ def stack_real(z: np.ndarray) -> np.ndarray:
 
 
 
-def log_unit_factor(d, sk: FrequencySweep) -> float:
-    """ln of the factor from ``sk``'s response units to the diagnosed record's (same dimensions)."""
+def log_unit_factor(record: FrequencySweep, sk: FrequencySweep) -> float:
+    """ln of the factor from ``sk``'s response units to ``record``'s (same dimensions)."""
     from ..data.units import unit_scale
 
-    if (d.data.input_unit, d.data.output_unit) == (sk.input_unit, sk.output_unit):
+    if (record.input_unit, record.output_unit) == (sk.input_unit, sk.output_unit):
         return 0.0
     try:
-        f = (unit_scale(sk.output_unit) / unit_scale(sk.input_unit)) / (unit_scale(d.data.output_unit)
-                                                                        / unit_scale(d.data.input_unit))
+        f = (unit_scale(sk.output_unit) / unit_scale(sk.input_unit)) / (unit_scale(record.output_unit)
+                                                                        / unit_scale(record.input_unit))
     except (KeyError, IPMCError):
         return 0.0
     return float(np.log(abs(f)))
@@ -183,36 +242,42 @@ def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int
     least over the two directions}`` for each of ``pairs``."""
     from .lsq import fit_parameters
 
+    view = RecordView(d)
     in_name, unit_in, out_name, unit_out = QUANTITY_UNITS[(d.kind, r.quantity)]
     sk = FrequencySweep(r.line_temperatures_c, r.line_frequencies_hz, np.ones(r.n_lines, complex), None, None,
                         in_name, unit_in, out_name, unit_out)
     cb = d.metadata.get("candidate_bounds", {})
+    same = r.quantity in view.sweeps
+    nm_q = nm["by_quantity"][r.quantity] if view.joint and same else nm
     out = {}
     for a, b in pairs:
         best = math.inf
         for truth, rival in ((a, b), (b, a)):
-            G = np.asarray(truth.model.predictor(sk, r.quantity).many([truth.values])[0])
+            G = np.asarray(view.many(truth.model, sk, r.quantity)([truth.values])[0])
             if r.joint:
-                s_ln, s_ph = line_sigma(nm, np.log(np.abs(G)) + log_unit_factor(d, sk), np.array([r.level]), True)
-                G0 = np.asarray(truth.model.predictor(d.data, d.quantity).many([truth.values])[0])
-                rec = FrequencySweep(d.data.temperature_c, d.data.frequency_hz, G0, d.data.magnitude_std_db,
-                                     d.data.phase_std_deg, d.data.input_name, d.data.input_unit, d.data.output_name,
-                                     d.data.output_unit)
-                if rec.magnitude_std_db is None:
-                    s0l, s0p, _ = noise_std(d.data)
-                    rec = FrequencySweep(rec.temperature_c, rec.frequency_hz, G0, s0l * 20 / math.log(10),
-                                         np.degrees(s0p), rec.input_name, rec.input_unit, rec.output_name,
-                                         rec.output_unit)
-                new = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10),
-                                     np.degrees(s_ph[0]), sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-                sw = merge_records(rec, new)
-                q = d.quantity
+                rs = view.sweeps.get(r.quantity)
+                logabs = np.log(np.abs(G)) + (log_unit_factor(rs, sk) if rs is not None else 0.0)
+                s_ln, s_ph = line_sigma(nm_q, logabs, np.array([r.level]), same)
+                sweeps = {}
+                for q0, s0 in view.sweeps.items():      # the record, as the truth predicts it, with its σ
+                    G0 = np.asarray(view.many(truth.model, s0, q0)([truth.values])[0])
+                    if s0.magnitude_std_db is None:
+                        s0l, s0p, _ = noise_std(s0)
+                        std0 = (s0l * 20 / math.log(10), np.degrees(s0p))
+                    else:
+                        std0 = (s0.magnitude_std_db, s0.phase_std_deg)
+                    sweeps[q0] = FrequencySweep(s0.temperature_c, s0.frequency_hz, G0, *std0, s0.input_name,
+                                                s0.input_unit, s0.output_name, s0.output_unit)
+                new = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
+                                     sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
+                sweeps[r.quantity] = merge_records(sweeps[r.quantity], new) if same else new
+                sw, factory = view.restacked(sweeps)
             else:
                 s_ln, s_ph = line_sigma(nm, np.log(np.abs(G)), np.array([r.level]), False)
-                sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10),
-                                    np.degrees(s_ph[0]), sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-                q = r.quantity
-            pm = rival.model.predictor(sw, q).many
+                sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
+                                    sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
+                factory = lambda model, sw=sw: model.predictor(sw, r.quantity).many  # noqa: E731
+            pm = factory(rival.model)
             typical = {f"{c}.{p}": v[2] for c in rival.effects for p, v in cb.get(c, {}).items()}
             for k, start in enumerate((rival.values, {**rival.values, **typical})):
                 free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in rival.free]
@@ -223,6 +288,6 @@ def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int
     return out
 
 
-
-__all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "fit_competing_models", "line_sigma", "log_ratio",
-           "log_unit_factor", "noise_model", "refit_check", "refit_model", "stack_real", "t_criterion"]
+__all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
+           "log_ratio", "log_unit_factor", "noise_model", "refit_check", "refit_model", "stack_real",
+           "sweep_noise_model", "t_criterion"]

@@ -75,15 +75,19 @@ class CandidateMeasurement:
     refit_by_pair: dict = field(default_factory=dict)
     line_temperatures_c: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     line_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    #: A quantity a joint diagnosis did not hold, diagnosed jointly with its quantities.
+    added_quantity: bool = field(default=False, repr=False)
 
     def describe(self) -> str:
         """The experiment in words."""
         T = ", ".join(f"{t:g}" for t in self.temperatures_c)
+        merged = self.joint and not self.added_quantity
         return (f"{self.quantity} at {T} °C, {self.band_hz[0]:.3g}–{self.band_hz[1]:.3g} Hz "
                 f"({self.n_lines} lines"
-                + (", none inside the record's band at its temperatures" if self.joint else "")
+                + (", none inside the record's band at its temperatures" if merged else "")
                 + f"), drive ×{self.level:g}"
-                + (" (merged with the diagnosed record)" if self.joint else " (a record of its own)"))
+                + (" (merged with the diagnosed record)" if merged else " (diagnosed jointly with the record's "
+                   "quantities)" if self.joint else " (a record of its own)"))
 
     def to_dict(self) -> dict:
         """JSON-ready form."""
