@@ -108,3 +108,41 @@ def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
                          "tip_displacement", "mm", "current", "uA")
     d2 = diag(merge_records(sweep, new))
     assert d2.verdict == "named" and d2.named == ["transimpedance"]
+
+
+def test_ipmc_runs_the_bath_step_on_its_virtual_lab(tmp_path, isn):
+    """The scenario step with an op-amp stage hidden in the virtual lab (seed 000's stages, GBW
+    1 MHz, A0 2e5, the lab's own strip impedance as source): one 35 °C record leaves it ambiguous
+    with an amplifier pole, the search steps the bath, the lab measures there and the two records
+    name the stage.  Independent of the diagnosis: the second record over the plain strip is the
+    independent sensor's op-amp node equations (its own code) with the strip's Z at that bath."""
+    from physmodel.data.files import read_csv
+    from scenarios.runner import run_scenario
+    from scenarios.spec import bundled_scenarios, load_scenario
+
+    demo = [p for p in bundled_scenarios() if p.stem == "next_measurement_demo"][0].read_text(encoding="utf-8")
+    gbw = 1e6
+    text = (demo.replace("effects = { amplifier_bandwidth = { time_constant = 2e-4 } }",
+                         f"effects = {{ transimpedance = {{ unity_gain_time = {1 / (2 * math.pi * gbw)!r}, "
+                         "inverse_dc_gain = 5e-6 } }\ntemperature_limits_c = [5.0, 65.0]")
+            .replace('candidates = ["time_delay", "amplifier_bandwidth"]', 'candidates = ["amplifier_bandwidth", "transimpedance"]')
+            .replace('name = "next_measurement_demo"', 'name = "next_measurement_bath"'))
+    assert "transimpedance = {" in text and "temperature_limits_c" in text
+    path = tmp_path / "bath.toml"
+    path.write_text(text, encoding="utf-8")
+    res = run_scenario(load_scenario(path, quick=True), tmp_path / "run", quiet=True)
+    assert res.passed, [(c.name, c.value) for c in res.checks if not c.passed]
+    rec2 = read_csv(tmp_path / "run" / "next_measurement" / "record2.csv")
+    T2 = np.unique(rec2.temperature_c)
+    assert set(T2.tolist()) - {35.0}                               # a bath step
+    plain = physics_model("sensor", get_parameter_set("seed000_sensor_dev", T_ref=308.15))
+    for t in T2:
+        on = rec2.temperature_c == t
+        f = rec2.frequency_hz[on]
+        r = plain.frequency_response(f, [t], quantities=("S", "Z"))
+        ratio = rec2.response[on] / (r["S"][0, 0] * 1e3)
+        expect = isn.opamp_chain(2j * np.pi * f, r["Z"][0, 0], gbw)
+        assert np.median(np.abs(np.log(ratio / expect))) < 0.02
+        # with the strip's Z at the record's 35 °C instead, the stage would be another (the bath moved it)
+        at35 = isn.opamp_chain(2j * np.pi * f, plain.frequency_response(f, [35.0], quantities=("Z",))["Z"][0, 0], gbw)
+        assert np.median(np.abs(np.log(ratio / at35))) > 0.05
