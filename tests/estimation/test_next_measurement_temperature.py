@@ -2,7 +2,8 @@
 refits show to be nested (a single amplifier pole is a transimpedance stage with a feedback
 capacitor) no longer drags the search onto a quantity that sees no chain element, and a pair that
 only a bath step separates (an op-amp stage loaded by the strip's impedance vs an amplifier pole)
-gets one, which the independent sensor then confirms."""
+gets one, which the independent sensor then confirms — and ``ipmc``'s own virtual lab, with the
+op-amp stage hidden in it, runs the bath step it recommends."""
 
 from __future__ import annotations
 
