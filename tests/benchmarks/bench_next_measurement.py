@@ -73,7 +73,8 @@ states the limitation); the third (7436, λ 0.4) was forecast not to separate.  
 
 Earlier (2026-11-26, bath fixed at 35 °C and a sensor without temperature laws; kept as measured —
 the independent sensor's records at 35 °C are unchanged, bit for bit; to rerun the sensor rows add
-``--bath-limits-c 35 35``).  Seeds the helper did not develop on; development used 900-905 and the
+``--bath-limits-c 35 35``; rerun so on the evening's code the two sensor columns give the same
+11/11 and 2/5).  Seeds the helper did not develop on; development used 900-905 and the
 scenario's virtual-lab record, 2 shared cores:
 
 ===============================================  =====================  ========================  =======================
