@@ -4,7 +4,10 @@ records diagnosed together name the hidden effect (issue 27, item 3).
 
 The hidden effect is an instrument element between the strip and the DAQ (a response-level
 library effect written with the Laplace variable only: amplifier poles, a delay, a laser lag, AC
-coupling), put into the transfer function the virtual lab realises and simulates, so both records
+coupling; or with the strip's impedance as its source: ``transimpedance``, seed 000's op-amp
+stages, which then move with the bath as Z does — give ``temperature_limits_c`` wider than the
+record's to let the search step the bath), put into the transfer function the virtual lab
+realises and simulates, so both records
 are time-domain experiments measured like a DAQ (:mod:`scenarios.virtual_lab`): the first with the
 table's design (``temperatures_c``, ``fmin_hz`` … ``rms``, ``output_noise_rms``, ``noise_seed``),
 the second with the same design moved to the recommended band, temperatures and drive level, and
@@ -31,7 +34,9 @@ DESIGN = ("temperatures_c", "fmin_hz", "fmax_hz", "points", "fs_hz", "period_s",
 class InstrumentModel:
     """A physics model with a hidden instrument element on its main quantity: ``evaluate`` (what the
     virtual lab realises) multiplies M or S by the library effect's factor at the Laplace points;
-    everything else is the wrapped model's."""
+    everything else is the wrapped model's.  An element loaded by the strip (``transimpedance``:
+    op-amp stages with the strip's impedance Z as source) gets the wrapped model's Z at the same
+    points and temperatures, so it moves with the bath as the strip does."""
 
     def __init__(self, model, effects: dict):
         from types import SimpleNamespace
@@ -45,12 +50,18 @@ class InstrumentModel:
                 raise ScenarioError(f"[next_measurement] effects.{name}: the virtual lab can hide an instrument "
                                     "element only (a response-level library effect, e.g. amplifier_bandwidth)")
             full = {**e.off, **vals}
-            try:       # the factor must be a function of s alone (no state of the strip)
+            needs_z = False
+            try:       # the factor must be a function of s alone (no state of the strip) ...
                 e.apply("S", SimpleNamespace(s=np.array([1j])), full)
             except AttributeError:
-                raise ScenarioError(f"[next_measurement] effects.{name}: its factor needs the strip's state; "
-                                    "hide an instrument element (amplifier_bandwidth, time_delay, ...)") from None
-            self._effects[name] = (e, full)
+                try:   # ... or of s and the strip's impedance Z (a stage the strip drives)
+                    e.apply("S", SimpleNamespace(s=np.array([1j]), base={"Z": np.array([1.0 + 0j])}), full)
+                    needs_z = True
+                except (AttributeError, KeyError):
+                    raise ScenarioError(f"[next_measurement] effects.{name}: its factor needs the strip's state "
+                                        "beyond its impedance; hide an instrument element (amplifier_bandwidth, "
+                                        "time_delay, transimpedance, ...)") from None
+            self._effects[name] = (e, full, needs_z)
 
     def __getattr__(self, name):
         return getattr(self._model, name)
@@ -63,7 +74,9 @@ class InstrumentModel:
         q = "M" if self._model.kind == "actuator" else "S"
         if q in out:
             ctx = SimpleNamespace(s=np.asarray(s, dtype=complex))
-            for e, v in self._effects.values():
+            if any(nz for _, _, nz in self._effects.values()):
+                ctx.base = {"Z": self._model.evaluate(s, temperature_c, quantities=("Z",))["Z"]}
+            for e, v, _ in self._effects.values():
                 out[q] = out[q] * e.apply(q, ctx, v)
         return out
 

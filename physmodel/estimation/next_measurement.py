@@ -26,11 +26,17 @@ J_B the Jacobian of ln G_B in B's free parameters (the user's base parameters an
 parameters, central differences), λ_A = ‖(I − P_{J_B}) Δ‖²_W, W the diagonal weights 1/σ² of the
 stacked lines.  A measurement of the diagnosed quantity is evaluated *together with* the diagnosed
 record (the two are merged and diagnosed jointly; the rival refits to both); one of another
-quantity alone (the diagnosis takes one quantity).  Since either model may be the true one the
+quantity alone.  A joint diagnosis (several quantities of one strip, :mod:`~physmodel.estimation.joint`)
+is searched the same way with every experiment evaluated together with its whole record: a
+measurement of one of its quantities is merged into that quantity's record, one of another
+quantity is one more quantity diagnosed jointly; each keeps its own σ and the diagnosis's
+``acts_on`` (:class:`~physmodel.estimation.next_measurement_design.RecordView`).  Since either model may be the true one the
 criterion is min(λ_A, λ_B), and with several rivals the least over every pair of them (the
 experiment must leave one standing, whichever is true).  A pair that no experiment separates even
 linearised (λ < :data:`SAME_FORM_LAMBDA` everywhere: the same response in two forms) is said and
-left out.  All candidate experiments are evaluated at once: the
+left out; so is one the nonlinear check below shows no experiment expected to separate it does
+(nested forms: a single amplifier pole is an op-amp stage with a feedback capacitor), after which
+the experiments are ranked again without it.  All candidate experiments are evaluated at once: the
 responses and Jacobians are computed once on the union grid of each quantity, and each experiment
 is a weight mask over it (batched normal equations).
 
@@ -39,7 +45,8 @@ one slope b clipped to [−1, 0]: b = 0 is noise proportional to the signal, b =
 instrument floor, as the virtual lab's DAQ noise is); at a line where the model predicts |G| and at
 excitation level a (a multiple of the record's drive) σ = σ_ref (|G|/|G_ref|)^b a^b.  Another
 quantity is given the record's median relative σ (its instrument is not known): stated in the
-result.
+result.  A joint record has one such noise model per quantity, and another quantity the median
+over them.
 
 Decision: the separation needed is λ* with Vuong power ``power`` at the diagnosis's α
 (:func:`~physmodel.estimation.signatures.vuong_power`: z ~ N(√λ/2, 1), so λ* = 4(z_crit + Φ⁻¹(power))²).
@@ -49,20 +56,44 @@ bath temperature; or than the quickest that reaches λ*),
 the recommendation is the one at the lowest drive level, then of the largest λ (the safest margin);
 when none reaches λ*, the one of largest λ, with ``separates = False`` and the sentence saying so.  The linearised λ of the
 recommendation (and of the next ones when it falls short) is then checked by a full nonlinear refit
-of the rival to the true model's noiseless predictions (``separation_refit``).
+of the rival to the true model's noiseless predictions (``separation_refit``), in rounds: a pair that
+the refits show to be inseparable in every checked experiment expected to separate it leaves the
+criterion and the experiments are ranked and checked again (at most one round per pair).
+
+Temperatures: the search offers bath steps (a 5-point grid of the allowed range and its ends with
+the middle) for every quantity the models predict at other temperatures through the parameter set's
+laws — for a sensor the strip's Z moves with d(T), κe(T) and T, so an op-amp stage loaded by the
+strip (``transimpedance``) moves with the bath while an amplifier pole does not.  The linearisation
+is at the competing models' fits to the record: a model whose fit took a nested form of itself (an
+op-amp stage fitted as ideal op-amps with a feedback capacitor, i.e. one pole) is searched in that
+form, and the search may then call the pair inseparable although the truth's own form would move
+with the bath.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..data.sweep import FrequencySweep
 from ..data.units import QUANTITY_UNITS
 from ..errors import IPMCError
+from .next_measurement_design import (
+    FD_RELATIVE_STEP,
+    REFIT_STARTS,
+    RecordView,
+    fit_competing_models,
+    line_sigma,
+    log_ratio,
+    log_unit_factor,
+    noise_model,
+    refit_check,
+    stack_real,
+    t_criterion,
+)
+from .next_measurement_results import CandidateMeasurement, NextMeasurement, json_ready, merge_records
 from .residuals import noise_std
 
 #: Temperature range [°C] a hydrated strip is measured in by default (above freezing of the bath,
@@ -80,172 +111,12 @@ PERIODS = 10
 #: Time a water bath takes to settle at a temperature the record was not measured at (a stated
 #: choice: minutes for a stirred bath and a 0.2 mm strip), added to a measurement's duration. [s]
 BATH_SETTLE_S = 600.0
-#: Relative step of the central differences of the Jacobians.
-FD_RELATIVE_STEP = 1e-5
 #: A pair whose linearised separation stays below this in every experiment is the same response in
 #: two forms (e.g. two amplifier poles and an op-amp stage's): said, and left out of the criterion.
 SAME_FORM_LAMBDA = 1.0
-#: Starts of each rival refit in the nonlinear check (its own fit, the typical size, and LHS).
-REFIT_STARTS = 3
-
-
-@dataclass
-class CandidateMeasurement:
-    """One experiment and the separation it is expected to give.
-
-    Attributes
-    ----------
-    quantity : str
-        What is measured (actuator M, H, Z, I; sensor S, Z).
-    band_hz : tuple of float
-        Lowest and highest line. [Hz]
-    temperatures_c : tuple of float
-        Bath temperatures. [°C]
-    level : float
-        Excitation amplitude as a multiple of the diagnosed record's drive. [-]
-    n_lines : int
-        Lines of the new record (all temperatures).
-    frequencies_hz : ndarray
-        The lines (per temperature). [Hz]
-    separation : float
-        Expected noiseless χ² between the competing models (linearised T-criterion, the least over
-        which model is true and over the rival pairs). [-]
-    separation_by_pair : dict
-        ``"A vs B"`` → {"A true": λ_A, "B true": λ_B}. [-]
-    joint : bool
-        Evaluated together with the diagnosed record (same quantity: merge and diagnose both).
-    duration_s : float
-        Measurement time estimate: temperatures × :data:`PERIODS` / lowest frequency, plus
-        :data:`BATH_SETTLE_S` per temperature the record was not measured at. [s]
-    power : float
-        Probability that Vuong's test separates them at the diagnosis's α (normal approximation).
-    separation_refit : float
-        λ after full nonlinear refits of the rivals (NaN unless checked), pairs that are the same
-        response in another form left out. [-]
-    refit_by_pair : dict
-        ``"A vs B"`` → λ after the refits, the least over the two directions (checked experiments). [-]
-    line_temperatures_c, line_frequencies_hz : ndarray
-        Every line of the new record (a joint record leaves out the diagnosed record's band at its
-        temperatures). [°C], [Hz]
-    """
-
-    quantity: str
-    band_hz: tuple
-    temperatures_c: tuple
-    level: float
-    n_lines: int
-    frequencies_hz: np.ndarray = field(repr=False)
-    separation: float
-    separation_by_pair: dict
-    joint: bool
-    duration_s: float
-    power: float
-    separation_refit: float = float("nan")
-    refit_by_pair: dict = field(default_factory=dict)
-    line_temperatures_c: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    line_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-
-    def describe(self) -> str:
-        """The experiment in words."""
-        T = ", ".join(f"{t:g}" for t in self.temperatures_c)
-        return (f"{self.quantity} at {T} °C, {self.band_hz[0]:.3g}–{self.band_hz[1]:.3g} Hz "
-                f"({self.n_lines} lines"
-                + (", none inside the record's band at its temperatures" if self.joint else "")
-                + f"), drive ×{self.level:g}"
-                + (" (merged with the diagnosed record)" if self.joint else " (a record of its own)"))
-
-    def to_dict(self) -> dict:
-        """JSON-ready form."""
-        return {"quantity": self.quantity, "band_hz": list(self.band_hz), "temperatures_c": list(self.temperatures_c),
-                "level": self.level, "n_lines": self.n_lines, "frequencies_hz": self.frequencies_hz.tolist(),
-                "lines": {"temperature_c": self.line_temperatures_c.tolist(),
-                          "frequency_hz": self.line_frequencies_hz.tolist()},
-                "separation": self.separation, "separation_by_pair": self.separation_by_pair, "joint": self.joint,
-                "duration_s": self.duration_s, "power": self.power, "separation_refit": self.separation_refit,
-                "refit_by_pair": self.refit_by_pair,
-                "description": self.describe()}
-
-
-@dataclass
-class NextMeasurement:
-    """What :func:`next_measurement` found.
-
-    Attributes
-    ----------
-    models : list of tuple
-        The competing models (effect names each); the first is the diagnosis's best.
-    recommended : CandidateMeasurement or None
-        The experiment to run (None when there is nothing to separate).
-    separates : bool
-        The recommendation is expected to reach ``target`` (and its refit check agrees).
-    target : float
-        The separation needed, 4 (z_crit + Φ⁻¹(power))². [-]
-    current : float
-        The same criterion on the diagnosed record alone. [-]
-    evaluated : int
-        Candidate experiments evaluated.
-    ranking : list of CandidateMeasurement
-        The best experiments by separation (up to 10).
-    noise_model : dict
-        How σ at new lines was predicted (slope b, reference, quantity rule).
-    fitted : dict
-        Model label → the fitted values each prediction used.
-    message : str
-        The recommendation in words (what the report and stderr say).
-    inseparable : list of str
-        ``"A vs B"`` pairs no experiment within the limits separates (the same response in another
-        form: linearised, or after the refits of every checked experiment).
-    best_by_quantity : dict
-        Quantity → the largest linearised separation any experiment of it reaches. [-]
-    """
-
-    models: list
-    recommended: CandidateMeasurement | None
-    separates: bool
-    target: float
-    current: float
-    evaluated: int
-    ranking: list
-    noise_model: dict
-    fitted: dict
-    message: str
-    inseparable: list = field(default_factory=list)
-    best_by_quantity: dict = field(default_factory=dict)
-
-    @classmethod
-    def unavailable(cls, reason: str, models=()) -> NextMeasurement:
-        """The record of a search that gave no recommendation (``reason``: why), so that a finished
-        diagnosis still carries, reports and says it instead of losing it."""
-        return cls([tuple(m) for m in models], None, False, math.nan, math.nan, 0, [], {}, {},
-                   f"no recommendation: {reason}")
-
-    def to_dict(self) -> dict:
-        """JSON-ready form (finite floats; NaN as None)."""
-        return json_ready({"models": [list(m) for m in self.models],
-                      "recommended": self.recommended.to_dict() if self.recommended else None,
-                      "separates": self.separates, "target": self.target, "current": self.current,
-                      "evaluated": self.evaluated, "ranking": [r.to_dict() for r in self.ranking],
-                      "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
-                      "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity})
 
 
 # =============================================================================== competing models
-def json_ready(o):
-    """``o`` with dict keys as str, tuples as lists, numpy scalars as Python ones and non-finite floats
-    as None: what ``json.dumps(..., allow_nan=False)`` accepts (the reports' one sanitiser)."""
-    if isinstance(o, dict):
-        return {str(k): json_ready(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [json_ready(v) for v in o]
-    if isinstance(o, (float, np.floating)):
-        return float(o) if math.isfinite(o) else None
-    if isinstance(o, np.bool_):
-        return bool(o)
-    if isinstance(o, np.integer):
-        return int(o)
-    return o
-
-
 def competing_models(d) -> list[tuple]:
     """The models an ``ambiguous`` / ``at_bound`` diagnosis ``d`` leaves competing: the best (its
     final effects) first, then each alternative — another named single effect, a pair with one member
@@ -278,6 +149,7 @@ def competing_models(d) -> list[tuple]:
             if alt not in alts and set(alt) != set(final):
                 alts.append(alt)
     return [final] + alts if alts else []
+
 
 
 # =============================================================================== the search
@@ -313,137 +185,6 @@ def _temperature_sets(data_T: np.ndarray, lo: float, hi: float) -> list[tuple]:
     elif not np.any(np.isclose(data_T, lo)):
         sets.append((float(lo),))
     return list(dict.fromkeys(sets))
-
-
-class _Model:
-    """A competing model: its predictor factory, free parameters and fitted values."""
-
-    def __init__(self, d, effects: tuple, values: dict, free: list):
-        from ..effects import EffectModel
-
-        self.effects, self.values, self.free = effects, dict(values), list(free)
-        beff = {k: dict(v) for k, v in (d.metadata.get("baseline_effects") or {}).items()}
-        on = {c: {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith(c + ".")} for c in effects}
-        self.model = EffectModel(d.base_parameters, d.kind, {**beff, **on}, kernel=d.metadata.get("kernel",
-                                                                                                   "boundary_charge"))
-
-    def log_response(self, sweep: FrequencySweep, q: str) -> tuple[np.ndarray, np.ndarray]:
-        """(ln G at θ (N,), ∂ ln G/∂θ (N, k)) on ``sweep``'s lines (central differences in θ)."""
-        pm = self.model.predictor(sweep, q).many
-        sets, steps = [self.values], []
-        for fp in self.free:
-            v = self.values[fp.name]
-            h = FD_RELATIVE_STEP * (abs(v) if v != 0 else (fp.upper - fp.lower))
-            up, dn = min(v + h, fp.upper), max(v - h, fp.lower)
-            sets += [{**self.values, fp.name: up}, {**self.values, fp.name: dn}]
-            steps.append(up - dn)
-        with np.errstate(all="ignore"):
-            G = np.asarray(pm(sets), dtype=complex)
-            L0 = np.log(G[0])
-            J = np.stack([np.log(G[1 + 2 * j] / G[2 + 2 * j]) / steps[j] for j in range(len(self.free))], axis=-1) \
-                if self.free else np.zeros((G.shape[1], 0), complex)
-        return L0, J
-
-
-def _refit(d, effects: tuple, start: dict, max_nfev: int):
-    """The model ``effects`` refitted to the diagnosed record from ``start`` (free: the diagnosis's
-    base parameters and the effects' parameters within their candidate bounds)."""
-    from .lsq import fit_parameters
-    from .records import FreeParameter
-
-    free = [fp.with_initial(min(max(start.get(fp.name, fp.initial if fp.initial is not None else fp.lower),
-                                    fp.lower), fp.upper)) for fp in d.baseline.free]
-    cb = d.metadata.get("candidate_bounds", {})
-    for c in effects:
-        for p, (lo, hi, typ) in cb.get(c, {}).items():
-            name = f"{c}.{p}"
-            v = start.get(name, typ)
-            free.append(FreeParameter(name, lo, hi, "linear", float(min(max(v, lo), hi))))
-    m = _Model(d, effects, {fp.name: fp.initial for fp in free}, free)
-    pm = m.model.predictor(d.data, d.quantity).many
-    # the effects' values ride in the predictor's base model; the fit varies them through the names
-    res = fit_parameters(d.data, None, free, predict_many=pm, starts=1, seed=0, max_nfev=max_nfev, identify=False,
-                         hold_undetermined=False)
-    return _Model(d, effects, dict(res.values), free), float(res.cost)
-
-
-def _models_for(d, models: Sequence[tuple], max_nfev: int) -> list[_Model]:
-    """Each competing model with its fitted values: the diagnosis's final fit for the first, a refit
-    to the record (from the baseline optimum and the candidates' own fitted values) for the others."""
-    out = []
-    for i, effs in enumerate(models):
-        if i == 0 and d.final is not None and set(effs) == set(d.final_effects):
-            cb = d.metadata.get("candidate_bounds", {})
-            from .records import FreeParameter
-
-            free = list(d.baseline.free) + [FreeParameter(f"{c}.{p}", lo, hi, "linear", d.final.values[f"{c}.{p}"])
-                                            for c in effs for p, (lo, hi, _) in cb.get(c, {}).items()]
-            out.append(_Model(d, effs, dict(d.final.values), free))
-            continue
-        start = dict(d.final.values if d.final is not None else d.baseline.values)
-        start = {k: v for k, v in start.items() if "." not in k or k.split(".", 1)[0] in effs}
-        for c in effs:
-            if c in d.candidates:
-                start.update({f"{c}.{p}": v for p, v in d.candidates[c].values.items()})
-        out.append(_refit(d, effs, start, max_nfev)[0])
-    return out
-
-
-def _noise_model(d) -> dict:
-    """σ_ln, σ_φ of the record against |G| (module doc): slope b ∈ [−1, 0] and the references."""
-    s_ln, s_ph, estimated = noise_std(d.data)
-    a = np.log(np.abs(d.data.response))
-    b = 0.0
-    if not estimated and a.size > 2 and np.ptp(a) > 0.1:
-        y = np.log(np.concatenate([s_ln, s_ph]))
-        x = np.concatenate([a, a])
-        X = np.column_stack([np.ones_like(x), x, np.r_[np.zeros(a.size), np.ones(a.size)]])
-        coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-        b = float(np.clip(coef[1], -1.0, 0.0))
-    ref_ln = float(np.exp(np.median(np.log(s_ln) - b * a)))
-    ref_ph = float(np.exp(np.median(np.log(s_ph) - b * a)))
-    return {"slope": b, "ref_ln": ref_ln, "ref_ph": ref_ph, "median_ln": float(np.median(s_ln)),
-            "median_ph": float(np.median(s_ph)), "estimated": bool(estimated),
-            "rule": ("σ = σ_ref·(|G|)^b·level^b on the diagnosed quantity, b from the record "
-                     "(0: proportional to the signal, −1: a fixed floor); another quantity: the record's "
-                     "median relative σ, independent of the level (its instrument is unknown)")}
-
-
-def _sigma(nm: dict, logabs: np.ndarray, level: np.ndarray, same_quantity: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(σ_ln, σ_φ) per (experiment level, line): shapes (n_levels, N)."""
-    if same_quantity:
-        f = np.exp(nm["slope"] * logabs)[None, :] * (level[:, None] ** nm["slope"])
-        return nm["ref_ln"] * f, nm["ref_ph"] * f
-    one = np.ones((level.size, logabs.size))
-    return nm["median_ln"] * one, nm["median_ph"] * one
-
-
-def _lambda(delta: np.ndarray, J: np.ndarray, w: np.ndarray, base: tuple | None = None) -> np.ndarray:
-    """min_δ Σ w |Δ − J δ|² per weight row of ``w`` (n_exp, 2N); ``delta`` (2N,), ``J`` (2N, k)
-    real-stacked; ``base`` adds fixed (rᵀr, Jᵀr, JᵀJ) sums of the diagnosed record."""
-    rr = w @ (delta * delta)
-    Jr = w @ (J * delta[:, None])
-    JJ = np.einsum("ei,ij,ik->ejk", w, J, J, optimize=True)
-    if base is not None:
-        rr, Jr, JJ = rr + base[0], Jr + base[1], JJ + base[2]
-    k = J.shape[1]
-    if k == 0:
-        return rr
-    scale = np.sqrt(np.maximum(np.einsum("ejj->ej", JJ), 1e-300))
-    A = JJ / (scale[:, :, None] * scale[:, None, :]) + 1e-10 * np.eye(k)
-    x = np.linalg.solve(A, (Jr / scale)[..., None])[..., 0]
-    return np.maximum(rr - np.einsum("ej,ej->e", Jr / scale, x), 0.0)
-
-
-def _diff(La: np.ndarray, Lb: np.ndarray) -> np.ndarray:
-    """ln(G_A/G_B) from the two log-responses, its phase wrapped to (−π, π]."""
-    D = La - Lb
-    return D.real + 1j * np.angle(np.exp(1j * D.imag))
-
-
-def _stack(z: np.ndarray) -> np.ndarray:
-    """Complex (N, ...) → real (2N, ...): log-magnitude rows, then phase rows."""
-    return np.concatenate([z.real, z.imag], axis=0)
 
 
 def next_measurement(d, *, quantities: Sequence[str] | None = None,
@@ -504,24 +245,25 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     z_crit = vuong_critical(d.alpha)
     target = 4.0 * (z_crit + float(norm.ppf(power))) ** 2
     mods = list(models) if models is not None else competing_models(d)
-    nm = _noise_model(d)
+    nm = noise_model(d)
+    view = RecordView(d)
     if len(mods) < 2:
         return NextMeasurement([tuple(m) for m in mods], None, False, target, 0.0, 0, [], nm, {},
                                "No competing model to separate: the diagnosis names no rival "
                                + ("(widen the bound it stopped at instead)." if d.verdict == "at_bound" else "."))
-    fitted = _models_for(d, mods, max_nfev)
+    fitted = fit_competing_models(d, mods, max_nfev)
     label = lambda m: " + ".join(m.effects)  # noqa: E731
     # ---- the record itself (the part every joint experiment shares)
     s_ln0, s_ph0, _ = noise_std(d.data)
     w0 = np.concatenate([1 / s_ln0 ** 2, 1 / s_ph0 ** 2])
     rec = {}
     for m in fitted:
-        rec[id(m)] = m.log_response(d.data, d.quantity)
+        rec[id(m)] = m.log_response_of(view.record_many(m.model))
     # ---- candidate grids
     f_data = d.data.frequency_hz
     T_data = d.data.temperatures()
     fmin, fmax = float(f_data.min()), float(f_data.max())
-    n_per_T = f_data.size / max(T_data.size, 1)
+    n_per_T = f_data.size / max(T_data.size, 1) / len(view.sweeps)
     lpd = lines_per_decade or max(n_per_T / max(math.log10(fmax / fmin), 0.5), 5.0)
     f_lo = max(band_limits_hz[0], fmin / 10.0)
     f_hi = min(band_limits_hz[1], fmax * 10.0)
@@ -539,16 +281,20 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     for a, b in pairs:
         La, Ja = rec[id(a)]
         Lb, Jb = rec[id(b)]
-        D = _stack(_diff(La, Lb))
-        lam_a = _lambda(D, _stack(Jb), w0[None, :])[0]
-        lam_b = _lambda(-D, _stack(Ja), w0[None, :])[0]
+        D = stack_real(log_ratio(La, Lb))
+        lam_a = t_criterion(D, stack_real(Jb), w0[None, :])[0]
+        lam_b = t_criterion(-D, stack_real(Ja), w0[None, :])[0]
         current = min(current, lam_a, lam_b)
     for q in qs:
         sk = _skeleton(d.kind, q, f_grid, T_grid)
-        resp = {id(m): m.log_response(sk, q) for m in fitted}
-        same = q == d.quantity
-        logabs = resp[id(fitted[0])][0].real + _log_unit_factor(d, sk)      # in the record's units
-        sl, sp = _sigma(nm, logabs, lv, same)                   # (n_levels, N)
+        resp = {id(m): m.log_response_of(view.many(m.model, sk, q)) for m in fitted}
+        rs = view.sweeps.get(q)               # the record of this quantity, if any: the new lines merge with it
+        same = rs is not None
+        together = same or view.joint         # evaluated with the record (merged, or one more quantity of a joint one)
+        logabs = resp[id(fitted[0])][0].real + (log_unit_factor(rs, sk) if same else 0.0)   # in the record's units
+        sl, sp = line_sigma(nm["by_quantity"][q] if view.joint and same else nm, logabs, lv, same)   # (n_levels, N)
+        if same:
+            T_q, fmin_q, fmax_q = rs.temperatures(), float(rs.frequency_hz.min()), float(rs.frequency_hz.max())
         # masks: experiment e = (window, temperature set) × level
         masks, meta, seen = [], [], set()
         for (a, b) in windows:
@@ -556,8 +302,8 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
             for ts in tsets:
                 m_ = fm & np.isin(sk.temperature_c, ts)
                 if same:        # merged with the record: no line inside its band at its temperatures
-                    m_ &= ~(np.isin(sk.temperature_c, T_data) & (sk.frequency_hz >= fmin * (1 - 1e-9))
-                            & (sk.frequency_hz <= fmax * (1 + 1e-9)))
+                    m_ &= ~(np.isin(sk.temperature_c, T_q) & (sk.frequency_hz >= fmin_q * (1 - 1e-9))
+                            & (sk.frequency_hz <= fmax_q * (1 + 1e-9)))
                 key = m_.tobytes()
                 if m_.sum() < 2 or key in seen:      # bands clipped to the same lines are one experiment
                     continue
@@ -571,18 +317,18 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         for a, b in pairs:
             La, Ja = resp[id(a)]
             Lb, Jb = resp[id(b)]
-            D = _stack(_diff(La, Lb))
+            D = stack_real(log_ratio(La, Lb))
             base_ab = base_ba = None
-            if same:
+            if together:
                 Ra, RJa = rec[id(a)]
                 Rb, RJb = rec[id(b)]
-                D0, JB0, JA0 = _stack(_diff(Ra, Rb)), _stack(RJb), _stack(RJa)
+                D0, JB0, JA0 = stack_real(log_ratio(Ra, Rb)), stack_real(RJb), stack_real(RJa)
                 base_ab = (w0 @ (D0 * D0), (w0[:, None] * JB0).T @ D0, (w0[:, None] * JB0).T @ JB0)
                 base_ba = (w0 @ (D0 * D0), -(w0[:, None] * JA0).T @ D0, (w0[:, None] * JA0).T @ JA0)
             for i, _ in enumerate(lv):
                 W = np.hstack([M / sl[i] ** 2, M / sp[i] ** 2])
-                la = _lambda(D, _stack(Jb), W, base_ab)
-                lb = _lambda(-D, _stack(Ja), W, base_ba)
+                la = t_criterion(D, stack_real(Jb), W, base_ab)
+                lb = t_criterion(-D, stack_real(Ja), W, base_ba)
                 for e in range(M.shape[0]):
                     by_pair[i * M.shape[0] + e][f"{label(a)} vs {label(b)}"] = {
                         f"{label(a)} true": float(la[e]), f"{label(b)} true": float(lb[e])}
@@ -592,53 +338,74 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                 fl = np.unique(sk.frequency_hz[on])
                 rows.append(CandidateMeasurement(q, (float(fl.min()), float(fl.max())), tuple(ts), float(level),
                                                  int(M[e].sum()), fl, math.inf, by_pair[i * M.shape[0] + e],
-                                                 same, len(ts) * PERIODS / float(fl.min())
+                                                 together, len(ts) * PERIODS / float(fl.min())
                                                  + BATH_SETTLE_S * int(np.sum(~np.isin(ts, T_data))), 0.0,
                                                  line_temperatures_c=sk.temperature_c[on],
-                                                 line_frequencies_hz=sk.frequency_hz[on]))
+                                                 line_frequencies_hz=sk.frequency_hz[on],
+                                                 added_quantity=together and not same))
     if not rows:
         raise IPMCError("next_measurement: no candidate experiment within the limits")
     # a pair that no experiment separates even linearised (the same response in another form) is
     # said, and left out of the criterion: the others can still be told apart
+    key = lambda a, b: f"{label(a)} vs {label(b)}"  # noqa: E731
     best_pair = {k: max(min(r.separation_by_pair[k].values()) for r in rows) for k in rows[0].separation_by_pair}
     same_form = [k for k, v in best_pair.items() if v < SAME_FORM_LAMBDA]
-    for r in rows:
-        vals = [min(v.values()) for k, v in r.separation_by_pair.items() if k not in same_form]
-        r.separation = float(min(vals)) if vals else 0.0
-        r.power = vuong_power(r.separation, z_crit)
-    live = [(a, b) for a, b in pairs if f"{label(a)} vs {label(b)}" not in same_form]
-    ranking = sorted(rows, key=lambda r: -r.separation)
-    # among those reaching the target: within the time budget (the record's own duration, or the
-    # quickest that reaches it), the lowest drive, then the largest separation (the safest margin)
-    ok = [r for r in rows if r.separation >= target]
-    budget = max(T_data.size * PERIODS / fmin, min((r.duration_s for r in ok), default=0.0))
-    ok = sorted((r for r in ok if r.duration_s <= budget * (1 + 1e-9)), key=lambda r: (r.level, -r.separation))
-    order = ok or ranking
-    # the nonlinear check (the linearised λ overstates what a rival can reach after a full refit):
-    # the preferred experiment, then the one of largest linearised λ, then the next preferred ones
-    to_check = list(dict.fromkeys([id(r) for r in order[:1] + ranking[:1] + order[1:]]))
     by_id = {id(r): r for r in rows}
     checked: list = []
-    for rid in to_check[:max(check_refit, 0) if live else 0]:
-        r = by_id[rid]
-        r.refit_by_pair = _refit_check(d, live, r, nm, max_nfev, label)
-        checked.append(r)
-    # a pair no checked experiment separates after refits is the same response in another form here
-    same_refit = [k for k in (checked[0].refit_by_pair if checked else {})
-                  if all(r.refit_by_pair[k] < SAME_FORM_LAMBDA for r in checked)]
+    same_refit: list = []
+    # the nonlinear check (the linearised λ overstates what a rival can reach after a full refit), in
+    # rounds: a pair the refits show to be the same response in another form leaves the criterion,
+    # the experiments are ranked again without it and the new preferred ones checked (otherwise one
+    # such pair — two nested forms, or a linearisation error on a quantity that cannot see the
+    # effects — ranks every experiment near 0 and the check lands on one that separates nothing)
+    for _ in range(max(len(pairs), 1)):
+        gone = same_form + same_refit
+        for r in rows:
+            vals = [min(v.values()) for k, v in r.separation_by_pair.items() if k not in gone]
+            r.separation = float(min(vals)) if vals else 0.0
+            r.power = vuong_power(r.separation, z_crit)
+        live = [(a, b) for a, b in pairs if key(a, b) not in gone]
+        ranking = sorted(rows, key=lambda r: -r.separation)
+        # among those reaching the target: within the time budget (the record's own duration, or the
+        # quickest that reaches it), the lowest drive, then the largest separation (the safest margin)
+        ok = [r for r in rows if r.separation >= target]
+        budget = max(T_data.size * PERIODS / fmin, min((r.duration_s for r in ok), default=0.0))
+        ok = sorted((r for r in ok if r.duration_s <= budget * (1 + 1e-9)), key=lambda r: (r.level, -r.separation))
+        order = ok or ranking
+        # the preferred experiment, then the one of largest linearised λ, then the next preferred ones
+        to_check = [rid for rid in dict.fromkeys([id(r) for r in order[:1] + ranking[:1] + order[1:]])
+                    if not any(id(c) == rid for c in checked)]
+        for rid in to_check[:max(check_refit, 0) if live else 0]:
+            r = by_id[rid]
+            r.refit_by_pair = refit_check(d, live, r, nm, max_nfev, label)
+            checked.append(r)
+        # a pair is the same response in another form here when every checked experiment expected
+        # (linearised) to separate it does not after the refits — one that was not expected to says nothing
+        new_same = []
+        for a, b in live:
+            k = key(a, b)
+            judged = [r for r in checked if k in r.refit_by_pair
+                      and min(r.separation_by_pair[k].values()) >= SAME_FORM_LAMBDA]
+            if judged and all(r.refit_by_pair[k] < SAME_FORM_LAMBDA for r in judged):
+                new_same.append(k)
+        same_refit += new_same
+        if not new_same:
+            break
+    live = [(a, b) for a, b in pairs if key(a, b) not in same_form + same_refit]
     for r in checked:
         vals = [v for k, v in r.refit_by_pair.items() if k not in same_refit]
         r.separation_refit = float(min(vals)) if vals else 0.0
-    good = [r for r in checked if r.separation_refit >= target]
+    done = {id(r) for r in checked}
+    good = [r for r in order if id(r) in done and r.separation_refit >= target] \
+        or [r for r in checked if r.separation_refit >= target]
     chosen = good[0] if good else (max(checked, key=lambda r: r.separation_refit) if checked else order[0])
     same_form = same_form + same_refit
-    sep_ok = bool(live) and len(same_refit) < len(live) and chosen.separation >= target \
-        and (not checked or chosen.separation_refit >= target)
+    sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
     who = " vs ".join(" + ".join(m) for m in mods)
     alike = (" Not separable within the limits (the same response in another form; best λ after refits "
              "below " f"{SAME_FORM_LAMBDA:g}): " + "; ".join(same_form) + "." if same_form else "")
-    if not live or len(same_refit) == len(live):
+    if not live:
         sep_ok = False
         msg = f"No experiment within the limits can separate {who}.{alike}"
     elif sep_ok:
@@ -658,29 +425,6 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                            {q: max(r.separation for r in rows if r.quantity == q) for q in qs
                             if any(r.quantity == q for r in rows)})
 
-
-def merge_records(record: FrequencySweep, new: FrequencySweep) -> FrequencySweep:
-    """One sweep of the same quantity from the diagnosed ``record`` and the ``new`` measurement (lines
-    sorted by temperature, then frequency; in ``record``'s units), to be diagnosed jointly; a line
-    both hold at the same temperature and frequency is refused (measure it once, or average first)."""
-    if not isinstance(record, FrequencySweep) or not isinstance(new, FrequencySweep):
-        raise IPMCError("merge_records: both records must be FrequencySweep")
-    b = new.in_units(record.input_unit, record.output_unit)
-    if (record.magnitude_std_db is None) != (b.magnitude_std_db is None):
-        raise IPMCError("merge_records: one record carries per-line standard deviations and the other does not")
-    T = np.r_[record.temperature_c, b.temperature_c]
-    f = np.r_[record.frequency_hz, b.frequency_hz]
-    order = np.lexsort((f, T))
-    dup = (np.diff(T[order]) == 0) & (np.diff(f[order]) == 0)
-    if np.any(dup):
-        k = order[1:][dup][0]
-        raise IPMCError(f"merge_records: both records hold a line at {T[k]:g} °C, {f[k]:g} Hz")
-    std = record.magnitude_std_db is not None
-    return FrequencySweep(T[order], f[order], np.r_[record.response, b.response][order],
-                          np.r_[record.magnitude_std_db, b.magnitude_std_db][order] if std else None,
-                          np.r_[record.phase_std_deg, b.phase_std_deg][order] if std else None,
-                          record.input_name, record.input_unit, record.output_name, record.output_unit,
-                          {**dict(record.metadata or {}), "merged_with": dict(b.metadata or {})})
 
 
 def _laws_valid_range(base) -> tuple:
@@ -730,66 +474,6 @@ def _temperature_limits(limits, base) -> tuple[float, float, str]:
     return c_lo, c_hi, (f" Bath limits {t_lo:g}–{t_hi:g} °C clipped to {c_lo:g}–{c_hi:g} °C, the temperature "
                         "laws' valid range.")
 
-
-def _log_unit_factor(d, sk: FrequencySweep) -> float:
-    """ln of the factor from ``sk``'s response units to the diagnosed record's (same dimensions)."""
-    from ..data.units import unit_scale
-
-    if (d.data.input_unit, d.data.output_unit) == (sk.input_unit, sk.output_unit):
-        return 0.0
-    try:
-        f = (unit_scale(sk.output_unit) / unit_scale(sk.input_unit)) / (unit_scale(d.data.output_unit)
-                                                                        / unit_scale(d.data.input_unit))
-    except (KeyError, IPMCError):
-        return 0.0
-    return float(np.log(abs(f)))
-
-
-def _refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int, label) -> dict:
-    """λ of experiment ``r`` by full refits: each rival refitted to the other's noiseless predictions
-    on the new lines (with the record's lines when joint) from its own fit, from its effect at its
-    typical size and from :data:`REFIT_STARTS` − 2 more Latin-hypercube starts; ``{"A vs B": the
-    least over the two directions}`` for each of ``pairs``."""
-    from .lsq import fit_parameters
-
-    in_name, unit_in, out_name, unit_out = QUANTITY_UNITS[(d.kind, r.quantity)]
-    sk = FrequencySweep(r.line_temperatures_c, r.line_frequencies_hz, np.ones(r.n_lines, complex), None, None,
-                        in_name, unit_in, out_name, unit_out)
-    cb = d.metadata.get("candidate_bounds", {})
-    out = {}
-    for a, b in pairs:
-        best = math.inf
-        for truth, rival in ((a, b), (b, a)):
-            G = np.asarray(truth.model.predictor(sk, r.quantity).many([truth.values])[0])
-            if r.joint:
-                s_ln, s_ph = _sigma(nm, np.log(np.abs(G)) + _log_unit_factor(d, sk), np.array([r.level]), True)
-                G0 = np.asarray(truth.model.predictor(d.data, d.quantity).many([truth.values])[0])
-                rec = FrequencySweep(d.data.temperature_c, d.data.frequency_hz, G0, d.data.magnitude_std_db,
-                                     d.data.phase_std_deg, d.data.input_name, d.data.input_unit, d.data.output_name,
-                                     d.data.output_unit)
-                if rec.magnitude_std_db is None:
-                    s0l, s0p, _ = noise_std(d.data)
-                    rec = FrequencySweep(rec.temperature_c, rec.frequency_hz, G0, s0l * 20 / math.log(10),
-                                         np.degrees(s0p), rec.input_name, rec.input_unit, rec.output_name,
-                                         rec.output_unit)
-                new = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10),
-                                     np.degrees(s_ph[0]), sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-                sw = merge_records(rec, new)
-                q = d.quantity
-            else:
-                s_ln, s_ph = _sigma(nm, np.log(np.abs(G)), np.array([r.level]), False)
-                sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10),
-                                    np.degrees(s_ph[0]), sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-                q = r.quantity
-            pm = rival.model.predictor(sw, q).many
-            typical = {f"{c}.{p}": v[2] for c in rival.effects for p, v in cb.get(c, {}).items()}
-            for k, start in enumerate((rival.values, {**rival.values, **typical})):
-                free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in rival.free]
-                res = fit_parameters(sw, None, free, predict_many=pm, starts=1 if k == 0 else REFIT_STARTS - 1,
-                                     seed=0, max_nfev=max_nfev, identify=False, hold_undetermined=False)
-                best = min(best, 2.0 * float(res.cost))
-        out[f"{label(a)} vs {label(b)}"] = best
-    return out
 
 
 __all__ = ["CandidateMeasurement", "NextMeasurement", "competing_models", "json_ready", "merge_records",

@@ -37,6 +37,24 @@ Chain elements (own parametrisation), each a factor on G:
                   per frequency, over the ideal gain
 out of library:   ``gain_ripple`` (a sinusoidal ripple of ln|G| and ∠G in log f) and ``notch``
                   ((s² + 2ζ(1 − depth) ωn s + ωn²)/(s² + 2ζ ωn s + ωn²)).
+
+Bath temperature (issue 27 item 3: a bath step as the next measurement)
+-----------------------------------------------------------------------
+The records of :func:`make_case` are at the strip's own temperature ``base["T"]`` (35 °C); given
+``temperature_c``, :func:`response` and :func:`strip_sensor` move the strip there with laws
+written here (physics.md §7's defaults, the ones the actuator generator's thermal base uses, each
+factor over its value at ``base["T"]``):
+
+* diffusivity, Arrhenius with :data:`EA_D` = 15 kJ/mol: d ∝ exp(−Ea/R (1/T − 1/T0));
+* permittivity ∝ that of water, Owen, Miller, Milner & Cogan (1961) (``independent_physics``;
+  the library uses Malmberg & Maryott 1956, 0.1–0.2 % apart over 5–65 °C);
+* modulus, log-linear :data:`E_LOGSLOPE` = −0.75 %/K (the stress per tip displacement ∝ E);
+* leakage conductance Gp by Nernst–Einstein (∝ d/T), and T itself in K = F² d C/(ε R T);
+* electrode sheet and through-thickness resistances, C and a0: constant (as the user's laws).
+
+Z follows through d, ε, Gp and T, so the ``opamp`` element (the strip as its source) changes with
+the bath while the other chain elements do not.  At ``base["T"]`` every factor is exactly 1 and the
+default path (``temperature_c=None``) is the module as it was: earlier sets stay bit-identical.
 """
 
 from __future__ import annotations
@@ -65,6 +83,10 @@ START = dict(L=18e-3, W=6.5e-3, h=0.105e-3, d=4e-11, C=1091.0, eps=1.3e-6, a0=0.
              Gp=2.0, E=3e8, T=TEMPERATURE_C + ip.T_ZERO)
 R1, R2, R3, A0 = 470e3, 10e3, 10e3, 2e5
 LAMBDA_CP = 3.926602312047919          # first root of tan λ = tanh λ (brentq check in the benchmark)
+#: Temperature laws of the strip (module doc, "Bath temperature"): diffusivity activation energy
+#: [J/mol] and the modulus's log-linear slope [1/K] (physics.md §7 defaults).
+EA_D = 15e3
+E_LOGSLOPE = -0.0075
 
 # name -> (library name or None, {param: (draw, lo, hi)}); "log": lo·(hi/lo)^q, "lin": lo + q(hi − lo)
 EFFECT_SPECS = {
@@ -88,8 +110,33 @@ EFFECT_SPECS.update(PHYSICAL_FORM_SPECS)
 
 
 # --------------------------------------------------------------------------- strip
-def strip_sensor(base: dict, s) -> tuple:
-    """(G [A/m], Z [Ω]) of the strip at Laplace points s (1-D)."""
+def at_temperature(base: dict, temperature_c: float) -> dict:
+    """The strip ``base`` (given at its temperature ``base["T"]`` [K]) at ``temperature_c`` [°C]
+    (module doc, "Bath temperature"): d, ε, E and Gp by their laws, T; the rest unchanged."""
+    T0, T = base["T"], float(temperature_c) + ip.T_ZERO
+    if not 0.0 < float(temperature_c) < 100.0:
+        raise ValueError(f"temperature_c={temperature_c!r}: the laws here hold for liquid water, 0-100 °C")
+    arr = math.exp(-EA_D / ip.R_GAS * (1.0 / T - 1.0 / T0))
+    out = dict(base)
+    out["d"] = base["d"] * arr
+    out["eps"] = base["eps"] * float(ip.water_permittivity(T - ip.T_ZERO) / ip.water_permittivity(T0 - ip.T_ZERO))
+    out["E"] = base["E"] * math.exp(E_LOGSLOPE * (T - T0))
+    out["Gp"] = base["Gp"] * arr * T0 / T
+    out["T"] = T
+    return out
+
+
+def strip_sensor(base: dict, s, temperature_c=None) -> tuple:
+    """(G [A/m], Z [Ω]) of the strip at Laplace points s (1-D); ``temperature_c`` [°C] (a number or
+    one per point; default the strip's own ``base["T"]``)."""
+    if temperature_c is not None:
+        s = np.asarray(s, complex)
+        t = np.broadcast_to(np.asarray(temperature_c, float), s.shape)
+        G, Z = np.empty(s.shape, complex), np.empty(s.shape, complex)
+        for tc in np.unique(t):
+            on = t == tc
+            G[on], Z[on] = strip_sensor(at_temperature(base, tc), s[on])
+        return G, Z
     st = {k: np.asarray(v, float) for k, v in base.items()}
     st.update(alpha=0.0, zeta=0.1, f1=1.0)
     s2 = np.asarray(s, complex)[None, :]
@@ -168,11 +215,12 @@ def chain_factor(name: str, v: dict, s, Z, f_hz):
     raise ValueError(f"unknown effect {name!r}; expected one of {sorted(EFFECT_SPECS)}")
 
 
-def response(base: dict, effects: dict, f_hz) -> np.ndarray:
-    """Measured G [A/m] with the chain elements ``effects`` = {name: {param: value}}."""
+def response(base: dict, effects: dict, f_hz, temperature_c=None) -> np.ndarray:
+    """Measured G [A/m] with the chain elements ``effects`` = {name: {param: value}}; ``temperature_c``
+    [°C] the bath (a number or one per line; default the strip's own ``base["T"]``)."""
     f = np.asarray(f_hz, float)
     s = 2j * np.pi * f
-    G, Z = strip_sensor(base, s)
+    G, Z = strip_sensor(base, s, temperature_c)
     for n, v in effects.items():
         G = G * chain_factor(n, v, s, Z, f)
     return G
@@ -235,11 +283,14 @@ def library_fields(base: dict) -> dict:
 
 
 __all__ = [
+    "EA_D",
     "EFFECT_SPECS",
+    "E_LOGSLOPE",
     "IN_LIBRARY",
     "OUT_OF_LIBRARY",
     "PHYSICAL_FORM_SPECS",
     "START",
+    "at_temperature",
     "chain_factor",
     "library_fields",
     "make_case",

@@ -74,3 +74,48 @@ def test_cases_are_reproducible_and_labelled():
     assert t0["lam_baseline"] == 0.0 and t0["expected"] == []
     with pytest.raises(ValueError):
         isn.make_case(1, "nope")
+
+
+# ------------------------------------------------------------------ the bath temperature (issue 27 item 3)
+@pytest.mark.parametrize("t", [5.0, 20.0, 50.0, 65.0])
+def test_strip_away_from_its_temperature_agrees_with_the_library_laws(t, start):
+    """The generator's own laws against the library's defaults at other bath temperatures: the same
+    Arrhenius, log-linear and Nernst–Einstein laws, but water's permittivity from another published
+    fit (Owen et al. 1961 here, Malmberg & Maryott 1956 there, ≤ 0.2 % apart over 5–65 °C)."""
+    f = np.geomspace(1.0, 1000.0, 25)
+    G, Z = isn.strip_sensor(isn.START, 2j * np.pi * f, t)
+    r = SensorModel(start).frequency_response(f, [t], quantities=("S", "Z"))
+    assert np.max(np.abs(G / r["S"][0, 0] - 1)) < 2e-3
+    assert np.max(np.abs(Z / r["Z"][0, 0] - 1)) < 2e-3
+    Z35 = isn.strip_sensor(isn.START, 2j * np.pi * f)[1]
+    assert np.max(np.abs(Z / Z35 - 1)) > 0.05              # the bath moves the strip's impedance
+
+
+def test_the_default_temperature_is_the_strip_as_it_was():
+    """At the strip's own temperature every law's factor is exactly 1: the records of the sealed sets
+    (made without a temperature) and the same lines asked for at 35 °C are bit-identical."""
+    _, tr = isn.make_case(11, "opamp")
+    f = np.geomspace(1.0, 1000.0, 17)
+    assert np.array_equal(isn.response(tr["base"], tr["effects"], f),
+                          isn.response(tr["base"], tr["effects"], f, temperature_c=isn.TEMPERATURE_C))
+    assert isn.at_temperature(tr["base"], isn.TEMPERATURE_C) == tr["base"]
+    with pytest.raises(ValueError, match="0-100"):
+        isn.at_temperature(tr["base"], 308.15)               # kelvin typed for °C
+
+
+@pytest.mark.parametrize("t", [5.0, 65.0])
+def test_only_the_opamp_stage_follows_the_bath(t, start):
+    """The op-amp stages see the strip's impedance, which the bath changes; an amplifier pole does
+    not.  Each element's factor at t against the library's effect at t, and against itself at 35 °C."""
+    f = np.geomspace(10.0, 1000.0, 21)
+    fac = {}
+    for name in ("amplifier", "opamp"):
+        v = isn.draw_effect(name, np.random.default_rng(3), 0.8)
+        lib, lv = LIBRARY_FORM[name](v)
+        a = isn.response(isn.START, {name: v}, f, t)
+        b = EffectModel(start, "sensor", {lib: lv}).frequency_response(f, [t])["S"][0, 0]
+        assert np.max(np.abs(a / b - 1)) < 2e-3
+        fac[name] = [isn.response(isn.START, {name: v}, f, tt) / isn.response(isn.START, {}, f, tt)
+                     for tt in (t, isn.TEMPERATURE_C)]
+    assert np.max(np.abs(fac["amplifier"][0] / fac["amplifier"][1] - 1)) < 1e-12
+    assert np.max(np.abs(fac["opamp"][0] / fac["opamp"][1] - 1)) > 0.02

@@ -29,13 +29,13 @@ def test_batched_criterion_matches_direct_least_squares():
     D0, J0, w0 = rng.standard_normal(10), rng.standard_normal((10, k)), rng.uniform(0.5, 2, 10)
     W = (rng.uniform(size=(n_exp, n)) > 0.4) * rng.uniform(0.5, 3.0, (n_exp, n))
     base = (w0 @ (D0 * D0), (w0[:, None] * J0).T @ D0, (w0[:, None] * J0).T @ J0)
-    got = nmod._lambda(D, J, W, base)
+    got = nmod.t_criterion(D, J, W, base)
     for e in range(n_exp):
         sw = np.sqrt(np.r_[W[e], w0])
         A, b = np.vstack([J, J0]) * sw[:, None], np.r_[D, D0] * sw
         x, *_ = np.linalg.lstsq(A, b, rcond=None)
         assert got[e] == pytest.approx(float(np.sum((b - A @ x) ** 2)), rel=1e-7, abs=1e-9)
-    assert np.all(nmod._lambda(D, J[:, :0], W) == pytest.approx(W @ (D * D)))     # nothing to refit: Σ w Δ²
+    assert np.all(nmod.t_criterion(D, J[:, :0], W) == pytest.approx(W @ (D * D)))     # nothing to refit: Σ w Δ²
 
 
 def _sweep(T, f, H=None, std=True):

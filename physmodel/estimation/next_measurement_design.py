@@ -1,0 +1,293 @@
+"""The design algebra of the next-measurement search (:mod:`~physmodel.estimation.next_measurement`).
+
+The competing models with their fitted values and log-response Jacobians
+(:class:`CompetingModel`, :func:`fit_competing_models`), the noise a new line is expected to carry
+(:func:`noise_model`, :func:`line_sigma`), the linearised T-criterion over many experiments at once
+(:func:`t_criterion`, on real-stacked log-ratios :func:`log_ratio`, :func:`stack_real`) and its
+nonlinear check by full refits of the rivals (:func:`refit_check`).  The method is described in
+:mod:`~physmodel.estimation.next_measurement`'s module documentation.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..data.sweep import FrequencySweep
+from ..data.units import QUANTITY_UNITS
+from ..errors import IPMCError
+from .next_measurement_results import CandidateMeasurement, merge_records
+from .residuals import noise_std
+
+#: Relative step of the central differences of the Jacobians.
+FD_RELATIVE_STEP = 1e-5
+#: Starts of each rival refit in the nonlinear check (its own fit, the typical size, and LHS).
+REFIT_STARTS = 3
+
+
+class CompetingModel:
+    """A competing model: its predictor factory, free parameters and fitted values."""
+
+    def __init__(self, d, effects: tuple, values: dict, free: list):
+        from ..effects import EffectModel
+
+        self.effects, self.values, self.free = effects, dict(values), list(free)
+        beff = {k: dict(v) for k, v in (d.metadata.get("baseline_effects") or {}).items()}
+        on = {c: {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith(c + ".")} for c in effects}
+        self.model = EffectModel(d.base_parameters, d.kind, {**beff, **on}, kernel=d.metadata.get("kernel",
+                                                                                                   "boundary_charge"))
+
+    def log_response(self, sweep: FrequencySweep, q: str) -> tuple[np.ndarray, np.ndarray]:
+        """(ln G at θ (N,), ∂ ln G/∂θ (N, k)) on ``sweep``'s lines (central differences in θ)."""
+        return self.log_response_of(self.model.predictor(sweep, q).many)
+
+    def log_response_of(self, pm) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`log_response` of a predictor ``pm(values_list) -> (n_sets, N)`` of this model's lines."""
+        sets, steps = [self.values], []
+        for fp in self.free:
+            v = self.values[fp.name]
+            h = FD_RELATIVE_STEP * (abs(v) if v != 0 else (fp.upper - fp.lower))
+            up, dn = min(v + h, fp.upper), max(v - h, fp.lower)
+            sets += [{**self.values, fp.name: up}, {**self.values, fp.name: dn}]
+            steps.append(up - dn)
+        with np.errstate(all="ignore"):
+            G = np.asarray(pm(sets), dtype=complex)
+            L0 = np.log(G[0])
+            J = np.stack([np.log(G[1 + 2 * j] / G[2 + 2 * j]) / steps[j] for j in range(len(self.free))], axis=-1) \
+                if self.free else np.zeros((G.shape[1], 0), complex)
+        return L0, J
+
+
+class RecordView:
+    """The diagnosed record as the search sees it: one quantity's sweep, or the sweeps of a joint
+    diagnosis (:mod:`~physmodel.estimation.joint`, one per quantity, effects narrowed by its
+    ``acts_on``), each a quantity a new measurement of it is merged with."""
+
+    def __init__(self, d):
+        jd = getattr(d, "joint", None)
+        self.kind, self.joint, self._d, self._jd = d.kind, jd is not None, d, jd
+        self.acts_on = {k: tuple(v) for k, v in ((d.metadata or {}).get("acts_on") or {}).items()} if self.joint else {}
+        self.sweeps = dict(zip(jd.quantities, jd.sweeps)) if jd is not None else {d.quantity: d.data}
+
+    def record_many(self, model):
+        """The predictor of ``model`` on the whole diagnosed record (stacked when joint)."""
+        if self._jd is not None:
+            return self._jd.predictor(model, self.acts_on)
+        return model.predictor(self._d.data, self._d.quantity).many
+
+    def many(self, model, sweep: FrequencySweep, q: str):
+        """The predictor of ``model`` on ``sweep``'s lines of quantity ``q`` (``acts_on`` applied when joint)."""
+        if not self.joint:
+            return model.predictor(sweep, q).many
+        from .joint import joint_data
+
+        if sweep.magnitude_std_db is None:        # σ does not enter a prediction; the stacking wants one
+            n = sweep.frequency_hz.size
+            sweep = FrequencySweep(sweep.temperature_c, sweep.frequency_hz, sweep.response, np.ones(n), np.ones(n),
+                                   sweep.input_name, sweep.input_unit, sweep.output_name, sweep.output_unit)
+        return joint_data([sweep], self.kind, (q,)).predictor(model, self.acts_on)
+
+    def restacked(self, sweeps: dict) -> tuple:
+        """(record, predictor factory ``model -> many``) of ``{quantity: sweep}`` diagnosed as the
+        record is (jointly when it is joint)."""
+        if not self.joint:
+            (q, sw), = sweeps.items()
+            return sw, lambda model: model.predictor(sw, q).many
+        from .joint import joint_data
+
+        jd = joint_data(list(sweeps.values()), self.kind, tuple(sweeps))
+        return jd.stacked, lambda model: jd.predictor(model, self.acts_on)
+
+
+def refit_model(d, effects: tuple, start: dict, max_nfev: int):
+    """The model ``effects`` refitted to the diagnosed record from ``start`` (free: the diagnosis's
+    base parameters and the effects' parameters within their candidate bounds)."""
+    from .lsq import fit_parameters
+    from .records import FreeParameter
+
+    free = [fp.with_initial(min(max(start.get(fp.name, fp.initial if fp.initial is not None else fp.lower),
+                                    fp.lower), fp.upper)) for fp in d.baseline.free]
+    cb = d.metadata.get("candidate_bounds", {})
+    for c in effects:
+        for p, (lo, hi, typ) in cb.get(c, {}).items():
+            name = f"{c}.{p}"
+            v = start.get(name, typ)
+            free.append(FreeParameter(name, lo, hi, "linear", float(min(max(v, lo), hi))))
+    m = CompetingModel(d, effects, {fp.name: fp.initial for fp in free}, free)
+    pm = RecordView(d).record_many(m.model)
+    # the effects' values ride in the predictor's base model; the fit varies them through the names
+    res = fit_parameters(d.data, None, free, predict_many=pm, starts=1, seed=0, max_nfev=max_nfev, identify=False,
+                         hold_undetermined=False)
+    return CompetingModel(d, effects, dict(res.values), free), float(res.cost)
+
+
+def fit_competing_models(d, models: Sequence[tuple], max_nfev: int) -> list[CompetingModel]:
+    """Each competing model with its fitted values: the diagnosis's final fit for the first, a refit
+    to the record (from the baseline optimum and the candidates' own fitted values) for the others."""
+    out = []
+    for i, effs in enumerate(models):
+        if i == 0 and d.final is not None and set(effs) == set(d.final_effects):
+            cb = d.metadata.get("candidate_bounds", {})
+            from .records import FreeParameter
+
+            free = list(d.baseline.free) + [FreeParameter(f"{c}.{p}", lo, hi, "linear", d.final.values[f"{c}.{p}"])
+                                            for c in effs for p, (lo, hi, _) in cb.get(c, {}).items()]
+            out.append(CompetingModel(d, effs, dict(d.final.values), free))
+            continue
+        start = dict(d.final.values if d.final is not None else d.baseline.values)
+        start = {k: v for k, v in start.items() if "." not in k or k.split(".", 1)[0] in effs}
+        for c in effs:
+            if c in d.candidates:
+                start.update({f"{c}.{p}": v for p, v in d.candidates[c].values.items()})
+        out.append(refit_model(d, effs, start, max_nfev)[0])
+    return out
+
+
+
+def noise_model(d) -> dict:
+    """σ_ln, σ_φ of the record against |G| (:mod:`~physmodel.estimation.next_measurement`, "Noise at
+    the new lines"): slope b ∈ [−1, 0] and the references; a joint record's per quantity
+    (``by_quantity``), with the median relative σ over its quantities for another one."""
+    view = RecordView(d)
+    if not view.joint:
+        return sweep_noise_model(d.data)
+    by_q = {q: sweep_noise_model(s) for q, s in view.sweeps.items()}
+    return {"by_quantity": by_q, "median_ln": float(np.median([v["median_ln"] for v in by_q.values()])),
+            "median_ph": float(np.median([v["median_ph"] for v in by_q.values()])),
+            "estimated": any(v["estimated"] for v in by_q.values()),
+            "rule": next(iter(by_q.values()))["rule"].replace("the diagnosed quantity", "each diagnosed quantity")
+            .replace("the record's median relative σ", "the median over the diagnosed quantities of their median "
+                     "relative σ")}
+
+
+def sweep_noise_model(sweep: FrequencySweep) -> dict:
+    """:func:`noise_model` of one quantity's sweep."""
+    s_ln, s_ph, estimated = noise_std(sweep)
+    a = np.log(np.abs(sweep.response))
+    b = 0.0
+    if not estimated and a.size > 2 and np.ptp(a) > 0.1:
+        y = np.log(np.concatenate([s_ln, s_ph]))
+        x = np.concatenate([a, a])
+        X = np.column_stack([np.ones_like(x), x, np.r_[np.zeros(a.size), np.ones(a.size)]])
+        coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+        b = float(np.clip(coef[1], -1.0, 0.0))
+    ref_ln = float(np.exp(np.median(np.log(s_ln) - b * a)))
+    ref_ph = float(np.exp(np.median(np.log(s_ph) - b * a)))
+    return {"slope": b, "ref_ln": ref_ln, "ref_ph": ref_ph, "median_ln": float(np.median(s_ln)),
+            "median_ph": float(np.median(s_ph)), "estimated": bool(estimated),
+            "rule": ("σ = σ_ref·(|G|)^b·level^b on the diagnosed quantity, b from the record "
+                     "(0: proportional to the signal, −1: a fixed floor); another quantity: the record's "
+                     "median relative σ, independent of the level (its instrument is unknown)")}
+
+
+def line_sigma(nm: dict, logabs: np.ndarray, level: np.ndarray, same_quantity: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(σ_ln, σ_φ) per (experiment level, line): shapes (n_levels, N)."""
+    if same_quantity:
+        f = np.exp(nm["slope"] * logabs)[None, :] * (level[:, None] ** nm["slope"])
+        return nm["ref_ln"] * f, nm["ref_ph"] * f
+    one = np.ones((level.size, logabs.size))
+    return nm["median_ln"] * one, nm["median_ph"] * one
+
+
+def t_criterion(delta: np.ndarray, J: np.ndarray, w: np.ndarray, base: tuple | None = None) -> np.ndarray:
+    """min_δ Σ w |Δ − J δ|² per weight row of ``w`` (n_exp, 2N); ``delta`` (2N,), ``J`` (2N, k)
+    real-stacked; ``base`` adds fixed (rᵀr, Jᵀr, JᵀJ) sums of the diagnosed record."""
+    rr = w @ (delta * delta)
+    Jr = w @ (J * delta[:, None])
+    JJ = np.einsum("ei,ij,ik->ejk", w, J, J, optimize=True)
+    if base is not None:
+        rr, Jr, JJ = rr + base[0], Jr + base[1], JJ + base[2]
+    k = J.shape[1]
+    if k == 0:
+        return rr
+    scale = np.sqrt(np.maximum(np.einsum("ejj->ej", JJ), 1e-300))
+    A = JJ / (scale[:, :, None] * scale[:, None, :]) + 1e-10 * np.eye(k)
+    x = np.linalg.solve(A, (Jr / scale)[..., None])[..., 0]
+    return np.maximum(rr - np.einsum("ej,ej->e", Jr / scale, x), 0.0)
+
+
+def log_ratio(La: np.ndarray, Lb: np.ndarray) -> np.ndarray:
+    """ln(G_A/G_B) from the two log-responses, its phase wrapped to (−π, π]."""
+    D = La - Lb
+    return D.real + 1j * np.angle(np.exp(1j * D.imag))
+
+
+def stack_real(z: np.ndarray) -> np.ndarray:
+    """Complex (N, ...) → real (2N, ...): log-magnitude rows, then phase rows."""
+    return np.concatenate([z.real, z.imag], axis=0)
+
+
+
+def log_unit_factor(record: FrequencySweep, sk: FrequencySweep) -> float:
+    """ln of the factor from ``sk``'s response units to ``record``'s (same dimensions)."""
+    from ..data.units import unit_scale
+
+    if (record.input_unit, record.output_unit) == (sk.input_unit, sk.output_unit):
+        return 0.0
+    try:
+        f = (unit_scale(sk.output_unit) / unit_scale(sk.input_unit)) / (unit_scale(record.output_unit)
+                                                                        / unit_scale(record.input_unit))
+    except (KeyError, IPMCError):
+        return 0.0
+    return float(np.log(abs(f)))
+
+
+
+def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int, label) -> dict:
+    """λ of experiment ``r`` by full refits: each rival refitted to the other's noiseless predictions
+    on the new lines (with the record's lines when joint) from its own fit, from its effect at its
+    typical size and from :data:`REFIT_STARTS` − 2 more Latin-hypercube starts; ``{"A vs B": the
+    least over the two directions}`` for each of ``pairs``."""
+    from .lsq import fit_parameters
+
+    view = RecordView(d)
+    in_name, unit_in, out_name, unit_out = QUANTITY_UNITS[(d.kind, r.quantity)]
+    sk = FrequencySweep(r.line_temperatures_c, r.line_frequencies_hz, np.ones(r.n_lines, complex), None, None,
+                        in_name, unit_in, out_name, unit_out)
+    cb = d.metadata.get("candidate_bounds", {})
+    same = r.quantity in view.sweeps
+    nm_q = nm["by_quantity"][r.quantity] if view.joint and same else nm
+    out = {}
+    for a, b in pairs:
+        best = math.inf
+        for truth, rival in ((a, b), (b, a)):
+            G = np.asarray(view.many(truth.model, sk, r.quantity)([truth.values])[0])
+            if r.joint:
+                rs = view.sweeps.get(r.quantity)
+                logabs = np.log(np.abs(G)) + (log_unit_factor(rs, sk) if rs is not None else 0.0)
+                s_ln, s_ph = line_sigma(nm_q, logabs, np.array([r.level]), same)
+                sweeps = {}
+                for q0, s0 in view.sweeps.items():      # the record, as the truth predicts it, with its σ
+                    G0 = np.asarray(view.many(truth.model, s0, q0)([truth.values])[0])
+                    if s0.magnitude_std_db is None:
+                        s0l, s0p, _ = noise_std(s0)
+                        std0 = (s0l * 20 / math.log(10), np.degrees(s0p))
+                    else:
+                        std0 = (s0.magnitude_std_db, s0.phase_std_deg)
+                    sweeps[q0] = FrequencySweep(s0.temperature_c, s0.frequency_hz, G0, *std0, s0.input_name,
+                                                s0.input_unit, s0.output_name, s0.output_unit)
+                new = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
+                                     sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
+                sweeps[r.quantity] = merge_records(sweeps[r.quantity], new) if same else new
+                sw, factory = view.restacked(sweeps)
+            else:
+                s_ln, s_ph = line_sigma(nm, np.log(np.abs(G)), np.array([r.level]), False)
+                sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
+                                    sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
+                factory = lambda model, sw=sw: model.predictor(sw, r.quantity).many  # noqa: E731
+            pm = factory(rival.model)
+            typical = {f"{c}.{p}": v[2] for c in rival.effects for p, v in cb.get(c, {}).items()}
+            for k, start in enumerate((rival.values, {**rival.values, **typical})):
+                free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in rival.free]
+                res = fit_parameters(sw, None, free, predict_many=pm, starts=1 if k == 0 else REFIT_STARTS - 1,
+                                     seed=0, max_nfev=max_nfev, identify=False, hold_undetermined=False)
+                best = min(best, 2.0 * float(res.cost))
+        out[f"{label(a)} vs {label(b)}"] = best
+    return out
+
+
+__all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
+           "log_ratio", "log_unit_factor", "noise_model", "refit_check", "refit_model", "stack_real",
+           "sweep_noise_model", "t_criterion"]

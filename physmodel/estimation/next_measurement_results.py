@@ -1,0 +1,210 @@
+"""The records of a next-measurement search and the merging of a new record with the diagnosed one.
+
+:class:`CandidateMeasurement` (one experiment and the separation it is expected to give) and
+:class:`NextMeasurement` (what :func:`~physmodel.estimation.next_measurement.next_measurement`
+found), :func:`json_ready` (the reports' one JSON sanitiser) and :func:`merge_records` (the
+diagnosed record and the new measurement as one sweep, to be diagnosed jointly).  The search itself
+is :mod:`~physmodel.estimation.next_measurement`; the design algebra it uses (competing models,
+noise at new lines, the T-criterion, the nonlinear check) is
+:mod:`~physmodel.estimation.next_measurement_design`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..data.sweep import FrequencySweep
+from ..errors import IPMCError
+
+
+@dataclass
+class CandidateMeasurement:
+    """One experiment and the separation it is expected to give.
+
+    Attributes
+    ----------
+    quantity : str
+        What is measured (actuator M, H, Z, I; sensor S, Z).
+    band_hz : tuple of float
+        Lowest and highest line. [Hz]
+    temperatures_c : tuple of float
+        Bath temperatures. [°C]
+    level : float
+        Excitation amplitude as a multiple of the diagnosed record's drive. [-]
+    n_lines : int
+        Lines of the new record (all temperatures).
+    frequencies_hz : ndarray
+        The lines (per temperature). [Hz]
+    separation : float
+        Expected noiseless χ² between the competing models (linearised T-criterion, the least over
+        which model is true and over the rival pairs). [-]
+    separation_by_pair : dict
+        ``"A vs B"`` → {"A true": λ_A, "B true": λ_B}. [-]
+    joint : bool
+        Evaluated together with the diagnosed record (same quantity: merge and diagnose both).
+    duration_s : float
+        Measurement time estimate: temperatures × :data:`~physmodel.estimation.next_measurement.PERIODS` / lowest frequency, plus
+        :data:`~physmodel.estimation.next_measurement.BATH_SETTLE_S` per temperature the record was not measured at. [s]
+    power : float
+        Probability that Vuong's test separates them at the diagnosis's α (normal approximation).
+    separation_refit : float
+        λ after full nonlinear refits of the rivals (NaN unless checked), pairs that are the same
+        response in another form left out. [-]
+    refit_by_pair : dict
+        ``"A vs B"`` → λ after the refits, the least over the two directions (checked experiments). [-]
+    line_temperatures_c, line_frequencies_hz : ndarray
+        Every line of the new record (a joint record leaves out the diagnosed record's band at its
+        temperatures). [°C], [Hz]
+    """
+
+    quantity: str
+    band_hz: tuple
+    temperatures_c: tuple
+    level: float
+    n_lines: int
+    frequencies_hz: np.ndarray = field(repr=False)
+    separation: float
+    separation_by_pair: dict
+    joint: bool
+    duration_s: float
+    power: float
+    separation_refit: float = float("nan")
+    refit_by_pair: dict = field(default_factory=dict)
+    line_temperatures_c: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    line_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    #: A quantity a joint diagnosis did not hold, diagnosed jointly with its quantities.
+    added_quantity: bool = field(default=False, repr=False)
+
+    def describe(self) -> str:
+        """The experiment in words."""
+        T = ", ".join(f"{t:g}" for t in self.temperatures_c)
+        merged = self.joint and not self.added_quantity
+        return (f"{self.quantity} at {T} °C, {self.band_hz[0]:.3g}–{self.band_hz[1]:.3g} Hz "
+                f"({self.n_lines} lines"
+                + (", none inside the record's band at its temperatures" if merged else "")
+                + f"), drive ×{self.level:g}"
+                + (" (merged with the diagnosed record)" if merged else " (diagnosed jointly with the record's "
+                   "quantities)" if self.joint else " (a record of its own)"))
+
+    def to_dict(self) -> dict:
+        """JSON-ready form."""
+        return {"quantity": self.quantity, "band_hz": list(self.band_hz), "temperatures_c": list(self.temperatures_c),
+                "level": self.level, "n_lines": self.n_lines, "frequencies_hz": self.frequencies_hz.tolist(),
+                "lines": {"temperature_c": self.line_temperatures_c.tolist(),
+                          "frequency_hz": self.line_frequencies_hz.tolist()},
+                "separation": self.separation, "separation_by_pair": self.separation_by_pair, "joint": self.joint,
+                "duration_s": self.duration_s, "power": self.power, "separation_refit": self.separation_refit,
+                "refit_by_pair": self.refit_by_pair,
+                "description": self.describe()}
+
+
+@dataclass
+class NextMeasurement:
+    """What :func:`~physmodel.estimation.next_measurement.next_measurement` found.
+
+    Attributes
+    ----------
+    models : list of tuple
+        The competing models (effect names each); the first is the diagnosis's best.
+    recommended : CandidateMeasurement or None
+        The experiment to run (None when there is nothing to separate).
+    separates : bool
+        The recommendation is expected to reach ``target`` (and its refit check agrees).
+    target : float
+        The separation needed, 4 (z_crit + Φ⁻¹(power))². [-]
+    current : float
+        The same criterion on the diagnosed record alone. [-]
+    evaluated : int
+        Candidate experiments evaluated.
+    ranking : list of CandidateMeasurement
+        The best experiments by separation (up to 10).
+    noise_model : dict
+        How σ at new lines was predicted (slope b, reference, quantity rule).
+    fitted : dict
+        Model label → the fitted values each prediction used.
+    message : str
+        The recommendation in words (what the report and stderr say).
+    inseparable : list of str
+        ``"A vs B"`` pairs no experiment within the limits separates (the same response in another
+        form: linearised, or after the refits of every checked experiment).
+    best_by_quantity : dict
+        Quantity → the largest linearised separation any experiment of it reaches. [-]
+    """
+
+    models: list
+    recommended: CandidateMeasurement | None
+    separates: bool
+    target: float
+    current: float
+    evaluated: int
+    ranking: list
+    noise_model: dict
+    fitted: dict
+    message: str
+    inseparable: list = field(default_factory=list)
+    best_by_quantity: dict = field(default_factory=dict)
+
+    @classmethod
+    def unavailable(cls, reason: str, models=()) -> NextMeasurement:
+        """The record of a search that gave no recommendation (``reason``: why), so that a finished
+        diagnosis still carries, reports and says it instead of losing it."""
+        return cls([tuple(m) for m in models], None, False, math.nan, math.nan, 0, [], {}, {},
+                   f"no recommendation: {reason}")
+
+    def to_dict(self) -> dict:
+        """JSON-ready form (finite floats; NaN as None)."""
+        return json_ready({"models": [list(m) for m in self.models],
+                      "recommended": self.recommended.to_dict() if self.recommended else None,
+                      "separates": self.separates, "target": self.target, "current": self.current,
+                      "evaluated": self.evaluated, "ranking": [r.to_dict() for r in self.ranking],
+                      "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
+                      "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity})
+
+
+
+def json_ready(o):
+    """``o`` with dict keys as str, tuples as lists, numpy scalars as Python ones and non-finite floats
+    as None: what ``json.dumps(..., allow_nan=False)`` accepts (the reports' one sanitiser)."""
+    if isinstance(o, dict):
+        return {str(k): json_ready(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [json_ready(v) for v in o]
+    if isinstance(o, (float, np.floating)):
+        return float(o) if math.isfinite(o) else None
+    if isinstance(o, np.bool_):
+        return bool(o)
+    if isinstance(o, np.integer):
+        return int(o)
+    return o
+
+
+
+def merge_records(record: FrequencySweep, new: FrequencySweep) -> FrequencySweep:
+    """One sweep of the same quantity from the diagnosed ``record`` and the ``new`` measurement (lines
+    sorted by temperature, then frequency; in ``record``'s units), to be diagnosed jointly; a line
+    both hold at the same temperature and frequency is refused (measure it once, or average first)."""
+    if not isinstance(record, FrequencySweep) or not isinstance(new, FrequencySweep):
+        raise IPMCError("merge_records: both records must be FrequencySweep")
+    b = new.in_units(record.input_unit, record.output_unit)
+    if (record.magnitude_std_db is None) != (b.magnitude_std_db is None):
+        raise IPMCError("merge_records: one record carries per-line standard deviations and the other does not")
+    T = np.r_[record.temperature_c, b.temperature_c]
+    f = np.r_[record.frequency_hz, b.frequency_hz]
+    order = np.lexsort((f, T))
+    dup = (np.diff(T[order]) == 0) & (np.diff(f[order]) == 0)
+    if np.any(dup):
+        k = order[1:][dup][0]
+        raise IPMCError(f"merge_records: both records hold a line at {T[k]:g} °C, {f[k]:g} Hz")
+    std = record.magnitude_std_db is not None
+    return FrequencySweep(T[order], f[order], np.r_[record.response, b.response][order],
+                          np.r_[record.magnitude_std_db, b.magnitude_std_db][order] if std else None,
+                          np.r_[record.phase_std_deg, b.phase_std_deg][order] if std else None,
+                          record.input_name, record.input_unit, record.output_name, record.output_unit,
+                          {**dict(record.metadata or {}), "merged_with": dict(b.metadata or {})})
+
+
+
+__all__ = ["CandidateMeasurement", "NextMeasurement", "json_ready", "merge_records"]
