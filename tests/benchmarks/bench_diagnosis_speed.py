@@ -171,15 +171,36 @@ def _child_cpu() -> float:
     return ru.ru_utime + ru.ru_stime
 
 
-def run_commands(cases: str, rounds: int) -> list[dict]:
+def _same_numbers(a, b, path="") -> list[str]:
+    """Where two reports (parsed JSON) differ, number by number; timings and the output folder's
+    name (in the model file's provenance) are left out."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for k in sorted(set(a) | set(b)):
+            if k in ("elapsed_s", "seconds", "cpu_s", "command"):
+                continue
+            out += ([f"{path}/{k}: on one side only"] if k not in a or k not in b else
+                    _same_numbers(a[k], b[k], f"{path}/{k}"))
+        return out
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{path}: {len(a)} vs {len(b)} items"]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in _same_numbers(x, y, f"{path}[{i}]")]
+    same = a == b or (isinstance(a, float) and isinstance(b, float) and a != a and b != b)
+    return [] if same else [f"{path}: {a!r} vs {b!r}"]
+
+
+def run_commands(cases: str, rounds: int, roots: list[Path] | None = None) -> list[dict]:
     """The issue's own measure: ``ipmc calibrate`` vs ``ipmc diagnose`` on the same sweep file and
     free parameters, as a user types them (start-up, report and figures included), interleaved;
-    CPU of each child process (RUSAGE_CHILDREN)."""
+    CPU of each child process (RUSAGE_CHILDREN).  ``roots``: checkouts to run the commands from
+    (PYTHONPATH), interleaved per round with their order alternating (before / after a change);
+    their report.json and model.json are then compared number by number."""
     from physmodel.data.sweep import write_csv
 
     ipmc = [sys.executable, "-m", "scenarios.cli"]
     free = [x for n in FREE for x in ("--free", n)]
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    roots = roots or [ROOT]
     rows = []
     for spec in cases.split(","):
         seed, label, sweep, base, expected = _case(spec)
@@ -187,26 +208,41 @@ def run_commands(cases: str, rounds: int) -> list[dict]:
             t = Path(tmp)
             write_csv(sweep, t / "sweep.csv")
             (t / "base.json").write_text(json.dumps(base.to_dict()))
-            cmds = {
-                "calibrate": ipmc + ["calibrate", "sweep.csv", "--set", "base.json", "--kind", "actuator", *free,
-                                     "--out", "cal", "--force", "--quiet", "--accept-misfit"],
-                "diagnose": ipmc + ["diagnose", "--data", "sweep.csv", "--set", "base.json", "--kind", "actuator",
-                                    *free, "--seed", str(seed), "--out", "dia", "--force", "--quiet"],
-            }
-            times: dict = {k: [] for k in cmds}
-            codes: dict = {k: set() for k in cmds}
-            for _ in range(rounds):
-                for k, c in cmds.items():
-                    c0 = _child_cpu()
-                    r = subprocess.run(c, cwd=t, env=env, capture_output=True, text=True)
-                    times[k].append(_child_cpu() - c0)
-                    codes[k].add(r.returncode)
-            med = {k: float(np.median(v)) for k, v in times.items()}
-            row = dict(seed=seed, label=label, expected=expected, codes={k: sorted(v) for k, v in codes.items()}, **med)
+            times: dict = {}
+            codes: dict = {}
+            for r in range(rounds):
+                for i in (range(len(roots)) if r % 2 == 0 else reversed(range(len(roots)))):
+                    env = dict(os.environ, PYTHONPATH=str(roots[i]), MPLBACKEND="Agg")
+                    cmds = {
+                        "calibrate": ipmc + ["calibrate", "sweep.csv", "--set", "base.json", "--kind", "actuator",
+                                             *free, "--out", f"cal{i}", "--force", "--quiet", "--accept-misfit"],
+                        "diagnose": ipmc + ["diagnose", "--data", "sweep.csv", "--set", "base.json", "--kind",
+                                            "actuator", *free, "--seed", str(seed), "--out", f"dia{i}", "--force",
+                                            "--quiet"],
+                    }
+                    for k, c in cmds.items():
+                        c0 = _child_cpu()
+                        p = subprocess.run(c, cwd=t, env=env, capture_output=True, text=True)
+                        times.setdefault((i, k), []).append(_child_cpu() - c0)
+                        codes.setdefault((i, k), set()).add(p.returncode)
+            med = {key: float(np.median(v)) for key, v in times.items()}
+            diffs = []
+            for i in range(1, len(roots)):
+                for f in ("report.json", "model.json"):
+                    diffs += [f"{f}{d}" for d in _same_numbers(json.loads((t / "dia0" / f).read_text()),
+                                                               json.loads((t / f"dia{i}" / f).read_text()))]
+            row = dict(seed=seed, label=label, expected=expected, roots=[str(x) for x in roots],
+                       calibrate=[med[i, "calibrate"] for i in range(len(roots))],
+                       diagnose=[med[i, "diagnose"] for i in range(len(roots))],
+                       codes={f"{i}/{k}": sorted(v) for (i, k), v in codes.items()}, report_differences=diffs)
             rows.append(row)
-            print(f"== seed {seed} {label}: ipmc calibrate {med['calibrate']:.2f} s CPU (exit {row['codes']['calibrate']}), "
-                  f"ipmc diagnose {med['diagnose']:.2f} s CPU (exit {row['codes']['diagnose']}): "
-                  f"ratio {med['diagnose'] / med['calibrate']:.1f}x")
+            ratios = [d / c for d, c in zip(row["diagnose"], row["calibrate"])]
+            print(f"== seed {seed} {label}: ipmc calibrate " + " / ".join(f"{x:.2f}" for x in row["calibrate"])
+                  + " s CPU, ipmc diagnose " + " / ".join(f"{x:.2f}" for x in row["diagnose"])
+                  + " s CPU: ratio " + " / ".join(f"{x:.1f}x" for x in ratios) + f" (exit {row['codes']})"
+                  + ("" if len(roots) < 2 else
+                     f"; reports {'the same, number by number' if not diffs else 'DIFFER: ' + '; '.join(diffs[:5])}"),
+                  flush=True)
     return rows
 
 
@@ -234,13 +270,22 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds per case (median)")
     ap.add_argument("--commands", action="store_true",
                     help="time the ipmc commands (what the issue measured) instead of the library calls")
+    ap.add_argument("--roots", default="",
+                    help="with --commands: comma-separated checkouts to run the commands from, interleaved "
+                         "(e.g. before,after); their reports are compared number by number")
     a = ap.parse_args(argv)
     print("command: python3 " + " ".join([os.path.relpath(__file__, ROOT)] + list(argv if argv is not None else sys.argv[1:])))
     if a.commands:
-        rows = run_commands(a.cases, a.rounds)
-        ratios = [r["diagnose"] / r["calibrate"] for r in rows]
-        print(f"\nipmc diagnose / ipmc calibrate, CPU: median {np.median(ratios):.1f}x, max {max(ratios):.1f}x "
-              f"(goal <= 5x)")
+        roots = [Path(x).resolve() for x in a.roots.split(",") if x] or None
+        rows = run_commands(a.cases, a.rounds, roots)
+        for i, root in enumerate(roots or [ROOT]):
+            ratios = [r["diagnose"][i] / r["calibrate"][i] for r in rows]
+            print(f"\n{root}: ipmc diagnose / ipmc calibrate, CPU: median {np.median(ratios):.1f}x, "
+                  f"max {max(ratios):.1f}x (goal <= 5x)" + ("" if max(ratios) <= 5 else
+                                                             f"; above 5x: {', '.join(str(r['seed']) for r, x in zip(rows, ratios) if x > 5)}"))
+        bad = [r["seed"] for r in rows if r["report_differences"]]
+        if bad:
+            print(f"reports differ between the roots on seeds {bad}", file=sys.stderr)
         return 0
     rows = run(a.cases, a.rounds)
     print("\nsummary (median over rounds): case, diagnose/calibrate CPU ratio, diagnose CPU s, calibrate CPU s")
