@@ -98,10 +98,15 @@ def _constrained_lr_gram(G, B, one_sided):
                     ok &= d1 >= 0
             else:
                 idx = np.array(sub)
-                Ginv = np.linalg.pinv(G[..., idx[:, None], idx[None, :]])
-                b = B[..., idx, :]                  # (..., m, n)
+                whole = m == k                      # every parameter: G and B as they are (no copy)
+                Ginv = np.linalg.pinv(G if whole else G[..., idx[:, None], idx[None, :]])
+                b = B if whole else B[..., idx, :]  # (..., m, n)
                 d = Ginv @ b
-                lr = np.sum(b * d, axis=-2)
+                # Σ_j b_j d_j over the m rows: what np.sum(b * d, axis=-2) adds, in its order
+                # (the first row, then each next one added), without the (..., m, n) product
+                lr = b[..., 0, :] * d[..., 0, :]
+                for j in range(1, m):
+                    lr += b[..., j, :] * d[..., j, :]
                 ok = lr > best
                 for j, c in enumerate(sub):
                     if one_sided[c]:
