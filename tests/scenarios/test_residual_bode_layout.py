@@ -15,14 +15,14 @@ from scenarios import plots
 from scenarios.plots import canvas
 
 
-def _sweep(decades: float, phase_turns: float, resid: float):
+def _sweep(decades: float, phase_turns: float, resid: float, sigma_db: float = 0.1):
     f = np.tile(np.logspace(-2, 3, 31), 3)
     t = np.repeat([5.0, 35.0, 65.0], 31)
     x = np.log10(f) + 2                                        # 0 … 5
     G = 10 ** (-decades * x / 5) * np.exp(-2j * np.pi * phase_turns * x / 5)
-    sd = np.full(f.size, 0.1)
-    data = FrequencySweep(t, f, G, sd, np.full(f.size, 1.0), "voltage", "V", "tip_displacement", "mm")
-    model = G * np.exp(resid * 0.1 * np.log(10) / 20 * np.sin(x))      # residuals up to ±resid
+    sd = np.full(f.size, sigma_db)
+    data = FrequencySweep(t, f, G, sd, np.full(f.size, 10 * sigma_db), "voltage", "V", "tip_displacement", "mm")
+    model = G * np.exp(resid * sigma_db * np.log(10) / 20 * np.sin(x))      # residuals up to ±resid
     return data, model
 
 
@@ -55,3 +55,24 @@ def test_every_label_of_the_diagnosis_figure_is_inside_the_canvas(tmp_path, monk
     boxes = [ax.get_window_extent(r) for ax in fig.axes]
     for upper, lower in zip(boxes, boxes[1:]):
         assert lower.y1 < upper.y0
+
+
+def test_the_before_after_pair_on_one_canvas_draws_the_same_images_as_two_figures(tmp_path):
+    """residual_bode_pair draws the second figure by resetting the model's lines of the first:
+    both images are pixel for pixel those of two separate residual_bode calls (limits from the
+    second model's lines and residuals, the data's bands included), for models whose curves and
+    residuals reach past the first one's limits and stay inside them."""
+    from matplotlib.image import imread
+
+    data, G = _sweep(1.0, 0.3, 1.0, sigma_db=3.0)           # bands well beyond the curves
+    rng = np.random.default_rng(2)
+    for G2 in (G * np.exp(2.0 * rng.normal(size=G.size) + 0.8j * rng.normal(size=G.size)),   # wider
+               data.response * (1 + 0.001j)):                                                # narrower
+        pair = plots.residual_bode_pair((tmp_path / "a.png", tmp_path / "b.png"), data, (G, G2),
+                                        ("baseline (before)", "after: + second_mode"))
+        one = plots.residual_bode(tmp_path / "a1.png", data, G, "baseline (before)")
+        two = plots.residual_bode(tmp_path / "b1.png", data, G2, "after: + second_mode")
+        np.testing.assert_array_equal(imread(pair[0]), imread(one))
+        np.testing.assert_array_equal(imread(pair[1]), imread(two))
+    with pytest.raises(ValueError, match="lines"):
+        plots.residual_bode_pair((tmp_path / "a.png", tmp_path / "b.png"), data, (G, G[:-1]), ("x", "y"))
