@@ -201,6 +201,13 @@ def run_commands(cases: str, rounds: int, roots: list[Path] | None = None) -> li
     ipmc = [sys.executable, "-m", "scenarios.cli"]
     free = [x for n in FREE for x in ("--free", n)]
     roots = roots or [ROOT]
+    # every root runs from bytecode: with PYTHONDONTWRITEBYTECODE set, a checkout without
+    # __pycache__ would compile every module in every process (~0.1 s CPU, seen as a slower
+    # calibrate in one root), so the bytecode goes to one cache outside the checkouts, filled by
+    # an untimed run of each command per root below
+    base_env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    base_env.setdefault("PYTHONPYCACHEPREFIX", str(Path(tempfile.gettempdir()) / "bench_diagnosis_speed_pyc"))
+    warm = True
     rows = []
     for spec in cases.split(","):
         seed, label, sweep, base, expected = _case(spec)
@@ -210,9 +217,9 @@ def run_commands(cases: str, rounds: int, roots: list[Path] | None = None) -> li
             (t / "base.json").write_text(json.dumps(base.to_dict()))
             times: dict = {}
             codes: dict = {}
-            for r in range(rounds):
+            for r in range(-1 if warm else 0, rounds):        # round -1: the untimed warm-up
                 for i in (range(len(roots)) if r % 2 == 0 else reversed(range(len(roots)))):
-                    env = dict(os.environ, PYTHONPATH=str(roots[i]), MPLBACKEND="Agg")
+                    env = dict(base_env, PYTHONPATH=str(roots[i]), MPLBACKEND="Agg")
                     cmds = {
                         "calibrate": ipmc + ["calibrate", "sweep.csv", "--set", "base.json", "--kind", "actuator",
                                              *free, "--out", f"cal{i}", "--force", "--quiet", "--accept-misfit"],
@@ -223,8 +230,10 @@ def run_commands(cases: str, rounds: int, roots: list[Path] | None = None) -> li
                     for k, c in cmds.items():
                         c0 = _child_cpu()
                         p = subprocess.run(c, cwd=t, env=env, capture_output=True, text=True)
-                        times.setdefault((i, k), []).append(_child_cpu() - c0)
-                        codes.setdefault((i, k), set()).add(p.returncode)
+                        if r >= 0:
+                            times.setdefault((i, k), []).append(_child_cpu() - c0)
+                            codes.setdefault((i, k), set()).add(p.returncode)
+            warm = False
             med = {key: float(np.median(v)) for key, v in times.items()}
             diffs = []
             for i in range(1, len(roots)):
