@@ -2,6 +2,7 @@
 
     python3 tests/benchmarks/bench_diagnosis_speed.py                      # 5 cases, 3 rounds
     python3 tests/benchmarks/bench_diagnosis_speed.py --rounds 5 --cases 41000:none,41009:water_uptake
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --roots BEFORE,AFTER   # the ipmc commands
 
 Cases come from the independent generator (tests/discrepancy/independent_generator.py: its own
 actuator physics and its own parametrisation of every effect; no data written by the library's
@@ -19,8 +20,73 @@ parameter sets predicted, batched model calls, least-squares fits, fit points (e
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 
-Measured 2026-11-26, second round (the model layer; 2 cores shared by ~6 sessions, load 2-4): the
-commands as the issue measures them, child-process CPU.  "Before" = main at 795c454, "after" = the
+Measured 2026-11-26, third round (h-dspeed2: figures, the null scan, the CPE-order and fluid
+batches; 2 cores shared by ~6 sessions, load ~2): the commands as the issue measures them,
+child-process CPU, median over rounds.  "Before" = f5fe250 (this work's base, exported to a plain
+folder), "after" = this branch; the benchmark runs the commands from both, interleaved with the
+order alternating, every process from bytecode (``--roots``: PYTHONDONTWRITEBYTECODE is set here,
+and a checkout without __pycache__ compiled every module in every process, ~0.1 s, which had made
+this worktree's calibrate look slower and its ratio better), and compares report.json and
+model.json number by number: the same on every case below (verdicts, names, costs, thresholds,
+LRs, the next-measurement search)::
+
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 3 --roots BASE,. \
+        --cases 41000:none,41009:water_uptake,41038:contact_resistance+time_delay,41003:leakage,41005:added_fluid_mass,43103:added_fluid_mass
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2 --roots BASE,. \
+        --cases 44101:none,44102:added_fluid_mass,44103:fractional_transport,44104:contact_resistance,44105:added_fluid_mass
+
+    case                                  ipmc calibrate   ipmc diagnose CPU s   diagnose / calibrate
+                                          CPU s b / a      before    after        before   after
+    41000 none                            1.42 / 1.45      4.89      4.52         3.4x     3.1x
+    41009 water_uptake                    1.47 / 1.48      5.87      5.22         4.0x     3.5x
+    41038 contact_resistance+time_delay   1.48 / 1.47      7.38      6.70         5.0x     4.6x
+    41003 leakage                         1.43 / 1.44      4.39      3.70         3.1x     2.6x
+    41005 added_fluid_mass                1.49 / 1.46      8.32      7.57         5.6x     5.2x
+    43103 added_fluid_mass                1.46 / 1.41     10.50      9.56         7.2x     6.8x
+    fresh strips (not profiled on), two rounds:
+    44101 none                            1.49 / 1.49      5.05      4.37         3.4x     2.9x
+    44102 added_fluid_mass                1.50 / 1.51     10.58      9.86         7.0x     6.5x
+    44103 fractional_transport            1.55 / 1.45      7.99      6.84         5.2x     4.7x
+    44104 contact_resistance              1.40 / 1.47      5.07      4.47         3.6x     3.0x
+    44105 added_fluid_mass                1.39 / 1.43      4.99      4.48         3.6x     3.1x
+
+Median 4.5x -> 4.1x (profiled set), 3.6x -> 3.1x (fresh).  Still above 5x: the fluid-load strips
+whose viscous-fluid refits run long (41005 5.2x, 43103 6.8x, 44102 6.5x; 44105, also a fluid
+load, is 3.1x).  What changed, each the same numbers bit for bit (every model call of a diagnosis
+of 41000, 41005, 41038 and 43103 recorded on the base and replayed, every null-scan Gram call of
+41005 and 43103 replayed, the figures compared pixel for pixel):
+
+* the two figures of ``ipmc diagnose`` drawn on one canvas (``plots.residual_bode_pair``: the
+  baseline's, written, then the model's and residuals' lines set to the final model and the limits
+  recomputed) with fixed margins instead of ``tight_layout`` (a second full draw per figure):
+  0.94 -> 0.56 s CPU, matplotlib's import included;
+* ``fractional_transport`` (a kernel effect, one ŝ grid per call) in one model call for the sets
+  where it is on, each on its own ŝ (``evaluate_grid`` takes per-set points): a Jacobian's
+  finite-difference set of β had cost a second full call (pairs with it 2.15 ms a point on 41005
+  against 1.4-1.6 for the others);
+* the null scan's constrained LR (``_constrained_lr_gram``): the one-parameter subsets in closed
+  form and Σ b_j d_j added row by row, 0.27 -> 0.18 s on 43103;
+* Γ of the fluid load on the distinct (width, viscosity) rows of a batch instead of ``np.unique``
+  over every Reynolds number (a few per cent of a fluid call: the Bessel functions themselves stay);
+* parameter rows to dicts through one ``tolist()``.
+
+Where ``ipmc diagnose`` spends its CPU now (in-process timers, seconds): 41005 start-up 0.65,
+``diagnose()`` 5.3, the next-measurement search 1.0, the figures 0.6; 43103 0.67, 7.05, 1.36,
+0.55.  ``ipmc calibrate`` is 1.45, mostly start-up and its figure.  Inside ``diagnose()`` on
+43103 the model is 4.2-4.6 s (replayed alone), three quarters of it in calls with the fluid load, where the
+Bessel functions of Sader's Γ (``scipy.special.kve`` of complex arguments, 1.27 million Reynolds
+numbers, none repeated between calls: every fit step moves the viscosity) are ~0.7 s and another
+~0.5 s in the next-measurement search; the estimation layer is ~2.6 s (the model replaced by the
+recorded outputs: scipy's trust region, the range penalties of ``priors``, residuals, the null
+scan).  The viscous-fluid refits themselves are the bulk: 849 points for the single-candidate
+refit on 43103, 969 for its four null refits, 933 in its pairs, at 1.4-2.8 ms a point.  Not done
+here: a faster Γ (its numbers would change at round-off and with them the fits' paths), the
+next-measurement search (physmodel/estimation/next_measurement*.py, another helper's), the range
+penalties (priors.py), and sharing one model call between the quantities of a joint diagnosis
+(``JointData.predictor`` calls the model once per quantity; none of these cases is joint).
+
+Second round, older table (measured 2026-11-26 on the model layer; 2 cores shared by ~6 sessions,
+load 2-4): the commands as the issue measures them, child-process CPU.  "Before" = main at 795c454, "after" = the
 same plus this work (h-dspeed), interleaved per case and round (before/after order alternating);
 the reports (report.json) compared number by number::
 
