@@ -88,7 +88,8 @@ def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Seque
         raise IPMCError(f"per-set points must have shape ({n_sets}, 1, n_s), got {s.shape}")
     n_s = s.shape[-1]
     n_rows = n_sets * n_T
-    s_rows = np.repeat(s[:, 0, :], n_T, axis=0) if per_set else None       # (n_rows, n_s), set-major
+    # the points of each row (n_rows, n_s), set-major, or one row for all (1, n_s)
+    pts = np.repeat(s[:, 0, :], n_T, axis=0) if per_set else s[None, :]
     flat_state = {k: np.ascontiguousarray(getattr(state, k).reshape(n_rows)) for k in STATE_FIELDS}
     results: dict[str, np.ndarray] = {}
     for q in quantities:
@@ -107,7 +108,7 @@ def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Seque
             params = {k: v[r] for k, v in flat_state.items()}
             for start in range(0, n_s, chunk_size):
                 stop = min(start + chunk_size, n_s)
-                vals = kernel(params, s_rows[r, start:stop] if per_set else s[start:stop], quantities)
+                vals = kernel(params, pts[r if per_set else 0, start:stop], quantities)
                 for q in quantities:
                     rows_out[q][r, start:stop] = vals[q]
                 if progress:
@@ -118,7 +119,7 @@ def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Seque
     for r0 in range(0, n_rows, rows_per_block):
         r1 = min(r0 + rows_per_block, n_rows)
         params = {k: v[r0:r1, None] for k, v in flat_state.items()}
-        vals = kernel(params, s_rows[r0:r1] if per_set else s[None, :], quantities)
+        vals = kernel(params, pts[r0:r1] if per_set else pts, quantities)
         for q in quantities:
             rows_out[q][r0:r1] = vals[q]
         if progress:
