@@ -479,7 +479,9 @@ class _EffectMixin:
         is the batched form (n_sets, N) for ``fit_parameters(predict_many=...)``; it uses the first
         parameter set of this model as the base and evaluates every set in one model call, the
         values of the batchable effects (:attr:`Effect.batchable`) as arrays over the sets (one call
-        per distinct set of values of the others).  ``predict.many_grouped`` is the same with one
+        per distinct set of values of the others, except a kernel effect's: one call for the sets
+        where it is on, each on its own ŝ, one for those where it is off).  ``predict.many_grouped``
+        is the same with one
         model call per distinct set of effect values.
         """
         from ..data.sweep import sweep_layout
@@ -565,7 +567,8 @@ class _EffectMixin:
 
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
             # one batched model call for every set (effect values as arrays over the sets), or one
-            # per distinct set of values of the non-batchable effects (Effect.batchable)
+            # per distinct set of values of the non-batchable effects (Effect.batchable; a kernel
+            # effect's: one per on / off)
             if values_list:
                 keys = tuple(values_list[0])
                 if all(tuple(v) == keys for v in values_list):
