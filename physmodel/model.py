@@ -74,12 +74,22 @@ def check_s(s) -> np.ndarray:
 def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Sequence[str],
                   chunk_size: int = DEFAULT_CHUNK, out: Mapping[str, np.ndarray] | None = None,
                   progress: Callable[[int], None] | None = None) -> dict[str, np.ndarray]:
-    """Evaluate ``kernel`` on every (set, temperature, s) point; returns arrays (n_sets, n_T, n_s)."""
+    """Evaluate ``kernel`` on every (set, temperature, s) point; returns arrays (n_sets, n_T, n_s).
+
+    ``s``: the points (n_s,), or one row of points per parameter set (n_sets, 1, n_s) — a kernel
+    effect whose ŝ differs between the sets of a batch (each row evaluated on its own set's points,
+    the same operations as a call per set)."""
     if chunk_size < 1:
         raise IPMCError(f"chunk_size must be >= 1, got {chunk_size}")
     n_sets, n_T = state.T.shape[:2]
-    n_s = s.size
+    s = np.asarray(s)
+    per_set = s.ndim == 3
+    if per_set and s.shape[:2] != (n_sets, 1):
+        raise IPMCError(f"per-set points must have shape ({n_sets}, 1, n_s), got {s.shape}")
+    n_s = s.shape[-1]
     n_rows = n_sets * n_T
+    # the points of each row (n_rows, n_s), set-major, or one row for all (1, n_s)
+    pts = np.repeat(s[:, 0, :], n_T, axis=0) if per_set else s[None, :]
     flat_state = {k: np.ascontiguousarray(getattr(state, k).reshape(n_rows)) for k in STATE_FIELDS}
     results: dict[str, np.ndarray] = {}
     for q in quantities:
@@ -98,7 +108,7 @@ def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Seque
             params = {k: v[r] for k, v in flat_state.items()}
             for start in range(0, n_s, chunk_size):
                 stop = min(start + chunk_size, n_s)
-                vals = kernel(params, s[start:stop], quantities)
+                vals = kernel(params, pts[r if per_set else 0, start:stop], quantities)
                 for q in quantities:
                     rows_out[q][r, start:stop] = vals[q]
                 if progress:
@@ -109,7 +119,7 @@ def evaluate_grid(state: State, s: np.ndarray, kernel: Kernel, quantities: Seque
     for r0 in range(0, n_rows, rows_per_block):
         r1 = min(r0 + rows_per_block, n_rows)
         params = {k: v[r0:r1, None] for k, v in flat_state.items()}
-        vals = kernel(params, s[None, :], quantities)
+        vals = kernel(params, pts[r0:r1] if per_set else pts, quantities)
         for q in quantities:
             rows_out[q][r0:r1] = vals[q]
         if progress:

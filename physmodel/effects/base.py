@@ -76,7 +76,9 @@ class Effect:
     ``batchable``: ``apply`` takes its values as arrays over parameter sets, shaped (n_sets, 1, 1)
     to broadcast against the model's (n_sets, n_T, n_f) arrays, so one model call evaluates sets
     with different values of it (``EffectModel(...).predictor(...).many``); a
-    ``kernel`` effect is not (the charge dynamics are evaluated on one ŝ grid per call).
+    ``kernel`` effect is not, but the sets of a batch where it is on still share one call, each
+    with its own ŝ (:func:`physmodel.model.evaluate_grid`'s per-set points); those where it is off
+    take another.
     """
 
     name: str

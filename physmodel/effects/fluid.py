@@ -133,8 +133,31 @@ def mass_factor(s, st, T_ref, v):
     :func:`kinematic_viscosity`; the density is held constant with temperature)."""
     omega = np.abs(np.imag(s))
     mu = math.pi * fluid_density(v) * st.W / (8.0 * st.rho * st.h)
-    re = reynolds_number(omega, st.W, kinematic_viscosity(v, st.T, T_ref))
-    return 1.0 + mu * np.conj(gamma_rectangular(re))
+    nu = kinematic_viscosity(v, st.T, T_ref)
+    return 1.0 + mu * np.conj(_gamma_by_row(omega, st.W, nu))
+
+
+def _gamma_by_row(omega, W, nu):
+    """Γ_rect(Re) with Re = :func:`reynolds_number` (ω, W, ν) for ``W``, ``ν`` (n_sets, n_T, 1) and
+    the frequencies ``omega`` (1, 1, n_f): evaluated on the distinct (W, ν) rows only — a batch's
+    finite-difference sets of every parameter but the viscosity's (and the width's) repeat the
+    point's rows, and the Bessel functions are the costly part — then spread back; the same numbers
+    as :func:`gamma_rectangular` of the whole grid (each Re the same product and quotient, each Γ
+    the same function of it), without sorting every Reynolds number of the batch."""
+    W = np.asarray(W, dtype=float)
+    nu = np.asarray(nu, dtype=float)
+    shape = np.broadcast_shapes(W.shape, nu.shape)
+    if len(shape) != 3 or shape[2] != 1 or np.ndim(omega) != 3 or shape[0] * shape[1] < 2:
+        return gamma_rectangular(reynolds_number(omega, W, nu))
+    rows = np.stack(np.broadcast_arrays(W, nu), axis=-1).reshape(-1, 2)      # (n_sets·n_T, 2)
+    first: dict = {}
+    inv = np.array([first.setdefault(key, len(first)) for key in map(tuple, rows.tolist())])
+    if len(first) == rows.shape[0]:
+        return gamma_rectangular(reynolds_number(omega, W, nu))
+    kept = np.array(list(first), dtype=float)                                   # (k, 2)
+    re = reynolds_number(omega, kept[:, 0, None, None], kept[:, 1, None, None])   # (k, 1, n_f)
+    g = rectangular_correction(re) * gamma_circular(re)
+    return g[inv, 0, :].reshape(shape[0], shape[1], -1)
 
 
 def loaded_first_mode(s, omega_n, xi, m):

@@ -208,6 +208,16 @@ def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], pa
     return ParameterTable(cols, table.groups, n)
 
 
+def _group_value(e: Effect, given: Mapping[str, float], own_effects: Mapping) -> tuple:
+    """How the sets of a batch are grouped by a non-batchable effect ``e`` (one model call per
+    group): by its values, except a kernel effect, by whether it is on — the sets where it is on go
+    in one call with their own ŝ each (:meth:`_EffectMixin._batch_effects`), e.g. a Jacobian's
+    finite-difference set of the CPE order with the point's."""
+    if e.level == "kernel":
+        return ("on",) if not e.is_off({**own_effects.get(e.name, e.off), **given}) else ("off",)
+    return tuple(sorted(given.items()))
+
+
 def _batched_entry(e: Effect, vals: dict):
     """The ``_active`` entry ``(effect, {param: (n_sets, 1, 1)}, on mask or None)`` of a batchable
     effect with values ``vals = {param: (n_sets,) array}`` (checked against its bounds), None where it
@@ -279,8 +289,22 @@ class _EffectMixin:
             own = self.effects.get(name, e.off)
             if not e.batchable:
                 if any(ev.get(name, {}) != canon[0].get(name, {}) for ev in canon):
-                    raise IPMCError(f"effect {name!r} is not batchable: one model call needs one set of its values")
-                if name in self.effects and not e.is_off(own):
+                    if e.level != "kernel":
+                        raise IPMCError(f"effect {name!r} is not batchable: one model call needs one set of its values")
+                    # a kernel effect on in every set: its ŝ per set (ModelBase evaluate_grid's per-set points)
+                    vals = {p.name: np.array([ev.get(name, {}).get(p.name, own[p.name]) for ev in canon], dtype=float)
+                            for p in e.parameters}
+                    entry = _batched_entry(e, vals)
+                    if entry is None or entry[2] is not None:
+                        raise IPMCError(f"effect {name!r}: one model call takes its values per set only where it is "
+                                        "on in every set")
+                    active.append(entry)
+                    continue
+                if e.level == "kernel":       # the same values in every set: these (the model may be a cached one)
+                    own = {**own, **canon[0].get(name, {})}
+                    if not e.is_off(own):
+                        active.append((e, own, None))
+                elif name in self.effects and not e.is_off(own):
                     active.append((e, own, None))
                 continue
             for ev in canon:
@@ -294,10 +318,12 @@ class _EffectMixin:
                 active.append(entry)
         self._active = active
 
-    def _batch_effect_arrays(self, given: Mapping[str, Mapping[str, np.ndarray]]) -> None:
+    def _batch_effect_arrays(self, given: Mapping[str, Mapping[str, np.ndarray]]) -> bool:
         """:meth:`_batch_effects` with the values already as arrays over the sets: ``given`` =
-        ``{effect: {param: (n_sets,) array}}``, canonical names of batchable effects with known
-        parameters (missing parameters: this model's value, else off)."""
+        ``{effect: {param: (n_sets,) array}}``, canonical names of batchable effects or of a kernel
+        effect with known parameters (missing parameters: this model's value, else off).  False
+        (nothing changed) when a kernel effect is on in some sets and off in others: those go in
+        separate calls (:meth:`_batch_effects`)."""
         n = len(self.params)
         active = []
         for name in (*self.effects, *(k for k in given if k not in self.effects)):
@@ -305,6 +331,20 @@ class _EffectMixin:
             if self.kind not in e.kinds:
                 raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model (it applies to {e.kinds})")
             own = self.effects.get(name, e.off)
+            if not e.batchable and name in given and e.level == "kernel":
+                g = given[name]
+                vals = {p.name: np.asarray(g[p.name], dtype=float) if p.name in g else np.full(n, float(own[p.name]))
+                        for p in e.parameters}
+                entry = _batched_entry(e, vals)                     # checks the values; None: off in every set
+                if entry is None:
+                    continue
+                if all(np.all(a == a[0]) for a in vals.values()):   # one ŝ grid, as a call of its own
+                    active.append((e, {k: float(a[0]) for k, a in vals.items()}, None))
+                elif entry[2] is not None:
+                    return False
+                else:
+                    active.append(entry)
+                continue
             if not e.batchable:
                 if name in given:
                     raise IPMCError(f"effect {name!r} is not batchable: give its values through _batch_effects")
@@ -318,6 +358,7 @@ class _EffectMixin:
             if entry is not None:
                 active.append(entry)
         self._active = active
+        return True
 
     def state(self, temperature_c) -> State:
         st = super().state(temperature_c) if self._batch_table is None else self._batch_table.state(temperature_c)
@@ -374,7 +415,8 @@ class _EffectMixin:
                 if "M" in need:
                     vals["M"] = vals["H"] * G
         T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
-        ctx = _Context(s[None, None, :], s_kernel[None, None, :], st, dict(vals), T_ref)
+        ctx = _Context(s[None, None, :], s_kernel if s_kernel.ndim == 3 else s_kernel[None, None, :], st, dict(vals),
+                       T_ref)
         strip = [(e, v, m) for e, v, m in self._active if e.level == "strip"]
         if strip:                           # the strip itself: every quantity computed, Z included
             partly = [m for _, _, m in strip if m is not None]
@@ -437,7 +479,9 @@ class _EffectMixin:
         is the batched form (n_sets, N) for ``fit_parameters(predict_many=...)``; it uses the first
         parameter set of this model as the base and evaluates every set in one model call, the
         values of the batchable effects (:attr:`Effect.batchable`) as arrays over the sets (one call
-        per distinct set of values of the others).  ``predict.many_grouped`` is the same with one
+        per distinct set of values of the others, except a kernel effect's: one call for the sets
+        where it is on, each on its own ŝ, one for those where it is off).  ``predict.many_grouped``
+        is the same with one
         model call per distinct set of effect values.
         """
         from ..data.sweep import sweep_layout
@@ -485,7 +529,7 @@ class _EffectMixin:
                     e.parameter(ep[1])
                 except IPMCError:
                     return None
-                if not e.batchable or self.kind not in e.kinds or ep[1] in effects.get(e.name, {}):
+                if (not e.batchable and e.level != "kernel") or self.kind not in e.kinds or ep[1] in effects.get(e.name, {}):
                     return None
                 effects.setdefault(e.name, {})[ep[1]] = j
             return base, omega, effects
@@ -512,7 +556,8 @@ class _EffectMixin:
                     models.pop(next(iter(models)))
                 m = models[(), n] = make_effect_model([self.params[0]] * n, self.kind, self.effects, **self._extra())
             m._use_table(table)
-            m._batch_effect_arrays({e: {p: X[:, j] for p, j in pj.items()} for e, pj in effects.items()})
+            if not m._batch_effect_arrays({e: {p: X[:, j] for p, j in pj.items()} for e, pj in effects.items()}):
+                return None                 # a kernel effect on in some sets only: the general path
             r = m.frequency_response(freqs, temps, quantities=(q,))[q]
             # C order, as the general path's: r[:, ti, fi] alone comes out in Fortran order, and the
             # estimation layer's reductions and products over it then round differently
@@ -522,7 +567,8 @@ class _EffectMixin:
 
         def predict_many(values_list: Sequence[Mapping[str, float]]) -> np.ndarray:
             # one batched model call for every set (effect values as arrays over the sets), or one
-            # per distinct set of values of the non-batchable effects (Effect.batchable)
+            # per distinct set of values of the non-batchable effects (Effect.batchable; a kernel
+            # effect's: one per on / off)
             if values_list:
                 keys = tuple(values_list[0])
                 if all(tuple(v) == keys for v in values_list):
@@ -539,12 +585,14 @@ class _EffectMixin:
             split = [split_values(v) for v in values_list]
             groups: dict = {}
             for i, (_, e) in enumerate(split):
-                key = tuple(sorted((get_effect(n).name, tuple(sorted(pv.items()))) for n, pv in e.items()
-                                   if not get_effect(n).batchable))
+                key = tuple(sorted((get_effect(n).name, _group_value(get_effect(n), pv, self.effects))
+                                   for n, pv in e.items() if not get_effect(n).batchable))
                 groups.setdefault(key, []).append(i)
             for key, rows in groups.items():
                 effects = {n: dict(v) for n, v in self.effects.items()}
-                for n, pv in split[rows[0]][1].items():    # the non-batchable values (all the same here)
+                # the non-batchable values (all the same in a group, but a kernel effect's, which
+                # _batch_effects takes per set)
+                for n, pv in split[rows[0]][1].items():
                     if not get_effect(n).batchable:
                         effects.setdefault(n, {}).update(pv)
                 # the base values as arrays (no record per set), or a record per set when a name

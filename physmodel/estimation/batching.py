@@ -54,7 +54,11 @@ class ModelBatch:
                 if k in pos and (p[0] == "constant" or (p[1] in pos and p[1] not in plan))}
 
     def _dicts(self, X):
-        return [dict(self.fixed, **dict(zip(self.names, map(float, row)))) for row in X]
+        # X.tolist() gives the same Python floats as float() of each element, in one call
+        names, fixed = self.names, self.fixed
+        if not fixed:
+            return [dict(zip(names, row)) for row in np.asarray(X, dtype=float).tolist()]
+        return [{**fixed, **dict(zip(names, row))} for row in np.asarray(X, dtype=float).tolist()]
 
     def __call__(self, X: np.ndarray) -> np.ndarray:
         n_sets = len(X)

@@ -82,16 +82,36 @@ def _constrained_lr_gram(G, B, one_sided):
     best = np.zeros(B.shape[:-2] + B.shape[-1:])
     for m in range(1, k + 1):
         for sub in combinations(range(k), m):
-            idx = np.array(sub)
-            Ginv = np.linalg.pinv(G[..., idx[:, None], idx[None, :]])
-            b = B[..., idx, :]                  # (..., m, n)
-            d = Ginv @ b
-            lr = np.sum(b * d, axis=-2)
-            ok = np.ones(lr.shape, bool)
-            for j, c in enumerate(sub):
-                if one_sided[c]:
-                    ok &= d[..., j, :] >= 0
-            best = np.where(ok & (lr > best), lr, best)
+            if m == 1:
+                # one parameter: pinv of a 1 × 1 Gram is 1/g (0 for a left-out zero column) and the
+                # product and the sum over its one row are single multiplications: the same numbers
+                # as the general branch, without its batched SVD, matmul and reduction
+                j = sub[0]
+                g = G[..., j:j + 1, j]                          # (..., 1)
+                with np.errstate(divide="ignore"):
+                    ginv = np.where(g == 0.0, 0.0, 1.0 / np.where(g == 0.0, 1.0, g))
+                b1 = B[..., j, :]                               # (..., n)
+                d1 = ginv * b1
+                lr = b1 * d1
+                ok = lr > best
+                if one_sided[j]:
+                    ok &= d1 >= 0
+            else:
+                idx = np.array(sub)
+                whole = m == k                      # every parameter: G and B as they are (no copy)
+                Ginv = np.linalg.pinv(G if whole else G[..., idx[:, None], idx[None, :]])
+                b = B if whole else B[..., idx, :]  # (..., m, n)
+                d = Ginv @ b
+                # Σ_j b_j d_j over the m rows: what np.sum(b * d, axis=-2) adds, in its order
+                # (the first row, then each next one added), without the (..., m, n) product
+                lr = b[..., 0, :] * d[..., 0, :]
+                for j in range(1, m):
+                    lr += b[..., j, :] * d[..., j, :]
+                ok = lr > best
+                for j, c in enumerate(sub):
+                    if one_sided[c]:
+                        ok &= d[..., j, :] >= 0
+            np.copyto(best, lr, where=ok)
     return best
 
 

@@ -545,8 +545,8 @@ def run(args) -> int:
             after = "after: + " + (", ".join(d.final_effects) or "nothing")
             for sw, q, gb, ga in zip(d.joint.sweeps, d.joint.quantities, d.joint.split(d.predicted_before),
                                      d.joint.split(d.predicted_after)):
-                plots.residual_bode(stage / f"bode_before_{q}.png", sw, gb, f"{q}: baseline (before)")
-                plots.residual_bode(stage / f"bode_after_{q}.png", sw, ga, f"{q}: {after}")
+                plots.residual_bode_pair((stage / f"bode_before_{q}.png", stage / f"bode_after_{q}.png"), sw,
+                                         (gb, ga), (f"{q}: baseline (before)", f"{q}: {after}"))
     if not args.quiet:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)

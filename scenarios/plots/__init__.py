@@ -36,6 +36,7 @@ from .residuals import (
     plot_calibration,
     plot_residual_bode,
     residual_bode,
+    residual_bode_pair,
 )
 from .roots import (
     plot_pole_zero_locus,
@@ -52,5 +53,5 @@ __all__ = [
     "plot_poles_zeros_vs_temperature", "plot_residual_bode", "plot_time",
     "a0_series", "bode", "bode_overlay", "calibration_figure", "compare_figure", "curves", "diagnosis_figures",
     "effect_intervals", "feedforward_check", "frf_estimate", "inversion_traces", "pole_zero_locus",
-    "pole_zero_maps", "residual_bode", "save_bode", "save_poles_zeros_vs_temperature", "traces", "tracking",
+    "pole_zero_maps", "residual_bode", "residual_bode_pair", "save_bode", "save_poles_zeros_vs_temperature", "traces", "tracking",
 ]

@@ -15,7 +15,7 @@ from physmodel.errors import IPMCError
 from .canvas import axes_grid, new_figure, save_figure, temperature_colors
 
 __all__ = ["calibration_figure", "diagnosis_figures", "frf_estimate", "plot_calibration", "plot_residual_bode",
-           "residual_bode"]
+           "residual_bode", "residual_bode_pair"]
 
 
 def plot_calibration(data, result, axes=None, *, model=None):
@@ -133,8 +133,6 @@ def plot_residual_bode(data, model, axes=None):
     ValueError
         When ``model`` is not on the data's lines.
     """
-    from physmodel.estimation.residuals import noise_std
-
     G = np.asarray(getattr(model, "response", model), dtype=complex)
     if G.shape != data.response.shape:
         raise ValueError(f"model: expected the response at the data's {data.response.size} lines "
@@ -143,33 +141,56 @@ def plot_residual_bode(data, model, axes=None):
                                                and np.array_equal(model.temperature_c, data.temperature_c)):
         raise ValueError("model: a sweep on other lines (frequencies or temperatures) than the data's")
     ret, grid = axes_grid(axes, 3, 1, "magnitude, phase, residuals", figsize=(7, 9), sharex=True)
-    ax = grid[:, 0]
-    s_ln, s_ph, _ = noise_std(data)
-    for i, t in enumerate(data.temperatures()):
+    _draw_residual_bode(data, G, grid[:, 0])
+    return ret
+
+
+def _model_curves(data, G, s_ln, s_ph):
+    """Per temperature of ``data``: its lines' mask, the model's magnitude [dB] and phase [deg]
+    (on the data's branch: the same unwrap offset at the first line) and the standardised
+    log-magnitude and phase residuals — what :func:`plot_residual_bode` draws of the model."""
+    for t in data.temperatures():
         m = data.temperature_c == t
+        ph_d = np.degrees(np.unwrap(np.angle(data.response[m])))
+        ph_m = np.degrees(np.unwrap(np.angle(G[m])))
+        ph_m += 360 * np.round((ph_d[0] - ph_m[0]) / 360)
+        lr = np.log(data.response[m] / G[m])
+        yield t, m, 20 * np.log10(np.abs(G[m])), ph_m, lr.real / s_ln[m], lr.imag / s_ph[m]
+
+
+def _draw_residual_bode(data, G, ax) -> list:
+    """:func:`plot_residual_bode` on the three Axes ``ax``; returns the model's lines per
+    temperature ``(magnitude, phase, magnitude residual, phase residual)``."""
+    from physmodel.estimation.residuals import noise_std
+
+    s_ln, s_ph, _ = noise_std(data)
+    handles = []
+    for i, (t, m, mag_m, ph_m, r_mag, r_ph) in enumerate(_model_curves(data, G, s_ln, s_ph)):
         f = data.frequency_hz[m]
         col = f"C{i % 10}"
         mag_d = 20 * np.log10(np.abs(data.response[m]))
         sd = s_ln[m] * 20 / np.log(10)
         ax[0].fill_between(f, mag_d - 2 * sd, mag_d + 2 * sd, color=col, alpha=0.2)
         ax[0].semilogx(f, mag_d, ".", color=col, ms=3)
-        ax[0].semilogx(f, 20 * np.log10(np.abs(G[m])), "-", color=col, label=f"{t:g} °C")
+        (l_mag,) = ax[0].semilogx(f, mag_m, "-", color=col, label=f"{t:g} °C")
         ph_d = np.degrees(np.unwrap(np.angle(data.response[m])))
-        ph_m = np.degrees(np.unwrap(np.angle(G[m])))
-        ph_m += 360 * np.round((ph_d[0] - ph_m[0]) / 360)
         sp = np.degrees(s_ph[m])
         ax[1].fill_between(f, ph_d - 2 * sp, ph_d + 2 * sp, color=col, alpha=0.2)
         ax[1].semilogx(f, ph_d, ".", color=col, ms=3)
-        ax[1].semilogx(f, ph_m, "-", color=col)
-        lr = np.log(data.response[m] / G[m])
-        ax[2].semilogx(f, lr.real / s_ln[m], "-", color=col)
-        ax[2].semilogx(f, lr.imag / s_ph[m], "--", color=col)
+        (l_ph,) = ax[1].semilogx(f, ph_m, "-", color=col)
+        (l_rm,) = ax[2].semilogx(f, r_mag, "-", color=col)
+        (l_rp,) = ax[2].semilogx(f, r_ph, "--", color=col)
+        handles.append((l_mag, l_ph, l_rm, l_rp))
     ax[2].axhspan(-2, 2, color="0.85", zorder=0)
     ax[0].set_ylabel(f"magnitude [dB {data.output_unit}/{data.input_unit}]")
     ax[1].set_ylabel("phase [deg]")
     ax[2].set_ylabel("std. residual (— mag, -- phase)")
     ax[2].set_xlabel("frequency [Hz]")
-    return ret
+    return handles
+
+
+#: Subplot margins of :func:`residual_bode`'s 7 × 9 inch figure [fraction of the figure].
+RESIDUAL_BODE_MARGINS = {"left": 0.13, "right": 0.975, "bottom": 0.065, "top": 0.96, "hspace": 0.09}
 
 
 def residual_bode(path, data, G, title: str) -> Path:
@@ -187,19 +208,69 @@ def residual_bode(path, data, G, title: str) -> Path:
         Title (followed by "— data ±2σ bands, model lines").
     """
     fig, ax = new_figure(3, 1, figsize=(7, 9), sharex=True)
+    # fixed margins instead of tight_layout, whose measuring pass is a second full draw (a third of
+    # the figure's cost): what it chose for these panels (their tick labels have at most 5
+    # characters), with room for a sixth
+    fig.subplots_adjust(**RESIDUAL_BODE_MARGINS)
     plot_residual_bode(data, G, ax)
     ax[0].legend(fontsize=7)
     ax[0].set_title(title + " — data ±2σ bands, model lines")
-    fig.tight_layout()
     return save_figure(fig, path, dpi=90)
 
 
+def residual_bode_pair(paths, data, models, titles) -> list[Path]:
+    """:func:`residual_bode` of the same data against two models (a diagnosis's before and after)
+    on one canvas: drawn with the first model and written, then the model's and the residuals'
+    lines set to the second, the limits recomputed from everything drawn (as a new figure's
+    autoscaling does: lines, bands, the ±2 band) and written again — the same two images as two
+    calls of :func:`residual_bode`, without building the axes and their ticks twice.
+
+    Parameters
+    ----------
+    paths : two str or Path
+        The figure files.
+    data : FrequencySweep
+        The measured sweep.
+    models : two array_like
+        The models' complex responses at the data's lines.
+    titles : two str
+        Their titles (each followed by "— data ±2σ bands, model lines").
+    """
+    from physmodel.estimation.residuals import noise_std
+
+    (p0, p1), (G0, G1), (t0, t1) = paths, models, titles
+    G0, G1 = (np.asarray(getattr(g, "response", g), dtype=complex) for g in (G0, G1))
+    for g in (G0, G1):
+        if g.shape != data.response.shape:
+            raise ValueError(f"model: expected the response at the data's {data.response.size} lines "
+                             f"(shape {data.response.shape}), got shape {g.shape}")
+    fig, ax = new_figure(3, 1, figsize=(7, 9), sharex=True)
+    fig.subplots_adjust(**RESIDUAL_BODE_MARGINS)
+    handles = _draw_residual_bode(data, G0, ax)
+    ax[0].legend(fontsize=7)
+    ax[0].set_title(t0 + " — data ±2σ bands, model lines")
+    out = [save_figure(fig, p0, dpi=90)]
+    s_ln, s_ph, _ = noise_std(data)
+    for lines, (_, _, mag_m, ph_m, r_mag, r_ph) in zip(handles, _model_curves(data, G1, s_ln, s_ph)):
+        for line, y in zip(lines, (mag_m, ph_m, r_mag, r_ph)):
+            line.set_ydata(y)
+    for a in ax:
+        a.relim()                               # older matplotlib leaves collections (the bands) out: added
+        for c in a.collections:
+            a.update_datalim(c.get_datalim(a.transData))
+        a.autoscale_view()
+    ax[0].set_title(t1 + " — data ±2σ bands, model lines")
+    out.append(save_figure(fig, p1, dpi=90))
+    return out
+
+
 def diagnosis_figures(diagnosis, folder) -> list[Path]:
-    """bode_before.png and bode_after.png of a :class:`~physmodel.estimation.discrepancy.Diagnosis`."""
+    """bode_before.png and bode_after.png of a :class:`~physmodel.estimation.discrepancy.Diagnosis`
+    (:func:`residual_bode_pair`)."""
     folder = Path(folder)
-    return [residual_bode(folder / "bode_before.png", diagnosis.data, diagnosis.predicted_before, "baseline (before)"),
-            residual_bode(folder / "bode_after.png", diagnosis.data, diagnosis.predicted_after,
-                          "after: + " + (", ".join(diagnosis.final_effects) or "nothing"))]
+    return residual_bode_pair((folder / "bode_before.png", folder / "bode_after.png"), diagnosis.data,
+                              (diagnosis.predicted_before, diagnosis.predicted_after),
+                              ("baseline (before)", "after: + " + (", ".join(diagnosis.final_effects) or "nothing")))
 
 
 def frf_estimate(items, path, title: str = "") -> Path:

@@ -2,6 +2,7 @@
 
     python3 tests/benchmarks/bench_diagnosis_speed.py                      # 5 cases, 3 rounds
     python3 tests/benchmarks/bench_diagnosis_speed.py --rounds 5 --cases 41000:none,41009:water_uptake
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --roots BEFORE,AFTER   # the ipmc commands
 
 Cases come from the independent generator (tests/discrepancy/independent_generator.py: its own
 actuator physics and its own parametrisation of every effect; no data written by the library's
@@ -19,8 +20,73 @@ parameter sets predicted, batched model calls, least-squares fits, fit points (e
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 
-Measured 2026-11-26, second round (the model layer; 2 cores shared by ~6 sessions, load 2-4): the
-commands as the issue measures them, child-process CPU.  "Before" = main at 795c454, "after" = the
+Measured 2026-11-26, third round (h-dspeed2: figures, the null scan, the CPE-order and fluid
+batches; 2 cores shared by ~6 sessions, load ~2): the commands as the issue measures them,
+child-process CPU, median over rounds.  "Before" = f5fe250 (this work's base, exported to a plain
+folder), "after" = this branch; the benchmark runs the commands from both, interleaved with the
+order alternating, every process from bytecode (``--roots``: PYTHONDONTWRITEBYTECODE is set here,
+and a checkout without __pycache__ compiled every module in every process, ~0.1 s, which had made
+this worktree's calibrate look slower and its ratio better), and compares report.json and
+model.json number by number: the same on every case below (verdicts, names, costs, thresholds,
+LRs, the next-measurement search)::
+
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 3 --roots BASE,. \
+        --cases 41000:none,41009:water_uptake,41038:contact_resistance+time_delay,41003:leakage,41005:added_fluid_mass,43103:added_fluid_mass
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2 --roots BASE,. \
+        --cases 44101:none,44102:added_fluid_mass,44103:fractional_transport,44104:contact_resistance,44105:added_fluid_mass
+
+    case                                  ipmc calibrate   ipmc diagnose CPU s   diagnose / calibrate
+                                          CPU s b / a      before    after        before   after
+    41000 none                            1.42 / 1.45      4.89      4.52         3.4x     3.1x
+    41009 water_uptake                    1.47 / 1.48      5.87      5.22         4.0x     3.5x
+    41038 contact_resistance+time_delay   1.48 / 1.47      7.38      6.70         5.0x     4.6x
+    41003 leakage                         1.43 / 1.44      4.39      3.70         3.1x     2.6x
+    41005 added_fluid_mass                1.49 / 1.46      8.32      7.57         5.6x     5.2x
+    43103 added_fluid_mass                1.46 / 1.41     10.50      9.56         7.2x     6.8x
+    fresh strips (not profiled on), two rounds:
+    44101 none                            1.49 / 1.49      5.05      4.37         3.4x     2.9x
+    44102 added_fluid_mass                1.50 / 1.51     10.58      9.86         7.0x     6.5x
+    44103 fractional_transport            1.55 / 1.45      7.99      6.84         5.2x     4.7x
+    44104 contact_resistance              1.40 / 1.47      5.07      4.47         3.6x     3.0x
+    44105 added_fluid_mass                1.39 / 1.43      4.99      4.48         3.6x     3.1x
+
+Median 4.5x -> 4.1x (profiled set), 3.6x -> 3.1x (fresh).  Still above 5x: the fluid-load strips
+whose viscous-fluid refits run long (41005 5.2x, 43103 6.8x, 44102 6.5x; 44105, also a fluid
+load, is 3.1x).  What changed, each the same numbers bit for bit (every model call of a diagnosis
+of 41000, 41005, 41038 and 43103 recorded on the base and replayed, every null-scan Gram call of
+41005 and 43103 replayed, the figures compared pixel for pixel):
+
+* the two figures of ``ipmc diagnose`` drawn on one canvas (``plots.residual_bode_pair``: the
+  baseline's, written, then the model's and residuals' lines set to the final model and the limits
+  recomputed) with fixed margins instead of ``tight_layout`` (a second full draw per figure):
+  0.94 -> 0.56 s CPU, matplotlib's import included;
+* ``fractional_transport`` (a kernel effect, one ŝ grid per call) in one model call for the sets
+  where it is on, each on its own ŝ (``evaluate_grid`` takes per-set points): a Jacobian's
+  finite-difference set of β had cost a second full call (pairs with it 2.15 ms a point on 41005
+  against 1.4-1.6 for the others);
+* the null scan's constrained LR (``_constrained_lr_gram``): the one-parameter subsets in closed
+  form and Σ b_j d_j added row by row, 0.27 -> 0.18 s on 43103;
+* Γ of the fluid load on the distinct (width, viscosity) rows of a batch instead of ``np.unique``
+  over every Reynolds number (a few per cent of a fluid call: the Bessel functions themselves stay);
+* parameter rows to dicts through one ``tolist()``.
+
+Where ``ipmc diagnose`` spends its CPU now (in-process timers, seconds): 41005 start-up 0.65,
+``diagnose()`` 5.3, the next-measurement search 1.0, the figures 0.6; 43103 0.67, 7.05, 1.36,
+0.55.  ``ipmc calibrate`` is 1.45, mostly start-up and its figure.  Inside ``diagnose()`` on
+43103 the model is 4.2-4.6 s (replayed alone), three quarters of it in calls with the fluid load, where the
+Bessel functions of Sader's Γ (``scipy.special.kve`` of complex arguments, 1.27 million Reynolds
+numbers, none repeated between calls: every fit step moves the viscosity) are ~0.7 s and another
+~0.5 s in the next-measurement search; the estimation layer is ~2.6 s (the model replaced by the
+recorded outputs: scipy's trust region, the range penalties of ``priors``, residuals, the null
+scan).  The viscous-fluid refits themselves are the bulk: 849 points for the single-candidate
+refit on 43103, 969 for its four null refits, 933 in its pairs, at 1.4-2.8 ms a point.  Not done
+here: a faster Γ (its numbers would change at round-off and with them the fits' paths), the
+next-measurement search (physmodel/estimation/next_measurement*.py, another helper's), the range
+penalties (priors.py), and sharing one model call between the quantities of a joint diagnosis
+(``JointData.predictor`` calls the model once per quantity; none of these cases is joint).
+
+Second round, older table (measured 2026-11-26 on the model layer; 2 cores shared by ~6 sessions,
+load 2-4): the commands as the issue measures them, child-process CPU.  "Before" = main at 795c454, "after" = the
 same plus this work (h-dspeed), interleaved per case and round (before/after order alternating);
 the reports (report.json) compared number by number::
 
@@ -171,15 +237,43 @@ def _child_cpu() -> float:
     return ru.ru_utime + ru.ru_stime
 
 
-def run_commands(cases: str, rounds: int) -> list[dict]:
+def _same_numbers(a, b, path="") -> list[str]:
+    """Where two reports (parsed JSON) differ, number by number; timings and the output folder's
+    name (in the model file's provenance) are left out."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = []
+        for k in sorted(set(a) | set(b)):
+            if k in ("elapsed_s", "seconds", "cpu_s", "command"):
+                continue
+            out += ([f"{path}/{k}: on one side only"] if k not in a or k not in b else
+                    _same_numbers(a[k], b[k], f"{path}/{k}"))
+        return out
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{path}: {len(a)} vs {len(b)} items"]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in _same_numbers(x, y, f"{path}[{i}]")]
+    same = a == b or (isinstance(a, float) and isinstance(b, float) and a != a and b != b)
+    return [] if same else [f"{path}: {a!r} vs {b!r}"]
+
+
+def run_commands(cases: str, rounds: int, roots: list[Path] | None = None) -> list[dict]:
     """The issue's own measure: ``ipmc calibrate`` vs ``ipmc diagnose`` on the same sweep file and
     free parameters, as a user types them (start-up, report and figures included), interleaved;
-    CPU of each child process (RUSAGE_CHILDREN)."""
+    CPU of each child process (RUSAGE_CHILDREN).  ``roots``: checkouts to run the commands from
+    (PYTHONPATH), interleaved per round with their order alternating (before / after a change);
+    their report.json and model.json are then compared number by number."""
     from physmodel.data.sweep import write_csv
 
     ipmc = [sys.executable, "-m", "scenarios.cli"]
     free = [x for n in FREE for x in ("--free", n)]
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    roots = roots or [ROOT]
+    # every root runs from bytecode: with PYTHONDONTWRITEBYTECODE set, a checkout without
+    # __pycache__ would compile every module in every process (~0.1 s CPU, seen as a slower
+    # calibrate in one root), so the bytecode goes to one cache outside the checkouts, filled by
+    # an untimed run of each command per root below
+    base_env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    base_env.setdefault("PYTHONPYCACHEPREFIX", str(Path(tempfile.gettempdir()) / "bench_diagnosis_speed_pyc"))
+    warm = True
     rows = []
     for spec in cases.split(","):
         seed, label, sweep, base, expected = _case(spec)
@@ -187,26 +281,43 @@ def run_commands(cases: str, rounds: int) -> list[dict]:
             t = Path(tmp)
             write_csv(sweep, t / "sweep.csv")
             (t / "base.json").write_text(json.dumps(base.to_dict()))
-            cmds = {
-                "calibrate": ipmc + ["calibrate", "sweep.csv", "--set", "base.json", "--kind", "actuator", *free,
-                                     "--out", "cal", "--force", "--quiet", "--accept-misfit"],
-                "diagnose": ipmc + ["diagnose", "--data", "sweep.csv", "--set", "base.json", "--kind", "actuator",
-                                    *free, "--seed", str(seed), "--out", "dia", "--force", "--quiet"],
-            }
-            times: dict = {k: [] for k in cmds}
-            codes: dict = {k: set() for k in cmds}
-            for _ in range(rounds):
-                for k, c in cmds.items():
-                    c0 = _child_cpu()
-                    r = subprocess.run(c, cwd=t, env=env, capture_output=True, text=True)
-                    times[k].append(_child_cpu() - c0)
-                    codes[k].add(r.returncode)
-            med = {k: float(np.median(v)) for k, v in times.items()}
-            row = dict(seed=seed, label=label, expected=expected, codes={k: sorted(v) for k, v in codes.items()}, **med)
+            times: dict = {}
+            codes: dict = {}
+            for r in range(-1 if warm else 0, rounds):        # round -1: the untimed warm-up
+                for i in (range(len(roots)) if r % 2 == 0 else reversed(range(len(roots)))):
+                    env = dict(base_env, PYTHONPATH=str(roots[i]), MPLBACKEND="Agg")
+                    cmds = {
+                        "calibrate": ipmc + ["calibrate", "sweep.csv", "--set", "base.json", "--kind", "actuator",
+                                             *free, "--out", f"cal{i}", "--force", "--quiet", "--accept-misfit"],
+                        "diagnose": ipmc + ["diagnose", "--data", "sweep.csv", "--set", "base.json", "--kind",
+                                            "actuator", *free, "--seed", str(seed), "--out", f"dia{i}", "--force",
+                                            "--quiet"],
+                    }
+                    for k, c in cmds.items():
+                        c0 = _child_cpu()
+                        p = subprocess.run(c, cwd=t, env=env, capture_output=True, text=True)
+                        if r >= 0:
+                            times.setdefault((i, k), []).append(_child_cpu() - c0)
+                            codes.setdefault((i, k), set()).add(p.returncode)
+            warm = False
+            med = {key: float(np.median(v)) for key, v in times.items()}
+            diffs = []
+            for i in range(1, len(roots)):
+                for f in ("report.json", "model.json"):
+                    diffs += [f"{f}{d}" for d in _same_numbers(json.loads((t / "dia0" / f).read_text()),
+                                                               json.loads((t / f"dia{i}" / f).read_text()))]
+            row = dict(seed=seed, label=label, expected=expected, roots=[str(x) for x in roots],
+                       calibrate=[med[i, "calibrate"] for i in range(len(roots))],
+                       diagnose=[med[i, "diagnose"] for i in range(len(roots))],
+                       codes={f"{i}/{k}": sorted(v) for (i, k), v in codes.items()}, report_differences=diffs)
             rows.append(row)
-            print(f"== seed {seed} {label}: ipmc calibrate {med['calibrate']:.2f} s CPU (exit {row['codes']['calibrate']}), "
-                  f"ipmc diagnose {med['diagnose']:.2f} s CPU (exit {row['codes']['diagnose']}): "
-                  f"ratio {med['diagnose'] / med['calibrate']:.1f}x")
+            ratios = [d / c for d, c in zip(row["diagnose"], row["calibrate"])]
+            print(f"== seed {seed} {label}: ipmc calibrate " + " / ".join(f"{x:.2f}" for x in row["calibrate"])
+                  + " s CPU, ipmc diagnose " + " / ".join(f"{x:.2f}" for x in row["diagnose"])
+                  + " s CPU: ratio " + " / ".join(f"{x:.1f}x" for x in ratios) + f" (exit {row['codes']})"
+                  + ("" if len(roots) < 2 else
+                     f"; reports {'the same, number by number' if not diffs else 'DIFFER: ' + '; '.join(diffs[:5])}"),
+                  flush=True)
     return rows
 
 
@@ -234,13 +345,22 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds per case (median)")
     ap.add_argument("--commands", action="store_true",
                     help="time the ipmc commands (what the issue measured) instead of the library calls")
+    ap.add_argument("--roots", default="",
+                    help="with --commands: comma-separated checkouts to run the commands from, interleaved "
+                         "(e.g. before,after); their reports are compared number by number")
     a = ap.parse_args(argv)
     print("command: python3 " + " ".join([os.path.relpath(__file__, ROOT)] + list(argv if argv is not None else sys.argv[1:])))
     if a.commands:
-        rows = run_commands(a.cases, a.rounds)
-        ratios = [r["diagnose"] / r["calibrate"] for r in rows]
-        print(f"\nipmc diagnose / ipmc calibrate, CPU: median {np.median(ratios):.1f}x, max {max(ratios):.1f}x "
-              f"(goal <= 5x)")
+        roots = [Path(x).resolve() for x in a.roots.split(",") if x] or None
+        rows = run_commands(a.cases, a.rounds, roots)
+        for i, root in enumerate(roots or [ROOT]):
+            ratios = [r["diagnose"][i] / r["calibrate"][i] for r in rows]
+            print(f"\n{root}: ipmc diagnose / ipmc calibrate, CPU: median {np.median(ratios):.1f}x, "
+                  f"max {max(ratios):.1f}x (goal <= 5x)" + ("" if max(ratios) <= 5 else
+                                                             f"; above 5x: {', '.join(str(r['seed']) for r, x in zip(rows, ratios) if x > 5)}"))
+        bad = [r["seed"] for r in rows if r["report_differences"]]
+        if bad:
+            print(f"reports differ between the roots on seeds {bad}", file=sys.stderr)
         return 0
     rows = run(a.cases, a.rounds)
     print("\nsummary (median over rounds): case, diagnose/calibrate CPU ratio, diagnose CPU s, calibrate CPU s")

@@ -143,3 +143,23 @@ def test_rectangular_correction_is_numpys_polyval_of_sader_coefficients():
     # the same Horner steps as numpy's polyval (bit for bit with numpy 2.x); older numpy orders its
     # additions differently, so the claim across versions is a few ulp
     np.testing.assert_allclose(fl.rectangular_correction(10.0 ** tau), want, rtol=4 * np.finfo(float).eps, atol=0)
+
+
+def test_gamma_by_row_of_a_batch_equals_the_whole_grid_bit_for_bit():
+    """mass_factor evaluates Γ on the distinct (width, viscosity) rows of a batch (issue 27 item 6):
+    the same numbers as Γ_rect of every Reynolds number of the grid, and each equal to the mpmath
+    Γ_circ times Sader's Ω (rows that repeat, rows that do not, one set, all sets alike)."""
+    rng = np.random.default_rng(8)
+    omega = (2 * np.pi * np.logspace(-1.3, 1.7, 31))[None, None, :]
+    T = np.array([292.0, 310.0, 328.0])[None, :, None]
+    for n_sets, distinct in ((9, 3), (5, 5), (1, 1), (4, 1)):
+        nu_set = 10.0 ** rng.uniform(-6.5, -3.0, distinct)[rng.integers(0, distinct, n_sets)]
+        nu = nu_set[:, None, None] * (T / 300.0) ** 2
+        W = np.full((n_sets, 1, 1), 4e-3)
+        want = fl.gamma_rectangular(fl.reynolds_number(omega, W, nu))
+        got = fl._gamma_by_row(omega, W, nu)
+        assert got.shape == want.shape == (n_sets, 3, 31)
+        np.testing.assert_array_equal(got, want)
+    re = fl.reynolds_number(omega, W, nu)
+    x = float(re[0, 1, 7])
+    assert complex(got[0, 1, 7]) == pytest.approx(fl.rectangular_correction(x) * _gamma_circ_mp(x), rel=1e-12)

@@ -124,16 +124,35 @@ def test_batchable_effects_take_one_model_call(monkeypatch):
     assert len(calls) > 1
 
 
-def test_a_non_batchable_effect_is_grouped_by_its_values(monkeypatch):
+@pytest.mark.parametrize("kind, q, p, gain", CASES, ids=[f"{c[0]}-{c[1]}" for c in CASES])
+def test_a_kernel_effect_is_grouped_by_whether_it_is_on(monkeypatch, kind, q, p, gain):
+    """fractional_transport changes the charge dynamics' ŝ: the sets where it is on go in one call,
+    each on its own ŝ (issue 27 item 6: a Jacobian's finite-difference set of β joins the point's),
+    those where it is off in another; each set's response is the same, bit for bit, as in a call
+    of the sets sharing its β alone (one ŝ grid per call, as before), and agrees with the
+    one-call-per-distinct-values reference."""
     assert not LIBRARY["fractional_transport"].batchable
-    pred = _predictor("actuator", "M", P_ACT)
-    sets = [{"fractional_transport.beta": b, "time_delay.delay": t}
-            for b, t in ((0.8, 1e-3), (0.9, 2e-3), (0.8, 3e-3), (1.0, 0.0), (0.9, 0.0))]
+    pred = _predictor(kind, q, p)
+    g0 = getattr(p, gain)
+    sets = [{"fractional_transport.beta": b, gain: g0 * f}
+            for b, f in ((0.8, 1.0), (0.9, 1.1), (0.8, 0.9), (1.0, 1.0), (0.9, 1.0))]
     calls = _count_calls(monkeypatch)
     out = pred.many(sets)
-    assert sorted(calls) == [1, 2, 2]          # beta 0.8, 0.9 (two sets each) and 1.0
+    assert sorted(calls) == [1, 4]             # beta on (0.8, 0.9: four sets) and off (1.0)
     calls.clear()
+    on = [s for s in sets if s["fractional_transport.beta"] < 1.0]
+    pred.many(on)
+    assert calls == [4]                        # on in every set: one call
+    calls.clear()
+    for beta in (0.8, 0.9, 1.0):
+        rows = [i for i, s in enumerate(sets) if s["fractional_transport.beta"] == beta]
+        alone = pred.many([sets[i] for i in rows])
+        assert calls == [len(rows)]
+        calls.clear()
+        np.testing.assert_array_equal(out[rows], alone)
     np.testing.assert_allclose(out, pred.many_grouped(sets), rtol=1e-10, atol=0)
+    with pytest.raises(ParameterError, match="beta"):
+        pred.many([{"fractional_transport.beta": 0.8}, {"fractional_transport.beta": 0.2}])
 
 
 def test_a_set_does_not_depend_on_its_batch_mates():
