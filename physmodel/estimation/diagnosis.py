@@ -14,7 +14,7 @@ import numpy as np
 from ..data.files import atomic_write
 from ..data.sweep import FrequencySweep
 from ..effects import LIBRARY, get_effect
-from ..errors import IPMCError, ParameterError
+from ..errors import ParameterError
 from .joint import JointData
 from .next_measurement import NextMeasurement, json_ready
 from .records import CalibrationResult
@@ -236,9 +236,6 @@ class Diagnosis:
 
         if self.verdict not in ("ambiguous", "at_bound"):
             return None
-        if self.joint is not None:
-            raise IPMCError(f"the next-measurement search takes a diagnosis of one quantity; this one is joint over "
-                            f"{self.quantity}: diagnose the quantity to extend on its own first")
         self.next_measurement = next_measurement(self, **kw)
         return self.next_measurement
 

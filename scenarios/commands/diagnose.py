@@ -67,7 +67,9 @@ actuator, S for a sensor when diagnosed, else the first — with that quantity's
 in its provenance (the command line, kept there, lists every file); an effect held off on it
 (--acts-on) is left out of it, and a misfit left in ANY quantity makes it say "does not fit" (exit 3
 unless --accept-misfit), as every later command that reads it will. The next-measurement search
-takes a diagnosis of one quantity: for a joint one it says "no recommendation" and why.
+of a joint diagnosis evaluates every candidate experiment with the whole joint record: a new record
+of a diagnosed quantity is merged into that quantity's record, another quantity is added as one more,
+each with its own noise and the diagnosis's --acts-on.
 
 Writes model.json (the model it ends with — the baseline plus the named effect(s), refitted, with the
 goodness-of-fit verdict and the data's provenance: what ``--model`` takes in every later command),
