@@ -106,7 +106,7 @@ from .priors import (
 )
 from .records import CalibrationResult, FreeParameter
 from .refits import Refitter, StageCounter
-from .residuals import standardised_residuals
+from .residuals import GOF_ALPHA, standardised_residuals
 from .signatures import (
     declare_confusable,
     gap_statistics,
@@ -707,7 +707,9 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
     warn = cost_warning(cost_f, N, n_free_after) if not estimated else ""
     if warn:
         message += f" Cost vs declared noise: {warn}."
-    per_q = jd.per_quantity(G0, Gf, k0, n_free_after, alpha) if jd is not None else []
+    # each quantity's "does it fit" at the model file's goodness-of-fit level shared out over the
+    # quantities (the pooled verdict's test, residuals.GOF_ALPHA), not at the detection α
+    per_q = jd.per_quantity(G0, Gf, k0, n_free_after, GOF_ALPHA) if jd is not None else []
     message += per_quantity_sentence(per_q)
     declare_confusable(confusable, separation, confusability, sigs, raw_sigs, data)
     say("audit", f"verdict {verdict}" + (f": {', '.join(named)}" if named else ""))

@@ -195,7 +195,10 @@ class JointData:
     def per_quantity(self, G_before, G_after, n_free_before: int, n_free_after: int, alpha: float) -> list[dict]:
         """Each quantity's lines, noise and weighted cost before/after against its expectation
         (the fitted parameters shared out by lines), with ``misfit`` when 2·cost after exceeds the
-        χ² quantile at α/len(quantities) (None for estimated noise: not a test)."""
+        χ² quantile at α/len(quantities) (None for estimated noise: not a test).  The diagnosis passes
+        the model file's goodness-of-fit level (:data:`~physmodel.estimation.residuals.GOF_ALPHA`,
+        the level of the pooled "does the model fit" verdict), so one quantity's misfit is judged at
+        the same family-wise level as the whole."""
         from scipy.stats import chi2
 
         N = sum(self.sizes)
