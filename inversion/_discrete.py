@@ -419,7 +419,10 @@ class Plan:
         written over the causal part's array (``stable``, the caller's if given), which is then
         not returned (None): one record-sized array fewer, and no fresh memory to fault in for
         it.  :meth:`run` with ``keep_unstable=True`` and the same ``chunk`` recomputes both parts
-        bit for bit (``stable + unstable`` is what was written).
+        bit for bit (``stable + unstable`` is what was written), and on the block-wise path its
+        ``output_sum`` is summed in the same blocks and order, so it equals the first pass's sum
+        bit for bit when the input is the same (a fingerprint of the input that does not read
+        ``output`` again, see :attr:`inversion.InversionResult.stable_part`).
         """
         n = ua.size
         if stable is None:
@@ -435,28 +438,24 @@ class Plan:
         # the block is in cache
         in_place = not (keep_unstable or keep_stable)
         output = stable if in_place else np.empty(n)
-        if not keep_unstable:
-            total = [0.0]
+        unstable = None if not keep_unstable else np.empty(n)
+        total = [0.0]
 
-            def put_o(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-                o = output[c0:c1]
-                np.add(stable[c0:c1], y, out=o)
-                if output_sum is not None:
-                    with np.errstate(over="ignore", invalid="ignore"):
-                        total[0] += float(np.add.reduce(o))
-
-            self.backward(ua, n, chunk, put_o)
+        def put(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+            # the same additions and block sums whether the anticausal part is kept or not: the
+            # recomputation (keep_unstable=True) reproduces the first pass's output_sum bit for bit
+            if unstable is not None:
+                unstable[c0:c1] = y
+            o = output[c0:c1]
+            np.add(stable[c0:c1], y, out=o)
             if output_sum is not None:
-                output_sum.append(total[0])
-            return (None if in_place else stable), None, output
-        unstable = np.empty(n)
+                with np.errstate(over="ignore", invalid="ignore"):
+                    total[0] += float(np.add.reduce(o))
 
-        def put_b(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            unstable[c0:c1] = y
-            np.add(stable[c0:c1], y, out=output[c0:c1])
-
-        self.backward(ua, n, chunk, put_b)
-        return stable, unstable, _summed(output, output_sum)
+        self.backward(ua, n, chunk, put)
+        if output_sum is not None:
+            output_sum.append(total[0])
+        return (None if in_place else stable), unstable, output
 
     def anticausal(self, u: np.ndarray, chunk: int | None = None) -> np.ndarray:
         """Anticausal part for the in-memory record ``u`` (zero beyond its end), as an array,

@@ -421,6 +421,9 @@ class AutoPreviewPasses:
         ``"l2"`` path, whose ``unstable`` is always kept).
     signal : ndarray or None
         The copy of the signal the errors are computed from (the ``"linf"`` and chunked paths).
+    output_sum : float or None
+        The sum of ``output`` as the pass wrote it (see :meth:`~inversion._discrete.Plan.run`;
+        None on the whole-record ``"l2"`` path).
     """
 
     choice: PreviewChoice
@@ -430,6 +433,7 @@ class AutoPreviewPasses:
     finite: bool = False
     plan: Plan | None = None
     signal: np.ndarray | None = None
+    output_sum: float | None = None
 
 
 #: Probes of the full inverse for the linf reference: equally spaced samples, plus the extremes
@@ -535,7 +539,7 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
     return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(sums[0]), plan=plan,
-                             signal=ua_copy)
+                             signal=ua_copy, output_sum=sums[0])
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float) -> AutoPreviewPasses:
