@@ -56,6 +56,7 @@ run separately as sections.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 from typing import Any
 
@@ -66,7 +67,7 @@ from ._norms import expm_small
 from ._sections import FusedPass, sos_sections
 from .split import InverseSplit
 
-__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan", "plan_for",
+__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan", "plan_for", "pass_errstate",
            "central_difference_kernel", "left_powers", "FUSED_BLOCK", "PLAN_CACHE_SIZE"]
 
 #: Samples per block of the fused finite-preview backward pass (intermediates stay in cache).
@@ -513,6 +514,13 @@ def plan_for(split: InverseSplit, dt: float, n_preview: int | None) -> Plan:
             cache.pop(next(iter(cache)), None)
         cache[key] = plan
     return plan
+
+
+def pass_errstate(quiet: bool) -> contextlib.AbstractContextManager[Any]:
+    """numpy's overflow/invalid warnings silenced (``quiet``) or not, for a caller of the passes
+    that refuses a non-finite output itself, naming the sample (:func:`inversion.invert`): a
+    non-finite input sample, or an overflow, makes ``inf - inf`` and ``D * x`` warn on the way."""
+    return np.errstate(over="ignore", invalid="ignore") if quiet else contextlib.nullcontext()
 
 
 def _summed(output: np.ndarray, output_sum: list[float] | None) -> np.ndarray:

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import plan_for
+from ._discrete import pass_errstate, plan_for
 from ._errors import InversionError, NonFiniteSignalError
 from .preview import (
     DEFAULT_PREVIEW_TOL,
@@ -314,34 +314,36 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
     chunk = int(chunk_size)
     choice = None
-    # a non-finite input sample, or an overflow, is refused below with its index (numpy's warnings
-    # on the way, e.g. inf - inf in the output's sum, would only announce it)
-    with np.errstate(invalid="ignore", over="ignore"):
-        if rule == "auto":
-            # the causal pass, the preview certified from exact values of the full inverse at a
-            # few samples, then the finite-preview anticausal pass (see auto_preview_passes)
-            passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
-                                         keep_unstable=False, finite_checked=False, keep_stable=False)
-            choice = passes.choice
-            n_prev, prev_s = choice.samples, choice.seconds
-            stable, unstable, output = passes.stable, passes.unstable, passes.output
-            signal_copy = passes.signal
-            if signal_copy is not None:     # the signal inverted, whatever the caller does with its array
-                signal_copy.flags.writeable = False
-                ua = signal_copy
-            finite = passes.finite
-            written_sum = passes.output_sum
-            plan = passes.plan
-        else:
-            n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
-            plan = plan_for(split, dt, n_prev)
-            # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
-            sums: list[float] = []
+    # a non-finite input sample, or an overflow, is refused below with its index: numpy's warnings
+    # inside the passes (e.g. inf - inf adding the parts, D * u overflowing) would only announce it,
+    # so they are silenced there (pass_errstate) and nowhere else (not in the preview choice)
+    if rule == "auto":
+        # the causal pass, the preview certified from exact values of the full inverse at a
+        # few samples, then the finite-preview anticausal pass (see auto_preview_passes)
+        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
+                                     keep_unstable=False, finite_checked=False, keep_stable=False,
+                                     quiet_passes=True)
+        choice = passes.choice
+        n_prev, prev_s = choice.samples, choice.seconds
+        stable, unstable, output = passes.stable, passes.unstable, passes.output
+        signal_copy = passes.signal
+        if signal_copy is not None:     # the signal inverted, whatever the caller does with its array
+            signal_copy.flags.writeable = False
+            ua = signal_copy
+        finite = passes.finite
+        written_sum = passes.output_sum
+        plan = passes.plan
+    else:
+        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
+        plan = plan_for(split, dt, n_prev)
+        # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
+        sums: list[float] = []
+        with pass_errstate(True):
             stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums,
                                                 keep_stable=False)
-            written_sum = sums[0]
-            finite = math.isfinite(written_sum)
-            signal_copy = None
+        written_sum = sums[0]
+        finite = math.isfinite(written_sum)
+        signal_copy = None
     # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
     # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
     # element-wise check, of the input first (a bad input sample is named as as_signal names it)

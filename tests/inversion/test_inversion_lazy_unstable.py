@@ -122,7 +122,6 @@ def test_whole_record_infinite_preview_keeps_its_unstable_part():
     np.testing.assert_array_equal(res.stable_part + res.unstable_part, res.output)
 
 
-@pytest.mark.filterwarnings("ignore::RuntimeWarning")     # numpy's overflow warnings on the way
 @pytest.mark.parametrize("preview", [0.3, "auto", "inf"])
 @pytest.mark.parametrize("chunk", [None, 700])
 def test_an_overflowing_inverse_is_refused_on_every_path(preview, chunk):
