@@ -463,17 +463,17 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
         np.linspace(0, n - 1, REFERENCE_PROBES).astype(np.intp),
         extremes or (int(np.argmax(ua)), int(np.argmin(ua))), np.arange(max(0, n - 8), n))))
     best = 0.0
-    for k in probes:
-        seg = ua[k:k + M]
-        with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):      # an overflow is refused below, by name
+        for k in probes:
+            seg = ua[k:k + M]
             y = float(stable[k]) + float(np.dot(seg, hk[:seg.size]))
-        if not math.isfinite(y):
-            # the tolerance is relative to this inverse: it cannot be certified, say why
-            raise NonFiniteSignalError(
-                f"the inverse overflowed: output sample {int(k)} of the full (infinite-preview) inverse is "
-                f"{y!r} (input peak {umax:.3g}); scale the signal to the model's units")
-        slack = rest * umax + 1e-12 * (abs(float(stable[k])) + l1 * umax)
-        best = max(best, abs(y) - slack)
+            if not math.isfinite(y):
+                # the tolerance is relative to this inverse: it cannot be certified, say why
+                raise NonFiniteSignalError(
+                    f"the inverse overflowed: output sample {int(k)} of the full (infinite-preview) inverse "
+                    f"is {y!r} (input peak {umax:.3g}); scale the signal to the model's units")
+            slack = rest * umax + 1e-12 * (abs(float(stable[k])) + l1 * umax)
+            best = max(best, abs(y) - slack)
     return best
 
 
