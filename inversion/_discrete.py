@@ -56,6 +56,7 @@ run separately as sections.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 from typing import Any
 
@@ -66,7 +67,7 @@ from ._norms import expm_small
 from ._sections import FusedPass, sos_sections
 from .split import InverseSplit
 
-__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan", "plan_for",
+__all__ = ["foh_matrices", "expm_small", "FOHFilter", "FusedPass", "Plan", "plan_for", "pass_errstate",
            "central_difference_kernel", "left_powers", "FUSED_BLOCK", "PLAN_CACHE_SIZE"]
 
 #: Samples per block of the fused finite-preview backward pass (intermediates stay in cache).
@@ -419,7 +420,10 @@ class Plan:
         written over the causal part's array (``stable``, the caller's if given), which is then
         not returned (None): one record-sized array fewer, and no fresh memory to fault in for
         it.  :meth:`run` with ``keep_unstable=True`` and the same ``chunk`` recomputes both parts
-        bit for bit (``stable + unstable`` is what was written).
+        bit for bit (``stable + unstable`` is what was written), and on the block-wise path its
+        ``output_sum`` is summed in the same blocks and order, so it equals the first pass's sum
+        bit for bit when the input is the same (a fingerprint of the input that does not read
+        ``output`` again, see :attr:`inversion.InversionResult.stable_part`).
         """
         n = ua.size
         if stable is None:
@@ -435,28 +439,24 @@ class Plan:
         # the block is in cache
         in_place = not (keep_unstable or keep_stable)
         output = stable if in_place else np.empty(n)
-        if not keep_unstable:
-            total = [0.0]
+        unstable = None if not keep_unstable else np.empty(n)
+        total = [0.0]
 
-            def put_o(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-                o = output[c0:c1]
-                np.add(stable[c0:c1], y, out=o)
-                if output_sum is not None:
-                    with np.errstate(over="ignore", invalid="ignore"):
-                        total[0] += float(np.add.reduce(o))
-
-            self.backward(ua, n, chunk, put_o)
+        def put(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
+            # the same additions and block sums whether the anticausal part is kept or not: the
+            # recomputation (keep_unstable=True) reproduces the first pass's output_sum bit for bit
+            if unstable is not None:
+                unstable[c0:c1] = y
+            o = output[c0:c1]
+            np.add(stable[c0:c1], y, out=o)
             if output_sum is not None:
-                output_sum.append(total[0])
-            return (None if in_place else stable), None, output
-        unstable = np.empty(n)
+                with np.errstate(over="ignore", invalid="ignore"):
+                    total[0] += float(np.add.reduce(o))
 
-        def put_b(c0: int, c1: int, y: np.ndarray, _x: np.ndarray) -> None:
-            unstable[c0:c1] = y
-            np.add(stable[c0:c1], y, out=output[c0:c1])
-
-        self.backward(ua, n, chunk, put_b)
-        return stable, unstable, _summed(output, output_sum)
+        self.backward(ua, n, chunk, put)
+        if output_sum is not None:
+            output_sum.append(total[0])
+        return (None if in_place else stable), unstable, output
 
     def anticausal(self, u: np.ndarray, chunk: int | None = None) -> np.ndarray:
         """Anticausal part for the in-memory record ``u`` (zero beyond its end), as an array,
@@ -514,6 +514,13 @@ def plan_for(split: InverseSplit, dt: float, n_preview: int | None) -> Plan:
             cache.pop(next(iter(cache)), None)
         cache[key] = plan
     return plan
+
+
+def pass_errstate(quiet: bool) -> contextlib.AbstractContextManager[Any]:
+    """numpy's overflow/invalid warnings silenced (``quiet``) or not, for a caller of the passes
+    that refuses a non-finite output itself, naming the sample (:func:`inversion.invert`): a
+    non-finite input sample, or an overflow, makes ``inf - inf`` and ``D * x`` warn on the way."""
+    return np.errstate(over="ignore", invalid="ignore") if quiet else contextlib.nullcontext()
 
 
 def _summed(output: np.ndarray, output_sum: list[float] | None) -> np.ndarray:

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import plan_for
+from ._discrete import pass_errstate, plan_for
 from ._errors import InversionError, NonFiniteSignalError
 from .preview import (
     DEFAULT_PREVIEW_TOL,
@@ -66,21 +66,31 @@ class InversionResult(SampledRecord):
     t : ndarray
         Sample times [s] (built on first access when only ``dt`` was given).
     input : ndarray
-        The signal that was inverted [model output units, e.g. uA for a sensor].
+        The signal that was inverted [model output units, e.g. uA for a sensor]: the caller's
+        array, or for ``preview="auto"`` (``"linf"`` norm, or chunked) the read-only copy it keeps
+        (``signal_copy``), so that the errors and bounds read later are those of this signal.
     output : ndarray
         The reconstruction ``H[u]`` = ``stable_part + unstable_part`` [model input units,
         e.g. mm for a sensor, V for an actuator].
     stable_part : ndarray
         Causal contribution: feedthrough, polynomial (derivative) part and ``H_s[u]``.  When the
-        anticausal pass ran block by block the output was written over it, and it is recomputed
-        when first read, as ``unstable_part`` is (below; both in the same passes).
+        anticausal pass ran block by block (a finite preview, or ``chunk_size``) the output was
+        written over it, and it is recomputed when first read, with ``unstable_part`` (below).
     unstable_part : ndarray
         Anticausal contribution ``H_u[u]`` (truncated to the preview when it is finite).
-        When the anticausal pass ran block by block (a finite preview, or ``chunk_size``) it
-        is not stored but recomputed from ``input`` when first read — one more anticausal
-        pass, the same values bit for bit, checked to give ``stable_part + unstable_part ==
-        output`` exactly (:class:`InversionError` if ``input`` was modified in place since).
-        Keeping it would cost a record-sized array that nothing but this attribute reads.
+        When the anticausal pass ran block by block it is not stored but recomputed when first
+        read, with ``stable_part``: one more causal and anticausal pass over the signal
+        inverted, the same values bit for bit as those whose sum was written to ``output``.
+        Keeping them would cost record-sized arrays that nothing but these attributes reads.
+        ``output`` is not read for it: the caller may edit ``output`` in place (e.g. clip a
+        drive) and still read the parts of the inversion.  For ``preview="auto"`` the parts are
+        recomputed from the copy of the signal it keeps (``input`` is that copy, read-only),
+        so they are those of the signal inverted whatever happens to the caller's array.
+        Otherwise ``input`` is the caller's array (no copy is made) and the parts are
+        recomputed from it; an ``input`` modified in place since the inversion is refused
+        (:class:`InversionError`): the sum of the recomputed output, summed in the same blocks
+        and order as the inversion summed it (to prove it finite), must equal that sum bit for
+        bit (a change that leaves it bit for bit the same is not seen).
     preview_s : float
         Preview actually used, ``preview_samples * dt`` [s]; ``inf`` for infinite preview.
     preview_samples : int or None
@@ -118,9 +128,11 @@ class InversionResult(SampledRecord):
         The causal part itself, or None when it is recomputed with ``unstable_part``
         (internal; read ``stable_part``) [model input units].
     signal_copy : ndarray or None
-        The copy of the input that ``preview="auto"`` keeps (internal): the parts are then
-        recomputed from it, so that they are those of the signal inverted even if the caller
-        reuses its array [model output units].
+        The read-only copy of the signal that ``preview="auto"`` keeps (internal; it is also
+        ``input``): the parts are then recomputed from it without a check [model output units].
+    output_sum : float or None
+        The sum of ``output`` as the block-wise pass wrote it (internal): the fingerprint the
+        parts recomputed from the caller's ``input`` are checked against [model input units].
     """
 
     input: np.ndarray
@@ -142,6 +154,8 @@ class InversionResult(SampledRecord):
     stable_source: np.ndarray | None = field(default=None, repr=False)
     #: preview="auto"'s copy of the input, which the parts are recomputed from (see ``stable_part``)
     signal_copy: np.ndarray | None = field(default=None, repr=False)
+    #: the sum of output as written, checked when the parts are recomputed from the caller's input
+    output_sum: float | None = field(default=None, repr=False)
 
     @property
     def notes(self) -> tuple[str, ...]:
@@ -165,24 +179,27 @@ class InversionResult(SampledRecord):
 
     @cached_property
     def _parts(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(stable_part, unstable_part)`` recomputed from the input (the copy ``preview="auto"``
-        keeps, else ``input``) by the passes that made ``output``, checked to sum to it bit for bit."""
+        """``(stable_part, unstable_part)`` recomputed by the passes that made ``output`` (see the
+        class doc), from ``preview="auto"``'s copy of the signal, or from ``input`` checked
+        unchanged by the sum of the output it gives (``output`` itself is not read)."""
         src = self.unstable_source
         if isinstance(src, np.ndarray):        # only the causal part was not kept
             raise InversionError("internal: a kept anticausal part without its causal part")  # pragma: no cover
         plan, chunk = src
-        u = self.signal_copy if self.signal_copy is not None else self.input
-        stable = self.stable_source
-        if stable is None:
-            stable, unstable, _ = plan.run(u, chunk)
+        sums: list[float] = []
+        if self.signal_copy is not None:
+            # the copy is the signal inverted (read-only): nothing to check
+            stable, unstable, _ = plan.run(self.signal_copy, chunk, self.stable_source)
         else:
-            unstable = plan.anticausal(u, chunk)
-        if not np.array_equal(stable + unstable, self.output):
-            raise InversionError(
-                "the stable and unstable parts are recomputed from result.input when first read, and "
-                "that input no longer gives result.output: the input array (or result.output) was "
-                "modified in place after the inversion; invert a copy (or read stable_part and "
-                "unstable_part before modifying them)")
+            stable, unstable, _ = plan.run(self.input, chunk, self.stable_source, output_sum=sums)
+            if self.output_sum is None or sums[0] != self.output_sum:
+                raise InversionError(
+                    "the stable and unstable parts are recomputed from result.input when first read, and "
+                    f"that input no longer gives the output of the inversion (its sum is {sums[0]!r}, the "
+                    f"inversion's was {self.output_sum!r}): the caller's input array was modified in place "
+                    "after the inversion; invert a copy (or read stable_part and unstable_part first)")
+        if stable is None or unstable is None:     # pragma: no cover - keep_unstable=True keeps both
+            raise InversionError("internal: the recomputation did not keep both parts")
         return stable, unstable
 
     @cached_property
@@ -297,29 +314,36 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         raise InversionError(f"chunk_size must be a positive integer; got {chunk_size!r}")
     chunk = int(chunk_size)
     choice = None
-    # a non-finite input sample, or an overflow, is refused below with its index (numpy's warnings
-    # on the way, e.g. inf - inf in the output's sum, would only announce it)
-    with np.errstate(invalid="ignore", over="ignore"):
-        if rule == "auto":
-            # the causal pass, the preview certified from exact values of the full inverse at a
-            # few samples, then the finite-preview anticausal pass (see auto_preview_passes)
-            passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
-                                         keep_unstable=False, finite_checked=False, keep_stable=False)
-            choice = passes.choice
-            n_prev, prev_s = choice.samples, choice.seconds
-            stable, unstable, output = passes.stable, passes.unstable, passes.output
-            signal_copy = passes.signal
-            finite = passes.finite
-            plan = passes.plan
-        else:
-            n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
-            plan = plan_for(split, dt, n_prev)
-            # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
-            sums: list[float] = []
+    # a non-finite input sample, or an overflow, is refused below with its index: numpy's warnings
+    # inside the passes (e.g. inf - inf adding the parts, D * u overflowing) would only announce it,
+    # so they are silenced there (pass_errstate) and nowhere else (not in the preview choice)
+    if rule == "auto":
+        # the causal pass, the preview certified from exact values of the full inverse at a
+        # few samples, then the finite-preview anticausal pass (see auto_preview_passes)
+        passes = auto_preview_passes(split, dt, ua, tol=preview_tol, norm=preview_norm, chunk=chunk,
+                                     keep_unstable=False, finite_checked=False, keep_stable=False,
+                                     quiet_passes=True)
+        choice = passes.choice
+        n_prev, prev_s = choice.samples, choice.seconds
+        stable, unstable, output = passes.stable, passes.unstable, passes.output
+        signal_copy = passes.signal
+        if signal_copy is not None:     # the signal inverted, whatever the caller does with its array
+            signal_copy.flags.writeable = False
+            ua = signal_copy
+        finite = passes.finite
+        written_sum = passes.output_sum
+        plan = passes.plan
+    else:
+        n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
+        plan = plan_for(split, dt, n_prev)
+        # the anticausal part is recomputed if it is ever read (InversionResult.unstable_part)
+        sums: list[float] = []
+        with pass_errstate(True):
             stable, unstable, output = plan.run(ua, chunk, keep_unstable=False, output_sum=sums,
                                                 keep_stable=False)
-            finite = math.isfinite(sums[0])
-            signal_copy = None
+        written_sum = sums[0]
+        finite = math.isfinite(written_sum)
+        signal_copy = None
     # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
     # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
     # element-wise check, of the input first (a bad input sample is named as as_signal names it)
@@ -332,7 +356,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
             "scale the signal to the model's units")
     return InversionResult(
-        input=ua, output=output, stable_source=stable, signal_copy=signal_copy,
+        input=ua, output=output, stable_source=stable, signal_copy=signal_copy, output_sum=written_sum,
         unstable_source=unstable if unstable is not None else (plan, chunk),
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),

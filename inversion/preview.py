@@ -38,8 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from ._discrete import Plan, left_powers, plan_for
-from ._errors import InversionError, PreviewError
+from ._discrete import Plan, left_powers, pass_errstate, plan_for
+from ._errors import InversionError, NonFiniteSignalError, PreviewError
 from .signals import as_signal, check_finite, sampling_interval, signal_snapshot
 from .split import InverseSplit, check_split_for
 
@@ -421,6 +421,9 @@ class AutoPreviewPasses:
         ``"l2"`` path, whose ``unstable`` is always kept).
     signal : ndarray or None
         The copy of the signal the errors are computed from (the ``"linf"`` and chunked paths).
+    output_sum : float or None
+        The sum of ``output`` as the pass wrote it (see :meth:`~inversion._discrete.Plan.run`;
+        None on the whole-record ``"l2"`` path).
     """
 
     choice: PreviewChoice
@@ -430,6 +433,7 @@ class AutoPreviewPasses:
     finite: bool = False
     plan: Plan | None = None
     signal: np.ndarray | None = None
+    output_sum: float | None = None
 
 
 #: Probes of the full inverse for the linf reference: equally spaced samples, plus the extremes
@@ -459,18 +463,24 @@ def reference_lower_bound(split: InverseSplit, dt: float, ua: np.ndarray, stable
         np.linspace(0, n - 1, REFERENCE_PROBES).astype(np.intp),
         extremes or (int(np.argmax(ua)), int(np.argmin(ua))), np.arange(max(0, n - 8), n))))
     best = 0.0
-    for k in probes:
-        seg = ua[k:k + M]
-        y = float(stable[k]) + float(np.dot(seg, hk[:seg.size]))
-        slack = rest * umax + 1e-12 * (abs(float(stable[k])) + l1 * umax)
-        best = max(best, abs(y) - slack)
+    with np.errstate(over="ignore", invalid="ignore"):      # an overflow is refused below, by name
+        for k in probes:
+            seg = ua[k:k + M]
+            y = float(stable[k]) + float(np.dot(seg, hk[:seg.size]))
+            if not math.isfinite(y):
+                # the tolerance is relative to this inverse: it cannot be certified, say why
+                raise NonFiniteSignalError(
+                    f"the inverse overflowed: output sample {int(k)} of the full (infinite-preview) inverse "
+                    f"is {y!r} (input peak {umax:.3g}); scale the signal to the model's units")
+            slack = rest * umax + 1e-12 * (abs(float(stable[k])) + l1 * umax)
+            best = max(best, abs(y) - slack)
     return best
 
 
 def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: float = DEFAULT_PREVIEW_TOL,
                         norm: str = "linf", chunk: int | None = None,
                         keep_unstable: bool = True, finite_checked: bool = True,
-                        keep_stable: bool = True) -> AutoPreviewPasses:
+                        keep_stable: bool = True, quiet_passes: bool = False) -> AutoPreviewPasses:
     """Choose the automatic preview for the validated signal ``ua`` and invert it (see
     :func:`choose_preview`).
 
@@ -483,7 +493,10 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     ``keep_unstable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
     ``keep_stable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
     ``finite_checked=False``: ``ua`` was not yet checked finite (it is checked here, on the
-    ``"linf"`` path in the pass that copies it, see below).
+    ``"linf"`` path in the pass that copies it, see below).  ``quiet_passes``: the caller refuses
+    a non-finite output itself (from ``output_sum``, as :func:`~inversion.invert` does), so
+    numpy's overflow/invalid warnings inside the inverse's passes are silenced (only there: the
+    choice's own arithmetic, e.g. the ``"l2"`` norms, is not).
 
     The errors read later are those of the signal inverted now, whatever happens to the caller's
     array or to the result's afterwards, so the ``"linf"`` path keeps a copy of ``ua``; it is made
@@ -495,17 +508,19 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     chunk = n if chunk is None else int(chunk)
     plan0 = plan_for(split, dt, None)
     if norm == "l2" and chunk >= n:
-        return _auto_l2(split, dt, ua if finite_checked else check_finite(ua), plan0, tol)
+        return _auto_l2(split, dt, ua if finite_checked else check_finite(ua), plan0, tol, quiet_passes)
     ua_copy, imax, imin = signal_snapshot(ua)
     extremes = (imax, imin)
-    stable = plan0.causal(ua, chunk)
+    with pass_errstate(quiet_passes):
+        stable = plan0.causal(ua, chunk)
     umax = max(float(ua_copy[imax]), -float(ua_copy[imin]))
-    size_u = umax if norm == "linf" else float(np.sqrt(np.dot(ua, ua)))
+    size_u = umax if norm == "linf" else l2_norm(ua_copy)
     if norm == "linf":
         ref = reference_lower_bound(split, dt, ua, stable, umax, extremes)
     else:     # chunked l2: the full inverse once for its norm
-        y_inf = plan0.run(ua, chunk, stable)[2]
-        ref = float(np.sqrt(np.dot(y_inf, y_inf)))
+        with pass_errstate(quiet_passes):
+            y_inf = plan0.run(ua, chunk, stable)[2]
+        ref = _l2_reference(y_inf)
     if split.n_unstable == 0:
         N = 0
         tail_n = 0.0
@@ -516,15 +531,16 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         tail_n = float(tail[min(N, tail.size - 1)])
     plan = plan_for(split, dt, N)
     sums: list[float] = []
-    stable_kept, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable, output_sum=sums,
-                                             keep_stable=keep_stable)
+    with pass_errstate(quiet_passes):
+        stable_kept, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable,
+                                                 output_sum=sums, keep_stable=keep_stable)
 
     def errors() -> tuple[float, float, float]:
         # from the copy of the signal inverted (the result's arrays, or the caller's input, may have
         # been changed since)
         minus_e = _truncation_head(split, dt, ua_copy, N)     # -e_N[:n - N]; e_N is zero beyond
         y_inf = plan0.run(ua_copy, ua_copy.size)[2]
-        size = _peak if norm == "linf" else (lambda e: float(np.sqrt(np.dot(e, e))))
+        size = _peak if norm == "linf" else l2_norm
         r = size(y_inf)
         emax = _peak(minus_e) if minus_e.size else 0.0
         e = emax if norm == "linf" else (size(minus_e) if minus_e.size else 0.0)
@@ -535,20 +551,19 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
     return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(sums[0]), plan=plan,
-                             signal=ua_copy)
+                             signal=ua_copy, output_sum=sums[0])
 
 
-def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float) -> AutoPreviewPasses:
+def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float,
+             quiet_passes: bool = False) -> AutoPreviewPasses:
     """The l2 choice: ``||y_inf||_2`` needs the full inverse, so three passes whose sums are the
     inverse with the chosen preview (the causal part, the full anticausal part, the truncation error)."""
     n = ua.size
-    stable, y_u, output = plan0.run(ua, n)
+    with pass_errstate(quiet_passes):
+        stable, y_u, output = plan0.run(ua, n)
     y_u = y_u.copy() if y_u is stable else y_u
-
-    def size(e: np.ndarray) -> float:
-        return float(np.sqrt(np.dot(e, e)))
-
-    ref = size(output)
+    size = l2_norm
+    ref = _l2_reference(output)
     umax = _peak(ua)
     if split.n_unstable == 0 or ref == 0.0:
         zero = PreviewChoice(0, 0.0, float(tol), "l2", 0.0, split.auto_preview_s if split.n_unstable else 0.0,
@@ -567,6 +582,39 @@ def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: f
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=lambda: errs)
     return AutoPreviewPasses(choice, stable, y_u, output, finite=math.isfinite(ref + emax))
+
+
+def l2_norm(x: np.ndarray) -> float:
+    """``||x||_2``, without overflow or underflow of the sum of squares.
+
+    ``sqrt(dot(x, x))`` when the sum of squares is a normal number; otherwise (a signal beyond
+    ~1e154, where it overflows to inf, or below ~1e-140, where it loses digits) the same of
+    ``x / max|x|`` times ``max|x|``.  Non-finite for a non-finite ``x`` only.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        s = float(np.dot(x, x))
+    if math.isfinite(s) and (s == 0.0 or s >= 1e-280):
+        if s > 0.0 or not np.any(x):
+            return math.sqrt(s)
+    p = _peak(x) if x.size else 0.0
+    if p == 0.0 or not math.isfinite(p):
+        return p
+    y = x / p
+    return p * math.sqrt(float(np.dot(y, y)))
+
+
+def _l2_reference(y_inf: np.ndarray) -> float:
+    """``||y_inf||_2`` for the ``"l2"`` choice, or :class:`NonFiniteSignalError` naming the overflow
+    (an infinite reference made every preview pass, and the relative error NaN)."""
+    ref = l2_norm(y_inf)
+    if math.isfinite(ref):
+        return ref
+    bad = np.flatnonzero(~np.isfinite(y_inf))
+    what = (f"output sample {int(bad[0])} is {float(y_inf[bad[0]])!r}" if bad.size
+            else f"its l2 norm exceeds the double range (peak {_peak(y_inf):.3g})")
+    raise NonFiniteSignalError(
+        f"the inverse overflowed: {what}; preview_norm='l2' needs ||y_inf||_2 of the full inverse: "
+        "scale the signal to the model's units (or use preview_norm='linf')")
 
 
 def _peak(x: np.ndarray) -> float:

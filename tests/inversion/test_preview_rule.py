@@ -20,6 +20,7 @@ import scipy.integrate as si
 import scipy.signal as ss
 
 from inversion import (
+    NonFiniteSignalError,
     PreviewError,
     StreamingInverter,
     choose_preview,
@@ -296,7 +297,6 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
 
 def test_signal_snapshot_is_a_copy_with_numpys_extremes_and_refuses_non_finite_samples():
     # oracle: np.argmax / np.argmin of the whole record (first occurrence) and np.isfinite
-    from inversion import NonFiniteSignalError
     from inversion.signals import SNAPSHOT_BLOCK, signal_snapshot
 
     rng = np.random.default_rng(8)
@@ -316,3 +316,29 @@ def test_signal_snapshot_is_a_copy_with_numpys_extremes_and_refuses_non_finite_s
             signal_snapshot(v)
         with pytest.raises(NonFiniteSignalError, match=f"sample {2 * SNAPSHOT_BLOCK + 40} is"):
             invert(toy_actuator(), DT, v)            # preview='auto' checks in the snapshot
+
+
+@pytest.mark.parametrize("scale", [1e160, 1e300, 1e-160])
+@pytest.mark.parametrize("chunk", [None, 700])
+def test_l2_choice_does_not_depend_on_the_signal_scale(scale, chunk):
+    # the inverse is linear, so the l2 choice and its relative errors are scale-invariant (the
+    # oracle).  A sum of squares overflows beyond ~1e154 and underflows below ~1e-154: the choice
+    # was preview 0 with relative_error NaN (1e160, with numpy's overflow warning silenced) and a
+    # relative_error of 0 (1e-160).  pytest turns any warning into an error here.
+    G = (SEED000_NUM_35C, SEED000_DEN_35C)
+    k = np.arange(3000)
+    u = np.sin(0.02 * k) + 0.3 * np.sin(0.2 * k)
+    ref = invert(G, 1e-3, u, preview_norm="l2", chunk_size=chunk).preview_choice
+    got = invert(G, 1e-3, u * scale, preview_norm="l2", chunk_size=chunk).preview_choice
+    assert ref.samples > 0 and got.samples == ref.samples
+    for name in ("relative_error", "error_bound"):
+        assert math.isfinite(getattr(got, name)) and getattr(got, name) > 0
+        assert getattr(got, name) == pytest.approx(getattr(ref, name), rel=1e-9)
+    assert got.reference_bound / scale == pytest.approx(ref.reference_bound, rel=1e-9)
+
+
+def test_l2_choice_refuses_an_overflowing_full_inverse_by_name():
+    G = ([1e-10, -5e-10], [1.0, 10.0])        # inverse gain 1e10
+    u = np.sin(0.02 * np.arange(3000)) * 1e300
+    with pytest.raises(NonFiniteSignalError, match="the inverse overflowed: output sample"):
+        invert(G, 1e-3, u, preview_norm="l2")
