@@ -55,6 +55,17 @@ def test_a_nested_pair_does_not_hide_the_experiment_that_separates_the_others(th
     # the same answer as a search restricted to S (the quantity that carries the chain elements)
     only_s = next_measurement(d, quantities=["S"])
     assert only_s.recommended.describe() == r.describe()
+    # review S3: with Z searched too the pair survives the linearised λ (Z's linearisation error) and
+    # is dropped by the refit rounds — said as "not separated as fitted", not "not separable"; the
+    # S-only search drops it linearised, and says that
+    assert nm.inseparable_as_fitted == ["amplifier_bandwidth vs transimpedance"]
+    assert "as fitted" in nm.message and "may separate in another form" in nm.message
+    assert "Not separable within the limits" not in nm.message
+    assert nm.to_dict()["inseparable_as_fitted"] == nm.inseparable_as_fitted
+    assert only_s.inseparable == ["amplifier_bandwidth vs transimpedance"] and only_s.inseparable_as_fitted == []
+    assert "Not separable within the limits" in only_s.message and "as fitted" not in only_s.message
+    # the record's 35 °C: no temperature premise
+    assert nm.premise == "" and "Premise" not in nm.message
 
 
 # ------------------------------------------------------------------ a bath step, checked on the independent sensor
@@ -93,10 +104,19 @@ def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
     assert d1.verdict == "ambiguous" and set(d1.named) == {"amplifier_bandwidth", "transimpedance"}
     fixed = next_measurement(d1, quantities=["S"], temperature_limits_c=(35.0, 35.0), band_limits_hz=(0.1, 1000.0))
     assert not fixed.separates
+    assert fixed.premise == ""                     # no bath step, no premise on the laws
     nm = next_measurement(d1, quantities=["S"], band_limits_hz=(0.1, 1000.0))
     r = nm.recommended
     assert nm.separates and set(r.temperatures_c) - {35.0}
     assert not nm.inseparable
+    # review S2: the bath step's separation rests on the user's temperature laws; the recommendation
+    # names them (the start set's: Arrhenius d 15 kJ/mol, log-linear E −0.75 %/K) and says what a
+    # misfit at the new temperature may mean — in the message (report, stderr) and the JSON
+    new_t = sorted(set(r.temperatures_c) - {35.0})
+    assert nm.premise and nm.premise in nm.message and nm.to_dict()["premise"] == nm.premise
+    assert "activation_energy=15000" in nm.premise and "slope=-0.0075" in nm.premise
+    assert "laws, not the effect, may be wrong" in nm.premise
+    assert all(f"{t:g}" in nm.premise.split("(the record")[0] for t in new_t)
     # measure it: the independent sensor at the recommended lines and bath temperatures, fresh noise
     f, T = r.line_frequencies_hz, r.line_temperatures_c
     H = isn.response(truth["base"], truth["effects"], f, temperature_c=T) * 1e3
