@@ -266,6 +266,8 @@ def baseline_noncentrality(H1, base, sig, f):
     sg = {k: math.copysign(1.0, base[k]) for k in PERTURBED}
 
     def res(x):
+        if np.max(x) > 709.0:                 # math.exp would overflow (it raised, ending the case): a
+            return np.full(2 * f.size, 1e6)   # large residual LM refuses; every other step is as before
         b = dict(base, **{k: sg[k] * math.exp(v) for k, v in zip(PERTURBED, x)})
         r = np.log(H1 / response(b, {}, f)) / sig
         return np.concatenate([r.real, r.imag])
