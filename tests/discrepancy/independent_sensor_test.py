@@ -79,7 +79,7 @@ def test_cases_are_reproducible_and_labelled():
 # ------------------------------------------------------------------ the bath temperature (issue 27 item 3)
 @pytest.mark.parametrize("t", [5.0, 20.0, 50.0, 65.0])
 def test_strip_away_from_its_temperature_agrees_with_the_library_laws(t, start):
-    """The generator's own laws against the library's defaults at other bath temperatures: the same
+    """The generator's own code for the laws against the library's defaults at other bath temperatures: the same
     Arrhenius, log-linear and Nernst–Einstein laws, but water's permittivity from another published
     fit (Owen et al. 1961 here, Malmberg & Maryott 1956 there, ≤ 0.2 % apart over 5–65 °C)."""
     f = np.geomspace(1.0, 1000.0, 25)

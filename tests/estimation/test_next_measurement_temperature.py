@@ -83,7 +83,8 @@ def isn():
 
 
 def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
-    """The independent sensor (its own strip, laws and op-amp node equations) with seed 000's op-amp
+    """The independent sensor (its own code for the strip, the library's temperature-law forms and
+    constants, and its own op-amp node equations) with seed 000's op-amp
     stages loaded by the strip: one 35 °C record leaves amplifier_bandwidth and transimpedance
     ambiguous.  At the bath's 35 °C no band up to 1 kHz is expected to separate them (the op-amp
     stages' corner GBW·|Z|/R1 is one more pole); with the bath free the search steps it, since Z
