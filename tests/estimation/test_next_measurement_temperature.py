@@ -161,6 +161,9 @@ def test_ipmc_runs_the_bath_step_on_its_virtual_lab(tmp_path, isn):
     rec2 = read_csv(tmp_path / "run" / "next_measurement" / "record2.csv")
     T2 = np.unique(rec2.temperature_c)
     assert set(T2.tolist()) - {35.0}                               # a bath step
+    # ... and the report the user reads says what that step assumes (review S2)
+    summary = (tmp_path / "run" / "next_measurement" / "diagnosis1" / "summary.md").read_text(encoding="utf-8")
+    assert "Premise:" in summary and "laws, not the effect, may be wrong" in summary
     plain = physics_model("sensor", get_parameter_set("seed000_sensor_dev", T_ref=308.15))
     for t in T2:
         on = rec2.temperature_c == t
