@@ -399,15 +399,14 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     good = [r for r in order if id(r) in done and r.separation_refit >= target] \
         or [r for r in checked if r.separation_refit >= target]
     chosen = good[0] if good else (max(checked, key=lambda r: r.separation_refit) if checked else order[0])
-    same_form = same_form + same_refit
     sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
     who = " vs ".join(" + ".join(m) for m in mods)
-    alike = (" Not separable within the limits (the same response in another form; best λ after refits "
-             "below " f"{SAME_FORM_LAMBDA:g}): " + "; ".join(same_form) + "." if same_form else "")
+    alike = _inseparable_note(same_form, same_refit)
     if not live:
         sep_ok = False
-        msg = f"No experiment within the limits can separate {who}.{alike}"
+        msg = (f"No experiment within the limits can separate {who}.{alike}" if not same_refit else
+               f"No experiment within the limits is expected to separate {who} as they were fitted.{alike}")
     elif sep_ok:
         msg = (f"Next measurement to separate {who}: {chosen.describe()} — expected separation λ = {lam_said:.3g} "
                f"(≥ {target:.3g} needed for {power:.0%} power at α = {d.alpha:g}; the record alone gives "
@@ -419,11 +418,66 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_said)}× "
                   "as many" if 0 < lam_said < target else "")
                + f"), widen the limits, or accept the ambiguity.{alike}")
-    msg += t_note
+    premise = temperature_premise(chosen, T_data, d.base_parameters)
+    msg += t_note + (" " + premise if premise else "")
     return NextMeasurement([tuple(m) for m in mods], chosen, bool(sep_ok), target, float(current), len(rows),
-                           ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form,
+                           ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form + same_refit,
                            {q: max(r.separation for r in rows if r.quantity == q) for q in qs
-                            if any(r.quantity == q for r in rows)})
+                            if any(r.quantity == q for r in rows)}, list(same_refit), premise)
+
+
+def _inseparable_note(same_form: list, same_refit: list) -> str:
+    """The message's sentence on the pairs left out: ``same_form`` no experiment separates even
+    linearised (the same response in another form), ``same_refit`` the refits of the checked
+    experiments did not separate as the models were fitted (one fit a nested form of the other: the
+    truth's own form may still separate)."""
+    out = ""
+    if same_form:
+        out += (" Not separable within the limits (the same response in another form; linearised λ below "
+                f"{SAME_FORM_LAMBDA:g} in every experiment): " + "; ".join(same_form) + ".")
+    if same_refit:
+        out += (" Not separated as fitted (one model's fit is a nested form of the other: λ after refits below "
+                f"{SAME_FORM_LAMBDA:g} in every checked experiment expected to separate it) — may separate in "
+                "another form, which this search, linearised at the fits, does not try: " + "; ".join(same_refit)
+                + ".")
+    return out
+
+
+def laws_in_play(laws) -> str:
+    """The non-constant temperature laws of ``laws`` (a ``TemperatureLaws``), e.g. ``d
+    Arrhenius(activation_energy=15000); E LogLinear(slope=-0.0075)`` — the format of the diagnosis
+    report's "Temperature laws" line (``diagnosis.describe_laws``, not imported: diagnosis imports
+    this module)."""
+    from dataclasses import fields
+
+    parts = []
+    for f in fields(laws):
+        law = getattr(laws, f.name)
+        if type(law).__name__ == "Constant":
+            continue
+        args = ", ".join(f"{k.name}={getattr(law, k.name):g}" for k in fields(law) if k.name != "valid_c")
+        parts.append(f"{f.name} {type(law).__name__}({args})")
+    return "; ".join(parts) if parts else "every parameter constant (isothermal)"
+
+
+def temperature_premise(r, record_temperatures_c, base) -> str:
+    """The premise of a recommended experiment ``r`` that steps the bath away from the record's
+    temperatures: its separation is predicted through the diagnosed model's temperature laws (those
+    of ``base``, named), so a misfit at the new temperature may mean the laws, not the effect, are
+    wrong.  Empty when ``r`` (or its temperatures) stays at the record's."""
+    if r is None:
+        return ""
+    new = [t for t in r.temperatures_c if not np.any(np.isclose(t, np.asarray(record_temperatures_c, float)))]
+    if not new:
+        return ""
+    laws = getattr(base, "laws", None)
+    said = laws_in_play(laws) if laws is not None else "the parameter set's"
+    at = ", ".join(f"{t:g}" for t in np.unique(np.asarray(record_temperatures_c, float)))
+    return (f"Premise: this experiment steps the bath to {', '.join(f'{t:g}' for t in new)} °C (the record: {at} "
+            f"°C), so its separation relies on the diagnosed model's temperature laws ({said}); a misfit at the "
+            "new temperature (an 'unexplained' verdict on both records) means the laws, not the effect, may be "
+            "wrong — check them (e.g. a record of the plain strip at that temperature) before reading it as an "
+            "effect.")
 
 
 
@@ -477,6 +531,6 @@ def _temperature_limits(limits, base) -> tuple[float, float, str]:
 
 
 __all__ = ["CandidateMeasurement", "NextMeasurement", "competing_models", "json_ready", "merge_records",
-           "next_measurement", "MAX_BATH_C",
+           "next_measurement", "laws_in_play", "temperature_premise", "MAX_BATH_C",
            "PERIODS", "BATH_SETTLE_S", "SAME_FORM_LAMBDA", "REFIT_STARTS", "FD_RELATIVE_STEP",
            "DEFAULT_BAND_LIMITS_HZ", "DEFAULT_LEVELS", "DEFAULT_TEMPERATURE_LIMITS_C"]

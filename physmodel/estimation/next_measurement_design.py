@@ -147,9 +147,11 @@ def fit_competing_models(d, models: Sequence[tuple], max_nfev: int) -> list[Comp
 
 
 def noise_model(d) -> dict:
-    """σ_ln, σ_φ of the record against |G| (:mod:`~physmodel.estimation.next_measurement`, "Noise at
-    the new lines"): slope b ∈ [−1, 0] and the references; a joint record's per quantity
-    (``by_quantity``), with the median relative σ over its quantities for another one."""
+    """σ_ln [Np], σ_φ [rad] of the record against |G| (:mod:`~physmodel.estimation.next_measurement`,
+    "Noise at the new lines"): slope b ∈ [−1, 0] [-] and the references ``ref_ln`` [Np], ``ref_ph``
+    [rad] (σ at |G| = 1 in the record's response units, level 1), the medians ``median_ln`` [Np],
+    ``median_ph`` [rad]; a joint record's per quantity (``by_quantity``), with the median relative σ
+    over its quantities for another one."""
     view = RecordView(d)
     if not view.joint:
         return sweep_noise_model(d.data)
@@ -183,7 +185,11 @@ def sweep_noise_model(sweep: FrequencySweep) -> dict:
 
 
 def line_sigma(nm: dict, logabs: np.ndarray, level: np.ndarray, same_quantity: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(σ_ln, σ_φ) per (experiment level, line): shapes (n_levels, N)."""
+    """(σ_ln [Np], σ_φ [rad]) per (experiment level, line): shapes (n_levels, N).
+
+    ``nm`` a :func:`noise_model`; ``logabs`` ln|G| of the lines in the record's response units [Np];
+    ``level`` the drive levels, multiples of the record's [-]; ``same_quantity`` the diagnosed
+    quantity (σ regressed on |G|) or another (the record's median σ_ln, σ_φ, independent of level)."""
     if same_quantity:
         f = np.exp(nm["slope"] * logabs)[None, :] * (level[:, None] ** nm["slope"])
         return nm["ref_ln"] * f, nm["ref_ph"] * f

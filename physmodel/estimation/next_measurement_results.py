@@ -44,7 +44,9 @@ class CandidateMeasurement:
     separation_by_pair : dict
         ``"A vs B"`` → {"A true": λ_A, "B true": λ_B}. [-]
     joint : bool
-        Evaluated together with the diagnosed record (same quantity: merge and diagnose both).
+        Evaluated together with the diagnosed record: either merged with it (the same quantity:
+        merge and diagnose both) or, when ``added_quantity``, one more quantity diagnosed jointly
+        with the record's quantities.  False: a record of its own.
     duration_s : float
         Measurement time estimate: temperatures × :data:`~physmodel.estimation.next_measurement.PERIODS` / lowest frequency, plus
         :data:`~physmodel.estimation.next_measurement.BATH_SETTLE_S` per temperature the record was not measured at. [s]
@@ -58,6 +60,9 @@ class CandidateMeasurement:
     line_temperatures_c, line_frequencies_hz : ndarray
         Every line of the new record (a joint record leaves out the diagnosed record's band at its
         temperatures). [°C], [Hz]
+    added_quantity : bool
+        A quantity the diagnosed record did not hold, diagnosed jointly with the record's quantities
+        (``joint`` is then True too).
     """
 
     quantity: str
@@ -75,7 +80,8 @@ class CandidateMeasurement:
     refit_by_pair: dict = field(default_factory=dict)
     line_temperatures_c: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
     line_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    #: A quantity a joint diagnosis did not hold, diagnosed jointly with its quantities.
+    #: A quantity the diagnosed record did not hold, diagnosed jointly with its quantities (then
+    #: ``joint`` is True too; ``joint and not added_quantity``: merged with the record).
     added_quantity: bool = field(default=False, repr=False)
 
     def describe(self) -> str:
@@ -96,7 +102,8 @@ class CandidateMeasurement:
                 "lines": {"temperature_c": self.line_temperatures_c.tolist(),
                           "frequency_hz": self.line_frequencies_hz.tolist()},
                 "separation": self.separation, "separation_by_pair": self.separation_by_pair, "joint": self.joint,
-                "duration_s": self.duration_s, "power": self.power, "separation_refit": self.separation_refit,
+                "added_quantity": self.added_quantity, "duration_s": self.duration_s, "power": self.power,
+                "separation_refit": self.separation_refit,
                 "refit_by_pair": self.refit_by_pair,
                 "description": self.describe()}
 
@@ -128,10 +135,20 @@ class NextMeasurement:
     message : str
         The recommendation in words (what the report and stderr say).
     inseparable : list of str
-        ``"A vs B"`` pairs no experiment within the limits separates (the same response in another
-        form: linearised, or after the refits of every checked experiment).
+        ``"A vs B"`` pairs left out of the criterion: no experiment within the limits separates them
+        linearised (the same response in another form), or — listed also in
+        ``inseparable_as_fitted`` — the refits of every checked experiment expected to separate them
+        did not.
     best_by_quantity : dict
         Quantity → the largest linearised separation any experiment of it reaches. [-]
+    inseparable_as_fitted : list of str
+        The pairs of ``inseparable`` dropped by the refits: not separated as the models were fitted
+        (one fit a nested form of the other); the truth's own form may still separate.
+    premise : str
+        When the recommended experiment steps the bath away from the record's temperatures: that
+        its separation relies on the diagnosed model's temperature laws (named), and that a misfit
+        at the new temperature may mean the laws, not the effect, are wrong ("" otherwise; also
+        the end of ``message``).
     """
 
     models: list
@@ -146,6 +163,8 @@ class NextMeasurement:
     message: str
     inseparable: list = field(default_factory=list)
     best_by_quantity: dict = field(default_factory=dict)
+    inseparable_as_fitted: list = field(default_factory=list)
+    premise: str = ""
 
     @classmethod
     def unavailable(cls, reason: str, models=()) -> NextMeasurement:
@@ -161,7 +180,8 @@ class NextMeasurement:
                       "separates": self.separates, "target": self.target, "current": self.current,
                       "evaluated": self.evaluated, "ranking": [r.to_dict() for r in self.ranking],
                       "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
-                      "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity})
+                      "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity,
+                      "inseparable_as_fitted": list(self.inseparable_as_fitted), "premise": self.premise})
 
 
 

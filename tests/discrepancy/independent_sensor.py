@@ -52,6 +52,12 @@ factor over its value at ``base["T"]``):
 * leakage conductance Gp by Nernst–Einstein (∝ d/T), and T itself in K = F² d C/(ε R T);
 * electrode sheet and through-thickness resistances, C and a0: constant (as the user's laws).
 
+These are this module's own code but the library's law FORMS and CONSTANTS (only the water
+permittivity fit differs): a bath step checked with them measures the search on the premise that
+the user's temperature laws are right.  ``laws={"ea_d": ..., "e_logslope": ...}``
+(:func:`law_constants`) gives the strip other constants (a strip the user's laws misdescribe);
+left out, the module's constants are used and every record is as before, bit for bit.
+
 Z follows through d, ε, Gp and T, so the ``opamp`` element (the strip as its source) changes with
 the bath while the other chain elements do not.  At ``base["T"]`` every factor is exactly 1 and the
 default path (``temperature_c=None``) is the module as it was: earlier sets stay bit-identical.
@@ -110,32 +116,49 @@ EFFECT_SPECS.update(PHYSICAL_FORM_SPECS)
 
 
 # --------------------------------------------------------------------------- strip
-def at_temperature(base: dict, temperature_c: float) -> dict:
+def law_constants(laws: dict | None) -> tuple[float, float]:
+    """(Ea_d [J/mol], E log-slope [1/K]) of ``laws`` = {"ea_d": ..., "e_logslope": ...} (either key
+    may be left out; None: :data:`EA_D`, :data:`E_LOGSLOPE`, the library's defaults).  Another
+    strip than the user's laws assume: ``bench_next_measurement.py --law-error``."""
+    laws = dict(laws or {})
+    bad = set(laws) - {"ea_d", "e_logslope"}
+    if bad:
+        raise ValueError(f"laws: unknown key(s) {sorted(bad)}; expected 'ea_d' [J/mol] and/or 'e_logslope' [1/K]")
+    ea, sl = float(laws.get("ea_d", EA_D)), float(laws.get("e_logslope", E_LOGSLOPE))
+    if not (math.isfinite(ea) and ea >= 0.0 and math.isfinite(sl) and abs(sl) < 0.1):
+        raise ValueError(f"laws={laws!r}: expected ea_d >= 0 J/mol and |e_logslope| < 0.1 /K")
+    return ea, sl
+
+
+def at_temperature(base: dict, temperature_c: float, laws: dict | None = None) -> dict:
     """The strip ``base`` (given at its temperature ``base["T"]`` [K]) at ``temperature_c`` [°C]
-    (module doc, "Bath temperature"): d, ε, E and Gp by their laws, T; the rest unchanged."""
+    (module doc, "Bath temperature"): d, ε, E and Gp by their laws, T; the rest unchanged.
+    ``laws``: other law constants (:func:`law_constants`; default the module's)."""
     T0, T = base["T"], float(temperature_c) + ip.T_ZERO
     if not 0.0 < float(temperature_c) < 100.0:
         raise ValueError(f"temperature_c={temperature_c!r}: the laws here hold for liquid water, 0-100 °C")
-    arr = math.exp(-EA_D / ip.R_GAS * (1.0 / T - 1.0 / T0))
+    ea_d, e_logslope = law_constants(laws)
+    arr = math.exp(-ea_d / ip.R_GAS * (1.0 / T - 1.0 / T0))
     out = dict(base)
     out["d"] = base["d"] * arr
     out["eps"] = base["eps"] * float(ip.water_permittivity(T - ip.T_ZERO) / ip.water_permittivity(T0 - ip.T_ZERO))
-    out["E"] = base["E"] * math.exp(E_LOGSLOPE * (T - T0))
+    out["E"] = base["E"] * math.exp(e_logslope * (T - T0))
     out["Gp"] = base["Gp"] * arr * T0 / T
     out["T"] = T
     return out
 
 
-def strip_sensor(base: dict, s, temperature_c=None) -> tuple:
+def strip_sensor(base: dict, s, temperature_c=None, laws: dict | None = None) -> tuple:
     """(G [A/m], Z [Ω]) of the strip at Laplace points s (1-D); ``temperature_c`` [°C] (a number or
-    one per point; default the strip's own ``base["T"]``)."""
+    one per point; default the strip's own ``base["T"]``); ``laws`` other law constants
+    (:func:`at_temperature`)."""
     if temperature_c is not None:
         s = np.asarray(s, complex)
         t = np.broadcast_to(np.asarray(temperature_c, float), s.shape)
         G, Z = np.empty(s.shape, complex), np.empty(s.shape, complex)
         for tc in np.unique(t):
             on = t == tc
-            G[on], Z[on] = strip_sensor(at_temperature(base, tc), s[on])
+            G[on], Z[on] = strip_sensor(at_temperature(base, tc, laws), s[on])
         return G, Z
     st = {k: np.asarray(v, float) for k, v in base.items()}
     st.update(alpha=0.0, zeta=0.1, f1=1.0)
@@ -215,12 +238,13 @@ def chain_factor(name: str, v: dict, s, Z, f_hz):
     raise ValueError(f"unknown effect {name!r}; expected one of {sorted(EFFECT_SPECS)}")
 
 
-def response(base: dict, effects: dict, f_hz, temperature_c=None) -> np.ndarray:
+def response(base: dict, effects: dict, f_hz, temperature_c=None, laws: dict | None = None) -> np.ndarray:
     """Measured G [A/m] with the chain elements ``effects`` = {name: {param: value}}; ``temperature_c``
-    [°C] the bath (a number or one per line; default the strip's own ``base["T"]``)."""
+    [°C] the bath (a number or one per line; default the strip's own ``base["T"]``); ``laws`` other
+    temperature-law constants than the module's (:func:`law_constants`)."""
     f = np.asarray(f_hz, float)
     s = 2j * np.pi * f
-    G, Z = strip_sensor(base, s, temperature_c)
+    G, Z = strip_sensor(base, s, temperature_c, laws)
     for n, v in effects.items():
         G = G * chain_factor(n, v, s, Z, f)
     return G
@@ -242,6 +266,8 @@ def baseline_noncentrality(H1, base, sig, f):
     sg = {k: math.copysign(1.0, base[k]) for k in PERTURBED}
 
     def res(x):
+        if np.max(x) > 709.0:                 # math.exp would overflow (it raised, ending the case): a
+            return np.full(2 * f.size, 1e6)   # large residual LM refuses; every other step is as before
         b = dict(base, **{k: sg[k] * math.exp(v) for k, v in zip(PERTURBED, x)})
         r = np.log(H1 / response(b, {}, f)) / sig
         return np.concatenate([r.real, r.imag])
@@ -292,6 +318,7 @@ __all__ = [
     "START",
     "at_temperature",
     "chain_factor",
+    "law_constants",
     "library_fields",
     "make_case",
     "opamp_chain",

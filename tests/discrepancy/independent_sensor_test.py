@@ -79,7 +79,7 @@ def test_cases_are_reproducible_and_labelled():
 # ------------------------------------------------------------------ the bath temperature (issue 27 item 3)
 @pytest.mark.parametrize("t", [5.0, 20.0, 50.0, 65.0])
 def test_strip_away_from_its_temperature_agrees_with_the_library_laws(t, start):
-    """The generator's own laws against the library's defaults at other bath temperatures: the same
+    """The generator's own code for the laws against the library's defaults at other bath temperatures: the same
     Arrhenius, log-linear and Nernst–Einstein laws, but water's permittivity from another published
     fit (Owen et al. 1961 here, Malmberg & Maryott 1956 there, ≤ 0.2 % apart over 5–65 °C)."""
     f = np.geomspace(1.0, 1000.0, 25)
@@ -106,16 +106,56 @@ def test_the_default_temperature_is_the_strip_as_it_was():
 @pytest.mark.parametrize("t", [5.0, 65.0])
 def test_only_the_opamp_stage_follows_the_bath(t, start):
     """The op-amp stages see the strip's impedance, which the bath changes; an amplifier pole does
-    not.  Each element's factor at t against the library's effect at t, and against itself at 35 °C."""
+    not.  Each element's response at t against the library's effect at t; then the LIBRARY's
+    element factor (its effect's S over its plain strip's S) at t against at 35 °C: the amplifier's
+    must not move with the bath (it would if the library tied the pole to the strip's state), the
+    op-amp stage's must, by as much as the generator's node equations say (its own code)."""
     f = np.geomspace(10.0, 1000.0, 21)
-    fac = {}
+    lib_fac, gen_fac = {}, {}
     for name in ("amplifier", "opamp"):
         v = isn.draw_effect(name, np.random.default_rng(3), 0.8)
         lib, lv = LIBRARY_FORM[name](v)
         a = isn.response(isn.START, {name: v}, f, t)
         b = EffectModel(start, "sensor", {lib: lv}).frequency_response(f, [t])["S"][0, 0]
         assert np.max(np.abs(a / b - 1)) < 2e-3
-        fac[name] = [isn.response(isn.START, {name: v}, f, tt) / isn.response(isn.START, {}, f, tt)
-                     for tt in (t, isn.TEMPERATURE_C)]
-    assert np.max(np.abs(fac["amplifier"][0] / fac["amplifier"][1] - 1)) < 1e-12
-    assert np.max(np.abs(fac["opamp"][0] / fac["opamp"][1] - 1)) > 0.02
+        lib_fac[name], gen_fac[name] = [], []
+        for tt in (t, isn.TEMPERATURE_C):
+            with_el = EffectModel(start, "sensor", {lib: lv}).frequency_response(f, [tt])["S"][0, 0]
+            lib_fac[name].append(with_el / SensorModel(start).frequency_response(f, [tt], quantities=("S",))["S"][0, 0])
+            gen_fac[name].append(isn.response(isn.START, {name: v}, f, tt) / isn.response(isn.START, {}, f, tt))
+    assert np.max(np.abs(lib_fac["amplifier"][0] / lib_fac["amplifier"][1] - 1)) < 1e-9
+    moved_lib = lib_fac["opamp"][0] / lib_fac["opamp"][1]
+    moved_gen = gen_fac["opamp"][0] / gen_fac["opamp"][1]
+    assert np.max(np.abs(moved_lib - 1)) > 0.02
+    assert np.max(np.abs(moved_lib / moved_gen - 1)) < 2e-3
+
+
+def test_other_law_constants_move_the_strip_as_the_library_with_those_constants(start):
+    """The ``laws`` option (bench_next_measurement ``--law-error``): left out, or given the module's
+    constants, every record is bit-identical to before; given other constants the generator agrees
+    with the LIBRARY configured with the same constants (its own Arrhenius and log-linear laws) and
+    no longer with the library's defaults; at the strip's own temperature nothing moves."""
+    from dataclasses import replace
+
+    from physmodel.temperature import Arrhenius, LogLinear
+
+    _, tr = isn.make_case(11, "opamp")
+    f = np.geomspace(1.0, 1000.0, 17)
+    moved = {"ea_d": 20e3, "e_logslope": -0.005}
+    assert np.array_equal(isn.response(tr["base"], tr["effects"], f, 5.0),
+                          isn.response(tr["base"], tr["effects"], f, 5.0,
+                                       laws={"ea_d": isn.EA_D, "e_logslope": isn.E_LOGSLOPE}))
+    assert np.array_equal(isn.response(tr["base"], tr["effects"], f, isn.TEMPERATURE_C, laws=moved),
+                          isn.response(tr["base"], tr["effects"], f))
+    lib = replace(start, laws=replace(start.laws, d=replace(start.laws.d, activation_energy=20e3),
+                                      E=replace(start.laws.E, slope=-0.005)))
+    assert isinstance(lib.laws.d, Arrhenius) and isinstance(lib.laws.E, LogLinear)
+    for t in (5.0, 65.0):
+        G, Z = isn.strip_sensor(isn.START, 2j * np.pi * f, t, laws=moved)
+        r = SensorModel(lib).frequency_response(f, [t], quantities=("S", "Z"))
+        assert np.max(np.abs(G / r["S"][0, 0] - 1)) < 2e-3
+        assert np.max(np.abs(Z / r["Z"][0, 0] - 1)) < 2e-3
+        r0 = SensorModel(start).frequency_response(f, [t], quantities=("S", "Z"))
+        assert np.max(np.abs(Z / r0["Z"][0, 0] - 1)) > 0.02          # a strip the default laws misdescribe
+    with pytest.raises(ValueError, match="unknown key"):
+        isn.response(tr["base"], {}, f, 5.0, laws={"Ea": 20e3})

@@ -191,8 +191,9 @@ def test_default_search_spans_quantities_temperatures_and_levels(ambiguous):
     assert nm.evaluated > 100 and nm.separates
     r = nm.recommended
     assert r.temperatures_c == (35.0,) and r.duration_s < nmod.BATH_SETTLE_S
-    rows = {(x["quantity"], x["joint"]) for x in nm.to_dict()["ranking"]}
-    assert ("S", True) in rows and "S" in qs
+    rows = {(x["quantity"], x["joint"], x["added_quantity"]) for x in nm.to_dict()["ranking"]}
+    assert ("S", True, False) in rows and "S" in qs           # merged with the S record
+    assert nm.premise == ""                                    # the record's temperature: no premise
     assert set(nm.best_by_quantity) == {"S", "Z"}      # Z evaluated too (a record of its own)
     assert nm.best_by_quantity["S"] >= max(nm.best_by_quantity.values())
     temps = {t for x in nm.to_dict()["ranking"] for t in x["temperatures_c"]}
@@ -332,3 +333,19 @@ def test_one_json_sanitiser_for_both_reports():
     assert diagnosis.json_ready is json_ready
     nm = NextMeasurement.unavailable("why", [("a",), ("b",)])
     assert json.loads(json.dumps(nm.to_dict(), allow_nan=False))["message"] == "no recommendation: why"
+
+
+def test_candidate_json_tells_a_merged_record_from_an_added_quantity():
+    """Review M4: ``joint`` is True both for a record merged with the diagnosed one and for a quantity
+    diagnosed jointly with it; the JSON must say which (``added_quantity``), as the description does."""
+    from physmodel.estimation.next_measurement_results import CandidateMeasurement
+
+    def cand(added):
+        return CandidateMeasurement("Z", (1.0, 10.0), (35.0,), 1.0, 3, np.array([1.0, 3.0, 10.0]), 50.0, {}, True,
+                                    30.0, 0.9, added_quantity=added)
+
+    merged, added = cand(False).to_dict(), cand(True).to_dict()
+    assert merged["joint"] and added["joint"]
+    assert merged["added_quantity"] is False and added["added_quantity"] is True
+    assert "merged with the diagnosed record" in merged["description"]
+    assert "diagnosed jointly with the record's quantities" in added["description"]

@@ -55,6 +55,17 @@ def test_a_nested_pair_does_not_hide_the_experiment_that_separates_the_others(th
     # the same answer as a search restricted to S (the quantity that carries the chain elements)
     only_s = next_measurement(d, quantities=["S"])
     assert only_s.recommended.describe() == r.describe()
+    # review S3: with Z searched too the pair survives the linearised λ (Z's linearisation error) and
+    # is dropped by the refit rounds — said as "not separated as fitted", not "not separable"; the
+    # S-only search drops it linearised, and says that
+    assert nm.inseparable_as_fitted == ["amplifier_bandwidth vs transimpedance"]
+    assert "as fitted" in nm.message and "may separate in another form" in nm.message
+    assert "Not separable within the limits" not in nm.message
+    assert nm.to_dict()["inseparable_as_fitted"] == nm.inseparable_as_fitted
+    assert only_s.inseparable == ["amplifier_bandwidth vs transimpedance"] and only_s.inseparable_as_fitted == []
+    assert "Not separable within the limits" in only_s.message and "as fitted" not in only_s.message
+    # the record's 35 °C: no temperature premise
+    assert nm.premise == "" and "Premise" not in nm.message
 
 
 # ------------------------------------------------------------------ a bath step, checked on the independent sensor
@@ -72,7 +83,8 @@ def isn():
 
 
 def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
-    """The independent sensor (its own strip, laws and op-amp node equations) with seed 000's op-amp
+    """The independent sensor (its own code for the strip, the library's temperature-law forms and
+    constants, and its own op-amp node equations) with seed 000's op-amp
     stages loaded by the strip: one 35 °C record leaves amplifier_bandwidth and transimpedance
     ambiguous.  At the bath's 35 °C no band up to 1 kHz is expected to separate them (the op-amp
     stages' corner GBW·|Z|/R1 is one more pole); with the bath free the search steps it, since Z
@@ -93,10 +105,23 @@ def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
     assert d1.verdict == "ambiguous" and set(d1.named) == {"amplifier_bandwidth", "transimpedance"}
     fixed = next_measurement(d1, quantities=["S"], temperature_limits_c=(35.0, 35.0), band_limits_hz=(0.1, 1000.0))
     assert not fixed.separates
+    assert fixed.premise == ""                     # no bath step, no premise on the laws
     nm = next_measurement(d1, quantities=["S"], band_limits_hz=(0.1, 1000.0))
     r = nm.recommended
     assert nm.separates and set(r.temperatures_c) - {35.0}
     assert not nm.inseparable
+    # review S2: the bath step's separation rests on the user's temperature laws; the recommendation
+    # names them (the start set's: Arrhenius d 15 kJ/mol, log-linear E −0.75 %/K) and says what a
+    # misfit at the new temperature may mean — in the message (report, stderr) and the JSON
+    new_t = sorted(set(r.temperatures_c) - {35.0})
+    assert nm.premise and nm.premise in nm.message and nm.to_dict()["premise"] == nm.premise
+    assert "activation_energy=15000" in nm.premise and "slope=-0.0075" in nm.premise
+    from physmodel.estimation.diagnosis import describe_laws
+    from physmodel.estimation.next_measurement import laws_in_play
+
+    assert laws_in_play(p0.laws) == describe_laws(p0.laws) and laws_in_play(p0.laws) in nm.premise   # as the report
+    assert "laws, not the effect, may be wrong" in nm.premise
+    assert all(f"{t:g}" in nm.premise.split("(the record")[0] for t in new_t)
     # measure it: the independent sensor at the recommended lines and bath temperatures, fresh noise
     f, T = r.line_frequencies_hz, r.line_temperatures_c
     H = isn.response(truth["base"], truth["effects"], f, temperature_c=T) * 1e3
@@ -136,6 +161,9 @@ def test_ipmc_runs_the_bath_step_on_its_virtual_lab(tmp_path, isn):
     rec2 = read_csv(tmp_path / "run" / "next_measurement" / "record2.csv")
     T2 = np.unique(rec2.temperature_c)
     assert set(T2.tolist()) - {35.0}                               # a bath step
+    # ... and the report the user reads says what that step assumes (review S2)
+    summary = (tmp_path / "run" / "next_measurement" / "diagnosis1" / "summary.md").read_text(encoding="utf-8")
+    assert "Premise:" in summary and "laws, not the effect, may be wrong" in summary
     plain = physics_model("sensor", get_parameter_set("seed000_sensor_dev", T_ref=308.15))
     for t in T2:
         on = rec2.temperature_c == t
