@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LM_STEPS", "damped_steps"]
+__all__ = ["LM_STEPS", "damped_steps", "crawling", "line_search", "CRAWL_POINTS", "CRAWL_GAIN", "CRAWL_SEARCHES"]
 
 #: Damped steps a later start takes before handing over to scipy's trust region.
 LM_STEPS = 30
@@ -52,3 +52,197 @@ def damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
         else:
             lam *= 4.0
     return pt
+
+
+#: The trust region is crawling when over this many of its points ...
+CRAWL_POINTS = 10
+#: ... its best cost fell by less than this fraction of the Gauss–Newton decrement predicted at
+#: the best point it had before them (a valley where the Gauss–Newton model's curvature is far
+#: below the cost's: the neglected Σ rᵢ∇²rᵢ, large along a direction the data barely determine).
+CRAWL_GAIN = 0.1
+#: Line searches (each followed by a fresh trust region) per search at most.
+CRAWL_SEARCHES = 8
+#: Secant steps of the profile search per crawl at most.
+PROFILE_STEPS = 12
+#: Gauss–Newton points of one inner fit (the other coordinates at a fixed flat one) at most ...
+INNER_POINTS = 6
+#: ... ending when its decrement falls below this times s² (the trust region converges after).
+INNER_DECREMENT = 1e-9
+
+
+def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
+    """Where the trust region crawls, the cost is flat along one direction the data barely
+    determine and curved across it (the Gauss–Newton model's smallest eigenvalue against the
+    neglected Σ rᵢ∇²rᵢ), so every step that model proposes leaves the curved valley.  Search the
+    valley as a profile instead: the coordinate k most aligned with JᵀJ's flattest eigenvector
+    fixed, the others fitted by Gauss–Newton (well determined: a few points, :data:`INNER_POINTS`),
+    and k moved by secant steps on the profile's derivative, which at an inner optimum is the
+    gradient's k-th component (Jᵀr)_k (the envelope theorem), regula falsi once bracketed; the
+    first step ``moved`` (what the trust region moved k by while crawling) times four.  At most
+    :data:`PROFILE_STEPS` secant steps, ending when a step moves k by less than 1e-9 of its range,
+    at a point with a status (converged, joined) or at the budget; the inner fits end at a
+    decrement below :data:`INNER_DECREMENT`·s² (``s2`` the engine's s²).  Returns the lowest
+    point reached; the trust region resumes from it (and its tests end the search)."""
+    n = len(pt[0])
+    if n < 2:
+        return pt
+    A = pt[2].T @ pt[2]
+    w, V = np.linalg.eigh(A / np.sqrt(np.outer(np.diag(A), np.diag(A)) + 1e-300))
+    k = int(np.argmax(np.abs(V[:, 0])))
+    o = np.array([i for i in range(n) if i != k])
+    span = hi - lo
+    lo_in = lo + 1e-10 * np.maximum(1.0, np.abs(lo))
+    hi_in = hi - 1e-10 * np.maximum(1.0, np.abs(hi))
+
+    def inner(p):
+        """The other coordinates fitted by Gauss–Newton steps at p's k (halved when the cost rises)."""
+        for _ in range(INNER_POINTS):
+            if p[3] is not None or stopped_at_budget():
+                return p
+            r, go = p[1], p[2][:, o].T @ p[1]
+            zo = p[0][o]
+            held = ((zo - lo[o] <= 1e-8 * span[o]) & (go > 0)) | ((hi[o] - zo <= 1e-8 * span[o]) & (go < 0))
+            f = o[~held]                 # coordinates at a bound pushed outwards stay there
+            if not len(f):
+                return p
+            Jf = p[2][:, f]
+            try:
+                sf = np.linalg.solve(Jf.T @ Jf, -(Jf.T @ r))
+            except np.linalg.LinAlgError:
+                return p
+            if -0.5 * float((Jf.T @ r) @ sf) < INNER_DECREMENT * s2:
+                return p
+            for _ in range(2):
+                z = p[0].copy()
+                z[f] = np.clip(z[f] + sf, lo_in[f], hi_in[f])
+                if stopped_at_budget():
+                    return p
+                count[0] += 1
+                new = evaluate(z)
+                if new[6] < p[6] or new[3] is not None:
+                    p = new
+                    break
+                sf = 0.5 * sf
+            else:
+                return p
+        return p
+
+    def grad_k(p):
+        return float(p[2][:, k] @ p[1])
+
+    cur = inner(pt)
+    best = cur if cur[6] < pt[6] else pt
+    if cur[3] is not None:
+        return cur
+    g = grad_k(cur)
+    step = 4.0 * moved[k] if moved[k] * -g > 0 else -np.sign(g) * 1e-3 * (hi[k] - lo[k])
+    below = above = None             # (z_k, g) with g < 0 and with g > 0: the bracket
+    for _ in range(PROFILE_STEPS):
+        if g == 0 or stopped_at_budget():
+            break
+        if g < 0:
+            below = (cur[0][k], g)
+        else:
+            above = (cur[0][k], g)
+        if below is not None and above is not None:
+            zk = below[0] - below[1] * (above[0] - below[0]) / (above[1] - below[1])
+        else:
+            zk = cur[0][k] + step
+        zk = float(np.clip(zk, lo_in[k], hi_in[k]))
+        if abs(zk - cur[0][k]) <= 1e-9 * (hi[k] - lo[k]):
+            break
+        z = cur[0].copy()
+        z[k] = zk
+        count[0] += 1
+        new = inner(evaluate(z))
+        if new[3] is not None:
+            return new if new[6] < best[6] else best
+        if not new[6] < cur[6] and below is None or above is None and not new[6] < cur[6]:
+            break                        # the profile does not fall that way: leave it to the trust region
+        g_new = grad_k(new)
+        if below is None or above is None:      # secant on g, at most four times further
+            dz = new[0][k] - cur[0][k]
+            slope = (g_new - g) / dz if dz != 0 else 0.0
+            step = -g_new / slope if slope > 0 else 4.0 * dz
+            step = float(np.clip(step, -4.0 * abs(dz), 4.0 * abs(dz)))
+        cur, g = new, g_new
+        if cur[6] < best[6]:
+            best = cur
+    return best
+
+
+#: Points per line search at most.
+LINE_POINTS = 4
+#: The line search's first point, as a fraction of the Gauss–Newton step.
+LINE_PROBE = 1e-3
+
+
+#: ... and that decrement is above this times s² (the point ≥ 0.014 standard errors from the
+#: optimum by the Gauss–Newton model: closer, the trust region's path left is short).
+CRAWL_DECREMENT = 1e-4
+
+
+def crawling(best: list, decrement, s2: float) -> bool:
+    """Whether the trust region crawls: ``best`` the lowest point reached after each of its
+    points (engine tuples, cost at index 6), ``decrement(pt)`` a point's Gauss–Newton decrement,
+    ``s2`` the engine's s²."""
+    if len(best) <= CRAWL_POINTS:
+        return False
+    old, now = best[-CRAWL_POINTS - 1], best[-1]
+    dec = decrement(old)
+    return dec > CRAWL_DECREMENT * s2 and old[6] - now[6] < CRAWL_GAIN * dec
+
+
+def line_search(pt, evaluate, lo, hi, count, stopped_at_budget):
+    """The cost's minimum along the Gauss–Newton step p from ``pt`` (engine tuple; the components
+    that would leave the box at a bound dropped) bent by its geodesic acceleration a (Transtrum &
+    Sethna 2012, arXiv:1201.5885): the curve z + t p + ½ t² a, a = −(JᵀJ)⁻¹Jᵀ r_pp, r_pp the
+    residuals' second derivative along p from the Jacobians at z and at a probe z + ε p
+    (ε = :data:`LINE_PROBE`).  A straight line leaves a curved valley at once (on the fluid load's
+    ν valley the cost rises by 0.02 at 1 % of the step); the curve follows it.  The first t is the
+    Newton estimate from the curve's second derivative |J p|² + rᵀ(r_pp + J a), then secant steps
+    on φ'(t) = ∇cost(c(t))·c'(t) (regula falsi once bracketed), at most :data:`LINE_POINTS` points
+    with the probe, ending when |φ'| falls below :data:`CRAWL_GAIN` of |φ'(0)|.  Points are clipped
+    to the box.  Returns the lowest point reached (``pt`` itself if none is lower)."""
+    z, r0, J0, step = pt[0], pt[1], pt[2], np.array(pt[5], dtype=float)
+    span = hi - lo
+    out = ((z - lo <= 1e-10 * span) & (step < 0)) | ((hi - z <= 1e-10 * span) & (step > 0))
+    step[out] = 0.0
+    d0 = float((J0.T @ r0) @ step)
+    if not d0 < 0 or stopped_at_budget():
+        return pt
+    count[0] += 1
+    probe = evaluate(np.clip(z + LINE_PROBE * step, lo, hi))
+    best = probe if probe[6] < pt[6] else pt
+    if probe[3] is not None:
+        return best
+    r_pp = (probe[2] @ step - J0 @ step) / LINE_PROBE
+    acc = -np.linalg.lstsq(J0, r_pp, rcond=None)[0]
+    acc[out] = 0.0
+    curv = -d0 + float(r0 @ (r_pp + J0 @ acc))
+    if not curv > 0:
+        return best
+    below, above = (0.0, d0), None          # the largest t with φ' < 0, the smallest with φ' >= 0
+    prev, t = (0.0, d0), min(-d0 / curv, 1.0)
+    for _ in range(LINE_POINTS - 1):
+        if stopped_at_budget():
+            break
+        count[0] += 1
+        new = evaluate(np.clip(z + t * step + 0.5 * t * t * acc, lo, hi))
+        if new[6] < best[6]:
+            best = new
+        if new[3] is not None:
+            break
+        d = float((new[2].T @ new[1]) @ (step + t * acc))
+        if abs(d) <= CRAWL_GAIN * abs(d0):
+            break
+        if d < 0:
+            below = (t, d)
+        else:
+            above = (t, d)
+        if above is not None:           # bracketed: regula falsi
+            t_next = below[0] - below[1] * (above[0] - below[0]) / (above[1] - below[1])
+        else:                           # secant from the last two, at most four times further
+            t_next = min(t - d * (t - prev[0]) / (d - prev[1]) if d > prev[1] else 4.0 * t, 4.0 * t)
+        prev, t = (t, d), t_next
+    return best
