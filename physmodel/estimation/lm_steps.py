@@ -1,12 +1,14 @@
 """Levenberg–Marquardt steps for the least-squares engine's later starts
-(:func:`physmodel.estimation.lsq.fit_parameters`), kept apart from :mod:`~physmodel.estimation.lsq`
-for its size."""
+(:func:`physmodel.estimation.lsq.fit_parameters`) and the profile search it runs when scipy's
+trust region crawls along a curved valley, kept apart from :mod:`~physmodel.estimation.lsq` for
+its size."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LM_STEPS", "damped_steps", "crawling", "line_search", "CRAWL_POINTS", "CRAWL_GAIN", "CRAWL_SEARCHES"]
+__all__ = ["LM_STEPS", "damped_steps", "crawling", "profile_search", "CRAWL_POINTS", "CRAWL_GAIN", "CRAWL_DECREMENT",
+           "CRAWL_SEARCHES"]
 
 #: Damped steps a later start takes before handing over to scipy's trust region.
 LM_STEPS = 30
@@ -60,7 +62,7 @@ CRAWL_POINTS = 10
 #: the best point it had before them (a valley where the Gauss–Newton model's curvature is far
 #: below the cost's: the neglected Σ rᵢ∇²rᵢ, large along a direction the data barely determine).
 CRAWL_GAIN = 0.1
-#: Line searches (each followed by a fresh trust region) per search at most.
+#: Profile searches (each followed by a fresh trust region) per search at most.
 CRAWL_SEARCHES = 8
 #: Secant steps of the profile search per crawl at most.
 PROFILE_STEPS = 12
@@ -171,12 +173,6 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
     return best
 
 
-#: Points per line search at most.
-LINE_POINTS = 4
-#: The line search's first point, as a fraction of the Gauss–Newton step.
-LINE_PROBE = 1e-3
-
-
 #: ... and that decrement is above this times s² (the point ≥ 0.014 standard errors from the
 #: optimum by the Gauss–Newton model: closer, the trust region's path left is short).
 CRAWL_DECREMENT = 1e-4
@@ -191,58 +187,3 @@ def crawling(best: list, decrement, s2: float) -> bool:
     old, now = best[-CRAWL_POINTS - 1], best[-1]
     dec = decrement(old)
     return dec > CRAWL_DECREMENT * s2 and old[6] - now[6] < CRAWL_GAIN * dec
-
-
-def line_search(pt, evaluate, lo, hi, count, stopped_at_budget):
-    """The cost's minimum along the Gauss–Newton step p from ``pt`` (engine tuple; the components
-    that would leave the box at a bound dropped) bent by its geodesic acceleration a (Transtrum &
-    Sethna 2012, arXiv:1201.5885): the curve z + t p + ½ t² a, a = −(JᵀJ)⁻¹Jᵀ r_pp, r_pp the
-    residuals' second derivative along p from the Jacobians at z and at a probe z + ε p
-    (ε = :data:`LINE_PROBE`).  A straight line leaves a curved valley at once (on the fluid load's
-    ν valley the cost rises by 0.02 at 1 % of the step); the curve follows it.  The first t is the
-    Newton estimate from the curve's second derivative |J p|² + rᵀ(r_pp + J a), then secant steps
-    on φ'(t) = ∇cost(c(t))·c'(t) (regula falsi once bracketed), at most :data:`LINE_POINTS` points
-    with the probe, ending when |φ'| falls below :data:`CRAWL_GAIN` of |φ'(0)|.  Points are clipped
-    to the box.  Returns the lowest point reached (``pt`` itself if none is lower)."""
-    z, r0, J0, step = pt[0], pt[1], pt[2], np.array(pt[5], dtype=float)
-    span = hi - lo
-    out = ((z - lo <= 1e-10 * span) & (step < 0)) | ((hi - z <= 1e-10 * span) & (step > 0))
-    step[out] = 0.0
-    d0 = float((J0.T @ r0) @ step)
-    if not d0 < 0 or stopped_at_budget():
-        return pt
-    count[0] += 1
-    probe = evaluate(np.clip(z + LINE_PROBE * step, lo, hi))
-    best = probe if probe[6] < pt[6] else pt
-    if probe[3] is not None:
-        return best
-    r_pp = (probe[2] @ step - J0 @ step) / LINE_PROBE
-    acc = -np.linalg.lstsq(J0, r_pp, rcond=None)[0]
-    acc[out] = 0.0
-    curv = -d0 + float(r0 @ (r_pp + J0 @ acc))
-    if not curv > 0:
-        return best
-    below, above = (0.0, d0), None          # the largest t with φ' < 0, the smallest with φ' >= 0
-    prev, t = (0.0, d0), min(-d0 / curv, 1.0)
-    for _ in range(LINE_POINTS - 1):
-        if stopped_at_budget():
-            break
-        count[0] += 1
-        new = evaluate(np.clip(z + t * step + 0.5 * t * t * acc, lo, hi))
-        if new[6] < best[6]:
-            best = new
-        if new[3] is not None:
-            break
-        d = float((new[2].T @ new[1]) @ (step + t * acc))
-        if abs(d) <= CRAWL_GAIN * abs(d0):
-            break
-        if d < 0:
-            below = (t, d)
-        else:
-            above = (t, d)
-        if above is not None:           # bracketed: regula falsi
-            t_next = below[0] - below[1] * (above[0] - below[0]) / (above[1] - below[1])
-        else:                           # secant from the last two, at most four times further
-            t_next = min(t - d * (t - prev[0]) / (d - prev[1]) if d > prev[1] else 4.0 * t, 4.0 * t)
-        prev, t = (t, d), t_next
-    return best

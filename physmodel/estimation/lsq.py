@@ -37,6 +37,13 @@ Search and stopping (see ``_solve``)
     usually reaches an earlier optimum or converges there, for a third of the overhead of scipy's
     trust region, which rebuilds its model from an SVD every iteration); then — start 0 directly —
     scipy's trust-region reflective search.  The later starts' first points share one model call.
+    When the trust region crawls (:func:`~physmodel.estimation.lm_steps.crawling`: over
+    :data:`~physmodel.estimation.lm_steps.CRAWL_POINTS` points its best cost fell by less than a
+    tenth of the Gauss–Newton decrement it had, that decrement above 1e-4·s²) — a valley the data
+    barely determine, at a noise-size cost, where JᵀJ underrates the curvature along it and every
+    step leaves it (the viscous-fluid load's ν: 100-200 points for 1e-3 in cost) — the valley is
+    searched as a profile (:func:`~physmodel.estimation.lm_steps.profile_search`) and a fresh trust
+    region resumes from the lowest point.
     A start ends (status 1) when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
     below :data:`GN_DECREMENT`·s² (within 1.4e-6 standard errors of the optimum), or on scipy's
     tests.  A later start stops early (status −2, never chosen as best) once its cost is within
