@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["LM_STEPS", "damped_steps", "crawling", "profile_search", "CRAWL_POINTS", "CRAWL_GAIN", "CRAWL_DECREMENT",
-           "CRAWL_SEARCHES"]
+           "CRAWL_SEARCHES", "PROFILE_STEPS", "INNER_POINTS", "INNER_DECREMENT"]
 
 #: Damped steps a later start takes before handing over to scipy's trust region.
 LM_STEPS = 30
