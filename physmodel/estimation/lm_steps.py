@@ -1,12 +1,14 @@
 """Levenberg–Marquardt steps for the least-squares engine's later starts
-(:func:`physmodel.estimation.lsq.fit_parameters`), kept apart from :mod:`~physmodel.estimation.lsq`
-for its size."""
+(:func:`physmodel.estimation.lsq.fit_parameters`) and the profile search it runs when scipy's
+trust region crawls along a curved valley, kept apart from :mod:`~physmodel.estimation.lsq` for
+its size."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LM_STEPS", "damped_steps"]
+__all__ = ["LM_STEPS", "damped_steps", "crawling", "profile_search", "CRAWL_POINTS", "CRAWL_GAIN", "CRAWL_DECREMENT",
+           "CRAWL_SEARCHES", "PROFILE_STEPS", "INNER_POINTS", "INNER_DECREMENT"]
 
 #: Damped steps a later start takes before handing over to scipy's trust region.
 LM_STEPS = 30
@@ -52,3 +54,136 @@ def damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
         else:
             lam *= 4.0
     return pt
+
+
+#: The trust region is crawling when over this many of its points ...
+CRAWL_POINTS = 10
+#: ... its best cost fell by less than this fraction of the Gauss–Newton decrement predicted at
+#: the best point it had before them (a valley where the Gauss–Newton model's curvature is far
+#: below the cost's: the neglected Σ rᵢ∇²rᵢ, large along a direction the data barely determine).
+CRAWL_GAIN = 0.1
+#: Profile searches (each followed by a fresh trust region) per search at most.
+CRAWL_SEARCHES = 8
+#: Secant steps of the profile search per crawl at most.
+PROFILE_STEPS = 12
+#: Gauss–Newton points of one inner fit (the other coordinates at a fixed flat one) at most ...
+INNER_POINTS = 6
+#: ... ending when its decrement falls below this times s² (the trust region converges after).
+INNER_DECREMENT = 1e-9
+
+
+def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
+    """Where the trust region crawls, the cost is flat along one direction the data barely
+    determine and curved across it (the Gauss–Newton model's smallest eigenvalue against the
+    neglected Σ rᵢ∇²rᵢ), so every step that model proposes leaves the curved valley.  Search the
+    valley as a profile instead: the coordinate k most aligned with JᵀJ's flattest eigenvector
+    fixed, the others fitted by Gauss–Newton (well determined: a few points, :data:`INNER_POINTS`),
+    and k moved by secant steps on the profile's derivative, which at an inner optimum is the
+    gradient's k-th component (Jᵀr)_k (the envelope theorem), regula falsi once bracketed; the
+    first step ``moved`` (what the trust region moved k by while crawling) times four.  At most
+    :data:`PROFILE_STEPS` secant steps, ending when a step moves k by less than 1e-9 of its range,
+    at a point with a status (converged, joined) or at the budget; the inner fits end at a
+    decrement below :data:`INNER_DECREMENT`·s² (``s2`` the engine's s²).  Returns the lowest
+    point reached; the trust region resumes from it (and its tests end the search)."""
+    n = len(pt[0])
+    if n < 2:
+        return pt
+    A = pt[2].T @ pt[2]
+    w, V = np.linalg.eigh(A / np.sqrt(np.outer(np.diag(A), np.diag(A)) + 1e-300))
+    k = int(np.argmax(np.abs(V[:, 0])))
+    o = np.array([i for i in range(n) if i != k])
+    span = hi - lo
+    lo_in = lo + 1e-10 * np.maximum(1.0, np.abs(lo))
+    hi_in = hi - 1e-10 * np.maximum(1.0, np.abs(hi))
+
+    def inner(p):
+        """The other coordinates fitted by Gauss–Newton steps at p's k (halved when the cost rises)."""
+        for _ in range(INNER_POINTS):
+            if p[3] is not None or stopped_at_budget():
+                return p
+            r, go = p[1], p[2][:, o].T @ p[1]
+            zo = p[0][o]
+            held = ((zo - lo[o] <= 1e-8 * span[o]) & (go > 0)) | ((hi[o] - zo <= 1e-8 * span[o]) & (go < 0))
+            f = o[~held]                 # coordinates at a bound pushed outwards stay there
+            if not len(f):
+                return p
+            Jf = p[2][:, f]
+            try:
+                sf = np.linalg.solve(Jf.T @ Jf, -(Jf.T @ r))
+            except np.linalg.LinAlgError:
+                return p
+            if -0.5 * float((Jf.T @ r) @ sf) < INNER_DECREMENT * s2:
+                return p
+            for _ in range(2):
+                z = p[0].copy()
+                z[f] = np.clip(z[f] + sf, lo_in[f], hi_in[f])
+                if stopped_at_budget():
+                    return p
+                count[0] += 1
+                new = evaluate(z)
+                if new[6] < p[6] or new[3] is not None:
+                    p = new
+                    break
+                sf = 0.5 * sf
+            else:
+                return p
+        return p
+
+    def grad_k(p):
+        return float(p[2][:, k] @ p[1])
+
+    cur = inner(pt)
+    best = cur if cur[6] < pt[6] else pt
+    if cur[3] is not None:
+        return cur
+    g = grad_k(cur)
+    step = 4.0 * moved[k] if moved[k] * -g > 0 else -np.sign(g) * 1e-3 * (hi[k] - lo[k])
+    below = above = None             # (z_k, g) with g < 0 and with g > 0: the bracket
+    for _ in range(PROFILE_STEPS):
+        if g == 0 or stopped_at_budget():
+            break
+        if g < 0:
+            below = (cur[0][k], g)
+        else:
+            above = (cur[0][k], g)
+        if below is not None and above is not None:
+            zk = below[0] - below[1] * (above[0] - below[0]) / (above[1] - below[1])
+        else:
+            zk = cur[0][k] + step
+        zk = float(np.clip(zk, lo_in[k], hi_in[k]))
+        if abs(zk - cur[0][k]) <= 1e-9 * (hi[k] - lo[k]):
+            break
+        z = cur[0].copy()
+        z[k] = zk
+        count[0] += 1
+        new = inner(evaluate(z))
+        if new[3] is not None:
+            return new if new[6] < best[6] else best
+        if not new[6] < cur[6] and below is None or above is None and not new[6] < cur[6]:
+            break                        # the profile does not fall that way: leave it to the trust region
+        g_new = grad_k(new)
+        if below is None or above is None:      # secant on g, at most four times further
+            dz = new[0][k] - cur[0][k]
+            slope = (g_new - g) / dz if dz != 0 else 0.0
+            step = -g_new / slope if slope > 0 else 4.0 * dz
+            step = float(np.clip(step, -4.0 * abs(dz), 4.0 * abs(dz)))
+        cur, g = new, g_new
+        if cur[6] < best[6]:
+            best = cur
+    return best
+
+
+#: ... and that decrement is above this times s² (the point ≥ 0.014 standard errors from the
+#: optimum by the Gauss–Newton model: closer, the trust region's path left is short).
+CRAWL_DECREMENT = 1e-4
+
+
+def crawling(best: list, decrement, s2: float) -> bool:
+    """Whether the trust region crawls: ``best`` the lowest point reached after each of its
+    points (engine tuples, cost at index 6), ``decrement(pt)`` a point's Gauss–Newton decrement,
+    ``s2`` the engine's s²."""
+    if len(best) <= CRAWL_POINTS:
+        return False
+    old, now = best[-CRAWL_POINTS - 1], best[-1]
+    dec = decrement(old)
+    return dec > CRAWL_DECREMENT * s2 and old[6] - now[6] < CRAWL_GAIN * dec

@@ -37,6 +37,13 @@ Search and stopping (see ``_solve``)
     usually reaches an earlier optimum or converges there, for a third of the overhead of scipy's
     trust region, which rebuilds its model from an SVD every iteration); then — start 0 directly —
     scipy's trust-region reflective search.  The later starts' first points share one model call.
+    When the trust region crawls (:func:`~physmodel.estimation.lm_steps.crawling`: over
+    :data:`~physmodel.estimation.lm_steps.CRAWL_POINTS` points its best cost fell by less than a
+    tenth of the Gauss–Newton decrement it had, that decrement above 1e-4·s²) — a valley the data
+    barely determine, at a noise-size cost, where JᵀJ underrates the curvature along it and every
+    step leaves it (the viscous-fluid load's ν: 100-200 points for 1e-3 in cost) — the valley is
+    searched as a profile (:func:`~physmodel.estimation.lm_steps.profile_search`) and a fresh trust
+    region resumes from the lowest point.
     A start ends (status 1) when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
     below :data:`GN_DECREMENT`·s² (within 1.4e-6 standard errors of the optimum), or on scipy's
     tests.  A later start stops early (status −2, never chosen as best) once its cost is within
@@ -90,7 +97,7 @@ from .identifiability import (
     hold_record,
     refused_identifiability,
 )
-from .lm_steps import damped_steps
+from .lm_steps import CRAWL_POINTS, CRAWL_SEARCHES, crawling, damped_steps, profile_search
 from .observations import ScalarObservations
 from .records import (
     CalibrationResult,
@@ -229,6 +236,10 @@ class _Stop(Exception):
     """Ends scipy's search from inside the residual function."""
 
 
+class _Crawl(Exception):
+    """Ends scipy's search from inside the residual function: it crawls (``lm_steps.crawling``)."""
+
+
 def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatch, res, max_nfev, ftol,
            fd_step, optima: Sequence[_Fit] = (), first: tuple | None = None, damped: bool = True) -> _Fit:
     """Least squares over the ``active`` parameters of ``free`` in their scaled space (the others
@@ -245,7 +256,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     rows = ScaledRows(free, x_full, active)
     dof = res.size - len(act)
     cache: dict = {}
-    count, last = [0], [None]
+    count, last, searches = [0], [None], [0]
 
     def assess(z, r, J):
         """(status or None, message, Gauss–Newton step, cost, the start joined or None) of a point."""
@@ -278,12 +289,20 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         last[0] = cache[key]
         return cache[key]
 
+    best: list = []           # the trust region's lowest point after each of its points
+
     def fun(z):
         count[0] += 1
         pt = evaluate(z)
         if pt[3] is not None:
             raise _Stop()
+        best.append(pt if not best or pt[6] < best[-1][6] else best[-1])
+        if searches[0] < CRAWL_SEARCHES and crawling(best, decrement, 2.0 * best[-1][6] / max(dof, 1)):
+            raise _Crawl()
         return pt[1]
+
+    def decrement(pt):
+        return -0.5 * float((pt[2].T @ pt[1]) @ pt[5])
 
     stopped_at_budget = lambda: max_nfev is not None and count[0] >= max_nfev  # noqa: E731
     count[0] = 1
@@ -308,18 +327,37 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     if status is None and stopped_at_budget():
         status, msg = 0, f"stopped after {count[0]} function evaluations (max_nfev={max_nfev}) before converging"
     elif status is None:
-        count[0] -= 1              # scipy re-evaluates its start point (cached)
-        try:
-            sol = least_squares(fun, pt[0], jac=lambda z: evaluate(z)[2], bounds=(lo, hi), method="trf",
-                                x_scale=1.0, ftol=ftol, xtol=1e-10, gtol=1e-10,
-                                max_nfev=None if max_nfev is None else max(max_nfev - count[0], 1))
-            pt, status = evaluate(sol.x), int(sol.status)
-            msg = sol.message.rstrip(".") if sol.status > 0 else (
-                f"stopped after {count[0]} function evaluations (max_nfev={max_nfev}) before converging"
-                if sol.status == 0 else sol.message)
-        except _Stop:
-            pt = last[0]
-            status, msg = pt[3], pt[4]
+        while True:
+            count[0] -= 1              # scipy re-evaluates its start point (cached)
+            best.clear()
+            try:
+                sol = least_squares(fun, pt[0], jac=lambda z: evaluate(z)[2], bounds=(lo, hi), method="trf",
+                                    x_scale=1.0, ftol=ftol, xtol=1e-10, gtol=1e-10,
+                                    max_nfev=None if max_nfev is None else max(max_nfev - count[0], 1))
+                pt, status = evaluate(sol.x), int(sol.status)
+                msg = sol.message.rstrip(".") if sol.status > 0 else (
+                    f"stopped after {count[0]} function evaluations (max_nfev={max_nfev}) before converging"
+                    if sol.status == 0 else sol.message)
+            except _Stop:
+                pt = last[0]
+                status, msg = pt[3], pt[4]
+            except _Crawl:
+                # the trust region crawls along a valley whose curvature the Gauss-Newton model
+                # underrates: a profile search along it (lm_steps.profile_search), then a fresh trust region
+                searches[0] += 1
+                pt = profile_search(best[-1], evaluate, lo, hi, count, stopped_at_budget,
+                                    best[-1][0] - best[-CRAWL_POINTS - 1][0],
+                                    2.0 * best[-1][6] / max(dof, 1))
+                status, msg = pt[3], pt[4]
+                if status is None and stopped_at_budget():
+                    status, msg = 0, (f"stopped after {count[0]} function evaluations (max_nfev={max_nfev}) "
+                                      "before converging")
+                if status is None:
+                    if pt is best[-1]:         # the search found nothing lower: no more searches
+                        searches[0] = CRAWL_SEARCHES
+                    cache[pt[0].tobytes()] = pt
+                    continue                   # its point is counted; the restart re-evaluates it (cached)
+            break
     z, r, J = pt[0], pt[1], pt[2]
     return _Fit(index=-1, z=z, cost=float(0.5 * r @ r), J=J, r=r, nfev=count[0], status=status, message=msg,
                 joined=pt[7] if status == -2 else None)

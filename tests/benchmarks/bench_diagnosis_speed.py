@@ -20,6 +20,68 @@ parameter sets predicted, batched model calls, least-squares fits, fit points (e
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 
+Measured 2026-11-26, fourth round (h-fluid: why the fluid-load strips' viscous_fluid refits run
+long; 2 cores shared by ~6 sessions): "before" = c0116c8 (main, exported to a plain folder),
+"after" = this branch, interleaved as in the third round::
+
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2 --roots BASE,. \
+        --cases 41005:added_fluid_mass,43103:added_fluid_mass,44102:added_fluid_mass,44105:added_fluid_mass,41000:none
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2 --roots BASE,. \
+        --cases 45101:added_fluid_mass,45102:added_fluid_mass,45103:added_fluid_mass,45104:added_fluid_mass
+
+    case                                  ipmc calibrate   ipmc diagnose CPU s   diagnose / calibrate
+                                          CPU s b / a      before    after        before   after
+    41005 added_fluid_mass                1.57 / 1.55      8.06      6.75         5.1x     4.3x
+    43103 added_fluid_mass                1.57 / 1.59     10.35      7.27         6.6x     4.6x
+    44102 added_fluid_mass                1.60 / 1.57     10.37      8.81         6.5x     5.6x
+    44105 added_fluid_mass                1.70 / 1.66      5.07      4.57         3.0x     2.8x
+    41000 none                            1.64 / 1.57      4.89      4.78         3.0x     3.0x
+    fresh fluid strips (not profiled on):
+    45101 added_fluid_mass                1.45 / 1.47      6.53      6.34         4.5x     4.3x
+    45102 added_fluid_mass                1.45 / 1.40      6.83      5.89         4.7x     4.2x
+    45103 added_fluid_mass                1.38 / 1.38      4.61      4.34         3.3x     3.2x
+    45104 added_fluid_mass                1.42 / 1.50      6.78      7.33         4.8x     4.9x
+
+Still above 5x: 44102 (5.6x).  Why the refits ran long (every start of ``_solve`` recorded on
+43103: its points, scipy's nfev/njev, the path in z and the Jacobian's column norms and
+condition): not the starts (six per candidate refit, as designed), not x_scale (``x_scale="jac"``
+took 270 points where 1.0 took 125 on the data refit, the same optimum), not a one-sided
+difference at a bound.  The trust region crawled: on the data's viscous_fluid refit it reached
+1.2e-3 above the optimum in 25 points and spent 100 more moving log10 ν by 0.28 (z 0.134 ->
+0.202, ξ and ωn following) for that 1.2e-3; condition of J 6e5, the √(ρ_f η) column 1e5 against
+ν's 1e3.  The Gauss–Newton step along the valley was 35x too long (its ν component 2.36 where
+the optimum was 0.06 away) — at a noise-size cost (s² ≈ 0.9) JᵀJ underrates the curvature along
+the direction the data barely determine (the neglected Σ rᵢ∇²rᵢ) — and the valley is curved, so
+even 1 % of that step raised the cost by 0.02: scipy's trust region rejected step after step.
+The later starts, which the engine stops when their Gauss–Newton step lands within 0.1 standard
+errors of an earlier optimum, crawled the same valley, where that step is wrong until the very
+end (they joined after 54-132 points, or ran into the 200-point budget: 705 of the refit's 830
+points).  Tried and dropped: a line search along the Gauss–Newton step (straight or bent by its
+geodesic acceleration: the valley leaves a straight line at once), Newton steps on a
+finite-difference Hessian (its differences of finite-difference gradients drown the valley's
+eigenvalue in round-off), a second crawl test (the decrement not halving in 10 points: more
+points on 43103 and 41005).  Taken (physmodel/estimation/lsq.py, lm_steps.py): when the trust
+region crawls (10 of its points gaining < 10 % of the Gauss–Newton decrement it had, that
+decrement > 1e-4·s²) the valley is searched as a profile — the coordinate most aligned with
+JᵀJ's flattest eigenvector fixed, the others fitted by Gauss–Newton, that coordinate moved by
+secant steps on (Jᵀr)_k (the profile's derivative) — and a fresh trust region resumes.  On a
+synthetic valley with a closed-form profile (tests/estimation/test_lsq_crawl.py) the engine
+before spent its 200-point budget 0.07-0.5 short of the optimum; after, 22-26 points to it.
+Fit points of a whole diagnosis (``metadata["profile"]``, before -> after): 41005 3978 -> 3141,
+43103 4897 -> 3619, 44102 5817 -> 4714, 44105 2375 -> 2079, 45102 3685 -> 3046, 45104 3429 ->
+3451, 41000 2598 -> 2594.
+
+Verdicts and names identical on all 22 cases compared (``diagnose()`` from both checkouts, same
+seeds): the speed cases 41000, 41009, 41038, 41003, 41005, 43103, 44101-44105, and the fluid
+detection set (independent ``added_fluid_mass``: 1020-1023 and 5015-5017, the bench_discrepancy
+plans ``--first-seed 1000 --n-per-label 4`` and ``--first-seed 5000 --n-per-label 3``, and
+45101-45104).  The numbers move at the fits' convergence level: candidate LRs by at most
+2.6e-7 on 20 of the 22 cases, 3.7e-5 on two (41038 distributed_cpe, 5017 viscous_fluid: fits
+that had stopped on scipy's ftol inside a crawl); the final model's cost by at most 1.3e-7.
+bench_discrepancy.py ``--generator independent --first-seed 1000 --n-per-label 4 --null 0
+--labels added_fluid_mass --workers 1 --no-real`` from both checkouts: the same four outcomes.
+The report files differ in those digits (the benchmark's number-by-number comparison says DIFFER).
+
 Measured 2026-11-26, third round (h-dspeed2: figures, the null scan, the CPE-order and fluid
 batches; 2 cores shared by ~6 sessions, load ~2): the commands as the issue measures them,
 child-process CPU, median over rounds.  "Before" = f5fe250 (this work's base, exported to a plain
