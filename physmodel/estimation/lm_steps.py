@@ -89,8 +89,17 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
     if n < 2:
         return pt
     A = pt[2].T @ pt[2]
-    w, V = np.linalg.eigh(A / np.sqrt(np.outer(np.diag(A), np.diag(A)) + 1e-300))
-    k = int(np.argmax(np.abs(V[:, 0])))
+    # k: the coordinate most aligned with JᵀJ's flattest direction in the engine's coordinates,
+    # among those the residuals depend on (a column of zeros — a parameter without effect — has an
+    # exact zero eigenvalue and would be chosen, with a zero gradient: no search).  Not on the
+    # correlation matrix D^-½ A D^-½: for two strongly correlated coordinates its flattest
+    # eigenvector is (1, 1)/√2 exactly, so the choice fell to the order of the parameters.
+    d = np.diag(A)
+    act = np.flatnonzero(d > 1e-12 * float(np.max(d))) if np.max(d) > 0 else np.zeros(0, dtype=int)
+    if len(act) < 2:
+        return pt
+    w, V = np.linalg.eigh(A[np.ix_(act, act)])
+    k = int(act[int(np.argmax(np.abs(V[:, 0])))])
     o = np.array([i for i in range(n) if i != k])
     span = hi - lo
     lo_in = lo + 1e-10 * np.maximum(1.0, np.abs(lo))

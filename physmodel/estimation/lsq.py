@@ -301,8 +301,26 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
             raise _Crawl()
         return pt[1]
 
+    span_b = hi - lo
+
     def decrement(pt):
-        return -0.5 * float((pt[2].T @ pt[1]) @ pt[5])
+        """The Gauss–Newton decrement with the coordinates at a bound that the gradient pushes
+        outwards held there (as the profile's inner fit holds them): unbounded, such a
+        coordinate's step promises a gain no point in the box can give, and the crawl test
+        fired at an optimum on a bound."""
+        z, r, J = pt[0], pt[1], pt[2]
+        g = J.T @ r
+        held = ((z - lo <= 1e-8 * span_b) & (g > 0)) | ((hi - z <= 1e-8 * span_b) & (g < 0))
+        if not np.any(held):
+            return -0.5 * float(g @ pt[5]) if pt[5] is not None else 0.0
+        f = np.flatnonzero(~held)
+        if not len(f):
+            return 0.0
+        try:
+            sf = np.linalg.lstsq(J[:, f], -r, rcond=None)[0]
+        except np.linalg.LinAlgError:
+            return 0.0
+        return -0.5 * float(g[f] @ sf)
 
     stopped_at_budget = lambda: max_nfev is not None and count[0] >= max_nfev  # noqa: E731
     count[0] = 1

@@ -35,17 +35,23 @@ def _problem(seed):
     a0 = grid[int(np.argmin([profile(a) for a in grid]))]
     o = minimize_scalar(profile, bounds=(max(a0 - 1e-3, 0.0), min(a0 + 1e-3, 1.0)), method="bounded",
                         options={"xatol": 1e-12})
-    return residuals, float(o.x), float(o.fun)
+    return residuals, float(o.x), float(o.fun), profile
 
 
-@pytest.mark.parametrize("seed", [1, 4, 6])
-def test_a_crawling_trust_region_reaches_the_valleys_optimum(seed):
-    residuals, a_opt, cost_opt = _problem(seed)
+@pytest.mark.parametrize("order", ["ab", "ba"])
+@pytest.mark.parametrize("seed", range(12))
+def test_a_crawling_trust_region_reaches_the_valleys_optimum(seed, order):
+    # both orders of the parameters: the coordinate the profile holds must not depend on it
+    # (review: on the correlation matrix it did, by an exact tie)
+    residuals, a_opt, cost_opt, profile = _problem(seed)
     obs = ScalarObservations(values=np.ones(M + 1), sigma_ln=np.ones(M + 1))     # r = ln(model) = residuals
-    free = [FreeParameter("a", 0.0, 1.0, "linear", 0.1), FreeParameter("b", -2.0, 2.0, "linear", 0.0)]
-    res = fit_parameters(obs, None, free, predict_array=lambda X: np.exp(residuals(X)), identify=False,
+    pa, pb = FreeParameter("a", 0.0, 1.0, "linear", 0.1), FreeParameter("b", -2.0, 2.0, "linear", 0.0)
+    free, cols = ([pa, pb], [0, 1]) if order == "ab" else ([pb, pa], [1, 0])
+    res = fit_parameters(obs, None, free, predict_array=lambda X: np.exp(residuals(X[:, cols])), identify=False,
                          hold_undetermined=False, max_nfev=60)
-    # before the profile search: 200 points (the budget) and a 0.07-0.5 short of the optimum
+    # before the profile search: seeds 1, 4, 6 ran to the budget (200 points) 0.07-0.5 short of the optimum
     assert res.converged, res.message
-    assert res.values["a"] == pytest.approx(a_opt, abs=1e-5)
     assert res.cost == pytest.approx(cost_opt, abs=1e-8)
+    # a is as well determined as the cost makes it (its standard error is ~10 here): the returned a
+    # lies where the closed-form profile is within the same 1e-8 of its minimum
+    assert profile(res.values["a"]) <= cost_opt + 1e-8, (res.values["a"], a_opt)
