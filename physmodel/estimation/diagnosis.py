@@ -302,6 +302,12 @@ class Diagnosis:
             notes.append(f"this file is the model of {q_model}; {', '.join(held_off)} acted only on "
                          + "; ".join(f"{e}: {', '.join(self.metadata['acts_on'][e])}" for e in held_off)
                          + " in the diagnosis and is left out")
+        if self.verdict == "unexplained" and verdict.adequate:
+            # the gap test (α/GAP_ALPHA_DIVISOR) found a gap no candidate closes while the χ² test at
+            # GOF_ALPHA passes: the file says what the diagnosis found, so every later command says it
+            lead.append("unexplained: a significant gap remains that no candidate effect closes "
+                        "(the diagnosis's gap test); the χ² test alone passes")
+            verdict = _replace(verdict, adequate=False)
         bad = [r for r in self.per_quantity if r.get("misfit")]
         if bad:                             # a misfit in one quantity is a misfit of the model, said first
             lead.append("a misfit remains in " + "; ".join(

@@ -256,3 +256,19 @@ def test_cli_names_the_file_whose_noise_cannot_weight_a_fit(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "Zzero.csv" in err and "standard deviations must be > 0" in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_an_unexplained_verdict_makes_the_model_file_say_it_does_not_fit():
+    # the gap test (α/5) can find a gap no candidate closes while the χ² test (GOF_ALPHA) passes:
+    # the model file then says "unexplained", not "fits", so later commands and the exit code say it
+    from dataclasses import replace
+
+    M, Z, truth = make_joint_case(8410, "none")          # a null strip: the χ² test passes
+    d = _diag(M, truth, 8410)
+    assert d.verdict == "none"
+    fits = d.to_model_file().verdict
+    assert fits.adequate
+    said = replace(d, verdict="unexplained").to_model_file().verdict
+    assert not said.adequate and said.diagnosis == "unexplained"
+    assert said.reason.startswith("unexplained: a significant gap remains")
+    assert fits.reason in said.reason                     # the χ² test's own sentence is kept
