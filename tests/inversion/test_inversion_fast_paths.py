@@ -90,7 +90,10 @@ def test_long_previews_keep_the_transfer_function_fused_pass_and_equal_the_windo
 
     e = truncation_error(split, dt, u, n_prev)
     e_ref = _truncation_oracle(split, dt, n_prev, u)
-    np.testing.assert_allclose(e, e_ref, rtol=0, atol=1e-11 * np.max(np.abs(e_ref)))
+    # to the tail filter's guaranteed 1e-10 (its frequency response against the exact one,
+    # inversion._discrete's check) of the error's own peak: measured 2.3e-11 on numpy 1.24 /
+    # scipy 1.13 and below 1e-11 on numpy 2.4 (this line held 1e-11 until the lowest-versions CI job)
+    np.testing.assert_allclose(e, e_ref, rtol=0, atol=1e-10 * np.max(np.abs(e_ref)))
 
 
 def _truncation_oracle(split, dt, n_prev, u):

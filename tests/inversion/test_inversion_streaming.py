@@ -33,8 +33,17 @@ def _stream(inv, u, sizes):
     return np.concatenate(outs)
 
 
+#: What the two implementations guarantee: every filter of a plan matches its exact frequency response
+#: to 1e-10 (relative; inversion._discrete's check), so streaming and batch agree to that, not to
+#: round-off.  Measured at a 3-sample preview (the largest difference): 1.4e-13 at f5fe250, 4.5e-13
+#: (numpy 2.4) and 1.1e-12 (numpy 1.24) since the fused pass's transfer function is built from the
+#: unit rows' numerators (FOHFilter.with_row, the speed/accuracy trade in CHANGELOG); this test held
+#: 1e-12 until the lowest-versions CI job measured 1.13e-12.
+AGREEMENT = 1e-10
+
+
 def _close(a, b):
-    np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.max(np.abs(b)))
+    np.testing.assert_allclose(a, b, rtol=0, atol=AGREEMENT * np.max(np.abs(b)))
 
 
 @pytest.mark.parametrize("preview", ["4/r0", 0.01, 0.05, 0.5], ids=["auto", "fir", "blocks50", "blocks500"])
