@@ -11,7 +11,11 @@
    evaluations on the same 500 lines (``ActuatorModel(base).frequency_response(FREQS, TEMPS)``,
    100 calls), interleaved in one interpreter, medians over the rounds (goal <= 1.14).  Measured
    2026-11-26 (2 shared cores, 30 rounds, two runs each): before (d968249) 1.209 / 1.219, after
-   1.047 / 1.044 (4-start estimates bit for bit equal on 8 noise draws);
+   1.047 / 1.044 (4-start estimates bit for bit equal on 8 noise draws).  Re-measured 2026-11-26
+   late (session 10, ``--ratio 7``): 1.65 on main (27.6 ms vs 16.8 ms) and 1.65 on f5fe250
+   (28.0 vs 17.0 ms) — the goal is no longer met: the model-layer speed-ups of the diagnosis
+   work made the denominator (single evaluations) faster, not the calibration's per-point
+   bookkeeping (the model kernel is ~12 ms of the 27.6);
 5. ``--speed PAIRS --root OTHER``: wall time of the calibrations above against another checkout
    (e.g. the commit before the speed work), paired and interleaved: each pair runs one fresh
    interpreter per checkout (order alternating), each times ``--reps`` calls after one warm-up
