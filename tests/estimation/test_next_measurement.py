@@ -10,14 +10,13 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from next_measurement_cases import TAU, virtual_lab_record
 
 from physmodel import get_parameter_set, physics_model
 from physmodel.data.sweep import FrequencySweep
 from physmodel.errors import IPMCError
 from physmodel.estimation import next_measurement as nmod
 from physmodel.estimation.next_measurement import merge_records, next_measurement
-
-TAU = 2e-4          # the hidden amplifier pole [s]: corner 796 Hz
 
 
 def test_batched_criterion_matches_direct_least_squares():
@@ -70,15 +69,7 @@ def ambiguous():
     """The scenario's first record (virtual lab, hidden amplifier pole, 10–100 Hz) and its diagnosis
     between time_delay and amplifier_bandwidth (quick null)."""
     from physmodel.estimation.discrepancy import diagnose
-    from scenarios.steps_next_measurement import InstrumentModel
-    from scenarios.virtual_lab import from_config
-
-    p = get_parameter_set("seed000_sensor_dev", T_ref=308.15)
-    truth = InstrumentModel(physics_model("sensor", p), {"amplifier_bandwidth": {"time_constant": TAU}})
-    design = dict(source="virtual_lab", temperatures_c=[35.0], fmin_hz=10.0, fmax_hz=100.0, points=31,
-                  excitation="multisine", fs_hz=5000.0, period_s=1.0, periods=8, transient_periods=2, rms=1.0,
-                  oversample=8)
-    rec = from_config(truth, design, {"kind": "time", "output_noise_rms": 3e-6, "seed": 5}).sweep
+    p, truth, rec = virtual_lab_record()
     d = diagnose(rec, p, kind="sensor", free=("a0", "d", "kappa_e"), candidates=["time_delay", "amplifier_bandwidth"],
                  null_draws=400, null_refits=0, seed=0)
     return SimpleNamespace(p=p, truth=truth, rec=rec, d=d)

@@ -7,30 +7,22 @@ lab then measures the recommendation."""
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from next_measurement_cases import independent
 
 from physmodel import get_parameter_set
 from physmodel.data.sweep import FrequencySweep
 from physmodel.estimation.discrepancy import diagnose
 from physmodel.estimation.next_measurement import merge_records, next_measurement
 
-ROOT = Path(__file__).resolve().parents[2]
 CANDS = ["amplifier_bandwidth", "time_delay", "transimpedance"]
 
 
 @pytest.fixture(scope="module")
 def gen():
-    sys.path.insert(0, str(ROOT / "tests" / "discrepancy"))
-    try:
-        import independent_sensor
-        import joint_cases
-    finally:
-        sys.path.remove(str(ROOT / "tests" / "discrepancy"))
-    return independent_sensor, joint_cases
+    return independent("independent_sensor"), independent("joint_cases")
 
 
 def test_joint_record_search_and_the_lab_confirms(gen):

@@ -8,32 +8,21 @@ op-amp stage hidden in it, runs the bath step it recommends."""
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from next_measurement_cases import independent, virtual_lab_record
 
 from physmodel import get_parameter_set, physics_model
 from physmodel.estimation.discrepancy import diagnose
 from physmodel.estimation.next_measurement import merge_records, next_measurement
-
-TAU = 2e-4          # the hidden amplifier pole [s]: corner 796 Hz
 
 
 @pytest.fixture(scope="module")
 def three_way():
     """The scenario's first virtual-lab record (hidden single amplifier pole, 10-100 Hz, 35 °C)
     diagnosed among time_delay, amplifier_bandwidth and transimpedance (quick null)."""
-    from scenarios.steps_next_measurement import InstrumentModel
-    from scenarios.virtual_lab import from_config
-
-    p = get_parameter_set("seed000_sensor_dev", T_ref=308.15)
-    truth = InstrumentModel(physics_model("sensor", p), {"amplifier_bandwidth": {"time_constant": TAU}})
-    design = dict(source="virtual_lab", temperatures_c=[35.0], fmin_hz=10.0, fmax_hz=100.0, points=31,
-                  excitation="multisine", fs_hz=5000.0, period_s=1.0, periods=8, transient_periods=2, rms=1.0,
-                  oversample=8)
-    rec = from_config(truth, design, {"kind": "time", "output_noise_rms": 3e-6, "seed": 5}).sweep
+    p, _, rec = virtual_lab_record()
     return diagnose(rec, p, kind="sensor", free=("a0", "d", "kappa_e"),
                     candidates=["time_delay", "amplifier_bandwidth", "transimpedance"], null_draws=400,
                     null_refits=0, seed=0)
@@ -69,17 +58,9 @@ def test_a_nested_pair_does_not_hide_the_experiment_that_separates_the_others(th
 
 
 # ------------------------------------------------------------------ a bath step, checked on the independent sensor
-ROOT = Path(__file__).resolve().parents[2]
-
-
 @pytest.fixture(scope="module")
 def isn():
-    sys.path.insert(0, str(ROOT / "tests" / "discrepancy"))
-    try:
-        import independent_sensor
-    finally:
-        sys.path.remove(str(ROOT / "tests" / "discrepancy"))
-    return independent_sensor
+    return independent("independent_sensor")
 
 
 def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
