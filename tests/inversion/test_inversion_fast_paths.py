@@ -20,9 +20,10 @@ G35 = seed000_sensor_35c("coefficients")
 CLUSTERED = (np.poly([20.0, -10.0, -12.0, -15.0]), np.poly([-100.0, -120.0, -150.0, -180.0]))
 
 
-def _window_sum_oracle(split, dt, n_prev, u):
-    """y_u[k] = C_r sum_{i=k}^{k+N-1} Phi^(i-k) (alpha u_i + beta u_{i+1}), u = 0 past the end,
-    as x[k] - Phi^N x[k+N] of the explicit backward recursion x[k] = Phi x[k+1] + g_k."""
+def _backward_states(split, dt, n_prev, u):
+    """``(x, Phi, C_r)``: the states of the explicit backward recursion x[k] = Phi x[k+1] + g_k of the
+    anticausal part's first-order-hold discretisation (scipy's expm of the augmented matrix),
+    u = 0 past the end, x zero beyond it."""
     M, B, Cr = -split.A_u, split.B_u, -split.C_u
     m = M.shape[0]
     big = np.zeros((m + 2, m + 2))
@@ -35,6 +36,14 @@ def _window_sum_oracle(split, dt, n_prev, u):
     x = np.zeros((n + n_prev + 1, m))
     for k in range(n - 1, -1, -1):
         x[k] = Phi @ x[k + 1] + alpha * up[k] + beta * up[k + 1]
+    return x, Phi, Cr
+
+
+def _window_sum_oracle(split, dt, n_prev, u):
+    """y_u[k] = C_r sum_{i=k}^{k+N-1} Phi^(i-k) (alpha u_i + beta u_{i+1}), u = 0 past the end,
+    as x[k] - Phi^N x[k+N] of the explicit backward recursion."""
+    x, Phi, Cr = _backward_states(split, dt, n_prev, u)
+    n = u.size
     xbar = x[:n] - x[n_prev:n_prev + n] @ np.linalg.matrix_power(Phi, n_prev).T
     return xbar @ Cr
 
@@ -99,18 +108,8 @@ def test_long_previews_keep_the_transfer_function_fused_pass_and_equal_the_windo
 def _truncation_oracle(split, dt, n_prev, u):
     """e_N[k] = -(C_r Phi**N) x[k+N] from the explicit backward recursion (as in _window_sum_oracle,
     without its difference of two O(1) sums, which would bury an error of 1e-8 of them)."""
-    M, B, Cr = -split.A_u, split.B_u, -split.C_u
-    m = M.shape[0]
-    big = np.zeros((m + 2, m + 2))
-    big[:m, :m], big[:m, m], big[m, m + 1] = M * dt, B * dt, 1.0
-    E = sla.expm(big)
-    Phi, alpha = E[:m, :m], E[:m, m + 1]
-    beta = E[:m, m] - alpha
+    x, Phi, Cr = _backward_states(split, dt, n_prev, u)
     n = u.size
-    up = np.append(u, 0.0)
-    x = np.zeros((n + n_prev + 1, m))
-    for k in range(n - 1, -1, -1):
-        x[k] = Phi @ x[k + 1] + alpha * up[k] + beta * up[k + 1]
     return -(x[n_prev:n_prev + n] @ (Cr @ np.linalg.matrix_power(Phi, n_prev)))
 
 
