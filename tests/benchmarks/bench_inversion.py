@@ -79,18 +79,8 @@ def bench_batch(n: int, reps: int) -> None:
 
 
 def _thread_medians(fns: dict, reps: int) -> dict:
-    """Median thread CPU time [s] of each callable over ``reps`` interleaved rounds (CPU time of
-    this thread: on a shared machine the wall time also counts the time other processes run)."""
-    import gc
-
-    times: dict = {k: [] for k in fns}
-    for _ in range(reps):
-        for k, f in fns.items():
-            gc.collect()
-            t0 = time.thread_time()
-            f()
-            times[k].append(time.thread_time() - t0)
-    return {k: float(np.median(v)) for k, v in times.items()}
+    """Median thread CPU time [s] of each callable over ``reps`` interleaved rounds."""
+    return interleaved(fns, reps, clock=time.thread_time)
 
 
 def bench_floor(n: int, reps: int) -> None:

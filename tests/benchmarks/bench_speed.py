@@ -562,16 +562,7 @@ CLOCK = {"name": "wall"}
 def _median_interleaved(fns: dict, reps: int) -> dict:
     from _timing import interleaved
 
-    if CLOCK["name"] == "wall":
-        return interleaved(fns, reps)
-    times: dict = {k: [] for k in fns}
-    for _ in range(reps):
-        for k, f in fns.items():
-            gc.collect()
-            t0 = time.thread_time()
-            f()
-            times[k].append(time.thread_time() - t0)
-    return {k: float(np.median(v)) for k, v in times.items()}
+    return interleaved(fns, reps, clock=time.perf_counter if CLOCK["name"] == "wall" else time.thread_time)
 
 
 def stream_section(args):
