@@ -179,6 +179,19 @@ class TemperatureLaws:
     C_minus: _Law = field(default_factory=Constant)
     h: _Law = field(default_factory=Constant)
 
+    def describe(self) -> str:
+        """One clause per non-constant law, e.g. ``d Arrhenius(activation_energy=15000); E
+        LogLinear(slope=-0.0075)`` (reports, and the premise of a recommended bath step)."""
+        parts = []
+        for f in fields(self):
+            law = getattr(self, f.name)
+            kind = type(law).__name__
+            if kind == "Constant":
+                continue
+            args = ", ".join(f"{k.name}={getattr(law, k.name):g}" for k in fields(law) if k.name != "valid_c")
+            parts.append(f"{f.name} {kind}({args})")
+        return "; ".join(parts) if parts else "every parameter constant (isothermal)"
+
     def factors(self, T_K, T_ref_K) -> dict[str, np.ndarray]:
         """Multiplicative factors for every law parameter at temperatures ``T_K`` [K].
 

@@ -524,21 +524,6 @@ def _g(x) -> str:
     return "–" if x is None or not math.isfinite(x) else f"{x:.3g}"
 
 
-def describe_laws(laws) -> str:
-    """One line per non-constant law, e.g. ``d Arrhenius(activation_energy=15000)``."""
-    from dataclasses import fields
-
-    parts = []
-    for f in fields(laws):
-        law = getattr(laws, f.name)
-        kind = type(law).__name__
-        if kind == "Constant":
-            continue
-        args = ", ".join(f"{k.name}={getattr(law, k.name):g}" for k in fields(law) if k.name != "valid_c")
-        parts.append(f"{f.name} {kind}({args})")
-    return "; ".join(parts) if parts else "every parameter constant (isothermal)"
-
-
 def resolve_laws(base, laws):
     """``(base with the chosen laws, a sentence stating the choice)``.
 
@@ -553,14 +538,14 @@ def resolve_laws(base, laws):
 
     named = {"isothermal": ISOTHERMAL, "default": TemperatureLaws(), "set": None}
     if laws is None:
-        return base, f"those of the parameter set {base.name!r}: {describe_laws(base.laws)}"
+        return base, f"those of the parameter set {base.name!r}: {base.laws.describe()}"
     if isinstance(laws, TemperatureLaws):
-        return replace(base, laws=laws), f"given: {describe_laws(laws)}"
+        return replace(base, laws=laws), f"given: {laws.describe()}"
     if isinstance(laws, str):
         if laws not in named:
             raise ParameterError(f"laws = {laws!r}; expected one of {sorted(named)}, a table of laws, or TemperatureLaws")
         chosen = named[laws] or base.laws
-        return replace(base, laws=chosen), f"{laws!r}: {describe_laws(chosen)}"
+        return replace(base, laws=chosen), f"{laws!r}: {chosen.describe()}"
     if isinstance(laws, Mapping):
         spec = dict(laws)
         start = spec.pop("base", "set")
@@ -578,7 +563,7 @@ def resolve_laws(base, laws):
             chosen = TemperatureLaws.from_dict(cur)
         except TypeError as exc:
             raise ParameterError(f"laws: {exc}") from None
-        return replace(base, laws=chosen), f"{start!r} with changes: {describe_laws(chosen)}"
+        return replace(base, laws=chosen), f"{start!r} with changes: {chosen.describe()}"
     raise ParameterError(f"laws must be None, a name, a mapping or TemperatureLaws; got {type(laws).__name__}")
 
 

@@ -443,23 +443,6 @@ def _inseparable_note(same_form: list, same_refit: list) -> str:
     return out
 
 
-def laws_in_play(laws) -> str:
-    """The non-constant temperature laws of ``laws`` (a ``TemperatureLaws``), e.g. ``d
-    Arrhenius(activation_energy=15000); E LogLinear(slope=-0.0075)`` — the format of the diagnosis
-    report's "Temperature laws" line (``diagnosis.describe_laws``, not imported: diagnosis imports
-    this module)."""
-    from dataclasses import fields
-
-    parts = []
-    for f in fields(laws):
-        law = getattr(laws, f.name)
-        if type(law).__name__ == "Constant":
-            continue
-        args = ", ".join(f"{k.name}={getattr(law, k.name):g}" for k in fields(law) if k.name != "valid_c")
-        parts.append(f"{f.name} {type(law).__name__}({args})")
-    return "; ".join(parts) if parts else "every parameter constant (isothermal)"
-
-
 def temperature_premise(r, record_temperatures_c, base) -> str:
     """The premise of a recommended experiment ``r`` that steps the bath away from the record's
     temperatures: its separation is predicted through the diagnosed model's temperature laws (those
@@ -471,7 +454,7 @@ def temperature_premise(r, record_temperatures_c, base) -> str:
     if not new:
         return ""
     laws = getattr(base, "laws", None)
-    said = laws_in_play(laws) if laws is not None else "the parameter set's"
+    said = laws.describe() if laws is not None else "the parameter set's"
     at = ", ".join(f"{t:g}" for t in np.unique(np.asarray(record_temperatures_c, float)))
     return (f"Premise: this experiment steps the bath to {', '.join(f'{t:g}' for t in new)} °C (the record: {at} "
             f"°C), so its separation relies on the diagnosed model's temperature laws ({said}); a misfit at the "
@@ -531,6 +514,6 @@ def _temperature_limits(limits, base) -> tuple[float, float, str]:
 
 
 __all__ = ["CandidateMeasurement", "NextMeasurement", "competing_models", "json_ready", "merge_records",
-           "next_measurement", "laws_in_play", "temperature_premise", "MAX_BATH_C",
+           "next_measurement", "temperature_premise", "MAX_BATH_C",
            "PERIODS", "BATH_SETTLE_S", "SAME_FORM_LAMBDA", "REFIT_STARTS", "FD_RELATIVE_STEP",
            "DEFAULT_BAND_LIMITS_HZ", "DEFAULT_LEVELS", "DEFAULT_TEMPERATURE_LIMITS_C"]

@@ -97,10 +97,7 @@ def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
     new_t = sorted(set(r.temperatures_c) - {35.0})
     assert nm.premise and nm.premise in nm.message and nm.to_dict()["premise"] == nm.premise
     assert "activation_energy=15000" in nm.premise and "slope=-0.0075" in nm.premise
-    from physmodel.estimation.diagnosis import describe_laws
-    from physmodel.estimation.next_measurement import laws_in_play
-
-    assert laws_in_play(p0.laws) == describe_laws(p0.laws) and laws_in_play(p0.laws) in nm.premise   # as the report
+    assert p0.laws.describe() in nm.premise          # as the diagnosis report's "Temperature laws" line
     assert "laws, not the effect, may be wrong" in nm.premise
     assert all(f"{t:g}" in nm.premise.split("(the record")[0] for t in new_t)
     # measure it: the independent sensor at the recommended lines and bath temperatures, fresh noise
