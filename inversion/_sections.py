@@ -3,6 +3,7 @@ and the factored fused finite-preview pass (see :mod:`inversion._discrete`)."""
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -151,6 +152,13 @@ class FusedPass:
 #: Largest number of denominator coefficients (the order) :func:`polynomial_denominator` searches.
 POLY_MAX_ORDER = 8
 
+#: Largest probe of :func:`_running_error_ok` [samples]; slower poles keep the sections.
+PROBE_MAX = 1 << 15
+
+#: The unit-circle test points of ``FOHFilter`` (as ``1/z``): a logarithmic grid down to 1e-7 of
+#: the Nyquist frequency, and z = 1.
+_ZINV = 1.0 / np.exp(1j * np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0])))
+
 
 def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact: list) -> np.ndarray | None:
     """The all-pole cascade ``sos`` as one denominator polynomial ``a`` (ascending powers of 1/z)
@@ -163,18 +171,42 @@ def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact:
     order one (at 20 kHz, ``a(1)`` is 2.9e-6 of coefficients up to 2.9): rounding each
     coefficient to the nearest double leaves ~1e-10 of ``a(1)``, and evaluating the check in
     double adds as much again (so the single transfer function of ``FOHFilter.build`` fails it).
-    Here the exact coefficients are the product of the sections in extended precision
-    (``np.longdouble``), the doubles within 2 ulp of them (1 ulp beyond order 4) that best match
-    the exact denominator at the test points are chosen (the rounding errors of the coefficients
-    then partly cancel where the polynomial is small: 1.6e-11 instead of 9.2e-11 at 20 kHz), and
-    the check is evaluated in extended precision too.  The check bounds the coefficients, not
-    the rounding while the recursion runs: that is probed against the sections
-    (:func:`_running_error_ok`).  Where ``np.longdouble`` is no wider than double (the check could
-    not see the error it is meant to bound), the order is above :data:`POLY_MAX_ORDER` or the
-    probe fails (the seed 000 sensor at 50 and 100 kHz), None: the sections are kept.
+    Here (:func:`_rounded_denominator`) the exact coefficients are the product of the sections
+    in extended precision (``np.longdouble``), the doubles within 2 ulp of them (1 ulp beyond
+    order 4) that best match the exact denominator at the test points are chosen (the rounding
+    errors of the coefficients then partly cancel where the polynomial is small: 1.6e-11 instead
+    of 9.2e-11 at 20 kHz), and the check is evaluated in extended precision too.  The check
+    bounds the coefficients, not the rounding while the recursion runs: that is probed against
+    the sections (:func:`_running_error_ok`).  Where ``np.longdouble`` is no wider than double
+    (the check could not see the error it is meant to bound), the order is above
+    :data:`POLY_MAX_ORDER`, the probe would be longer than :data:`PROBE_MAX` or fails (the seed
+    000 sensor at 50 and 100 kHz), None: the sections are kept.
     """
     if any(len(f) != 1 for f in firs) or np.finfo(np.longdouble).eps > 1e-18:
         return None
+    sos = np.ascontiguousarray(sos, dtype=float)
+    found = _rounded_denominator(sos.tobytes(), sos.shape[0])
+    if found is None:
+        return None
+    a = np.array(found)
+    ld = np.longdouble
+    zl = np.asarray(zinv, dtype=np.clongdouble)
+    den = _horner(a.astype(ld), zl)
+    for fir, ex in zip(firs, exact):
+        val = (_horner(np.asarray(fir[0], dtype=ld), zl) / den).astype(complex)
+        scale = float(np.max(np.abs(ex)))
+        if not np.all(np.abs(val - ex) <= 1e-10 * np.maximum(np.abs(ex), 1e-3 * scale)):
+            return None
+    return a
+
+
+@functools.lru_cache(maxsize=32)
+def _rounded_denominator(sos_bytes: bytes, n_sections: int) -> tuple[float, ...] | None:
+    """The best-rounded double polynomial of the all-pole sections (see
+    :func:`polynomial_denominator`) if its recursion passes :func:`_running_error_ok`, else None.
+    It depends on the poles only (not on the preview's numerator), so it is kept per cascade: a
+    plan for another preview at the same sampling interval does not search and probe again."""
+    sos = np.frombuffer(sos_bytes, dtype=float).reshape(n_sections, 6).copy()
     ld = np.longdouble
     exact_den = np.ones(1, dtype=ld)
     for r in sos:
@@ -185,37 +217,22 @@ def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact:
         return None
     nearest = exact_den.astype(float)
     span = 2 if m <= 4 else 1
-    steps = np.arange(-span, span + 1)
     # every combination of -span..span ulp steps on coefficients 1..m (the leading 1 is exact)
-    grid = np.stack(np.meshgrid(*([steps] * m), indexing="ij"), axis=-1).reshape(-1, m)
+    grid = np.stack(np.meshgrid(*([np.arange(2 * span + 1)] * m), indexing="ij"), axis=-1).reshape(-1, m)
     cand = np.empty((grid.shape[0], m + 1))
     cand[:, 0] = 1.0
     for i in range(m):
         c = nearest[i + 1]
-        ups = [c]
+        ups, downs = [c], [c]
         for _ in range(span):
             ups.append(np.nextafter(ups[-1], np.inf))
-        downs = [c]
-        for _ in range(span):
             downs.append(np.nextafter(downs[-1], -np.inf))
-        table = np.array(downs[:0:-1] + ups)          # index 0 .. 2 span for -span .. +span
-        cand[:, i + 1] = table[grid[:, i] + span]
-    zl = np.asarray(zinv, dtype=np.clongdouble)
+        cand[:, i + 1] = np.array(downs[:0:-1] + ups)[grid[:, i]]     # -span .. +span ulp
+    zl = _ZINV.astype(np.clongdouble)
     ref = _horner(exact_den, zl)
     err = np.max(np.abs(_horner(cand.astype(ld).T, zl[:, None]) / ref[:, None] - 1.0), axis=0)
-    a = cand[int(np.argmin(err))]
-    den = _horner(a.astype(ld), zl)
-    for fir, ex in zip(firs, exact):
-        val = (_horner(np.asarray(fir[0], dtype=ld), zl) / den).astype(complex)
-        scale = float(np.max(np.abs(ex)))
-        if not np.all(np.abs(val - ex) <= 1e-10 * np.maximum(np.abs(ex), 1e-3 * scale)):
-            return None
-    a = np.ascontiguousarray(a)
-    return a if _running_error_ok(a, sos) else None
-
-
-#: Largest probe of :func:`_running_error_ok` [samples]; slower poles keep the sections.
-PROBE_MAX = 1 << 16
+    a = np.ascontiguousarray(cand[int(np.argmin(err))])
+    return tuple(float(v) for v in a) if _running_error_ok(a, sos) else None
 
 
 def _running_error_ok(a: np.ndarray, sos: np.ndarray) -> bool:
@@ -226,10 +243,11 @@ def _running_error_ok(a: np.ndarray, sos: np.ndarray) -> bool:
     the seed 000 polynomial passes the check at 1.0e-11 but runs 3-4e-10 off the explicit
     recursion).  A step is where the rounding errors add up coherently (a constant input repeats
     the same rounding), a random walk a slowly varying input; each runs 20 time constants of
-    the slowest pole (at least 2,000 samples); half of 1e-10 is the margin for other signals.
-    Measured for the seed 000 sensor at 20 kHz: 2.1e-11 (step) and 1.5e-11 (walk) here, and
-    2.5e-11 at most against an explicit extended-precision recursion on 2**21-sample records."""
-    rho = float(np.max(np.abs(np.roots(a)))) if a.size > 1 else 0.0
+    the slowest pole (at least 2,000 samples, at most :data:`PROBE_MAX`: slower poles fail);
+    half of 1e-10 is the margin for other signals.  Measured for the seed 000 sensor at 20 kHz:
+    2.1e-11 (step) and 1.5e-11 (walk) here, and 2.5e-11 at most against an explicit
+    extended-precision recursion on 2**21-sample records."""
+    rho = float(np.max(np.abs(np.roots(a))))
     if not rho < 1.0:
         return False
     length = 20.0 / (1.0 - rho)
