@@ -11,7 +11,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.signal as sig
 
-__all__ = ["FusedPass", "sos_sections", "polynomial_denominator", "POLY_MAX_ORDER"]
+__all__ = ["FusedPass", "sos_sections", "polynomial_denominator", "best_rounded_polynomial", "running_error_ok",
+           "all_pole_sections", "POLY_MAX_ORDER", "PROBE_MAX"]
 
 
 def sos_sections(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray,
@@ -37,7 +38,7 @@ def sos_sections(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: 
     return np.ascontiguousarray(sig.zpk2sos(zeros, poles, k))
 
 
-def _all_pole_sections(poles: np.ndarray) -> np.ndarray:
+def all_pole_sections(poles: np.ndarray) -> np.ndarray:
     """Second-order sections ``1/((1 - p z^-1)(1 - p' z^-1))`` of the given poles: conjugate
     pairs together, real poles in pairs (one first-order section if their number is odd)."""
     upper = [p for p in poles if p.imag > 0]
@@ -112,7 +113,7 @@ class FusedPass:
         each numerator is one kernel and the cascade of poles has a double-precision polynomial
         accurate enough (:func:`polynomial_denominator`), the transfer-function form with that
         denominator (``lfilter``) instead of the sections (``sosfilt``)."""
-        sos = _all_pole_sections(_conjugate_clean(np.linalg.eigvals(f1.Phi)))
+        sos = all_pole_sections(_conjugate_clean(np.linalg.eigvals(f1.Phi)))
         firs = []
         theta = np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0]))
         zs = np.exp(1j * theta)
@@ -152,7 +153,7 @@ class FusedPass:
 #: Largest number of denominator coefficients (the order) :func:`polynomial_denominator` searches.
 POLY_MAX_ORDER = 8
 
-#: Largest probe of :func:`_running_error_ok` [samples]; slower poles keep the sections.
+#: Largest probe of :func:`running_error_ok` [samples]; slower poles keep the sections.
 PROBE_MAX = 1 << 15
 
 #: The unit-circle test points of ``FOHFilter`` (as ``1/z``): a logarithmic grid down to 1e-7 of
@@ -177,7 +178,7 @@ def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact:
     errors of the coefficients then partly cancel where the polynomial is small: 1.6e-11 instead
     of 9.2e-11 at 20 kHz), and the check is evaluated in extended precision too.  The check
     bounds the coefficients, not the rounding while the recursion runs: that is probed against
-    the sections (:func:`_running_error_ok`).  Where ``np.longdouble`` is no wider than double
+    the sections (:func:`running_error_ok`).  Where ``np.longdouble`` is no wider than double
     (the check could not see the error it is meant to bound), the order is above
     :data:`POLY_MAX_ORDER`, the probe would be longer than :data:`PROBE_MAX` or fails (the seed
     000 sensor at 50 and 100 kHz), None: the sections are kept.
@@ -203,10 +204,21 @@ def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact:
 @functools.lru_cache(maxsize=32)
 def _rounded_denominator(sos_bytes: bytes, n_sections: int) -> tuple[float, ...] | None:
     """The best-rounded double polynomial of the all-pole sections (see
-    :func:`polynomial_denominator`) if its recursion passes :func:`_running_error_ok`, else None.
+    :func:`polynomial_denominator`) if its recursion passes :func:`running_error_ok`, else None.
     It depends on the poles only (not on the preview's numerator), so it is kept per cascade: a
     plan for another preview at the same sampling interval does not search and probe again."""
     sos = np.frombuffer(sos_bytes, dtype=float).reshape(n_sections, 6).copy()
+    a = best_rounded_polynomial(sos)
+    if a is None:
+        return None
+    return tuple(float(v) for v in a) if running_error_ok(a, sos) else None
+
+
+def best_rounded_polynomial(sos: np.ndarray) -> np.ndarray | None:
+    """The double-precision denominator polynomial of the all-pole sections ``sos`` (ascending
+    powers of 1/z) closest to their exact product at the test points (see
+    :func:`polynomial_denominator`; no check of the running error), or None above
+    :data:`POLY_MAX_ORDER`."""
     ld = np.longdouble
     exact_den = np.ones(1, dtype=ld)
     for r in sos:
@@ -231,11 +243,10 @@ def _rounded_denominator(sos_bytes: bytes, n_sections: int) -> tuple[float, ...]
     zl = _ZINV.astype(np.clongdouble)
     ref = _horner(exact_den, zl)
     err = np.max(np.abs(_horner(cand.astype(ld).T, zl[:, None]) / ref[:, None] - 1.0), axis=0)
-    a = np.ascontiguousarray(cand[int(np.argmin(err))])
-    return tuple(float(v) for v in a) if _running_error_ok(a, sos) else None
+    return np.ascontiguousarray(cand[int(np.argmin(err))])
 
 
-def _running_error_ok(a: np.ndarray, sos: np.ndarray) -> bool:
+def running_error_ok(a: np.ndarray, sos: np.ndarray) -> bool:
     """The recursion ``lfilter(1, a)`` stays within half the 1e-10 guarantee of the sections
     ``sos`` (accurate to ~1e-13, measured) on a step and on a random walk, relative to the
     largest output: the check at the test points bounds the coefficients, not the rounding
