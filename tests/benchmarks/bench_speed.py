@@ -122,6 +122,37 @@ stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilte
         20 kHz for both, i.e. the goal 0.3 is met only within the run-to-run spread at 1 and 5 kHz
         and not at 20 kHz.  auto ÷ chosen 1.12/1.15/1.15, 1.14/1.12/1.11 (main 1.13/1.13/1.14,
         1.08/1.15/1.13); streaming chunk 4096 ÷ batch (1 kHz only) 1.02, 0.93 (main 0.98, 0.98).
+        2026-11-26, issue 29 at 20 kHz (branch h-20k 17c4dae against main 133819a via ``--root``,
+        ``--clock thread``, 5 alternating runs each, load 5.4-6.5 on 2 cores; per run, main ->
+        branch): the fused pass at 20 kHz runs ``lfilter`` with one denominator polynomial instead
+        of ``sosfilt`` (the polynomial re-expanded from the sections in extended precision, its
+        coefficients rounded to the best doubles, checked in extended precision and by a
+        running-error probe, ``inversion._sections.polynomial_denominator``): ``preview='auto'``
+        16.0/16.6/15.9/15.8/16.2 -> 14.9/14.9/14.7/14.9/14.3 ns/sample; lfilter ÷ auto
+        0.27/0.26/0.27/0.27/0.27 -> 0.29/0.29/0.30/0.29/0.30; lfilter ÷ given (4/r0)
+        0.30/0.31/0.31/0.31/0.30 -> 0.35/0.34/0.34/0.34/0.35; lfilter ÷ floor 0.30-0.32 -> 0.34-0.36;
+        auto ÷ chosen 1.12-1.17 -> 1.15-1.18 (auto's own cost is unchanged, the chosen preview's
+        dropped from 13.9-14.0 to 12.4-12.7).  Outputs: the same preview (4919 samples), within
+        9.7e-12 (this noisy sine) and 2.3e-11 (an offset sine) of main's relative to the peak,
+        2.5e-11 at most from an explicit extended-precision recursion on 2**21 samples (main's
+        sections: 1.3e-13); at 1 and 5 kHz bit for bit the same.  1 and 5 kHz (code unchanged) in
+        the same rounds: lfilter ÷ auto 0.30/0.30/0.31/0.30/0.31 and 0.30/0.31/0.30/0.30/0.30 (main)
+        against 0.32/0.28/0.30/0.30/0.32 and 0.30/0.29/0.30/0.29/0.30 (branch).  So the goal 0.3 is
+        now reached at 20 kHz as at 1 and 5 kHz: within the run-to-run spread, not robustly above
+        it.  What stands in the way, in ns/sample at 20 kHz: the chosen preview's filters alone
+        12.1-12.5 (two latency-bound recursions ~3.7-3.9 each, two 4-tap correlations 0.65 + 0.88,
+        the add and sum 0.6, the rest memory), and auto's own ~2.0 (timed inside the call): the copy
+        it keeps with its extremes, 1.45 (the copy alone 1.0 into fresh memory, page faults
+        included, 0.55 into reused memory) and the probes of the reference, 0.3 (74 dot products
+        of 7,806 taps).  Tried and not kept (auto ÷ chosen, same load unless said): the copy
+        written by the anticausal pass from the blocks it reads, only the extremes before
+        (1.19-1.24 against 1.11-1.16); the causal pass block by block with the copy and the
+        extremes per block (1.22-1.29); ``FUSED_BLOCK`` 2**14-2**17 (within 0.5 ns/sample of each
+        other); a first-order recursion as blocked matrix products (7.9 ns/sample against
+        lfilter's 3.8); ``lfilter`` in complex arithmetic carrying both numerators (19 ns/sample)
+        and in ``np.longdouble`` (24).  The polynomial is refused where its running rounding
+        drifts: at 100 kHz it passes the response check (1.0e-11) but runs 3.1e-10 off on a step,
+        so 50 and 100 kHz keep the sections.
 """
 
 from __future__ import annotations
