@@ -273,7 +273,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                      "found": {}, "note": FORMS_NONE}
         out.message += " " + FORMS_NONE
         return out
-    return _search(d, fitted, alts, **opts)
+    return _search(d, fitted, alts, first_inseparable=list(out.inseparable), **opts)
 
 
 #: Said when a pair is inseparable as fitted and its models fit the record in no other form.
@@ -283,10 +283,13 @@ FORMS_NONE = ("Other forms tried: the models of the pairs not separated fit the 
 
 
 def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz, temperature_limits_c,
-            lines_per_decade, power, check_refit, max_nfev, z_crit, target, nm, view) -> NextMeasurement:
+            lines_per_decade, power, check_refit, max_nfev, z_crit, target, nm, view,
+            first_inseparable: Sequence[str] = ()) -> NextMeasurement:
     """The search of :func:`next_measurement` over its ``fitted`` competing models; ``alts``
     (``id(model) -> [(form, cost), ...]``, the fit first, :func:`~physmodel.estimation.next_measurement_forms.alternative_forms`)
-    the other forms each model's fit may take, searched as possible truths in every pair it is in."""
+    the other forms each model's fit may take, searched as possible truths in every pair it is in;
+    ``first_inseparable`` the pairs the search without them found inseparable (their fits are the
+    same response: left to parsimony, only their other forms searched)."""
     from .signatures import vuong_power
 
     label = lambda m: " + ".join(m.effects)  # noqa: E731
@@ -296,9 +299,6 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     rec = {}
     for m in fitted:
         rec[id(m)] = m.log_response_of(view.record_many(m.model))
-    forms_all = [f for m in fitted for f, _ in (alts or {}).get(id(m), [])[1:]]
-    for f in forms_all:
-        rec[id(f)] = f.log_response_of(view.record_many(f.model))
     # ---- candidate grids
     f_data = d.data.frequency_hz
     T_data = d.data.temperatures()
@@ -318,7 +318,11 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     pairs = [(a, b) for i, a in enumerate(fitted) for b in fitted[i + 1:]]     # every pair must separate
     key = lambda a, b: f"{label(a)} vs {label(b)}"  # noqa: E731
     contests, forms_resp, forms_said = ({}, {}, {}) if not alts else \
-        _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view)
+        _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, first_inseparable)
+    for c in contests.values():          # the forms' and re-based rivals' responses on the record
+        for m in c.models():
+            if id(m) not in rec:
+                rec[id(m)] = m.log_response_of(view.record_many(m.model))
     # the criterion on the record alone
     current = math.inf
     for a, b in pairs:
@@ -466,7 +470,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
     who = " vs ".join(" + ".join(m) for m in mods)
-    alike = _inseparable_note(same_form, same_refit)
+    alike = _inseparable_note(same_form, same_refit, bool(contests))
     if not live:
         sep_ok = False
         msg = (f"No experiment within the limits can separate {who}.{alike}" if not same_refit else
@@ -496,7 +500,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                             if any(r.quantity == q for r in rows)}, list(same_refit), premise, forms)
 
 
-def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view) -> tuple:
+def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, first_inseparable=()) -> tuple:
     """The pairs searched with their models' forms (every pair a model with other forms is in):
     ``({"A vs B": FormContest}, {q: {id(form): log-response on the search grid}}, {label: [form
     summaries]})``; a form whose response on the whole grid is within :data:`SAME_FORM_LAMBDA` of one
@@ -525,14 +529,21 @@ def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view) 
         said[label(m)] = [form_summary(label(m), f, c, best, thr, "the fit to the record" if j == 0 else
                                        "another form that fits" if j in keep else "the same response as a kept form")
                           for j, (f, c) in enumerate(found)]
-    for q in qs:                     # the fits' own responses are the search's
-        for m in fitted:
-            resp[q].pop(id(m), None)
     contests = {}
+    base_names = [fp.name for fp in d.baseline.free]
     for a, b in pairs:
         if id(a) in kept or id(b) in kept:
             fa, fb = kept.get(id(a), [a]), kept.get(id(b), [b])
-            contests[key(a, b)] = FormContest(key(a, b), [(f"{label(a)} true", fa, fb), (f"{label(b)} true", fb, fa)])
+            contests[key(a, b)] = FormContest(key(a, b), [(f"{label(a)} true", fa, fb), (f"{label(b)} true", fb, fa)],
+                                              base_names, key(a, b) in first_inseparable)
+    for c in contests.values():      # the re-based rivals' responses on the search grid
+        for m in c.models():
+            for q in qs:
+                if id(m) not in resp[q]:
+                    resp[q][id(m)] = m.log_response_of(view.many(m.model, _skeleton(d.kind, q, f_grid, T_grid), q))
+    for q in qs:                     # the fits' own responses are the search's
+        for m in fitted:
+            resp[q].pop(id(m), None)
     return contests, resp, said
 
 
@@ -563,20 +574,22 @@ def _forms_note(said: dict, contests: dict, alpha: float) -> str:
     return out
 
 
-def _inseparable_note(same_form: list, same_refit: list) -> str:
+def _inseparable_note(same_form: list, same_refit: list, forms_searched: bool = False) -> str:
     """The message's sentence on the pairs left out: ``same_form`` no experiment separates even
     linearised (the same response in another form), ``same_refit`` the refits of the checked
     experiments did not separate as the models were fitted (one fit a nested form of the other: the
-    truth's own form may still separate)."""
+    truth's own form may still separate — unless ``forms_searched``: the models' other forms that fit
+    were searched too)."""
     out = ""
     if same_form:
         out += (" Not separable within the limits (the same response in another form; linearised λ below "
                 f"{SAME_FORM_LAMBDA:g} in every experiment): " + "; ".join(same_form) + ".")
     if same_refit:
         out += (" Not separated as fitted (one model's fit is a nested form of the other: λ after refits below "
-                f"{SAME_FORM_LAMBDA:g} in every checked experiment expected to separate it) — may separate in "
-                "another form, which this search, linearised at the fits, does not try: " + "; ".join(same_refit)
-                + ".")
+                f"{SAME_FORM_LAMBDA:g} in every checked experiment expected to separate it) — "
+                + ("nor in the other forms of the fits that the record cannot reject (below): " if forms_searched else
+                   "may separate in another form, which this search, linearised at the fits, does not try: ")
+                + "; ".join(same_refit) + ".")
     return out
 
 

@@ -33,7 +33,7 @@ class CompetingModel:
     def __init__(self, d, effects: tuple, values: dict, free: list):
         from ..effects import EffectModel
 
-        self.effects, self.values, self.free = effects, dict(values), list(free)
+        self.effects, self.values, self.free, self.d = effects, dict(values), list(free), d
         beff = {k: dict(v) for k, v in (d.metadata.get("baseline_effects") or {}).items()}
         on = {c: {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith(c + ".")} for c in effects}
         self.model = EffectModel(d.base_parameters, d.kind, {**beff, **on}, kernel=d.metadata.get("kernel",

@@ -159,11 +159,20 @@ class FormContest:
     separates them from the rival: nested in it); per candidate experiment the linearised λ and,
     when checked, the refit λ of each truth form."""
 
-    def __init__(self, key: str, directions: list):
+    def __init__(self, key: str, directions: list, base_names: list, same_as_fitted: bool = False):
         from .next_measurement import SAME_FORM_LAMBDA
 
         self.key, self.directions, self.limit = key, directions, SAME_FORM_LAMBDA
-        self.excluded: dict = {name: {} for name, _, _ in directions}     # name -> {form index: why}
+        # per direction and truth form, the rival's fit moved to the truth form's base parameters: one
+        # more point the rival's refit may start from (its base values need not be the ones its own fit
+        # to the record took; a quantity the effects do not reach sees only those)
+        self.rebased = {(name, j): CompetingModel(rivals[0].d, rivals[0].effects,
+                                                  {**rivals[0].values, **{n: t.values[n] for n in base_names}},
+                                                  rivals[0].free)
+                        for name, truths, rivals in directions for j, t in enumerate(truths)}
+        # name -> {form index: why}; a pair the search without forms found inseparable: its two fits
+        # (form 0 of each direction) are the same response, each a nested form of the other
+        self.excluded: dict = {name: ({0: "as fitted"} if same_as_fitted else {}) for name, _, _ in directions}
         self.lin: dict = {}            # id(row) -> {name: [λ per truth form]}
         self.refit: dict = {}          # id(row) -> {name: {form index: λ}}
 
@@ -176,9 +185,9 @@ class FormContest:
         out: dict = {}
         for name, truths, rivals in self.directions:
             per = []
-            for t in truths:
+            for j, t in enumerate(truths):
                 lam = np.full(W.shape[0], np.inf)
-                for rv in rivals:
+                for rv in rivals + [self.rebased[(name, j)]]:
                     D = stack_real(log_ratio(resp[id(t)][0], resp[id(rv)][0]))
                     base = None
                     if rec is not None:
@@ -188,6 +197,12 @@ class FormContest:
                 per.append(lam)
             out[name] = per
         return [{name: [float(x[e]) for x in per] for name, per in out.items()} for e in range(W.shape[0])]
+
+    def models(self) -> list:
+        """Every model whose responses the contest uses (forms and re-based rivals)."""
+        out = {id(m): m for _, truths, rivals in self.directions for m in truths + rivals}
+        out.update({id(m): m for m in self.rebased.values()})
+        return list(out.values())
 
     def settle_linearised(self, rows: list) -> None:
         """Store each row's per-form λ and leave to parsimony the truth forms no experiment separates
@@ -227,7 +242,8 @@ class FormContest:
             for j, t in enumerate(truths):
                 if j in self.excluded[name] or j in got[name]:
                     continue
-                got[name][j] = refit_lambda(d, r, nm, t, rivals[0], max_nfev, [rv.values for rv in rivals[1:]])
+                got[name][j] = refit_lambda(d, r, nm, t, rivals[0], max_nfev,
+                                            [rv.values for rv in rivals[1:] + [self.rebased[(name, j)]]])
         return self.refit_value(id(r))
 
     def refit_value(self, rid: int) -> float:
