@@ -19,10 +19,13 @@ pair comes out inseparable as fitted it asks this module for the model's other f
   forms whose responses on the search grid are within :data:`~physmodel.estimation.next_measurement.SAME_FORM_LAMBDA`
   (χ², summed over every candidate line) of one already kept are one form (:func:`distinct`).
 
-The search then takes each form that fits as a possible truth (the criterion, per direction, is
-the least λ over them, the rival refitting from each of its own forms), and leaves out a truth form
-no experiment separates from the rival (λ below ``SAME_FORM_LAMBDA`` everywhere): the truth is then
-a nested form of the rival and the diagnosis decides it by parsimony, which the result says.
+The search then takes each form that fits as a possible truth (:class:`FormContest`: the criterion,
+per direction, is the least λ over them, the rival linearised at and refitted from each of its own
+forms and from its fit moved to the truth form's base parameters), and leaves out a truth form no
+experiment separates from the rival (λ below ``SAME_FORM_LAMBDA`` everywhere linearised, or after
+the refits of every checked experiment expected to separate it) and the two fits of a pair the first
+search found inseparable: the truth is then a nested form of the rival and the diagnosis decides it
+by parsimony, which the result says.
 """
 
 from __future__ import annotations
