@@ -94,6 +94,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -272,7 +273,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                                "No competing model to separate: the diagnosis names no rival "
                                + ("(widen the bound it stopped at instead)." if d.verdict == "at_bound" else "."))
     fitted = fit_competing_models(d, mods, max_nfev)
-    opts = dict(mods=mods, qs=qs, lv=lv, band_limits_hz=band_limits_hz, temperature_limits_c=temperature_limits_c,
+    opts: dict[str, Any] = dict(mods=mods, qs=qs, lv=lv, band_limits_hz=band_limits_hz, temperature_limits_c=temperature_limits_c,
                 lines_per_decade=lines_per_decade, power=power, check_refit=check_refit, max_nfev=max_nfev,
                 z_crit=z_crit, target=target, nm=nm, view=view)
     out = _search(d, fitted, None, **opts)
@@ -542,7 +543,7 @@ def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, 
                 resp[q][id(f)] = L
                 r_f.append(L[0])
             by_form.append(r_f)
-        keep = distinct([f for f, _ in found], by_form, w)
+        keep = distinct([f for f, _ in found], by_form, w, SAME_FORM_LAMBDA)
         kept[id(m)] = [found[j][0] for j in keep]
         best = min(c for _, c in found)
         thr = form_threshold(d.alpha, len(m.free) - len(d.baseline.free))
@@ -555,7 +556,7 @@ def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, 
         if id(a) in kept or id(b) in kept:
             fa, fb = kept.get(id(a), [a]), kept.get(id(b), [b])
             contests[key(a, b)] = FormContest(key(a, b), [(f"{label(a)} true", fa, fb), (f"{label(b)} true", fb, fa)],
-                                              base_names, key(a, b) in first_inseparable)
+                                              base_names, SAME_FORM_LAMBDA, key(a, b) in first_inseparable)
     for c in contests.values():      # the re-based rivals' responses on the search grid
         for m in c.models():
             for q in qs:

@@ -91,8 +91,12 @@ def alternative_forms(d, m: CompetingModel, max_nfev: int) -> list[tuple[Competi
         start = {**m.values, **{n: t for n, lo_, hi_, t in eff if n != name and near_lo(m.values[n], lo_, hi_)}}
         free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in m.free if fp.name != name]
         held = {name: float(lo)}
-        res = fit_parameters(d.data, None, free, predict_many=lambda sets, held=held: pm([{**s, **held} for s in sets]),
-                             starts=1, seed=0, max_nfev=max_nfev, identify=False, hold_undetermined=False)
+
+        def pm_held(sets, held=held):
+            return pm([{**s, **held} for s in sets])
+
+        res = fit_parameters(d.data, None, free, predict_many=pm_held, starts=1, seed=0, max_nfev=max_nfev,
+                             identify=False, hold_undetermined=False)
         found.append({**m.values, **dict(res.values), **held})
     # one multi-start: the diagnosis's own candidate fit(s) and the best points of a log grid of the effect
     initials = []
@@ -120,13 +124,13 @@ def alternative_forms(d, m: CompetingModel, max_nfev: int) -> list[tuple[Competi
     return out
 
 
-def distinct(forms: list, responses: list, weights: list) -> list[int]:
+def distinct(forms: list, responses: list, weights: list, limit: float) -> list[int]:
     """Indices of ``forms`` kept as distinct: the first (the fit) always, then farthest first — the
     form whose log-response is farthest (χ² summed over the search grid) from every kept one — while
-    that distance is at least :data:`~physmodel.estimation.next_measurement.SAME_FORM_LAMBDA`, at most
-    :data:`MAX_FORMS` more.  ``responses``: per form, a list over quantities of complex
-    log-responses; ``weights``: per quantity, (1/σ_ln², 1/σ_φ²) of its lines."""
-    from .next_measurement import SAME_FORM_LAMBDA
+    that distance is at least ``limit`` (the search's
+    :data:`~physmodel.estimation.next_measurement.SAME_FORM_LAMBDA`), at most :data:`MAX_FORMS` more.
+    ``responses``: per form, a list over quantities of complex log-responses; ``weights``: per
+    quantity, (1/σ_ln², 1/σ_φ²) of its lines."""
     from .next_measurement_design import log_ratio
 
     def chi(i: int, j: int) -> float:
@@ -140,7 +144,7 @@ def distinct(forms: list, responses: list, weights: list) -> list[int]:
     near = np.array([chi(0, j) for j in range(len(forms))])
     while len(keep) <= MAX_FORMS:
         j = int(np.argmax(near))
-        if not near[j] >= SAME_FORM_LAMBDA:
+        if not near[j] >= limit:
             break
         keep.append(j)
         near = np.minimum(near, [chi(j, k) for k in range(len(forms))])
@@ -162,10 +166,8 @@ class FormContest:
     separates them from the rival: nested in it); per candidate experiment the linearised λ and,
     when checked, the refit λ of each truth form."""
 
-    def __init__(self, key: str, directions: list, base_names: list, same_as_fitted: bool = False):
-        from .next_measurement import SAME_FORM_LAMBDA
-
-        self.key, self.directions, self.limit = key, directions, SAME_FORM_LAMBDA
+    def __init__(self, key: str, directions: list, base_names: list, limit: float, same_as_fitted: bool = False):
+        self.key, self.directions, self.limit = key, directions, float(limit)
         # per direction and truth form, the rival's fit moved to the truth form's base parameters: one
         # more point the rival's refit may start from (its base values need not be the ones its own fit
         # to the record took; a quantity the effects do not reach sees only those)
