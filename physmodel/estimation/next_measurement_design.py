@@ -33,7 +33,7 @@ class CompetingModel:
     def __init__(self, d, effects: tuple, values: dict, free: list):
         from ..effects import EffectModel
 
-        self.effects, self.values, self.free = effects, dict(values), list(free)
+        self.effects, self.values, self.free, self.d = effects, dict(values), list(free), d
         beff = {k: dict(v) for k, v in (d.metadata.get("baseline_effects") or {}).items()}
         on = {c: {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith(c + ".")} for c in effects}
         self.model = EffectModel(d.base_parameters, d.kind, {**beff, **on}, kernel=d.metadata.get("kernel",
@@ -246,6 +246,18 @@ def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int
     on the new lines (with the record's lines when joint) from its own fit, from its effect at its
     typical size and from :data:`REFIT_STARTS` − 2 more Latin-hypercube starts; ``{"A vs B": the
     least over the two directions}`` for each of ``pairs``."""
+    out = {}
+    for a, b in pairs:
+        out[f"{label(a)} vs {label(b)}"] = min(refit_lambda(d, r, nm, truth, rival, max_nfev)
+                                               for truth, rival in ((a, b), (b, a)))
+    return out
+
+
+def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, rival: CompetingModel,
+                 max_nfev: int, rival_starts: Sequence[dict] = ()) -> float:
+    """λ of experiment ``r`` when ``truth`` is true: ``rival`` refitted to its noiseless predictions
+    (:func:`refit_check`), from its own fit, its effect at its typical size (and Latin-hypercube
+    starts) and each of ``rival_starts`` (values of every free parameter: the rival's other forms)."""
     from .lsq import fit_parameters
 
     view = RecordView(d)
@@ -255,45 +267,42 @@ def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int
     cb = d.metadata.get("candidate_bounds", {})
     same = r.quantity in view.sweeps
     nm_q = nm["by_quantity"][r.quantity] if view.joint and same else nm
-    out = {}
-    for a, b in pairs:
-        best = math.inf
-        for truth, rival in ((a, b), (b, a)):
-            G = np.asarray(view.many(truth.model, sk, r.quantity)([truth.values])[0])
-            if r.joint:
-                rs = view.sweeps.get(r.quantity)
-                logabs = np.log(np.abs(G)) + (log_unit_factor(rs, sk) if rs is not None else 0.0)
-                s_ln, s_ph = line_sigma(nm_q, logabs, np.array([r.level]), same)
-                sweeps = {}
-                for q0, s0 in view.sweeps.items():      # the record, as the truth predicts it, with its σ
-                    G0 = np.asarray(view.many(truth.model, s0, q0)([truth.values])[0])
-                    if s0.magnitude_std_db is None:
-                        s0l, s0p, _ = noise_std(s0)
-                        std0 = (s0l * 20 / math.log(10), np.degrees(s0p))
-                    else:
-                        std0 = (s0.magnitude_std_db, s0.phase_std_deg)
-                    sweeps[q0] = FrequencySweep(s0.temperature_c, s0.frequency_hz, G0, *std0, s0.input_name,
-                                                s0.input_unit, s0.output_name, s0.output_unit)
-                new = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
-                                     sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-                sweeps[r.quantity] = merge_records(sweeps[r.quantity], new) if same else new
-                sw, factory = view.restacked(sweeps)
+    best = math.inf
+    G = np.asarray(view.many(truth.model, sk, r.quantity)([truth.values])[0])
+    if r.joint:
+        rs = view.sweeps.get(r.quantity)
+        logabs = np.log(np.abs(G)) + (log_unit_factor(rs, sk) if rs is not None else 0.0)
+        s_ln, s_ph = line_sigma(nm_q, logabs, np.array([r.level]), same)
+        sweeps = {}
+        for q0, s0 in view.sweeps.items():      # the record, as the truth predicts it, with its σ
+            G0 = np.asarray(view.many(truth.model, s0, q0)([truth.values])[0])
+            if s0.magnitude_std_db is None:
+                s0l, s0p, _ = noise_std(s0)
+                std0 = (s0l * 20 / math.log(10), np.degrees(s0p))
             else:
-                s_ln, s_ph = line_sigma(nm, np.log(np.abs(G)), np.array([r.level]), False)
-                sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
-                                    sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-                factory = lambda model, sw=sw: model.predictor(sw, r.quantity).many  # noqa: E731
-            pm = factory(rival.model)
-            typical = {f"{c}.{p}": v[2] for c in rival.effects for p, v in cb.get(c, {}).items()}
-            for k, start in enumerate((rival.values, {**rival.values, **typical})):
-                free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in rival.free]
-                res = fit_parameters(sw, None, free, predict_many=pm, starts=1 if k == 0 else REFIT_STARTS - 1,
-                                     seed=0, max_nfev=max_nfev, identify=False, hold_undetermined=False)
-                best = min(best, 2.0 * float(res.cost))
-        out[f"{label(a)} vs {label(b)}"] = best
-    return out
+                std0 = (s0.magnitude_std_db, s0.phase_std_deg)
+            sweeps[q0] = FrequencySweep(s0.temperature_c, s0.frequency_hz, G0, *std0, s0.input_name,
+                                        s0.input_unit, s0.output_name, s0.output_unit)
+        new = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
+                             sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
+        sweeps[r.quantity] = merge_records(sweeps[r.quantity], new) if same else new
+        sw, factory = view.restacked(sweeps)
+    else:
+        s_ln, s_ph = line_sigma(nm, np.log(np.abs(G)), np.array([r.level]), False)
+        sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
+                            sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
+        factory = lambda model, sw=sw: model.predictor(sw, r.quantity).many  # noqa: E731
+    pm = factory(rival.model)
+    typical = {f"{c}.{p}": v[2] for c in rival.effects for p, v in cb.get(c, {}).items()}
+    starts = [(rival.values, 1), ({**rival.values, **typical}, REFIT_STARTS - 1)] + [(s, 1) for s in rival_starts]
+    for start, n in starts:
+        free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in rival.free]
+        res = fit_parameters(sw, None, free, predict_many=pm, starts=n, seed=0, max_nfev=max_nfev, identify=False,
+                             hold_undetermined=False)
+        best = min(best, 2.0 * float(res.cost))
+    return best
 
 
 __all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
-           "log_ratio", "log_unit_factor", "noise_model", "refit_check", "refit_model", "stack_real",
+           "log_ratio", "log_unit_factor", "noise_model", "refit_check", "refit_lambda", "refit_model", "stack_real",
            "sweep_noise_model", "t_criterion"]

@@ -149,6 +149,14 @@ class NextMeasurement:
         its separation relies on the diagnosed model's temperature laws (named), and that a misfit
         at the new temperature may mean the laws, not the effect, are wrong ("" otherwise; also
         the end of ``message``).
+    forms : dict
+        Empty unless a pair came out inseparable as fitted: then the search was run again with the
+        other forms its models' fits may take
+        (:mod:`~physmodel.estimation.next_measurement_forms`) — ``found``: per model, each form
+        (effect values, ½χ² on the record, 2Δcost to the best and the χ² threshold, its role);
+        ``contests``: per pair and direction (``"A true"``), each truth form searched or left to
+        parsimony (nested in the rival); ``note``: the sentence of ``message`` that says which forms
+        the separation assumes.  When no other form fits: ``tried``, ``found`` {} and ``note``.
     """
 
     models: list
@@ -165,6 +173,7 @@ class NextMeasurement:
     best_by_quantity: dict = field(default_factory=dict)
     inseparable_as_fitted: list = field(default_factory=list)
     premise: str = ""
+    forms: dict = field(default_factory=dict)
 
     @classmethod
     def unavailable(cls, reason: str, models=()) -> NextMeasurement:
@@ -181,7 +190,8 @@ class NextMeasurement:
                       "evaluated": self.evaluated, "ranking": [r.to_dict() for r in self.ranking],
                       "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
                       "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity,
-                      "inseparable_as_fitted": list(self.inseparable_as_fitted), "premise": self.premise})
+                      "inseparable_as_fitted": list(self.inseparable_as_fitted), "premise": self.premise,
+                      **({"forms": self.forms} if self.forms else {})})
 
 
 

@@ -75,6 +75,47 @@ states the limitation); the third (7436, λ 0.4) was forecast not to separate.  
     python tests/benchmarks/bench_next_measurement.py --first-seed 7440 --seeds 20 --candidates time_delay amplifier_bandwidth
     python tests/benchmarks/bench_next_measurement.py --first-seed 7430 --seeds 8 --labels opamp
 
+Other forms of the fits (2026-11-26 night, issue 27 item 3): a pair the search finds inseparable
+(linearised, or as fitted after the refits) is searched again with the other forms its models' fits
+take — each effect parameter held at its off value in turn, and a multi-start from the candidate's
+fit and a log grid; the forms the record cannot reject (2Δcost within the χ²_p quantile at the
+diagnosis's α) are possible truths, the least λ over them per direction, a form nested in its rival
+left to parsimony (next_measurement's module doc, ``NextMeasurement.forms``).  Development on
+7430-7437 (opamp) and 950-967; the extra row above is now 8/8 [0.68, 1.00] (7430: S at 65 °C,
+226-1000 Hz, λ 90 expected; 7437: S at 65 °C, λ 166; 7436: named though λ 3 was forecast).  Fresh
+seeds, run once on the final code (746021a; later commits change no number), and on the main
+branch's copy (133819a) on the same seeds, 2 shared cores (load 6), bath 5-65 °C:
+
+=========================================  ==========================  ==========================
+                                           opamp, all seven            sensor, all seven
+                                           (7500-7511)                 (7520-7525)
+=========================================  ==========================  ==========================
+ambiguous after one record                 12/12                       10/12
+named exactly, main                        8/12 [0.39, 0.86]           9/10 [0.60, 0.98]
+named exactly, other forms searched        **12/12** [0.76, 1.00]      **10/10** [0.72, 1.00]
+recommended with a bath step, main |       8 | 12                      9 | 10
+forms searched
+expected to separate, main | forms         12/12 | 11/12               8/10 | 8/10
+next_measurement CPU per call, median      2.8 | 6.4 (max 7.5 | 31.5)  3.5 | 3.6 (max 6.0 | 18.1)
+(max), main | forms [s]
+=========================================  ==========================  ==========================
+
+Main's four opamp misses (7504, 7506, 7507, 7510) and its one on the main set (7524, amplifier)
+ended ambiguous between amplifier_bandwidth and transimpedance after a 35 °C record that the search
+had chosen with that pair called inseparable (as fitted in 4 of the 5); with the forms searched each
+got a bath step and was named.  On the main set this adds to the 16/17 of 7400-7411 above: 26/27
+together.  The search costs more where a pair is inseparable (the forms' refits and a second
+search; CPU per call up to 31.5 s against main's 7.5 s, medians 6.4 against 2.8 s on the opamp
+seeds; wall medians 14.3 | 4.8 s and 13.1 | 9.2 s under the shared load) and the same where none
+is (to_dict byte-identical to main on the scenario's virtual-lab record with time_delay and
+amplifier_bandwidth, and on seeds 950 and 951 amplifier).  Commands (``timed_bench.py`` wraps this
+file's ``next_measurement`` with a wall and thread-CPU clock; the main branch's copy is run from
+``git -C <main> archive HEAD``)::
+
+    python tests/benchmarks/bench_next_measurement.py --first-seed 7430 --seeds 8 --labels opamp
+    python tests/benchmarks/bench_next_measurement.py --first-seed 7500 --seeds 12 --labels opamp
+    python tests/benchmarks/bench_next_measurement.py --first-seed 7520 --seeds 6
+
 The premise dropped (``--law-error``, 2026-11-26 late evening, fresh seeds, run once on the final code):
 the generator's strip moves with the bath by Ea_d 20 kJ/mol and an E slope of −0.50 %/K (chosen
 a priori, round values; not tuned) while the user's start keeps the library's 15 kJ/mol and
