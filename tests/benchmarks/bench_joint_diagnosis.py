@@ -27,6 +27,7 @@ but ``none`` on a null strip.
 
     python tests/benchmarks/bench_joint_diagnosis.py --set null --first-seed 8412 --seeds 12
     python tests/benchmarks/bench_joint_diagnosis.py --set null --first-seed 8424 --seeds 48
+    python tests/benchmarks/bench_joint_diagnosis.py --set null --first-seed 8400 --seeds 72
     python tests/benchmarks/bench_joint_diagnosis.py --set sensor --labels none --first-seed 8600 --seeds 8
 
 Measured 2026-11-26 with the commands above (fresh seeds; development used 900-905), library
@@ -87,13 +88,19 @@ figures say:
 * More null strips (session 11, 2026-11-26, fresh seeds, run once on main at 133819a:
   ``--set null --first-seed 8424 --seeds 48``): one quantity 46/48 ``none`` (8443 ``unexplained``,
   8461 named diffusivity_temperature), jointly 46/48 (8457 and 8461 named diffusivity_temperature);
-  4.5 s and 5.9 s per diagnosis.  Pooled with 8400-8423: false positives jointly **5/72 = 6.9 %
-  [3.0, 15.2]**, one quantity **3/72 = 4.2 % [1.4, 11.5]**.  Neither is distinguishable from the
-  issue's 5 % (jointly: P(≥ 5 of 72 | 5 %) = 0.29).  What the design promises: the candidates' LR
-  threshold is the null's (1 − α) quantile of the largest LR over the candidates (family-wise over
-  candidates), and the gap test adds at most α/GAP_ALPHA_DIVISOR = 1 %, so a null strip's verdict
-  is wrong with probability up to 1.2 α = 6 % by the union bound, not α; the joint false
-  positives are the detection's (2 of the new 48: a diffusivity law refitted on noise).
+  4.5 s and 5.9 s per diagnosis.  Pooled with 8400-8423: false positives jointly 5/72, one
+  quantity 3/72.  What the design had promised: the candidates' LR threshold was the null's
+  (1 − α) quantile of the largest LR over the candidates, and the gap test added α/5, so a null
+  strip's verdict was wrong with probability up to 1.2 α = 6 % by the union bound, not the α the
+  ``alpha`` parameter documents.  Since 8d0f217 the LR test runs at α − α/5 (the verdict's
+  family-wise rate is α by the union bound).  Re-run on all 72 (``--first-seed 8400 --seeds 72``):
+  one quantity **70/72** (2.8 % [0.8, 9.6]; 8402's diffusivity law is no longer named; 8443
+  ``unexplained``, 8461 named), jointly **67/72**, unchanged (6.9 % [3.0, 15.2]: 8403 ambiguous at
+  LR 15, 8411 and 8422 ``unexplained`` — the gap test, at its 1 %, 2/72 —, 8457 and 8461 named
+  diffusivity_temperature — the LR test, with 8403 3/72 at its 4 %).  Neither count is
+  distinguishable from the issue's 5 % (jointly: P(≥ 5 of 72 | 5 %) = 0.29).  The same split on
+  ``bench_discrepancy.py --generator independent --first-seed 47000 --n-per-label 2 --null 48``
+  (92 fresh cases, before and after): every verdict identical (0/48 false positives in both).
 * Sensor: Z does not separate a lag from an amplifier pole — neither acts on the strip's own
   impedance, and with the library's default (chain effects on every quantity, i.e. Z measured
   through S's amplifier) they act identically on both.  Without ``acts_on`` every sensor S+Z case
