@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["LM_STEPS", "damped_steps", "crawling", "profile_search", "CRAWL_POINTS", "CRAWL_GAIN", "CRAWL_DECREMENT",
-           "CRAWL_SEARCHES", "PROFILE_STEPS", "INNER_POINTS", "INNER_DECREMENT"]
+           "CRAWL_SEARCHES", "PROFILE_STEPS", "PROFILE_STALE", "INNER_POINTS",
+           "INNER_DECREMENT"]
 
 #: Damped steps a later start takes before handing over to scipy's trust region.
 LM_STEPS = 30
@@ -66,6 +67,9 @@ CRAWL_GAIN = 0.1
 CRAWL_SEARCHES = 8
 #: Secant steps of the profile search per crawl at most.
 PROFILE_STEPS = 12
+#: Secant steps in a row without a lower point that end the search (an inner fit whose
+#: Jacobian jumps between points — a kink of the model — moves k back and forth for nothing).
+PROFILE_STALE = 3
 #: Gauss–Newton points of one inner fit (the other coordinates at a fixed flat one) at most ...
 INNER_POINTS = 6
 #: ... ending when its decrement falls below this times s² (the trust region converges after).
@@ -79,12 +83,16 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
     valley as a profile instead: the coordinate k most aligned with JᵀJ's flattest eigenvector
     fixed, the others fitted by Gauss–Newton (well determined: a few points, :data:`INNER_POINTS`),
     and k moved by secant steps on the profile's derivative, which at an inner optimum is the
-    gradient's k-th component (Jᵀr)_k (the envelope theorem), regula falsi once bracketed; the
-    first step ``moved`` (what the trust region moved k by while crawling) times four.  At most
-    :data:`PROFILE_STEPS` secant steps, ending when a step moves k by less than 1e-9 of its range,
-    at a point with a status (converged, joined) or at the budget; the inner fits end at a
-    decrement below :data:`INNER_DECREMENT`·s² (``s2`` the engine's s²).  Returns the lowest
-    point reached; the trust region resumes from it (and its tests end the search)."""
+    gradient's k-th component (Jᵀr)_k (the envelope theorem), regula falsi (Illinois) once
+    bracketed — also by a step that overshoots the minimum, where the cost rises but that
+    derivative changes sign; the first step ``moved`` (what the trust region moved k by while
+    crawling) times four.  Each step starts the others where the last point's Gauss–Newton model
+    puts them at the new k (along the valley).  At most :data:`PROFILE_STEPS` secant steps,
+    ending when a step moves k by less than 1e-9 of its range, after :data:`PROFILE_STALE` steps
+    without a lower point, at a point with a status (converged, joined) or at the budget; the
+    inner fits end at a decrement below :data:`INNER_DECREMENT`·s² (``s2`` the engine's s²).
+    Returns the lowest point reached; the trust region resumes from it (and its tests end the
+    search)."""
     n = len(pt[0])
     if n < 2:
         return pt
@@ -105,23 +113,51 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
     lo_in = lo + 1e-10 * np.maximum(1.0, np.abs(lo))
     hi_in = hi - 1e-10 * np.maximum(1.0, np.abs(hi))
 
+    def gn_step(p, rr):
+        """The Gauss–Newton step of the coordinates other than k for residuals ``rr`` with p's
+        Jacobian, as (those that move, their step): a coordinate at a bound that the gradient or
+        the step pushes outwards stays there (the step is solved again without it: clipped at the
+        bound, it would leave the others' step aimed at a point they no longer reach and the
+        inner fit gave up, the cost risen); None for a singular system."""
+        J, zo = p[2], p[0][o]
+        at_lo, at_hi = zo - lo[o] <= 1e-8 * span[o], hi[o] - zo <= 1e-8 * span[o]
+        go = J[:, o].T @ rr
+        held = (at_lo & (go > 0)) | (at_hi & (go < 0))
+        while True:
+            f = o[~held]
+            if not len(f):
+                return f, np.zeros(0)
+            Jf = J[:, f]
+            try:
+                sf = np.linalg.solve(Jf.T @ Jf, -(Jf.T @ rr))
+            except np.linalg.LinAlgError:
+                return None
+            out = (at_lo[~held] & (sf < 0)) | (at_hi[~held] & (sf > 0))
+            if not out.any():
+                return f, sf
+            held[np.flatnonzero(~held)[out]] = True
+
+    def along(p, zk):
+        """p's point with k moved to zk and the others where p's Gauss–Newton model has its
+        minimum at that k: from an inner optimum, along the valley's tangent (moving k alone
+        leaves the valley: the cost rose a hundredfold and the inner fit took 4-5 points back)."""
+        z = p[0].copy()
+        st = gn_step(p, p[1] + p[2][:, k] * (zk - z[k]))
+        if st is not None and len(st[0]):
+            z[st[0]] = np.clip(z[st[0]] + st[1], lo_in[st[0]], hi_in[st[0]])
+        z[k] = zk
+        return z
+
     def inner(p):
         """The other coordinates fitted by Gauss–Newton steps at p's k (halved when the cost rises)."""
         for _ in range(INNER_POINTS):
             if p[3] is not None or stopped_at_budget():
                 return p
-            r, go = p[1], p[2][:, o].T @ p[1]
-            zo = p[0][o]
-            held = ((zo - lo[o] <= 1e-8 * span[o]) & (go > 0)) | ((hi[o] - zo <= 1e-8 * span[o]) & (go < 0))
-            f = o[~held]                 # coordinates at a bound pushed outwards stay there
-            if not len(f):
+            st = gn_step(p, p[1])
+            if st is None or not len(st[0]):
                 return p
-            Jf = p[2][:, f]
-            try:
-                sf = np.linalg.solve(Jf.T @ Jf, -(Jf.T @ r))
-            except np.linalg.LinAlgError:
-                return p
-            if -0.5 * float((Jf.T @ r) @ sf) < INNER_DECREMENT * s2:
+            f, sf = st
+            if -0.5 * float((p[2][:, f].T @ p[1]) @ sf) < INNER_DECREMENT * s2:
                 return p
             for _ in range(2):
                 z = p[0].copy()
@@ -148,37 +184,45 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
     g = grad_k(cur)
     step = 4.0 * moved[k] if moved[k] * -g > 0 else -np.sign(g) * 1e-3 * (hi[k] - lo[k])
     below = above = None             # (z_k, g) with g < 0 and with g > 0: the bracket
+    last = 0                         # the end the previous point replaced (-1 below, +1 above)
+    stale = 0                        # secant steps since the lowest point last moved
     for _ in range(PROFILE_STEPS):
-        if g == 0 or stopped_at_budget():
+        if g == 0 or stopped_at_budget() or stale >= PROFILE_STALE:
             break
-        if g < 0:
+        side = -1 if g < 0 else 1
+        if side < 0:
             below = (cur[0][k], g)
         else:
             above = (cur[0][k], g)
         if below is not None and above is not None:
+            if side == last:         # the same end replaced twice: halve the other's g (Illinois),
+                if side < 0:         # else regula falsi creeps up to the minimum from one side
+                    above = (above[0], 0.5 * above[1])
+                else:
+                    below = (below[0], 0.5 * below[1])
             zk = below[0] - below[1] * (above[0] - below[0]) / (above[1] - below[1])
         else:
             zk = cur[0][k] + step
+        last = side
         zk = float(np.clip(zk, lo_in[k], hi_in[k]))
         if abs(zk - cur[0][k]) <= 1e-9 * (hi[k] - lo[k]):
             break
-        z = cur[0].copy()
-        z[k] = zk
         count[0] += 1
-        new = inner(evaluate(z))
+        new = inner(evaluate(along(cur, zk)))
         if new[3] is not None:
             return new if new[6] < best[6] else best
-        if not new[6] < cur[6] and below is None or above is None and not new[6] < cur[6]:
-            break                        # the profile does not fall that way: leave it to the trust region
         g_new = grad_k(new)
+        if not new[6] < cur[6] and (below is None or above is None) and not g_new * g < 0:
+            break                        # the profile does not fall that way: leave it to the trust region
         if below is None or above is None:      # secant on g, at most four times further
             dz = new[0][k] - cur[0][k]
             slope = (g_new - g) / dz if dz != 0 else 0.0
             step = -g_new / slope if slope > 0 else 4.0 * dz
             step = float(np.clip(step, -4.0 * abs(dz), 4.0 * abs(dz)))
         cur, g = new, g_new
+        stale += 1
         if cur[6] < best[6]:
-            best = cur
+            best, stale = cur, 0
     return best
 
 

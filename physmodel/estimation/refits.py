@@ -106,13 +106,16 @@ class Refitter:
         return out
 
     def refit(self, effects_on: Sequence[str], start_vals: Mapping, eff_starts: list, sim=None, identify=True,
-              from_user=False) -> CalibrationResult:
+              from_user=False, more: Sequence[tuple[str, Mapping, list]] = ()) -> CalibrationResult:
         """Best of the refits from ``start_vals`` (and, ``from_user``, the user's start) × ``eff_starts``,
-        searched as one multi-start (warm starts from the baseline optimum first): a start that
-        reaches an earlier one's optimum stops there."""
+        and from each ``(origin, start values, effect starts)`` of ``more``, searched as one
+        multi-start (warm starts from the baseline optimum first): a start that reaches an earlier
+        one's optimum stops there."""
         origins, points = [], []
-        for origin, sv in [("baseline optimum", start_vals)] + ([("user start", self.user0)] if from_user else []):
-            for starts in eff_starts:
+        sources = ([("baseline optimum", start_vals, eff_starts)]
+                   + ([("user start", self.user0, eff_starts)] if from_user else []) + list(more))
+        for origin, sv, e_starts in sources:
+            for starts in e_starts:
                 fr = self.from_(sv)
                 for c in effects_on:
                     st = None if starts is None else starts.get(c)

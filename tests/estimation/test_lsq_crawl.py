@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
+from physmodel.estimation.lm_steps import profile_search
 from physmodel.estimation.lsq import fit_parameters
 from physmodel.estimation.observations import ScalarObservations
 from physmodel.estimation.records import FreeParameter
@@ -55,3 +56,44 @@ def test_a_crawling_trust_region_reaches_the_valleys_optimum(seed, order):
     # a is as well determined as the cost makes it (its standard error is ~10 here): the returned a
     # lies where the closed-form profile is within the same 1e-8 of its minimum
     assert profile(res.values["a"]) <= cost_opt + 1e-8, (res.values["a"], a_opt)
+
+
+def _engine_point(residuals_jac):
+    """An ``evaluate(z)`` as the engine's: (z, r, J, status, message, Gauss–Newton step, cost, joined)."""
+    def evaluate(z):
+        r, J = residuals_jac(np.asarray(z, dtype=float))
+        return (np.array(z, dtype=float), r, J, None, "", np.linalg.lstsq(J, -r, rcond=None)[0], 0.5 * float(r @ r),
+                None)
+    return evaluate
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_profile_step_past_the_minimum_brackets_it(seed):
+    # the profile search's first step is four times what the crawl moved; from a start on the
+    # valley floor with a crawl that moved the whole way to the optimum, that step lands three
+    # times as far beyond it, where the cost is higher.  The search must bracket the minimum
+    # there (the profile's derivative changed sign) and close in on it, not stop at the start
+    # (before the fix it returned the start's inner fit: the trust region then crawled on).
+    residuals, a_opt, cost_opt, profile = _problem(seed)
+    rng = np.random.default_rng(seed)
+    e, c = rng.normal(size=M), rng.normal(size=M)          # the same draws as _problem's
+
+    def residuals_jac(z):                # z = (a, (b + 2)/4): the engine's scaled coordinates
+        a, b = z[0], 4.0 * z[1] - 2.0
+        r = np.concatenate([[K * (b - np.sin(3 * a))], e + EPS * np.cos(2 * a + c)])
+        J = np.zeros((M + 1, 2))
+        J[0] = [-3.0 * K * np.cos(3 * a), 4.0 * K]
+        J[1:, 0] = -2.0 * EPS * np.sin(2 * a + c)
+        return r, J
+
+    assert np.allclose(residuals_jac(np.array([0.3, 0.6]))[0], residuals(np.array([[0.3, 0.4]]))[0])
+    a0 = a_opt - 0.1 if a_opt > 0.5 else a_opt + 0.1
+    z0 = np.array([a0, (np.sin(3 * a0) + 2.0) / 4.0])       # on the valley floor
+    z_opt = np.array([a_opt, (np.sin(3 * a_opt) + 2.0) / 4.0])
+    evaluate = _engine_point(residuals_jac)
+    start = evaluate(z0)
+    count = [0]
+    out = profile_search(start, evaluate, np.zeros(2), np.ones(2), count, lambda: False, z_opt - z0,
+                         2.0 * start[6] / (M - 1))
+    assert out[6] == pytest.approx(cost_opt, abs=1e-8), (out[0], z_opt, count)
+    assert profile(out[0][0]) <= cost_opt + 1e-8

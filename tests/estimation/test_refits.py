@@ -92,3 +92,34 @@ def test_the_scan_skips_points_where_the_effect_is_off_and_gives_the_same_statis
     short = scan_lr(*args, is_off=lambda v: v["amp"] == AMP.off)
     np.testing.assert_array_equal(short, full)
     assert sum(seen) == n_full // 2           # the amplitude-off half of the grid is the baseline
+
+
+def test_a_refit_from_several_origins_is_one_multistart_with_the_separate_refits_best():
+    # the pair refits of a diagnosis: starts from several origins searched as one multi-start
+    # (Refitter.refit(more=...)) instead of one fit per origin, each of which ran to the same optimum
+    from physmodel.estimation.priors import PenalisedProblem
+    from physmodel.estimation.refits import Refitter, StageCounter
+
+    data = _sweep()
+
+    def pm(values_list):                 # the baseline gain g; the candidate "lag" adds the pole fc
+        return np.array([_lag(v["g"], v["lag.fc"]) if "lag.fc" in v else np.full(N, v["g"] + 0j)
+                         for v in values_list])
+
+    counter = StageCounter(pm)
+    rf = Refitter(PenalisedProblem(data, counter.predict_many), [FreeParameter("g", 0.1, 20.0, "log", 1.0)],
+                  {"lag": [EffectParameter("fc", "Hz", 50.0, 0.5, 50.0, 10.0)]}, {}, seed=0, max_nfev=200,
+                  baseline_starts=1, counter=counter)
+    origins = [("baseline optimum", {"g": 1.5}, [None, {"lag": {"fc": 4.0}}]),
+               ("second", {"g": 2.05}, [{"lag": {"fc": 5.1}}]), ("third", {"g": 0.5}, [{"lag": {"fc": 20.0}}])]
+    alone = [rf.refit(["lag"], sv, es) for _, sv, es in origins]
+    best_alone = min(alone, key=lambda r: r.cost)
+    one = rf.refit(["lag"], origins[0][1], origins[0][2], more=origins[1:])
+    ms = one.metadata["refit_multistart"]
+    assert ms["origins"] == ["baseline optimum", "baseline optimum", "second", "third"]
+    assert len(one.starts) == 4 and ms["n_joined"] >= 1          # a later start stopped in an earlier basin
+    assert one.cost == pytest.approx(best_alone.cost, rel=1e-9)
+    for k in ("g", "lag.fc"):
+        assert one.values[k] == pytest.approx(best_alone.values[k], rel=1e-5)
+    assert one.values["lag.fc"] == pytest.approx(5.0, rel=0.05)    # the lag written here
+    assert sum(s.nfev for s in one.starts) < sum(s.nfev for r in alone for s in r.starts)
