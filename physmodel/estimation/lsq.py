@@ -80,6 +80,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -139,6 +140,13 @@ class _Fit:
     status: int
     message: str
     joined: int | None = None       # the earlier start whose optimum this one reached (status -2)
+    _gram: np.ndarray | None = None
+
+    def gram(self) -> np.ndarray:
+        """JᵀJ at the optimum, computed once (later starts test every point against it)."""
+        if self._gram is None:
+            self._gram = self.J.T @ self.J
+        return self._gram
 
 
 def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step, res):
@@ -151,28 +159,45 @@ def _residuals_and_jacobian(batch: ModelBatch, rows: ScaledRows, z, hi, fd_step,
 def _residuals_and_jacobians(batch: ModelBatch, rows: ScaledRows, zs, hi, fd_step, res) -> list:
     """:func:`_residuals_and_jacobian` at several points ``zs`` in one batched model call (a model
     call costs about the same for one row or twenty: its per-call work dominates)."""
-    plan = batch.jacobian_plan(rows.active)
-    n = len(zs[0])
-    fd = [i for i in range(n) if i not in plan]
-    eye = np.eye(n)[fd]
-    blocks, all_steps = [], []
-    for z in zs:
-        steps = np.where(z + fd_step <= hi, fd_step, -fd_step)[fd]
-        blocks.append(z[None, :] + np.vstack([np.zeros_like(z), eye * steps[:, None]]))
+    fd, fd_rows, known, scaled = _layout(batch, rows, res)
+    n, m = len(zs[0]), len(fd)
+    hi_fd = hi[fd]
+    Z = np.repeat(np.asarray(zs, dtype=float), m + 1, axis=0)       # each point, then its m steps
+    all_steps = []
+    for b, z in enumerate(zs):
+        steps = np.where(z[fd] + fd_step <= hi_fd, fd_step, -fd_step)   # backwards at the upper bound
+        Z[b * (m + 1) + fd_rows, fd] += steps
         all_steps.append(steps)
-    R = res(batch(rows(np.vstack(blocks))))
-    # the known columns: constant ones are the same at every point, scaled ones a fixed factor
-    known = {i: (res.constant_column(p[1]) if p[0] == "constant" else (p[1], res.scaled_column(1.0, p[2])))
-             for i, p in plan.items()}
+    R = res(batch(rows(Z)))
     out = []
     for b, steps in enumerate(all_steps):
-        Rb = R[b * (len(fd) + 1):(b + 1) * (len(fd) + 1)]
+        Rb = R[b * (m + 1):(b + 1) * (m + 1)]
         J = np.empty((Rb.shape[1], n))
-        J[:, fd] = ((Rb[1:] - Rb[0][None, :]) / steps[:, None]).T
-        for i, k in known.items():
-            J[:, i] = k if not isinstance(k, tuple) else J[:, k[0]] * k[1]
+        D = Rb[1:] - Rb[0]
+        D /= steps[:, None]
+        J[:, fd] = D.T
+        for i, col in known:        # constant columns: the same at every point
+            J[:, i] = col
+        for i, j, c in scaled:      # scaled columns: a fixed factor times a difference column
+            J[:, i] = J[:, j] * c
         out.append((Rb[0], J))
     return out
+
+
+def _layout(batch: ModelBatch, rows: ScaledRows, res) -> tuple:
+    """What :func:`_residuals_and_jacobians` needs for ``rows.active`` that no point changes, kept
+    on ``batch`` (one residual model per batch): the difference columns ``fd`` and the rows of
+    their steps, the known columns (:meth:`ModelBatch.jacobian_plan`) as (i, column) for the
+    constant ones and (i, j, factor) for the scaled ones."""
+    key = rows.active.tobytes()
+    lay = batch.layouts.get(key)
+    if lay is None:
+        plan = batch.jacobian_plan(rows.active)
+        fd = np.array([i for i in range(len(rows.active)) if i not in plan], dtype=int)
+        known = [(i, res.constant_column(p[1])) for i, p in plan.items() if p[0] == "constant"]
+        scaled = [(i, p[1], res.scaled_column(1.0, p[2])) for i, p in plan.items() if p[0] != "constant"]
+        lay = batch.layouts[key] = (fd, np.arange(1, len(fd) + 1), known, scaled)
+    return lay
 
 
 def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[FreeParameter], values: Values, *,
@@ -198,6 +223,23 @@ def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[
     z = np.array([float(fp.to_z(v)) for fp, v in zip(free, x)])
     hi = np.array([fp.z_bounds[1] for fp in free])
     return _residuals_and_jacobian(batch, ScaledRows(free, x, range(len(free))), z, hi, fd_step, res)
+
+
+@lru_cache(maxsize=32)
+def _lhs_cached(free: tuple, n: int, seed) -> np.ndarray:
+    out = lhs_starts(list(free), n, seed)
+    out.flags.writeable = False
+    return out
+
+
+def _lhs_starts(free: Sequence[FreeParameter], n: int, seed) -> np.ndarray:
+    """:func:`~physmodel.estimation.records.lhs_starts`, kept per (free, n, seed): the same points
+    for every calibration of one problem (Monte Carlo draws, repeated fits) without rebuilding
+    scipy's sampler."""
+    try:
+        return _lhs_cached(tuple(free), n, seed)
+    except TypeError:             # unhashable: not kept (lhs_starts says what is wrong with it)
+        return lhs_starts(free, n, seed)
 
 
 def joined_start(record: StartRecord) -> int | None:
@@ -273,7 +315,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         for opt in optima:
             if opt.status > 0 and opt.cost <= c <= opt.cost + JOIN_COST * s2:
                 d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
-                if float(d @ (opt.J.T @ opt.J) @ d) <= JOIN_DISTANCE**2 * s2:
+                if float(d @ opt.gram() @ d) <= JOIN_DISTANCE**2 * s2:
                     return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
                                 f"errors of start {opt.index}'s optimum"), step, c, opt.index
         return None, "", step, c, None
@@ -477,7 +519,7 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     active = [k for k, fp in enumerate(free) if fp.name not in held]
     z_given = [[fp.to_z(min(max(float(v[fp.name]), fp.lower), fp.upper)) for fp in free] for v in initials]
     z_starts = np.vstack([z_init[None, :], np.array(z_given, float).reshape(-1, len(free)),
-                          lhs_starts(free, int(starts) - 1, seed)])
+                          _lhs_starts(free, int(starts) - 1, seed)])
     z_starts[:, [k for k in range(len(free)) if k not in active]] = z_init[[k for k in range(len(free)) if k not in active]]
     records, fits, ends = [], [], []
     firsts: dict = {}
