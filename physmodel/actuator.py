@@ -105,17 +105,31 @@ def shared_rows(state: State):
     finite-difference sets of a parameter acting only on the mode or the gain — the ``shared``
     argument of :func:`actuator_kernel` for its flat rows (set-major); None when no set does."""
     n_sets, n_T = state.T.shape[:2]
-    cols = [getattr(state, f) for f in LINE_FIELDS]
-    if n_sets < 2 or any(c.shape != (n_sets, n_T, 1) for c in cols):
+    cols = {f: getattr(state, f) for f in LINE_FIELDS}
+    if n_sets < 2 or any(c.shape != (n_sets, n_T, 1) for c in cols.values()):
         return None
-    F = np.concatenate(cols, axis=2)                                  # (n_sets, n_T, n_fields)
-    keys = {n: np.ascontiguousarray(F[:, :, :n]).reshape(n_sets, -1) for n in (len(LINE_FIELDS), len(SLICE_FIELDS))}
+    return shared_sets(cols, n_sets, n_T)
+
+
+def shared_sets(values, n_sets: int, n_T: int, differ=LINE_FIELDS):
+    """:func:`shared_rows` for values given per field, ``n_sets·n_T`` each, set-major (any shape),
+    of which only the fields ``differ`` may differ between sets (the others must be the same in
+    every set: they are not compared).  Sets are compared bit for bit (their bytes)."""
     t = np.arange(n_T)
 
-    def level(sets, n_fields):
+    def keys(fields):
+        """Each set's values of ``fields`` as bytes (one key per set)."""
+        fs = [f for f in fields if f in differ]
+        if not fs:
+            return [b""] * n_sets
+        b = np.concatenate([np.asarray(values[f]).reshape(n_sets, n_T, 1) for f in fs], axis=2).tobytes()
+        w = len(b) // n_sets
+        return [b[i * w:(i + 1) * w] for i in range(n_sets)]
+
+    def level(sets, key):
         """(first, inverse) over the rows of ``sets``: each set mapped onto the first identical one."""
         seen: dict = {}
-        first = [seen.setdefault(keys[n_fields][i].tobytes(), j) for j, i in enumerate(sets)]
+        first = [seen.setdefault(key[i], j) for j, i in enumerate(sets)]
         kept = sorted(set(first))
         if len(kept) == len(sets):
             return None, list(sets)
@@ -123,8 +137,8 @@ def shared_rows(state: State):
         inv = np.array([pos[j] for j in first])
         return ((np.array(kept)[:, None] * n_T + t).ravel(), (inv[:, None] * n_T + t).ravel()), [sets[j] for j in kept]
 
-    line, kept = level(list(range(n_sets)), len(LINE_FIELDS))
-    sl, _ = level(kept, len(SLICE_FIELDS))
+    line, kept = level(list(range(n_sets)), keys(LINE_FIELDS))
+    sl, _ = level(kept, keys(SLICE_FIELDS))
     return None if line is None and sl is None else (line, sl)
 
 
@@ -175,6 +189,27 @@ class ActuatorModel(PhysicsModel):
             return super().evaluate_state(state, s, qs)
         n = n_sets * n_T
         p = {k: np.ascontiguousarray(getattr(state, k).reshape(n))[:, None] for k in STATE_FIELDS}
+        vals = actuator_kernel(p, s[None, :], qs, shared)
+        return {q: vals[q].reshape(n_sets, n_T, s.size) for q in qs}
+
+    def evaluate_columns(self, p, n_sets: int, n_T: int, s, quantities=None, differ=STATE_FIELDS) -> dict:
+        """:meth:`evaluate_state` for a state given as flat columns ``p[field]`` (n_sets·n_T, 1),
+        set-major (:meth:`~physmodel.parameter_paths.StateMap.columns`: no State to build and take
+        apart per call), of which only the fields ``differ`` may differ between sets; the same
+        numbers bit for bit.  The columns are only read.
+
+        Returns
+        -------
+        dict of str to ndarray
+            Complex arrays (n_sets, n_T, n_s) [Ω, m/V, -, m/V, A/V].
+        """
+        qs = self._check_quantities(quantities or self.quantities)
+        s = np.asarray(s)
+        shared = (shared_sets(p, n_sets, n_T, differ) if 1 < n_sets and n_sets * n_T * s.size <= self.chunk_size
+                  else None)
+        if shared is None:
+            state = State(**{k: p[k].reshape(n_sets, n_T, 1) for k in STATE_FIELDS})
+            return super().evaluate_state(state, s, qs)
         vals = actuator_kernel(p, s[None, :], qs, shared)
         return {q: vals[q].reshape(n_sets, n_T, s.size) for q in qs}
 

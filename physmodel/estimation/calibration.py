@@ -112,9 +112,15 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
         # lines laid out as the (temperature × frequency) grid, row-major: a reshape, not a gather
         on_grid = inv_T.size == Tu.size * fu.size and np.array_equal(inv_T * fu.size + inv_f, np.arange(inv_T.size))
 
+        columns = getattr(model, "evaluate_columns", None)     # states as flat columns, no State per call
+
         def predict_array(X):
             with np.errstate(all="ignore"):     # a non-finite response is refused by the residuals
-                R = model.evaluate_state(smap(X), s_data, (q,))[q]
+                if columns is not None:
+                    p, n_rows, differ = smap.columns(X)
+                    R = columns(p, n_rows, Tu.size, s_data, (q,), differ)[q]
+                else:
+                    R = model.evaluate_state(smap(X), s_data, (q,))[q]
             if on_grid:
                 R = R.reshape(R.shape[0], -1)
                 R *= factor

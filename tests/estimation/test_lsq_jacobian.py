@@ -68,6 +68,25 @@ def test_state_map_matches_sets_built_one_by_one(problem):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=0, err_msg=f)
 
 
+def test_state_map_columns_are_its_states(problem):
+    # the oracle: the map's own states (checked against state_at above), field by field
+    base, _, _, free = problem
+    smap = StateMap.build(base, FREE, [fp.lower for fp in free], [fp.upper for fp in free],
+                          [fp.initial for fp in free], TEMPS)
+    for n_rows in (7, 1, 7):                 # the second 7: the fixed columns kept for that count
+        X = _rows_in_box(free, n_rows, seed=n_rows)
+        st = smap(X)
+        p, rows, differ = smap.columns(X)
+        assert rows == n_rows and sorted(p) == sorted(STATE_FIELDS)
+        for f in STATE_FIELDS:
+            assert p[f].shape == (n_rows * TEMPS.size, 1)
+            assert np.array_equal(p[f].reshape(n_rows, TEMPS.size, 1), getattr(st, f)), f
+            if f not in differ:             # the same in every row, and not writable
+                assert np.array_equal(getattr(st, f), np.broadcast_to(getattr(st, f)[:1], getattr(st, f).shape))
+                assert not p[f].flags.writeable
+    assert {"d", "kappa_e", "alpha0", "E", "xi", "r1"} <= set(differ) and "L" not in differ
+
+
 def test_state_map_refuses_what_is_not_log_affine(problem):
     base, _, _, _ = problem
     linear_law = replace(base, laws=base.laws.with_(r1_sheet=Linear(2e-3)))
