@@ -38,11 +38,17 @@ SLICE_FIELDS = ("h", "d", "K", "W", "kappa_e", "r2", "Rp")
 LINE_FIELDS = SLICE_FIELDS + ("r1", "L")
 
 
-def _take(p, idx, fields):
-    return p if idx is None else {f: p[f][idx] for f in fields}
+def _take(p, idx, fields, differ=None):
+    """The rows ``idx`` of ``p``'s ``fields``; a field not in ``differ`` (the same in every set,
+    rows set-major) as its first ``len(idx)`` rows, the same values without a gather."""
+    if idx is None:
+        return p
+    if differ is None:
+        return {f: p[f][idx] for f in fields}
+    return {f: p[f][idx] if f in differ else p[f][:len(idx)] for f in fields}
 
 
-def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
+def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None, differ=None) -> dict:
     """The actuator ``quantities`` at points ``s`` for parameter values ``p`` (see :class:`State`).
 
     Only what the quantities need is computed: G alone needs no charge dynamics or electrode
@@ -50,7 +56,8 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
     ``(line, slice)`` for ``p`` as (n, 1) columns (see :func:`shared_rows`), each None or
     ``(first, inverse)``: the electrode line is evaluated only on the rows ``line[0]`` (row r takes
     the values of ``line[0][line[1][r]]``), the slice terms only on ``slice[0]`` of those; the
-    same operations on the same numbers, so the same results bit for bit.
+    same operations on the same numbers, so the same results bit for bit.  ``differ``: with
+    ``shared``, the fields that may differ between sets (default all; see :func:`shared_sets`).
     """
     out = {}
     wn = p["omega_n"]
@@ -66,8 +73,8 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
     if not (want_z or want_h):
         return out
     line, sl = shared if shared is not None else (None, None)
-    pl = _take(p, None if line is None else line[0], LINE_FIELDS)
-    ps = _take(pl, None if sl is None else sl[0], SLICE_FIELDS)
+    pl = _take(p, None if line is None else line[0], LINE_FIELDS, differ)
+    ps = _take(pl, None if sl is None else sl[0], SLICE_FIELDS, differ)
     up = (lambda a: a) if sl is None else (lambda a: a[sl[1]])          # slice rows -> line rows
     full = (lambda a: a) if line is None else (lambda a: a[line[1]])    # line rows -> all rows
     c = transport.charge_terms(s, ps["h"], ps["d"], ps["K"])
@@ -210,7 +217,7 @@ class ActuatorModel(PhysicsModel):
         if shared is None:
             state = State(**{k: p[k].reshape(n_sets, n_T, 1) for k in STATE_FIELDS})
             return super().evaluate_state(state, s, qs)
-        vals = actuator_kernel(p, s[None, :], qs, shared)
+        vals = actuator_kernel(p, s[None, :], qs, shared, differ)
         return {q: vals[q].reshape(n_sets, n_T, s.size) for q in qs}
 
     def dc_gain(self, temperature_c) -> dict:

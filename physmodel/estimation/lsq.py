@@ -172,15 +172,15 @@ def _residuals_and_jacobians(batch: ModelBatch, rows: ScaledRows, zs, hi, fd_ste
     out = []
     for b, steps in enumerate(all_steps):
         Rb = R[b * (m + 1):(b + 1) * (m + 1)]
-        J = np.empty((Rb.shape[1], n))
+        JT = np.empty((n, Rb.shape[1]))         # built by rows, handed on as J = JTᵀ (C-ordered)
         D = Rb[1:] - Rb[0]
         D /= steps[:, None]
-        J[:, fd] = D.T
+        JT[fd] = D
         for i, col in known:        # constant columns: the same at every point
-            J[:, i] = col
+            JT[i] = col
         for i, j, c in scaled:      # scaled columns: a fixed factor times a difference column
-            J[:, i] = J[:, j] * c
-        out.append((Rb[0], J))
+            np.multiply(JT[j], c, out=JT[i])
+        out.append((Rb[0], np.ascontiguousarray(JT.T)))
     return out
 
 
