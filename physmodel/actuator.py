@@ -15,6 +15,8 @@ Sign convention of eq. (13): with α0 < 0 a positive voltage gives a positive ti
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from . import beam, electrode, transport
@@ -122,30 +124,40 @@ def shared_sets(values, n_sets: int, n_T: int, differ=LINE_FIELDS):
     """:func:`shared_rows` for values given per field, ``n_sets·n_T`` each, set-major (any shape),
     of which only the fields ``differ`` may differ between sets (the others must be the same in
     every set: they are not compared).  Sets are compared bit for bit (their bytes)."""
-    t = np.arange(n_T)
 
-    def keys(fields):
-        """Each set's values of ``fields`` as bytes (one key per set)."""
+    def firsts(fields, sets):
+        """For each of ``sets`` the position in ``sets`` of the first one with the same bytes of ``fields``."""
         fs = [f for f in fields if f in differ]
         if not fs:
-            return [b""] * n_sets
+            return (0,) * len(sets)
         b = np.concatenate([np.asarray(values[f]).reshape(n_sets, n_T, 1) for f in fs], axis=2).tobytes()
         w = len(b) // n_sets
-        return [b[i * w:(i + 1) * w] for i in range(n_sets)]
-
-    def level(sets, key):
-        """(first, inverse) over the rows of ``sets``: each set mapped onto the first identical one."""
         seen: dict = {}
-        first = [seen.setdefault(key[i], j) for j, i in enumerate(sets)]
+        return tuple(seen.setdefault(b[i * w:(i + 1) * w], j) for j, i in enumerate(sets))
+
+    line = firsts(LINE_FIELDS, range(n_sets))
+    return _shared_index(line, firsts(SLICE_FIELDS, sorted(set(line))), n_T)
+
+
+@lru_cache(maxsize=64)
+def _shared_index(line_first: tuple, slice_first: tuple, n_T: int):
+    """The ``shared`` argument of :func:`actuator_kernel` from each set's first identical set
+    (electrode line over all sets, slice over the line's kept sets); kept per pattern (a
+    calibration repeats a few), its arrays read-only."""
+    t = np.arange(n_T)
+
+    def level(first):
         kept = sorted(set(first))
-        if len(kept) == len(sets):
-            return None, list(sets)
+        if len(kept) == len(first):
+            return None
         pos = {j: k for k, j in enumerate(kept)}
         inv = np.array([pos[j] for j in first])
-        return ((np.array(kept)[:, None] * n_T + t).ravel(), (inv[:, None] * n_T + t).ravel()), [sets[j] for j in kept]
+        out = ((np.array(kept)[:, None] * n_T + t).ravel(), (inv[:, None] * n_T + t).ravel())
+        for a in out:
+            a.flags.writeable = False
+        return out
 
-    line, kept = level(list(range(n_sets)), keys(LINE_FIELDS))
-    sl, _ = level(kept, keys(SLICE_FIELDS))
+    line, sl = level(line_first), level(slice_first)
     return None if line is None and sl is None else (line, sl)
 
 
