@@ -120,6 +120,11 @@ from .residuals import (
 FD_STEP = 1e-6
 #: A search ends when a Gauss–Newton step would gain less than this (times s², see ``_solve``).
 GN_DECREMENT = 1e-12
+#: Predictions (parameter sets × lines) per batched model call at most when several points are
+#: evaluated together: the kernel's temporaries then stay in cache.  Measured on the benchmark (500
+#: lines, 7 sets per point; 2 shared cores): three points in one call of 21 sets took 1.37 ms,
+#: in three calls 1.25 ms, two in one call 0.69 ms against 0.41 ms for one.
+CALL_VALUES = 8192
 #: A later start stops in an earlier start's basin when its cost is within this (times s²) above
 #: that start's optimum and ...
 JOIN_COST = 25.0
@@ -161,6 +166,10 @@ def _residuals_and_jacobians(batch: ModelBatch, rows: ScaledRows, zs, hi, fd_ste
     call costs about the same for one row or twenty: its per-call work dominates)."""
     fd, fd_rows, known, scaled = _layout(batch, rows, res)
     n, m = len(zs[0]), len(fd)
+    per_call = max(1, CALL_VALUES // ((m + 1) * res.n_values))
+    if len(zs) > per_call:      # in calls of at most CALL_VALUES predictions
+        return [out for i in range(0, len(zs), per_call)
+                for out in _residuals_and_jacobians(batch, rows, zs[i:i + per_call], hi, fd_step, res)]
     hi_fd = hi[fd]
     Z = np.repeat(np.asarray(zs, dtype=float), m + 1, axis=0)       # each point, then its m steps
     all_steps = []

@@ -197,3 +197,22 @@ def test_calibrated_estimate_is_stationary_for_the_reference_residuals(problem):
         if s.status == -2:
             assert "stopped early" in s.message and s.cost >= res.cost
     assert res.cost == pytest.approx(min(s.cost for s in res.starts if s.status != -2), rel=1e-12)
+
+
+def test_points_evaluated_together_or_apart_give_the_same_fit(problem, monkeypatch):
+    # the later starts' first points share model calls (at most CALL_VALUES predictions each): how
+    # they are grouped must not change a bit of the result, only the number of calls
+    from physmodel.estimation import lsq
+
+    base, _, sw, _ = problem
+    runs = []
+    for per_call in (10**9, 1):          # all first points in one call; one point per call
+        monkeypatch.setattr(lsq, "CALL_VALUES", per_call)
+        runs.append(calibrate(sw, base, FREE, starts=4, seed=3))
+    together, apart = runs
+    assert apart.n_model_calls == together.n_model_calls + 2
+    assert apart.n_evaluations == together.n_evaluations
+    for n in FREE:
+        assert together.values[n] == apart.values[n]
+        assert together.ci_lower[n] == apart.ci_lower[n] and together.ci_upper[n] == apart.ci_upper[n]
+    assert [(s.cost, s.nfev, s.status) for s in together.starts] == [(s.cost, s.nfev, s.status) for s in apart.starts]
