@@ -50,7 +50,10 @@ def standardised_residuals(model_response, data: FrequencySweep, s_ln, s_ph) -> 
         # written into the halves of one array (no concatenation)
         a = np.abs(q)
         np.divide(np.log(a, out=a), s_ln, out=out[..., :n])
-        np.divide(np.angle(q), s_ph, out=out[..., n:])
+        # arg q = np.angle(q), on contiguous copies of the parts: numpy's arctan2 is one function for
+        # strided and contiguous input, which it reads faster (the same values bit for bit)
+        ph = np.arctan2(np.ascontiguousarray(q.imag), np.ascontiguousarray(q.real))
+        np.divide(ph, s_ph, out=out[..., n:])
         # one sum, not an elementwise test: finite unless some residual is not (or it overflows)
         finite = math.isfinite(out.sum()) or bool(np.all(np.isfinite(out)))
     if not finite:
