@@ -300,15 +300,16 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
                          predict_array=predict_many.array, max_nfev=max_nfev, identify=identify,
                          hold_undetermined=hold_undetermined, probe=probe, progress=progress, **kwargs)
     label = name or f"{base.name}_calibrated"
+    fingerprint = data.fingerprint()          # a SHA-256 of the data: once
     src = (f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
-           f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"
+           f"{fingerprint[:12]} ({kind} {q}); free: {', '.join(res.names)}"
            + (f"; undetermined (held at base): {', '.join(res.held)}" if res.held else "")
            + (f"; undetermined, NOT held (holding would worsen the fit beyond its test): {', '.join(res.hold_refused)}"
               if res.hold_refused else "")
            + f"; base: {base.name}")
     res.parameters = replace(apply_values(base, res.values, paths), name=label, source=src)
     res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
-                         "data_fingerprint": data.fingerprint(), "seed": seed})
+                         "data_fingerprint": fingerprint, "seed": seed})
     if effects:
         res.metadata["effects"] = {k: dict(v) for k, v in effects.items()}
     if not res.adequate:

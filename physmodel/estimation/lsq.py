@@ -251,6 +251,18 @@ def _lhs_starts(free: Sequence[FreeParameter], n: int, seed) -> np.ndarray:
         return lhs_starts(free, n, seed)
 
 
+@lru_cache(maxsize=256)
+def _z_bounds(fp: FreeParameter) -> tuple[float, float]:
+    return fp.z_bounds
+
+
+def _z_box(free: Sequence[FreeParameter]) -> tuple[np.ndarray, np.ndarray]:
+    """The lower and upper bounds of ``free`` in the scaled coordinates (n,), (n,), each
+    parameter's read once per process (FreeParameter is immutable)."""
+    zb = [_z_bounds(fp) for fp in free]
+    return np.array([b[0] for b in zb]), np.array([b[1] for b in zb])
+
+
 def joined_start(record: StartRecord) -> int | None:
     """The index of the earlier start whose optimum ``record``'s start joined (status −2), else None."""
     return record.joined if record.status == -2 else None
@@ -302,8 +314,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     False: a later start goes straight to the trust region, as start 0 does.
     """
     act = [free[k] for k in active]
-    lo = np.array([fp.z_bounds[0] for fp in act])
-    hi = np.array([fp.z_bounds[1] for fp in act])
+    lo, hi = _z_box(act)
     rows = ScaledRows(free, x_full, active)
     dof = res.size - len(act)
     cache: dict = {}
@@ -381,7 +392,7 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     pt = evaluate(z_start)
     while pt[3] is None and pt[5] is not None and not stopped_at_budget():      # Gauss–Newton steps
         z_new = pt[0] + pt[5]
-        if np.any(z_new < lo) or np.any(z_new > hi):
+        if (z_new < lo).any() or (z_new > hi).any():
             break
         count[0] += 1
         new = evaluate(z_new)
@@ -535,8 +546,7 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     for i, z0 in enumerate(z_starts):
         if i == 1 and len(z_starts) > 2:
             # the later starts' first points in one model call (it costs about one point's)
-            lo_a = np.array([free[k].z_bounds[0] for k in active])
-            hi_a = np.array([free[k].z_bounds[1] for k in active])
+            lo_a, hi_a = _z_box([free[k] for k in active])
             pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[1:]]
             firsts = dict(enumerate(_residuals_and_jacobians(batch, ScaledRows(free, x_full, active), pts, hi_a,
                                                              fd_step, res), start=1))
