@@ -189,7 +189,7 @@ class StateMap:
         # each State field's position in [moving fields..., fixed fields...]
         self._order = [varying.index(f) if f in varying else len(varying) + self._fixed_names.index(f)
                        for f in STATE_FIELDS]
-        self._fixed_columns: dict = {}    # n_rows -> the fixed fields as flat columns (see columns)
+        self._fixed_columns = {}          # n_rows -> the fixed fields as flat columns (see columns)
 
     @classmethod
     def build(cls, base: IPMCParameters, names, lower, upper, reference, temperature_c) -> StateMap | None:
