@@ -284,7 +284,9 @@ class StateMap:
             raise ParameterError(f"StateMap: {X.shape[1]} columns for {len(self.names)} parameters {self.names}")
         U = X.copy()
         U[:, self._logged] = np.log(np.abs(X[:, self._logged]))      # ParameterPath.natural, all columns at once
-        return self._sign[:, None, :] * np.exp(self._log_state(U).transpose(1, 0, 2))
+        E = np.exp(self._log_state(U).transpose(1, 0, 2))
+        # written C-ordered (n_var, n_rows, n_T): each field's rows are then one contiguous block
+        return np.multiply(self._sign[:, None, :], E, out=np.empty(E.shape))
 
     def columns(self, X) -> tuple[dict, int, tuple]:
         """The state of the rows of ``X`` (n_rows, n_names) [each parameter's SI unit] as flat
