@@ -36,7 +36,8 @@ Search and stopping (see ``_solve``)
     (:func:`~physmodel.estimation.lm_steps.damped_steps`: it
     usually reaches an earlier optimum or converges there, for a third of the overhead of scipy's
     trust region, which rebuilds its model from an SVD every iteration); then — start 0 directly —
-    scipy's trust-region reflective search.  The later starts' first points share one model call.
+    scipy's trust-region reflective search.  All starts' first points are evaluated up front,
+    several per model call (at most :data:`CALL_VALUES` predictions).
     When the trust region crawls (:func:`~physmodel.estimation.lm_steps.crawling`: over
     :data:`~physmodel.estimation.lm_steps.CRAWL_POINTS` points its best cost fell by less than a
     tenth of the Gauss–Newton decrement it had, that decrement above 1e-4·s²) — a valley the data
@@ -544,12 +545,13 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     records, fits, ends = [], [], []
     firsts: dict = {}
     for i, z0 in enumerate(z_starts):
-        if i == 1 and len(z_starts) > 2:
-            # the later starts' first points in one model call (it costs about one point's)
+        if i == 0 and len(z_starts) > 1:
+            # every start's first point up front, several per model call (CALL_VALUES; two points
+            # cost far less than two calls): the same residuals and Jacobians as one by one
             lo_a, hi_a = _z_box([free[k] for k in active])
-            pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[1:]]
+            pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts]
             firsts = dict(enumerate(_residuals_and_jacobians(batch, ScaledRows(free, x_full, active), pts, hi_a,
-                                                             fd_step, res), start=1))
+                                                             fd_step, res)))
         fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits, firsts.get(i),
                      damped)
         fit.index = i

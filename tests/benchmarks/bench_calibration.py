@@ -236,8 +236,9 @@ def speed(pairs: int, root: str, reps: int, draws: int):
           f"model evaluations {a['n_evaluations']} vs {b['n_evaluations']}")
 
 
-def ratio(rounds: int):
-    """Calibration (4 starts) ÷ 100 model evaluations on the same lines, interleaved (issue 29)."""
+def ratio(rounds: int, cpu: bool = False):
+    """Calibration (4 starts) ÷ 100 model evaluations on the same lines, interleaved (issue 29);
+    wall time, or with ``cpu`` this thread's CPU time (steadier on a shared machine)."""
     import gc
 
     import physmodel
@@ -253,14 +254,16 @@ def ratio(rounds: int):
     res = calibrate(sw, base, FREE, starts=4, seed=0)      # warm-up (imports, caches)
     evaluations()
     t_cal, t_ev = [], []
+    clock = time.thread_time if cpu else time.perf_counter
     for _ in range(rounds):
         for fn, out in ((lambda: calibrate(sw, base, FREE, starts=4, seed=0), t_cal), (evaluations, t_ev)):
             gc.collect()
-            t0 = time.perf_counter()
+            t0 = clock()
             fn()
-            out.append(time.perf_counter() - t0)
+            out.append(clock() - t0)
     r = np.array(t_cal) / np.array(t_ev)
-    print(f"== calibration ÷ 100 model evaluations ({physmodel.__file__}), {rounds} interleaved rounds")
+    print(f"== calibration ÷ 100 model evaluations ({physmodel.__file__}), {rounds} interleaved rounds, "
+          f"{'CPU' if cpu else 'wall'} time")
     print(f"8-parameter calibration, 4 starts: {np.median(t_cal) * 1e3:.1f} ms ({res.n_evaluations} parameter sets in "
           f"{res.n_model_calls} model calls); 100 evaluations of {res.n_lines} lines: {np.median(t_ev) * 1e3:.1f} ms")
     print(f"ratio (medians) {np.median(t_cal) / np.median(t_ev):.3f}; per round median {np.median(r):.3f} "
@@ -280,10 +283,11 @@ def main(argv=None):
     ap.add_argument("--speed-draws", type=int, default=10, help="1-start calibrations per repeat in --speed")
     ap.add_argument("--ratio", type=int, default=0, metavar="ROUNDS",
                     help="only calibration ÷ 100 model evaluations, this many interleaved rounds")
+    ap.add_argument("--cpu", action="store_true", help="with --ratio: this thread's CPU time instead of wall time")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.ratio:
-        return ratio(args.ratio)
+        return ratio(args.ratio, args.cpu)
     if args.worker:
         return worker(args.reps, args.speed_draws)
     if args.speed:

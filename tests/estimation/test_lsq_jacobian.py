@@ -200,8 +200,8 @@ def test_calibrated_estimate_is_stationary_for_the_reference_residuals(problem):
 
 
 def test_points_evaluated_together_or_apart_give_the_same_fit(problem, monkeypatch):
-    # the later starts' first points share model calls (at most CALL_VALUES predictions each): how
-    # they are grouped must not change a bit of the result, only the number of calls
+    # the starts' first points share model calls (at most CALL_VALUES predictions each): how they
+    # are grouped must not change a bit of the result, only the number of calls
     from physmodel.estimation import lsq
 
     base, _, sw, _ = problem
@@ -210,7 +210,7 @@ def test_points_evaluated_together_or_apart_give_the_same_fit(problem, monkeypat
         monkeypatch.setattr(lsq, "CALL_VALUES", per_call)
         runs.append(calibrate(sw, base, FREE, starts=4, seed=3))
     together, apart = runs
-    assert apart.n_model_calls == together.n_model_calls + 2
+    assert apart.n_model_calls == together.n_model_calls + 3       # four first points: one call or four
     assert apart.n_evaluations == together.n_evaluations
     for n in FREE:
         assert together.values[n] == apart.values[n]
