@@ -15,7 +15,18 @@
    late (session 10, ``--ratio 7``): 1.65 on main (27.6 ms vs 16.8 ms) and 1.65 on f5fe250
    (28.0 vs 17.0 ms) — the goal is no longer met: the model-layer speed-ups of the diagnosis
    work made the denominator (single evaluations) faster, not the calibration's per-point
-   bookkeeping (the model kernel is ~12 ms of the 27.6);
+   bookkeeping (the model kernel is ~12 ms of the 27.6).  Session 11 (the per-point bookkeeping
+   pass, h-cal; 2 cores shared by ~6 sessions, load 6-7), back to back, main = 133819a exported:
+   ``--ratio 7`` (wall) main 1.678 / 1.515 / 1.734 / 1.698, after 1.299 / 1.299 / 1.406 / 1.374;
+   ``--ratio 7 --cpu`` (this thread's CPU time, steadier here) main 1.575 / 1.652, after 1.299 /
+   1.310 (the calibration 26.9-28.6 -> 21.9-22.8 ms CPU, 100 evaluations 16.3-18.2 ms).  Still
+   above the goal; what remains (thread-time split of 60 calibrations, 20.7 ms CPU): the model
+   calls 15.9 ms (35 calls of 7-14 sets x 500 lines; the kernel's physics ~8 ms of it, the
+   residuals' complex division, |q| and arctan2 ~1.4 ms, state map, shared rows and Jacobian the
+   rest), the search's own steps 2.5 ms (the 8x8 solves, lm_steps' damped steps), identifiability
+   with its probe call 0.7 ms, predictor and result 1.6 ms.  Estimates, intervals, correlations
+   and start records bit for bit those of main (the benchmark's calibration and 32 more: 12 noise
+   draws x 1 and 4 starts, 4 estimated-noise draws x 1 and 4 starts), 35 model calls as on main;
 5. ``--speed PAIRS --root OTHER``: wall time of the calibrations above against another checkout
    (e.g. the commit before the speed work), paired and interleaved: each pair runs one fresh
    interpreter per checkout (order alternating), each times ``--reps`` calls after one warm-up
@@ -23,6 +34,7 @@
 
     python3 tests/benchmarks/bench_calibration.py [--draws 400] [--starts 4]
     python3 tests/benchmarks/bench_calibration.py --speed 7 --root /path/to/baseline/checkout
+    python3 tests/benchmarks/bench_calibration.py --ratio 7 [--cpu] [--root /path/to/other/checkout]
 
 Measured (2 shared cores, 2026-11-23, issue 17), against a06d884 (the engine before the issue-17
 work; main at df39d69 timed the same), ``--speed 11 --reps 3 --speed-draws 10``, ratio
