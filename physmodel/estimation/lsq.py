@@ -236,7 +236,7 @@ def residual_jacobian(data: FrequencySweep | ScalarObservations, free: Sequence[
 
 
 @lru_cache(maxsize=32)
-def _lhs_cached(free: tuple, n: int, seed) -> np.ndarray:
+def _lhs_cached(free: tuple, n: int, seed, seed_type: type) -> np.ndarray:
     out = lhs_starts(list(free), n, seed)
     out.flags.writeable = False
     return out
@@ -247,7 +247,8 @@ def _lhs_starts(free: Sequence[FreeParameter], n: int, seed) -> np.ndarray:
     for every calibration of one problem (Monte Carlo draws, repeated fits) without rebuilding
     scipy's sampler."""
     try:
-        return _lhs_cached(tuple(free), n, seed)
+        # keyed by the seed's type too: True == 1, but lhs_starts refuses a bool
+        return _lhs_cached(tuple(free), n, seed, type(seed))
     except TypeError:             # unhashable: not kept (lhs_starts says what is wrong with it)
         return lhs_starts(free, n, seed)
 

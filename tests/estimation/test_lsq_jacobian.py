@@ -216,3 +216,13 @@ def test_points_evaluated_together_or_apart_give_the_same_fit(problem, monkeypat
         assert together.values[n] == apart.values[n]
         assert together.ci_lower[n] == apart.ci_lower[n] and together.ci_upper[n] == apart.ci_upper[n]
     assert [(s.cost, s.nfev, s.status) for s in together.starts] == [(s.cost, s.nfev, s.status) for s in apart.starts]
+
+
+def test_the_kept_starts_do_not_let_a_bool_seed_through(problem):
+    # the Latin-hypercube starts are kept per (free, n, seed): True == 1, but a bool seed is refused
+    from physmodel.errors import ParameterError
+
+    base, _, sw, _ = problem
+    calibrate(sw, base, ["d", "alpha0"], starts=2, seed=1)
+    with pytest.raises(ParameterError, match="seed must be a non-negative integer"):
+        calibrate(sw, base, ["d", "alpha0"], starts=2, seed=True)
