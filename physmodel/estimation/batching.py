@@ -46,6 +46,9 @@ class ModelBatch:
         self.predict, self.predict_many, self.predict_array = predict, predict_many, predict_array
         self.evaluations = 0
         self.calls = 0
+        #: whether each row's prediction is the same whatever other rows share its call (two rows
+        #: or more): ``predict_array.rows_independent`` (lets the engine group points freely)
+        self.rows_independent = predict_array is not None and bool(getattr(predict_array, "rows_independent", False))
         #: per set of active columns, what the engine's Jacobians need that no point changes
         #: (:func:`physmodel.estimation.lsq._residuals_and_jacobians`); one residual model per batch
         self.layouts: dict = {}

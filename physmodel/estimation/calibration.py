@@ -139,6 +139,11 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
                 _PLANS.pop(next(iter(_PLANS)))
             _PLANS[key] = _jacobian_plan(smap, list(free), predict_array, inv_T)
         predict_array.jacobian_plan = _PLANS[key]
+        # each row evaluated on its own: the kernel is elementwise and its batch-wide tests (the
+        # smallest Re γ, the smallest line argument) only choose between forms giving the same
+        # numbers; the state map's matrix product rounds every row alike in calls of two rows or
+        # more (a single row takes a matrix-vector product)
+        predict_array.rows_independent = True
         predict_many.array = predict_array
     return predict_many, SensitivityProbe(f_probe, probe_many, probe_array), q
 

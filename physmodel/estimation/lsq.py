@@ -36,8 +36,10 @@ Search and stopping (see ``_solve``)
     (:func:`~physmodel.estimation.lm_steps.damped_steps`: it
     usually reaches an earlier optimum or converges there, for a third of the overhead of scipy's
     trust region, which rebuilds its model from an SVD every iteration); then — start 0 directly —
-    scipy's trust-region reflective search.  All starts' first points are evaluated up front,
-    several per model call (at most :data:`CALL_VALUES` predictions).
+    scipy's trust-region reflective search.  The later starts' first points share one model call;
+    for a predictor whose rows do not depend on their call (``rows_independent``: the physics
+    array path), every start's first point is evaluated up front, several per model call (at most
+    :data:`CALL_VALUES` predictions).
     When the trust region crawls (:func:`~physmodel.estimation.lm_steps.crawling`: over
     :data:`~physmodel.estimation.lm_steps.CRAWL_POINTS` points its best cost fell by less than a
     tenth of the Gauss–Newton decrement it had, that decrement above 1e-4·s²) — a valley the data
@@ -167,7 +169,7 @@ def _residuals_and_jacobians(batch: ModelBatch, rows: ScaledRows, zs, hi, fd_ste
     call costs about the same for one row or twenty: its per-call work dominates)."""
     fd, fd_rows, known, scaled = _layout(batch, rows, res)
     n, m = len(zs[0]), len(fd)
-    per_call = max(1, CALL_VALUES // ((m + 1) * res.n_values))
+    per_call = max(1, CALL_VALUES // ((m + 1) * res.n_values)) if _regroups(batch, m) else len(zs)
     if len(zs) > per_call:      # in calls of at most CALL_VALUES predictions
         return [out for i in range(0, len(zs), per_call)
                 for out in _residuals_and_jacobians(batch, rows, zs[i:i + per_call], hi, fd_step, res)]
@@ -192,6 +194,16 @@ def _residuals_and_jacobians(batch: ModelBatch, rows: ScaledRows, zs, hi, fd_ste
             np.multiply(JT[j], c, out=JT[i])
         out.append((Rb[0], np.ascontiguousarray(JT.T)))
     return out
+
+
+def _regroups(batch: ModelBatch, m: int) -> bool:
+    """Whether points may be grouped into model calls freely (:data:`CALL_VALUES`, every start's
+    first point up front): only for a predictor whose rows do not depend on the other rows of
+    their call (``batch.rows_independent``) and points of two sets or more (``m`` ≥ 1 difference
+    columns: a single set goes through a matrix-vector product, rounded otherwise).  Else the
+    points are grouped as before (an effect model's mode count, e.g., follows the lowest mode in
+    its call)."""
+    return batch.rows_independent and m >= 1
 
 
 def _layout(batch: ModelBatch, rows: ScaledRows, res) -> tuple:
@@ -545,14 +557,16 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     z_starts[:, [k for k in range(len(free)) if k not in active]] = z_init[[k for k in range(len(free)) if k not in active]]
     records, fits, ends = [], [], []
     firsts: dict = {}
+    rows0 = ScaledRows(free, x_full, active)
+    regroup = len(z_starts) > 1 and _regroups(batch, len(_layout(batch, rows0, res)[0]))
     for i, z0 in enumerate(z_starts):
-        if i == 0 and len(z_starts) > 1:
-            # every start's first point up front, several per model call (CALL_VALUES; two points
-            # cost far less than two calls): the same residuals and Jacobians as one by one
+        if (i == 0 and regroup) or (i == 1 and not regroup and len(z_starts) > 2):
+            # the starts' first points together: with rows independent of their call (_regroups)
+            # every start's up front, several per model call (CALL_VALUES; two points cost far
+            # less than two calls), else the later starts' in one call
             lo_a, hi_a = _z_box([free[k] for k in active])
-            pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts]
-            firsts = dict(enumerate(_residuals_and_jacobians(batch, ScaledRows(free, x_full, active), pts, hi_a,
-                                                             fd_step, res)))
+            pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[i:]]
+            firsts = dict(enumerate(_residuals_and_jacobians(batch, rows0, pts, hi_a, fd_step, res), start=i))
         fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits, firsts.get(i),
                      damped)
         fit.index = i

@@ -226,3 +226,33 @@ def test_the_kept_starts_do_not_let_a_bool_seed_through(problem):
     calibrate(sw, base, ["d", "alpha0"], starts=2, seed=1)
     with pytest.raises(ParameterError, match="seed must be a non-negative integer"):
         calibrate(sw, base, ["d", "alpha0"], starts=2, seed=True)
+
+
+def test_a_predictor_without_independent_rows_keeps_its_calls(problem, monkeypatch):
+    # grouping points differently is allowed only where each row's prediction does not depend on
+    # its call (an effect model's mode count follows the lowest mode in the call): a per-set
+    # predictor sees start 0's first point alone and the later starts' first points in one call,
+    # however small CALL_VALUES
+    from physmodel.estimation import lsq
+
+    base, _, sw, _ = problem
+    free = [default_free_parameter(base, n) for n in ("d", "alpha0", "laws.d.activation_energy")]
+    pm, probe, _ = physics_predictor(sw, base, free=free)
+    sizes = []
+
+    def spy(values_list):
+        sizes.append(len(values_list))
+        return pm(values_list)
+
+    monkeypatch.setattr(lsq, "CALL_VALUES", 1)
+    res = fit_parameters(sw, None, free, predict_many=spy, probe=replace(probe, predict_array=None), starts=4, seed=2)
+    # 1 + 3 difference sets per point: start 0's points one by one, then the later three first points together
+    n0 = res.starts[0].nfev
+    assert sizes[:n0] == [4] * n0 and sizes[n0] == 12 and set(sizes[n0 + 1:]) == {4}
+    # the array path with a single set per point (alpha0's column is known): grouped as before too
+    runs = []
+    for per_call in (10**9, 1):
+        monkeypatch.setattr(lsq, "CALL_VALUES", per_call)
+        runs.append(calibrate(sw, base, ["alpha0"], starts=4, seed=2))
+    assert runs[0].n_model_calls == runs[1].n_model_calls
+    assert runs[0].values == runs[1].values
