@@ -16,17 +16,19 @@
    (28.0 vs 17.0 ms) — the goal is no longer met: the model-layer speed-ups of the diagnosis
    work made the denominator (single evaluations) faster, not the calibration's per-point
    bookkeeping (the model kernel is ~12 ms of the 27.6).  Session 11 (the per-point bookkeeping
-   pass, h-cal; 2 cores shared by ~6 sessions, load 6-7), back to back, main = 133819a exported:
-   ``--ratio 7`` (wall) main 1.678 / 1.515 / 1.734 / 1.698, after 1.299 / 1.299 / 1.406 / 1.374;
-   ``--ratio 7 --cpu`` (this thread's CPU time, steadier here) main 1.575 / 1.652, after 1.299 /
-   1.310 (the calibration 26.9-28.6 -> 21.9-22.8 ms CPU, 100 evaluations 16.3-18.2 ms).  Still
-   above the goal; what remains (thread-time split of 60 calibrations, 20.7 ms CPU): the model
-   calls 15.9 ms (35 calls of 7-14 sets x 500 lines; the kernel's physics ~8 ms of it, the
-   residuals' complex division, |q| and arctan2 ~1.4 ms, state map, shared rows and Jacobian the
-   rest), the search's own steps 2.5 ms (the 8x8 solves, lm_steps' damped steps), identifiability
-   with its probe call 0.7 ms, predictor and result 1.6 ms.  Estimates, intervals, correlations
-   and start records bit for bit those of main (the benchmark's calibration and 32 more: 12 noise
-   draws x 1 and 4 starts, 4 estimated-noise draws x 1 and 4 starts), 35 model calls as on main;
+   pass, h-cal; 2 shared cores, load ~1 at the time), back to back, main = 133819a exported:
+   ``--ratio 7`` (wall) main 1.599 / 1.638 (25.2 / 25.3 ms vs 15.8 / 15.4 ms), after 1.301 /
+   1.351 (21.1 / 21.1 ms vs 16.2 / 15.6 ms); ``--ratio 7 --cpu`` (this thread's CPU time) main
+   1.597 / 1.633, after 1.312 / 1.314 (20.7 / 20.8 ms vs 15.8 ms); earlier under load 6-7: wall
+   main 1.68 / 1.52 / 1.73 / 1.70, after 1.30 / 1.30 / 1.41 / 1.37.  Still above the goal; what
+   remains (CPU split of 60 calibrations, 20.1-20.7 ms): the points' 34 calls 16.0 ms — the
+   kernel's physics 9.8 ms (7-14 sets x 500 lines a call), the residuals (complex division, |q|,
+   arctan2) 1.8 ms, the state map, shared rows and call layers ~2 ms, the Jacobian and rows
+   ~2 ms — the search's own steps ~2.2 ms (assess's 8x8 solves, lm_steps' damped steps),
+   identifiability with its probe call 0.65 ms, predictor and result ~1 ms; the goal needs ~3 ms
+   more.  Estimates, intervals, correlations, start records and model calls bit for bit / the
+   same as main's (the benchmark's calibration and 32 more: 12 noise draws x 1 and 4 starts, 4
+   estimated-noise draws x 1 and 4 starts; 35 model calls on the benchmark);
 5. ``--speed PAIRS --root OTHER``: wall time of the calibrations above against another checkout
    (e.g. the commit before the speed work), paired and interleaved: each pair runs one fresh
    interpreter per checkout (order alternating), each times ``--reps`` calls after one warm-up
