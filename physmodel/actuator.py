@@ -15,6 +15,8 @@ Sign convention of eq. (13): with α0 < 0 a positive voltage gives a positive ti
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from . import beam, electrode, transport
@@ -38,11 +40,17 @@ SLICE_FIELDS = ("h", "d", "K", "W", "kappa_e", "r2", "Rp")
 LINE_FIELDS = SLICE_FIELDS + ("r1", "L")
 
 
-def _take(p, idx, fields):
-    return p if idx is None else {f: p[f][idx] for f in fields}
+def _take(p, idx, fields, differ=None):
+    """The rows ``idx`` of ``p``'s ``fields``; a field not in ``differ`` (the same in every set,
+    rows set-major) as its first ``len(idx)`` rows, the same values without a gather."""
+    if idx is None:
+        return p
+    if differ is None:
+        return {f: p[f][idx] for f in fields}
+    return {f: p[f][idx] if f in differ else p[f][:len(idx)] for f in fields}
 
 
-def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
+def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None, differ=None) -> dict:
     """The actuator ``quantities`` at points ``s`` for parameter values ``p`` (see :class:`State`).
 
     Only what the quantities need is computed: G alone needs no charge dynamics or electrode
@@ -50,7 +58,8 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
     ``(line, slice)`` for ``p`` as (n, 1) columns (see :func:`shared_rows`), each None or
     ``(first, inverse)``: the electrode line is evaluated only on the rows ``line[0]`` (row r takes
     the values of ``line[0][line[1][r]]``), the slice terms only on ``slice[0]`` of those; the
-    same operations on the same numbers, so the same results bit for bit.
+    same operations on the same numbers, so the same results bit for bit.  ``differ``: with
+    ``shared``, the fields that may differ between sets (default all; see :func:`shared_sets`).
     """
     out = {}
     wn = p["omega_n"]
@@ -66,8 +75,8 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None) -> dict:
     if not (want_z or want_h):
         return out
     line, sl = shared if shared is not None else (None, None)
-    pl = _take(p, None if line is None else line[0], LINE_FIELDS)
-    ps = _take(pl, None if sl is None else sl[0], SLICE_FIELDS)
+    pl = _take(p, None if line is None else line[0], LINE_FIELDS, differ)
+    ps = _take(pl, None if sl is None else sl[0], SLICE_FIELDS, differ)
     up = (lambda a: a) if sl is None else (lambda a: a[sl[1]])          # slice rows -> line rows
     full = (lambda a: a) if line is None else (lambda a: a[line[1]])    # line rows -> all rows
     c = transport.charge_terms(s, ps["h"], ps["d"], ps["K"])
@@ -105,26 +114,50 @@ def shared_rows(state: State):
     finite-difference sets of a parameter acting only on the mode or the gain — the ``shared``
     argument of :func:`actuator_kernel` for its flat rows (set-major); None when no set does."""
     n_sets, n_T = state.T.shape[:2]
-    cols = [getattr(state, f) for f in LINE_FIELDS]
-    if n_sets < 2 or any(c.shape != (n_sets, n_T, 1) for c in cols):
+    cols = {f: getattr(state, f) for f in LINE_FIELDS}
+    if n_sets < 2 or any(c.shape != (n_sets, n_T, 1) for c in cols.values()):
         return None
-    F = np.concatenate(cols, axis=2)                                  # (n_sets, n_T, n_fields)
-    keys = {n: np.ascontiguousarray(F[:, :, :n]).reshape(n_sets, -1) for n in (len(LINE_FIELDS), len(SLICE_FIELDS))}
+    return shared_sets(cols, n_sets, n_T)
+
+
+def shared_sets(values, n_sets: int, n_T: int, differ=LINE_FIELDS):
+    """:func:`shared_rows` for values given per field, ``n_sets·n_T`` each, set-major (any shape),
+    of which only the fields ``differ`` may differ between sets (the others must be the same in
+    every set: they are not compared).  Sets are compared bit for bit (their bytes)."""
+
+    def firsts(fields, sets):
+        """For each of ``sets`` the position in ``sets`` of the first one with the same bytes of ``fields``."""
+        fs = [f for f in fields if f in differ]
+        if not fs:
+            return (0,) * len(sets)
+        b = np.concatenate([np.asarray(values[f]).reshape(n_sets, n_T, 1) for f in fs], axis=2).tobytes()
+        w = len(b) // n_sets
+        seen: dict = {}
+        return tuple(seen.setdefault(b[i * w:(i + 1) * w], j) for j, i in enumerate(sets))
+
+    line = firsts(LINE_FIELDS, range(n_sets))
+    return _shared_index(line, firsts(SLICE_FIELDS, sorted(set(line))), n_T)
+
+
+@lru_cache(maxsize=64)
+def _shared_index(line_first: tuple, slice_first: tuple, n_T: int):
+    """The ``shared`` argument of :func:`actuator_kernel` from each set's first identical set
+    (electrode line over all sets, slice over the line's kept sets); kept per pattern (a
+    calibration repeats a few), its arrays read-only."""
     t = np.arange(n_T)
 
-    def level(sets, n_fields):
-        """(first, inverse) over the rows of ``sets``: each set mapped onto the first identical one."""
-        seen: dict = {}
-        first = [seen.setdefault(keys[n_fields][i].tobytes(), j) for j, i in enumerate(sets)]
+    def level(first):
         kept = sorted(set(first))
-        if len(kept) == len(sets):
-            return None, list(sets)
+        if len(kept) == len(first):
+            return None
         pos = {j: k for k, j in enumerate(kept)}
         inv = np.array([pos[j] for j in first])
-        return ((np.array(kept)[:, None] * n_T + t).ravel(), (inv[:, None] * n_T + t).ravel()), [sets[j] for j in kept]
+        out = ((np.array(kept)[:, None] * n_T + t).ravel(), (inv[:, None] * n_T + t).ravel())
+        for a in out:
+            a.flags.writeable = False
+        return out
 
-    line, kept = level(list(range(n_sets)), len(LINE_FIELDS))
-    sl, _ = level(kept, len(SLICE_FIELDS))
+    line, sl = level(line_first), level(slice_first)
     return None if line is None and sl is None else (line, sl)
 
 
@@ -176,6 +209,27 @@ class ActuatorModel(PhysicsModel):
         n = n_sets * n_T
         p = {k: np.ascontiguousarray(getattr(state, k).reshape(n))[:, None] for k in STATE_FIELDS}
         vals = actuator_kernel(p, s[None, :], qs, shared)
+        return {q: vals[q].reshape(n_sets, n_T, s.size) for q in qs}
+
+    def evaluate_columns(self, p, n_sets: int, n_T: int, s, quantities=None, differ=STATE_FIELDS) -> dict:
+        """:meth:`evaluate_state` for a state given as flat columns ``p[field]`` (n_sets·n_T, 1),
+        set-major (:meth:`~physmodel.parameter_paths.StateMap.columns`: no State to build and take
+        apart per call), of which only the fields ``differ`` may differ between sets; the same
+        numbers bit for bit.  The columns are only read.
+
+        Returns
+        -------
+        dict of str to ndarray
+            Complex arrays (n_sets, n_T, n_s) [Ω, m/V, -, m/V, A/V].
+        """
+        qs = self._check_quantities(quantities or self.quantities)
+        s = np.asarray(s)
+        shared = (shared_sets(p, n_sets, n_T, differ) if 1 < n_sets and n_sets * n_T * s.size <= self.chunk_size
+                  else None)
+        if shared is None:
+            state = State(**{k: p[k].reshape(n_sets, n_T, 1) for k in STATE_FIELDS})
+            return super().evaluate_state(state, s, qs)
+        vals = actuator_kernel(p, s[None, :], qs, shared, differ)
         return {q: vals[q].reshape(n_sets, n_T, s.size) for q in qs}
 
     def dc_gain(self, temperature_c) -> dict:

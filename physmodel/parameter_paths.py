@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ParameterError
-from .params import IPMCParameters
+from .params import STATE_FIELDS, IPMCParameters, State
 
 Values = Mapping[str, float]
 
@@ -182,12 +182,14 @@ class StateMap:
         self._log_ref = log_ref        # (n_var, n_T) ln|state| at the reference row
         self._slope = slope            # (n_var, n_T, n_names) ∂ln|state|/∂u
         self._sign = sign              # (n_var, n_T) sign of each moving field
-        self._logged = np.array([not m.startswith("laws.") for m in self.names])
-        from .params import STATE_FIELDS
-
+        self._logged = np.flatnonzero([not m.startswith("laws.") for m in self.names])
         self._fixed_names = [f for f in STATE_FIELDS if f not in varying]
         self._fixed = np.array([getattr(ref_state, f)[:, :, 0] for f in self._fixed_names]).reshape(
             len(self._fixed_names), 1, -1)                                                    # (n_fixed, 1, n_T)
+        # each State field's position in [moving fields..., fixed fields...]
+        self._order = [varying.index(f) if f in varying else len(varying) + self._fixed_names.index(f)
+                       for f in STATE_FIELDS]
+        self._fixed_columns = {}          # n_rows -> the fixed fields as flat columns (see columns)
 
     @classmethod
     def build(cls, base: IPMCParameters, names, lower, upper, reference, temperature_c) -> StateMap | None:
@@ -216,7 +218,7 @@ class StateMap:
 
     @classmethod
     def _build(cls, base, paths: tuple[ParameterPath, ...], lower, upper, reference, temperature_c) -> StateMap | None:
-        from .params import STATE_FIELDS, State, state_at
+        from .params import state_at
 
         names = [pp.name for pp in paths]
         by_name = {pp.name: pp for pp in paths}
@@ -272,23 +274,48 @@ class StateMap:
 
     def _log_state(self, U):
         """ln|state| of the moving fields, (n_rows, n_var, n_T), at natural coordinates ``U``."""
-        return self._log_ref[None] + np.moveaxis(self._slope @ (U - self._u_ref[None, :]).T, -1, 0)
+        # (n_var, n_T, n_rows) seen as (n_rows, n_var, n_T): np.moveaxis(·, -1, 0), without its Python layer
+        return self._log_ref[None] + (self._slope @ (U - self._u_ref[None, :]).T).transpose(2, 0, 1)
 
-    def __call__(self, X):
-        """The :class:`~physmodel.params.State` (n_rows, n_T, 1) of the rows of ``X`` (n_rows, n_names)
-        [each parameter's SI unit]."""
-        from .params import STATE_FIELDS, State
-
+    def _moving(self, X):
+        """The moving fields (n_var, n_rows, n_T) at the rows of ``X`` (n_rows, n_names)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != len(self.names):
             raise ParameterError(f"StateMap: {X.shape[1]} columns for {len(self.names)} parameters {self.names}")
         U = X.copy()
         U[:, self._logged] = np.log(np.abs(X[:, self._logged]))      # ParameterPath.natural, all columns at once
-        moving = self._sign[:, None, :] * np.exp(self._log_state(U).transpose(1, 0, 2))   # (n_var, n_rows, n_T)
-        fixed = np.repeat(self._fixed, X.shape[0], axis=1)                                # (n_fixed, n_rows, n_T)
-        vals = {f: moving[i, :, :, None] for i, f in enumerate(self._varying)}
-        vals.update({f: fixed[i, :, :, None] for i, f in enumerate(self._fixed_names)})
-        return State(**{f: vals[f] for f in STATE_FIELDS})
+        E = np.exp(self._log_state(U).transpose(1, 0, 2))
+        # written C-ordered (n_var, n_rows, n_T): each field's rows are then one contiguous block
+        return np.multiply(self._sign[:, None, :], E, out=np.empty(E.shape))
+
+    def columns(self, X) -> tuple[dict, int, tuple]:
+        """The state of the rows of ``X`` (n_rows, n_names) [each parameter's SI unit] as flat
+        columns {field: (n_rows·n_T, 1)}, set-major, with n_rows and the fields that move with
+        the parameters (the others are the same in every row): what
+        :meth:`~physmodel.actuator.ActuatorModel.evaluate_columns` takes.  The fixed fields'
+        columns are kept per row count, read-only; the values are those of :meth:`__call__`."""
+        moving = self._moving(X)
+        n_rows = moving.shape[1]
+        n = n_rows * moving.shape[2]
+        cols = self._fixed_columns.get(n_rows)
+        if cols is None:
+            if len(self._fixed_columns) >= 16:
+                self._fixed_columns.pop(next(iter(self._fixed_columns)))
+            fixed = np.repeat(self._fixed, n_rows, axis=1)
+            fixed.flags.writeable = False
+            cols = self._fixed_columns[n_rows] = {f: fixed[i].reshape(n)[:, None] for i, f in enumerate(self._fixed_names)}
+        p = dict(cols)
+        for i, f in enumerate(self._varying):
+            p[f] = moving[i].reshape(n)[:, None]
+        return p, n_rows, tuple(self._varying)
+
+    def __call__(self, X):
+        """The :class:`~physmodel.params.State` (n_rows, n_T, 1) of the rows of ``X`` (n_rows, n_names)
+        [each parameter's SI unit]."""
+        moving = self._moving(X)                                              # (n_var, n_rows, n_T)
+        fixed = np.repeat(self._fixed, moving.shape[1], axis=1)               # (n_fixed, n_rows, n_T)
+        parts = [*moving[:, :, :, None], *fixed[:, :, :, None]]
+        return State(**dict(zip(STATE_FIELDS, [parts[i] for i in self._order])))
 
 
 @lru_cache(maxsize=32)

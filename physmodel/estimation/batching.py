@@ -27,8 +27,10 @@ class ScaledRows:
 
     def __call__(self, Z: np.ndarray) -> np.ndarray:
         X = np.repeat(self.x_full[None, :], len(Z), axis=0)
-        # clipped as in FreeParameter.from_z, so that the interval of an undetermined parameter stays finite
-        X[:, self.active] = np.where(self.log, self.sign * 10.0 ** np.clip(Z, -300.0, 300.0), self.lower + Z * self.span)
+        # clipped as in FreeParameter.from_z (np.clip's values, without its Python layer), so that
+        # the interval of an undetermined parameter stays finite
+        E = np.power(10.0, np.minimum(np.maximum(Z, -300.0), 300.0))
+        X[:, self.active] = np.where(self.log, np.multiply(self.sign, E, out=E), self.lower + Z * self.span)
         return X
 
 
@@ -44,6 +46,12 @@ class ModelBatch:
         self.predict, self.predict_many, self.predict_array = predict, predict_many, predict_array
         self.evaluations = 0
         self.calls = 0
+        #: whether each row's prediction is the same whatever other rows share its call (two rows
+        #: or more): ``predict_array.rows_independent`` (lets the engine group points freely)
+        self.rows_independent = predict_array is not None and bool(getattr(predict_array, "rows_independent", False))
+        #: per set of active columns, what the engine's Jacobians need that no point changes
+        #: (:func:`physmodel.estimation.lsq._residuals_and_jacobians`); one residual model per batch
+        self.layouts: dict = {}
 
     def jacobian_plan(self, active) -> dict:
         """The predictor's known Jacobian columns (``predict_array.jacobian_plan``: {k: ("scaled",

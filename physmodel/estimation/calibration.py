@@ -112,9 +112,15 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
         # lines laid out as the (temperature × frequency) grid, row-major: a reshape, not a gather
         on_grid = inv_T.size == Tu.size * fu.size and np.array_equal(inv_T * fu.size + inv_f, np.arange(inv_T.size))
 
+        columns = getattr(model, "evaluate_columns", None)     # states as flat columns, no State per call
+
         def predict_array(X):
             with np.errstate(all="ignore"):     # a non-finite response is refused by the residuals
-                R = model.evaluate_state(smap(X), s_data, (q,))[q]
+                if columns is not None:
+                    p, n_rows, differ = smap.columns(X)
+                    R = columns(p, n_rows, Tu.size, s_data, (q,), differ)[q]
+                else:
+                    R = model.evaluate_state(smap(X), s_data, (q,))[q]
             if on_grid:
                 R = R.reshape(R.shape[0], -1)
                 R *= factor
@@ -133,6 +139,11 @@ def physics_predictor(data: FrequencySweep, base: IPMCParameters, kind: str = "a
                 _PLANS.pop(next(iter(_PLANS)))
             _PLANS[key] = _jacobian_plan(smap, list(free), predict_array, inv_T)
         predict_array.jacobian_plan = _PLANS[key]
+        # each row evaluated on its own: the kernel is elementwise and its batch-wide tests (the
+        # smallest Re γ, the smallest line argument) only choose between forms giving the same
+        # numbers; the state map's matrix product rounds every row alike in calls of two rows or
+        # more (a single row takes a matrix-vector product)
+        predict_array.rows_independent = True
         predict_many.array = predict_array
     return predict_many, SensitivityProbe(f_probe, probe_many, probe_array), q
 
@@ -294,15 +305,16 @@ def calibrate(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamet
                          predict_array=predict_many.array, max_nfev=max_nfev, identify=identify,
                          hold_undetermined=hold_undetermined, probe=probe, progress=progress, **kwargs)
     label = name or f"{base.name}_calibrated"
+    fingerprint = data.fingerprint()          # a SHA-256 of the data: once
     src = (f"calibrated by physmodel.estimation.calibration to {data.output_name}/{data.input_name} sweep "
-           f"{data.fingerprint()[:12]} ({kind} {q}); free: {', '.join(res.names)}"
+           f"{fingerprint[:12]} ({kind} {q}); free: {', '.join(res.names)}"
            + (f"; undetermined (held at base): {', '.join(res.held)}" if res.held else "")
            + (f"; undetermined, NOT held (holding would worsen the fit beyond its test): {', '.join(res.hold_refused)}"
               if res.hold_refused else "")
            + f"; base: {base.name}")
     res.parameters = replace(apply_values(base, res.values, paths), name=label, source=src)
     res.metadata.update({"kind": kind, "quantity": q, "kernel": kernel, "base": base.name,
-                         "data_fingerprint": data.fingerprint(), "seed": seed})
+                         "data_fingerprint": fingerprint, "seed": seed})
     if effects:
         res.metadata["effects"] = {k: dict(v) for k, v in effects.items()}
     if not res.adequate:

@@ -15,7 +15,20 @@
    late (session 10, ``--ratio 7``): 1.65 on main (27.6 ms vs 16.8 ms) and 1.65 on f5fe250
    (28.0 vs 17.0 ms) — the goal is no longer met: the model-layer speed-ups of the diagnosis
    work made the denominator (single evaluations) faster, not the calibration's per-point
-   bookkeeping (the model kernel is ~12 ms of the 27.6);
+   bookkeeping (the model kernel is ~12 ms of the 27.6).  Session 11 (the per-point bookkeeping
+   pass, h-cal; 2 shared cores, load ~1 at the time), back to back, main = 133819a exported:
+   ``--ratio 7`` (wall) main 1.599 / 1.638 (25.2 / 25.3 ms vs 15.8 / 15.4 ms), after 1.301 /
+   1.351 (21.1 / 21.1 ms vs 16.2 / 15.6 ms); ``--ratio 7 --cpu`` (this thread's CPU time) main
+   1.597 / 1.633, after 1.312 / 1.314 (20.7 / 20.8 ms vs 15.8 ms); earlier under load 6-7: wall
+   main 1.68 / 1.52 / 1.73 / 1.70, after 1.30 / 1.30 / 1.41 / 1.37.  Still above the goal; what
+   remains (CPU split of 60 calibrations, 20.1-20.7 ms): the points' 34 calls 16.0 ms — the
+   kernel's physics 9.8 ms (7-14 sets x 500 lines a call), the residuals (complex division, |q|,
+   arctan2) 1.8 ms, the state map, shared rows and call layers ~2 ms, the Jacobian and rows
+   ~2 ms — the search's own steps ~2.2 ms (assess's 8x8 solves, lm_steps' damped steps),
+   identifiability with its probe call 0.65 ms, predictor and result ~1 ms; the goal needs ~3 ms
+   more.  Estimates, intervals, correlations, start records and model calls bit for bit / the
+   same as main's (the benchmark's calibration and 32 more: 12 noise draws x 1 and 4 starts, 4
+   estimated-noise draws x 1 and 4 starts; 35 model calls on the benchmark);
 5. ``--speed PAIRS --root OTHER``: wall time of the calibrations above against another checkout
    (e.g. the commit before the speed work), paired and interleaved: each pair runs one fresh
    interpreter per checkout (order alternating), each times ``--reps`` calls after one warm-up
@@ -23,6 +36,7 @@
 
     python3 tests/benchmarks/bench_calibration.py [--draws 400] [--starts 4]
     python3 tests/benchmarks/bench_calibration.py --speed 7 --root /path/to/baseline/checkout
+    python3 tests/benchmarks/bench_calibration.py --ratio 7 [--cpu] [--root /path/to/other/checkout]
 
 Measured (2 shared cores, 2026-11-23, issue 17), against a06d884 (the engine before the issue-17
 work; main at df39d69 timed the same), ``--speed 11 --reps 3 --speed-draws 10``, ratio
@@ -236,8 +250,9 @@ def speed(pairs: int, root: str, reps: int, draws: int):
           f"model evaluations {a['n_evaluations']} vs {b['n_evaluations']}")
 
 
-def ratio(rounds: int):
-    """Calibration (4 starts) ÷ 100 model evaluations on the same lines, interleaved (issue 29)."""
+def ratio(rounds: int, cpu: bool = False):
+    """Calibration (4 starts) ÷ 100 model evaluations on the same lines, interleaved (issue 29);
+    wall time, or with ``cpu`` this thread's CPU time (steadier on a shared machine)."""
     import gc
 
     import physmodel
@@ -253,14 +268,16 @@ def ratio(rounds: int):
     res = calibrate(sw, base, FREE, starts=4, seed=0)      # warm-up (imports, caches)
     evaluations()
     t_cal, t_ev = [], []
+    clock = time.thread_time if cpu else time.perf_counter
     for _ in range(rounds):
         for fn, out in ((lambda: calibrate(sw, base, FREE, starts=4, seed=0), t_cal), (evaluations, t_ev)):
             gc.collect()
-            t0 = time.perf_counter()
+            t0 = clock()
             fn()
-            out.append(time.perf_counter() - t0)
+            out.append(clock() - t0)
     r = np.array(t_cal) / np.array(t_ev)
-    print(f"== calibration ÷ 100 model evaluations ({physmodel.__file__}), {rounds} interleaved rounds")
+    print(f"== calibration ÷ 100 model evaluations ({physmodel.__file__}), {rounds} interleaved rounds, "
+          f"{'CPU' if cpu else 'wall'} time")
     print(f"8-parameter calibration, 4 starts: {np.median(t_cal) * 1e3:.1f} ms ({res.n_evaluations} parameter sets in "
           f"{res.n_model_calls} model calls); 100 evaluations of {res.n_lines} lines: {np.median(t_ev) * 1e3:.1f} ms")
     print(f"ratio (medians) {np.median(t_cal) / np.median(t_ev):.3f}; per round median {np.median(r):.3f} "
@@ -280,10 +297,11 @@ def main(argv=None):
     ap.add_argument("--speed-draws", type=int, default=10, help="1-start calibrations per repeat in --speed")
     ap.add_argument("--ratio", type=int, default=0, metavar="ROUNDS",
                     help="only calibration ÷ 100 model evaluations, this many interleaved rounds")
+    ap.add_argument("--cpu", action="store_true", help="with --ratio: this thread's CPU time instead of wall time")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.ratio:
-        return ratio(args.ratio)
+        return ratio(args.ratio, args.cpu)
     if args.worker:
         return worker(args.reps, args.speed_draws)
     if args.speed:

@@ -68,6 +68,25 @@ def test_state_map_matches_sets_built_one_by_one(problem):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=0, err_msg=f)
 
 
+def test_state_map_columns_are_its_states(problem):
+    # the oracle: the map's own states (checked against state_at above), field by field
+    base, _, _, free = problem
+    smap = StateMap.build(base, FREE, [fp.lower for fp in free], [fp.upper for fp in free],
+                          [fp.initial for fp in free], TEMPS)
+    for n_rows in (7, 1, 7):                 # the second 7: the fixed columns kept for that count
+        X = _rows_in_box(free, n_rows, seed=n_rows)
+        st = smap(X)
+        p, rows, differ = smap.columns(X)
+        assert rows == n_rows and sorted(p) == sorted(STATE_FIELDS)
+        for f in STATE_FIELDS:
+            assert p[f].shape == (n_rows * TEMPS.size, 1)
+            assert np.array_equal(p[f].reshape(n_rows, TEMPS.size, 1), getattr(st, f)), f
+            if f not in differ:             # the same in every row, and not writable
+                assert np.array_equal(getattr(st, f), np.broadcast_to(getattr(st, f)[:1], getattr(st, f).shape))
+                assert not p[f].flags.writeable
+    assert {"d", "kappa_e", "alpha0", "E", "xi", "r1"} <= set(differ) and "L" not in differ
+
+
 def test_state_map_refuses_what_is_not_log_affine(problem):
     base, _, _, _ = problem
     linear_law = replace(base, laws=base.laws.with_(r1_sheet=Linear(2e-3)))
@@ -178,3 +197,62 @@ def test_calibrated_estimate_is_stationary_for_the_reference_residuals(problem):
         if s.status == -2:
             assert "stopped early" in s.message and s.cost >= res.cost
     assert res.cost == pytest.approx(min(s.cost for s in res.starts if s.status != -2), rel=1e-12)
+
+
+def test_points_evaluated_together_or_apart_give_the_same_fit(problem, monkeypatch):
+    # the starts' first points share model calls (at most CALL_VALUES predictions each): how they
+    # are grouped must not change a bit of the result, only the number of calls
+    from physmodel.estimation import lsq
+
+    base, _, sw, _ = problem
+    runs = []
+    for per_call in (10**9, 1):          # all first points in one call; one point per call
+        monkeypatch.setattr(lsq, "CALL_VALUES", per_call)
+        runs.append(calibrate(sw, base, FREE, starts=4, seed=3))
+    together, apart = runs
+    assert apart.n_model_calls == together.n_model_calls + 3       # four first points: one call or four
+    assert apart.n_evaluations == together.n_evaluations
+    for n in FREE:
+        assert together.values[n] == apart.values[n]
+        assert together.ci_lower[n] == apart.ci_lower[n] and together.ci_upper[n] == apart.ci_upper[n]
+    assert [(s.cost, s.nfev, s.status) for s in together.starts] == [(s.cost, s.nfev, s.status) for s in apart.starts]
+
+
+def test_the_kept_starts_do_not_let_a_bool_seed_through(problem):
+    # the Latin-hypercube starts are kept per (free, n, seed): True == 1, but a bool seed is refused
+    from physmodel.errors import ParameterError
+
+    base, _, sw, _ = problem
+    calibrate(sw, base, ["d", "alpha0"], starts=2, seed=1)
+    with pytest.raises(ParameterError, match="seed must be a non-negative integer"):
+        calibrate(sw, base, ["d", "alpha0"], starts=2, seed=True)
+
+
+def test_a_predictor_without_independent_rows_keeps_its_calls(problem, monkeypatch):
+    # grouping points differently is allowed only where each row's prediction does not depend on
+    # its call (an effect model's mode count follows the lowest mode in the call): a per-set
+    # predictor sees start 0's first point alone and the later starts' first points in one call,
+    # however small CALL_VALUES
+    from physmodel.estimation import lsq
+
+    base, _, sw, _ = problem
+    free = [default_free_parameter(base, n) for n in ("d", "alpha0", "laws.d.activation_energy")]
+    pm, probe, _ = physics_predictor(sw, base, free=free)
+    sizes = []
+
+    def spy(values_list):
+        sizes.append(len(values_list))
+        return pm(values_list)
+
+    monkeypatch.setattr(lsq, "CALL_VALUES", 1)
+    res = fit_parameters(sw, None, free, predict_many=spy, probe=replace(probe, predict_array=None), starts=4, seed=2)
+    # 1 + 3 difference sets per point: start 0's points one by one, then the later three first points together
+    n0 = res.starts[0].nfev
+    assert sizes[:n0] == [4] * n0 and sizes[n0] == 12 and set(sizes[n0 + 1:]) == {4}
+    # the array path with a single set per point (alpha0's column is known): grouped as before too
+    runs = []
+    for per_call in (10**9, 1):
+        monkeypatch.setattr(lsq, "CALL_VALUES", per_call)
+        runs.append(calibrate(sw, base, ["alpha0"], starts=4, seed=2))
+    assert runs[0].n_model_calls == runs[1].n_model_calls
+    assert runs[0].values == runs[1].values

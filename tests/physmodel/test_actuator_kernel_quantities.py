@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from physmodel import ActuatorModel, beam, electrode, get_parameter_set, transport
-from physmodel.actuator import actuator_kernel, shared_rows
+from physmodel.actuator import LINE_FIELDS, SLICE_FIELDS, actuator_kernel, shared_rows, shared_sets
 from physmodel.model import PhysicsModel
 from physmodel.params import STATE_FIELDS, state_at
 
@@ -118,3 +118,64 @@ def test_evaluate_state_refuses_unknown_quantities():
     m = ActuatorModel(get_parameter_set("seed002_table3"))
     with pytest.raises(IPMCError, match="unknown quantity"):
         m.evaluate_state(_batch(), np.array([1j]), ("S",))
+
+
+def _first_identical(state, fields, sets):
+    """For each of ``sets`` the position (in ``sets``) of the first set with the same values of
+    ``fields`` at every temperature: a plain double loop with np.array_equal (the oracle of
+    shared_rows' grouping)."""
+    out = []
+    for j, i in enumerate(sets):
+        out.append(next(k for k, i2 in enumerate(sets)
+                        if all(np.array_equal(getattr(state, f)[i2], getattr(state, f)[i]) for f in fields)))
+    return out
+
+
+def _decode(level, n_sets_or_kept, n_T):
+    """(first rows, inverse) of one level of ``shared`` back to set indices."""
+    first, inverse = level
+    return first.reshape(-1, n_T)[:, 0] // n_T, inverse.reshape(-1, n_T)[:, 0] // n_T
+
+
+def test_shared_rows_groups_the_sets_an_independent_loop_groups():
+    st = _batch()
+    n_sets, n_T = st.T.shape[:2]
+    (line, sl) = shared_rows(st)
+    first = _first_identical(st, LINE_FIELDS, list(range(n_sets)))
+    kept = sorted(set(first))
+    rows, inv = _decode(line, n_sets, n_T)
+    assert rows.tolist() == kept and [kept[k] for k in inv] == first
+    first_s = _first_identical(st, SLICE_FIELDS, kept)
+    kept_s = sorted(set(first_s))
+    rows_s, inv_s = _decode(sl, len(kept), n_T)
+    assert rows_s.tolist() == kept_s and [kept_s[k] for k in inv_s] == first_s
+    # the fields that do not differ between sets need not be compared: the same grouping
+    differ = [f for f in LINE_FIELDS if not all(np.array_equal(getattr(st, f)[i], getattr(st, f)[0])
+                                                for i in range(n_sets))]
+    assert 0 < len(differ) < len(LINE_FIELDS)
+    got = shared_sets({f: getattr(st, f) for f in LINE_FIELDS}, n_sets, n_T, differ)
+    for a, b in zip(got, (line, sl)):
+        assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+
+
+@pytest.mark.parametrize("qs", [("M",), ("Z", "I"), ActuatorModel.quantities], ids="".join)
+def test_evaluate_columns_equals_evaluate_state_bit_for_bit(qs):
+    st = _batch()
+    n_sets, n_T = st.T.shape[:2]
+    m = ActuatorModel(get_parameter_set("seed002_table3"))
+    s = 2j * np.pi * np.logspace(-1, 3, 30)
+    p = {k: np.ascontiguousarray(getattr(st, k).reshape(-1))[:, None] for k in STATE_FIELDS}
+    for k in p.values():
+        k.flags.writeable = False           # the columns are only read
+    ref = m.evaluate_state(st, s, qs)
+    # only the fields that differ between sets named: the others are taken without a gather
+    differ = [f for f in STATE_FIELDS if not np.array_equal(getattr(st, f), np.broadcast_to(getattr(st, f)[:1],
+                                                                                           getattr(st, f).shape))]
+    assert {"d", "r1", "r2"} <= set(differ) and "L" not in differ
+    for got in (m.evaluate_columns(p, n_sets, n_T, s, qs), m.evaluate_columns(p, n_sets, n_T, s, qs, differ)):
+        for q in qs:
+            assert np.array_equal(got[q], ref[q]), q
+    # one set: the generic path, as evaluate_state takes it
+    one = {k: v[:n_T] for k, v in p.items()}
+    first = type(st)(**{k: getattr(st, k)[:1] for k in STATE_FIELDS})
+    assert np.array_equal(m.evaluate_columns(one, 1, n_T, s, ("M",))["M"], m.evaluate_state(first, s, ("M",))["M"])

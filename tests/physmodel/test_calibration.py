@@ -60,6 +60,27 @@ def test_residuals_closed_form_and_phase_wrap():
     assert residuals(np.vstack([model, model2]), sw).shape == (2, 6)
 
 
+def test_residuals_are_the_textbook_formula_bit_for_bit():
+    # oracle: ln|q|/σ_ln and np.angle(q)/σ_φ of q = G_d/G_m, written out here (the engine writes
+    # the halves in place and takes arg q on contiguous parts)
+    rng = np.random.default_rng(7)
+    n = 300
+    data = (rng.normal(size=n) + 1j * rng.normal(size=n)) * np.exp(rng.normal(size=n) * 3)
+    sw = FrequencySweep(np.full(n, 25.0), np.arange(1.0, n + 1), data, rng.uniform(0.05, 1, n), rng.uniform(0.5, 5, n))
+    G = (rng.normal(size=(4, n)) + 1j * rng.normal(size=(4, n))) * np.exp(rng.normal(size=(4, n)) * 3)
+    s_ln, s_ph = sw.magnitude_std_db * (math.log(10.0) / 20.0), np.radians(sw.phase_std_deg)   # σ_ln [Np], σ_φ [rad]
+    q = data / G
+    want = np.concatenate([np.log(np.abs(q)) / s_ln, np.angle(q) / s_ph], axis=-1)
+    assert np.array_equal(residuals(G, sw), want)
+    assert np.array_equal(residuals(G[1], sw), want[1])
+    # residuals whose sum overflows are still finite: no error
+    huge = FrequencySweep([25.0, 25.0], [1.0, 2.0], [1.0 + 0j, 1.0 + 0j], [4e-307, 4e-307], [1.0, 1.0])
+    r = residuals(np.array([1e-3, 1e-3]), huge)
+    with np.errstate(over="ignore"):
+        total = float(np.sum(r))
+    assert np.all(np.isfinite(r)) and not math.isfinite(total)
+
+
 def test_residuals_fallback_without_std():
     sw = FrequencySweep([25.0, 25.0], [1.0, 2.0], [1.0 + 0j, 1.0 + 0j])
     model = np.array([1.0, 1.0]) * np.exp(-FALLBACK_RELATIVE_STD)    # ln|G_d/G_m| = FALLBACK
