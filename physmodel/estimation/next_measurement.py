@@ -280,6 +280,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                 lines_per_decade=lines_per_decade, power=power, check_refit=check_refit, max_nfev=max_nfev,
                 z_crit=z_crit, target=target, nm=nm, view=view)
     out = _search(d, fitted, None, **opts)
+    assert out is not None          # None only when other forms are given
     if not out.inseparable:
         return out
     # a pair inseparable as fitted: the search again, with the other forms its models' fits may take
@@ -291,13 +292,14 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
             found = alternative_forms(d, m, max_nfev)
             if len(found) > 1:
                 alts[id(m)] = found
-    if not alts:
+    again = _search(d, fitted, alts, first_inseparable=list(out.inseparable), **opts) if alts else None
+    if again is None:       # no other form, or every other form the same response as the fit
         out.forms = {"tried": sorted(" + ".join(m.effects) for m in fitted
                                      if any(" + ".join(m.effects) in k.split(" vs ") for k in out.inseparable)),
                      "found": {}, "note": FORMS_NONE}
         out.message += " " + FORMS_NONE
         return out
-    return _search(d, fitted, alts, first_inseparable=list(out.inseparable), **opts)
+    return again
 
 
 #: Said when a pair is inseparable as fitted and its models fit the record in no other form.
@@ -308,12 +310,13 @@ FORMS_NONE = ("Other forms tried: the models of the pairs not separated fit the 
 
 def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz, temperature_limits_c,
             lines_per_decade, power, check_refit, max_nfev, z_crit, target, nm, view,
-            first_inseparable: Sequence[str] = ()) -> NextMeasurement:
+            first_inseparable: Sequence[str] = ()) -> NextMeasurement | None:
     """The search of :func:`next_measurement` over its ``fitted`` competing models; ``alts``
     (``id(model) -> [(form, cost), ...]``, the fit first, :func:`~physmodel.estimation.next_measurement_forms.alternative_forms`)
     the other forms each model's fit may take, searched as possible truths in every pair it is in;
     ``first_inseparable`` the pairs the search without them found inseparable (their fits are the
-    same response: left to parsimony, only their other forms searched)."""
+    same response: left to parsimony, only their other forms searched).  None when ``alts`` is
+    given but no model keeps a form distinct from its fit (nothing new to search)."""
     from .signatures import vuong_power
 
     label = lambda m: " + ".join(m.effects)  # noqa: E731
@@ -343,6 +346,8 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     key = lambda a, b: f"{label(a)} vs {label(b)}"  # noqa: E731
     contests, forms_resp, forms_said = ({}, {}, {}) if not alts else \
         _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, first_inseparable)
+    if alts and not contests:
+        return None
     for c in contests.values():          # the forms' and re-based rivals' responses on the record
         for m in c.models():
             if id(m) not in rec:
@@ -547,6 +552,8 @@ def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, 
                 r_f.append(L[0])
             by_form.append(r_f)
         keep = distinct([f for f, _ in found], by_form, w, SAME_FORM_LAMBDA)
+        if len(keep) < 2:        # every other form is the fit's own response: nothing new to search
+            continue
         kept[id(m)] = [found[j][0] for j in keep]
         best = min(c for _, c in found)
         thr = form_threshold(d.alpha, len(m.free) - len(d.baseline.free))

@@ -55,18 +55,37 @@ def form_threshold(alpha: float, n_params: int) -> float:
 
 
 def _record_costs(d, m: CompetingModel, sets: list) -> np.ndarray:
-    """½ Σ r² of each parameter set of ``sets`` on the diagnosed record (one predict_many call)."""
+    """½ Σ r² of each parameter set of ``sets`` on the diagnosed record (one predict_many call, the
+    residuals of every set in one array); a set the model refuses or where it is not finite costs
+    inf (it is not a form), found set by set only when the batch fails."""
     s_ln, s_ph, _ = noise_std(d.data)
-    G = np.asarray(RecordView(d).record_many(m.model)(sets))
-    with np.errstate(all="ignore"):
-        out = np.full(len(sets), math.inf)
-        for i in range(len(sets)):
-            try:
-                r = standardised_residuals(G[i], d.data, s_ln, s_ph)
-            except Exception:  # noqa: BLE001 — a start where the model is not finite is not a form
-                continue
-            out[i] = 0.5 * float(r @ r)
+    pm = RecordView(d).record_many(m.model)
+    try:
+        r = standardised_residuals(np.asarray(pm(sets)), d.data, s_ln, s_ph)
+        return 0.5 * np.einsum("ij,ij->i", r, r)
+    except (ValueError, FloatingPointError):
+        pass
+    out = np.full(len(sets), math.inf)
+    for i, one in enumerate(sets):
+        try:
+            r = standardised_residuals(np.asarray(pm([one]))[0], d.data, s_ln, s_ph)
+        except (ValueError, FloatingPointError):    # not a form
+            continue
+        out[i] = 0.5 * float(r @ r)
     return out
+
+
+def _grid_axis(lo: float, hi: float, typ: float) -> list[float]:
+    """Screening values of one effect parameter within [lo, hi]: a log grid where the range is
+    positive (from typical/30 when the lower bound is 0, which is kept), a linear one for a
+    parameter that changes sign (e.g. a temperature coefficient), else the two bounds."""
+    if lo > 0 and hi > lo:
+        return [float(v) for v in np.geomspace(lo, hi, GRID_POINTS)]
+    if lo == 0 and typ > 0 and hi > typ / 30.0:
+        return [0.0] + [float(v) for v in np.geomspace(typ / 30.0, hi, GRID_POINTS)]
+    if lo < 0 < hi:
+        return [float(v) for v in np.linspace(lo, hi, GRID_POINTS)]
+    return [float(lo), float(hi)]
 
 
 def alternative_forms(d, m: CompetingModel, max_nfev: int) -> list[tuple[CompetingModel, float]]:
@@ -106,8 +125,7 @@ def alternative_forms(d, m: CompetingModel, max_nfev: int) -> list[tuple[Competi
             rng = (cr.multistart or {}).get("ranges", {})
             initials.append({**m.values, **{k: 0.5 * (v[0] + v[1]) for k, v in rng.items() if k in names},
                              **{f"{c}.{p}": v for p, v in cr.values.items() if f"{c}.{p}" in names}})
-    axes = [([lo] if lo == 0 else []) + list(np.geomspace(max(lo, typ / 30.0) if lo == 0 else lo, hi, GRID_POINTS))
-            if hi > 0 and (lo > 0 or typ > 0) else [lo, hi] for _, lo, hi, typ in eff]
+    axes = [_grid_axis(lo, hi, typ) for _, lo, hi, typ in eff]
     grid = [{**m.values, **{n: float(v) for (n, *_), v in zip(eff, pt)}} for pt in itertools.product(*axes)]
     screened = _record_costs(d, m, grid)
     initials += [grid[i] for i in np.argsort(screened)[:GRID_REFITS] if np.isfinite(screened[i])]

@@ -191,7 +191,7 @@ class NextMeasurement:
                       "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
                       "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity,
                       "inseparable_as_fitted": list(self.inseparable_as_fitted), "premise": self.premise,
-                      **({"forms": self.forms} if self.forms else {})})
+                      "forms": self.forms})
 
 
 

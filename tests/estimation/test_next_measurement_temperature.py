@@ -225,3 +225,29 @@ def test_a_fit_in_a_nested_form_is_searched_in_its_other_forms(isn):
                          "tip_displacement", "mm", "current", "uA")
     d2 = diag(merge_records(sweep, new))
     assert d2.verdict == "named" and d2.named == ["transimpedance"]
+
+
+def test_other_forms_of_an_effect_whose_range_changes_sign():
+    """A parameter whose candidate range changes sign (leakage's temperature coefficient, [-0.01,
+    0.01] /K) is screened on a linear grid: every form returned lies within its candidate bounds
+    and has a finite cost on the record, the fit first (a log grid over the range had given NaN
+    starts, and the model refused them: next_measurement raised for any inseparable pair with such
+    an effect).  Record: the independent sensor (hidden amplifier pole, seed 950)."""
+    from physmodel.estimation.next_measurement_design import fit_competing_models
+    from physmodel.estimation.next_measurement_forms import alternative_forms
+    from scenarios.steps_chain import physics_free
+
+    isn, jc = independent("independent_sensor"), independent("joint_cases")
+    S, _, _ = jc.make_joint_sensor_case(950, "amplifier")
+    p0 = get_parameter_set("seed000_sensor_dev", T_ref=isn.TEMPERATURE_C + 273.15)
+    d = diagnose(S, p0, kind="sensor", candidates=["time_delay", "leakage"],
+                 free=physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)), null_draws=200,
+                 null_refits=1, baseline_starts=2, seed=1)
+    (m,) = fit_competing_models(d, [("leakage",)], 100)
+    found = alternative_forms(d, m, 100)
+    bounds = d.metadata["candidate_bounds"]["leakage"]
+    assert found[0][0] is m
+    for form, cost in found:
+        assert math.isfinite(cost)
+        for p, (lo, hi, _) in bounds.items():
+            assert lo <= form.values[f"leakage.{p}"] <= hi
