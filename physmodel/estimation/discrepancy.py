@@ -481,7 +481,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                 # (three separate fits each ran to the same optimum)
                 fitted_pairs[key] = refit([a, b], own, [None, {b: lin_start(b, r_a, Qa)}],
                                           more=[(f"{b} refit", own_b, [{a: lin_start(a, r_b, Qb)}]),
-                                                ("baseline optimum, joint linearised", v0, [joint_start(a, b)])])
+                                                ("baseline optimum, joint linearised", v0, [joint_start(a, b)])],
+                                          origin=f"{a} refit")
                 counter.enter(was)
             return fitted_pairs[key]
 

@@ -85,11 +85,13 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
     and k moved by secant steps on the profile's derivative, which at an inner optimum is the
     gradient's k-th component (Jᵀr)_k (the envelope theorem), regula falsi (Illinois) once
     bracketed — also by a step that overshoots the minimum, where the cost rises but that
-    derivative changes sign; the first step ``moved`` (what the trust region moved k by while
-    crawling) times four.  Each step starts the others where the last point's Gauss–Newton model
+    derivative changes sign, provided the inner fit converged there or the cost rose by at most
+    4 s² (else the point is on the valley's wall, its gradient the wall's, and the search ends);
+    the first step ``moved`` (what the trust region moved k by while crawling) times four.  Each step starts the others where the last point's Gauss–Newton model
     puts them at the new k (along the valley).  At most :data:`PROFILE_STEPS` secant steps,
     ending when a step moves k by less than 1e-9 of its range, after :data:`PROFILE_STALE` steps
-    without a lower point, at a point with a status (converged, joined) or at the budget; the
+    without a point lower by more than :data:`INNER_DECREMENT`·s² (near the optimum g is
+    finite-difference noise and "lower" by 1e-12 kept the search going), at a point with a status (converged, joined) or at the budget; the
     inner fits end at a decrement below :data:`INNER_DECREMENT`·s² (``s2`` the engine's s²).
     Returns the lowest point reached; the trust region resumes from it (and its tests end the
     search)."""
@@ -149,21 +151,25 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
         return z
 
     def inner(p):
-        """The other coordinates fitted by Gauss–Newton steps at p's k (halved when the cost rises)."""
+        """The other coordinates fitted by Gauss–Newton steps at p's k (halved when the cost
+        rises), as (point, converged): converged when the decrement fell below
+        :data:`INNER_DECREMENT`·s² (or nothing is left to move)."""
         for _ in range(INNER_POINTS):
             if p[3] is not None or stopped_at_budget():
-                return p
+                return p, p[3] is not None
             st = gn_step(p, p[1])
-            if st is None or not len(st[0]):
-                return p
+            if st is None:
+                return p, False
+            if not len(st[0]):
+                return p, True
             f, sf = st
             if -0.5 * float((p[2][:, f].T @ p[1]) @ sf) < INNER_DECREMENT * s2:
-                return p
+                return p, True
             for _ in range(2):
                 z = p[0].copy()
                 z[f] = np.clip(z[f] + sf, lo_in[f], hi_in[f])
                 if stopped_at_budget():
-                    return p
+                    return p, False
                 count[0] += 1
                 new = evaluate(z)
                 if new[6] < p[6] or new[3] is not None:
@@ -171,13 +177,13 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
                     break
                 sf = 0.5 * sf
             else:
-                return p
-        return p
+                return p, False
+        return p, False
 
     def grad_k(p):
         return float(p[2][:, k] @ p[1])
 
-    cur = inner(pt)
+    cur, _ = inner(pt)
     best = cur if cur[6] < pt[6] else pt
     if cur[3] is not None:
         return cur
@@ -208,10 +214,16 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
         if abs(zk - cur[0][k]) <= 1e-9 * (hi[k] - lo[k]):
             break
         count[0] += 1
-        new = inner(evaluate(along(cur, zk)))
+        new, converged = inner(evaluate(along(cur, zk)))
         if new[3] is not None:
             return new if new[6] < best[6] else best
         g_new = grad_k(new)
+        if not np.isfinite(g_new):
+            break
+        # a point whose inner fit did not get back into the valley (its cost far above the last)
+        # is no profile point: its g is the steep wall's, not the profile's derivative
+        if not converged and new[6] > cur[6] + 4.0 * s2:
+            break
         if not new[6] < cur[6] and (below is None or above is None) and not g_new * g < 0:
             break                        # the profile does not fall that way: leave it to the trust region
         if below is None or above is None:      # secant on g, at most four times further
@@ -221,8 +233,10 @@ def profile_search(pt, evaluate, lo, hi, count, stopped_at_budget, moved, s2):
             step = float(np.clip(step, -4.0 * abs(dz), 4.0 * abs(dz)))
         cur, g = new, g_new
         stale += 1
-        if cur[6] < best[6]:
+        if cur[6] < best[6] - INNER_DECREMENT * s2:
             best, stale = cur, 0
+        elif cur[6] < best[6]:
+            best = cur
     return best
 
 

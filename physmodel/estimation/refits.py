@@ -106,13 +106,14 @@ class Refitter:
         return out
 
     def refit(self, effects_on: Sequence[str], start_vals: Mapping, eff_starts: list, sim=None, identify=True,
-              from_user=False, more: Sequence[tuple[str, Mapping, list]] = ()) -> CalibrationResult:
-        """Best of the refits from ``start_vals`` (and, ``from_user``, the user's start) × ``eff_starts``,
-        and from each ``(origin, start values, effect starts)`` of ``more``, searched as one
-        multi-start (warm starts from the baseline optimum first): a start that reaches an earlier
-        one's optimum stops there."""
+              from_user=False, more: Sequence[tuple[str, Mapping, list]] = (),
+              origin: str = "baseline optimum") -> CalibrationResult:
+        """Best of the refits from ``start_vals`` (named ``origin`` in the spread's record; and,
+        ``from_user``, the user's start) × ``eff_starts``, and from each ``(origin, start values,
+        effect starts)`` of ``more``, searched as one multi-start in that order: a start that
+        reaches an earlier one's optimum stops there."""
         origins, points = [], []
-        sources = ([("baseline optimum", start_vals, eff_starts)]
+        sources = ([(origin, start_vals, eff_starts)]
                    + ([("user start", self.user0, eff_starts)] if from_user else []) + list(more))
         for origin, sv, e_starts in sources:
             for starts in e_starts:

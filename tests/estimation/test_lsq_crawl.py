@@ -97,3 +97,35 @@ def test_a_profile_step_past_the_minimum_brackets_it(seed):
                          2.0 * start[6] / (M - 1))
     assert out[6] == pytest.approx(cost_opt, abs=1e-8), (out[0], z_opt, count)
     assert profile(out[0][0]) <= cost_opt + 1e-8
+
+
+def test_a_point_on_the_valleys_wall_is_not_a_bracket_end():
+    # review of the bracketing: a step past the valley's fold lands where the inner fit cannot get
+    # back to the floor (b's bound holds it), with the steep wall's gradient (+1e4 against the
+    # floor's ~0.3).  Taken as a bracket end, regula falsi crept 1e-5 a step from the good end and
+    # spent every secant step (28 evaluations) for nothing.  Floor: ½Σ(0.5(a − 0.4) + e)², wall
+    # K(b − sin 3a), a in [0, 1], b in [-2, 2]; the lowest point evaluated is what is returned.
+    e = 0.1 * np.random.default_rng(0).normal(size=20)
+    seen = []
+
+    def residuals_jac(z):
+        a, b = z
+        r = np.concatenate([[K * (b - np.sin(3 * a))], 0.5 * (a - 0.4) + e])
+        J = np.zeros((21, 2))
+        J[0] = [-3.0 * K * np.cos(3 * a), K]
+        J[1:, 0] = 0.5
+        return r, J
+
+    base = _engine_point(residuals_jac)
+
+    def evaluate(z):
+        p = base(z)
+        seen.append(p[6])
+        return p
+
+    start = evaluate(np.array([0.3, np.sin(0.9)]))
+    count = [1]
+    out = profile_search(start, evaluate, np.array([0.0, -2.0]), np.array([1.0, 2.0]), count, lambda: False,
+                         np.array([0.1, 0.0]), 2.0 * start[6] / 19)
+    assert out[6] == min(seen) and out[6] < start[6]
+    assert count[0] <= 15, count      # 28 when the wall point bracketed the search

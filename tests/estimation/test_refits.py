@@ -118,6 +118,11 @@ def test_a_refit_from_several_origins_is_one_multistart_with_the_separate_refits
     ms = one.metadata["refit_multistart"]
     assert ms["origins"] == ["baseline optimum", "baseline optimum", "second", "third"]
     assert len(one.starts) == 4 and ms["n_joined"] >= 1          # a later start stopped in an earlier basin
+    # each start began at its own origin's values, the off value 50 Hz where no effect start is given
+    # (review: a start of `more` taken from start_vals or from the first origin's effect starts
+    # went unnoticed)
+    expected = [v for _, sv, e_s in origins for es in e_s for v in (sv["g"], (es or {}).get("lag", {}).get("fc", 50.0))]
+    assert [v for s in one.starts for v in (s.initial["g"], s.initial["lag.fc"])] == pytest.approx(expected, rel=1e-12)
     assert one.cost == pytest.approx(best_alone.cost, rel=1e-9)
     for k in ("g", "lag.fc"):
         assert one.values[k] == pytest.approx(best_alone.values[k], rel=1e-5)
