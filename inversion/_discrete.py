@@ -51,10 +51,12 @@ separate passes; the results agree to rounding.  When the poles cluster near z =
 sampling) and the denominator polynomial of ``ss2tf`` is not accurate enough, the poles are
 factored into second-order sections (:class:`FusedPass`, :mod:`inversion._sections`); the
 all-pole pass then runs as one polynomial re-expanded from those sections in extended precision
-and rounded to the best doubles, if that and its running rounding stay within 1e-10 (one
-``lfilter``: the seed 000 sensor at 20 kHz), else as the sections (``sosfilt``, ~1.3 ns/sample
-slower: at 50 kHz and above), with the same correlations in front; only if that, too, fails the
-accuracy check are the two passes run separately as sections.
+and rounded to the best doubles, if that and its running rounding stay within 1e-10 and the
+cascade amplifies nothing more than a constant, so that a step probes the worst case of that
+rounding (one ``lfilter``: the seed 000 sensor at 20 kHz), else as the
+sections (``sosfilt``, ~1.3 ns/sample slower: at 50 kHz and above, or a resonant anticausal
+part), with the same correlations in front; only if that, too, fails the accuracy check are the
+two passes run separately as sections.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ import scipy.linalg as sla
 import scipy.signal as sig
 
 __all__ = ["FusedPass", "sos_sections", "polynomial_denominator", "best_rounded_polynomial", "running_error_ok",
-           "all_pole_sections", "POLY_MAX_ORDER", "PROBE_MAX"]
+           "all_pole_sections", "probe_length", "POLY_MAX_ORDER", "PROBE_MAX", "DC_PEAK_TOL"]
 
 
 def sos_sections(Phi: np.ndarray, Bd: np.ndarray, C: np.ndarray, Dd: float, zs: np.ndarray,
@@ -57,6 +57,12 @@ def _conjugate_clean(r: np.ndarray) -> np.ndarray:
     small = np.abs(r.imag) <= 1e-12 * np.maximum(1.0, np.abs(r))
     r[small] = r[small].real
     return r
+
+
+#: The unit-circle test points of ``FOHFilter``: a logarithmic grid down to 1e-7 of the Nyquist
+#: frequency, and z = 1.  The factored responses are checked there (:meth:`FusedPass.factored`) and
+#: the rounded denominator polynomial is chosen there (:func:`best_rounded_polynomial`).
+_TEST_Z = np.exp(1j * np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0])))
 
 
 @dataclass
@@ -115,8 +121,7 @@ class FusedPass:
         denominator (``lfilter``) instead of the sections (``sosfilt``)."""
         sos = all_pole_sections(_conjugate_clean(np.linalg.eigvals(f1.Phi)))
         firs = []
-        theta = np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0]))
-        zs = np.exp(1j * theta)
+        zs = _TEST_Z
         zinv = 1.0 / zs
         den = np.prod([np.polyval(r[3:][::-1], zinv) for r in sos], axis=0)
         exacts = []
@@ -156,9 +161,10 @@ POLY_MAX_ORDER = 8
 #: Largest probe of :func:`running_error_ok` [samples]; slower poles keep the sections.
 PROBE_MAX = 1 << 15
 
-#: The unit-circle test points of ``FOHFilter`` (as ``1/z``): a logarithmic grid down to 1e-7 of
-#: the Nyquist frequency, and z = 1.
-_ZINV = 1.0 / np.exp(1j * np.pi * np.concatenate((np.logspace(-7, 0, 36), [0.0])))
+#: How far the all-pole cascade may amplify anything more than it amplifies a constant (its gain
+#: at any frequency, the l1 norm of its impulse response, both relative to its DC gain) for the
+#: step probe of :func:`running_error_ok` to stand for the worst case (:func:`probe_length`).
+DC_PEAK_TOL = 1e-9
 
 
 def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact: list) -> np.ndarray | None:
@@ -172,21 +178,23 @@ def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact:
     order one (at 20 kHz, ``a(1)`` is 2.9e-6 of coefficients up to 2.9): rounding each
     coefficient to the nearest double leaves ~1e-10 of ``a(1)``, and evaluating the check in
     double adds as much again (so the single transfer function of ``FOHFilter.build`` fails it).
-    Here (:func:`_rounded_denominator`) the exact coefficients are the product of the sections
-    in extended precision (``np.longdouble``), the doubles within 2 ulp of them (1 ulp beyond
-    order 4) that best match the exact denominator at the test points are chosen (the rounding
-    errors of the coefficients then partly cancel where the polynomial is small: 1.6e-11 instead
-    of 9.2e-11 at 20 kHz), and the check is evaluated in extended precision too.  The check
-    bounds the coefficients, not the rounding while the recursion runs: that is probed against
-    the sections (:func:`running_error_ok`).  Where ``np.longdouble`` is no wider than double
-    (the check could not see the error it is meant to bound), the order is above
-    :data:`POLY_MAX_ORDER`, the probe would be longer than :data:`PROBE_MAX` or fails (the seed
-    000 sensor at 50 and 100 kHz), None: the sections are kept.
+    Here the exact coefficients are the product of the sections in extended precision
+    (``np.longdouble``), the doubles within 2 ulp of them (1 ulp beyond order 4) that best match
+    the exact denominator at the test points are chosen (:func:`best_rounded_polynomial`: the
+    rounding errors of the coefficients then partly cancel where the polynomial is small: 1.6e-11
+    instead of 9.2e-11 at 20 kHz), and the check is evaluated in extended precision too.  The
+    check bounds the coefficients, not the rounding while the recursion runs: that is probed
+    against the sections (:func:`running_error_ok`), and only where a step is the worst case for
+    it (:func:`probe_length`: the cascade amplifies nothing more than a constant).  Where
+    ``np.longdouble`` is no wider than double (the check could not see the error it is meant to
+    bound), the order is above :data:`POLY_MAX_ORDER`, the cascade peaks away from DC (a resonant
+    anticausal part), the probe would be longer than :data:`PROBE_MAX` or fails (the seed 000
+    sensor at 50 and 100 kHz), None: the sections are kept.
     """
     if any(len(f) != 1 for f in firs) or np.finfo(np.longdouble).eps > 1e-18:
         return None
     sos = np.ascontiguousarray(sos, dtype=float)
-    found = _rounded_denominator(sos.tobytes(), sos.shape[0])
+    found = _rounded_denominator(sos.tobytes(), sos.shape[0], PROBE_MAX, POLY_MAX_ORDER)
     if found is None:
         return None
     a = np.array(found)
@@ -202,69 +210,151 @@ def polynomial_denominator(sos: np.ndarray, firs: list, zinv: np.ndarray, exact:
 
 
 @functools.lru_cache(maxsize=32)
-def _rounded_denominator(sos_bytes: bytes, n_sections: int) -> tuple[float, ...] | None:
+def _rounded_denominator(sos_bytes: bytes, n_sections: int, probe_max: int,
+                         max_order: int) -> tuple[float, ...] | None:
     """The best-rounded double polynomial of the all-pole sections (see
     :func:`polynomial_denominator`) if its recursion passes :func:`running_error_ok`, else None.
     It depends on the poles only (not on the preview's numerator), so it is kept per cascade: a
-    plan for another preview at the same sampling interval does not search and probe again."""
+    plan for another preview at the same sampling interval does not search and probe again.  The
+    limits it is decided under (:data:`PROBE_MAX`, :data:`POLY_MAX_ORDER`) are part of the key.
+    The cheap rejections (:func:`probe_length`: an unstable or too slow cascade, one that peaks
+    away from DC) come before the search for the coefficients."""
     sos = np.frombuffer(sos_bytes, dtype=float).reshape(n_sections, 6).copy()
-    a = best_rounded_polynomial(sos)
-    if a is None:
+    length = probe_length(sos, probe_max)
+    if length is None:
         return None
-    return tuple(float(v) for v in a) if running_error_ok(a, sos) else None
+    a = best_rounded_polynomial(sos, max_order)
+    if a is None or not _probes_pass(a, sos, length):
+        return None
+    return tuple(float(v) for v in a)
 
 
-def best_rounded_polynomial(sos: np.ndarray) -> np.ndarray | None:
+def best_rounded_polynomial(sos: np.ndarray, max_order: int | None = None) -> np.ndarray | None:
     """The double-precision denominator polynomial of the all-pole sections ``sos`` (ascending
     powers of 1/z) closest to their exact product at the test points (see
-    :func:`polynomial_denominator`; no check of the running error), or None above
-    :data:`POLY_MAX_ORDER`."""
+    :func:`polynomial_denominator`; no check of the running error), or None above ``max_order``
+    (default :data:`POLY_MAX_ORDER`) or where the exact product, though formed in extended
+    precision, is not resolved at a test point (poles too clustered: 8 poles within 5e-3 of z = 1,
+    whose product at z = 1 is 2.5e-21 of coefficients up to 69, comes out as 0 or as 3e-18 of
+    rounding, depending on the numpy version).
+
+    The exact coefficients ``c_i`` are formed once in ``np.longdouble``, with their nearest doubles
+    ``n_i`` and the residuals ``r_i = c_i - n_i`` (exact there, then rounded to double).  A
+    candidate is ``n_i + d_i``, ``d_i`` one of the steps of -2..2 ulp (-1..1 beyond order 4) to the
+    neighbouring doubles (exact in double); its error relative to the exact polynomial at a test
+    point ``z`` is ``sum_i (d_i - r_i) z**-i / c(z)``, a sum of terms of the size of an ulp that is
+    evaluated in double, for all 5**m (3**m) candidates as one small matrix product.  Evaluating
+    the candidates themselves in ``np.clongdouble`` (as before) takes differences of values of the
+    size of ``c(z)``, which leave ~2 digits of the errors at 20 kHz, and runs in software where
+    ``np.longdouble`` is quad precision (aarch64 Linux); both choose the same coefficients for the
+    seed 000 sensor at 20 kHz (equal bits); on x86-64 the search takes 0.2 ms instead of 0.8 there
+    (order 3), 2.2 ms instead of 40 at order 8."""
+    max_order = POLY_MAX_ORDER if max_order is None else max_order
     ld = np.longdouble
     exact_den = np.ones(1, dtype=ld)
     for r in sos:
         exact_den = np.convolve(exact_den, np.asarray(r[3:], dtype=ld))
     exact_den = np.trim_zeros(exact_den, "b")
     m = exact_den.size - 1
-    if m < 1 or m > POLY_MAX_ORDER:
+    if m < 1 or m > max_order:
         return None
+    zinv = 1.0 / _TEST_Z
+    ref_ld = _horner(exact_den, zinv.astype(np.clongdouble))
+    # resolved: the rounding of the product and of its evaluation (~(m+1) eps of the coefficients'
+    # sum) below 1e-3 of its value, so that the candidates' errors relative to it are meaningful
+    floor = 1024 * (m + 1) * np.finfo(ld).eps * np.sum(np.abs(exact_den))
+    if not np.all(np.isfinite(ref_ld) & (np.abs(ref_ld) > floor)):
+        return None
+    ref = ref_ld.astype(complex)
     nearest = exact_den.astype(float)
+    resid = (exact_den - nearest.astype(ld)).astype(float)
     span = 2 if m <= 4 else 1
-    # every combination of -span..span ulp steps on coefficients 1..m (the leading 1 is exact)
-    grid = np.stack(np.meshgrid(*([np.arange(2 * span + 1)] * m), indexing="ij"), axis=-1).reshape(-1, m)
-    cand = np.empty((grid.shape[0], m + 1))
-    cand[:, 0] = 1.0
+    # the neighbouring doubles of each coefficient 1..m (the leading 1 is exact), -span .. +span ulp
+    values = np.empty((m, 2 * span + 1))
     for i in range(m):
         c = nearest[i + 1]
         ups, downs = [c], [c]
         for _ in range(span):
             ups.append(np.nextafter(ups[-1], np.inf))
             downs.append(np.nextafter(downs[-1], -np.inf))
-        cand[:, i + 1] = np.array(downs[:0:-1] + ups)[grid[:, i]]     # -span .. +span ulp
-    zl = _ZINV.astype(np.clongdouble)
-    ref = _horner(exact_den, zl)
-    err = np.max(np.abs(_horner(cand.astype(ld).T, zl[:, None]) / ref[:, None] - 1.0), axis=0)
-    return np.ascontiguousarray(cand[int(np.argmin(err))])
+        values[i] = downs[:0:-1] + ups
+    # every combination of them, as indices: (candidates, m)
+    grid = np.stack(np.meshgrid(*([np.arange(2 * span + 1)] * m), indexing="ij"), axis=-1).reshape(-1, m)
+    dev = (values - nearest[1:, None] - resid[1:, None])[np.arange(m), grid]
+    powers = zinv[None, :] ** np.arange(1, m + 1)[:, None]
+    err = np.max(np.abs(dev @ powers) / np.abs(ref), axis=1)
+    best = grid[int(np.argmin(err))]
+    return np.concatenate(([1.0], values[np.arange(m), best]))
 
 
-def running_error_ok(a: np.ndarray, sos: np.ndarray) -> bool:
+def probe_length(sos: np.ndarray, probe_max: int | None = None) -> int | None:
+    """Samples of the running-error probe of the all-pole sections ``sos`` (:func:`running_error_ok`):
+    20 time constants of the slowest pole, at least 2,000; None where that is longer than
+    ``probe_max`` (default :data:`PROBE_MAX`), the cascade is not stable, or its probe on a step
+    would not be the worst case.
+
+    The rounding while ``lfilter(1, a)`` runs is a sequence of small local errors ``e[k]`` that
+    the recursion itself propagates: the output is off by ``h * e``, ``h`` the impulse response
+    of ``1/a``.  A step (a constant input repeats the same rounding: the errors add up
+    coherently) and a slowly varying walk see its DC gain; a sine sees ``|1/a(e^jw)|`` at its
+    frequency, and an error sequence matched to the signs of ``h`` sees ``||h||_1``.  Where
+    ``|1/a|`` peaks away from DC this is beyond what the probes measure (a resonant anticausal
+    part at 20 kHz, sensor ``poly([600, 15±200j]) / poly([-1000]*3)``: the probes accepted the
+    polynomial, a sine at the resonance ran 1.15e-10 off the extended-precision recursion, the
+    sections 1.0e-11).  So the polynomial is only considered where a constant is amplified the
+    most: ``|1/a|`` is at most ``1 + DC_PEAK_TOL`` times its DC value on a dense grid of
+    frequencies (computed from the poles, each factor ``|1 - p/z|**2 = (1-|p|)**2 + 4|p|
+    sin**2((w - arg p)/2)`` without cancellation near z = 1), and ``||h||_1`` (over the probe's
+    length) at most ``1 + DC_PEAK_TOL`` times ``|sum h|``, i.e. ``h`` is nonnegative up to that.
+    The second bound is the one that makes the step the worst case: no error sequence of a given
+    size is amplified more than by ``||h||_1 = sum h``, and a constant one gets that much (a sine
+    at the frequency of the largest ``|1/a|`` would be the step itself).  It also implies the
+    first at every frequency (``|1/a(e^jw)| <= ||h||_1``); the grid states the peak condition on
+    its own and does not depend on the truncation of ``h``.  Seed 000 at 20 kHz: ``h`` > 0 (its
+    complex pair alone has a negative lobe, ``||h||_1`` 2.4% above ``sum h``, which the slow real
+    pole smooths out), kept."""
+    probe_max = PROBE_MAX if probe_max is None else probe_max
+    poles = np.concatenate([np.roots(r[3:]) for r in sos])
+    rho = float(np.max(np.abs(poles)))
+    if not rho < 1.0 or 20.0 / (1.0 - rho) > probe_max:
+        return None
+    length = max(2000, int(math.ceil(20.0 / (1.0 - rho))))
+    r, theta = np.abs(poles)[:, None], np.angle(poles)[:, None]
+    d = 1.0 - r
+    w = np.concatenate((np.linspace(0.0, np.pi, 2049), np.geomspace(1e-3 * float(np.min(d)), np.pi, 2049),
+                        (np.abs(theta) + d * np.linspace(-8.0, 8.0, 161)).ravel(), [0.0]))
+    w = w[(w >= 0.0) & (w <= np.pi)]
+    log_a2 = np.sum(np.log(d**2 + 4.0 * r * np.sin((w - theta) / 2.0) ** 2), axis=0)   # log |a(e^jw)|**2
+    if not np.min(log_a2) >= log_a2[-1] - 2.0 * math.log1p(DC_PEAK_TOL):
+        return None
+    impulse = np.zeros(length)
+    impulse[0] = 1.0
+    h = sig.sosfilt(sos, impulse)
+    if not np.sum(np.abs(h)) <= (1.0 + DC_PEAK_TOL) * abs(float(np.sum(h))):
+        return None
+    return length
+
+
+def running_error_ok(a: np.ndarray, sos: np.ndarray, probe_max: int | None = None) -> bool:
     """The recursion ``lfilter(1, a)`` stays within half the 1e-10 guarantee of the sections
     ``sos`` (accurate to ~1e-13, measured) on a step and on a random walk, relative to the
-    largest output: the check at the test points bounds the coefficients, not the rounding
-    while the recursion runs, which near z = 1 is amplified by up to ``1/|a(1)|`` (at 100 kHz
-    the seed 000 polynomial passes the check at 1.0e-11 but runs 3-4e-10 off the explicit
-    recursion).  A step is where the rounding errors add up coherently (a constant input repeats
-    the same rounding), a random walk a slowly varying input; each runs 20 time constants of
-    the slowest pole (at least 2,000 samples, at most :data:`PROBE_MAX`: slower poles fail);
-    half of 1e-10 is the margin for other signals.  Measured for the seed 000 sensor at 20 kHz:
+    largest output, and the step is the worst case for its rounding (:func:`probe_length`,
+    which also sets the length, at most ``probe_max``, default :data:`PROBE_MAX`: slower poles
+    fail).  The check at the test points bounds the coefficients, not the rounding while the
+    recursion runs, which near z = 1 is amplified by up to ``1/|a(1)|`` (at 100 kHz the seed 000
+    polynomial passes the check at 1.0e-11 but runs 3-4e-10 off the explicit recursion).  A step
+    is where the rounding errors add up coherently (a constant input repeats the same rounding),
+    a random walk a slowly varying input; each runs 20 time constants of the slowest pole; half
+    of 1e-10 is the margin for other signals.  Measured for the seed 000 sensor at 20 kHz:
     2.1e-11 (step) and 1.5e-11 (walk) here, and 2.5e-11 at most against an explicit
     extended-precision recursion on 2**21-sample records."""
-    rho = float(np.max(np.abs(np.roots(a))))
-    if not rho < 1.0:
-        return False
-    length = 20.0 / (1.0 - rho)
-    if length > PROBE_MAX:
-        return False
-    length = max(2000, int(math.ceil(length)))
+    length = probe_length(sos, probe_max)
+    return length is not None and _probes_pass(a, sos, length)
+
+
+def _probes_pass(a: np.ndarray, sos: np.ndarray, length: int) -> bool:
+    """``lfilter(1, a)`` within 0.5e-10 of ``sosfilt(sos)`` on a step and a random walk of ``length``
+    samples, relative to the largest output (see :func:`running_error_ok`)."""
     walk = np.cumsum(np.random.default_rng(0).standard_normal(length))
     for x in (np.ones(length), walk):
         ref = sig.sosfilt(sos, x)
