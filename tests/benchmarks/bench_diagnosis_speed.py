@@ -117,6 +117,16 @@ refit had not converged: 5016 series_cpe + viscous_fluid (every start of main's 
 the 24: 81956 -> 77466 (5015 4240 -> 4413, the one that grew).  The report files differ in those
 digits.
 
+Review fixes of the fifth round (session 11, 2026-11-26): a point whose inner fit did not get back
+to the valley floor (cost up > 4 s²) no longer becomes a bracket end, and only a point lower by
+more than INNER_DECREMENT·s² resets the stale count.  The same 24 cases, ``diagnose()`` from the
+merged fifth round and from the fixed search (the review's /tmp/d44/instr.py): verdicts and names
+identical 24/24, candidate LRs the same to 1.3e-13, candidate costs to 2.2e-12; fit points 77416 ->
+77021 (44102 4263 -> 4225; 45101 4197 -> 4308, the one that grew).  On the crawl test's problem
+(tests/estimation/test_lsq_crawl.py, 12 seeds × 2 orders, max_nfev 60) the evaluations are 646
+before the fifth round, 544 after it, 526 with the fixes; a profile secant convergence test and a
+bisection safeguard the review also proposed cost 614 and 568 there and were not taken.
+
 Measured 2026-11-26, fourth round (h-fluid: why the fluid-load strips' viscous_fluid refits run
 long; 2 cores shared by ~6 sessions): "before" = c0116c8 (main, exported to a plain folder),
 "after" = this branch, interleaved as in the third round::
