@@ -116,6 +116,14 @@ file's ``next_measurement`` with a wall and thread-CPU clock; the main branch's 
     python tests/benchmarks/bench_next_measurement.py --first-seed 7500 --seeds 12 --labels opamp
     python tests/benchmarks/bench_next_measurement.py --first-seed 7520 --seeds 6
 
+Re-run on merged main (session 11, after the review fixes of the forms search, the diagnosis's α
+split — the LR test at α − α/5 — and the engine's fifth round): ``--first-seed 7500 --seeds 12
+--labels opamp`` named exactly **11/12** [0.65, 0.99]; the miss, 7505 (λ 1.5 in the record), got
+S at 50 °C, λ 94.8 expected, and ended ambiguous (amplifier_bandwidth, tip_driven_beam,
+transimpedance; cost/expected 1.19).  The forms search's own fixes do not change 7505 (the same
+recommendation and second verdict from the tree before them); the difference to the branch's
+12/12 comes from the merges after it.
+
 The premise dropped (``--law-error``, 2026-11-26 late evening, fresh seeds, run once on the final code):
 the generator's strip moves with the bath by Ea_d 20 kJ/mol and an E slope of −0.50 %/K (chosen
 a priori, round values; not tuned) while the user's start keeps the library's 15 kJ/mol and
