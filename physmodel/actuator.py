@@ -217,6 +217,19 @@ class ActuatorModel(PhysicsModel):
         apart per call), of which only the fields ``differ`` may differ between sets; the same
         numbers bit for bit.  The columns are only read.
 
+        Parameters
+        ----------
+        p : mapping of str to ndarray
+            The state's fields as columns (n_sets·n_T, 1) [SI units of each field].
+        n_sets, n_T : int
+            Parameter sets and temperatures the columns hold.
+        s : array_like
+            Laplace variable on the imaginary axis, 2πj·f [1/s].
+        quantities : sequence of str or None
+            The quantities to evaluate (default: the model's).
+        differ : sequence of str
+            The fields that may differ between sets (the others are read from the first set).
+
         Returns
         -------
         dict of str to ndarray

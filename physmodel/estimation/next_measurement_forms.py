@@ -252,6 +252,8 @@ class FormContest:
                 if len(self.excluded[n]) < len(v)}
 
     def apply(self, rows: list) -> None:
+        """Write this pair's linearised separation (the least over its kept truth forms) into each
+        row's ``separation_by_pair``."""
         for r in rows:
             r.separation_by_pair[self.key] = self.value(id(r))
 
@@ -270,6 +272,8 @@ class FormContest:
         return self.refit_value(id(r))
 
     def refit_value(self, rid: int) -> float:
+        """The refit λ of the row with ``id`` ``rid``: the least over the directions' truth forms not
+        left to parsimony (0 when none was refitted). [-]"""
         got = self.refit.get(rid, {})
         vals = [v for n in got for j, v in got[n].items() if j not in self.excluded[n]]
         return float(min(vals)) if vals else 0.0
