@@ -38,7 +38,10 @@
    outputs of 45 random sets, both kinds, every quantity, off-axis s, the array path with shared
    rows, every effect; the 35 calibrations above identical in every field): exp(−x) and the sign
    flips of the line kernels on the doubles (~9 µs less per 2500-point call), the shared rows'
-   gathers by ndarray.take (~6 µs a call).  Tried and dropped: principal_sqrt in real arithmetic
+   gathers by ndarray.take (~6 µs a call); A/B on the benchmark's recorded kernel calls (CPU, best
+   of 3 alternating processes): a 70-row call 226.8 -> 210.5 µs, a 140-row call 247.4 -> 228.7 µs,
+   one point (model, residuals, Jacobian) 377.7 -> 365.5 µs, a 500-line evaluation 148 / 151 µs
+   (unchanged) — about 0.5 ms of a calibration, below the rounds' noise.  Tried and dropped: principal_sqrt in real arithmetic
    (glibc's csqrt formula with hypot is bit for bit, but hypot costs what csqrt saves: 28 vs 27
    µs at 2500 points; with numpy's |z| it is 19 µs but an ulp off, and those ulps moved a sensor
    calibration's holds — relative differences up to 0.66 — so no rewrite that is not bit for bit
