@@ -45,9 +45,10 @@ def _take(p, idx, fields, differ=None):
     rows set-major) as its first ``len(idx)`` rows, the same values without a gather."""
     if idx is None:
         return p
+    # ndarray.take: the same gather as p[f][idx], without fancy indexing's set-up (~0.3 against 0.7 µs)
     if differ is None:
-        return {f: p[f][idx] for f in fields}
-    return {f: p[f][idx] if f in differ else p[f][:len(idx)] for f in fields}
+        return {f: p[f].take(idx, 0) for f in fields}
+    return {f: p[f].take(idx, 0) if f in differ else p[f][:len(idx)] for f in fields}
 
 
 def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None, differ=None) -> dict:
@@ -77,8 +78,8 @@ def actuator_kernel(p, s, quantities=("Z", "H", "G", "M"), shared=None, differ=N
     line, sl = shared if shared is not None else (None, None)
     pl = _take(p, None if line is None else line[0], LINE_FIELDS, differ)
     ps = _take(pl, None if sl is None else sl[0], SLICE_FIELDS, differ)
-    up = (lambda a: a) if sl is None else (lambda a: a[sl[1]])          # slice rows -> line rows
-    full = (lambda a: a) if line is None else (lambda a: a[line[1]])    # line rows -> all rows
+    up = (lambda a: a) if sl is None else (lambda a: a.take(sl[1], 0))          # slice rows -> line rows
+    full = (lambda a: a) if line is None else (lambda a: a.take(line[1], 0))    # line rows -> all rows
     c = transport.charge_terms(s, ps["h"], ps["d"], ps["K"])
     theta = transport.polymer_admittance(ps["W"], ps["h"], ps["kappa_e"], c)
     A, frac = electrode.slice_admittance(theta, ps["r2"], ps["Rp"])

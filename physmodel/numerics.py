@@ -89,6 +89,15 @@ def tanh_and_gmt(g, min_real=None):
     return t, gmt
 
 
+def _negated(z, out=None):
+    """−z for a complex array: the signs flipped on its doubles (exact, and several times faster
+    than numpy's complex negation); plain negation for a 0-d or non-contiguous array."""
+    if z.ndim and z.flags.c_contiguous and (out is None or out is z):
+        v = z.view(np.float64)
+        return np.negative(v, out=None if out is None else v).view(complex)
+    return np.negative(z, out=out)
+
+
 #: Re x above which sech x < 1e-17 relative to x tanh x: X = (x − 1)/x², x coth x = x.
 LINE_ASYMPTOTIC_ABOVE = 40.0
 
@@ -107,14 +116,14 @@ def line_kernels(x, want_xcoth: bool = True):
     expm1 replaces exp − 1 for |x| < 0.1.
     """
     x = np.asarray(x, dtype=complex)
-    ax = np.abs(x)
-    if ax.size and ax.min() >= EXP_FAST_ABOVE:
-        em1 = np.exp(-x)
+    # |x| ≥ Re x: the real parts decide the usual case without |x| (the same test's outcome)
+    if x.size and (x.real.min() >= EXP_FAST_ABOVE or np.abs(x).min() >= EXP_FAST_ABOVE):
+        em1 = np.exp(_negated(x))
         em1 -= 1.0
         small = None
         xs = x
     else:
-        small = ax < X_SERIES_BELOW
+        small = np.abs(x) < X_SERIES_BELOW
         xs = np.where(small, 1.0, x)
         em1 = _em1(xs)
     two_p = em1 + 2.0
@@ -126,13 +135,13 @@ def line_kernels(x, want_xcoth: bool = True):
     den = one_p_e2 * xs
     den *= xs
     X = np.divide(num, den, out=num)
-    np.negative(X, out=X)
+    _negated(X, out=X)
     xcoth = None
     if want_xcoth:
         xcoth = xs * one_p_e2
         two_p *= em1
         xcoth /= two_p
-        np.negative(xcoth, out=xcoth)
+        _negated(xcoth, out=xcoth)
     if small is not None and np.any(small):
         x2 = x[small] ** 2
         X[small] = _poly_x2(_X_COEF, x2)

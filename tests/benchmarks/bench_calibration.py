@@ -28,7 +28,35 @@
    identifiability with its probe call 0.65 ms, predictor and result ~1 ms; the goal needs ~3 ms
    more.  Estimates, intervals, correlations, start records and model calls bit for bit / the
    same as main's (the benchmark's calibration and 32 more: 12 noise draws x 1 and 4 starts, 4
-   estimated-noise draws x 1 and 4 starts; 35 model calls on the benchmark);
+   estimated-noise draws x 1 and 4 starts; 35 model calls on the benchmark).  Session 12 (h-cal2,
+   the kernel's per-point cost; main = e43af67 exported; load 1.3-1.7): ``--ratio 7`` (wall)
+   this 1.185 / 1.286 (24.5 / 22.0 ms vs 20.7 / 17.1 ms), main 1.265 / 1.265 (23.1 / 22.5 vs
+   18.3 / 17.8 ms); ``--ratio 7 --cpu`` this 1.227 / 1.288 (22.7 / 22.0 vs 18.5 / 17.1 ms), main
+   1.322 / 1.299 (23.7 / 22.0 vs 18.0 / 16.9 ms); steadier, ``--ratio 30 --cpu`` twice: this
+   1.288 / 1.288 (21.8 / 21.4 ms vs 16.9 / 16.6 ms), main 1.296 / 1.296 (22.1 / 21.3 vs 17.1 /
+   16.4 ms) — the same within the noise: the goal is not met.  Kept (bit for bit: 1201 model
+   outputs of 45 random sets, both kinds, every quantity, off-axis s, the array path with shared
+   rows, every effect; the 35 calibrations above identical in every field): exp(−x) and the sign
+   flips of the line kernels on the doubles (~9 µs less per 2500-point call), the shared rows'
+   gathers by ndarray.take (~6 µs a call); A/B on the benchmark's recorded kernel calls (CPU, best
+   of 3 alternating processes): a 70-row call 226.8 -> 210.5 µs, a 140-row call 247.4 -> 228.7 µs,
+   one point (model, residuals, Jacobian) 377.7 -> 365.5 µs, a 500-line evaluation 148 / 151 µs
+   (unchanged) — about 0.5 ms of a calibration, below the rounds' noise.  Tried and dropped: principal_sqrt in real arithmetic
+   (glibc's csqrt formula with hypot is bit for bit, but hypot costs what csqrt saves: 28 vs 27
+   µs at 2500 points; with numpy's |z| it is 19 µs but an ulp off, and those ulps moved a sensor
+   calibration's holds — relative differences up to 0.66 — so no rewrite that is not bit for bit
+   is safe here); the mode's denominator in real parts (exact, 13 vs 12 µs: strided writes);
+   shared_sets compared as an int64 matrix (25 vs 12 µs).  Why the ratio resists: the kernel is
+   near its floor in numpy with exact arithmetic (per 70x50-row call ~220 µs: complex exp 34,
+   complex sqrt 27, hypot 10 — numpy's complex exp is glibc's exp x sincos, and numpy's own real
+   exp differs from glibc's in 4 % of values, so it cannot be split exactly — and ~50 complex
+   operations of 2-5 µs, the broadcast ones 2-3x a contiguous one); and the denominator is half
+   kernel overhead (a 500-line call: 161 µs CPU, its kernel 75 µs, the state 35 µs), so a cut
+   of the kernel's per-call cost lowers 100 evaluations more than the calibration's 35 calls
+   and raises the ratio.  What remains, per 4-start calibration (CPU, 21 ms on this load): 34
+   points ~370 µs each (kernel ~220, residuals 39, state columns 16, shared rows 11, the
+   Jacobian's bookkeeping ~30, physical rows 7), the search's own steps, identifiability with
+   its probe and the result ~5 ms;
 5. ``--speed PAIRS --root OTHER``: wall time of the calibrations above against another checkout
    (e.g. the commit before the speed work), paired and interleaved: each pair runs one fresh
    interpreter per checkout (order alternating), each times ``--reps`` calls after one warm-up
