@@ -429,8 +429,9 @@ class Diagnosis:
             L.append(f"| {lab} | {g['cost']:.4g} | {g['expected_cost']:.4g} ± {g['cost_std']:.3g} | {g['z']:.3g} | "
                      + " | ".join(f"{a:.3g} / {b:.3g}" for a, b in zip(g["rms_db"], g["rms_deg"])) + " |")
         L += ["", f"Gap shrink (cost − expected, before / after): {gap_shrink(self):.3g}×", "",
-              f"LR threshold (family-wise α = {self.alpha:g}, Monte Carlo under the null): {self.threshold:.3g}; "
-              f"gap threshold on 2·cost: {self.gap_threshold:.4g}", "",
+              f"LR threshold (at {self.alpha * (1 - 1 / GAP_ALPHA_DIVISOR):g} of the verdict's family-wise "
+              f"α = {self.alpha:g}, Monte Carlo under the null): {self.threshold:.3g}; "
+              f"gap threshold on 2·cost (at α/{GAP_ALPHA_DIVISOR:g}): {self.gap_threshold:.4g}", "",
               "## Candidates", "", "| effect | LR | significant | closes gap | AIC | BIC | fitted values "
               "[candidate bounds] | at/near a bound, outside plausible range |",
               "|---|---|---|---|---|---|---|---|"]
