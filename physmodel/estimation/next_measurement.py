@@ -537,7 +537,8 @@ def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, 
     from .next_measurement_forms import FormContest, distinct, form_summary, form_threshold
 
     resp: dict = {q: {} for q in qs}
-    w = [(1.0 / nm["median_ln"] ** 2, 1.0 / nm["median_ph"] ** 2) for _ in qs]
+    by_q = nm.get("by_quantity", {})       # a joint record: each diagnosed quantity its own σ
+    w = [(1.0 / by_q.get(q, nm)["median_ln"] ** 2, 1.0 / by_q.get(q, nm)["median_ph"] ** 2) for q in qs]
     kept, said = {}, {}
     for m in fitted:
         found = alts.get(id(m))

@@ -44,6 +44,10 @@ MAX_FORMS = 3
 GRID_POINTS = 4
 #: Grid points refitted after the screen (the best by screened cost).
 GRID_REFITS = 3
+#: Screened points at most (a model with many effect parameters: a seeded random subset of the
+#: product grid, so one predict_many call stays bounded; an evenly strided subset would hold the
+#: fastest axes fixed).
+MAX_GRID = 625
 
 
 def form_threshold(alpha: float, n_params: int) -> float:
@@ -126,7 +130,11 @@ def alternative_forms(d, m: CompetingModel, max_nfev: int) -> list[tuple[Competi
             initials.append({**m.values, **{k: 0.5 * (v[0] + v[1]) for k, v in rng.items() if k in names},
                              **{f"{c}.{p}": v for p, v in cr.values.items() if f"{c}.{p}" in names}})
     axes = [_grid_axis(lo, hi, typ) for _, lo, hi, typ in eff]
-    grid = [{**m.values, **{n: float(v) for (n, *_), v in zip(eff, pt)}} for pt in itertools.product(*axes)]
+    points = list(itertools.product(*axes))
+    if len(points) > MAX_GRID:
+        keep = np.sort(np.random.default_rng(0).choice(len(points), MAX_GRID, replace=False))
+        points = [points[i] for i in keep]
+    grid = [{**m.values, **{n: float(v) for (n, *_), v in zip(eff, pt)}} for pt in points]
     screened = _record_costs(d, m, grid)
     initials += [grid[i] for i in np.argsort(screened)[:GRID_REFITS] if np.isfinite(screened[i])]
     free = [fp.with_initial(min(max(m.values[fp.name], fp.lower), fp.upper)) for fp in m.free]
