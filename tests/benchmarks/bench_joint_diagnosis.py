@@ -8,6 +8,8 @@ Cases come from the independently written generators (no ``physmodel`` physics):
 * ``thermal`` — the same actuator with a hidden polymer temperature law (modulus, permittivity) or
   water uptake;
 * ``null`` — the same actuator, no hidden effect;
+* ``oo`` — the same actuator with a hidden effect the library does not have (viscoelastic creep, a
+  plain fixture resonance, gain ripple), scored ``unexplained``;
 * ``sensor`` — the independent sensor (``independent_sensor``: 35 °C, 10-100 Hz): a hidden
   amplifier (two poles) or acquisition delay, the set-up of ``bench_chain_detection.py``.
 
@@ -28,6 +30,7 @@ but ``none`` on a null strip.
     python tests/benchmarks/bench_joint_diagnosis.py --set null --first-seed 8412 --seeds 12
     python tests/benchmarks/bench_joint_diagnosis.py --set null --first-seed 8424 --seeds 48
     python tests/benchmarks/bench_joint_diagnosis.py --set null --first-seed 8400 --seeds 72
+    python tests/benchmarks/bench_joint_diagnosis.py --set oo --first-seed 48300 --seeds 8
     python tests/benchmarks/bench_joint_diagnosis.py --set sensor --labels none --first-seed 8600 --seeds 8
 
 Measured 2026-11-26 with the commands above (fresh seeds; development used 900-905), library
@@ -101,6 +104,21 @@ figures say:
   distinguishable from the issue's 5 % (jointly: P(≥ 5 of 72 | 5 %) = 0.29).  The same split on
   ``bench_discrepancy.py --generator independent --first-seed 47000 --n-per-label 2 --null 48``
   (92 fresh cases, before and after): every verdict identical (0/48 false positives in both).
+* Out of library (``--set oo``, session 11, 2026-11-26; the generator's three effects the library does
+  not have, scored ``unexplained``; fresh seeds, run once on main at dc57622:
+  ``--set oo --first-seed 48300 --seeds 8``): one quantity **17/24** [0.51, 0.85], jointly with Z
+  **16/24** [0.47, 0.82].  By effect: fixture resonance 8/8 and 8/8; gain ripple 6/8 and 4/8;
+  viscoelastic creep 3/8 and 4/8.  Verdicts, one quantity: unexplained 17, none 3, ambiguous 2,
+  named 2; jointly: unexplained 16, none 4, **named 4** (48300 creep → distributed_cpe, gain ripple →
+  viscous_fluid; 48304 creep → distributed_cpe + permittivity_temperature; 48305 creep →
+  distributed_cpe).  So Z does not rescue the out-of-library row as hoped: a creep that
+  distributed_cpe plus a temperature law reproduces in M (the bench_discrepancy 47000 misses 47034
+  and 47035: the library pair closes the gap, 2·cost 331 < 368 and 337 < 361) becomes
+  ``unexplained`` with Z on those two, but on fresh seeds the joint fit names the CPE confidently
+  in 3 of 8 creep strips, and two weak effects (λ 13, 88) that M alone called ``unexplained`` end
+  ``none`` jointly — the pooled gap test spreads its power over Z's lines, which the effect does not
+  touch.  Development (not counted): 48200-48211 creep only, M alone 4/12 unexplained (3 named),
+  jointly 9/12 (1 named).  Not corrected: the next person's lead for issue 27's out-of-library row.
 * Sensor: Z does not separate a lag from an amplifier pole — neither acts on the strip's own
   impedance, and with the library's default (chain effects on every quantity, i.e. Z measured
   through S's amplifier) they act identically on both.  Without ``acts_on`` every sensor S+Z case
@@ -137,6 +155,7 @@ SETS = {
     "contact": ("actuator", ("contact_resistance", "diffusivity_temperature")),
     "thermal": ("actuator", ("water_uptake", "modulus_temperature", "permittivity_temperature")),
     "null": ("actuator", ("none",)),
+    "oo": ("actuator", ("viscoelastic_creep", "fixture_resonance", "gain_ripple")),
     "sensor": ("sensor", ("amplifier", "delay")),
 }
 #: The sensor chain's element acts on S, not on the analyser's Z.
@@ -170,7 +189,9 @@ def run_case(seed: int, label: str, kind: str, args) -> dict:
     t1 = time.perf_counter()
     d2 = diagnose([first, Z], base, acts_on=acts_on, **kw)
     t2 = time.perf_counter()
-    ok = lambda d: (d.verdict == "none") if not expected else (d.verdict == "named" and sorted(d.named) == expected)  # noqa: E731
+    oo = kind == "actuator" and truth.get("out_of_library", False)
+    ok = lambda d: ((d.verdict == "unexplained") if oo else (d.verdict == "none") if not expected  # noqa: E731
+                    else (d.verdict == "named" and sorted(d.named) == expected))
     return {"seed": seed, "label": label, "expected": expected, "lam": lam,
             "single": (d1.verdict, sorted(d1.named)), "joint": (d2.verdict, sorted(d2.named)),
             "single_ok": ok(d1), "joint_ok": ok(d2), "t_single": t1 - t0, "t_joint": t2 - t1,
@@ -205,7 +226,9 @@ def main(argv=None):
     for key, what in (("single_ok", "one quantity"), ("joint_ok", "joint")):
         k = sum(r[key] for r in rows)
         lo, hi = wilson(k, n)
-        print(f"{what:13s}: {'none (no false positive)' if all(not r['expected'] for r in rows) else 'named exactly'} {k}/{n}"
+        what_ok = ("unexplained (out of library)" if args.set == "oo" else
+                   "none (no false positive)" if all(not r["expected"] for r in rows) else "named exactly")
+        print(f"{what:13s}: {what_ok} {k}/{n}"
               f" [{lo:.2f}, {hi:.2f}]")
     for lab in labels:
         sub = [r for r in rows if r["label"] == lab]
