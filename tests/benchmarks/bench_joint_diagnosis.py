@@ -115,7 +115,7 @@ figures say:
   distributed_cpe plus a temperature law reproduces in M (the bench_discrepancy 47000 misses 47034
   and 47035: the library pair closes the gap, 2·cost 331 < 368 and 337 < 361) becomes
   ``unexplained`` with Z on those two, but on fresh seeds the joint fit names the CPE confidently
-  in 3 of 8 creep strips, and two weak effects (λ 13, 88) that M alone called ``unexplained`` end
+  in 3 of 8 creep strips, and three weak effects (λ 13, 13, 88) that M alone called ``unexplained`` end
   ``none`` jointly — the pooled gap test spreads its power over Z's lines, which the effect does not
   touch.  Development (not counted): 48200-48211 creep only, M alone 4/12 unexplained (3 named),
   jointly 9/12 (1 named).  Not corrected: the next person's lead for issue 27's out-of-library row.
