@@ -28,6 +28,20 @@ def three_way():
                     null_refits=0, seed=0)
 
 
+def _measured(isn, truth, r):
+    """The independent sensor's record of the recommended measurement ``r`` (its lines and bath
+    temperatures), with the case's relative noise drawn afresh."""
+    from physmodel.data.sweep import FrequencySweep
+
+    f, T = r.line_frequencies_hz, r.line_temperatures_c
+    H = isn.response(truth["base"], truth["effects"], f, temperature_c=T) * 1e3
+    sig = truth["sigma_rel"] / math.sqrt(2.0)
+    rng = np.random.default_rng(27_0003)
+    noisy = H * (1 + sig * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)))
+    return FrequencySweep(T, f, noisy, np.full(f.size, 20 / math.log(10) * sig), np.full(f.size, math.degrees(sig)),
+                          "tip_displacement", "mm", "current", "uA")
+
+
 def test_a_nested_pair_does_not_hide_the_experiment_that_separates_the_others(three_way):
     """With S and Z searched, the pole-vs-op-amp pair is ~0 in every experiment when the pole is true
     (the op-amp stage with a feedback capacitor holds a single pole exactly), and Z sees no chain
@@ -115,16 +129,7 @@ def test_a_bath_step_separates_an_opamp_stage_from_an_amplifier_pole(isn):
     assert "laws, not the effect, may be wrong" in nm.premise
     assert all(f"{t:g}" in nm.premise.split("(the record")[0] for t in new_t)
     # measure it: the independent sensor at the recommended lines and bath temperatures, fresh noise
-    f, T = r.line_frequencies_hz, r.line_temperatures_c
-    H = isn.response(truth["base"], truth["effects"], f, temperature_c=T) * 1e3
-    sig = truth["sigma_rel"] / math.sqrt(2.0)
-    rng = np.random.default_rng(27_0003)
-    noisy = H * (1 + sig * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)))
-    from physmodel.data.sweep import FrequencySweep
-
-    new = FrequencySweep(T, f, noisy, np.full(f.size, 20 / math.log(10) * sig), np.full(f.size, math.degrees(sig)),
-                         "tip_displacement", "mm", "current", "uA")
-    d2 = diag(merge_records(sweep, new))
+    d2 = diag(merge_records(sweep, _measured(isn, truth, r)))
     assert d2.verdict == "named" and d2.named == ["transimpedance"]
 
 
@@ -214,16 +219,7 @@ def test_a_fit_in_a_nested_form_is_searched_in_its_other_forms(isn):
     assert any(x["role"] == "searched as a possible truth" for x in roles["transimpedance true"])
     assert nm.to_dict()["forms"]["note"] in nm.message
     # measure it: the independent sensor at the recommended lines and bath temperatures, fresh noise
-    f, T = r.line_frequencies_hz, r.line_temperatures_c
-    H = isn.response(truth["base"], truth["effects"], f, temperature_c=T) * 1e3
-    sig = truth["sigma_rel"] / math.sqrt(2.0)
-    rng = np.random.default_rng(27_0003)
-    noisy = H * (1 + sig * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)))
-    from physmodel.data.sweep import FrequencySweep
-
-    new = FrequencySweep(T, f, noisy, np.full(f.size, 20 / math.log(10) * sig), np.full(f.size, math.degrees(sig)),
-                         "tip_displacement", "mm", "current", "uA")
-    d2 = diag(merge_records(sweep, new))
+    d2 = diag(merge_records(sweep, _measured(isn, truth, r)))
     assert d2.verdict == "named" and d2.named == ["transimpedance"]
 
 
