@@ -40,7 +40,7 @@ import numpy as np
 
 from ._discrete import Plan, left_powers, pass_errstate, plan_for
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .signals import as_signal, check_finite, sampling_interval, signal_snapshot
+from .signals import as_signal, check_finite, check_output_sum, sampling_interval, signal_extremes
 from .split import InverseSplit, check_split_for
 
 __all__ = ["PreviewChoice", "AutoPreviewPasses", "auto_preview_passes", "choose_preview", "discrete_tail_l1",
@@ -509,12 +509,11 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     plan0 = plan_for(split, dt, None)
     if norm == "l2" and chunk >= n:
         return _auto_l2(split, dt, ua if finite_checked else check_finite(ua), plan0, tol, quiet_passes)
-    ua_copy, imax, imin = signal_snapshot(ua)
-    extremes = (imax, imin)
+    extremes = signal_extremes(ua)
     with pass_errstate(quiet_passes):
         stable = plan0.causal(ua, chunk)
-    umax = max(float(ua_copy[imax]), -float(ua_copy[imin]))
-    size_u = umax if norm == "linf" else l2_norm(ua_copy)
+    umax = max(float(ua[extremes[0]]), -float(ua[extremes[1]]))
+    size_u = umax if norm == "linf" else l2_norm(ua)
     if norm == "linf":
         ref = reference_lower_bound(split, dt, ua, stable, umax, extremes)
     else:     # chunked l2: the full inverse once for its norm
@@ -534,12 +533,19 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     with pass_errstate(quiet_passes):
         stable_kept, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable,
                                                  output_sum=sums, keep_stable=keep_stable)
+    written = sums[0]
 
     def errors() -> tuple[float, float, float]:
-        # from the copy of the signal inverted (the result's arrays, or the caller's input, may have
-        # been changed since)
-        minus_e = _truncation_head(split, dt, ua_copy, N)     # -e_N[:n - N]; e_N is zero beyond
-        y_inf = plan0.run(ua_copy, ua_copy.size)[2]
+        # from the caller's array, checked unchanged by the sum of the output it gives (the result's
+        # arrays are not read: the caller may have edited them)
+        stable0, _, y_inf = plan0.run(ua, n)
+        again: list[float] = []
+        with pass_errstate(quiet_passes):      # the inversion's pass again, its sum only
+            plan.run(ua, chunk, stable0 if chunk >= n else plan0.causal(ua, chunk), keep_unstable=False,
+                     output_sum=again, keep_stable=False)
+        check_output_sum(again[0], written, "the truncation errors of the automatic preview",
+                         "preview_choice.relative_error (or max_error, error_bound)")
+        minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
         size = _peak if norm == "linf" else l2_norm
         r = size(y_inf)
         emax = _peak(minus_e) if minus_e.size else 0.0
@@ -550,8 +556,8 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
-    return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(sums[0]), plan=plan,
-                             signal=ua_copy, output_sum=sums[0])
+    return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(written), plan=plan,
+                             output_sum=written)
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float,
@@ -566,8 +572,9 @@ def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: f
     ref = _l2_reference(output)
     umax = _peak(ua)
     if split.n_unstable == 0 or ref == 0.0:
-        zero = PreviewChoice(0, 0.0, float(tol), "l2", 0.0, split.auto_preview_s if split.n_unstable else 0.0,
-                             ref)
+        # tail_bound as its doc says (it is 0 but for a signal whose inverse underflows to 0)
+        zero = PreviewChoice(0, 0.0, float(tol), "l2", float(split.tail_l1_norm(0.0)) * umax,
+                             split.auto_preview_s if split.n_unstable else 0.0, ref)
         return AutoPreviewPasses(zero, stable, np.zeros(n), stable.copy())
     tail = _anti_kernel(split, dt, n)[1] * size(ua)
     ok = np.flatnonzero(tail <= tol * ref)

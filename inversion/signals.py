@@ -18,8 +18,8 @@ from physmodel.errors import IPMCError
 from ._errors import InversionError, NonFiniteSignalError, NonUniformSamplingError
 from .split import InverseSplit, check_split_for, split_inverse
 
-__all__ = ["UNIFORM_RTOL", "as_signal", "as_split", "check_finite", "sampling_interval", "signal_snapshot",
-           "time_base", "SNAPSHOT_BLOCK"]
+__all__ = ["UNIFORM_RTOL", "as_signal", "as_split", "check_finite", "sampling_interval", "signal_extremes",
+           "time_base", "EXTREMES_BLOCK", "check_output_sum"]
 
 def sampling_interval(t: Any) -> float:
     """Return the sampling interval [s] of uniformly spaced time stamps ``t`` [s] (or of a scalar
@@ -61,7 +61,7 @@ def as_signal(u: Any, *, finite: bool = True) -> np.ndarray:
     """The signal as a finite 1-D float array of at least 2 samples (else a message naming the sample).
 
     ``finite=False`` skips the finiteness check (:func:`check_finite`) for a caller that proves it
-    otherwise in a pass it makes anyway (:func:`signal_snapshot`).
+    otherwise in a pass it makes anyway (:func:`signal_extremes`).
     """
     ua = np.asarray(u, dtype=float)
     if ua.ndim != 1:
@@ -92,27 +92,26 @@ def _refuse_non_finite(ua: np.ndarray) -> None:
             "fill or interpolate gaps before inverting)")
 
 
-#: Samples per block of :func:`signal_snapshot` (a block's extremes are found while it is in cache).
-SNAPSHOT_BLOCK = 1 << 15
+#: Samples per block of :func:`signal_extremes` (a block's extremes are found while it is in cache).
+EXTREMES_BLOCK = 1 << 15
 
 
-def signal_snapshot(ua: np.ndarray) -> tuple[np.ndarray, int, int]:
-    """``(copy, argmax, argmin)`` of the 1-D float signal ``ua``, checked finite, in one pass.
+def signal_extremes(ua: np.ndarray) -> tuple[int, int]:
+    """``(argmax, argmin)`` of the 1-D float signal ``ua``, checked finite, in one pass that writes nothing.
 
-    The copy is written block by block and each block's extremes are searched while it is in
-    cache, instead of a copy and two more passes over the record (``np.argmax``/``np.argmin``
-    treat NaN as the extreme, so finite extremes of every block prove every sample finite:
-    the check of :func:`check_finite` comes with it).  The positions are those ``np.argmax`` and
-    ``np.argmin`` of the whole record give (the first occurrence).  Raises
-    :class:`NonFiniteSignalError` as :func:`as_signal` does.
+    Each block's extremes are searched while it is in cache, instead of two passes over the
+    record (``np.argmax``/``np.argmin`` treat NaN as the extreme, so finite extremes of every
+    block prove every sample finite: the check of :func:`check_finite` comes with it).  The
+    positions are those ``np.argmax`` and ``np.argmin`` of the whole record give (the first
+    occurrence).  Raises :class:`NonFiniteSignalError` as :func:`as_signal` does.  No copy is
+    made: the automatic preview reads the caller's array and checks later that it did not
+    change (:func:`inversion.preview.auto_preview_passes`).
     """
     n = ua.size
-    out = np.empty(n)
     imax = imin = 0
     vmax, vmin = -math.inf, math.inf
-    for c0 in range(0, n, SNAPSHOT_BLOCK):
-        o = out[c0:c0 + SNAPSHOT_BLOCK]
-        np.copyto(o, ua[c0:c0 + SNAPSHOT_BLOCK])
+    for c0 in range(0, n, EXTREMES_BLOCK):
+        o = ua[c0:c0 + EXTREMES_BLOCK]
         i, j = int(np.argmax(o)), int(np.argmin(o))
         hi, lo = float(o[i]), float(o[j])
         if not (math.isfinite(hi) and math.isfinite(lo)):
@@ -121,4 +120,24 @@ def signal_snapshot(ua: np.ndarray) -> tuple[np.ndarray, int, int]:
             vmax, imax = hi, c0 + i
         if lo < vmin:
             vmin, imin = lo, c0 + j
-    return out, imax, imin
+    return imax, imin
+
+
+def check_output_sum(again: float, written: float | None, what: str, read_first: str) -> None:
+    """Refuse a signal changed since it was inverted: ``again``, the sum of the output recomputed from
+    the caller's array (the same blocks and order), must equal ``written``, the sum the inversion
+    took while it wrote the output, bit for bit (NaN matching NaN).
+
+    No copy of the signal is kept (it would cost a pass over the record on every inversion), so
+    what is computed later from it — ``what``, e.g. the parts of the inverse or the truncation
+    errors of the automatic preview — comes from the caller's array.  A change that leaves the sum
+    bit for bit the same is not seen.  ``read_first``: what the caller could read before reusing
+    its array.
+    """
+    if written is not None and (again == written or (math.isnan(again) and math.isnan(written))):
+        return
+    raise InversionError(
+        f"{what} are recomputed when first read from the signal inverted, which is the caller's own "
+        f"array (no copy is kept), and that array no longer gives the output of the inversion (its sum "
+        f"is {again!r}, the inversion's was {written!r}): the caller's input array was modified in "
+        f"place after the inversion; invert a copy (or read {read_first} first)")
