@@ -25,7 +25,7 @@ from .preview import (
     resolve_preview,
     truncation_error,
 )
-from .signals import as_signal, as_split, check_finite, check_output_sum, sampling_interval, time_base
+from .signals import as_signal, as_split, check_finite, check_unchanged, sampling_interval, time_base
 from .split import InverseSplit
 
 __all__ = [
@@ -189,7 +189,7 @@ class InversionResult(SampledRecord):
         plan, chunk = src
         sums: list[float] = []
         stable, unstable, _ = plan.run(self.input, chunk, self.stable_source, output_sum=sums)
-        check_output_sum(sums[0], self.output_sum, "the stable and unstable parts (result.stable_part, "
+        check_unchanged(sums[0], self.output_sum, "the stable and unstable parts (result.stable_part, "
                          "result.unstable_part)", "stable_part and unstable_part")
         if stable is None or unstable is None:     # pragma: no cover - keep_unstable=True keeps both
             raise InversionError("internal: the recomputation did not keep both parts")

@@ -304,7 +304,7 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
 
 def test_signal_extremes_are_numpys_without_a_write_and_refuse_non_finite_samples():
     # oracle: np.argmax / np.argmin of the whole record (first occurrence) and np.isfinite
-    from inversion.signals import EXTREMES_BLOCK, signal_extremes
+    from inversion.signals import EXTREMES_BLOCK, block_sum, signal_extremes
 
     rng = np.random.default_rng(8)
     n = 3 * EXTREMES_BLOCK + 17
@@ -314,9 +314,13 @@ def test_signal_extremes_are_numpys_without_a_write_and_refuse_non_finite_sample
     u[[EXTREMES_BLOCK - 1, 3 * EXTREMES_BLOCK + 2]] = -9.0
     before = u.copy()
     u.flags.writeable = False            # nothing is written (a write would raise)
-    i, j = signal_extremes(u)
+    i, j, total = signal_extremes(u)
     assert np.array_equal(u, before)
     assert (i, j) == (int(np.argmax(u)), int(np.argmin(u))) == (5, EXTREMES_BLOCK - 1)
+    # the fingerprint: the sum (math.fsum, correctly rounded, as oracle), and block_sum's bits
+    assert total == pytest.approx(math.fsum(u), rel=0, abs=1e-12 * n * np.max(np.abs(u)))
+    assert total == block_sum(u)
+    assert block_sum(np.where(np.arange(n) == 2 * EXTREMES_BLOCK + 7, u + 1.0, u)) != total
     for bad in (np.nan, np.inf, -np.inf):
         v = u.copy()
         v[2 * EXTREMES_BLOCK + 40] = bad
