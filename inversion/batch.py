@@ -72,10 +72,13 @@ class InversionResult(SampledRecord):
         over the record on every inversion): what is computed from it later — the parts (below),
         and for ``preview="auto"`` the truncation errors in ``preview_choice`` and
         ``truncation_error`` — is checked against the inversion and refused
-        (:class:`InversionError`) if the array was modified in place since; invert a copy to reuse
-        the array.  ``truncation_bound`` of ``preview="auto"`` is the choice's, taken at the
-        inversion; ``discretisation_error_estimate`` (and ``truncation_bound`` of a given preview)
-        are computed from ``input`` as it is when first read, without a check.
+        (:class:`InversionError`) if the array was modified in place since (a fingerprint taken
+        during the inversion must be the same: the sum of the output for the parts, the sum of
+        the signal's bit patterns for the errors; a change that leaves it so is not seen); invert
+        a copy to reuse the array.  ``truncation_bound`` of ``preview="auto"`` is the choice's,
+        taken at the inversion; ``discretisation_error_estimate`` (and ``truncation_error``,
+        ``truncation_bound`` of a given preview) are computed from ``input`` as it is when first
+        read, without a check.
     output : ndarray
         The reconstruction ``H[u]`` = ``stable_part + unstable_part`` [model input units,
         e.g. mm for a sensor, V for an actuator].
@@ -134,8 +137,9 @@ class InversionResult(SampledRecord):
         (internal; read ``stable_part``) [model input units].
     output_sum : float or None
         The sum of ``output`` as the block-wise pass wrote it (internal): the fingerprint the
-        parts recomputed from the caller's ``input`` are checked against (``preview="auto"``'s
-        errors are checked against the same sum, kept by its choice) [model input units].
+        parts recomputed from the caller's ``input`` are checked against [model input units]
+        (``preview="auto"``'s errors are checked against another fingerprint its choice keeps:
+        the sum of the signal's bit patterns, see :func:`~inversion.preview.auto_preview_passes`).
     """
 
     input: np.ndarray

@@ -41,7 +41,14 @@ import numpy as np
 
 from ._discrete import Plan, left_powers, pass_errstate, plan_for
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .signals import as_signal, block_sum, check_finite, check_unchanged, sampling_interval, signal_extremes
+from .signals import (
+    as_signal,
+    check_finite,
+    check_unchanged,
+    sampling_interval,
+    signal_extremes,
+    signal_fingerprint,
+)
 from .split import InverseSplit, check_split_for
 
 __all__ = ["PreviewChoice", "AutoPreviewPasses", "auto_preview_passes", "choose_preview", "discrete_tail_l1",
@@ -365,10 +372,12 @@ class PreviewChoice:
     ``relative_error``, ``max_error`` and ``error_bound`` need the full inverse and the exact
     truncation error of the signal (two more passes over it); for ``"linf"`` (and a chunked
     ``"l2"``) they are computed when first read, not when the preview is chosen, from the
-    caller's array (no copy is kept), which must not have been modified in place since: its sum,
-    taken block by block when the preview was chosen, must be bit for bit the same when they are
-    first read, else :class:`InversionError` (read them before reusing the array, or pass a copy).
-    A change that leaves that sum bit for bit the same (e.g. two samples exchanged) is not seen.
+    caller's array (no copy is kept), which must not have been modified in place since: its
+    fingerprint taken when the preview was chosen (the sum of its samples' bit patterns modulo
+    2**64, :func:`~inversion.signals.signal_fingerprint`) must be the same when they are first
+    read, else :class:`InversionError` (read them before reusing the array, or pass a copy).  Any
+    change of one sample is seen; changes of several that cancel in that sum (e.g. two samples
+    exchanged) are not.
     """
 
     samples: int
@@ -502,18 +511,20 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
 
     No copy of ``ua`` is kept (a copy was 1.45 of ~14.5 ns/sample at 20 kHz): one pass,
     :func:`~inversion.signals.signal_extremes`, reads it block by block for the peak (the bound),
-    the extremes (probes of the reference), the proof that it is finite and a fingerprint, its
-    sum taken block by block.  The errors are computed when first read from ``ua`` itself, so
-    ``ua`` (the caller's array) must not change in the meantime: they first take that sum again
-    (:func:`~inversion.signals.block_sum`) and refuse (:class:`InversionError`,
-    :func:`~inversion.signals.check_unchanged`) one that is not bit for bit the same.  A change
-    that leaves the sum bit for bit the same (e.g. two samples exchanged, or changes that cancel
-    exactly) is not seen.  The fingerprint costs ~0.2 ns/sample here and ~0.3 when the errors
-    are read; the sum of the output this pass takes anyway would cost nothing here but one more
-    finite-preview pass over the signal when the errors are read (measured at 2**21 samples,
-    seed 000 sensor, 1-20 kHz: reading the errors 21 -> 27-29 ns/sample), which ``ipmc
-    feedforward`` and the scenarios always do.  The result's arrays (``output``, ``stable``) are
-    not read: the caller may edit them.
+    the extremes (probes of the reference), the proof that it is finite and a fingerprint
+    (:func:`~inversion.signals.signal_fingerprint`: the sum of the samples' 64-bit patterns
+    modulo 2**64, which any change of one sample changes).  The errors are computed when first
+    read from ``ua`` itself, so ``ua`` (the caller's array) must not change in the meantime: they
+    first take the fingerprint again and refuse (:class:`InversionError`,
+    :func:`~inversion.signals.check_unchanged`) one that differs.  A change that leaves it the
+    same (changes of several samples that cancel modulo 2**64, e.g. two samples exchanged) is not
+    seen.  The fingerprint costs ~0.14 ns/sample here and ~0.3 when the errors are read
+    (2**21 samples).  Measured and not kept: the sum of the output this pass takes anyway as the
+    fingerprint (nothing here, but the errors would run this pass again: reading them went from
+    21 to 27-29 ns/sample, seed 000 sensor at 1-20 kHz, and ``ipmc feedforward`` and the
+    scenarios always read them); the float sum of the signal (~0.2 ns/sample here, and a change
+    of one sample smaller than its rounding goes unseen).  The result's arrays (``output``,
+    ``stable``) are not read: the caller may edit them.
     """
     _check_tolerance(tol, norm)
     n = ua.size
@@ -549,10 +560,11 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     written = sums[0]
 
     def errors() -> tuple[float, float, float]:
-        # from the caller's array, checked unchanged by its block sum (the result's arrays are not
+        # from the caller's array, checked unchanged by its fingerprint (the result's arrays are not
         # read: the caller may have edited them)
-        check_unchanged(block_sum(ua), fingerprint, "the truncation errors of the automatic preview",
-                        "preview_choice.relative_error (or max_error, error_bound)", "its block sum")
+        check_unchanged(signal_fingerprint(ua), fingerprint, "the truncation errors of the automatic preview",
+                        "preview_choice.relative_error (or max_error, error_bound)",
+                        "its fingerprint (the sum of its samples' bit patterns modulo 2**64)")
         minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
         y_inf = plan0.run(ua, n)[2]
         size = _peak if norm == "linf" else l2_norm

@@ -261,3 +261,14 @@ def test_automatic_preview_keeps_the_callers_array_as_its_input_and_checks_it(ch
     # not checked (documented): the sampling-error estimate is of the array as it is when read
     assert later.discretisation_error_estimate == pytest.approx(100 * fresh.discretisation_error_estimate,
                                                                 rel=1e-12)
+
+
+@pytest.mark.parametrize("chunk", CHUNKS)
+def test_automatic_preview_errors_see_one_sample_changed_by_one_ulp(chunk):
+    # the errors' fingerprint is the sum of the samples' bit patterns (exact): a change far below
+    # what a floating-point sum of the signal would register is still refused
+    u = _windowed_sine()
+    res = invert(G_NMP, 1e-3, u, chunk_size=chunk)
+    u[1234] = np.nextafter(u[1234], np.inf)
+    with pytest.raises(InversionError, match="input array was modified in place"):
+        _ = res.preview_choice.error_bound

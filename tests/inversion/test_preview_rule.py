@@ -13,6 +13,7 @@ Oracles (independent of the code under test):
 """
 
 import math
+import struct
 
 import numpy as np
 import pytest
@@ -302,9 +303,9 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
     assert ffa.preview_s > 2.5 * ffa.auto_preview_s                   # measured 0.124 vs 0.034 s
 
 
-def test_signal_extremes_are_numpys_without_a_write_and_refuse_non_finite_samples():
+def test_signal_extremes_are_numpys_with_the_fingerprint_without_a_write_and_refuse_non_finite_samples():
     # oracle: np.argmax / np.argmin of the whole record (first occurrence) and np.isfinite
-    from inversion.signals import EXTREMES_BLOCK, block_sum, signal_extremes
+    from inversion.signals import EXTREMES_BLOCK, signal_extremes, signal_fingerprint
 
     rng = np.random.default_rng(8)
     n = 3 * EXTREMES_BLOCK + 17
@@ -317,10 +318,20 @@ def test_signal_extremes_are_numpys_without_a_write_and_refuse_non_finite_sample
     i, j, total = signal_extremes(u)
     assert np.array_equal(u, before)
     assert (i, j) == (int(np.argmax(u)), int(np.argmin(u))) == (5, EXTREMES_BLOCK - 1)
-    # the fingerprint: the sum (math.fsum, correctly rounded, as oracle), and block_sum's bits
-    assert total == pytest.approx(math.fsum(u), rel=0, abs=1e-12 * n * np.max(np.abs(u)))
-    assert total == block_sum(u)
-    assert block_sum(np.where(np.arange(n) == 2 * EXTREMES_BLOCK + 7, u + 1.0, u)) != total
+    # the fingerprint: the sum of the samples' bit patterns modulo 2**64 (oracle: struct and Python
+    # integers), whole or strided; one sample one ulp away, or -0.0 for 0.0, changes it
+    def oracle(x):
+        return sum(struct.unpack(f"<{x.size}Q", np.ascontiguousarray(x).astype("<f8").tobytes())) % 2**64
+
+    assert total == oracle(u) == signal_fingerprint(u)
+    assert signal_extremes(u[::3])[2] == signal_fingerprint(u[::3]) == oracle(u[::3])
+    k = 2 * EXTREMES_BLOCK + 7
+    for changed in (np.nextafter(u[k], np.inf), np.nextafter(u[k], -np.inf)):
+        v = u.copy()
+        v[k] = changed
+        assert signal_fingerprint(v) == oracle(v) != total
+    z = np.zeros(5)
+    assert signal_fingerprint(z) != signal_fingerprint(np.where(np.arange(5) == 2, -0.0, z))
     for bad in (np.nan, np.inf, -np.inf):
         v = u.copy()
         v[2 * EXTREMES_BLOCK + 40] = bad
