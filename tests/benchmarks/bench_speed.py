@@ -161,8 +161,8 @@ stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilte
         0.34/0.34/0.33, 0.33/0.34/0.34, 0.32/0.33/0.31; auto ÷ chosen 1.09/1.11/1.12,
         1.12/1.13/1.15, 1.11/1.15/1.14 -> 1.06/1.09/1.11, 1.11/1.10/1.10, 1.11/1.11/1.12.  The pass
         before the inversion now only reads the signal (extremes, finiteness, and a fingerprint for
-        the errors read later: the sum of its bit patterns modulo 2**64): ~0.58 against the copy's
-        0.84-0.90 ns/sample (in-process loop over 2**21 samples, reused memory).  So the goal 0.3 is
+        the errors read later: the sum of its bit patterns modulo 2**64): 0.58-0.61 against the copying
+        pass's 0.90 ns/sample (medians of in-process loops over 2**21 samples, reused memory).  So the goal 0.3 is
         met in every run at every rate, at 20 kHz by 0.01-0.04 (main in the same rounds 0.00-0.03):
         a margin the size of the run-to-run spread, not more.  Streaming chunk 4096 row: batch auto
         20.0-20.5 -> 16.9-17.7 ns/sample (streaming ÷ batch 0.97-0.99 -> 1.11-1.17, still ≤ 1.5),
