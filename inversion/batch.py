@@ -25,7 +25,7 @@ from .preview import (
     resolve_preview,
     truncation_error,
 )
-from .signals import as_signal, as_split, check_finite, sampling_interval, time_base
+from .signals import as_signal, as_split, check_finite, check_unchanged, sampling_interval, time_base
 from .split import InverseSplit
 
 __all__ = [
@@ -67,8 +67,18 @@ class InversionResult(SampledRecord):
         Sample times [s] (built on first access when only ``dt`` was given).
     input : ndarray
         The signal that was inverted [model output units, e.g. uA for a sensor]: the caller's
-        array, or for ``preview="auto"`` (``"linf"`` norm, or chunked) the read-only copy it keeps
-        (``signal_copy``), so that the errors and bounds read later are those of this signal.
+        array itself for every preview, ``"auto"`` included (a 1-D float64 array; anything else
+        is converted, and ``input`` is the conversion).  No copy is kept (it would cost a pass
+        over the record on every inversion): what is computed from it later — the parts (below),
+        and for ``preview="auto"`` the truncation errors in ``preview_choice`` and
+        ``truncation_error`` — is checked against the inversion and refused
+        (:class:`InversionError`) if the array was modified in place since (a fingerprint taken
+        during the inversion must be the same: the sum of the output for the parts, the sum of
+        the signal's bit patterns for the errors; a change that leaves it so is not seen); invert
+        a copy to reuse the array.  ``truncation_bound`` of ``preview="auto"`` is the choice's,
+        taken at the inversion; ``discretisation_error_estimate`` (and ``truncation_error``,
+        ``truncation_bound`` of a given preview) are computed from ``input`` as it is when first
+        read, without a check.
     output : ndarray
         The reconstruction ``H[u]`` = ``stable_part + unstable_part`` [model input units,
         e.g. mm for a sensor, V for an actuator].
@@ -83,14 +93,12 @@ class InversionResult(SampledRecord):
         inverted, the same values bit for bit as those whose sum was written to ``output``.
         Keeping them would cost record-sized arrays that nothing but these attributes reads.
         ``output`` is not read for it: the caller may edit ``output`` in place (e.g. clip a
-        drive) and still read the parts of the inversion.  For ``preview="auto"`` the parts are
-        recomputed from the copy of the signal it keeps (``input`` is that copy, read-only),
-        so they are those of the signal inverted whatever happens to the caller's array.
-        Otherwise ``input`` is the caller's array (no copy is made) and the parts are
-        recomputed from it; an ``input`` modified in place since the inversion is refused
-        (:class:`InversionError`): the sum of the recomputed output, summed in the same blocks
-        and order as the inversion summed it (to prove it finite), must equal that sum bit for
-        bit (a change that leaves it bit for bit the same is not seen).
+        drive) and still read the parts of the inversion.  ``input`` is the caller's array (no
+        copy is made, ``preview="auto"`` included) and the parts are recomputed from it; an
+        ``input`` modified in place since the inversion is refused (:class:`InversionError`):
+        the sum of the recomputed output, summed in the same blocks and order as the inversion
+        summed it (to prove it finite), must equal that sum bit for bit (a change that leaves it
+        bit for bit the same is not seen).
     preview_s : float
         Preview actually used, ``preview_samples * dt`` [s]; ``inf`` for infinite preview.
     preview_samples : int or None
@@ -127,12 +135,11 @@ class InversionResult(SampledRecord):
     stable_source : ndarray or None
         The causal part itself, or None when it is recomputed with ``unstable_part``
         (internal; read ``stable_part``) [model input units].
-    signal_copy : ndarray or None
-        The read-only copy of the signal that ``preview="auto"`` keeps (internal; it is also
-        ``input``): the parts are then recomputed from it without a check [model output units].
     output_sum : float or None
         The sum of ``output`` as the block-wise pass wrote it (internal): the fingerprint the
-        parts recomputed from the caller's ``input`` are checked against [model input units].
+        parts recomputed from the caller's ``input`` are checked against [model input units]
+        (``preview="auto"``'s errors are checked against another fingerprint its choice keeps:
+        the sum of the signal's bit patterns, see :func:`~inversion.preview.auto_preview_passes`).
     """
 
     input: np.ndarray
@@ -152,8 +159,6 @@ class InversionResult(SampledRecord):
     unstable_source: Any = field(default=None, repr=False)
     #: the causal part, or None: recomputed with the anticausal part (see ``stable_part``)
     stable_source: np.ndarray | None = field(default=None, repr=False)
-    #: preview="auto"'s copy of the input, which the parts are recomputed from (see ``stable_part``)
-    signal_copy: np.ndarray | None = field(default=None, repr=False)
     #: the sum of output as written, checked when the parts are recomputed from the caller's input
     output_sum: float | None = field(default=None, repr=False)
 
@@ -180,24 +185,16 @@ class InversionResult(SampledRecord):
     @cached_property
     def _parts(self) -> tuple[np.ndarray, np.ndarray]:
         """``(stable_part, unstable_part)`` recomputed by the passes that made ``output`` (see the
-        class doc), from ``preview="auto"``'s copy of the signal, or from ``input`` checked
-        unchanged by the sum of the output it gives (``output`` itself is not read)."""
+        class doc) from ``input``, checked unchanged by the sum of the output it gives (``output``
+        itself is not read)."""
         src = self.unstable_source
         if isinstance(src, np.ndarray):        # only the causal part was not kept
             raise InversionError("internal: a kept anticausal part without its causal part")  # pragma: no cover
         plan, chunk = src
         sums: list[float] = []
-        if self.signal_copy is not None:
-            # the copy is the signal inverted (read-only): nothing to check
-            stable, unstable, _ = plan.run(self.signal_copy, chunk, self.stable_source)
-        else:
-            stable, unstable, _ = plan.run(self.input, chunk, self.stable_source, output_sum=sums)
-            if self.output_sum is None or sums[0] != self.output_sum:
-                raise InversionError(
-                    "the stable and unstable parts are recomputed from result.input when first read, and "
-                    f"that input no longer gives the output of the inversion (its sum is {sums[0]!r}, the "
-                    f"inversion's was {self.output_sum!r}): the caller's input array was modified in place "
-                    "after the inversion; invert a copy (or read stable_part and unstable_part first)")
+        stable, unstable, _ = plan.run(self.input, chunk, self.stable_source, output_sum=sums)
+        check_unchanged(sums[0], self.output_sum, "the stable and unstable parts (result.stable_part, "
+                         "result.unstable_part)", "stable_part and unstable_part")
         if stable is None or unstable is None:     # pragma: no cover - keep_unstable=True keeps both
             raise InversionError("internal: the recomputation did not keep both parts")
         return stable, unstable
@@ -214,9 +211,12 @@ class InversionResult(SampledRecord):
 
     @cached_property
     def truncation_bound(self) -> float:
-        """Signal-independent bound on the preview error, ``tail_l1_norm(T_p) max|u|`` [output units]."""
+        """Signal-independent bound on the preview error, ``tail_l1_norm(T_p) max|u|`` [output units]
+        (for ``preview="auto"`` the choice's ``tail_bound``, the same number, taken at the inversion)."""
         if self.preview_samples is None:
             return 0.0
+        if self.preview_choice is not None:
+            return self.preview_choice.tail_bound
         return float(self.split.tail_l1_norm(self.preview_s)) * float(np.max(np.abs(self.input)))
 
 
@@ -301,8 +301,8 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
     request); or :func:`inversion.limits.check_limits` on ``result.output``.
     """
     rule = preview_rule(preview)
-    # the signal is proved finite in a pass made anyway: preview="auto" in the one that copies it
-    # (auto_preview_passes), any other preview by the sum of the output (below): every input sample
+    # the signal is proved finite in a pass made anyway: preview="auto" in the one that finds its
+    # extremes (auto_preview_passes), any other preview by the sum of the output (below): every input sample
     # reaches its own output sample through the causal pass's b0 * u[k] (computed even for b0 = 0,
     # and 0 * NaN, 0 * inf are NaN), so a finite output proves a finite input
     ua = as_signal(u, finite=False)
@@ -326,10 +326,6 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         choice = passes.choice
         n_prev, prev_s = choice.samples, choice.seconds
         stable, unstable, output = passes.stable, passes.unstable, passes.output
-        signal_copy = passes.signal
-        if signal_copy is not None:     # the signal inverted, whatever the caller does with its array
-            signal_copy.flags.writeable = False
-            ua = signal_copy
         finite = passes.finite
         written_sum = passes.output_sum
         plan = passes.plan
@@ -343,7 +339,6 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
                                                 keep_stable=False)
         written_sum = sums[0]
         finite = math.isfinite(written_sum)
-        signal_copy = None
     # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
     # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
     # element-wise check, of the input first (a bad input sample is named as as_signal names it)
@@ -356,7 +351,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
             "scale the signal to the model's units")
     return InversionResult(
-        input=ua, output=output, stable_source=stable, signal_copy=signal_copy, output_sum=written_sum,
+        input=ua, output=output, stable_source=stable, output_sum=written_sum,
         unstable_source=unstable if unstable is not None else (plan, chunk),
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),

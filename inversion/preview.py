@@ -15,10 +15,11 @@ of the kernel, :func:`discrete_tail_l1`) computed for every ``N`` at once from t
 for the max norm a lower bound of ``max|y_inf|`` from the exact values of ``y_inf`` at a few
 samples (:func:`reference_lower_bound`, multiply-adds over the kernel, no pass), so
 ``invert(preview="auto")`` costs the causal pass and the finite-preview anticausal pass of the
-chosen preview — what inverting with that preview given costs — plus one copy of the signal
-(:func:`~inversion.signals.signal_snapshot`, which also finds its peak and checks it finite), and
-the exact error of ``N`` (one more anticausal pass, plus the full inverse for the relative error)
-is computed from that copy only when it is read.  For the l2 norm ``||y_inf||_2`` itself is computed (the full inverse, then one more
+chosen preview — what inverting with that preview given costs — plus one pass that reads the signal
+(:func:`~inversion.signals.signal_extremes`: its peak, and the proof that it is finite), and the
+exact error of ``N`` (one more anticausal pass, plus the full inverse for the relative error) is
+computed only when it is read, from the caller's array, checked unchanged (no copy is kept; see
+:func:`auto_preview_passes`).  For the l2 norm ``||y_inf||_2`` itself is computed (the full inverse, then one more
 anticausal pass for the exact error; the three passes sum to the finite-preview inverse).
 The bound is tight for a signal that follows the sign pattern of the kernel's tail; for a
 sinusoid it gives away the ratio of the tail's l1 norm to its gain at that frequency, i.e. a
@@ -40,7 +41,14 @@ import numpy as np
 
 from ._discrete import Plan, left_powers, pass_errstate, plan_for
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
-from .signals import as_signal, check_finite, sampling_interval, signal_snapshot
+from .signals import (
+    as_signal,
+    check_finite,
+    check_unchanged,
+    sampling_interval,
+    signal_extremes,
+    signal_fingerprint,
+)
 from .split import InverseSplit, check_split_for
 
 __all__ = ["PreviewChoice", "AutoPreviewPasses", "auto_preview_passes", "choose_preview", "discrete_tail_l1",
@@ -362,8 +370,14 @@ class PreviewChoice:
         inverse in that norm (<= ``tolerance``).
 
     ``relative_error``, ``max_error`` and ``error_bound`` need the full inverse and the exact
-    truncation error of the signal (two more passes over it); for ``"linf"`` they are computed
-    when first read, from the signal, not when the preview is chosen.
+    truncation error of the signal (two more passes over it); for ``"linf"`` (and a chunked
+    ``"l2"``) they are computed when first read, not when the preview is chosen, from the
+    caller's array (no copy is kept), which must not have been modified in place since: its
+    fingerprint taken when the preview was chosen (the sum of its samples' bit patterns modulo
+    2**64, :func:`~inversion.signals.signal_fingerprint`) must be the same when they are first
+    read, else :class:`InversionError` (read them before reusing the array, or pass a copy).  Any
+    change of one sample is seen; changes of several that cancel in that sum (e.g. two samples
+    exchanged) are not.
     """
 
     samples: int
@@ -419,8 +433,6 @@ class AutoPreviewPasses:
     plan : Plan or None
         The plan of the chosen preview that produced ``unstable``/``output`` (None on the
         ``"l2"`` path, whose ``unstable`` is always kept).
-    signal : ndarray or None
-        The copy of the signal the errors are computed from (the ``"linf"`` and chunked paths).
     output_sum : float or None
         The sum of ``output`` as the pass wrote it (see :meth:`~inversion._discrete.Plan.run`;
         None on the whole-record ``"l2"`` path).
@@ -432,7 +444,6 @@ class AutoPreviewPasses:
     output: np.ndarray
     finite: bool = False
     plan: Plan | None = None
-    signal: np.ndarray | None = None
     output_sum: float | None = None
 
 
@@ -493,15 +504,27 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     ``keep_unstable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
     ``keep_stable``: as in :meth:`~inversion._discrete.Plan.run` (the ``"linf"`` path).
     ``finite_checked=False``: ``ua`` was not yet checked finite (it is checked here, on the
-    ``"linf"`` path in the pass that copies it, see below).  ``quiet_passes``: the caller refuses
+    ``"linf"`` path in the pass that finds its extremes, see below).  ``quiet_passes``: the caller refuses
     a non-finite output itself (from ``output_sum``, as :func:`~inversion.invert` does), so
     numpy's overflow/invalid warnings inside the inverse's passes are silenced (only there: the
     choice's own arithmetic, e.g. the ``"l2"`` norms, is not).
 
-    The errors read later are those of the signal inverted now, whatever happens to the caller's
-    array or to the result's afterwards, so the ``"linf"`` path keeps a copy of ``ua``; it is made
-    by :func:`~inversion.signals.signal_snapshot` in the same pass that finds the peak of ``ua``
-    (for the bound) and its extremes (probes of the reference) and checks it finite.
+    No copy of ``ua`` is kept (a copy was 1.45 of ~14.5 ns/sample at 20 kHz): one pass,
+    :func:`~inversion.signals.signal_extremes`, reads it block by block for the peak (the bound),
+    the extremes (probes of the reference), the proof that it is finite and a fingerprint
+    (:func:`~inversion.signals.signal_fingerprint`: the sum of the samples' 64-bit patterns
+    modulo 2**64, which any change of one sample changes).  The errors are computed when first
+    read from ``ua`` itself, so ``ua`` (the caller's array) must not change in the meantime: they
+    first take the fingerprint again and refuse (:class:`InversionError`,
+    :func:`~inversion.signals.check_unchanged`) one that differs.  A change that leaves it the
+    same (changes of several samples that cancel modulo 2**64, e.g. two samples exchanged) is not
+    seen.  The fingerprint costs ~0.14 ns/sample here and ~0.3 when the errors are read
+    (2**21 samples).  Measured and not kept: the sum of the output this pass takes anyway as the
+    fingerprint (nothing here, but the errors would run this pass again: reading them went from
+    21 to 27-29 ns/sample, seed 000 sensor at 1-20 kHz, and ``ipmc feedforward`` and the
+    scenarios always read them); the float sum of the signal (~0.2 ns/sample here, and a change
+    of one sample smaller than its rounding goes unseen).  The result's arrays (``output``,
+    ``stable``) are not read: the caller may edit them.
     """
     _check_tolerance(tol, norm)
     n = ua.size
@@ -509,12 +532,12 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     plan0 = plan_for(split, dt, None)
     if norm == "l2" and chunk >= n:
         return _auto_l2(split, dt, ua if finite_checked else check_finite(ua), plan0, tol, quiet_passes)
-    ua_copy, imax, imin = signal_snapshot(ua)
+    imax, imin, fingerprint = signal_extremes(ua)
     extremes = (imax, imin)
     with pass_errstate(quiet_passes):
         stable = plan0.causal(ua, chunk)
-    umax = max(float(ua_copy[imax]), -float(ua_copy[imin]))
-    size_u = umax if norm == "linf" else l2_norm(ua_copy)
+    umax = max(float(ua[extremes[0]]), -float(ua[extremes[1]]))
+    size_u = umax if norm == "linf" else l2_norm(ua)
     if norm == "linf":
         ref = reference_lower_bound(split, dt, ua, stable, umax, extremes)
     else:     # chunked l2: the full inverse once for its norm
@@ -534,12 +557,16 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     with pass_errstate(quiet_passes):
         stable_kept, unstable, output = plan.run(ua, chunk, stable, keep_unstable=keep_unstable,
                                                  output_sum=sums, keep_stable=keep_stable)
+    written = sums[0]
 
     def errors() -> tuple[float, float, float]:
-        # from the copy of the signal inverted (the result's arrays, or the caller's input, may have
-        # been changed since)
-        minus_e = _truncation_head(split, dt, ua_copy, N)     # -e_N[:n - N]; e_N is zero beyond
-        y_inf = plan0.run(ua_copy, ua_copy.size)[2]
+        # from the caller's array, checked unchanged by its fingerprint (the result's arrays are not
+        # read: the caller may have edited them)
+        check_unchanged(signal_fingerprint(ua), fingerprint, "the truncation errors of the automatic preview",
+                        "preview_choice.relative_error (or max_error, error_bound)",
+                        "its fingerprint (the sum of its samples' bit patterns modulo 2**64)")
+        minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
+        y_inf = plan0.run(ua, n)[2]
         size = _peak if norm == "linf" else l2_norm
         r = size(y_inf)
         emax = _peak(minus_e) if minus_e.size else 0.0
@@ -550,8 +577,8 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         samples=N, seconds=N * dt, tolerance=float(tol), norm=norm,
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
-    return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(sums[0]), plan=plan,
-                             signal=ua_copy, output_sum=sums[0])
+    return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(written), plan=plan,
+                             output_sum=written)
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float,
@@ -566,8 +593,9 @@ def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: f
     ref = _l2_reference(output)
     umax = _peak(ua)
     if split.n_unstable == 0 or ref == 0.0:
-        zero = PreviewChoice(0, 0.0, float(tol), "l2", 0.0, split.auto_preview_s if split.n_unstable else 0.0,
-                             ref)
+        # tail_bound as its doc says (it is 0 but for a signal whose inverse underflows to 0)
+        zero = PreviewChoice(0, 0.0, float(tol), "l2", float(split.tail_l1_norm(0.0)) * umax,
+                             split.auto_preview_s if split.n_unstable else 0.0, ref)
         return AutoPreviewPasses(zero, stable, np.zeros(n), stable.copy())
     tail = _anti_kernel(split, dt, n)[1] * size(ua)
     ok = np.flatnonzero(tail <= tol * ref)

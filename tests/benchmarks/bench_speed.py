@@ -153,6 +153,24 @@ stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilte
         and in ``np.longdouble`` (24).  The polynomial is refused where its running rounding
         drifts: at 100 kHz it passes the response check (1.0e-11) but runs 3.1e-10 off on a step,
         so 50 and 100 kHz keep the sections.
+        2026-11-27, issue 29, ``preview='auto'`` without its copy of the signal (branch h-nocopy
+        d36c65a against main 44cc471 via ``--root``, ``--clock thread``, 3 alternating runs each,
+        load 2.5-2.8 on 2 cores; per run at 1 / 5 / 20 kHz, main -> branch): ``preview='auto'``
+        13.2/13.2/13.4, 13.6/13.6/14.2, 14.1/14.2/14.5 -> 12.8/12.9/13.3, 13.2/13.1/13.1,
+        13.3/13.4/14.2 ns/sample; lfilter ÷ auto 0.33/0.33/0.33, 0.32/0.31/0.31, 0.32/0.32/0.30 ->
+        0.34/0.34/0.33, 0.33/0.34/0.34, 0.32/0.33/0.31; auto ÷ chosen 1.09/1.11/1.12,
+        1.12/1.13/1.15, 1.11/1.15/1.14 -> 1.06/1.09/1.11, 1.11/1.10/1.10, 1.11/1.11/1.12.  The pass
+        before the inversion now only reads the signal (extremes, finiteness, and a fingerprint for
+        the errors read later: the sum of its bit patterns modulo 2**64): 0.58-0.61 against the copying
+        pass's 0.90 ns/sample (medians of in-process loops over 2**21 samples, reused memory).  So the goal 0.3 is
+        met in every run at every rate, at 20 kHz by 0.01-0.04 (main in the same rounds 0.00-0.03):
+        a margin the size of the run-to-run spread, not more.  Streaming chunk 4096 row: batch auto
+        20.0-20.5 -> 16.9-17.7 ns/sample (streaming ÷ batch 0.97-0.99 -> 1.11-1.17, still ≤ 1.5),
+        mostly glibc's doing: main's 8 MiB copy came from fresh mmap'd pages; with
+        ``MALLOC_MMAP_THRESHOLD_=67108864`` main's batch is 16.7 too (branch 17.2, one run each),
+        and the 1 kHz 'given' and 'floor' columns (code unchanged), 0.7-1.5 ns/sample higher on the
+        branch in the default runs, agree again (given / floor 12.3 / 11.9 main, 11.8 / 11.7
+        branch): an artefact of the allocator's history in the run, not a cost.
 """
 
 from __future__ import annotations

@@ -292,7 +292,7 @@ def test_control_transfer_function_and_split_inputs_agree():
     (NMP, dict(preview="4/r0")),                                     # fused finite-preview pass
     (NMP, dict(preview="inf")),                                      # whole-record passes
     (NMP, dict(preview=0.05, chunk_size=700)),                       # block by block
-    (NMP, dict(preview="auto")),                                     # the snapshot's check
+    (NMP, dict(preview="auto")),                                     # the extremes pass's check
     ((np.poly([-50.0, -500.0]), np.poly([-10.0, -100.0])), dict(preview="inf")),   # causal only
     (([100.0], [1.0, 14.0, 100.0]), dict(improper="differentiate")),               # stencil, D = 0
     ((np.array([1.0, -30.0]), np.array([1.0, 40.0])), dict(preview=0.05)),          # no stable part
@@ -300,7 +300,7 @@ def test_control_transfer_function_and_split_inputs_agree():
 @pytest.mark.parametrize("where", [0, 777, 2999])
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 def test_a_non_finite_input_sample_is_named_whatever_the_path(model, kwargs, where, bad):
-    # the input is proved finite by the output's sum (or the auto preview's snapshot), not by a
+    # the input is proved finite by the output's sum (or the auto preview's extremes pass), not by a
     # pass of its own: every path must still refuse a bad sample and name it (oracle: its index)
     u = np.sin(2 * np.pi * 5e-3 * np.arange(3000))
     u[where] = bad

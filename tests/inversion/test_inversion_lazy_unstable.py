@@ -150,16 +150,20 @@ def test_the_output_is_written_over_the_causal_part_which_is_recomputed_when_rea
     np.testing.assert_array_equal(res.stable_part + res.unstable_part, res.output)
 
 
-def test_automatic_preview_recomputes_the_parts_of_the_signal_inverted():
-    # preview='auto' keeps a copy of the signal (for its errors): the parts come from it, so a
-    # caller reusing its array still reads the parts of what was inverted
+def test_automatic_preview_recomputes_the_parts_from_the_callers_array_and_refuses_a_changed_one():
+    # preview='auto' keeps no copy of the signal (issue 29): the parts come from the caller's array,
+    # the same bits as those of an untouched copy while it is unchanged, refused once it changed
     split = split_inverse(G35)
     u = _signal(2600, 12)
     ref = invert(split, 1e-3, u.copy())
-    res = invert(split, 1e-3, u)
-    u *= 100.0
+    res, later = invert(split, 1e-3, u), invert(split, 1e-3, u)
+    assert res.input is u and later.input is u
     np.testing.assert_array_equal(res.stable_part, ref.stable_part)
     np.testing.assert_array_equal(res.unstable_part, ref.unstable_part)
+    u *= 100.0
+    np.testing.assert_array_equal(res.unstable_part, ref.unstable_part)     # read before: kept
+    with pytest.raises(InversionError, match="input array was modified in place"):
+        _ = later.unstable_part
 
 
 # the review's reproduction (issue 29): a nonminimum-phase model (zeros 1 +- 2j), dt 1 ms, 4000 samples,
@@ -196,15 +200,15 @@ def test_editing_the_output_leaves_the_parts_readable_and_unchanged(preview, chu
 @pytest.mark.parametrize("chunk", CHUNKS)
 def test_reusing_the_input_array_is_refused_or_harmless_on_every_path(preview, chunk):
     # what each path does when the caller overwrites its input array before reading the parts:
-    # 'auto' recomputes them from its read-only copy (the parts of the signal inverted); the
-    # whole-record infinite preview kept both; every other path recomputes from the caller's
-    # array and refuses a changed one (found from the output's sum, not from the output)
+    # the whole-record infinite preview kept both; every other path ('auto' included, issue 29:
+    # it keeps no copy) recomputes from the caller's array and refuses a changed one (found from
+    # the output's sum, not from the output), and so do 'auto''s truncation errors
     u = _windowed_sine()
     fresh = invert(G_NMP, 1e-3, u.copy(), preview=preview, chunk_size=chunk)
     res = invert(G_NMP, 1e-3, u, preview=preview, chunk_size=chunk)
     res.output[:] = 0.0                      # not what the check reads: the refusal must still come
     u[:] = 0.0
-    if preview == "auto" or (preview == "inf" and chunk is None):
+    if preview == "inf" and chunk is None:
         np.testing.assert_array_equal(res.stable_part, fresh.stable_part)
         np.testing.assert_array_equal(res.unstable_part, fresh.unstable_part)
     else:
@@ -212,9 +216,13 @@ def test_reusing_the_input_array_is_refused_or_harmless_on_every_path(preview, c
             _ = res.stable_part
         with pytest.raises(InversionError, match="input array was modified in place"):
             _ = res.unstable_part
+    if preview == "auto":
+        with pytest.raises(InversionError, match="input array was modified in place"):
+            _ = res.preview_choice.relative_error
 
 
-@pytest.mark.parametrize("preview, chunk", [(0.5, None), (0.5, 1000), ("inf", 1000)])
+@pytest.mark.parametrize("preview, chunk", [(0.5, None), (0.5, 1000), ("inf", 1000), ("auto", None),
+                                            ("auto", 1000)])
 def test_one_changed_input_sample_is_refused(preview, chunk):
     # the paths that recompute from the caller's array (whole-record 'inf' keeps both parts)
     u = _windowed_sine()
@@ -222,18 +230,45 @@ def test_one_changed_input_sample_is_refused(preview, chunk):
     u[2345] += 1e-6
     with pytest.raises(InversionError, match="modified in place"):
         _ = res.stable_part
+    if preview == "auto":
+        with pytest.raises(InversionError, match="modified in place"):
+            _ = res.preview_choice.max_error
 
 
 @pytest.mark.parametrize("chunk", CHUNKS)
-def test_automatic_preview_keeps_a_read_only_copy_as_its_input(chunk):
-    # the bounds read later follow the signal inverted, not a reused buffer
+def test_automatic_preview_keeps_the_callers_array_as_its_input_and_checks_it(chunk):
+    # no copy (issue 29): input is the caller's array, writable; what is read later from it is the
+    # same bits as for an untouched copy while it is unchanged, and refused once it changed (never
+    # the errors of another signal: the review's reused buffer, 100x once)
     u = _windowed_sine()
     fresh = invert(G_NMP, 1e-3, u.copy(), chunk_size=chunk)
     res = invert(G_NMP, 1e-3, u, chunk_size=chunk)
+    assert res.input is u and res.input.flags.writeable
+    c, f = res.preview_choice, fresh.preview_choice
+    assert (c.relative_error, c.max_error, c.error_bound) == (f.relative_error, f.max_error, f.error_bound)
+    assert c.relative_error > 0
+    assert res.truncation_error == fresh.truncation_error
+    later = invert(G_NMP, 1e-3, u, chunk_size=chunk)
     u *= 100.0
-    assert res.input is not u and not res.input.flags.writeable
-    with pytest.raises(ValueError, match="read-only"):
-        res.input[0] = 1.0
-    assert res.truncation_bound == fresh.truncation_bound > 0
-    assert res.discretisation_error_estimate == fresh.discretisation_error_estimate > 0
+    for name in ("relative_error", "max_error", "error_bound"):
+        with pytest.raises(InversionError, match="input array was modified in place"):
+            getattr(later.preview_choice, name)
+    with pytest.raises(InversionError, match="input array was modified in place"):
+        _ = later.truncation_error
+    # read before the change: kept; the bound is the choice's, taken at the inversion
     assert res.preview_choice.relative_error == fresh.preview_choice.relative_error
+    assert later.truncation_bound == fresh.truncation_bound > 0
+    # not checked (documented): the sampling-error estimate is of the array as it is when read
+    assert later.discretisation_error_estimate == pytest.approx(100 * fresh.discretisation_error_estimate,
+                                                                rel=1e-12)
+
+
+@pytest.mark.parametrize("chunk", CHUNKS)
+def test_automatic_preview_errors_see_one_sample_changed_by_one_ulp(chunk):
+    # the errors' fingerprint is the sum of the samples' bit patterns (exact): a change far below
+    # what a floating-point sum of the signal would register is still refused
+    u = _windowed_sine()
+    res = invert(G_NMP, 1e-3, u, chunk_size=chunk)
+    u[1234] = np.nextafter(u[1234], np.inf)
+    with pytest.raises(InversionError, match="input array was modified in place"):
+        _ = res.preview_choice.error_bound

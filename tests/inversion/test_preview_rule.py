@@ -13,6 +13,7 @@ Oracles (independent of the code under test):
 """
 
 import math
+import struct
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ import scipy.integrate as si
 import scipy.signal as ss
 
 from inversion import (
+    InversionError,
     NonFiniteSignalError,
     PreviewError,
     StreamingInverter,
@@ -161,18 +163,24 @@ def test_auto_preview_errors_are_computed_from_the_signal_when_read():
     assert r.preview_choice.relative_error == pytest.approx(err / np.max(np.abs(y_inf)), rel=1e-6)
 
 
-def test_auto_preview_errors_are_of_the_signal_inverted_even_if_the_caller_reuses_its_array():
-    # the caller's own float64 array may be what the inversion holds: changing it afterwards must
-    # not change the error reported for the inversion already done (review finding: 100x once)
+def test_auto_preview_errors_are_of_the_signal_inverted_or_refused_if_the_caller_reuses_its_array():
+    # the caller's own float64 array is what the inversion holds (no copy, issue 29): changing it
+    # afterwards must never change the error reported for the inversion already done (review
+    # finding: 100x once): read before, it is kept; first read after, it is refused
     G = toy_actuator()
     t, d = _faded_sine(1.0)
     d = np.ascontiguousarray(d, dtype=float)
     y_inf = invert(G, t, d.copy(), preview="inf").output
-    r = invert(G, t, d)
+    r, later = invert(G, t, d), invert(G, t, d)
+    chosen = choose_preview(split_inverse(G), t[1] - t[0], d)
     err = float(np.max(np.abs(r.output - y_inf)))
-    d *= 100.0
     assert r.preview_choice.max_error == pytest.approx(err, rel=1e-6)
-    assert r.truncation_error == pytest.approx(err, rel=1e-6)
+    d *= 100.0
+    assert r.truncation_error == r.preview_choice.max_error == pytest.approx(err, rel=1e-6)
+    with pytest.raises(InversionError, match="input array was modified in place"):
+        _ = later.truncation_error
+    with pytest.raises(InversionError, match="truncation errors .* modified in place"):
+        _ = chosen.relative_error
 
 
 def test_auto_preview_grows_with_tighter_tolerance_and_l2_norm_is_available():
@@ -295,27 +303,43 @@ def test_default_preview_is_safe_on_the_seed001_actuator_surrogate(seed001_35c):
     assert ffa.preview_s > 2.5 * ffa.auto_preview_s                   # measured 0.124 vs 0.034 s
 
 
-def test_signal_snapshot_is_a_copy_with_numpys_extremes_and_refuses_non_finite_samples():
+def test_signal_extremes_are_numpys_with_the_fingerprint_without_a_write_and_refuse_non_finite_samples():
     # oracle: np.argmax / np.argmin of the whole record (first occurrence) and np.isfinite
-    from inversion.signals import SNAPSHOT_BLOCK, signal_snapshot
+    from inversion.signals import EXTREMES_BLOCK, signal_extremes, signal_fingerprint
 
     rng = np.random.default_rng(8)
-    n = 3 * SNAPSHOT_BLOCK + 17
+    n = 3 * EXTREMES_BLOCK + 17
     u = rng.standard_normal(n)
     # ties across blocks: the first occurrence wins, as for np.argmax
-    u[[5, SNAPSHOT_BLOCK + 3, 2 * SNAPSHOT_BLOCK + 1]] = 9.0
-    u[[SNAPSHOT_BLOCK - 1, 3 * SNAPSHOT_BLOCK + 2]] = -9.0
-    c, i, j = signal_snapshot(u)
-    assert c is not u and np.array_equal(c, u)
-    assert (i, j) == (int(np.argmax(u)), int(np.argmin(u))) == (5, SNAPSHOT_BLOCK - 1)
+    u[[5, EXTREMES_BLOCK + 3, 2 * EXTREMES_BLOCK + 1]] = 9.0
+    u[[EXTREMES_BLOCK - 1, 3 * EXTREMES_BLOCK + 2]] = -9.0
+    before = u.copy()
+    u.flags.writeable = False            # nothing is written (a write would raise)
+    i, j, total = signal_extremes(u)
+    assert np.array_equal(u, before)
+    assert (i, j) == (int(np.argmax(u)), int(np.argmin(u))) == (5, EXTREMES_BLOCK - 1)
+    # the fingerprint: the sum of the samples' bit patterns modulo 2**64 (oracle: struct and Python
+    # integers), whole or strided; one sample one ulp away, or -0.0 for 0.0, changes it
+    def oracle(x):
+        return sum(struct.unpack(f"<{x.size}Q", np.ascontiguousarray(x).astype("<f8").tobytes())) % 2**64
+
+    assert total == oracle(u) == signal_fingerprint(u)
+    assert signal_extremes(u[::3])[2] == signal_fingerprint(u[::3]) == oracle(u[::3])
+    k = 2 * EXTREMES_BLOCK + 7
+    for changed in (np.nextafter(u[k], np.inf), np.nextafter(u[k], -np.inf)):
+        v = u.copy()
+        v[k] = changed
+        assert signal_fingerprint(v) == oracle(v) != total
+    z = np.zeros(5)
+    assert signal_fingerprint(z) != signal_fingerprint(np.where(np.arange(5) == 2, -0.0, z))
     for bad in (np.nan, np.inf, -np.inf):
         v = u.copy()
-        v[2 * SNAPSHOT_BLOCK + 40] = bad
-        v[3 * SNAPSHOT_BLOCK + 1] = np.nan
-        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * SNAPSHOT_BLOCK + 40} is"):
-            signal_snapshot(v)
-        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * SNAPSHOT_BLOCK + 40} is"):
-            invert(toy_actuator(), DT, v)            # preview='auto' checks in the snapshot
+        v[2 * EXTREMES_BLOCK + 40] = bad
+        v[3 * EXTREMES_BLOCK + 1] = np.nan
+        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * EXTREMES_BLOCK + 40} is"):
+            signal_extremes(v)
+        with pytest.raises(NonFiniteSignalError, match=f"sample {2 * EXTREMES_BLOCK + 40} is"):
+            invert(toy_actuator(), DT, v)            # preview='auto' checks in the extremes' pass
 
 
 @pytest.mark.parametrize("scale", [1e160, 1e300, 1e-160])
