@@ -127,3 +127,26 @@ def test_blocks_add_up_to_the_pooled_statistic_with_effects_projected_out():
 def test_mismatched_quantity_names_are_refused():
     with pytest.raises(ValueError, match="quantity names"):
         GapTest.from_null(np.zeros((6, 10)), ALPHA_GAP, [0.0], None, ("M",), (1, 2))
+
+
+def test_a_weak_effect_in_M_alone_is_unexplained_jointly_and_the_report_says_where():
+    """Development seed 48204, a gain ripple (out of the library) on M only (λ 40 after the
+    generator's baseline refit): the pooled gap test over M and Z had ended ``none`` (2·cost 687 over
+    620 rows); M's own block is above its threshold, Z's is not (independent generator, no physmodel
+    physics)."""
+    from joint_cases import make_joint_case
+
+    from physmodel import IPMCParameters
+    from physmodel.estimation.discrepancy import diagnose
+
+    M, Z, truth = make_joint_case(48204, "gain_ripple")
+    base = IPMCParameters.from_dict(dict(truth["library_start"]))
+    d = diagnose([M, Z], base, kind="actuator", free=("alpha0", "d", "kappa_e", "xi", "omega_n"), seed=48204)
+    rows = {r["quantity"]: r for r in d.per_quantity}
+    assert d.verdict == "unexplained", d.message
+    assert rows["M"]["gap_before"] and rows["M"]["gap_left"] and not rows["Z"]["gap_before"], rows
+    assert 2 * rows["M"]["cost_before"] > rows["M"]["gap_threshold_before_2cost"]
+    assert "leaves the gap open in M" in d.message and "open in M (" in d.message and "Z (2·cost" not in d.message
+    assert np.isnan(d.gap_threshold) and set(d.null["gap_test"]["thresholds_2cost"]) == {"M", "Z"}
+    assert d.null["gap_test"]["level_per_block"] == 1 - d.null["alpha_gap"] / 2
+    assert "gap threshold on 2·cost" in d.summary() and "gap left" in d.summary()
