@@ -552,7 +552,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
             return "named", [a, b], list(best2[0]), best2[1], msg
 
         # a second effect must be significant and carry more than the share of the excess that a
-        # closing effect may leave (the tolerance for another author's parametrisation)
+        # closing effect may leave (the tolerance for another author's parametrisation; several
+        # quantities: the sum of what each quantity's slack allows)
         T2 = max(T, CLOSE_FRACTION * float(np.sum(gap.excess0)))
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
@@ -680,8 +681,9 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         flip = sign_flip(pm([rflip.values])[0], data, s_ln, s_ph)
         cost_now = final_fit.metadata["data_cost"] if final_fit is not None else cost0
         flip["refit_cost"] = float(rflip.metadata["data_cost"])
+        neg = partial(bc, residuals=lambda v: standardised_residuals(pneg.predict_many([v])[0], data, s_ln, s_ph))
         flip["recognised"] = bool(flip["refit_cost"] < cost_now and (
-            gap.closes(bc(rflip, residuals=lambda v: standardised_residuals(pneg.predict_many([v])[0], data, s_ln, s_ph)), []) or flip["refit_cost"] < 0.1 * cost0))
+            gap.closes(neg(rflip), []) or flip["refit_cost"] < 0.1 * cost0))
         if flip["recognised"]:
             verdict, final_effects, final_fit, at_bound, widen = "unexplained", [], None, [], []
             message = (f"Sign flip: the data are the model with its sign reversed — a constant "
@@ -714,7 +716,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
         verdict=verdict, named=named, message=message, kind=kind, quantity=q, alpha=alpha, threshold=T,
-        gap_threshold=float(gap.thr0[0]) if gap.K == 1 else math.nan, baseline=res0, final=final_fit, final_effects=fe, candidates=cres,
+        gap_threshold=float(gap.thr0[0]) if gap.K == 1 else math.nan, baseline=res0, final=final_fit,
+        final_effects=fe, candidates=cres,
         skipped=skipped, confusable=confusable, separation=separation, localisation_before=localise(data, r0, alpha),
         localisation_after=localise(data, rf, alpha), gap_before=gap_statistics(data, r0, k0),
         gap_after=gap_statistics(data, rf, n_free_after),

@@ -149,7 +149,8 @@ class GapTest:
         if self.K == 1:
             return np.array([res.metadata["data_cost"]])
         if "data_cost_by_quantity" not in res.metadata:
-            res.metadata["data_cost_by_quantity"] = dict(zip(self.quantities, self.block_costs(residuals(res.values)).tolist()))
+            costs = self.block_costs(residuals(res.values))
+            res.metadata["data_cost_by_quantity"] = dict(zip(self.quantities, costs.tolist()))
         return np.array([res.metadata["data_cost_by_quantity"][q] for q in self.quantities])
 
     def residual_sentence(self, res, costs, effs: Sequence[str] = ()) -> str:

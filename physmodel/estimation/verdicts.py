@@ -144,14 +144,14 @@ def residual_sentence(cost: float, expected: float, threshold: float, baseline_e
         return ""
     ratio = cost / expected if expected > 0 else float("inf")
     if where:
-        share = (f"{100.0 * (two - threshold) / baseline_excess:.2g} % of the baseline's excess over its gap threshold"
-                 if baseline_excess > 0 else "the baseline had no significant gap there")
+        where_share = (f"{100.0 * (two - threshold) / baseline_excess:.2g} % of the baseline's excess over its gap "
+                       "threshold" if baseline_excess > 0 else "the baseline had no significant gap there")
         if two - threshold <= max(threshold - 2.0 * expected, 0.0):
             return (f" A small residual misfit remains in {where} (weighted cost {ratio:.3g}× its expectation; "
-                    f"{share}): the data's own law for this effect differs slightly from the library's "
+                    f"{where_share}): the data's own law for this effect differs slightly from the library's "
                     "parametrisation.")
         return (f" The residual misfit in {where} is significant: its weighted cost is {ratio:.3g}× its expectation "
-                f"({cost:.4g} vs {expected:.4g}; {share}): the data's law differs from the library's "
+                f"({cost:.4g} vs {expected:.4g}; {where_share}): the data's law differs from the library's "
                 "parametrisation or something else is missing.")
     share = 100.0 * (two - threshold) / max(baseline_excess, 1e-300)
     if two - threshold <= max(threshold - 2.0 * expected, 0.0):

@@ -150,3 +150,19 @@ def test_a_weak_effect_in_M_alone_is_unexplained_jointly_and_the_report_says_whe
     assert np.isnan(d.gap_threshold) and set(d.null["gap_test"]["thresholds_2cost"]) == {"M", "Z"}
     assert d.null["gap_test"]["level_per_block"] == 1 - d.null["alpha_gap"] / 2
     assert "gap threshold on 2·cost" in d.summary() and "gap left" in d.summary()
+
+
+def test_the_residual_sentence_names_the_quantity_it_is_about():
+    from types import SimpleNamespace
+
+    sizes = (50, 50)
+    g = GapTest.from_null(_white(200, 4000, 31), ALPHA_GAP, [200.0, 40.0], None, ("M", "Z"), sizes)
+    thr = g.thresholds()
+    res = SimpleNamespace(names=["a", "b"], metadata={}, expected_cost=99.0)
+    # M above its threshold by far (significant), Z within: one sentence, about M
+    s = g.residual_sentence(res, [thr[0], 0.4 * thr[1]])
+    assert "The residual misfit in M is significant" in s and "Z" not in s
+    # Z above its threshold where the baseline had no gap there: said so, no share of a zero excess
+    s = g.residual_sentence(res, [0.4 * thr[0], 0.5 * thr[1] + 1.0])
+    assert "in Z" in s and "no significant gap there" in s and " M " not in s
+    assert g.residual_sentence(res, [0.4 * thr[0], 0.4 * thr[1]]) == ""
