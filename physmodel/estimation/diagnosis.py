@@ -123,7 +123,9 @@ class Diagnosis:
     alpha : float
         Significance level of the tests. [-]
     threshold, gap_threshold : float
-        Calibrated critical values of a candidate's likelihood-ratio statistic and of the gap test. [-]
+        Calibrated critical values of a candidate's likelihood-ratio statistic and of the gap test
+        on the baseline's 2·cost; NaN for several quantities, whose gap test is per quantity (each
+        one's threshold in ``per_quantity`` and ``null["gap_test"]``, :mod:`~physmodel.estimation.gap`). [-]
     baseline, final : CalibrationResult
         The baseline fit, and the fit with the named effects (None when nothing is named).
     final_effects : dict
@@ -170,7 +172,8 @@ class Diagnosis:
     per_quantity : list
         Diagnosed over several quantities (``quantity`` is then e.g. ``"M+Z"`` and ``data`` their
         stacked lines): per quantity its lines, unit, noise (declared or estimated, median σ), weighted
-        cost before/after against its expectation and whether a misfit remains; [] for one quantity.
+        cost before/after against its expectation and whether a misfit remains, and the gap test
+        there (thresholds on 2·cost before/after, ``gap_before``, ``gap_left``); [] for one quantity.
     joint : JointData or None
         The sweeps of those quantities and the σ used (:class:`~physmodel.estimation.joint.JointData`).
     next_measurement : NextMeasurement or None
@@ -400,11 +403,13 @@ class Diagnosis:
         L += [f"Temperature laws: {self.laws}", ""]
         if self.per_quantity:
             L += ["## Per quantity (diagnosed jointly)", "", "| quantity | lines | unit | noise | σ dB / deg (median) | "
-                  "cost before | cost after | expected | misfit left |", "|---|---|---|---|---|---|---|---|---|"]
+                  "cost before | cost after | expected | misfit left | gap threshold on 2·cost before / after | "
+                  "gap left |", "|---|---|---|---|---|---|---|---|---|---|---|"]
             L += [f"| {r['quantity']} | {r['lines']} | {r['unit']} | {r['noise']} | {r['sigma_db_median']:.3g} / "
                   f"{r['sigma_deg_median']:.3g} | {r['cost_before']:.4g} | {r['cost_after']:.4g} | "
-                  f"{r['expected_after']:.4g} | {'not tested (estimated noise)' if r['misfit'] is None else 'yes' if r['misfit'] else 'no'} |"
-                  for r in self.per_quantity]
+                  f"{r['expected_after']:.4g} | {'not tested (estimated noise)' if r['misfit'] is None else 'yes' if r['misfit'] else 'no'} | "
+                  f"{_g(r.get('gap_threshold_before_2cost'))} / {_g(r.get('gap_threshold_after_2cost'))} | "
+                  f"{'yes' if r.get('gap_left') else 'no'} |" for r in self.per_quantity]
             L += [""]
         L += ["## Baseline parameters", "", "| parameter | value | 95 % CI | fit bounds | plausible range | flag | "
               "multi-start range |", "|---|---|---|---|---|---|---|"]
@@ -431,7 +436,8 @@ class Diagnosis:
         L += ["", f"Gap shrink (cost − expected, before / after): {gap_shrink(self):.3g}×", "",
               f"LR threshold (at {self.alpha * (1 - 1 / GAP_ALPHA_DIVISOR):g} of the verdict's family-wise "
               f"α = {self.alpha:g}, Monte Carlo under the null): {self.threshold:.3g}; "
-              f"gap threshold on 2·cost (at α/{GAP_ALPHA_DIVISOR:g}): {self.gap_threshold:.4g}", "",
+              f"gap threshold on 2·cost (at α/{GAP_ALPHA_DIVISOR:g}): " + (f"{self.gap_threshold:.4g}" if not self.per_quantity
+                                                                          else "per quantity, in the table above"), "",
               "## Candidates", "", "| effect | LR | significant | closes gap | AIC | BIC | fitted values "
               "[candidate bounds] | at/near a bound, outside plausible range |",
               "|---|---|---|---|---|---|---|---|"]

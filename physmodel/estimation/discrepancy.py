@@ -51,11 +51,14 @@ user's free parameters, and:
    relaxing it would gain more than χ²₁ at α, :mod:`~physmodel.estimation.verdicts`: "widen the
    bound, or the effect is larger than allowed" — never a confident name; another candidate at its
    bound is only noted, and a parameter ending at its off value reports the effect in its simpler
-   form), ``unexplained`` (a significant gap
-   nothing closes).  The gap test
-   compares 2·cost (data lines only) with the (1 − α/5) quantile of its null distribution; an
-   effect that leaves at most :data:`CLOSE_FRACTION` of the baseline's excess above it also
-   closes the gap (the message then states the remaining share).
+   form), ``unexplained`` (a significant gap nothing closes).  The gap test
+   (:class:`~physmodel.estimation.gap.GapTest`) compares 2·cost (data lines only) with the
+   (1 − α/5) quantile of its null distribution; an effect that leaves at most
+   :data:`CLOSE_FRACTION` of the baseline's excess above it also closes the gap (the message then
+   states the remaining share).  Several quantities: per quantity, each one's 2·cost against its own
+   quantile at α/5/K (Bonferroni over K quantities), the gap significant if any quantity's is and
+   closed only if closed in every one (the slack of each quantity's own excess); the message says
+   where it stays open.
 
 The report also states the temperature laws used, warns when the weighted cost is inconsistent
 with the declared noise (too low or too high, with the factor), and says when the baseline fits
@@ -94,6 +97,7 @@ from .diagnosis import (
     stage_progress,
     worst_cells,
 )
+from .gap import GapTest, block_rows
 from .joint import check_acts_on, joint_data, per_quantity_sentence
 from .nullstats import bootstrap_ratio, constrained_lr, scan_lr, signature_stage
 from .priors import (
@@ -120,7 +124,7 @@ from .signatures import (
     vuong_critical,
     vuong_z,
 )
-from .verdicts import reduced_parameters, reduced_sentence, relax_gain, relax_threshold, residual_sentence, sign_flip
+from .verdicts import reduced_parameters, reduced_sentence, relax_gain, relax_threshold, sign_flip
 
 #: Pairs of two effects: every pair among this many most significant candidates, and each of them
 #: with the PAIR_EXPLAINERS candidates that best explain what its refit leaves; the PAIR_FITS best
@@ -310,10 +314,12 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         lin[c] = np.maximum(lin[c], scan_lr(pm, v0, c, cpars[c], degenerate[c], r0, data, s_ln, s_ph, Q0, Ep,
                                             is_off=LIBRARY[c].is_off))
     lin_max = np.max(np.vstack(list(lin.values())), axis=0) if lin else np.zeros(E.shape[1])
-    cost2_null = np.sum(Ep * Ep, axis=0)
     alpha_gap = alpha / GAP_ALPHA_DIVISOR
     T_lin = float(np.quantile(lin_max, 1 - (alpha - alpha_gap)))     # the LR test's share of α (module doc, 3)
-    gap_thr0 = float(np.quantile(cost2_null, 1 - alpha_gap))
+    # the gap test, per quantity of a joint record (gap.py); its costs per block of a fit
+    gap = GapTest.from_null(Ep, alpha_gap, [cost0] if jd is None else 0.5 * np.array(
+        [r0[i] @ r0[i] for i in block_rows(jd.sizes)]), sigs, qs, None if jd is None else jd.sizes)
+    bc = partial(gap.fit_costs, residuals=lambda v, p=pm: standardised_residuals(p([v])[0], data, s_ln, s_ph))
     say("signatures", f"linearised null: LR threshold {T_lin:.3g} from {E.shape[1]} draws")
 
     # ---- 4. candidate refits
@@ -381,22 +387,10 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
 
     counter.enter("verdicts")
     say_v("testing significance and the gap")
-    def gap_thr(effs: Sequence[str]) -> float:
-        if not effs:
-            return gap_thr0
-        Qs = orth(np.hstack([sigs[c] for c in effs]))
-        after = cost2_null - np.sum((Qs.T @ Ep) ** 2, axis=0)
-        return float(np.quantile(after, 1 - alpha_gap))
-
-    def closes_gap(cost, effs) -> bool:
-        """2·cost within its null band, or above it by at most CLOSE_FRACTION of the baseline's excess."""
-        thr = gap_thr(effs)
-        return 2 * cost <= thr or 2 * cost - thr <= CLOSE_FRACTION * max(2 * cost0 - gap_thr0, 0.0)
-
     for c, cr in cres.items():
         cr.significant = cr.lr > T
-        cr.closes_gap = closes_gap(cr.cost, [c])
-    gap0_sig = 2 * cost0 > gap_thr0
+        cr.closes_gap = gap.closes(bc(fits[c]), [c])
+    gap0_sig = gap.significant0
     z_crit = vuong_critical(alpha)
     confusability: dict = {"z_critical": z_crit, "data": [], "in_band": []}
     sig = sorted((c for c in cres if cres[c].significant), key=lambda c: -cres[c].lr)
@@ -408,7 +402,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
     if not sig:
         if gap0_sig:
             verdict = "unexplained"
-            message = (f"The baseline leaves a significant gap (2·cost {2 * cost0:.4g} > {gap_thr0:.4g}) "
+            message = (f"The baseline leaves a significant gap ({gap.compare(gap.cost0)}) "
                        f"that no library candidate reduces significantly; the gap remains in {where}.")
         else:
             verdict = "none"
@@ -430,8 +424,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
             return expl_cache[a]
 
         def strict(res, effs) -> bool:
-            """2·cost within its null band (no tolerance for a parametrisation mismatch)."""
-            return 2 * res.metadata["data_cost"] <= gap_thr(effs)
+            """2·cost within its null band in every block (no tolerance for a parametrisation mismatch)."""
+            return gap.strict(bc(res), effs)
 
         def screen_pairs(exclude=frozenset()):
             """Pairs among the PAIR_POOL most significant candidates and each of them with the
@@ -493,7 +487,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                 res2 = fit_pair(a, b)
                 lr_a, lr_b = 2 * (fits[b].cost - res2.cost), 2 * (fits[a].cost - res2.cost)   # each on top
                 gain = 2 * (best_single - res2.cost)                                           # over the best single
-                closes = closes_gap(res2.metadata["data_cost"], [a, b])
+                closes = gap.closes(bc(res2), [a, b])
                 # the pair's gain over the best single passes the calibrated threshold, and either
                 # carries more than the share of the excess a closing effect may leave, or the pair
                 # closes the gap strictly (within the noise band) where neither member alone does and
@@ -528,7 +522,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                     seen.add(key)
                     res2 = fit_pair(other, c)
                     ok = ok + [((other, c), res2, 2 * (fits[c].cost - res2.cost), 2 * (fits[other].cost - res2.cost),
-                                closes_gap(res2.metadata["data_cost"], [other, c]))]
+                                gap.closes(bc(res2), [other, c]))]
             return ok
 
         def name_pair(ok):
@@ -558,8 +552,9 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
             return "named", [a, b], list(best2[0]), best2[1], msg
 
         # a second effect must be significant and carry more than the share of the excess that a
-        # closing effect may leave (the tolerance for another author's parametrisation)
-        T2 = max(T, CLOSE_FRACTION * max(2 * cost0 - gap_thr0, 0.0))
+        # closing effect may leave (the tolerance for another author's parametrisation; several
+        # quantities: the sum of what each quantity's slack allows)
+        T2 = max(T, CLOSE_FRACTION * float(np.sum(gap.excess0)))
         closers = [c for c in sig if cres[c].closes_gap]
         if closers:
             top = min(closers, key=lambda c: cres[c].aic)
@@ -598,12 +593,10 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                 final_effects = list(ok[0][0]) if ok else [best]
                 final_fit = ok[0][1] if ok else fits[best]
                 message = (f"Unexplained: the best candidate {best} (LR {cres[best].lr:.4g}) reduces the cost but a "
-                           f"significant gap remains (2·cost {2 * final_fit.metadata['data_cost']:.4g} > "
-                           f"{gap_thr(final_effects):.4g}) in {where}; no candidate or pair of candidates in the "
-                           "library explains it.")
+                           f"significant gap remains ({gap.compare(bc(final_fit), final_effects)}) in {where}; no "
+                           "candidate or pair of candidates in the library explains it.")
     if verdict in ("named", "ambiguous") and final_fit is not None:
-        message += residual_sentence(final_fit.metadata["data_cost"], final_fit.expected_cost,
-                                     gap_thr(final_effects), max(2 * cost0 - gap_thr0, 0.0))
+        message += gap.residual_sentence(final_fit, bc(final_fit), final_effects)
     # ---- 7. audits of the final model: a named effect's own parameter at a bound that matters
     # (relaxing it would gain more than χ²₁ at α) makes the name 'at bound'; one at its off value
     # reduces the effect to its simpler form; another candidate's bound is only noted
@@ -651,7 +644,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         lr_w = 2 * (res0.cost - rw.cost)
         for a in mine:
             a["lr_widened"] = float(lr_w)
-            a["competes"] = bool(closes_gap(rw.metadata["data_cost"], [c]) or lr_w >= lr_named - relax_threshold(alpha))
+            a["competes"] = bool(gap.closes(bc(rw), [c]) or lr_w >= lr_named - relax_threshold(alpha))
     if verdict in ("named", "ambiguous") and any(a["competes"] for a in others_stuck):
         verdict = "at_bound"
         rival = [a for a in others_stuck if a["competes"]]
@@ -678,7 +671,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                 + "): widen it — the effect may be larger than allowed.")
     # a sign flip: the baseline with its sign reversed, refitted, explains what the candidates leave
     flip: dict = {}
-    resid_sig = final_fit is not None and 2 * final_fit.metadata["data_cost"] > gap_thr(final_effects)
+    resid_sig = final_fit is not None and not gap.strict(bc(final_fit), final_effects)
     if gap0_sig and (verdict in ("unexplained", "at_bound") or resid_sig):
         say_v("checking for a sign flip (the baseline with its sign reversed)")
         pneg = PenalisedProblem(data, lambda vals: -np.asarray(pm(vals)), prob.penalties)
@@ -688,14 +681,15 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         flip = sign_flip(pm([rflip.values])[0], data, s_ln, s_ph)
         cost_now = final_fit.metadata["data_cost"] if final_fit is not None else cost0
         flip["refit_cost"] = float(rflip.metadata["data_cost"])
+        neg = partial(bc, residuals=lambda v: standardised_residuals(pneg.predict_many([v])[0], data, s_ln, s_ph))
         flip["recognised"] = bool(flip["refit_cost"] < cost_now and (
-            closes_gap(flip["refit_cost"], []) or flip["refit_cost"] < 0.1 * cost0))
+            gap.closes(neg(rflip), []) or flip["refit_cost"] < 0.1 * cost0))
         if flip["recognised"]:
             verdict, final_effects, final_fit, at_bound, widen = "unexplained", [], None, [], []
             message = (f"Sign flip: the data are the model with its sign reversed — a constant "
                        f"{flip['phase_offset_deg']:.0f}° phase offset over the band with the magnitude matching "
                        f"(RMS {flip['magnitude_rms_db']:.2g} dB): with the sign reversed the baseline refits to "
-                       f"2·cost {2 * flip['refit_cost']:.4g} (gap threshold {gap_thr0:.4g}; as given "
+                       f"2·cost {2 * flip['refit_cost']:.4g} (gap threshold {gap.threshold_text()}; as given "
                        f"{2 * cost0:.4g}). No physical effect is needed: check the polarity of the excitation or "
                        "the sensor wiring and the sign convention of the measured quantity, then rerun.")
     message += audit_notes(verdict, at_bound, widen, audit0, final_implausible, res0, cres)
@@ -714,7 +708,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         message += f" Cost vs declared noise: {warn}."
     # each quantity's "does it fit" at the model file's goodness-of-fit level shared out over the
     # quantities (the pooled verdict's test, residuals.GOF_ALPHA), not at the detection α
-    per_q = jd.per_quantity(G0, Gf, k0, n_free_after, GOF_ALPHA) if jd is not None else []
+    per_q = gap.annotate(jd.per_quantity(G0, Gf, k0, n_free_after, GOF_ALPHA), final_effects) if jd is not None else []
     message += per_quantity_sentence(per_q)
     declare_confusable(confusable, separation, confusability, sigs, raw_sigs, data)
     say("audit", f"verdict {verdict}" + (f": {', '.join(named)}" if named else ""))
@@ -722,7 +716,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
           for c in final_effects} if final_fit is not None else {}
     return Diagnosis(
         verdict=verdict, named=named, message=message, kind=kind, quantity=q, alpha=alpha, threshold=T,
-        gap_threshold=gap_thr0, baseline=res0, final=final_fit, final_effects=fe, candidates=cres,
+        gap_threshold=float(gap.thr0[0]) if gap.K == 1 else math.nan, baseline=res0, final=final_fit,
+        final_effects=fe, candidates=cres,
         skipped=skipped, confusable=confusable, separation=separation, localisation_before=localise(data, r0, alpha),
         localisation_after=localise(data, rf, alpha), gap_before=gap_statistics(data, r0, k0),
         gap_after=gap_statistics(data, rf, n_free_after),
@@ -730,7 +725,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                         "max over candidates) scaled by full-refit parametric bootstrap",
               "draws": int(null_draws), "refits": int(null_refits), "lr_threshold_linearised": T_lin,
               "nonlinearity_ratio": ratio, "bootstrap_full_max_lr": full_max, "bootstrap_lin_max_lr": lin_used,
-              "alpha_gap": alpha_gap, "seed": seed},
+              "alpha_gap": alpha_gap, "gap_test": gap.describe(), "seed": seed},
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
         metadata={"base": base.name, "kernel": kernel, "free": names0, "baseline_effects": beff, "candidates": cand,

@@ -7,7 +7,8 @@ Z.  The lines of every quantity are stacked into one record (:class:`StackedSwee
 standardised residuals (:func:`~physmodel.estimation.residuals.standardised_residuals`,
 log-magnitude and phase over each line's own σ) are unit-free once each quantity is predicted in its
 own sweep's units, so the baseline, every candidate refit, the linearised null and the bootstrap
-refits of the diagnosis run unchanged on the stacked lines — one data path.  The predictor
+refits of the diagnosis run unchanged on the stacked lines — one data path (the gap test alone
+is per quantity, below).  The predictor
 (:meth:`JointData.predictor`) evaluates each quantity at its own sweep's lines with
 the model's ``predictor(sweep, quantity)`` and concatenates them; an effect that acts on one
 quantity only leaves the other unchanged (the library's ``quantities``), so it is still fitted
@@ -25,9 +26,17 @@ absorbed into the noise; the provisional baseline is weighted with the same esti
 data themselves (third differences of ln G, which a smooth response hardly moves), so a noisy
 quantity does not dominate it.  Each quantity's σ is one number for magnitude and one for phase.
 
+The gap test is per quantity (:mod:`~physmodel.estimation.gap`): each quantity's block of rows has
+its own 2·cost statistic and null quantile at α_gap/K (Bonferroni over the K quantities); the
+baseline's gap is significant when some block's is, and a candidate or pair closes it only when it
+closes it in every block — pooled over all lines, an effect on M alone was diluted by Z's lines,
+and a model could close the pooled gap while leaving M's.  Everything else (fits, LR, null draws)
+runs on the stacked lines.
+
 The report (``Diagnosis.per_quantity``) gives each quantity's
 lines, noise (declared or estimated) and its cost before and after against its expectation, so a
-misfit left in one quantity is visible.  With estimated noise that cost is not a test (the
+misfit left in one quantity is visible, and the gap test's thresholds there before and after
+(``gap_before``: the baseline's gap significant there; ``gap_left``: not closed there).  With estimated noise that cost is not a test (the
 estimate has a relative spread of about 1/√(lines); the same rule as for one quantity, whose
 estimated-noise cost is not checked either), so ``misfit`` is then None.
 """
@@ -286,9 +295,13 @@ def per_quantity_sentence(rows: Sequence[dict]) -> str:
              f"(expected {r['expected_after']:.4g}" + (", not a test with estimated noise)" if r["misfit"] is None else ")")
              for r in rows]
     bad = [r["quantity"] for r in rows if r["misfit"]]
+    gap = [r for r in rows if r.get("gap_left")]        # the diagnosis's gap test, per quantity (gap.py)
     return (" Diagnosed jointly over " + ", ".join(r["quantity"] for r in rows) + ": " + "; ".join(parts) + "."
             + (f" A misfit remains in {', '.join(bad)}: its cost is above its χ² band after the diagnosis."
-               if bad else ""))
+               if bad else "")
+            + (" The gap test (per quantity) leaves the gap open in " + "; ".join(
+                f"{r['quantity']} (2·cost {2 * r['cost_after']:.4g} > {r['gap_threshold_after_2cost']:.4g})" for r in gap)
+               + "." if gap else ""))
 
 
 # =============================================================================== noise estimates

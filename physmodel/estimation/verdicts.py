@@ -131,17 +131,29 @@ def sign_flip(G0: np.ndarray, data: FrequencySweep, s_ln, s_ph) -> dict:
             "magnitude_rms_db": float(np.sqrt(np.mean((20 * np.log10(np.abs(q))) ** 2)))}
 
 
-def residual_sentence(cost: float, expected: float, threshold: float, baseline_excess: float) -> str:
+def residual_sentence(cost: float, expected: float, threshold: float, baseline_excess: float, where: str = "") -> str:
     """What is said of the misfit a named model leaves (``cost``: its weighted data cost, ``expected``
     its χ² expectation, ``threshold`` the gap threshold on 2·cost for it, ``baseline_excess`` the
     baseline's 2·cost above its own threshold).  '' within the threshold; "a small residual misfit"
     when 2·cost exceeds the threshold by no more than the threshold exceeds the expectation (the
-    cost is near its expectation); otherwise the residual is significant, with cost/expected."""
+    cost is near its expectation); otherwise the residual is significant, with cost/expected.
+    ``where``: the quantity of a joint record whose block these are (its gap test is per quantity,
+    :mod:`~physmodel.estimation.gap`); the sentence then names it."""
     two = 2.0 * cost
     if two <= threshold:
         return ""
-    share = 100.0 * (two - threshold) / max(baseline_excess, 1e-300)
     ratio = cost / expected if expected > 0 else float("inf")
+    if where:
+        where_share = (f"{100.0 * (two - threshold) / baseline_excess:.2g} % of the baseline's excess over its gap "
+                       "threshold" if baseline_excess > 0 else "the baseline had no significant gap there")
+        if two - threshold <= max(threshold - 2.0 * expected, 0.0):
+            return (f" A small residual misfit remains in {where} (weighted cost {ratio:.3g}× its expectation; "
+                    f"{where_share}): the data's own law for this effect differs slightly from the library's "
+                    "parametrisation.")
+        return (f" The residual misfit in {where} is significant: its weighted cost is {ratio:.3g}× its expectation "
+                f"({cost:.4g} vs {expected:.4g}; {where_share}): the data's law differs from the library's "
+                "parametrisation or something else is missing.")
+    share = 100.0 * (two - threshold) / max(baseline_excess, 1e-300)
     if two - threshold <= max(threshold - 2.0 * expected, 0.0):
         return (f" A small residual misfit remains (weighted cost {ratio:.3g}× its expectation; {share:.2g} % of "
                 "the baseline's excess over the gap threshold): the data's own law for this effect differs "
