@@ -25,7 +25,16 @@ from .preview import (
     resolve_preview,
     truncation_error,
 )
-from .signals import as_signal, as_split, check_finite, check_unchanged, sampling_interval, time_base
+from .signals import (
+    SignalFingerprint,
+    as_signal,
+    as_split,
+    check_finite,
+    check_unchanged,
+    sampling_interval,
+    signal_fingerprint,
+    time_base,
+)
 from .split import InverseSplit
 
 __all__ = [
@@ -73,8 +82,11 @@ class InversionResult(SampledRecord):
         and for ``preview="auto"`` the truncation errors in ``preview_choice`` and
         ``truncation_error`` — is checked against the inversion and refused
         (:class:`InversionError`) if the array was modified in place since (a fingerprint taken
-        during the inversion must be the same: the sum of the output for the parts, the sum of
-        the signal's bit patterns for the errors; a change that leaves it so is not seen); invert
+        during the inversion must be the same: the sum of the output for the parts of a given
+        preview, :class:`~inversion.signals.SignalFingerprint` — the sum of the samples' bit
+        patterns, which sees any change of one sample, and the extremes — for the errors and parts of
+        ``"auto"`` and wherever the output's sum overflowed; a change that leaves it so is not
+        seen); invert
         a copy to reuse the array.  ``truncation_bound`` of ``preview="auto"`` is the choice's,
         taken at the inversion; ``discretisation_error_estimate`` (and ``truncation_error``,
         ``truncation_bound`` of a given preview) are computed from ``input`` as it is when first
@@ -96,9 +108,11 @@ class InversionResult(SampledRecord):
         drive) and still read the parts of the inversion.  ``input`` is the caller's array (no
         copy is made, ``preview="auto"`` included) and the parts are recomputed from it; an
         ``input`` modified in place since the inversion is refused (:class:`InversionError`):
-        the sum of the recomputed output, summed in the same blocks and order as the inversion
-        summed it (to prove it finite), must equal that sum bit for bit (a change that leaves it
-        bit for bit the same is not seen).
+        for a given preview the sum of the recomputed output, summed in the same blocks and
+        order as the inversion summed it (to prove it finite), must equal that sum bit for bit
+        (a change that leaves it bit for bit the same is not seen, e.g. two samples exchanged);
+        for ``"auto"``, and wherever that sum overflowed (every output sample finite, their
+        sum not: it would prove nothing), ``input_fingerprint`` must be the same.
     preview_s : float
         Preview actually used, ``preview_samples * dt`` [s]; ``inf`` for infinite preview.
     preview_samples : int or None
@@ -137,9 +151,12 @@ class InversionResult(SampledRecord):
         (internal; read ``stable_part``) [model input units].
     output_sum : float or None
         The sum of ``output`` as the block-wise pass wrote it (internal): the fingerprint the
-        parts recomputed from the caller's ``input`` are checked against [model input units]
-        (``preview="auto"``'s errors are checked against another fingerprint its choice keeps:
-        the sum of the signal's bit patterns, see :func:`~inversion.preview.auto_preview_passes`).
+        parts recomputed from the caller's ``input`` are checked against when
+        ``input_fingerprint`` is None [model input units].
+    input_fingerprint : SignalFingerprint or None
+        :func:`~inversion.signals.signal_fingerprint` of ``input`` at the inversion (internal;
+        ``preview="auto"``, which takes it in its extremes pass, or an output whose sum is not
+        finite): what the recomputed parts are checked against instead of ``output_sum``.
     """
 
     input: np.ndarray
@@ -161,6 +178,8 @@ class InversionResult(SampledRecord):
     stable_source: np.ndarray | None = field(default=None, repr=False)
     #: the sum of output as written, checked when the parts are recomputed from the caller's input
     output_sum: float | None = field(default=None, repr=False)
+    #: the input's signal_fingerprint at the inversion, or None (then output_sum is checked)
+    input_fingerprint: SignalFingerprint | None = field(default=None, repr=False)
 
     @property
     def notes(self) -> tuple[str, ...]:
@@ -185,16 +204,20 @@ class InversionResult(SampledRecord):
     @cached_property
     def _parts(self) -> tuple[np.ndarray, np.ndarray]:
         """``(stable_part, unstable_part)`` recomputed by the passes that made ``output`` (see the
-        class doc) from ``input``, checked unchanged by the sum of the output it gives (``output``
-        itself is not read)."""
+        class doc) from ``input``, checked unchanged by its fingerprint or the sum of the output it
+        gives (``output`` itself is not read)."""
         src = self.unstable_source
         if isinstance(src, np.ndarray):        # only the causal part was not kept
             raise InversionError("internal: a kept anticausal part without its causal part")  # pragma: no cover
         plan, chunk = src
+        what = "the stable and unstable parts (result.stable_part, result.unstable_part)"
+        if self.input_fingerprint is not None:
+            check_unchanged(signal_fingerprint(self.input), self.input_fingerprint, what,
+                            "stable_part and unstable_part", "its fingerprint (SignalFingerprint)")
         sums: list[float] = []
         stable, unstable, _ = plan.run(self.input, chunk, self.stable_source, output_sum=sums)
-        check_unchanged(sums[0], self.output_sum, "the stable and unstable parts (result.stable_part, "
-                         "result.unstable_part)", "stable_part and unstable_part")
+        if self.input_fingerprint is None:
+            check_unchanged(sums[0], self.output_sum, what, "stable_part and unstable_part")
         if stable is None or unstable is None:     # pragma: no cover - keep_unstable=True keeps both
             raise InversionError("internal: the recomputation did not keep both parts")
         return stable, unstable
@@ -328,6 +351,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
         stable, unstable, output = passes.stable, passes.unstable, passes.output
         finite = passes.finite
         written_sum = passes.output_sum
+        fingerprint = passes.fingerprint
         plan = passes.plan
     else:
         n_prev, prev_s = resolve_preview(preview, split, dt, ua.size)
@@ -339,11 +363,14 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
                                                 keep_stable=False)
         written_sum = sums[0]
         finite = math.isfinite(written_sum)
+        fingerprint = None
     # a finite sum of the output (summed while the pass wrote it) proves every sample finite (as
     # in as_signal); only a non-finite one (a bad sample, or an overflow of the sum) needs the
     # element-wise check, of the input first (a bad input sample is named as as_signal names it)
     if not finite:
         check_finite(ua)
+        if fingerprint is None:     # an overflowed sum proves nothing about a later input (class doc)
+            fingerprint = signal_fingerprint(ua)
     bad = None if finite else ~np.isfinite(output)
     if bad is not None and bad.any():
         i = int(np.flatnonzero(bad)[0])
@@ -351,7 +378,7 @@ def invert(model: Any, t: Any, u: Any, *, preview: Any = "auto", improper: str =
             f"the inverse overflowed: output sample {i} is {float(output[i])!r} (input peak {float(np.max(np.abs(ua))):.3g}); "
             "scale the signal to the model's units")
     return InversionResult(
-        input=ua, output=output, stable_source=stable, output_sum=written_sum,
+        input=ua, output=output, stable_source=stable, output_sum=written_sum, input_fingerprint=fingerprint,
         unstable_source=unstable if unstable is not None else (plan, chunk),
         preview_s=prev_s, preview_samples=n_prev, r0=split.r0,
         auto_preview_s=split.auto_preview_s, dt=dt, split=split, t0=float(t0),

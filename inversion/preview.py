@@ -42,6 +42,7 @@ import numpy as np
 from ._discrete import Plan, left_powers, pass_errstate, plan_for
 from ._errors import InversionError, NonFiniteSignalError, PreviewError
 from .signals import (
+    SignalFingerprint,
     as_signal,
     check_finite,
     check_unchanged,
@@ -373,11 +374,11 @@ class PreviewChoice:
     truncation error of the signal (two more passes over it); for ``"linf"`` (and a chunked
     ``"l2"``) they are computed when first read, not when the preview is chosen, from the
     caller's array (no copy is kept), which must not have been modified in place since: its
-    fingerprint taken when the preview was chosen (the sum of its samples' bit patterns modulo
-    2**64, :func:`~inversion.signals.signal_fingerprint`) must be the same when they are first
-    read, else :class:`InversionError` (read them before reusing the array, or pass a copy).  Any
-    change of one sample is seen; changes of several that cancel in that sum (e.g. two samples
-    exchanged) are not.
+    fingerprint taken when the preview was chosen (:class:`~inversion.signals.SignalFingerprint`:
+    the sum of its samples' bit patterns modulo 2**64 and its extremes) must be the same when
+    they are first read, else :class:`InversionError` (read them before reusing the array, or
+    pass a copy).  Any change of one sample is seen, and a shift, a reversal or a scaling of the
+    record; not, e.g., two samples exchanged when neither is an extreme.
     """
 
     samples: int
@@ -436,6 +437,9 @@ class AutoPreviewPasses:
     output_sum : float or None
         The sum of ``output`` as the pass wrote it (see :meth:`~inversion._discrete.Plan.run`;
         None on the whole-record ``"l2"`` path).
+    fingerprint : SignalFingerprint or None
+        :func:`~inversion.signals.signal_extremes` of the signal, taken in the extremes pass
+        (None on the whole-record ``"l2"`` path, which keeps both parts).
     """
 
     choice: PreviewChoice
@@ -445,6 +449,7 @@ class AutoPreviewPasses:
     finite: bool = False
     plan: Plan | None = None
     output_sum: float | None = None
+    fingerprint: SignalFingerprint | None = None
 
 
 #: Probes of the full inverse for the linf reference: equally spaced samples, plus the extremes
@@ -512,14 +517,17 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     No copy of ``ua`` is kept (a copy was 1.45 of ~14.5 ns/sample at 20 kHz): one pass,
     :func:`~inversion.signals.signal_extremes`, reads it block by block for the peak (the bound),
     the extremes (probes of the reference), the proof that it is finite and a fingerprint
-    (:func:`~inversion.signals.signal_fingerprint`: the sum of the samples' 64-bit patterns
-    modulo 2**64, which any change of one sample changes).  The errors are computed when first
+    (:class:`~inversion.signals.SignalFingerprint`: the sum of the samples' 64-bit patterns modulo
+    2**64, which any change of one sample changes, and the extremes' places and values).  The errors are computed when first
     read from ``ua`` itself, so ``ua`` (the caller's array) must not change in the meantime: they
     first take the fingerprint again and refuse (:class:`InversionError`,
     :func:`~inversion.signals.check_unchanged`) one that differs.  A change that leaves it the
-    same (changes of several samples that cancel modulo 2**64, e.g. two samples exchanged) is not
-    seen.  The fingerprint costs ~0.14 ns/sample here and ~0.3 when the errors are read
-    (2**21 samples).  Measured and not kept: the sum of the output this pass takes anyway as the
+    same (see there) is not seen.  The fingerprint's sum costs ~0.14 ns/sample here (2**21
+    samples) and the whole extremes pass ~0.6 when the errors are read.  The sum alone missed
+    an in-place circular shift (a periodic record's buffer reused) and the whole record scaled
+    by 2, ½, 4 … when its length times the power is a multiple of 4096 (review); the extremes
+    see both.  A position-weighted sum would see any exchange too, but cost ~0.4 ns/sample more
+    here (3 % of the automatic preview at 20 kHz).  Measured and not kept: the sum of the output this pass takes anyway as the
     fingerprint (nothing here, but the errors would run this pass again: reading them went from
     21 to 27-29 ns/sample, seed 000 sensor at 1-20 kHz, and ``ipmc feedforward`` and the
     scenarios always read them); the float sum of the signal (~0.2 ns/sample here, and a change
@@ -532,8 +540,8 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
     plan0 = plan_for(split, dt, None)
     if norm == "l2" and chunk >= n:
         return _auto_l2(split, dt, ua if finite_checked else check_finite(ua), plan0, tol, quiet_passes)
-    imax, imin, fingerprint = signal_extremes(ua)
-    extremes = (imax, imin)
+    fingerprint = signal_extremes(ua)
+    extremes = (fingerprint.imax, fingerprint.imin)
     with pass_errstate(quiet_passes):
         stable = plan0.causal(ua, chunk)
     umax = max(float(ua[extremes[0]]), -float(ua[extremes[1]]))
@@ -564,7 +572,7 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         # read: the caller may have edited them)
         check_unchanged(signal_fingerprint(ua), fingerprint, "the truncation errors of the automatic preview",
                         "preview_choice.relative_error (or max_error, error_bound)",
-                        "its fingerprint (the sum of its samples' bit patterns modulo 2**64)")
+                        "its fingerprint (SignalFingerprint)")
         minus_e = _truncation_head(split, dt, ua, N)     # -e_N[:n - N]; e_N is zero beyond
         y_inf = plan0.run(ua, n)[2]
         size = _peak if norm == "linf" else l2_norm
@@ -578,7 +586,7 @@ def auto_preview_passes(split: InverseSplit, dt: float, ua: np.ndarray, *, tol: 
         tail_bound=float(split.tail_l1_norm(N * dt)) * umax, rule_4_over_r0_s=split.auto_preview_s,
         reference_bound=ref, _errors_of=errors)
     return AutoPreviewPasses(choice, stable_kept, unstable, output, finite=math.isfinite(written), plan=plan,
-                             output_sum=written)
+                             output_sum=written, fingerprint=fingerprint)
 
 
 def _auto_l2(split: InverseSplit, dt: float, ua: np.ndarray, plan0: Plan, tol: float,

@@ -313,25 +313,31 @@ def test_signal_extremes_are_numpys_with_the_fingerprint_without_a_write_and_ref
     # ties across blocks: the first occurrence wins, as for np.argmax
     u[[5, EXTREMES_BLOCK + 3, 2 * EXTREMES_BLOCK + 1]] = 9.0
     u[[EXTREMES_BLOCK - 1, 3 * EXTREMES_BLOCK + 2]] = -9.0
-    before = u.copy()
     u.flags.writeable = False            # nothing is written (a write would raise)
-    i, j, total = signal_extremes(u)
-    assert np.array_equal(u, before)
+    fp = signal_extremes(u)
+    i, j, total = fp.imax, fp.imin, fp.total
     assert (i, j) == (int(np.argmax(u)), int(np.argmin(u))) == (5, EXTREMES_BLOCK - 1)
-    # the fingerprint: the sum of the samples' bit patterns modulo 2**64 (oracle: struct and Python
+    assert (fp.vmax, fp.vmin) == (9.0, -9.0)
+    # the fingerprint's sum: the samples' bit patterns modulo 2**64 (oracle: struct and Python
     # integers), whole or strided; one sample one ulp away, or -0.0 for 0.0, changes it
     def oracle(x):
         return sum(struct.unpack(f"<{x.size}Q", np.ascontiguousarray(x).astype("<f8").tobytes())) % 2**64
 
-    assert total == oracle(u) == signal_fingerprint(u)
-    assert signal_extremes(u[::3])[2] == signal_fingerprint(u[::3]) == oracle(u[::3])
+    assert total == oracle(u) and signal_fingerprint(u) == fp
+    assert signal_extremes(u[::3]).total == signal_fingerprint(u[::3]).total == oracle(u[::3])
+    assert signal_fingerprint(u.astype(">f8")) == fp          # the values, not their byte order
     k = 2 * EXTREMES_BLOCK + 7
     for changed in (np.nextafter(u[k], np.inf), np.nextafter(u[k], -np.inf)):
         v = u.copy()
         v[k] = changed
-        assert signal_fingerprint(v) == oracle(v) != total
+        assert signal_fingerprint(v).total == oracle(v) != total
     z = np.zeros(5)
     assert signal_fingerprint(z) != signal_fingerprint(np.where(np.arange(5) == 2, -0.0, z))
+    # what the sum alone misses, the extremes see: a scaling by 2 of 2**13 nonzero samples (each
+    # pattern + 2**52: the sum moves by 2**65), a circular shift
+    w = 1.5 + np.sin(np.arange(8192) * 0.01)
+    assert oracle(2 * w) == oracle(w)
+    assert signal_fingerprint(2 * w) != signal_fingerprint(w) != signal_fingerprint(np.roll(w, 700))
     for bad in (np.nan, np.inf, -np.inf):
         v = u.copy()
         v[2 * EXTREMES_BLOCK + 40] = bad
