@@ -171,6 +171,12 @@ stream  Streaming inversion cost per sample at chunk 1 and 4096 against ``lfilte
         and the 1 kHz 'given' and 'floor' columns (code unchanged), 0.7-1.5 ns/sample higher on the
         branch in the default runs, agree again (given / floor 12.3 / 11.9 main, 11.8 / 11.7
         branch): an artefact of the allocator's history in the run, not a cost.
+        After review (80c54ad: the fingerprint also keeps the extremes; a position-weighted sum
+        measured and dropped), against the merged branch a707072 via ``--root``, 3 alternating
+        runs, load 2-2.7: lfilter ÷ auto at 1 / 5 / 20 kHz 0.31/0.35/0.33, 0.31/0.32/0.31,
+        0.32/0.33/0.31 (a707072: 0.34/0.33/0.31, 0.31/0.33/0.31, 0.32/0.33/0.32); auto ÷ chosen
+        1.09-1.13.  The position-weighted sum (Σ wₖ·bitsₖ, odd pseudo-random wₖ: 0.72 against 0.30
+        ns/sample alone) had given 0.30/0.29/0.31 at 20 kHz against 0.31/0.31/0.33.
 """
 
 from __future__ import annotations
