@@ -285,6 +285,37 @@ ACTUATOR_FREE = ("alpha0", "d", "kappa_e", "xi", "omega_n")
 ACTUATOR_LABELS = ("contact_resistance", "diffusivity_temperature")
 
 
+def measure_actuator(truth, r, seed: int) -> tuple[str, FrequencySweep]:
+    """The independent actuator at the recommended lines (its own physics, at each bath temperature),
+    with the generator's relative noise and a fresh seed: ``(quantity, sweep)``."""
+    T, f = r.line_temperatures_c, r.line_frequencies_hz
+    H = np.concatenate([ip.actuator_response(truth["base"], f[T == t], [t], truth["effects"])[r.quantity][0]
+                        for t in np.unique(T)])
+    sig = truth["noise"]["sigma_rel"] / math.sqrt(2.0)      # the generator's relative noise, a fresh seed
+    rng = np.random.default_rng([NEW_NOISE, seed])
+    noisy = H * (1 + sig * (rng.standard_normal(H.size) + 1j * rng.standard_normal(H.size)))
+    std = (np.full(f.size, 20 / math.log(10) * sig), np.full(f.size, math.degrees(sig)))
+    if r.quantity == "M":
+        return "M", FrequencySweep(T, f, noisy * 1e3, *std, "voltage", "V", "tip_displacement", "mm")
+    return r.quantity, FrequencySweep(T, f, noisy, *std, "current", "A", "voltage", "V")
+
+
+def second_diagnosis(diag, sweep, q: str, new: FrequencySweep, acts_on: dict | None = None):
+    """An M record merged with the first and diagnosed; another quantity diagnosed jointly with it
+    (one strip, two quantities, each with its own noise; ``acts_on`` the effects of one instrument)."""
+    if q == "M":
+        return diag(merge_records(sweep, new), "M")
+    return diag([sweep, new], ("M", q), **({"acts_on": acts_on} if acts_on else {}))
+
+
+#: ``--pairs``: where the independent generator's measurement-chain effects act — its sampling skew,
+#: DAC hold and amplifier poles are on the displacement channel (``independent_physics.actuator_response``
+#: applies them to M only), so a user measuring Z with another instrument declares them on M
+#: (``diagnose(acts_on=...)``); ``--no-acts-on`` drops the declaration (the library's default: on every
+#: measured quantity).
+CHAIN_ON_M = {"time_delay": ("M",), "amplifier_bandwidth": ("M",)}
+
+
 def run_actuator_case(seed: int, label: str, args) -> dict:
     """The independent actuator (5 temperatures 19-55 °C, 0.05-50 Hz, M): the lab measures M or Z of
     the same strip; an M record is merged with the first, a Z record is diagnosed jointly with it
@@ -311,23 +342,111 @@ def run_actuator_case(seed: int, label: str, args) -> dict:
                    lam_expected=r.separation_refit if r else float("nan"),
                    truth_competing=any(expected in m for m in nm.models), inseparable=list(nm.inseparable))
         if r is not None:
-            T, f = r.line_temperatures_c, r.line_frequencies_hz
-            H = np.concatenate([ip.actuator_response(truth["base"], f[T == t], [t], truth["effects"])[r.quantity][0]
-                                for t in np.unique(T)])
-            sig = truth["noise"]["sigma_rel"] / math.sqrt(2.0)      # the generator's relative noise, a fresh seed
-            rng = np.random.default_rng([NEW_NOISE, seed])
-            noisy = H * (1 + sig * (rng.standard_normal(H.size) + 1j * rng.standard_normal(H.size)))
-            std = (np.full(f.size, 20 / math.log(10) * sig), np.full(f.size, math.degrees(sig)))
-            if r.quantity == "M":
-                new = FrequencySweep(T, f, noisy * 1e3, *std, "voltage", "V", "tip_displacement", "mm")
-                d2 = diag(merge_records(sweep, new), "M")
-            else:
-                # the Z record diagnosed jointly with the M record (one strip, two quantities)
-                d2 = diag([sweep, FrequencySweep(T, f, noisy, *std, "current", "A", "voltage", "V")], ("M", r.quantity))
+            d2 = second_diagnosis(diag, sweep, *measure_actuator(truth, r, seed))
             row.update(second=d2.verdict, second_named=sorted(d2.named))
     row["dt"] = time.perf_counter() - t0
     row["success"] = row["second"] == "named" and row["second_named"] == [expected]
     return row
+
+
+#: ``--pairs``: bench_discrepancy's two-effect cases of the independent generator (its plan, seeds and
+#: detectability: each effect's λ on top of the other, after refitting the workflow's free set, ≥ 25),
+#: diagnosed as bench_discrepancy does (every actuator candidate of M, the diagnosis's defaults).
+def pair_plan(args) -> list[tuple[str, int]]:
+    """``(label, seed)`` of bench_discrepancy's ``--labels pairs`` plan (``--seeds`` per label from
+    ``--first-seed``), so a case here is the case of that benchmark with the same seed."""
+    from bench_discrepancy import independent_plan
+
+    return [(lab, s) for _, lab, s in independent_plan(args.seeds, 0, args.first_seed, ",".join(args.labels))]
+
+
+def run_pair_case(seed: int, label: str, args) -> dict:
+    """Two hidden effects: diagnose M; when ambiguous or at bound, the recommended M or Z record of the
+    same strip (fresh noise) merged / diagnosed jointly; success: ``named`` with exactly both names."""
+    from bench_discrepancy import DETECTABLE, FREE_INDEPENDENT, WORKFLOW_FREE_GENERATOR
+
+    from physmodel import IPMCParameters
+
+    sweep, truth = ig.make_case(seed, label, workflow_free=WORKFLOW_FREE_GENERATOR)
+    expected = sorted(truth["expected"])
+    lam_each = dict(truth["lam_each_workflow"])
+    row = {"seed": seed, "label": label, "expected": expected, "lam_each": lam_each,
+           "lam": min(lam_each.values()), "detectable": min(lam_each.values()) >= DETECTABLE,
+           "first": None, "first_named": [], "second": None, "second_named": [], "recommended": None,
+           "separates": None, "lam_expected": float("nan"), "dt": 0.0, "success": False}
+    if not row["detectable"] and not args.all_pairs:
+        return row
+    base = IPMCParameters.from_dict(dict(truth["library_start"]))
+
+    def diag(data, q, **kw):
+        return diagnose(data, base, kind="actuator", quantity=q, free=FREE_INDEPENDENT, seed=seed,
+                        **({"candidates": list(args.candidates)} if args.candidates else {}), **kw)
+
+    t0 = time.perf_counter()
+    d1 = diag(sweep, "M")
+    row.update(first=d1.verdict, first_named=sorted(d1.named), first_final=sorted(d1.final_effects or ()),
+               first_declared=sorted(" ~ ".join(sorted((a, b))) for a, b, _ in d1.confusable))
+    if d1.verdict in ("ambiguous", "at_bound"):
+        t1 = time.perf_counter()
+        nm = next_measurement(d1, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz))
+        r = nm.recommended
+        row.update(nm_s=time.perf_counter() - t1, models=[" + ".join(m) for m in nm.models],
+                   truth_competing=any(sorted(m) == expected for m in nm.models), inseparable=list(nm.inseparable),
+                   as_fitted=list(nm.inseparable_as_fitted), separates=nm.separates,
+                   recommended=r.describe() if r else None,
+                   lam_expected=r.separation_refit if r else float("nan"),
+                   lam_linear=r.separation if r else float("nan"),
+                   by_pair={k: round(min(v.values()), 3) for k, v in (r.separation_by_pair if r else {}).items()},
+                   refit_by_pair=dict(r.refit_by_pair) if r else {}, nm_message=nm.message)
+        if r is not None:
+            d2 = second_diagnosis(diag, sweep, *measure_actuator(truth, r, seed),
+                                  acts_on=None if args.no_acts_on else CHAIN_ON_M)
+            row.update(second=d2.verdict, second_named=sorted(d2.named),
+                       second_final=sorted(d2.final_effects or ()), second_message=d2.message)
+    row["dt"] = time.perf_counter() - t0
+    row["success"] = row["second"] == "named" and row["second_named"] == expected
+    return row
+
+
+def pair_report(rows: list) -> None:
+    """The pair mode's summary: per case and the rates."""
+    print("\n| seed | hidden (λ each after the workflow's set) | first verdict | recommended (λ lin / refit; "
+          "expected to separate) | second verdict |")
+    for r in rows:
+        lam = ", ".join(f"{k} {v:.0f}" for k, v in r["lam_each"].items())
+        if r["first"] is None:
+            print(f"| {r['seed']} | {lam} | not detectable: not run | | |")
+            continue
+        rec = (f"{r['recommended']}; λ {r['lam_linear']:.3g} / {r['lam_expected']:.3g}; "
+               f"{'yes' if r['separates'] else 'no'}" if r["recommended"] else "-")
+        print(f"| {r['seed']} | {lam} | {r['first']} {r['first_named']} | {rec} | "
+              + (f"{r['second']} {r['second_named']} {'OK' if r['success'] else 'MISS'}" if r["second"] else "-")
+              + " |")
+    det = [r for r in rows if r["detectable"] and r["first"] is not None]
+    amb = [r for r in det if r["first"] in ("ambiguous", "at_bound")]
+    ok = sum(r["success"] for r in amb)
+    lo, hi = wilson(ok, len(amb))
+    first_exact = [r for r in det if r["first"] == "named" and r["first_named"] == r["expected"]]
+    print(f"\ndetectable pairs: {len(det)} of {len(rows)}; named exactly by the first record: {len(first_exact)}; "
+          f"ambiguous / at bound: {len(amb)}; named exactly (both) after the recommended measurement: {ok}/{len(amb)}"
+          + (f" = {ok / len(amb):.0%} (Wilson 95 % [{lo:.2f}, {hi:.2f}])" if amb else "") + "; goal >= 80 %")
+    tot = len(first_exact) + ok
+    lo2, hi2 = wilson(tot, len(det))
+    print(f"  detectable pairs named exactly after at most one recommended measurement: {tot}/{len(det)}"
+          + (f" (Wilson 95 % [{lo2:.2f}, {hi2:.2f}])" if det else ""))
+    print("  second verdict: " + verdict_line(amb))
+    print(f"  the truth among the competing models: {sum(bool(r.get('truth_competing')) for r in amb)}/{len(amb)}; "
+          f"expected to separate: {sum(bool(r['separates']) for r in amb)}/{len(amb)}")
+    for r in amb:
+        if not r["success"]:
+            print(f"  miss seed {r['seed']} {r['label']}: models {r.get('models')}; inseparable "
+                  f"{r.get('inseparable') or 'none'} (as fitted {r.get('as_fitted') or 'none'}); λ by pair "
+                  f"{r.get('by_pair')}, refits {r.get('refit_by_pair')}; second final {r.get('second_final')}")
+    nms = [r["nm_s"] for r in amb if "nm_s" in r]
+    dts = [r["dt"] for r in det]
+    if dts:
+        print(f"  wall per case median {np.median(dts):.0f} s (max {max(dts):.0f}); next_measurement median "
+              f"{np.median(nms) if nms else float('nan'):.0f} s")
 
 
 def residual_ratio(d) -> float:
@@ -423,18 +542,47 @@ def main(argv=None):
                     help="sensor: measure the recommended record on a strip whose temperature laws are not the "
                          "library's defaults the user starts from (LAW_ERROR: Ea_d 20 kJ/mol, E slope -0.50 %%/K; "
                          "the first record at 35 °C is unchanged)")
+    ap.add_argument("--pairs", action="store_true",
+                    help="actuator: two hidden effects, bench_discrepancy's --labels pairs cases (--seeds per "
+                         "label from --first-seed; --labels filters them: a pair label or 'pairs'); every "
+                         "actuator candidate unless --candidates; success: 'named' with exactly both")
+    ap.add_argument("--all-pairs", action="store_true",
+                    help="--pairs: diagnose pairs that are not detectable too (default: listed, not run)")
+    ap.add_argument("--no-acts-on", action="store_true",
+                    help="--pairs: a Z record diagnosed jointly without declaring the delay and amplifier on "
+                         "M only (CHAIN_ON_M)")
     ap.add_argument("--min-ambiguous", type=int, default=0,
                     help="stop once this many ambiguous cases are scored (0: run every seed)")
     args = ap.parse_args(argv)
     act = args.kind == "actuator"
     if act and args.law_error:
         ap.error("--law-error: the sensor's laws only (--kind sensor)")
+    if args.pairs and not act:
+        ap.error("--pairs: the independent actuator's two-effect cases (--kind actuator)")
+    if act and args.fmax_hz == 1000.0:
+        args.fmax_hz = 200.0                # the single-mode beam's band (second mode near 6.3 f1)
+    if args.pairs:
+        args.labels = args.labels or ["pairs"]
+        t0 = time.perf_counter()
+        rows = []
+        for lab, seed in pair_plan(args):
+            r = run_pair_case(seed, lab, args)
+            rows.append(r)
+            lam = ", ".join(f"{k} {v:.0f}" for k, v in r["lam_each"].items())
+            print(f"  seed {seed} {lab} (λ {lam}): " + ("not detectable, not run" if r["first"] is None else
+                  f"{r['first']} {r['first_named']}"
+                  + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} "
+                     f"refit; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
+                     f"inseparable {r['inseparable'] or '-'}] -> {r['second']} {r['second_named']} "
+                     f"{'OK' if r['success'] else 'MISS'}" if r["recommended"] else "")
+                  + f" ({r['dt']:.0f} s)"), flush=True)
+        pair_report(rows)
+        print(f"elapsed {time.perf_counter() - t0:.0f} s")
+        return rows
     if args.labels is None:
         args.labels = list(ACTUATOR_LABELS if act else LABELS)
     if args.candidates is None:
         args.candidates = list(ACTUATOR_LABELS if act else CANDIDATES)
-    if act and args.fmax_hz == 1000.0:
-        args.fmax_hz = 200.0                # the single-mode beam's band (second mode near 6.3 f1)
     t0 = time.perf_counter()
     rows = []
     for i in range(args.seeds):
