@@ -145,7 +145,7 @@ def competing_models(d) -> list[tuple]:
     """The models an ``ambiguous`` / ``at_bound`` diagnosis ``d`` leaves competing: the best (its
     final effects) first, then each alternative — another named single effect, a pair with one member
     swapped for a named alternative declared confusable with it (or either member when no declaration
-    says which), or for ``at_bound`` a confusable candidate that stopped at its bound and, widened,
+    says which), an ambiguous pair with both members swapped for such twins at once, or for ``at_bound`` a confusable candidate that stopped at its bound and, widened,
     competes (else the significant candidates that close the gap)."""
     final = tuple(d.final_effects) if d.final_effects else tuple(d.named[:1])
     if not final:
@@ -172,6 +172,15 @@ def competing_models(d) -> list[tuple]:
             alt = tuple(sorted([x for x in final if x != m] + [c]))
             if alt not in alts and set(alt) != set(final):
                 alts.append(alt)
+    # a pair whose members each have a named twin: both may stand for their twins at once (contact
+    # resistance + delay vs the diffusivity law + an amplifier pole), not only one at a time
+    if len(final) == 2 and d.verdict == "ambiguous":
+        twins = [[c for c in others if m in partner.get(c, ()) and c not in final] for m in final]
+        for a in twins[0]:
+            for b in twins[1]:
+                alt = tuple(sorted((a, b)))
+                if a != b and alt not in alts:
+                    alts.append(alt)
     return [final] + alts if alts else []
 
 

@@ -63,6 +63,27 @@ def test_refuses_a_verdict_with_nothing_to_separate():
             next_measurement(SimpleNamespace(verdict=v, base_parameters=object()))
 
 
+def test_a_pair_whose_members_each_have_a_twin_competes_with_both_swapped():
+    """Two effects named, each with a declared-confusable twin also named (the independent actuator's
+    contact resistance + delay: 'ambiguous' among them and the diffusivity law and the amplifier pole).
+    Either member may be the one its twin stands for, or both: the search must separate the fit from
+    the pair with both swapped too, not only from each single swap."""
+    from physmodel.estimation.next_measurement import competing_models
+
+    d = SimpleNamespace(verdict="ambiguous", final_effects={"contact_resistance": {}, "time_delay": {}},
+                        named=["amplifier_bandwidth", "contact_resistance", "diffusivity_temperature", "time_delay"],
+                        confusable=[("amplifier_bandwidth", "time_delay", "x"),
+                                    ("contact_resistance", "diffusivity_temperature", "x")],
+                        confusability={}, candidates={})
+    mods = competing_models(d)
+    assert mods[0] == ("contact_resistance", "time_delay")
+    assert set(mods[1:]) == {("amplifier_bandwidth", "contact_resistance"), ("diffusivity_temperature", "time_delay"),
+                             ("amplifier_bandwidth", "diffusivity_temperature")}
+    # a twin of one member only: no double swap to add (the list as before)
+    d.named, d.confusable = ["contact_resistance", "diffusivity_temperature", "time_delay"], d.confusable[1:]
+    assert competing_models(d) == [("contact_resistance", "time_delay"), ("diffusivity_temperature", "time_delay")]
+
+
 # ------------------------------------------------------------------ a virtual-lab case
 @pytest.fixture(scope="module")
 def ambiguous():
