@@ -518,11 +518,12 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                f"(≥ {target:.3g} needed for {power:.0%} power at α = {d.alpha:g}; the record alone gives "
                f"{current:.3g}).{alike}")
     else:
+        lam_low, lam_words = shortfall(chosen)
         msg = (f"No experiment within the limits is expected to separate {who} at the noise of this record: the "
-               f"best, {chosen.describe()}, gives λ = {lam_said:.3g} < {target:.3g} needed (the record alone "
+               f"best, {chosen.describe()}, gives λ = {lam_words} < {target:.3g} needed (the record alone "
                f"{current:.3g}); lower the noise (more periods"
-               + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_said)}× "
-                  "as many" if 0 < lam_said < target else "")
+               + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_low)}× "
+                  "as many" if 0 < lam_low < target else "")
                + f"), widen the limits, or accept the ambiguity.{alike}")
     forms: dict = {}
     if contests:
@@ -586,6 +587,18 @@ def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, 
         for m in fitted:
             resp[q].pop(id(m), None)
     return contests, resp, said
+
+
+def shortfall(r) -> tuple[float, str]:
+    """The separation of experiment ``r`` that falls short and its words: an experiment separates only
+    when its linearised λ and, where checked, the refits' both reach the target, so the lesser of the
+    two is the one said (with the other where they differ by more than 10 %)."""
+    lin, ref = float(r.separation), float(r.separation_refit)
+    if not math.isfinite(ref):
+        return lin, f"{lin:.3g}"
+    if ref <= lin:
+        return ref, f"{ref:.3g} after the refits" + (f" ({lin:.3g} linearised)" if lin > 1.1 * ref else "")
+    return lin, f"{lin:.3g} linearised" + (f" ({ref:.3g} after the refits)" if ref > 1.1 * lin else "")
 
 
 def _forms_note(said: dict, contests: dict, alpha: float) -> str:

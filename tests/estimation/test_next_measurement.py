@@ -84,6 +84,21 @@ def test_a_pair_whose_members_each_have_a_twin_competes_with_both_swapped():
     assert competing_models(d) == [("contact_resistance", "time_delay"), ("diffusivity_temperature", "time_delay")]
 
 
+def test_a_shortfall_quotes_the_separation_that_falls_short():
+    """When the linearised λ and the refits' disagree across the target, the recommendation is not
+    expected to separate (both must reach it) and the sentence quotes the one that falls short, not
+    the other (seen on the independent actuator's contact resistance + second mode, seed 48061 of
+    bench_next_measurement --pairs: 'gives λ = 294 < 42 needed', λ 3.51 linearised)."""
+    from physmodel.estimation.next_measurement import shortfall
+
+    lam, words = shortfall(SimpleNamespace(separation=3.51, separation_refit=294.0))
+    assert lam == 3.51 and "3.51" in words and "294" in words and "linearised" in words
+    lam, words = shortfall(SimpleNamespace(separation=60.0, separation_refit=12.0))
+    assert lam == 12.0 and words.startswith("12 ") and "refit" in words
+    lam, words = shortfall(SimpleNamespace(separation=7.0, separation_refit=math.nan))     # not checked
+    assert lam == 7.0 and words == "7"
+
+
 # ------------------------------------------------------------------ a virtual-lab case
 @pytest.fixture(scope="module")
 def ambiguous():
