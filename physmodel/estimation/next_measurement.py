@@ -96,7 +96,7 @@ docstring, which measures the named-exactly rate: 12/12 and 10/10 on fresh seeds
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -224,7 +224,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                      band_limits_hz: tuple = DEFAULT_BAND_LIMITS_HZ, temperature_limits_c: tuple | None = None,
                      levels: Sequence[float] = DEFAULT_LEVELS, lines_per_decade: float | None = None,
                      power: float = 0.9, models: Sequence[tuple] | None = None, check_refit: int = 2,
-                     max_nfev: int = 100) -> NextMeasurement:
+                     max_nfev: int = 100, acts_on: Mapping[str, Sequence[str]] | None = None) -> NextMeasurement:
     """The experiment that best separates the models diagnosis ``d`` leaves competing (module doc).
 
     Parameters
@@ -254,6 +254,13 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         until one reaches the target (0: none).
     max_nfev : int
         Function evaluations of each refit.
+    acts_on : mapping or None
+        A one-quantity record only: ``{effect: [quantities]}``, where an effect acts among the
+        quantities a new record may measure (each list including the record's own), as
+        ``diagnose``'s ``acts_on`` for a joint record — e.g. ``{"time_delay": ["M"]}`` when the
+        displacement channel carries the delay and Z is measured by another instrument; on a
+        quantity not listed the effect is held at its off values in the predictions (default: every
+        effect acts on every quantity it applies to).  A joint diagnosis carries its own.
     """
     from scipy.stats import norm
 
@@ -279,7 +286,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     target = 4.0 * (z_crit + float(norm.ppf(power))) ** 2
     mods = list(models) if models is not None else competing_models(d)
     nm = noise_model(d)
-    view = RecordView(d)
+    view = RecordView(d, acts_on)
     if len(mods) < 2:
         return NextMeasurement([tuple(m) for m in mods], None, False, target, 0.0, 0, [], nm, {},
                                "No competing model to separate: the diagnosis names no rival "
@@ -472,8 +479,8 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                     if not any(id(c) == rid for c in checked)]
         for rid in to_check[:max(check_refit, 0) if live else 0]:
             r = by_id[rid]
-            r.refit_by_pair = refit_check(d, [p for p in live if key(*p) not in contests], r, nm, max_nfev, label)
-            r.refit_by_pair.update({key(*p): contests[key(*p)].check(d, r, nm, max_nfev) for p in live
+            r.refit_by_pair = refit_check(d, [p for p in live if key(*p) not in contests], r, nm, max_nfev, label, view)
+            r.refit_by_pair.update({key(*p): contests[key(*p)].check(d, r, nm, max_nfev, view) for p in live
                                     if key(*p) in contests})
             checked.append(r)
         # a pair is the same response in another form here when every checked experiment expected

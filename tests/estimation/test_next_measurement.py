@@ -376,3 +376,24 @@ def test_candidate_json_tells_a_merged_record_from_an_added_quantity():
     assert merged["added_quantity"] is False and added["added_quantity"] is True
     assert "merged with the diagnosed record" in merged["description"]
     assert "diagnosed jointly with the record's quantities" in added["description"]
+
+
+def test_acts_on_keeps_the_chain_effects_off_a_quantity_another_instrument_measures(ambiguous):
+    """The lab's delay and amplifier pole are on the current channel of S; Z measured by an impedance
+    analyser carries neither, so no Z record can tell them apart: declared (``acts_on``), the search
+    says so and keeps S; undeclared, the library's default puts both on Z too and a Z record is
+    expected to separate them (bench_next_measurement --pairs: the independent actuator's Z record was
+    recommended for the delay vs the pole and could not separate them)."""
+    d = ambiguous.d
+    chain = {"time_delay": ["S"], "amplifier_bandwidth": ["S"]}
+    nm0 = next_measurement(d, quantities=["Z"])
+    assert nm0.separates and nm0.best_by_quantity["Z"] > nm0.target
+    nm = next_measurement(d, quantities=["Z"], acts_on=chain)
+    assert not nm.separates and nm.best_by_quantity["Z"] < nmod.SAME_FORM_LAMBDA
+    assert nm.inseparable == ["amplifier_bandwidth vs time_delay"]
+    both = next_measurement(d, quantities=["S", "Z"], acts_on=chain)
+    assert both.separates and both.recommended.quantity == "S" and both.best_by_quantity["Z"] < nmod.SAME_FORM_LAMBDA
+    with pytest.raises(IPMCError, match="time_delay.*include the diagnosed record's 'S'"):
+        next_measurement(d, quantities=["Z"], acts_on={"time_delay": ["Z"]})
+    with pytest.raises(IPMCError, match="acts_on\\['no_such_effect'\\]|no_such_effect"):
+        next_measurement(d, quantities=["Z"], acts_on={"no_such_effect": ["S"]})
