@@ -310,9 +310,10 @@ def second_diagnosis(diag, sweep, q: str, new: FrequencySweep, acts_on: dict | N
 
 #: ``--pairs``: where the independent generator's measurement-chain effects act — its sampling skew,
 #: DAC hold and amplifier poles are on the displacement channel (``independent_physics.actuator_response``
-#: applies them to M only), so a user measuring Z with another instrument declares them on M
-#: (``diagnose(acts_on=...)``); ``--no-acts-on`` drops the declaration (the library's default: on every
-#: measured quantity).
+#: applies them to M only), so a user measuring Z with another instrument declares them on M, to the
+#: search (``next_measurement(acts_on=...)``: a Z record cannot separate them) and to the joint diagnosis
+#: of a Z record (``diagnose(acts_on=...)``); ``--no-acts-on`` drops the declaration (the library's
+#: default: on every measured quantity).
 CHAIN_ON_M = {"time_delay": ("M",), "amplifier_bandwidth": ("M",)}
 
 
@@ -388,7 +389,8 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                first_declared=sorted(" ~ ".join(sorted((a, b))) for a, b, _ in d1.confusable))
     if d1.verdict in ("ambiguous", "at_bound"):
         t1 = time.perf_counter()
-        nm = next_measurement(d1, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz))
+        nm = next_measurement(d1, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz),
+                              acts_on=None if args.no_acts_on else CHAIN_ON_M)
         r = nm.recommended
         row.update(nm_s=time.perf_counter() - t1, models=[" + ".join(m) for m in nm.models],
                    truth_competing=any(sorted(m) == expected for m in nm.models), inseparable=list(nm.inseparable),
@@ -549,8 +551,8 @@ def main(argv=None):
     ap.add_argument("--all-pairs", action="store_true",
                     help="--pairs: diagnose pairs that are not detectable too (default: listed, not run)")
     ap.add_argument("--no-acts-on", action="store_true",
-                    help="--pairs: a Z record diagnosed jointly without declaring the delay and amplifier on "
-                         "M only (CHAIN_ON_M)")
+                    help="--pairs: the search and the joint diagnosis of a Z record without declaring the delay "
+                         "and amplifier on M only (CHAIN_ON_M)")
     ap.add_argument("--min-ambiguous", type=int, default=0,
                     help="stop once this many ambiguous cases are scored (0: run every seed)")
     args = ap.parse_args(argv)
