@@ -285,14 +285,15 @@ ACTUATOR_FREE = ("alpha0", "d", "kappa_e", "xi", "omega_n")
 ACTUATOR_LABELS = ("contact_resistance", "diffusivity_temperature")
 
 
-def measure_actuator(truth, r, seed: int) -> tuple[str, FrequencySweep]:
+def measure_actuator(truth, r, seed: int, round_: int = 0) -> tuple[str, FrequencySweep]:
     """The independent actuator at the recommended lines (its own physics, at each bath temperature),
-    with the generator's relative noise and a fresh seed: ``(quantity, sweep)``."""
+    with the generator's relative noise and a fresh seed (another for each later ``round_``):
+    ``(quantity, sweep)``."""
     T, f = r.line_temperatures_c, r.line_frequencies_hz
     H = np.concatenate([ip.actuator_response(truth["base"], f[T == t], [t], truth["effects"])[r.quantity][0]
                         for t in np.unique(T)])
     sig = truth["noise"]["sigma_rel"] / math.sqrt(2.0)      # the generator's relative noise, a fresh seed
-    rng = np.random.default_rng([NEW_NOISE, seed])
+    rng = np.random.default_rng([NEW_NOISE, seed] + ([round_] if round_ else []))
     noisy = H * (1 + sig * (rng.standard_normal(H.size) + 1j * rng.standard_normal(H.size)))
     std = (np.full(f.size, 20 / math.log(10) * sig), np.full(f.size, math.degrees(sig)))
     if r.quantity == "M":
@@ -401,13 +402,47 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                    by_pair={k: round(min(v.values()), 3) for k, v in (r.separation_by_pair if r else {}).items()},
                    refit_by_pair=dict(r.refit_by_pair) if r else {}, nm_message=nm.message)
         if r is not None:
-            d2 = second_diagnosis(diag, sweep, *measure_actuator(truth, r, seed),
-                                  acts_on=None if args.no_acts_on else CHAIN_ON_M)
+            chain = None if args.no_acts_on else CHAIN_ON_M
+            records = {"M": sweep}
+            data, q = records_add(records, *measure_actuator(truth, r, seed))
+            d2 = diag(data, q, **on_chain(records, chain))
             row.update(second=d2.verdict, second_named=sorted(d2.named),
                        second_final=sorted(d2.final_effects or ()), second_message=d2.message)
+            # --rounds: ask again while ambiguous (a user's next step; the first round is the score)
+            later, d = [], d2
+            for k in range(1, args.rounds):
+                if d.verdict not in ("ambiguous", "at_bound"):
+                    break
+                nm = next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz),
+                                      acts_on=chain if len(records) == 1 else None)
+                rk = nm.recommended
+                if rk is None:
+                    break
+                data, q = records_add(records, *measure_actuator(truth, rk, seed, k))
+                d = diag(data, q, **on_chain(records, chain))
+                later.append({"recommended": rk.describe(), "lam_linear": rk.separation, "lam_expected":
+                              rk.separation_refit, "separates": nm.separates, "verdict": d.verdict,
+                              "named": sorted(d.named)})
+            row.update(later=later, final=d.verdict, final_named=sorted(d.named))
     row["dt"] = time.perf_counter() - t0
     row["success"] = row["second"] == "named" and row["second_named"] == expected
+    row["success_final"] = row.get("final") == "named" and row.get("final_named") == expected
     return row
+
+
+def records_add(records: dict, q: str, new: FrequencySweep) -> tuple:
+    """``records`` (quantity -> sweep of one strip) with ``new`` merged into its quantity's record or
+    added as one more quantity: the ``(data, quantity)`` to diagnose (jointly when several)."""
+    records[q] = merge_records(records[q], new) if q in records else new
+    if len(records) == 1:
+        return records[q], q
+    return list(records.values()), tuple(records)
+
+
+def on_chain(records: dict, chain: dict | None) -> dict:
+    """``diagnose``'s ``acts_on`` for ``records``: the chain's effects on M when Z was added (a
+    one-quantity record takes none)."""
+    return {"acts_on": chain} if chain and len(records) > 1 else {}
 
 
 def pair_report(rows: list) -> None:
@@ -437,6 +472,12 @@ def pair_report(rows: list) -> None:
     print(f"  detectable pairs named exactly after at most one recommended measurement: {tot}/{len(det)}"
           + (f" (Wilson 95 % [{lo2:.2f}, {hi2:.2f}])" if det else ""))
     print("  second verdict: " + verdict_line(amb))
+    if any(r.get("later") for r in amb):
+        okf = sum(bool(r.get("success_final")) for r in amb)
+        lo3, hi3 = wilson(okf, len(amb))
+        n_more = sum(bool(r.get("later")) for r in amb)
+        print(f"  after further recommended measurements (--rounds; {n_more} cases asked again): named exactly "
+              f"{okf}/{len(amb)} (Wilson 95 % [{lo3:.2f}, {hi3:.2f}])")
     print(f"  the truth among the competing models: {sum(bool(r.get('truth_competing')) for r in amb)}/{len(amb)}; "
           f"expected to separate: {sum(bool(r['separates']) for r in amb)}/{len(amb)}")
     for r in amb:
@@ -550,6 +591,10 @@ def main(argv=None):
                          "actuator candidate unless --candidates; success: 'named' with exactly both")
     ap.add_argument("--all-pairs", action="store_true",
                     help="--pairs: diagnose pairs that are not detectable too (default: listed, not run)")
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="--pairs: recommended measurements at most, asked again while the verdict stays "
+                         "ambiguous (each measured with fresh noise and added to the strip's records); the "
+                         "score is the first round's, the later ones are reported apart")
     ap.add_argument("--no-acts-on", action="store_true",
                     help="--pairs: the search and the joint diagnosis of a Z record without declaring the delay "
                          "and amplifier on M only (CHAIN_ON_M)")
@@ -577,6 +622,9 @@ def main(argv=None):
                      f"refit; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
                      f"inseparable {r['inseparable'] or '-'}] -> {r['second']} {r['second_named']} "
                      f"{'OK' if r['success'] else 'MISS'}" if r["recommended"] else "")
+                  + "".join(f" -> [{x['recommended']}; λ expected {x['lam_linear']:.3g} linearised, "
+                            f"{x['lam_expected']:.3g} refit; {'separates' if x['separates'] else 'not expected to separate'}]"
+                            f" -> {x['verdict']} {x['named']}" for x in r.get("later", []))
                   + f" ({r['dt']:.0f} s)"), flush=True)
         pair_report(rows)
         print(f"elapsed {time.perf_counter() - t0:.0f} s")
