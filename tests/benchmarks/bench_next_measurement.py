@@ -390,8 +390,9 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                first_declared=sorted(" ~ ".join(sorted((a, b))) for a, b, _ in d1.confusable))
     if d1.verdict in ("ambiguous", "at_bound"):
         t1 = time.perf_counter()
+        chain = None if args.no_acts_on else CHAIN_ON_M
         nm = next_measurement(d1, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz),
-                              acts_on=None if args.no_acts_on else CHAIN_ON_M)
+                              **({"acts_on": chain} if chain else {}))
         r = nm.recommended
         row.update(nm_s=time.perf_counter() - t1, models=[" + ".join(m) for m in nm.models],
                    truth_competing=any(sorted(m) == expected for m in nm.models), inseparable=list(nm.inseparable),
@@ -402,7 +403,6 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                    by_pair={k: round(min(v.values()), 3) for k, v in (r.separation_by_pair if r else {}).items()},
                    refit_by_pair=dict(r.refit_by_pair) if r else {}, nm_message=nm.message)
         if r is not None:
-            chain = None if args.no_acts_on else CHAIN_ON_M
             records = {"M": sweep}
             data, q = records_add(records, *measure_actuator(truth, r, seed))
             d2 = diag(data, q, **on_chain(records, chain))
@@ -414,7 +414,7 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                 if d.verdict not in ("ambiguous", "at_bound"):
                     break
                 nm = next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz),
-                                      acts_on=chain if len(records) == 1 else None)
+                                      **({"acts_on": chain} if chain and len(records) == 1 else {}))
                 rk = nm.recommended
                 if rk is None:
                     break
