@@ -195,10 +195,11 @@ def _skeleton(kind: str, q: str, f: np.ndarray, T: np.ndarray) -> FrequencySweep
 
 
 def _band_windows(f_lo: float, f_hi: float, data_band: tuple) -> list[tuple]:
-    """Candidate bands: the measured band, and windows of ½–2 decades with edges every ⅓ decade."""
+    """Candidate bands: the measured band, and windows of ½–2 decades with edges every ⅓ decade and at
+    the limits ``f_lo``, ``f_hi`` (a limit off the ⅓-decade grid is an edge too, so a band can reach it)."""
     out = [tuple(data_band)]
     edges = 10 ** np.arange(math.floor(3 * math.log10(f_lo)) / 3, math.log10(f_hi) + 1e-9, 1 / 3)
-    edges = np.unique(np.clip(edges, f_lo, f_hi))
+    edges = np.unique(np.clip(np.append(edges, f_hi), f_lo, f_hi))
     for i, a in enumerate(edges):
         for b in edges[i + 1:]:
             w = math.log10(b / a)

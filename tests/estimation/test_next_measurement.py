@@ -397,3 +397,15 @@ def test_acts_on_keeps_the_chain_effects_off_a_quantity_another_instrument_measu
         next_measurement(d, quantities=["Z"], acts_on={"time_delay": ["Z"]})
     with pytest.raises(IPMCError, match="acts_on\\['no_such_effect'\\]|no_such_effect"):
         next_measurement(d, quantities=["Z"], acts_on={"no_such_effect": ["S"]})
+
+
+def test_bands_reach_the_highest_frequency_allowed(ambiguous):
+    """The pole and the delay part most at the top of the band, so the recommended band ends at the
+    limit: 300 Hz and 500 Hz, not the last third-decade edge below it (215, 464 Hz: the bands had
+    stopped there, and the independent actuator's M under a 200 Hz limit at 100 Hz, where the delay
+    and the pole stay within the noise)."""
+    for hi in (300.0, 500.0):
+        nm = next_measurement(ambiguous.d, quantities=["S"], band_limits_hz=(0.1, hi), temperature_limits_c=(35, 35))
+        r = nm.recommended
+        assert r.band_hz[1] == pytest.approx(hi) and r.line_frequencies_hz.max() == pytest.approx(hi)
+        assert nm.separates
