@@ -145,8 +145,9 @@ def competing_models(d) -> list[tuple]:
     """The models an ``ambiguous`` / ``at_bound`` diagnosis ``d`` leaves competing: the best (its
     final effects) first, then each alternative — another named single effect, a pair with one member
     swapped for a named alternative declared confusable with it (or either member when no declaration
-    says which), an ambiguous pair with both members swapped for such twins at once, or for ``at_bound`` a confusable candidate that stopped at its bound and, widened,
-    competes (else the significant candidates that close the gap)."""
+    says which), an ambiguous pair with both members swapped for such twins at once, or for
+    ``at_bound`` a confusable candidate that stopped at its bound and, widened, competes (else the
+    significant candidates that close the gap)."""
     final = tuple(d.final_effects) if d.final_effects else tuple(d.named[:1])
     if not final:
         return []

@@ -397,6 +397,10 @@ def test_acts_on_keeps_the_chain_effects_off_a_quantity_another_instrument_measu
         next_measurement(d, quantities=["Z"], acts_on={"time_delay": ["Z"]})
     with pytest.raises(IPMCError, match="acts_on\\['no_such_effect'\\]|no_such_effect"):
         next_measurement(d, quantities=["Z"], acts_on={"no_such_effect": ["S"]})
+    from physmodel.estimation.next_measurement_design import new_quantity_acts_on
+
+    with pytest.raises(IPMCError, match="joint diagnosis carries its own"):
+        new_quantity_acts_on(SimpleNamespace(joint=object(), kind="sensor", quantity="S"), chain)
 
 
 def test_bands_reach_the_highest_frequency_allowed(ambiguous):
