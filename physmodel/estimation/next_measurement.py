@@ -96,7 +96,7 @@ docstring, which measures the named-exactly rate: 12/12 and 10/10 on fresh seeds
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -145,8 +145,9 @@ def competing_models(d) -> list[tuple]:
     """The models an ``ambiguous`` / ``at_bound`` diagnosis ``d`` leaves competing: the best (its
     final effects) first, then each alternative — another named single effect, a pair with one member
     swapped for a named alternative declared confusable with it (or either member when no declaration
-    says which), or for ``at_bound`` a confusable candidate that stopped at its bound and, widened,
-    competes (else the significant candidates that close the gap)."""
+    says which), an ambiguous pair with both members swapped for such twins at once, or for
+    ``at_bound`` a confusable candidate that stopped at its bound and, widened, competes (else the
+    significant candidates that close the gap)."""
     final = tuple(d.final_effects) if d.final_effects else tuple(d.named[:1])
     if not final:
         return []
@@ -172,6 +173,15 @@ def competing_models(d) -> list[tuple]:
             alt = tuple(sorted([x for x in final if x != m] + [c]))
             if alt not in alts and set(alt) != set(final):
                 alts.append(alt)
+    # a pair whose members each have a named twin: both may stand for their twins at once (contact
+    # resistance + delay vs the diffusivity law + an amplifier pole), not only one at a time
+    if len(final) == 2 and d.verdict == "ambiguous":
+        twins = [[c for c in others if m in partner.get(c, ()) and c not in final] for m in final]
+        for a in twins[0]:
+            for b in twins[1]:
+                alt = tuple(sorted((a, b)))
+                if a != b and alt not in alts:
+                    alts.append(alt)
     return [final] + alts if alts else []
 
 
@@ -186,10 +196,11 @@ def _skeleton(kind: str, q: str, f: np.ndarray, T: np.ndarray) -> FrequencySweep
 
 
 def _band_windows(f_lo: float, f_hi: float, data_band: tuple) -> list[tuple]:
-    """Candidate bands: the measured band, and windows of ½–2 decades with edges every ⅓ decade."""
+    """Candidate bands: the measured band, and windows of ½–2 decades with edges every ⅓ decade and at
+    the limits ``f_lo``, ``f_hi`` (a limit off the ⅓-decade grid is an edge too, so a band can reach it)."""
     out = [tuple(data_band)]
     edges = 10 ** np.arange(math.floor(3 * math.log10(f_lo)) / 3, math.log10(f_hi) + 1e-9, 1 / 3)
-    edges = np.unique(np.clip(edges, f_lo, f_hi))
+    edges = np.unique(np.clip(np.append(edges, f_hi), f_lo, f_hi))
     for i, a in enumerate(edges):
         for b in edges[i + 1:]:
             w = math.log10(b / a)
@@ -215,7 +226,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                      band_limits_hz: tuple = DEFAULT_BAND_LIMITS_HZ, temperature_limits_c: tuple | None = None,
                      levels: Sequence[float] = DEFAULT_LEVELS, lines_per_decade: float | None = None,
                      power: float = 0.9, models: Sequence[tuple] | None = None, check_refit: int = 2,
-                     max_nfev: int = 100) -> NextMeasurement:
+                     max_nfev: int = 100, acts_on: Mapping[str, Sequence[str]] | None = None) -> NextMeasurement:
     """The experiment that best separates the models diagnosis ``d`` leaves competing (module doc).
 
     Parameters
@@ -245,6 +256,13 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         until one reaches the target (0: none).
     max_nfev : int
         Function evaluations of each refit.
+    acts_on : mapping or None
+        A one-quantity record only: ``{effect: [quantities]}``, where an effect acts among the
+        quantities a new record may measure (each list including the record's own), as
+        ``diagnose``'s ``acts_on`` for a joint record — e.g. ``{"time_delay": ["M"]}`` when the
+        displacement channel carries the delay and Z is measured by another instrument; on a
+        quantity not listed the effect is held at its off values in the predictions (default: every
+        effect acts on every quantity it applies to).  A joint diagnosis carries its own.
     """
     from scipy.stats import norm
 
@@ -270,7 +288,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     target = 4.0 * (z_crit + float(norm.ppf(power))) ** 2
     mods = list(models) if models is not None else competing_models(d)
     nm = noise_model(d)
-    view = RecordView(d)
+    view = RecordView(d, acts_on)
     if len(mods) < 2:
         return NextMeasurement([tuple(m) for m in mods], None, False, target, 0.0, 0, [], nm, {},
                                "No competing model to separate: the diagnosis names no rival "
@@ -463,8 +481,8 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                     if not any(id(c) == rid for c in checked)]
         for rid in to_check[:max(check_refit, 0) if live else 0]:
             r = by_id[rid]
-            r.refit_by_pair = refit_check(d, [p for p in live if key(*p) not in contests], r, nm, max_nfev, label)
-            r.refit_by_pair.update({key(*p): contests[key(*p)].check(d, r, nm, max_nfev) for p in live
+            r.refit_by_pair = refit_check(d, [p for p in live if key(*p) not in contests], r, nm, max_nfev, label, view)
+            r.refit_by_pair.update({key(*p): contests[key(*p)].check(d, r, nm, max_nfev, view) for p in live
                                     if key(*p) in contests})
             checked.append(r)
         # a pair is the same response in another form here when every checked experiment expected
@@ -509,11 +527,12 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                f"(≥ {target:.3g} needed for {power:.0%} power at α = {d.alpha:g}; the record alone gives "
                f"{current:.3g}).{alike}")
     else:
+        lam_low, lam_words = shortfall(chosen)
         msg = (f"No experiment within the limits is expected to separate {who} at the noise of this record: the "
-               f"best, {chosen.describe()}, gives λ = {lam_said:.3g} < {target:.3g} needed (the record alone "
+               f"best, {chosen.describe()}, gives λ = {lam_words} < {target:.3g} needed (the record alone "
                f"{current:.3g}); lower the noise (more periods"
-               + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_said)}× "
-                  "as many" if 0 < lam_said < target else "")
+               + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_low)}× "
+                  "as many" if 0 < lam_low < target else "")
                + f"), widen the limits, or accept the ambiguity.{alike}")
     forms: dict = {}
     if contests:
@@ -577,6 +596,18 @@ def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, 
         for m in fitted:
             resp[q].pop(id(m), None)
     return contests, resp, said
+
+
+def shortfall(r) -> tuple[float, str]:
+    """The separation of experiment ``r`` that falls short and its words: an experiment separates only
+    when its linearised λ and, where checked, the refits' both reach the target, so the lesser of the
+    two is the one said (with the other where they differ by more than 10 %)."""
+    lin, ref = float(r.separation), float(r.separation_refit)
+    if not math.isfinite(ref):
+        return lin, f"{lin:.3g}"
+    if ref <= lin:
+        return ref, f"{ref:.3g} after the refits" + (f" ({lin:.3g} linearised)" if lin > 1.1 * ref else "")
+    return lin, f"{lin:.3g} linearised" + (f" ({ref:.3g} after the refits)" if ref > 1.1 * lin else "")
 
 
 def _forms_note(said: dict, contests: dict, alpha: float) -> str:

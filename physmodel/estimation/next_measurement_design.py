@@ -11,7 +11,7 @@ nonlinear check by full refits of the rivals (:func:`refit_check`).  The method 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -65,11 +65,14 @@ class RecordView:
     diagnosis (:mod:`~physmodel.estimation.joint`, one per quantity, effects narrowed by its
     ``acts_on``), each a quantity a new measurement of it is merged with."""
 
-    def __init__(self, d):
+    def __init__(self, d, acts_on: Mapping[str, Sequence[str]] | None = None):
         jd = getattr(d, "joint", None)
         self.kind, self.joint, self._d, self._jd = d.kind, jd is not None, d, jd
         self.acts_on = {k: tuple(v) for k, v in ((d.metadata or {}).get("acts_on") or {}).items()} if self.joint else {}
         self.sweeps = dict(zip(jd.quantities, jd.sweeps)) if jd is not None else {d.quantity: d.data}
+        #: where effects act on a quantity the one-quantity record does not hold (the caller's
+        #: declaration, :func:`~physmodel.estimation.next_measurement.next_measurement`'s ``acts_on``)
+        self.new_acts_on = new_quantity_acts_on(d, acts_on) if acts_on else {}
 
     def record_many(self, model):
         """The predictor of ``model`` on the whole diagnosed record (stacked when joint)."""
@@ -78,8 +81,10 @@ class RecordView:
         return model.predictor(self._d.data, self._d.quantity).many
 
     def many(self, model, sweep: FrequencySweep, q: str):
-        """The predictor of ``model`` on ``sweep``'s lines of quantity ``q`` (``acts_on`` applied when joint)."""
-        if not self.joint:
+        """The predictor of ``model`` on ``sweep``'s lines of quantity ``q`` (``acts_on`` applied when
+        joint, ``new_acts_on`` on a quantity the record does not hold)."""
+        acts = self.acts_on if q in self.sweeps else {**self.acts_on, **self.new_acts_on}
+        if not self.joint and not acts:
             return model.predictor(sweep, q).many
         from .joint import joint_data
 
@@ -87,7 +92,7 @@ class RecordView:
             n = sweep.frequency_hz.size
             sweep = FrequencySweep(sweep.temperature_c, sweep.frequency_hz, sweep.response, np.ones(n), np.ones(n),
                                    sweep.input_name, sweep.input_unit, sweep.output_name, sweep.output_unit)
-        return joint_data([sweep], self.kind, (q,)).predictor(model, self.acts_on)
+        return joint_data([sweep], self.kind, (q,)).predictor(model, acts)
 
     def restacked(self, sweeps: dict) -> tuple:
         """(record, predictor factory ``model -> many``) of ``{quantity: sweep}`` diagnosed as the
@@ -99,6 +104,25 @@ class RecordView:
 
         jd = joint_data(list(sweeps.values()), self.kind, tuple(sweeps))
         return jd.stacked, lambda model: jd.predictor(model, self.acts_on)
+
+
+def new_quantity_acts_on(d, acts_on: Mapping[str, Sequence[str]]) -> dict:
+    """``acts_on`` for the quantities a one-quantity record ``d`` does not hold, validated: each
+    effect's quantities among ``d.kind``'s and including the record's own (the effect was diagnosed
+    there); an IPMCError naming the entry otherwise, and for a joint diagnosis (its ``acts_on`` is
+    the diagnosis's own: pass it to ``diagnose``)."""
+    from .joint import check_acts_on
+
+    if getattr(d, "joint", None) is not None:
+        raise IPMCError("acts_on: a joint diagnosis carries its own (diagnose(..., acts_on=...)); "
+                        "next_measurement takes one only for a one-quantity record")
+    kinds = [q for k, q in QUANTITY_UNITS if k == d.kind and q != "G"]
+    out = check_acts_on(acts_on, d.kind, kinds)
+    bad = {e: list(qs) for e, qs in out.items() if d.quantity not in qs}
+    if bad:
+        raise IPMCError(f"acts_on {bad}: each effect's quantities must include the diagnosed record's "
+                        f"{d.quantity!r} (where the effect was diagnosed)")
+    return out
 
 
 def refit_model(d, effects: tuple, start: dict, max_nfev: int):
@@ -241,26 +265,27 @@ def log_unit_factor(record: FrequencySweep, sk: FrequencySweep) -> float:
 
 
 
-def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int, label) -> dict:
+def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int, label,
+                view: RecordView | None = None) -> dict:
     """λ of experiment ``r`` by full refits: each rival refitted to the other's noiseless predictions
     on the new lines (with the record's lines when joint) from its own fit, from its effect at its
     typical size and from :data:`REFIT_STARTS` − 2 more Latin-hypercube starts; ``{"A vs B": the
     least over the two directions}`` for each of ``pairs``."""
     out = {}
     for a, b in pairs:
-        out[f"{label(a)} vs {label(b)}"] = min(refit_lambda(d, r, nm, truth, rival, max_nfev)
+        out[f"{label(a)} vs {label(b)}"] = min(refit_lambda(d, r, nm, truth, rival, max_nfev, view=view)
                                                for truth, rival in ((a, b), (b, a)))
     return out
 
 
 def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, rival: CompetingModel,
-                 max_nfev: int, rival_starts: Sequence[dict] = ()) -> float:
+                 max_nfev: int, rival_starts: Sequence[dict] = (), view: RecordView | None = None) -> float:
     """λ of experiment ``r`` when ``truth`` is true: ``rival`` refitted to its noiseless predictions
     (:func:`refit_check`), from its own fit, its effect at its typical size (and Latin-hypercube
     starts) and each of ``rival_starts`` (values of every free parameter: the rival's other forms)."""
     from .lsq import fit_parameters
 
-    view = RecordView(d)
+    view = view or RecordView(d)
     in_name, unit_in, out_name, unit_out = QUANTITY_UNITS[(d.kind, r.quantity)]
     sk = FrequencySweep(r.line_temperatures_c, r.line_frequencies_hz, np.ones(r.n_lines, complex), None, None,
                         in_name, unit_in, out_name, unit_out)
@@ -291,7 +316,7 @@ def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, ri
         s_ln, s_ph = line_sigma(nm, np.log(np.abs(G)), np.array([r.level]), False)
         sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
                             sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-        factory = lambda model, sw=sw: model.predictor(sw, r.quantity).many  # noqa: E731
+        factory = lambda model, sw=sw: view.many(model, sw, r.quantity)  # noqa: E731
     pm = factory(rival.model)
     typical = {f"{c}.{p}": v[2] for c in rival.effects for p, v in cb.get(c, {}).items()}
     starts = [(rival.values, 1), ({**rival.values, **typical}, REFIT_STARTS - 1)] + [(s, 1) for s in rival_starts]
@@ -304,5 +329,5 @@ def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, ri
 
 
 __all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
-           "log_ratio", "log_unit_factor", "noise_model", "refit_check", "refit_lambda", "refit_model", "stack_real",
+           "log_ratio", "log_unit_factor", "new_quantity_acts_on", "noise_model", "refit_check", "refit_lambda", "refit_model", "stack_real",
            "sweep_noise_model", "t_criterion"]

@@ -265,7 +265,7 @@ class FormContest:
         for r in rows:
             r.separation_by_pair[self.key] = self.value(id(r))
 
-    def check(self, d, r, nm: dict, max_nfev: int) -> float:
+    def check(self, d, r, nm: dict, max_nfev: int, view=None) -> float:
         """Refit λ of row ``r``: the least over directions and kept truth forms, the rival refitted
         from each of its forms (computed once per truth form and row)."""
         from .next_measurement_design import refit_lambda
@@ -276,7 +276,7 @@ class FormContest:
                 if j in self.excluded[name] or j in got[name]:
                     continue
                 got[name][j] = refit_lambda(d, r, nm, t, rivals[0], max_nfev,
-                                            [rv.values for rv in rivals[1:] + [self.rebased[(name, j)]]])
+                                            [rv.values for rv in rivals[1:] + [self.rebased[(name, j)]]], view=view)
         return self.refit_value(id(r))
 
     def refit_value(self, rid: int) -> float:

@@ -63,6 +63,42 @@ def test_refuses_a_verdict_with_nothing_to_separate():
             next_measurement(SimpleNamespace(verdict=v, base_parameters=object()))
 
 
+def test_a_pair_whose_members_each_have_a_twin_competes_with_both_swapped():
+    """Two effects named, each with a declared-confusable twin also named (the independent actuator's
+    contact resistance + delay: 'ambiguous' among them and the diffusivity law and the amplifier pole).
+    Either member may be the one its twin stands for, or both: the search must separate the fit from
+    the pair with both swapped too, not only from each single swap."""
+    from physmodel.estimation.next_measurement import competing_models
+
+    d = SimpleNamespace(verdict="ambiguous", final_effects={"contact_resistance": {}, "time_delay": {}},
+                        named=["amplifier_bandwidth", "contact_resistance", "diffusivity_temperature", "time_delay"],
+                        confusable=[("amplifier_bandwidth", "time_delay", "x"),
+                                    ("contact_resistance", "diffusivity_temperature", "x")],
+                        confusability={}, candidates={})
+    mods = competing_models(d)
+    assert mods[0] == ("contact_resistance", "time_delay")
+    assert set(mods[1:]) == {("amplifier_bandwidth", "contact_resistance"), ("diffusivity_temperature", "time_delay"),
+                             ("amplifier_bandwidth", "diffusivity_temperature")}
+    # a twin of one member only: no double swap to add (the list as before)
+    d.named, d.confusable = ["contact_resistance", "diffusivity_temperature", "time_delay"], d.confusable[1:]
+    assert competing_models(d) == [("contact_resistance", "time_delay"), ("diffusivity_temperature", "time_delay")]
+
+
+def test_a_shortfall_quotes_the_separation_that_falls_short():
+    """When the linearised λ and the refits' disagree across the target, the recommendation is not
+    expected to separate (both must reach it) and the sentence quotes the one that falls short, not
+    the other (seen on the independent actuator's contact resistance + second mode, seed 48061 of
+    bench_next_measurement --pairs: 'gives λ = 294 < 42 needed', λ 3.51 linearised)."""
+    from physmodel.estimation.next_measurement import shortfall
+
+    lam, words = shortfall(SimpleNamespace(separation=3.51, separation_refit=294.0))
+    assert lam == 3.51 and "3.51" in words and "294" in words and "linearised" in words
+    lam, words = shortfall(SimpleNamespace(separation=60.0, separation_refit=12.0))
+    assert lam == 12.0 and words.startswith("12 ") and "refit" in words
+    lam, words = shortfall(SimpleNamespace(separation=7.0, separation_refit=math.nan))     # not checked
+    assert lam == 7.0 and words == "7"
+
+
 # ------------------------------------------------------------------ a virtual-lab case
 @pytest.fixture(scope="module")
 def ambiguous():
@@ -340,3 +376,40 @@ def test_candidate_json_tells_a_merged_record_from_an_added_quantity():
     assert merged["added_quantity"] is False and added["added_quantity"] is True
     assert "merged with the diagnosed record" in merged["description"]
     assert "diagnosed jointly with the record's quantities" in added["description"]
+
+
+def test_acts_on_keeps_the_chain_effects_off_a_quantity_another_instrument_measures(ambiguous):
+    """The lab's delay and amplifier pole are on the current channel of S; Z measured by an impedance
+    analyser carries neither, so no Z record can tell them apart: declared (``acts_on``), the search
+    says so and keeps S; undeclared, the library's default puts both on Z too and a Z record is
+    expected to separate them (bench_next_measurement --pairs: the independent actuator's Z record was
+    recommended for the delay vs the pole and could not separate them)."""
+    d = ambiguous.d
+    chain = {"time_delay": ["S"], "amplifier_bandwidth": ["S"]}
+    nm0 = next_measurement(d, quantities=["Z"])
+    assert nm0.separates and nm0.best_by_quantity["Z"] > nm0.target
+    nm = next_measurement(d, quantities=["Z"], acts_on=chain)
+    assert not nm.separates and nm.best_by_quantity["Z"] < nmod.SAME_FORM_LAMBDA
+    assert nm.inseparable == ["amplifier_bandwidth vs time_delay"]
+    both = next_measurement(d, quantities=["S", "Z"], acts_on=chain)
+    assert both.separates and both.recommended.quantity == "S" and both.best_by_quantity["Z"] < nmod.SAME_FORM_LAMBDA
+    with pytest.raises(IPMCError, match="time_delay.*include the diagnosed record's 'S'"):
+        next_measurement(d, quantities=["Z"], acts_on={"time_delay": ["Z"]})
+    with pytest.raises(IPMCError, match="acts_on\\['no_such_effect'\\]|no_such_effect"):
+        next_measurement(d, quantities=["Z"], acts_on={"no_such_effect": ["S"]})
+    from physmodel.estimation.next_measurement_design import new_quantity_acts_on
+
+    with pytest.raises(IPMCError, match="joint diagnosis carries its own"):
+        new_quantity_acts_on(SimpleNamespace(joint=object(), kind="sensor", quantity="S"), chain)
+
+
+def test_bands_reach_the_highest_frequency_allowed(ambiguous):
+    """The pole and the delay part most at the top of the band, so the recommended band ends at the
+    limit: 300 Hz and 500 Hz, not the last third-decade edge below it (215, 464 Hz: the bands had
+    stopped there, and the independent actuator's M under a 200 Hz limit at 100 Hz, where the delay
+    and the pole stay within the noise)."""
+    for hi in (300.0, 500.0):
+        nm = next_measurement(ambiguous.d, quantities=["S"], band_limits_hz=(0.1, hi), temperature_limits_c=(35, 35))
+        r = nm.recommended
+        assert r.band_hz[1] == pytest.approx(hi) and r.line_frequencies_hz.max() == pytest.approx(hi)
+        assert nm.separates
