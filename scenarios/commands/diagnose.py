@@ -69,7 +69,9 @@ in its provenance (the command line, kept there, lists every file); an effect he
 unless --accept-misfit), as every later command that reads it will. The next-measurement search
 of a joint diagnosis evaluates every candidate experiment with the whole joint record: a new record
 of a diagnosed quantity is merged into that quantity's record, another quantity is added as one more,
-each with its own noise and the diagnosis's --acts-on.
+each with its own noise and the diagnosis's --acts-on. With one data file, --acts-on tells the
+next-measurement search alone where an effect acts among the quantities a new record may measure (e.g.
+time_delay=M when the displacement channel carries the delay and Z would come from an impedance analyser).
 
 Writes model.json (the model it ends with — the baseline plus the named effect(s), refitted, with the
 goodness-of-fit verdict and the data's provenance: what ``--model`` takes in every later command),
@@ -114,8 +116,9 @@ def add_parser(subparsers):
     p.add_argument("--quantity", help="actuator: M (default), H, Z, I; sensor: S (default), Z; several files: "
                                       "one per file, comma-separated (default: from each file's units)")
     p.add_argument("--acts-on", action="append", metavar="EFFECT=Q[,Q]",
-                   help="several quantities: the quantities an effect acts on (e.g. amplifier_bandwidth=S when Z "
-                        "is measured by another instrument; repeatable; default every quantity it applies to)")
+                   help="the quantities an effect acts on (e.g. amplifier_bandwidth=S when Z is measured by another "
+                        "instrument; repeatable; default every quantity it applies to): with several data files for "
+                        "the diagnosis and the next-measurement search, with one for the search only")
     p.add_argument("--kernel", choices=("boundary_charge", "reciprocal"), help="sensing kernel")
     p.add_argument("--set", "--model", dest="base_set",
                    help="start: a named parameter set or a JSON model/parameter file (a model file's effects are "
@@ -386,10 +389,10 @@ def build(args):
         if not sep or not e.strip() or not [q for q in qs.split(",") if q.strip()]:
             raise IPMCError(f"--acts-on {item!r}: expected EFFECT=Q[,Q], e.g. amplifier_bandwidth=S")
         acts_on[e.strip()] = [q.strip() for q in qs.split(",") if q.strip()]
-    if acts_on and not isinstance(quantity, tuple):
-        raise IPMCError(f"{'--acts-on' if args.acts_on else 'acts_on'}: says where effects act among several "
-                        "measured quantities; give one data file per quantity (--data repeated)")
-    kw = dict(kind=kind, quantity=quantity, acts_on=acts_on or None,
+    # one quantity: acts_on is for the next measurement's search (where an effect acts among the
+    # quantities a new record may measure), not for the diagnosis
+    args.next_acts_on = acts_on or None if not isinstance(quantity, tuple) else None
+    kw = dict(kind=kind, quantity=quantity, acts_on=(acts_on or None) if isinstance(quantity, tuple) else None,
               laws=_laws(spec, args, set_name), candidate_bounds=cb or None, candidate_starts=cs or None,
               plausible=pl or None, prior=prior, baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
               free=free, baseline_effects=effects, candidates=cands, alpha=float(pick(args.alpha, "alpha", 0.05)),
@@ -438,8 +441,9 @@ def _quantities(sweeps: list, paths: list, kind: str, given, option: str):
 def _next_kw(args, table: dict, kind: str) -> dict:
     """Keywords of :meth:`Diagnosis.recommend_next_measurement` from ``[next_measurement]`` (``table``,
     as :func:`build` read it) and the flags: ``quantities`` (what the lab measures), ``band_limits_hz``,
-    ``temperature_limits_c``, ``levels`` (drive multiples; cap them at what the strip takes), ``power``.
-    Checked before the diagnosis runs, whatever its verdict: bad input raises IPMCError (exit 2)
+    ``temperature_limits_c``, ``levels`` (drive multiples; cap them at what the strip takes), ``power``,
+    and for a one-quantity record the ``--acts-on`` that :func:`build` kept for the search
+    (``args.next_acts_on``).  Checked before the diagnosis runs, whatever its verdict: bad input raises IPMCError (exit 2)
     naming the flag or key."""
     import math
 
@@ -484,6 +488,8 @@ def _next_kw(args, table: dict, kind: str) -> dict:
         if isinstance(pw, bool) or not isinstance(pw, (int, float)) or not 0.5 <= pw < 1:
             raise IPMCError(f"next_measurement.power{where} = {pw!r}: expected a number in [0.5, 1)")
         kw["power"] = float(pw)
+    if getattr(args, "next_acts_on", None):
+        kw["acts_on"] = args.next_acts_on
     return kw
 
 

@@ -207,6 +207,11 @@ pair (time delay vs amplifier pole on the sensor).  Commands::
     python tests/benchmarks/bench_next_measurement.py --kind actuator --first-seed 7200 --seeds 10
     python tests/benchmarks/bench_next_measurement.py --kind actuator --first-seed 7210 --seeds 10
 
+Re-measured 2026-11-27 after the band-edge fix of the two-effect work (820df8b: candidate bands now
+reach an upper limit off the third-decade grid), ``--kind actuator --first-seed 7300 --seeds 10``:
+ambiguous 9/20, named exactly after the recommended measurement 8/9 [0.56, 0.98] — the same as before
+(the recommended records are Z below 42 Hz, which the fix does not touch); the miss is again 7307.
+
 (Earlier set-up, continued.)  A pair of library forms that no experiment up to ``--fmax-hz`` separates (two amplifier poles and an
 op-amp stage are the same low-pass here) is said by the recommendation (``inseparable``); such a case
 ends ``ambiguous`` between them and is counted as a miss, and listed.

@@ -272,3 +272,29 @@ def test_an_unexplained_verdict_makes_the_model_file_say_it_does_not_fit():
     assert not said.adequate and said.diagnosis == "unexplained"
     assert said.reason.startswith("unexplained: a significant gap remains")
     assert fits.reason in said.reason                     # the χ² test's own sentence is kept
+
+
+def test_cli_acts_on_with_one_file_goes_to_the_next_measurement_search(tmp_path):
+    # one data file: --acts-on is not the diagnosis's (it has one quantity) but the search's — where
+    # an effect acts among the quantities a new record may measure (next_measurement(acts_on=...));
+    # before, the command refused it (exit 2) and the search could not be told
+    from scenarios.cli import build_parser
+    from scenarios.commands.diagnose import _next_kw, build
+
+    M, _, truth = make_joint_case(902, "contact_resistance")
+    M.to_csv(tmp_path / "M.csv")
+    (tmp_path / "start.json").write_text(json.dumps(_base(truth).to_dict()))
+    argv = ["diagnose", "--data", str(tmp_path / "M.csv"), "--set", str(tmp_path / "start.json"),
+            "--acts-on", "contact_resistance=Z", "--out", str(tmp_path / "out")]
+    args = build_parser().parse_args(argv)
+    _, _, kw, _ = build(args)
+    assert kw["acts_on"] is None and args.next_acts_on == {"contact_resistance": ["Z"]}
+    # what run() hands the search: the table's keywords plus acts_on
+    assert _next_kw(args, args.next_table, kw["kind"])["acts_on"] == {"contact_resistance": ["Z"]}
+    # two files: the diagnosis's own, and nothing extra for the search (a joint diagnosis carries it)
+    Z = make_joint_case(902, "contact_resistance")[1]
+    Z.to_csv(tmp_path / "Z.csv")
+    args2 = build_parser().parse_args(argv[:3] + ["--data", str(tmp_path / "Z.csv")] + argv[3:])
+    _, _, kw2, _ = build(args2)
+    assert kw2["acts_on"] == {"contact_resistance": ["Z"]} and args2.next_acts_on is None
+    assert "acts_on" not in _next_kw(args2, args2.next_table, kw2["kind"])
