@@ -289,16 +289,21 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
     mods = list(models) if models is not None else competing_models(d)
     nm = noise_model(d)
     view = RecordView(d, acts_on)
+    assumed = {e: list(q) for e, q in {**view.acts_on, **view.new_acts_on}.items()}
+    acts_note = (" It assumes " + "; ".join(f"{e} acts on {', '.join(q)} only" for e, q in sorted(assumed.items()))
+                 + " (acts_on)." if assumed else "")
     if len(mods) < 2:
         return NextMeasurement([tuple(m) for m in mods], None, False, target, 0.0, 0, [], nm, {},
                                "No competing model to separate: the diagnosis names no rival "
-                               + ("(widen the bound it stopped at instead)." if d.verdict == "at_bound" else "."))
+                               + ("(widen the bound it stopped at instead)." if d.verdict == "at_bound" else ".")
+                               + acts_note, acts_on=assumed)
     fitted = fit_competing_models(d, mods, max_nfev)
     opts: dict[str, Any] = dict(mods=mods, qs=qs, lv=lv, band_limits_hz=band_limits_hz, temperature_limits_c=temperature_limits_c,
                 lines_per_decade=lines_per_decade, power=power, check_refit=check_refit, max_nfev=max_nfev,
                 z_crit=z_crit, target=target, nm=nm, view=view)
     out = _search(d, fitted, None, **opts)
     assert out is not None          # None only when other forms are given
+    out.acts_on, out.message = assumed, out.message + acts_note
     if not out.inseparable:
         return out
     # a pair inseparable as fitted: the search again, with the other forms its models' fits may take
@@ -317,6 +322,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                      "found": {}, "note": FORMS_NONE}
         out.message += " " + FORMS_NONE
         return out
+    again.acts_on, again.message = assumed, again.message + acts_note
     return again
 
 

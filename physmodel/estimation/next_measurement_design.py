@@ -106,23 +106,32 @@ class RecordView:
         return jd.stacked, lambda model: jd.predictor(model, self.acts_on)
 
 
-def new_quantity_acts_on(d, acts_on: Mapping[str, Sequence[str]]) -> dict:
-    """``acts_on`` for the quantities a one-quantity record ``d`` does not hold, validated: each
-    effect's quantities among ``d.kind``'s and including the record's own (the effect was diagnosed
-    there); an IPMCError naming the entry otherwise, and for a joint diagnosis (its ``acts_on`` is
-    the diagnosis's own: pass it to ``diagnose``)."""
+def check_new_acts_on(kind: str, quantity: str, acts_on: Mapping[str, Sequence[str]]) -> dict:
+    """``acts_on`` of a one-quantity record of ``quantity`` (a ``kind`` model), validated before any
+    search (the command checks it before the diagnosis runs): a mapping of library effects to
+    lists of ``kind``'s quantities, each including ``quantity`` (where the effect was diagnosed).
+    Returns it as ``{effect: [quantities]}``; an IPMCError names the entry and what was expected."""
     from .joint import check_acts_on
 
+    if not isinstance(acts_on, Mapping):
+        raise IPMCError(f"acts_on = {acts_on!r}: expected a mapping of effect names to lists of quantities")
+    kinds = [q for k, q in QUANTITY_UNITS if k == kind and q != "G"]
+    out = check_acts_on(acts_on, kind, kinds)
+    bad = {e: list(qs) for e, qs in out.items() if quantity not in qs}
+    if bad:
+        raise IPMCError(f"acts_on {bad}: each effect's quantities must include the diagnosed record's "
+                        f"{quantity!r} (where the effect was diagnosed)")
+    return out
+
+
+def new_quantity_acts_on(d, acts_on: Mapping[str, Sequence[str]]) -> dict:
+    """``acts_on`` for the quantities a one-quantity record ``d`` does not hold, validated
+    (:func:`check_new_acts_on`); an IPMCError for a joint diagnosis (its ``acts_on`` is the
+    diagnosis's own: pass it to ``diagnose``)."""
     if getattr(d, "joint", None) is not None:
         raise IPMCError("acts_on: a joint diagnosis carries its own (diagnose(..., acts_on=...)); "
                         "next_measurement takes one only for a one-quantity record")
-    kinds = [q for k, q in QUANTITY_UNITS if k == d.kind and q != "G"]
-    out = check_acts_on(acts_on, d.kind, kinds)
-    bad = {e: list(qs) for e, qs in out.items() if d.quantity not in qs}
-    if bad:
-        raise IPMCError(f"acts_on {bad}: each effect's quantities must include the diagnosed record's "
-                        f"{d.quantity!r} (where the effect was diagnosed)")
-    return out
+    return check_new_acts_on(d.kind, d.quantity, acts_on)
 
 
 def refit_model(d, effects: tuple, start: dict, max_nfev: int):
@@ -329,5 +338,5 @@ def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, ri
 
 
 __all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
-           "log_ratio", "log_unit_factor", "new_quantity_acts_on", "noise_model", "refit_check", "refit_lambda", "refit_model", "stack_real",
+           "log_ratio", "log_unit_factor", "check_new_acts_on", "new_quantity_acts_on", "noise_model", "refit_check", "refit_lambda", "refit_model", "stack_real",
            "sweep_noise_model", "t_criterion"]

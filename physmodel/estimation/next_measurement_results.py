@@ -148,7 +148,7 @@ class NextMeasurement:
         When the recommended experiment steps the bath away from the record's temperatures: that
         its separation relies on the diagnosed model's temperature laws (named), and that a misfit
         at the new temperature may mean the laws, not the effect, are wrong ("" otherwise; also
-        the end of ``message``).
+        said in ``message``).
     forms : dict
         Empty unless a pair came out inseparable as fitted: then the search was run again with the
         other forms its models' fits may take
@@ -157,6 +157,11 @@ class NextMeasurement:
         ``contests``: per pair and direction (``"A true"``), each truth form searched or left to
         parsimony (nested in the rival); ``note``: the sentence of ``message`` that says which forms
         the separation assumes.  When no other form fits: ``tried``, ``found`` {} and ``note``.
+    acts_on : dict
+        Where the search assumed an effect acts among the quantities (effect → quantities; on
+        the others it was held at its off values in the predictions of a new record): the
+        caller's ``acts_on`` for a one-quantity record, a joint diagnosis's own otherwise; empty
+        when every effect acts on every quantity it applies to.  ``message`` ends by saying it.
     """
 
     models: list
@@ -174,6 +179,7 @@ class NextMeasurement:
     inseparable_as_fitted: list = field(default_factory=list)
     premise: str = ""
     forms: dict = field(default_factory=dict)
+    acts_on: dict = field(default_factory=dict)
 
     @classmethod
     def unavailable(cls, reason: str, models=()) -> NextMeasurement:
@@ -191,7 +197,7 @@ class NextMeasurement:
                       "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
                       "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity,
                       "inseparable_as_fitted": list(self.inseparable_as_fitted), "premise": self.premise,
-                      "forms": self.forms})
+                      "forms": self.forms, "acts_on": self.acts_on})
 
 
 

@@ -390,8 +390,19 @@ def build(args):
             raise IPMCError(f"--acts-on {item!r}: expected EFFECT=Q[,Q], e.g. amplifier_bandwidth=S")
         acts_on[e.strip()] = [q.strip() for q in qs.split(",") if q.strip()]
     # one quantity: acts_on is for the next measurement's search (where an effect acts among the
-    # quantities a new record may measure), not for the diagnosis
-    args.next_acts_on = acts_on or None if not isinstance(quantity, tuple) else None
+    # quantities a new record may measure), not for the diagnosis; checked now, before the diagnosis runs
+    args.next_acts_on = None
+    if acts_on and not isinstance(quantity, tuple):
+        from physmodel.estimation.joint import quantity_of
+        from physmodel.estimation.next_measurement_design import check_new_acts_on
+
+        flag = "--acts-on" if args.acts_on else "acts_on"
+        q1 = quantity_of(data, kind, quantity, f"data file {paths[0]}")
+        try:
+            args.next_acts_on = {e: list(q) for e, q in check_new_acts_on(kind, q1, acts_on).items()}
+        except IPMCError as exc:
+            raise IPMCError(f"{flag} (one data file: where an effect acts among the quantities the next measurement "
+                            f"may record): {exc}") from None
     kw = dict(kind=kind, quantity=quantity, acts_on=(acts_on or None) if isinstance(quantity, tuple) else None,
               laws=_laws(spec, args, set_name), candidate_bounds=cb or None, candidate_starts=cs or None,
               plausible=pl or None, prior=prior, baseline_starts=int(pick(args.baseline_starts, "baseline_starts", 3)),
