@@ -174,6 +174,8 @@ class Diagnosis:
         stacked lines): per quantity its lines, unit, noise (declared or estimated, median σ), weighted
         cost before/after against its expectation and whether a misfit remains, and the gap test
         there (thresholds on 2·cost before/after, ``gap_before``, ``gap_left``); [] for one quantity.
+        The pooled gap test over all of them (a model closes the gap only if it closes it there too)
+        is ``null["gap_test"]["pooled"]``, a last row of the summary's table.
     joint : JointData or None
         The sweeps of those quantities and the σ used (:class:`~physmodel.estimation.joint.JointData`).
     next_measurement : NextMeasurement or None
@@ -410,6 +412,12 @@ class Diagnosis:
                   f"{r['expected_after']:.4g} | {'not tested (estimated noise)' if r['misfit'] is None else 'yes' if r['misfit'] else 'no'} | "
                   f"{_g(r.get('gap_threshold_before_2cost'))} / {_g(r.get('gap_threshold_after_2cost'))} | "
                   f"{'yes' if r.get('gap_left') else 'no'} |" for r in self.per_quantity]
+            pq = self.null.get("gap_test", {}).get("pooled") or {}
+            if "gap_left" in pq:         # the pooled gap test: closing needs it too (estimation.gap)
+                L += [f"| {pq['test']} | {sum(r['lines'] for r in self.per_quantity)} | – | – | – | "
+                      f"{pq['two_cost_before'] / 2:.4g} | {pq['two_cost_after'] / 2:.4g} | – | – | "
+                      f"{_g(pq['threshold_before_2cost'])} / {_g(pq['threshold_after_2cost'])} | "
+                      f"{'yes' if pq['gap_left'] else 'no'} |"]
             L += [""]
         L += ["## Baseline parameters", "", "| parameter | value | 95 % CI | fit bounds | plausible range | flag | "
               "multi-start range |", "|---|---|---|---|---|---|---|"]

@@ -57,8 +57,8 @@ user's free parameters, and:
    :data:`CLOSE_FRACTION` of the baseline's excess above it also closes the gap (the message then
    states the remaining share).  Several quantities: per quantity, each one's 2·cost against its own
    quantile at α/5/K (Bonferroni over K quantities), the gap significant if any quantity's is and
-   closed only if closed in every one (the slack of each quantity's own excess); the message says
-   where it stays open.
+   closed only if closed in every one (the slack of each quantity's own excess) and in the pooled
+   statistic at α/5; the message says which test leaves it open.
 
 The report also states the temperature laws used, warns when the weighted cost is inconsistent
 with the declared noise (too low or too high, with the factor), and says when the baseline fits
@@ -709,7 +709,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
     # each quantity's "does it fit" at the model file's goodness-of-fit level shared out over the
     # quantities (the pooled verdict's test, residuals.GOF_ALPHA), not at the detection α
     per_q = gap.annotate(jd.per_quantity(G0, Gf, k0, n_free_after, GOF_ALPHA), final_effects) if jd is not None else []
-    message += per_quantity_sentence(per_q)
+    pooled = gap.pooled_row(per_q, final_effects)      # the pooled gap test (gap.py), None for one quantity
+    message += per_quantity_sentence(per_q, pooled)
     declare_confusable(confusable, separation, confusability, sigs, raw_sigs, data)
     say("audit", f"verdict {verdict}" + (f": {', '.join(named)}" if named else ""))
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
@@ -725,7 +726,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                         "max over candidates) scaled by full-refit parametric bootstrap",
               "draws": int(null_draws), "refits": int(null_refits), "lr_threshold_linearised": T_lin,
               "nonlinearity_ratio": ratio, "bootstrap_full_max_lr": full_max, "bootstrap_lin_max_lr": lin_used,
-              "alpha_gap": alpha_gap, "gap_test": gap.describe(), "seed": seed},
+              "alpha_gap": alpha_gap, "gap_test": gap.describe(pooled), "seed": seed},
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
         metadata={"base": base.name, "kernel": kernel, "free": names0, "baseline_effects": beff, "candidates": cand,

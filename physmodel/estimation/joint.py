@@ -286,8 +286,10 @@ def joint_data(data: Sequence[FrequencySweep], kind: str, quantity: str | Sequen
     return _build(tuple(sweeps), qs, noise)
 
 
-def per_quantity_sentence(rows: Sequence[dict]) -> str:
-    """The report's sentence on each quantity's cost after the diagnosis ('' for one quantity)."""
+def per_quantity_sentence(rows: Sequence[dict], pooled: dict | None = None) -> str:
+    """The report's sentence on each quantity's cost after the diagnosis ('' for one quantity);
+    ``pooled``: the pooled gap test (:meth:`~physmodel.estimation.gap.GapTest.pooled_row`), named
+    when it leaves the gap open."""
     if not rows:
         return ""
     parts = [f"{r['quantity']} ({r['lines']} lines, {r['noise']} noise {r['sigma_db_median']:.3g} dB / "
@@ -295,13 +297,16 @@ def per_quantity_sentence(rows: Sequence[dict]) -> str:
              f"(expected {r['expected_after']:.4g}" + (", not a test with estimated noise)" if r["misfit"] is None else ")")
              for r in rows]
     bad = [r["quantity"] for r in rows if r["misfit"]]
-    gap = [r for r in rows if r.get("gap_left")]        # the diagnosis's gap test, per quantity (gap.py)
+    # the diagnosis's gap test (gap.py): where it leaves the gap open, per quantity and pooled
+    gap = [f"in {r['quantity']} (2·cost {2 * r['cost_after']:.4g} > {r['gap_threshold_after_2cost']:.4g})"
+           for r in rows if r.get("gap_left")]
+    if pooled and pooled.get("gap_left"):
+        gap.append(f"{pooled['test']} (2·cost {pooled['two_cost_after']:.4g} > {pooled['threshold_after_2cost']:.4g}"
+                   + ("; each quantity alone closes it)" if not gap else ")"))
     return (" Diagnosed jointly over " + ", ".join(r["quantity"] for r in rows) + ": " + "; ".join(parts) + "."
             + (f" A misfit remains in {', '.join(bad)}: its cost is above its χ² band after the diagnosis."
                if bad else "")
-            + (" The gap test (per quantity) leaves the gap open in " + "; ".join(
-                f"{r['quantity']} (2·cost {2 * r['cost_after']:.4g} > {r['gap_threshold_after_2cost']:.4g})" for r in gap)
-               + "." if gap else ""))
+            + (" The gap test leaves the gap open " + "; ".join(gap) + "." if gap else ""))
 
 
 # =============================================================================== noise estimates

@@ -56,6 +56,10 @@ def test_one_quantity_is_the_pooled_test_bit_for_bit():
             assert g.strict([cost], effs) is bool(2 * cost <= thr)
     assert g.significant0 is bool(2 * cost0 > thr0)
     assert g.compare([cost0]) == f"2·cost {2 * cost0:.4g} > {thr0:.4g}"
+    # the pooled test is the one block: not run a second time, not said, not reported
+    assert g.pooled_threshold() == thr0 and g.threshold_text() == f"{thr0:.4g}"
+    assert g.open_in([cost0]) == (["M"] if 2 * cost0 - thr0 > CLOSE * max(2 * cost0 - thr0, 0.0) else [])
+    assert g.pooled_row([{"cost_before": cost0, "cost_after": cost0}]) is None and "pooled" not in g.describe()
 
 
 def test_per_block_thresholds_are_the_chi2_quantiles_at_the_bonferroni_level():
@@ -67,6 +71,9 @@ def test_per_block_thresholds_are_the_chi2_quantiles_at_the_bonferroni_level():
     for k, n in enumerate(sizes):
         lo, hi = _q_band(1 - ALPHA_GAP / 2, draws, 2 * n)
         assert lo <= g.thr0[k] <= hi, (k, g.thr0[k], chi2.ppf(1 - ALPHA_GAP / 2, 2 * n), lo, hi)
+    # the pooled test: χ²_{2N} at 1 − α_gap (the whole α_gap, not shared out)
+    lo, hi = _q_band(1 - ALPHA_GAP, draws, 2 * sum(sizes))
+    assert lo <= g.pooled_threshold() <= hi, (g.pooled_threshold(), chi2.ppf(1 - ALPHA_GAP, 2 * sum(sizes)))
 
 
 def test_a_gap_in_one_quantity_only_is_found_per_block_where_the_pooled_test_misses_it():
@@ -93,6 +100,60 @@ def test_a_gap_in_one_quantity_only_is_found_per_block_where_the_pooled_test_mis
     rows = g.annotate([{"cost_before": g.cost0[0], "cost_after": thr[0] / 2 + 5.0},
                        {"cost_before": g.cost0[1], "cost_after": g.cost0[1]}])
     assert [r["gap_before"] for r in rows] == [True, False] and [r["gap_left"] for r in rows] == [True, False]
+
+
+def test_a_model_inside_each_quantitys_threshold_but_beyond_the_pooled_one_does_not_close():
+    """Issue 27: each block's 2·cost at its χ²_100 0.985 point, below the band of its own threshold
+    at 1 − α_gap/2; their sum above the band of the pooled χ²_200 quantile at 1 − α_gap (scipy, white
+    unprojected draws) by more than the slack a baseline pooled excess of at most 500 − that band's
+    lower end allows.  Closed in every quantity, open pooled: the gap is not closed, and the
+    report says which test left it open."""
+    from physmodel.estimation.joint import per_quantity_sentence
+
+    sizes, draws = (50, 50), 20000
+    g = GapTest.from_null(_white(200, draws, 41), ALPHA_GAP, [200.0, 50.0], None, ("M", "Z"), sizes)
+    two_k = chi2.ppf(0.985, 100)
+    assert two_k < _q_band(1 - ALPHA_GAP / 2, draws, 100)[0]            # within each block's threshold
+    p_lo, p_hi = _q_band(1 - ALPHA_GAP, draws, 200)
+    assert 2 * two_k - p_hi > CLOSE * (500.0 - p_lo)                    # beyond the pooled one and its slack
+    costs = [two_k / 2, two_k / 2]
+    assert g.closes_blocks(costs).tolist() == [True, True]
+    assert not g.closes(costs) and not g.strict(costs)
+    assert g.open_in(costs) == ["pooled over M and Z"]
+    assert "pooled over M and Z at 0.01: 2·cost" in g.compare(costs) and " > " in g.compare(costs).split(";")[-1]
+    # the baseline's significance stays per quantity (M's 400 is far above its threshold)
+    assert g.significant0 and g.significant(costs) is False
+    rows = g.annotate([{"quantity": q, "lines": 50, "noise": "declared", "sigma_db_median": 0.1, "sigma_deg_median": 1.0,
+                        "cost_before": c0, "cost_after": two_k / 2, "expected_after": 49.0, "misfit": False}
+                       for q, c0 in zip("MZ", g.cost0)])
+    pooled = g.pooled_row(rows)
+    assert pooled["gap_left"] and pooled["gap_before"] and not any(r["gap_left"] for r in rows)
+    assert pooled["two_cost_after"] == pytest.approx(2 * two_k)
+    said = per_quantity_sentence(rows, pooled)
+    assert "leaves the gap open pooled over M and Z (2·cost" in said and "each quantity alone closes it" in said
+    assert "open in M" not in said and "open in Z" not in said
+    # the same residual, one quantity's worth less: within the pooled threshold, it closes
+    assert g.closes([two_k / 2, (g.pooled_threshold() - two_k - 1.0) / 2])
+    # the pooled slack: CLOSE_FRACTION of the baseline's pooled excess, no more
+    ex = 2 * 250.0 - g.pooled_threshold()
+    assert g.pooled_excess0 == pytest.approx(ex)
+    for f, ok in ((0.9, True), (1.1, False)):
+        two = g.pooled_threshold() + f * CLOSE * ex
+        assert g.closes_blocks([two / 4, two / 4]).all() and g.closes([two / 4, two / 4]) is ok
+
+
+def test_a_correct_model_fails_to_close_at_most_twice_alpha_gap():
+    """The rule's price on white-noise records (a correct model's residual; fresh draws, not the
+    null's; no baseline excess, so no slack): some test of the gap — a block at α_gap/2 or the pooled
+    one at α_gap — rejects with a probability within [α_gap, 2·α_gap] (the larger of the two
+    families' own rates, their union bound), the count within its binomial band."""
+    sizes, draws, m = (155, 155), 8000, 40000
+    g = GapTest.from_null(_white(2 * sum(sizes), draws, 51), ALPHA_GAP, [0.0, 0.0], None, ("M", "Z"), sizes)
+    r = _white(2 * sum(sizes), m, 52)
+    costs = np.vstack([0.5 * np.sum(r[i] ** 2, axis=0) for i in block_rows(sizes)])
+    k = sum(not g.closes(costs[:, j]) for j in range(m))
+    se = np.sqrt(ALPHA_GAP * (1 - ALPHA_GAP) / draws)           # the thresholds' own Monte-Carlo error
+    assert binom.ppf(1e-4, m, ALPHA_GAP - 4 * se) <= k <= binom.ppf(1 - 1e-4, m, 2 * ALPHA_GAP + 4 * se), (k, m)
 
 
 def test_the_union_bound_holds_the_family_wise_level_on_white_noise():
