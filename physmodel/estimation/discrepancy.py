@@ -689,8 +689,9 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
             message = (f"Sign flip: the data are the model with its sign reversed — a constant "
                        f"{flip['phase_offset_deg']:.0f}° phase offset over the band with the magnitude matching "
                        f"(RMS {flip['magnitude_rms_db']:.2g} dB): with the sign reversed the baseline refits to "
-                       f"2·cost {2 * flip['refit_cost']:.4g} (gap threshold {gap.threshold_text()}; as given "
-                       f"{2 * cost0:.4g}). No physical effect is needed: check the polarity of the excitation or "
+                       + (f"2·cost {2 * flip['refit_cost']:.4g} (gap threshold {gap.threshold_text()}; as given "
+                          if gap.K == 1 else f"{gap.compare(neg(rflip))} (as given 2·cost ")
+                       + f"{2 * cost0:.4g}). No physical effect is needed: check the polarity of the excitation or "
                        "the sensor wiring and the sign convention of the measured quantity, then rerun.")
     message += audit_notes(verdict, at_bound, widen, audit0, final_implausible, res0, cres)
     named = list(final_effects) if verdict in ("named", "ambiguous", "at_bound") else []
