@@ -408,7 +408,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
             verdict = "none"
             message = (f"No significant discrepancy: best candidate LR "
                        f"{max([c.lr for c in cres.values()], default=0.0):.3g} ≤ threshold {T:.3g}, and the "
-                       f"baseline cost {cost0:.4g} is within its null band.")
+                       + (f"baseline cost {cost0:.4g} is within its null band." if gap.K == 1 else
+                          f"baseline is within its null band ({gap.compare(gap.cost0)})."))
     else:
         expl_cache: dict = {}
 
