@@ -207,6 +207,13 @@ figures say:
   so three tiny elements that S alone called ``none`` (λ 0.1-0.6 after the generator's own
   baseline refit) become significant (``ambiguous`` between the two), while the sensor null
   strips stay ``none`` 8/8.
+
+Null strips after the per-quantity gap test and the closing rule (2026-11-27, f36e2e3; fresh seeds, every
+candidate, run once: ``--set null --first-seed 49300 --seeds 48``): no false positive with M alone
+46/48 [0.86, 0.99] (49302 diffusivity law, 49337 permittivity law named), jointly with Z 47/48
+[0.89, 1.00] (49300 modulus law named).  With the earlier null sets, jointly: 8400-8471 5/72, 48600-48623
+2/24 (h-pq, before and after alike), 49300-49347 1/48 — 8/144 = 5.6 % [2.8, 10.6] not ``none``, against
+the design's 5 % (P(≥ 8 of 144 | 5 %) ≈ 0.44): consistent with α.
 """
 
 from __future__ import annotations
