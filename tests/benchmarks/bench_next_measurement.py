@@ -443,7 +443,14 @@ def run_actuator_case(seed: int, label: str, args) -> dict:
         row.update(recommended=r.describe() if r else None, separates=nm.separates,
                    lam_expected=r.separation_refit if r else float("nan"),
                    truth_competing=any(expected in m for m in nm.models), inseparable=list(nm.inseparable))
-        if r is not None:
+        if r is not None and nm.also:         # two records recommended: both measured, diagnosed together
+            records = {"M": sweep}
+            for j, x in enumerate([r] + nm.also):
+                data, q = records_add(records, *measure_actuator(truth, x, seed, ALSO_ROUND * j))
+            row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+            d2 = diag(data, q)
+            row.update(second=d2.verdict, second_named=sorted(d2.named))
+        elif r is not None:
             d2 = second_diagnosis(diag, sweep, *measure_actuator(truth, r, seed))
             row.update(second=d2.verdict, second_named=sorted(d2.named))
     row["dt"] = time.perf_counter() - t0
@@ -504,7 +511,10 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                    refit_by_pair=dict(r.refit_by_pair) if r else {}, nm_message=nm.message)
         if r is not None:
             records = {"M": sweep}
-            data, q = records_add(records, *measure_actuator(truth, r, seed))
+            for j, x in enumerate([r] + nm.also):      # every recommended record (a second one: nm.also)
+                data, q = records_add(records, *measure_actuator(truth, x, seed, ALSO_ROUND * j))
+            if nm.also:
+                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
             d2 = diag(data, q, **on_chain(records, chain))
             row.update(second=d2.verdict, second_named=sorted(d2.named),
                        second_final=sorted(d2.final_effects or ()), second_message=d2.message)
@@ -518,9 +528,11 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                 rk = nm.recommended
                 if rk is None:
                     break
-                data, q = records_add(records, *measure_actuator(truth, rk, seed, k))
+                for j, x in enumerate([rk] + nm.also):
+                    data, q = records_add(records, *measure_actuator(truth, x, seed, k + ALSO_ROUND * j))
                 d = diag(data, q, **on_chain(records, chain))
-                later.append({"recommended": rk.describe(), "lam_linear": rk.separation, "lam_expected":
+                later.append({"recommended": rk.describe() + "".join(f" and {x.describe()}" for x in nm.also),
+                              "lam_linear": nm.together["separation"] if nm.also else rk.separation, "lam_expected":
                               rk.separation_refit, "separates": nm.separates, "verdict": d.verdict,
                               "named": sorted(d.named)})
             row.update(later=later, final=d.verdict, final_named=sorted(d.named))
@@ -528,6 +540,10 @@ def run_pair_case(seed: int, label: str, args) -> dict:
     row["success"] = row["second"] == "named" and row["second_named"] == expected
     row["success_final"] = row.get("final") == "named" and row.get("final_named") == expected
     return row
+
+
+#: Noise-seed offset of a second recommended record (``NextMeasurement.also``) from its round's first.
+ALSO_ROUND = 1000
 
 
 def records_add(records: dict, q: str, new: FrequencySweep) -> tuple:
@@ -554,8 +570,10 @@ def pair_report(rows: list) -> None:
         if r["first"] is None:
             print(f"| {r['seed']} | {lam} | not detectable: not run | | |")
             continue
-        rec = (f"{r['recommended']}; λ {r['lam_linear']:.3g} / {r['lam_expected']:.3g}; "
-               f"{'yes' if r['separates'] else 'no'}" if r["recommended"] else "-")
+        rec = (f"{r['recommended']}; λ {r['lam_linear']:.3g} / {r['lam_expected']:.3g}"
+               + "".join(f"; and, with it, {a}" for a in r.get("also", []))
+               + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+               + f"; {'yes' if r['separates'] else 'no'}" if r["recommended"] else "-")
         print(f"| {r['seed']} | {lam} | {r['first']} {r['first_named']} | {rec} | "
               + (f"{r['second']} {r['second_named']} {'OK' if r['success'] else 'MISS'}" if r["second"] else "-")
               + " |")
@@ -580,6 +598,9 @@ def pair_report(rows: list) -> None:
               f"{okf}/{len(amb)} (Wilson 95 % [{lo3:.2f}, {hi3:.2f}])")
     print(f"  the truth among the competing models: {sum(bool(r.get('truth_competing')) for r in amb)}/{len(amb)}; "
           f"expected to separate: {sum(bool(r['separates']) for r in amb)}/{len(amb)}")
+    two = [r for r in amb if r.get("also")]
+    print(f"  two records recommended (no single one expected to separate every pair): {len(two)}/{len(amb)}, "
+          f"named exactly {sum(r['success'] for r in two)}/{len(two)}")
     for r in amb:
         if not r["success"]:
             print(f"  miss seed {r['seed']} {r['label']}: models {r.get('models')}; inseparable "
@@ -626,7 +647,13 @@ def run_case(seed: int, label: str, args) -> dict:
                                      "success": d2.verdict == "named" and sorted(d2.named) == [expected],
                                      "residual": residual_ratio(d2)}
             new = measure(truth, nm.recommended, seed, LAW_ERROR if args.law_error else None)
-            d2 = run_diagnosis(merge_records(sweep, new), args)
+            both = merge_records(sweep, new)
+            for j, x in enumerate(nm.also):         # a second recommended record (S too): merged as well
+                both = merge_records(both, measure(truth, x, seed + ALSO_ROUND * (j + 1),
+                                                   LAW_ERROR if args.law_error else None))
+            if nm.also:
+                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+            d2 = run_diagnosis(both, args)
             row.update(second=d2.verdict, second_named=sorted(d2.named), residual=residual_ratio(d2))
     row["dt"] = time.perf_counter() - t0
     row["success"] = row["second"] == "named" and row["second_named"] == [expected]
@@ -719,7 +746,9 @@ def main(argv=None):
             print(f"  seed {seed} {lab} (λ {lam}): " + ("not detectable, not run" if r["first"] is None else
                   f"{r['first']} {r['first_named']}"
                   + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} "
-                     f"refit; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
+                     + "".join(f" and, with it, {a}" for a in r.get("also", []))
+                     + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+                     + f"; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
                      f"inseparable {r['inseparable'] or '-'}] -> {r['second']} {r['second_named']} "
                      f"{'OK' if r['success'] else 'MISS'}" if r["recommended"] else "")
                   + "".join(f" -> [{x['recommended']}; λ expected {x['lam_linear']:.3g} linearised, "
@@ -741,7 +770,10 @@ def main(argv=None):
             rows.append(r)
             ex = r.get("exact_laws")
             print(f"  seed {r['seed']} {lab:10s} λ {r['lam']:8.1f}: {r['first']} {r['first_named']}"
-                  + (f" -> [{r['recommended']}; λ expected {r['lam_expected']:.3g}] -> {r['second']} {r['second_named']}"
+                  + (f" -> [{r['recommended']}"
+                     + "".join(f" and, with it, {a}" for a in r.get("also", []))
+                     + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+                     + f"; λ expected {r['lam_expected']:.3g}] -> {r['second']} {r['second_named']}"
                      f" {'OK' if r['success'] else 'MISS'}" if r['recommended'] else "")
                   + (f" cost/expected {r['residual']:.3g}" if r.get("residual") is not None else "")
                   + (f" (with the library's laws: {ex['second']} {ex['second_named']}, cost/expected "
