@@ -60,7 +60,7 @@ of the rival to the true model's noiseless predictions (``separation_refit``), i
 the refits show to be inseparable in every checked experiment expected to separate it leaves the
 criterion and the experiments are ranked and checked again (at most one round per pair).
 
-Two records: when no single experiment reaches λ* for every pair (two pairs that need different
+Two records: when no single experiment reaches λ* for every pair of several (two pairs that need different
 quantities — contact resistance vs the diffusivity law in Z, a delay vs an amplifier pole in M above
 the resonance), a second experiment is searched to add to the recommended one (greedy): the one
 maximising the least over the pairs of the two records' λ, computed by stacking their
@@ -539,7 +539,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
     plan = None          # no single experiment reaches the target: a second one with it (next_measurement_plan)
-    if live and not sep_ok:
+    if len(live) > 1 and not sep_ok:      # one pair: more data of one kind, said as 'lower the noise' (as before)
         from .next_measurement_plan import record_base, second_record
 
         bases = {key(a, b): dict(zip((f"{label(a)} true", f"{label(b)} true"), record_base(rec[id(a)], rec[id(b)], w0)))

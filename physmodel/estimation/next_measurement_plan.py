@@ -24,7 +24,8 @@ frequency, whatever the drive level).  The pair is recommended only when it reac
 where the best single experiment does not; its λ is linearised only (the nonlinear refits check the
 single experiments, not the pair — said in the message).  Pairs searched with their models' other
 forms (:mod:`~physmodel.estimation.next_measurement_forms`) are not combined: when one is still
-competing no second record is searched.
+competing no second record is searched.  Nor is one for a single pair: there a second record only
+adds lines of the same kind, which the shortfall message already covers (more periods).
 """
 
 from __future__ import annotations
