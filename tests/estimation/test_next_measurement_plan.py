@@ -94,3 +94,33 @@ def test_two_pairs_that_need_different_quantities_get_one_record_of_each():
 def sums_subset(sums: dict, n: int) -> dict:
     """``sums`` of the first ``n`` rows."""
     return {p: {d: tuple(a[:n] for a in v) for d, v in dd.items()} for p, dd in sums.items()}
+
+
+def test_the_independent_actuator_pair_gets_an_m_and_a_z_record():
+    """Development seed 47079 of bench_next_measurement ``--pairs`` (the independent generator's own
+    physics: contact resistance + delay): the first record leaves the pair and its twins (diffusivity
+    law, amplifier pole) ambiguous; the delay against the pole parts only in M (the chain is on M,
+    declared), the contact resistance against the diffusivity law best in Z, so no single record
+    reaches the target and two are recommended, one M and one Z, with the message saying both."""
+    from next_measurement_cases import independent
+
+    from physmodel import IPMCParameters
+    from physmodel.estimation.discrepancy import diagnose
+    from physmodel.estimation.next_measurement import next_measurement
+
+    ig = independent("independent_generator")
+    sweep, truth = ig.make_case(47079, "contact_resistance+time_delay",
+                                workflow_free=("alpha", "d", "eps", "zeta", "f1"))
+    base = IPMCParameters.from_dict(dict(truth["library_start"]))
+    d = diagnose(sweep, base, kind="actuator", quantity="M", free=("alpha0", "d", "kappa_e", "xi", "omega_n"),
+                 seed=47079)
+    assert d.verdict == "ambiguous"
+    nm = next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, 200.0),
+                          acts_on={"time_delay": ("M",), "amplifier_bandwidth": ("M",)})
+    r, also = nm.recommended, nm.also
+    assert len(also) == 1 and {r.quantity, also[0].quantity} == {"M", "Z"}
+    assert r.separation < nm.target <= nm.together["separation"] and nm.separates
+    assert set(nm.together["separation_by_pair"]) == set(r.separation_by_pair)
+    assert min(min(v.values()) for v in nm.together["separation_by_pair"].values()) == nm.together["separation"]
+    assert "and, with it," in nm.message and "together expected λ" in nm.message and "linearised" in nm.message
+    assert nm.to_dict()["also"][0]["quantity"] == also[0].quantity
