@@ -14,7 +14,10 @@ the second with the same design moved to the recommended band, temperatures and 
 a new noise seed.  The virtual lab records the model's main quantity only (actuator M, sensor S), so the
 search is restricted to it; the two records are then of the same quantity and are merged
 (:func:`physmodel.estimation.next_measurement.merge_records`, lines the first record already holds
-left out of the second) and diagnosed jointly.
+left out of the second) and diagnosed jointly.  When no single record is expected to separate
+every competing pair and two are (``NextMeasurement.also``), the virtual lab takes both (the
+second with the next noise seed, none of the lines already held) and the three are diagnosed
+together.
 """
 
 from __future__ import annotations
@@ -111,6 +114,18 @@ def _new_lines(record, new):
                    phase_std_deg=pick(new.phase_std_deg))
 
 
+def _design(sweep_cfg: dict, r) -> dict:
+    """The first record's virtual-lab design moved to recommended experiment ``r``'s band,
+    temperatures and drive level."""
+    sw2 = dict(sweep_cfg, fmin_hz=float(r.band_hz[0]), fmax_hz=float(r.band_hz[1]),
+               points=int(r.frequencies_hz.size), temperatures_c=[float(t) for t in r.temperatures_c])
+    for k in ("rms", "amplitude"):
+        sw2[k] = float(sweep_cfg.get(k, 1.0)) * r.level
+    if "period_s" in sw2:            # the design's period: whole periods of the new lowest line
+        sw2["period_s"] = max(float(sweep_cfg["period_s"]), 1.0 / r.band_hz[0])
+    return sw2
+
+
 def step_next_measurement(ctx: RunContext):
     """Ambiguous on one virtual-lab record → the recommended measurement → named on both."""
     from physmodel.estimation.next_measurement import merge_records
@@ -152,29 +167,27 @@ def step_next_measurement(ctx: RunContext):
     d2 = None
     if nm is not None and nm.recommended is not None:
         r = nm.recommended
-        ctx.metric("next_measurement.expected_separation", r.separation_refit if np.isfinite(r.separation_refit)
-                   else r.separation)
+        ctx.metric("next_measurement.expected_separation", nm.together["separation"] if nm.also else
+                   r.separation_refit if np.isfinite(r.separation_refit) else r.separation)
         ctx.metric("next_measurement.target", nm.target)
         ctx.metric("next_measurement.expected_to_separate", nm.separates)
-        sw2 = dict(sweep_cfg, fmin_hz=float(r.band_hz[0]), fmax_hz=float(r.band_hz[1]),
-                   points=int(r.frequencies_hz.size), temperatures_c=[float(t) for t in r.temperatures_c])
-        for k in ("rms", "amplitude"):
-            sw2[k] = float(sweep_cfg.get(k, 1.0)) * r.level
-        if "period_s" in sw2:            # the design's period: whole periods of the new lowest line
-            sw2["period_s"] = max(float(sweep_cfg["period_s"]), 1.0 / r.band_hz[0])
         fs = float(sweep_cfg["fs_hz"])
-        if r.band_hz[1] >= 0.4 * fs:
-            raise ScenarioError(f"{where}the recommended band reaches {r.band_hz[1]:g} Hz, beyond the virtual lab's "
-                                f"fs_hz = {fs:g} (set [next_measurement] band_limits_hz below 0.4·fs_hz)")
-        nz2 = dict(noise_cfg, seed=int(cfg.get("next_noise_seed", int(cfg["noise_seed"]) + 1)))
-        rec2 = _new_lines(rec1, from_config(truth, sw2, nz2, where=where).sweep)
-        ctx.file(rec2.to_csv(ctx.out / "next_measurement" / "record2.csv"))
-        both = merge_records(rec1, rec2)
+        both, seed2 = rec1, int(cfg.get("next_noise_seed", int(cfg["noise_seed"]) + 1))
+        for j, rj in enumerate([r] + list(nm.also)):    # a second record when no single one separates every pair
+            if rj.band_hz[1] >= 0.4 * fs:
+                raise ScenarioError(f"{where}the recommended band reaches {rj.band_hz[1]:g} Hz, beyond the virtual "
+                                    f"lab's fs_hz = {fs:g} (set [next_measurement] band_limits_hz below 0.4·fs_hz)")
+            nz2 = dict(noise_cfg, seed=seed2 + j)
+            rec2 = _new_lines(both, from_config(truth, _design(sweep_cfg, rj), nz2, where=where).sweep)
+            ctx.file(rec2.to_csv(ctx.out / "next_measurement" / f"record{j + 2}.csv"))
+            both = merge_records(both, rec2)
         d2 = _diagnose(ctx, both, cfg)
         folder2 = d2.write_report(ctx.out / "next_measurement" / "diagnosis2")
         plots.diagnosis_figures(d2, folder2)
-        rows.append((f"1 + 2: adds {r.describe()}", d2.verdict, ", ".join(d2.named) or "–",
-                     f"{ctx.metrics['next_measurement.expected_separation']:.3g}"))
+        what = f"adds {r.describe()}" + "".join(f" and {x.describe()}" for x in nm.also)
+        lam = ctx.metrics["next_measurement.expected_separation"]
+        rows.append((f"1 + {' + '.join(str(j + 2) for j in range(1 + len(nm.also)))}: {what}", d2.verdict,
+                     ", ".join(d2.named) or "–", f"{lam:.3g}"))
     for p in sorted((ctx.out / "next_measurement").rglob("*")):
         if p.is_file() and not p.name.startswith(".") and p.suffix != ".csv":
             ctx.file(Path(p))

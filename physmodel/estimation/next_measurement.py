@@ -60,6 +60,16 @@ of the rival to the true model's noiseless predictions (``separation_refit``), i
 the refits show to be inseparable in every checked experiment expected to separate it leaves the
 criterion and the experiments are ranked and checked again (at most one round per pair).
 
+Two records: when no single experiment reaches λ* for every pair of several (two pairs that need different
+quantities — contact resistance vs the diffusivity law in Z, a delay vs an amplifier pole in M above
+the resonance), a second experiment is searched to add to the recommended one (greedy): the one
+maximising the least over the pairs of the two records' λ, computed by stacking their
+normal-equation sums (λ is not additive: the rival refits one set of parameters to both), none of
+its lines the first's (:mod:`~physmodel.estimation.next_measurement_plan`).  When the two reach λ*
+they are recommended together (``NextMeasurement.also``; ``separates`` then refers to both; their λ
+is linearised only, the refits check the first alone); otherwise the single recommendation stands,
+unchanged.
+
 Temperatures: the search offers bath steps (a 5-point grid of the allowed range and its ends with
 the middle) for every quantity the models predict at other temperatures through the parameter set's
 laws — for a sensor the strip's Z moves with d(T), κe(T) and T, so an op-amp stage loaded by the
@@ -116,6 +126,8 @@ from .next_measurement_design import (
     refit_check,
     stack_real,
     t_criterion,
+    t_solve,
+    t_sums,
 )
 from .next_measurement_results import CandidateMeasurement, NextMeasurement, json_ready, merge_records
 from .residuals import noise_std
@@ -366,6 +378,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     tsets = _temperature_sets(T_data, t_lo, t_hi)
     T_grid = np.unique(np.concatenate([np.asarray([t for s in tsets for t in s]), T_data]))
     rows: list[CandidateMeasurement] = []
+    sums: dict = {}             # pair -> direction -> [t_sums per (quantity, level) block]: a second record
     pairs = [(a, b) for i, a in enumerate(fitted) for b in fitted[i + 1:]]     # every pair must separate
     key = lambda a, b: f"{label(a)} vs {label(b)}"  # noqa: E731
     contests, forms_resp, forms_said = ({}, {}, {}) if not alts else \
@@ -434,8 +447,10 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                 base_ba = (w0 @ (D0 * D0), -(w0[:, None] * JA0).T @ D0, (w0[:, None] * JA0).T @ JA0)
             for i, _ in enumerate(lv):
                 W = np.hstack([M / sl[i] ** 2, M / sp[i] ** 2])
-                la = t_criterion(D, stack_real(Jb), W, base_ab)
-                lb = t_criterion(-D, stack_real(Ja), W, base_ba)
+                sa, sb = t_sums(D, stack_real(Jb), W), t_sums(-D, stack_real(Ja), W)
+                la, lb = t_solve(sa, base_ab), t_solve(sb, base_ba)
+                for nme, s_ in ((f"{label(a)} true", sa), (f"{label(b)} true", sb)):   # kept for a second record
+                    sums.setdefault(key(a, b), {}).setdefault(nme, []).append(s_)
                 for e in range(M.shape[0]):
                     by_pair[i * M.shape[0] + e][f"{label(a)} vs {label(b)}"] = {
                         f"{label(a)} true": float(la[e]), f"{label(b)} true": float(lb[e])}
@@ -452,6 +467,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                                                  added_quantity=together and not same))
     if not rows:
         raise IPMCError("next_measurement: no candidate experiment within the limits")
+    sums = {k: {n: tuple(np.concatenate(x) for x in zip(*v)) for n, v in d_.items()} for k, d_ in sums.items()}
     # a pair that no experiment separates even linearised (the same response in another form) is
     # said, and left out of the criterion: the others can still be told apart
     for c in contests.values():
@@ -522,6 +538,14 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     chosen = good[0] if good else (max(checked, key=lambda r: r.separation_refit) if checked else order[0])
     sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
+    plan = None          # no single experiment reaches the target: a second one with it (next_measurement_plan)
+    if len(live) > 1 and not sep_ok:      # one pair: more data of one kind, said as 'lower the noise' (as before)
+        from .next_measurement_plan import record_base, second_record
+
+        bases = {key(a, b): dict(zip((f"{label(a)} true", f"{label(b)} true"), record_base(rec[id(a)], rec[id(b)], w0)))
+                 for a, b in live}
+        plan = second_record(chosen, rows, sums, bases, [key(a, b) for a, b in live])
+        plan = plan if plan is not None and plan.separation >= target else None
     who = " vs ".join(" + ".join(m) for m in mods)
     alike = _inseparable_note(same_form, same_refit, bool(contests))
     if not live:
@@ -532,6 +556,13 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
         msg = (f"Next measurement to separate {who}: {chosen.describe()} — expected separation λ = {lam_said:.3g} "
                f"(≥ {target:.3g} needed for {power:.0%} power at α = {d.alpha:g}; the record alone gives "
                f"{current:.3g}).{alike}")
+    elif plan is not None:
+        sep_ok = True
+        msg = (f"Next measurements to separate {who} (no single experiment within the limits is expected to): "
+               f"{chosen.describe()} and, with it, {plan.second.describe()}: together expected λ = "
+               f"{plan.separation:.3g}, linearised, the records diagnosed together (≥ {target:.3g} needed for "
+               f"{power:.0%} power at α = {d.alpha:g}; the first alone gives {shortfall(chosen)[1]}, the record "
+               f"alone {current:.3g}; the refits checked the first alone, not the pair).{alike}")
     else:
         lam_low, lam_words = shortfall(chosen)
         msg = (f"No experiment within the limits is expected to separate {who} at the noise of this record: the "
@@ -546,12 +577,16 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
         forms = {"found": forms_said, "contests": {k: c.describe(
             lambda f: {k2: v for k2, v in f.values.items() if "." in k2}) for k, c in contests.items()},
             "note": _forms_note(forms_said, contests, d.alpha).strip()}
-    premise = temperature_premise(chosen, T_data, d.base_parameters)
+    premise = temperature_premise(chosen, T_data, d.base_parameters) \
+        or (temperature_premise(plan.second, T_data, d.base_parameters) if plan is not None else "")
     msg += t_note + (" " + premise if premise else "")
     return NextMeasurement([tuple(m) for m in mods], chosen, bool(sep_ok), target, float(current), len(rows),
                            ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form + same_refit,
                            {q: max(r.separation for r in rows if r.quantity == q) for q in qs
-                            if any(r.quantity == q for r in rows)}, list(same_refit), premise, forms)
+                            if any(r.quantity == q for r in rows)}, list(same_refit), premise, forms,
+                           also=[plan.second] if plan is not None else [],
+                           together={"separation": plan.separation, "separation_by_pair": plan.separation_by_pair,
+                                     "linearised_only": True} if plan is not None else {})
 
 
 def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, first_inseparable=()) -> tuple:

@@ -233,12 +233,26 @@ def line_sigma(nm: dict, logabs: np.ndarray, level: np.ndarray, same_quantity: b
 def t_criterion(delta: np.ndarray, J: np.ndarray, w: np.ndarray, base: tuple | None = None) -> np.ndarray:
     """min_δ Σ w |Δ − J δ|² per weight row of ``w`` (n_exp, 2N); ``delta`` (2N,), ``J`` (2N, k)
     real-stacked; ``base`` adds fixed (rᵀr, Jᵀr, JᵀJ) sums of the diagnosed record."""
+    return t_solve(t_sums(delta, J, w), base)
+
+
+def t_sums(delta: np.ndarray, J: np.ndarray, w: np.ndarray) -> tuple:
+    """The normal-equation sums (rᵀWr (n_exp,), JᵀWr (n_exp, k), JᵀWJ (n_exp, k, k)) of
+    :func:`t_criterion` per weight row of ``w``: independent records' sums add, so the criterion of
+    records stacked is :func:`t_solve` of their summed sums (not the sum of their λ)."""
     rr = w @ (delta * delta)
     Jr = w @ (J * delta[:, None])
     JJ = np.einsum("ei,ij,ik->ejk", w, J, J, optimize=True)
+    return rr, Jr, JJ
+
+
+def t_solve(sums: tuple, base: tuple | None = None) -> np.ndarray:
+    """min_δ (rᵀWr − 2δᵀJᵀWr + δᵀJᵀWJδ) per experiment from :func:`t_sums` ``sums`` (plus ``base``,
+    fixed sums of the diagnosed record)."""
+    rr, Jr, JJ = sums
     if base is not None:
         rr, Jr, JJ = rr + base[0], Jr + base[1], JJ + base[2]
-    k = J.shape[1]
+    k = JJ.shape[-1]
     if k == 0:
         return rr
     scale = np.sqrt(np.maximum(np.einsum("ejj->ej", JJ), 1e-300))
@@ -339,4 +353,4 @@ def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, ri
 
 __all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
            "log_ratio", "log_unit_factor", "check_new_acts_on", "new_quantity_acts_on", "noise_model", "refit_check", "refit_lambda", "refit_model", "stack_real",
-           "sweep_noise_model", "t_criterion"]
+           "sweep_noise_model", "t_criterion", "t_solve", "t_sums"]

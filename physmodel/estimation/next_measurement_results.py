@@ -162,6 +162,14 @@ class NextMeasurement:
         the others it was held at its off values in the predictions of a new record): the
         caller's ``acts_on`` for a one-quantity record, a joint diagnosis's own otherwise; empty
         when every effect acts on every quantity it applies to.  ``message`` ends by saying it.
+    also : list of CandidateMeasurement
+        A second experiment to run with ``recommended`` when no single one is expected to separate
+        every pair and the two together are (:mod:`~physmodel.estimation.next_measurement_plan`);
+        empty otherwise.  ``separates`` then refers to the two records together.
+    together : dict
+        With ``also``: ``separation`` (linearised λ of the records together, the least over the
+        pairs), ``separation_by_pair`` and ``linearised_only`` (True: the refits checked
+        ``recommended`` alone); empty otherwise.
     """
 
     models: list
@@ -180,6 +188,8 @@ class NextMeasurement:
     premise: str = ""
     forms: dict = field(default_factory=dict)
     acts_on: dict = field(default_factory=dict)
+    also: list = field(default_factory=list)
+    together: dict = field(default_factory=dict)
 
     @classmethod
     def unavailable(cls, reason: str, models=()) -> NextMeasurement:
@@ -197,7 +207,8 @@ class NextMeasurement:
                       "noise_model": self.noise_model, "fitted": self.fitted, "message": self.message,
                       "inseparable": list(self.inseparable), "best_by_quantity": self.best_by_quantity,
                       "inseparable_as_fitted": list(self.inseparable_as_fitted), "premise": self.premise,
-                      "forms": self.forms, "acts_on": self.acts_on})
+                      "forms": self.forms, "acts_on": self.acts_on,
+                      "also": [r.to_dict() for r in self.also], "together": self.together})
 
 
 

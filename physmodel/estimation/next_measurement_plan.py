@@ -1,0 +1,114 @@
+"""A second record when no single one separates every competing pair (issue 27).
+
+:func:`~physmodel.estimation.next_measurement.next_measurement` searches ONE experiment maximising
+the least separation λ over the competing pairs.  When two pairs need different quantities (contact
+resistance vs the diffusivity law separate in Z; a time delay vs an amplifier pole in M above the
+resonance) no single experiment reaches the target for every pair, and the least over the pairs
+picks a record that separates none.  Then a SECOND experiment is searched to add to the best single
+one (greedy): the one maximising the least over the pairs of the two records' combined λ.
+
+Combined λ.  The linearised T-criterion of an experiment is λ = min_δ Σ w |Δ − Jδ|² over the rival's
+parameters δ (:func:`~physmodel.estimation.next_measurement_design.t_criterion`).  For independent
+records the weighted sums of squares add, but the rival refits ONE δ to both: λ(e₁ ∪ e₂) = min_δ
+[Q₁(δ) + Q₂(δ)] ≥ min Q₁ + min Q₂ = λ(e₁) + λ(e₂), with equality only when the two records ask the
+same δ of the rival.  So λ is not additive (it is super-additive; and a record evaluated together
+with the diagnosed one counts that record in each λ, which a sum would count twice): the combined λ
+is computed by stacking — the two experiments' normal-equation sums
+(:func:`~physmodel.estimation.next_measurement_design.t_sums`) added, with the diagnosed record's once
+when either is evaluated together with it (then all three are diagnosed together: a record of the
+same quantity merged, another quantity jointly), and solved
+(:func:`~physmodel.estimation.next_measurement_design.t_solve`).
+
+Not overlapping: a second record of the first's quantity holds none of its lines (temperature and
+frequency, whatever the drive level).  The pair is recommended only when it reaches the target
+where the best single experiment does not; its λ is linearised only (the nonlinear refits check the
+single experiments, not the pair — said in the message).  Pairs searched with their models' other
+forms (:mod:`~physmodel.estimation.next_measurement_forms`) are not combined: when one is still
+competing no second record is searched.  Nor is one for a single pair: there a second record only
+adds lines of the same kind, which the shortfall message already covers (more periods).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .next_measurement_design import log_ratio, stack_real, t_solve
+from .next_measurement_results import CandidateMeasurement
+
+
+@dataclass
+class RecordPair:
+    """Two experiments recommended together.
+
+    Attributes
+    ----------
+    second : CandidateMeasurement
+        The experiment added to the first.
+    separation : float
+        Linearised λ of both records (with the diagnosed record where either is evaluated with it),
+        the least over the live pairs and the two directions. [-]
+    separation_by_pair : dict
+        ``"A vs B"`` → {"A true": λ_A, "B true": λ_B} of both records. [-]
+    """
+
+    second: CandidateMeasurement
+    separation: float
+    separation_by_pair: dict = field(default_factory=dict)
+
+
+def record_base(rec_a: tuple, rec_b: tuple, w0: np.ndarray) -> tuple:
+    """The diagnosed record's fixed normal-equation sums of a pair, ``(A true, B true)``: for each
+    direction (rᵀWr, JᵀWr, JᵀWJ) of the rival on the record's lines (``rec_*`` the models'
+    ``(ln G, ∂ln G/∂θ)`` there, ``w0`` the record's weights)."""
+    D0 = stack_real(log_ratio(rec_a[0], rec_b[0]))
+    JB0, JA0 = stack_real(rec_b[1]), stack_real(rec_a[1])
+    base_ab = (w0 @ (D0 * D0), (w0[:, None] * JB0).T @ D0, (w0[:, None] * JB0).T @ JB0)
+    base_ba = (w0 @ (D0 * D0), -(w0[:, None] * JA0).T @ D0, (w0[:, None] * JA0).T @ JA0)
+    return base_ab, base_ba
+
+
+def overlaps(r1: CandidateMeasurement, r2: CandidateMeasurement) -> bool:
+    """Whether ``r2`` is ``r1`` or holds one of its lines (same quantity, temperature and frequency)."""
+    if r1 is r2:
+        return True
+    if r1.quantity != r2.quantity:
+        return False
+    have = set(zip(r1.line_temperatures_c.tolist(), r1.line_frequencies_hz.tolist()))
+    return any(x in have for x in zip(r2.line_temperatures_c.tolist(), r2.line_frequencies_hz.tolist()))
+
+
+def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: dict, live: list) -> RecordPair | None:
+    """The experiment of ``rows`` that, added to ``first``, maximises the least over the ``live``
+    pairs (``"A vs B"``) of the combined linearised λ (module doc).
+
+    ``sums[pair][direction]`` the :func:`~physmodel.estimation.next_measurement_design.t_sums` of
+    every row (arrays over ``rows`` in order) and ``bases[pair][direction]`` the diagnosed record's
+    sums (:func:`record_base`).  None when a live pair has no sums (searched with other forms) or
+    no row can be added."""
+    if not live or any(k not in sums for k in live):
+        return None
+    i1 = next(i for i, r in enumerate(rows) if r is first)
+    cand = np.array([j for j, r in enumerate(rows) if not overlaps(first, r)], int)
+    if cand.size == 0:
+        return None
+    with_rec = np.array([first.joint or rows[j].joint for j in cand], float)
+    least = np.full(cand.size, np.inf)
+    by: dict = {}
+    for k in live:
+        by[k] = {}
+        for name, (rr, Jr, JJ) in sums[k].items():
+            b = bases[k][name]
+            comb = (rr[i1] + rr[cand] + with_rec * b[0],
+                    Jr[i1][None, :] + Jr[cand] + with_rec[:, None] * b[1][None, :],
+                    JJ[i1][None, :, :] + JJ[cand] + with_rec[:, None, None] * b[2][None, :, :])
+            lam = t_solve(comb)
+            by[k][name] = lam
+            least = np.minimum(least, lam)
+    j = int(np.argmax(least))
+    return RecordPair(rows[int(cand[j])], float(least[j]),
+                      {k: {name: float(v[j]) for name, v in d.items()} for k, d in by.items()})
+
+
+__all__ = ["RecordPair", "overlaps", "record_base", "second_record"]

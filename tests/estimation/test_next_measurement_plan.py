@@ -1,0 +1,126 @@
+"""A second record when no single one separates every pair (issue 27, next_measurement_plan): the
+combined λ of two records against a direct least-squares oracle on the concatenated records, two
+pairs that need different quantities get one record of each, and a one-pair search is unchanged."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from physmodel.estimation.next_measurement_design import t_criterion, t_sums
+from physmodel.estimation.next_measurement_plan import overlaps, record_base, second_record
+from physmodel.estimation.next_measurement_results import CandidateMeasurement
+
+
+def _row(q: str, f, joint: bool = False) -> CandidateMeasurement:
+    f = np.asarray(f, float)
+    return CandidateMeasurement(q, (float(f.min()), float(f.max())), (35.0,), 1.0, f.size, f, 0.0, {}, joint, 1.0,
+                                0.0, line_temperatures_c=np.full(f.size, 35.0), line_frequencies_hz=f)
+
+
+def _lstsq_lambda(blocks) -> float:
+    """min_δ Σ w (Δ − Jδ)² over the concatenated records ``[(D, J, w), ...]`` by numpy.linalg.lstsq on
+    the explicitly weighted, stacked rows (not the normal equations the search adds)."""
+    A = np.vstack([J * np.sqrt(w)[:, None] for D, J, w in blocks])
+    b = np.concatenate([D * np.sqrt(w) for D, J, w in blocks])
+    x, *_ = np.linalg.lstsq(A, b, rcond=None)
+    return float(np.sum((b - A @ x) ** 2))
+
+
+def test_combined_lambda_is_the_stacked_records_not_the_sum_of_their_lambdas():
+    """Two records (one merged with the diagnosed record, one of another quantity): the combined λ
+    of second_record equals lstsq on the record + both new records concatenated, and it is not the
+    sum of the two single λ (the rival refits one δ to both; the record counted once)."""
+    rng = np.random.default_rng(11)
+    k = 3
+    D0, J0, w0 = rng.standard_normal(12), rng.standard_normal((12, k)), rng.uniform(0.5, 2, 12)
+    # the diagnosed record as log-responses (real: the phase rows carry nothing and weigh 0):
+    # ln G_a − ln G_b = D0 and the rival b's Jacobian −J0, so its rows are (D0, −J0, w0)
+    rec_a = (D0 + 0j, np.zeros((12, k), complex))
+    rec_b = (np.zeros(12, complex), -J0 + 0j)
+    w0s = np.r_[w0, np.zeros(12)]
+    base_ab, _ = record_base(rec_a, rec_b, w0s)
+    blocks, rows, sums_ab = [], [], []
+    for q, n, joint in (("M", 9, True), ("Z", 7, False), ("Z", 5, False)):
+        D, J, w = rng.standard_normal(n), rng.standard_normal((n, k)), rng.uniform(0.5, 3, n)
+        blocks.append((D, J, w))
+        rows.append(_row(q, np.arange(1, n + 1) * (10.0 if q == "M" else 1.0), joint))
+        sums_ab.append(t_sums(D, J, w[None, :]))
+    sums = {"A vs B": {"A true": tuple(np.concatenate(x) for x in zip(*sums_ab))}}
+    bases = {"A vs B": {"A true": base_ab}}
+    plan = second_record(rows[0], rows, sums, bases, ["A vs B"])
+    assert plan is not None
+    # the oracle for each candidate second record: the diagnosed record + the first + it, stacked
+    lam = {j: _lstsq_lambda([(D0, -J0, w0), blocks[0], blocks[j]]) for j in (1, 2)}
+    j_best = max(lam, key=lam.get)
+    assert plan.second is rows[j_best]
+    assert plan.separation == pytest.approx(lam[j_best], rel=1e-7)
+    assert plan.separation_by_pair["A vs B"]["A true"] == pytest.approx(lam[j_best], rel=1e-7)
+    single = [float(t_criterion(D, J, w[None, :], base_ab if rows[i].joint else None)[0])
+              for i, (D, J, w) in enumerate(blocks)]
+    assert single[0] == pytest.approx(_lstsq_lambda([(D0, -J0, w0), blocks[0]]), rel=1e-7)
+    assert abs(plan.separation - (single[0] + single[j_best])) > 1e-3 * plan.separation    # not additive
+
+
+def test_two_pairs_that_need_different_quantities_get_one_record_of_each():
+    """Pair A separates only in M, pair B only in Z (each quantity's Δ of the other pair is 0): the
+    best single record separates one pair at most, so the second is of the other quantity; and a
+    second M record never repeats the first's lines."""
+    k, n = 1, 6
+    J = np.zeros((2 * n, k))          # the rival has one parameter that no line sees: λ = Σ w Δ²
+    rows, s = [], {"A": [], "B": []}
+    for q, fs, big in (("M", [1, 2, 3, 4, 5, 6], 3.0), ("M", [7, 8, 9, 10, 11, 12], 2.0),
+                       ("Z", [1, 2, 3, 4, 5, 6], 1.0), ("Z", [20, 30, 40, 50, 60, 70], 0.5)):
+        rows.append(_row(q, np.asarray(fs, float)))
+        w = np.ones((1, 2 * n))
+        DA = np.r_[np.full(n, big), np.zeros(n)] if q == "M" else np.zeros(2 * n)
+        DB = np.r_[np.full(n, big), np.zeros(n)] if q == "Z" else np.zeros(2 * n)
+        s["A"].append(t_sums(DA, J, w))
+        s["B"].append(t_sums(DB, J, w))
+    sums = {p: {"x true": tuple(np.concatenate(x) for x in zip(*v))} for p, v in s.items()}
+    zero = (0.0, np.zeros(k), np.zeros((k, k)))
+    bases = {p: {"x true": zero} for p in sums}
+    plan = second_record(rows[0], rows, sums, bases, ["A", "B"])
+    assert plan is not None and plan.second is rows[2]              # Z, the larger of the Z records
+    assert plan.separation == pytest.approx(min(6 * 9.0, 6 * 1.0))
+    plan_z = second_record(rows[2], rows, sums, bases, ["A", "B"])
+    assert plan_z.second is rows[0]                                   # and the other way round
+    assert overlaps(rows[0], _row("M", [6.0, 13.0])) and not overlaps(rows[0], _row("Z", [6.0]))
+    only_m = second_record(rows[0], rows[:2], sums_subset(sums, 2), bases, ["A", "B"])
+    assert only_m.second is rows[1] and only_m.separation == 0.0      # M cannot see B: honest 0
+    assert second_record(rows[0], rows, sums, bases, ["A", "C"]) is None    # a pair without sums: no plan
+
+
+def sums_subset(sums: dict, n: int) -> dict:
+    """``sums`` of the first ``n`` rows."""
+    return {p: {d: tuple(a[:n] for a in v) for d, v in dd.items()} for p, dd in sums.items()}
+
+
+def test_the_independent_actuator_pair_gets_an_m_and_a_z_record():
+    """Development seed 47079 of bench_next_measurement ``--pairs`` (the independent generator's own
+    physics: contact resistance + delay): the first record leaves the pair and its twins (diffusivity
+    law, amplifier pole) ambiguous; the delay against the pole parts only in M (the chain is on M,
+    declared), the contact resistance against the diffusivity law best in Z, so no single record
+    reaches the target and two are recommended, one M and one Z, with the message saying both."""
+    from next_measurement_cases import independent
+
+    from physmodel import IPMCParameters
+    from physmodel.estimation.discrepancy import diagnose
+    from physmodel.estimation.next_measurement import next_measurement
+
+    ig = independent("independent_generator")
+    sweep, truth = ig.make_case(47079, "contact_resistance+time_delay",
+                                workflow_free=("alpha", "d", "eps", "zeta", "f1"))
+    base = IPMCParameters.from_dict(dict(truth["library_start"]))
+    d = diagnose(sweep, base, kind="actuator", quantity="M", free=("alpha0", "d", "kappa_e", "xi", "omega_n"),
+                 seed=47079)
+    assert d.verdict == "ambiguous"
+    nm = next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, 200.0),
+                          acts_on={"time_delay": ("M",), "amplifier_bandwidth": ("M",)})
+    r, also = nm.recommended, nm.also
+    assert len(also) == 1 and {r.quantity, also[0].quantity} == {"M", "Z"}
+    assert r.separation < nm.target <= nm.together["separation"] and nm.separates
+    assert set(nm.together["separation_by_pair"]) == set(r.separation_by_pair)
+    assert min(min(v.values()) for v in nm.together["separation_by_pair"].values()) == nm.together["separation"]
+    assert "and, with it," in nm.message and "together expected λ" in nm.message and "linearised" in nm.message
+    assert nm.to_dict()["also"][0]["quantity"] == also[0].quantity

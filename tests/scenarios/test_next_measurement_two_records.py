@@ -1,0 +1,45 @@
+"""The [next_measurement] scenario step measures every recommended record: when the search
+recommends a second one (``NextMeasurement.also``, issue 27) the virtual lab takes it too, with
+its own noise seed and none of the lines already held, and the three are diagnosed together."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def test_the_virtual_lab_takes_the_second_recommended_record(tmp_path, monkeypatch):
+    """The bundled demo with the recommendation given a second record (1-9 Hz at the record's 35 °C,
+    below the first record's band — a record no search chose here, added by the test so that the
+    step's handling is checked on a fast bundled case): record3.csv holds it, in its band and
+    sharing no line with records 1 and 2, and the summary's table counts three records."""
+    from dataclasses import replace
+
+    from physmodel.data.files import read_csv
+    from physmodel.estimation.diagnosis import Diagnosis
+    from scenarios.runner import run_scenario
+    from scenarios.spec import bundled_scenarios, load_scenario
+
+    real = Diagnosis.recommend_next_measurement
+
+    def with_second(self, **kw):
+        nm = real(self, **kw)
+        r = nm.recommended
+        f = np.arange(1.0, 10.0)
+        nm.also = [replace(r, band_hz=(1.0, 9.0), temperatures_c=(35.0,), level=1.0, n_lines=f.size, frequencies_hz=f,
+                           line_temperatures_c=np.full(f.size, 35.0), line_frequencies_hz=f)]
+        nm.together = {"separation": r.separation, "separation_by_pair": dict(r.separation_by_pair),
+                       "linearised_only": True}
+        return nm
+
+    monkeypatch.setattr(Diagnosis, "recommend_next_measurement", with_second)
+    path = [p for p in bundled_scenarios() if p.stem == "next_measurement_demo"][0]
+    run_scenario(load_scenario(path, quick=True), tmp_path / "run", quiet=True)
+    out = tmp_path / "run" / "next_measurement"
+    recs = [read_csv(out / f"record{i}.csv") for i in (1, 2, 3)]
+    r3 = recs[2]
+    assert r3.frequency_hz.size > 0 and r3.frequency_hz.min() >= 1.0 - 1e-9 and r3.frequency_hz.max() <= 9.0 + 1e-9
+    assert np.all(r3.temperature_c == 35.0)
+    held = {(float(t), float(f)) for r in recs[:2] for t, f in zip(r.temperature_c, r.frequency_hz)}
+    assert not held & {(float(t), float(f)) for t, f in zip(r3.temperature_c, r3.frequency_hz)}
+    text = " ".join(p.read_text(encoding="utf-8") for p in (tmp_path / "run").glob("*.md"))
+    assert "1 + 2 + 3: adds" in text
