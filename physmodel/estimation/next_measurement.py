@@ -107,6 +107,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -539,12 +540,16 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
     plan = None          # no single experiment reaches the target: a second one with it (next_measurement_plan)
-    if len(live) > 1 and not sep_ok:      # one pair: more data of one kind, said as 'lower the noise' (as before)
+    # one pair: more data of one kind, said as 'lower the noise' (as before); a first record whose linearised λ
+    # reaches the target but whose refits do not: the linearisation is not to be built on (no second record)
+    if len(live) > 1 and not sep_ok and chosen.separation < target:
         from .next_measurement_plan import record_base, second_record
 
         bases = {key(a, b): dict(zip((f"{label(a)} true", f"{label(b)} true"), record_base(rec[id(a)], rec[id(b)], w0)))
                  for a, b in live}
-        plan = second_record(chosen, rows, sums, bases, [key(a, b) for a, b in live])
+        short = {k: max(0.0, min(chosen.separation_by_pair[k].values()) - v)
+                 for k, v in chosen.refit_by_pair.items() if math.isfinite(v) and k in chosen.separation_by_pair}
+        plan = second_record(chosen, rows, sums, bases, [key(a, b) for a, b in live], short)
         plan = plan if plan is not None and plan.separation >= target else None
     who = " vs ".join(" + ".join(m) for m in mods)
     alike = _inseparable_note(same_form, same_refit, bool(contests))
@@ -558,6 +563,8 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                f"{current:.3g}).{alike}")
     elif plan is not None:
         sep_ok = True
+        if plan.second.joint and not chosen.joint:    # the pair's λ counts the record: the first joins it too
+            chosen = replace(chosen, joint=True, added_quantity=True)
         msg = (f"Next measurements to separate {who} (no single experiment within the limits is expected to): "
                f"{chosen.describe()} and, with it, {plan.second.describe()}: together expected λ = "
                f"{plan.separation:.3g}, linearised, the records diagnosed together (≥ {target:.3g} needed for "

@@ -30,7 +30,7 @@ adds lines of the same kind, which the shortfall message already covers (more pe
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -45,7 +45,9 @@ class RecordPair:
     Attributes
     ----------
     second : CandidateMeasurement
-        The experiment added to the first.
+        The experiment added to the first, described in its role: diagnosed jointly with the record
+        where the pair's λ counts the record (its ``separation``, ``power`` and ``separation_by_pair``
+        are still those of the experiment alone).
     separation : float
         Linearised λ of both records (with the diagnosed record where either is evaluated with it),
         the least over the live pairs and the two directions. [-]
@@ -79,9 +81,15 @@ def overlaps(r1: CandidateMeasurement, r2: CandidateMeasurement) -> bool:
     return any(x in have for x in zip(r2.line_temperatures_c.tolist(), r2.line_frequencies_hz.tolist()))
 
 
-def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: dict, live: list) -> RecordPair | None:
+def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: dict, live: list,
+                  deficit: dict | None = None) -> RecordPair | None:
     """The experiment of ``rows`` that, added to ``first``, maximises the least over the ``live``
     pairs (``"A vs B"``) of the combined linearised λ (module doc).
+
+    ``deficit[pair]``: how far the refits of ``first`` fell below its linearised λ of that pair
+    (≥ 0; 0 where not checked).  It is taken off the pair's combined λ: the combination adds only
+    non-negative terms to ``first``'s linearised sums, so without it a pair the refits say ``first``
+    cannot separate would count as separated whatever record is added (review).
 
     ``sums[pair][direction]`` the :func:`~physmodel.estimation.next_measurement_design.t_sums` of
     every row (arrays over ``rows`` in order) and ``bases[pair][direction]`` the diagnosed record's
@@ -103,11 +111,14 @@ def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: di
             comb = (rr[i1] + rr[cand] + with_rec * b[0],
                     Jr[i1][None, :] + Jr[cand] + with_rec[:, None] * b[1][None, :],
                     JJ[i1][None, :, :] + JJ[cand] + with_rec[:, None, None] * b[2][None, :, :])
-            lam = t_solve(comb)
+            lam = t_solve(comb) - (deficit or {}).get(k, 0.0)
             by[k][name] = lam
             least = np.minimum(least, lam)
     j = int(np.argmax(least))
-    return RecordPair(rows[int(cand[j])], float(least[j]),
+    second = rows[int(cand[j])]
+    if with_rec[j] and not second.joint:      # counted with the record: diagnosed jointly with it (review)
+        second = replace(second, joint=True, added_quantity=True)
+    return RecordPair(second, float(least[j]),
                       {k: {name: float(v[j]) for name, v in d.items()} for k, d in by.items()})
 
 

@@ -53,7 +53,11 @@ def test_combined_lambda_is_the_stacked_records_not_the_sum_of_their_lambdas():
     # the oracle for each candidate second record: the diagnosed record + the first + it, stacked
     lam = {j: _lstsq_lambda([(D0, -J0, w0), blocks[0], blocks[j]]) for j in (1, 2)}
     j_best = max(lam, key=lam.get)
-    assert plan.second is rows[j_best]
+    # the best row, described in its role: counted with the record, so diagnosed jointly with it (review)
+    best = rows[j_best]
+    assert (plan.second.quantity, plan.second.band_hz, plan.second.temperatures_c) == (
+        best.quantity, best.band_hz, best.temperatures_c)
+    assert plan.second.joint and plan.second.added_quantity and not best.joint
     assert plan.separation == pytest.approx(lam[j_best], rel=1e-7)
     assert plan.separation_by_pair["A vs B"]["A true"] == pytest.approx(lam[j_best], rel=1e-7)
     single = [float(t_criterion(D, J, w[None, :], base_ab if rows[i].joint else None)[0])
@@ -96,7 +100,7 @@ def sums_subset(sums: dict, n: int) -> dict:
     return {p: {d: tuple(a[:n] for a in v) for d, v in dd.items()} for p, dd in sums.items()}
 
 
-def test_the_independent_actuator_pair_gets_an_m_and_a_z_record():
+def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(monkeypatch):
     """Development seed 47079 of bench_next_measurement ``--pairs`` (the independent generator's own
     physics: contact resistance + delay): the first record leaves the pair and its twins (diffusivity
     law, amplifier pole) ambiguous; the delay against the pole parts only in M (the chain is on M,
@@ -124,3 +128,23 @@ def test_the_independent_actuator_pair_gets_an_m_and_a_z_record():
     assert min(min(v.values()) for v in nm.together["separation_by_pair"].values()) == nm.together["separation"]
     assert "and, with it," in nm.message and "together expected λ" in nm.message and "linearised" in nm.message
     assert nm.to_dict()["also"][0]["quantity"] == also[0].quantity
+    # the pair's λ counts the first record's linearised sums: where its refits fall short of them for a
+    # pair the first record carries alone, the shortfall is taken off, so a second record that sees
+    # nothing of that pair cannot make it "separated" (review: it had, with separates=True)
+    import physmodel.estimation.next_measurement as nmod
+
+    carried = min(also[0].separation_by_pair, key=lambda k: min(also[0].separation_by_pair[k].values()))
+    assert min(also[0].separation_by_pair[carried].values()) < 1.0       # the second record does not see it
+    assert min(r.separation_by_pair[carried].values()) >= nm.target      # the first carries it alone
+    real = nmod.refit_check
+
+    def capped(*a, **k):
+        out = real(*a, **k)
+        if carried in out:
+            out[carried] = min(out[carried], 5.0)
+        return out
+
+    monkeypatch.setattr(nmod, "refit_check", capped)
+    nm2 = next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, 200.0),
+                           acts_on={"time_delay": ("M",), "amplifier_bandwidth": ("M",)})
+    assert not nm2.separates and nm2.also == [] and "and, with it," not in nm2.message
