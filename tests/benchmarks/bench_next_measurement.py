@@ -355,6 +355,9 @@ found no pair of records reaching the target; 49278's pairs were searched with t
 forms, which this search does not combine (``next_measurement_plan``'s doc), and its Z record,
 expected λ 96, left AB ~ TD ambiguous.  Seven of seven two-record cases (development and evaluation)
 were named exactly [0.65, 1.00]; the goal (≥ 80 %) is still not met on the evaluation, 4/7.
+After the review fix (ce4fe6e: a pair's combined λ takes off the first record's refit shortfall;
+the records described in their role), the same command: the same 4/7 [0.25, 0.84], two records
+recommended 2/7 and both named, the same three misses.
 """
 
 from __future__ import annotations
