@@ -793,7 +793,7 @@ def main(argv=None):
             lam = ", ".join(f"{k} {v:.0f}" for k, v in r["lam_each"].items())
             print(f"  seed {seed} {lab} (λ {lam}): " + ("not detectable, not run" if r["first"] is None else
                   f"{r['first']} {r['first_named']}"
-                  + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} "
+                  + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} refit"
                      + "".join(f" and, with it, {a}" for a in r.get("also", []))
                      + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
                      + f"; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
