@@ -173,10 +173,11 @@ def step_next_measurement(ctx: RunContext):
         ctx.metric("next_measurement.expected_to_separate", nm.separates)
         fs = float(sweep_cfg["fs_hz"])
         both, seed2 = rec1, int(cfg.get("next_noise_seed", int(cfg["noise_seed"]) + 1))
-        for j, rj in enumerate([r] + list(nm.also)):    # a second record when no single one separates every pair
+        for rj in [r] + list(nm.also):      # every record checked before any is written (no half-written folder)
             if rj.band_hz[1] >= 0.4 * fs:
                 raise ScenarioError(f"{where}the recommended band reaches {rj.band_hz[1]:g} Hz, beyond the virtual "
                                     f"lab's fs_hz = {fs:g} (set [next_measurement] band_limits_hz below 0.4·fs_hz)")
+        for j, rj in enumerate([r] + list(nm.also)):    # a second record when no single one separates every pair
             nz2 = dict(noise_cfg, seed=seed2 + j)
             rec2 = _new_lines(both, from_config(truth, _design(sweep_cfg, rj), nz2, where=where).sweep)
             ctx.file(rec2.to_csv(ctx.out / "next_measurement" / f"record{j + 2}.csv"))

@@ -130,6 +130,7 @@ from .next_measurement_design import (
     t_solve,
     t_sums,
 )
+from .next_measurement_plan import record_base, second_record
 from .next_measurement_results import CandidateMeasurement, NextMeasurement, json_ready, merge_records
 from .residuals import noise_std
 
@@ -441,11 +442,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
             D = stack_real(log_ratio(La, Lb))
             base_ab = base_ba = None
             if together:
-                Ra, RJa = rec[id(a)]
-                Rb, RJb = rec[id(b)]
-                D0, JB0, JA0 = stack_real(log_ratio(Ra, Rb)), stack_real(RJb), stack_real(RJa)
-                base_ab = (w0 @ (D0 * D0), (w0[:, None] * JB0).T @ D0, (w0[:, None] * JB0).T @ JB0)
-                base_ba = (w0 @ (D0 * D0), -(w0[:, None] * JA0).T @ D0, (w0[:, None] * JA0).T @ JA0)
+                base_ab, base_ba = record_base(rec[id(a)], rec[id(b)], w0)
             for i, _ in enumerate(lv):
                 W = np.hstack([M / sl[i] ** 2, M / sp[i] ** 2])
                 sa, sb = t_sums(D, stack_real(Jb), W), t_sums(-D, stack_real(Ja), W)
@@ -543,8 +540,6 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     # one pair: more data of one kind, said as 'lower the noise' (as before); a first record whose linearised λ
     # reaches the target but whose refits do not: the linearisation is not to be built on (no second record)
     if len(live) > 1 and not sep_ok and chosen.separation < target:
-        from .next_measurement_plan import record_base, second_record
-
         bases = {key(a, b): dict(zip((f"{label(a)} true", f"{label(b)} true"), record_base(rec[id(a)], rec[id(b)], w0)))
                  for a, b in live}
         short = {k: max(0.0, min(chosen.separation_by_pair[k].values()) - v)
