@@ -18,6 +18,9 @@ LM_STEPS = 30
 def damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
     """Levenberg-Marquardt from the point ``pt``, a tuple ``(z, r, J, status, message, step,
     cost, joined)`` as the engine's ``evaluate(z)`` returns it (cached and counted in ``count``).
+    A generator, as ``evaluate`` is (``new = yield from evaluate(z)``: the engine's searches yield
+    their points to the caller, :func:`physmodel.estimation.lsq._search`); its return value
+    (``pt = yield from damped_steps(...)``) is the point it ends at.
 
     Steps ``(JᵀJ + λ diag JᵀJ) d = -Jᵀr`` clipped to just inside the box [lo, hi]; λ is divided by 3 after a
     decrease and multiplied by 4 after an increase.  Ends at a point with a status (converged, or
@@ -49,7 +52,7 @@ def damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget):
         if np.array_equal(z_new, z):
             break
         count[0] += 1
-        new = evaluate(z_new)
+        new = yield from evaluate(z_new)
         if new[6] < pt[6]:
             pt, lam = new, lam / 3.0
         else:

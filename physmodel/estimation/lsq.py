@@ -30,16 +30,21 @@ Scaled space
     evaluations (one per parameter set predicted, also inside batched calls); ``n_model_calls``
     counts the batched calls.
 
-Search and stopping (see ``_solve``)
+Search and stopping (see ``_search``)
     Gauss–Newton steps while they lower the cost inside the bounds; a later start then takes up to
     :data:`~physmodel.estimation.lm_steps.LM_STEPS` Levenberg–Marquardt steps clipped to the bounds
     (:func:`~physmodel.estimation.lm_steps.damped_steps`: it
     usually reaches an earlier optimum or converges there, for a third of the overhead of scipy's
     trust region, which rebuilds its model from an SVD every iteration); then — start 0 directly —
-    scipy's trust-region reflective search.  The later starts' first points share one model call;
-    for a predictor whose rows do not depend on their call (``rows_independent``: the physics
-    array path), every start's first point is evaluated up front, several per model call (at most
-    :data:`CALL_VALUES` predictions).
+    scipy's trust-region reflective search.  For a predictor whose rows do not depend on their
+    call (``rows_independent``: the physics array path) the starts advance together, a round at a
+    time: each round evaluates the next point of every running start (start 0 first) in shared
+    model calls of at most :data:`CALL_VALUES` predictions (two points in one call cost about 0.8
+    of two calls), and a later start can join an optimum once that start has converged.  Each
+    start takes the points it would take searched on its own, bit for bit, up to where it stops;
+    a later start may stop later than one searched after start 0 had converged (a start's trust
+    region, where scipy calls back, evaluates its points on their own).  Other predictors search
+    the starts one after another, the later starts' first points in one call.
     When the trust region crawls (:func:`~physmodel.estimation.lm_steps.crawling`: over
     :data:`~physmodel.estimation.lm_steps.CRAWL_POINTS` points its best cost fell by less than a
     tenth of the Gauss–Newton decrement it had, that decrement above 1e-4·s²) — a valley the data
@@ -50,7 +55,9 @@ Search and stopping (see ``_solve``)
     A start ends (status 1) when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
     below :data:`GN_DECREMENT`·s² (within 1.4e-6 standard errors of the optimum), or on scipy's
     tests.  A later start stops early (status −2, never chosen as best) once its cost is within
-    :data:`JOIN_COST`·s² of a converged earlier start's and its Gauss–Newton step lands within
+    :data:`JOIN_COST`·s² above a converged start's (or below it by no more than a displacement of
+    :data:`JOIN_DISTANCE` standard errors is worth, ½·JOIN_DISTANCE²·s²: a start that reaches the
+    optimum's cost first is in its basin too) and its Gauss–Newton step lands within
     :data:`JOIN_DISTANCE` standard errors of that optimum.
 
 Identifiability (see :func:`fit_parameters`, :mod:`physmodel.estimation.identifiability`)
@@ -121,18 +128,21 @@ from .residuals import (
 
 #: Forward finite-difference step in the scaled space.
 FD_STEP = 1e-6
-#: A search ends when a Gauss–Newton step would gain less than this (times s², see ``_solve``).
+#: A search ends when a Gauss–Newton step would gain less than this (times s², see ``_search``).
 GN_DECREMENT = 1e-12
 #: Predictions (parameter sets × lines) per batched model call at most when several points are
 #: evaluated together: the kernel's temporaries then stay in cache.  Measured on the benchmark (500
 #: lines, 7 sets per point; 2 shared cores): three points in one call of 21 sets took 1.37 ms,
 #: in three calls 1.25 ms, two in one call 0.69 ms against 0.41 ms for one.
 CALL_VALUES = 8192
-#: A later start stops in an earlier start's basin when its cost is within this (times s²) above
+#: A later start stops in a converged start's basin when its cost is within this (times s²) above
 #: that start's optimum and ...
 JOIN_COST = 25.0
-#: ... its Gauss–Newton step lands within this many standard errors of that optimum.
-JOIN_DISTANCE = 0.1
+#: ... its Gauss–Newton step lands within this many standard errors of that optimum: a distinct
+#: optimum there would differ from it by less than the estimate's own uncertainty (0.1 until
+#: 2026-11-27, when the starts began to advance together; it changes where a later start stops,
+#: not which optimum is reported, unless two lie within a standard error of each other).
+JOIN_DISTANCE = 1.0
 
 
 
@@ -318,18 +328,44 @@ class _Crawl(Exception):
 
 
 def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatch, res, max_nfev, ftol,
-           fd_step, optima: Sequence[_Fit] = (), first: tuple | None = None, damped: bool = True) -> _Fit:
+           fd_step) -> _Fit:
+    """One start's search (:func:`_search`) from ``z0``, each point evaluated when asked for."""
+    rows = ScaledRows(free, x_full, active)
+    hi = _z_box([free[k] for k in active])[1]
+    return _run(_search(free, active, z0, batch, res, max_nfev, ftol, fd_step, rows),
+                lambda z: _residuals_and_jacobian(batch, rows, z, hi, fd_step, res))
+
+
+def _run(search, evaluate) -> _Fit:
+    """A search (:func:`_search`) run to its end, each point it asks for evaluated at once by
+    ``evaluate(z) -> (r, J)``."""
+    try:
+        z = next(search)
+        while True:
+            z = search.send(evaluate(z))
+    except StopIteration as stop:
+        return stop.value
+
+
+def _search(free, active: Sequence[int], z0, batch: ModelBatch, res, max_nfev, ftol, fd_step, rows: ScaledRows,
+            optima: Sequence[_Fit] = (), first: tuple | None = None, damped: bool = True, later: bool = False):
     """Least squares over the ``active`` parameters of ``free`` in their scaled space (the others
-    at ``x_full``); search and stopping in the module doc.  A point costs one batched model call,
-    residuals and Jacobian together (a Broyden-updated Jacobian needed three times the points).
+    at ``rows.x_full``); search and stopping in the module doc.  A generator: it yields each point
+    of its Gauss–Newton and damped steps, ``z`` (scaled, active), and takes back its residuals
+    and Jacobian ``(r, J)`` (:func:`_residuals_and_jacobians`), so that :func:`fit_parameters`
+    can advance several starts in shared model calls; the trust region's points (scipy calls
+    back) it evaluates itself.  Returns its :class:`_Fit` (``StopIteration.value``).
+    A point costs one batched model call, residuals and Jacobian together (a Broyden-updated
+    Jacobian needed three times the points).
     Plain Gauss–Newton steps converge in 6–7 points on the benchmark where scipy's trust region,
     which starts small, needs 9–10.  s² = 2·cost/dof scales the tests to standard errors.
-    ``first``: the residuals and Jacobian at the (clipped) start, already computed.  ``damped``
-    False: a later start goes straight to the trust region, as start 0 does.
+    ``optima``: the converged searches a later one may join (read at every point: it may grow
+    while this one runs).  ``first``: the residuals and Jacobian at the (clipped) start, already
+    computed.  ``later``: a later start, which takes damped steps (:func:`damped_steps`) before the
+    trust region unless ``damped`` is False.
     """
     act = [free[k] for k in active]
     lo, hi = _z_box(act)
-    rows = ScaledRows(free, x_full, active)
     dof = res.size - len(act)
     cache: dict = {}
     count, last, searches = [0], [None], [0]
@@ -347,23 +383,35 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
         if 0 <= decrement < GN_DECREMENT * s2:
             return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c, None
         for opt in optima:
-            if opt.status > 0 and opt.cost <= c <= opt.cost + JOIN_COST * s2:
+            if opt.status > 0 and opt.cost - 0.5 * JOIN_DISTANCE**2 * s2 <= c <= opt.cost + JOIN_COST * s2:
                 d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
                 if float(d @ opt.gram() @ d) <= JOIN_DISTANCE**2 * s2:
                     return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
                                 f"errors of start {opt.index}'s optimum"), step, c, opt.index
         return None, "", step, c, None
 
+    def store(z, r, J):
+        """The point ``(z, r, J, status, message, step, cost, joined)``, cached for the last two."""
+        if len(cache) > 1:
+            cache.pop(next(iter(cache)))
+        pt = cache[z.tobytes()] = (z.copy(), r, J, *assess(z, r, J))
+        return pt
+
     def evaluate(z):
-        """(z, r, J, status, message, step, cost, joined) at ``z``, cached for the last two points."""
-        key = z.tobytes()
-        if key not in cache:
-            if len(cache) > 1:
-                cache.pop(next(iter(cache)))
-            r, J = _residuals_and_jacobian(batch, rows, z, hi, fd_step, res)
-            cache[key] = (z.copy(), r, J, *assess(z, r, J))
-        last[0] = cache[key]
-        return cache[key]
+        """The point at ``z``, evaluated here if not cached (the trust region's and profile search's)."""
+        pt = cache.get(z.tobytes())
+        if pt is None:
+            pt = store(z, *_residuals_and_jacobian(batch, rows, z, hi, fd_step, res))
+        last[0] = pt
+        return pt
+
+    def ask(z):
+        """The point at ``z``, asked of the caller if not cached (a generator: ``yield from``)."""
+        pt = cache.get(z.tobytes())
+        if pt is None:
+            pt = store(z, *(yield z))
+        last[0] = pt
+        return pt
 
     best: list = []           # the trust region's lowest point after each of its points
 
@@ -402,21 +450,21 @@ def _solve(free, active: Sequence[int], x_full: np.ndarray, z0, batch: ModelBatc
     count[0] = 1
     z_start = np.clip(np.asarray(z0, dtype=float), lo, hi)
     if first is not None:
-        cache[z_start.tobytes()] = (z_start.copy(), first[0], first[1], *assess(z_start, *first))
-    pt = evaluate(z_start)
+        store(z_start, *first)
+    pt = yield from ask(z_start)
     while pt[3] is None and pt[5] is not None and not stopped_at_budget():      # Gauss–Newton steps
         z_new = pt[0] + pt[5]
         if (z_new < lo).any() or (z_new > hi).any():
             break
         count[0] += 1
-        new = evaluate(z_new)
+        new = yield from ask(z_new)
         if not new[6] < pt[6]:
             break
         pt = new
-    if pt[3] is None and optima and damped and not stopped_at_budget():
+    if pt[3] is None and later and damped and not stopped_at_budget():
         # a later start: damped Gauss-Newton (Levenberg-Marquardt) steps kept in the box until it
         # converges or reaches an earlier optimum; scipy's trust region (below) only if it stalls
-        pt = damped_steps(pt, evaluate, lo, hi, count, stopped_at_budget)
+        pt = yield from damped_steps(pt, ask, lo, hi, count, stopped_at_budget)
     status, msg = pt[3], pt[4]
     if status is None and stopped_at_budget():
         status, msg = 0, f"stopped after {count[0]} function evaluations (max_nfev={max_nfev}) before converging"
@@ -555,30 +603,55 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     z_starts = np.vstack([z_init[None, :], np.array(z_given, float).reshape(-1, len(free)),
                           _lhs_starts(free, int(starts) - 1, seed)])
     z_starts[:, [k for k in range(len(free)) if k not in active]] = z_init[[k for k in range(len(free)) if k not in active]]
-    records, fits, ends = [], [], []
-    firsts: dict = {}
+    records, ends = [], []
+    fits: list = [None] * len(z_starts)
+    optima: list = []         # the finished starts, in the order they finished (a later one may join them)
     rows0 = ScaledRows(free, x_full, active)
-    regroup = len(z_starts) > 1 and _regroups(batch, len(_layout(batch, rows0, res)[0]))
-    for i, z0 in enumerate(z_starts):
-        if (i == 0 and regroup) or (i == 1 and not regroup and len(z_starts) > 2):
-            # the starts' first points together: with rows independent of their call (_regroups)
-            # every start's up front, several per model call (CALL_VALUES; two points cost far
-            # less than two calls), else the later starts' in one call
-            lo_a, hi_a = _z_box([free[k] for k in active])
-            pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[i:]]
-            firsts = dict(enumerate(_residuals_and_jacobians(batch, rows0, pts, hi_a, fd_step, res), start=i))
-        fit = _solve(free, active, x_full, z0[active], batch, res, max_nfev, ftol, fd_step, fits, firsts.get(i),
-                     damped)
+    hi_a = _z_box([free[k] for k in active])[1]
+
+    def search(i, first=None):
+        return _search(free, active, z_starts[i][active], batch, res, max_nfev, ftol, fd_step, rows0,
+                       optima if i else (), first, damped, later=i > 0)
+
+    def finish(i, fit):
         fit.index = i
-        fits.append(fit)
+        fits[i] = fit
+        optima.append(fit)
+        if progress:
+            progress(1)
+
+    if len(z_starts) > 1 and _regroups(batch, len(_layout(batch, rows0, res)[0])):
+        # with rows independent of their call (_regroups) the starts advance together, a round at
+        # a time: each round's points (one per running start, start 0 first) share model calls
+        # (CALL_VALUES: two points cost far less than two calls), and a later start joins an
+        # optimum once that start has converged
+        gens = {i: search(i) for i in range(len(z_starts))}
+        asked = {i: next(g) for i, g in gens.items()}
+        while asked:
+            order = sorted(asked)
+            for i, out in zip(order, _residuals_and_jacobians(batch, rows0, [asked[i] for i in order], hi_a,
+                                                                fd_step, res)):
+                try:
+                    asked[i] = gens[i].send(out)
+                except StopIteration as stop:
+                    del asked[i]
+                    finish(i, stop.value)
+    else:
+        firsts: dict = {}
+        for i in range(len(z_starts)):
+            if i == 1 and len(z_starts) > 2:    # the later starts' first points in one model call
+                lo_a = _z_box([free[k] for k in active])[0]
+                pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[1:]]
+                firsts = dict(enumerate(_residuals_and_jacobians(batch, rows0, pts, hi_a, fd_step, res), start=1))
+            finish(i, _run(search(i, firsts.get(i)), lambda z: _residuals_and_jacobian(batch, rows0, z, hi_a, fd_step,
+                                                                                      res)))
+    for i, (z0, fit) in enumerate(zip(z_starts, fits)):
         ends.append(z0.copy())
         ends[-1][active] = fit.z
         initial = dict(zip(names, x_init)) if i == 0 else {fp.name: float(fp.from_z(v)) for fp, v in zip(free, z0)}
         records.append(StartRecord(i, initial,
                                    {fp.name: float(fp.from_z(v)) for fp, v in zip(free, ends[-1])},
                                    fit.cost, fit.nfev, fit.status, fit.message, fit.joined))
-        if progress:
-            progress(1)
     best = min((k for k in range(len(fits)) if fits[k].status != -2), key=lambda k: fits[k].cost)
     fit = fits[best]
     converged = fit.status > 0
