@@ -387,7 +387,8 @@ def _search(free, active: Sequence[int], z0, batch: ModelBatch, res, max_nfev, f
                 d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
                 if float(d @ opt.gram() @ d) <= JOIN_DISTANCE**2 * s2:
                     return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
-                                f"errors of start {opt.index}'s optimum"), step, c, opt.index
+                                f"error{'' if JOIN_DISTANCE == 1 else 's'} of start {opt.index}'s optimum"), step, c, \
+                        opt.index
         return None, "", step, c, None
 
     def store(z, r, J):
