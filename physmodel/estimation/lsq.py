@@ -40,11 +40,12 @@ Search and stopping (see ``_search``)
     call (``rows_independent``: the physics array path) the starts advance together, a round at a
     time: each round evaluates the next point of every running start (start 0 first) in shared
     model calls of at most :data:`CALL_VALUES` predictions (two points in one call cost about 0.8
-    of two calls), and a later start can join an optimum once that start has converged.  Each
-    start takes the points it would take searched on its own, bit for bit, up to where it stops;
-    a later start may stop later than one searched after start 0 had converged (a start's trust
-    region, where scipy calls back, evaluates its points on their own).  Other predictors search
-    the starts one after another, the later starts' first points in one call.
+    of two calls), and a later start can join an earlier start's optimum once that start has
+    converged.  Each start takes the points it would take searched on its own, bit for bit, up
+    to where it stops; a later start may stop later than one searched after the earlier ones had
+    converged (a start's trust region, where scipy calls back, evaluates its points on their
+    own).  Other predictors search the starts one after another, the later starts' first points
+    in one call.
     When the trust region crawls (:func:`~physmodel.estimation.lm_steps.crawling`: over
     :data:`~physmodel.estimation.lm_steps.CRAWL_POINTS` points its best cost fell by less than a
     tenth of the Gauss–Newton decrement it had, that decrement above 1e-4·s²) — a valley the data
@@ -55,10 +56,14 @@ Search and stopping (see ``_search``)
     A start ends (status 1) when the Gauss–Newton decrement ½gᵀ(JᵀJ)⁻¹g falls
     below :data:`GN_DECREMENT`·s² (within 1.4e-6 standard errors of the optimum), or on scipy's
     tests.  A later start stops early (status −2, never chosen as best) once its cost is within
-    :data:`JOIN_COST`·s² above a converged start's (or below it by no more than a displacement of
-    :data:`JOIN_DISTANCE` standard errors is worth, ½·JOIN_DISTANCE²·s²: a start that reaches the
-    optimum's cost first is in its basin too) and its Gauss–Newton step lands within
-    :data:`JOIN_DISTANCE` standard errors of that optimum.
+    :data:`JOIN_COST`·s² above a converged earlier start's (below it only by what two converged
+    points of one minimum can differ: GN_DECREMENT·s² and the cost's rounding,
+    :data:`COST_ROUNDING`) and its Gauss–Newton step lands within :data:`JOIN_DISTANCE` standard
+    errors of that optimum.  Advancing together, a later start can converge before an earlier one
+    has: its optimum is then offered to the starts after it only once every earlier start has
+    finished, and is first tested against theirs (it joins one whose basin it lies in), so it
+    does not displace an earlier start's optimum whose basin it lies in (it would have joined
+    that one on its way there, searched after it).
 
 Identifiability (see :func:`fit_parameters`, :mod:`physmodel.estimation.identifiability`)
     From the SVD of the weighted, scaled Jacobian at the optimum a parameter is *undetermined* if
@@ -140,9 +145,12 @@ CALL_VALUES = 8192
 JOIN_COST = 25.0
 #: ... its Gauss–Newton step lands within this many standard errors of that optimum: a distinct
 #: optimum there would differ from it by less than the estimate's own uncertainty (0.1 until
-#: 2026-11-27, when the starts began to advance together; it changes where a later start stops,
-#: not which optimum is reported, unless two lie within a standard error of each other).
+#: 2026-11-27; it moves where a later start stops, not the estimate, on the benchmark's 20
+#: calibrations compared).
 JOIN_DISTANCE = 1.0
+#: Relative rounding of a cost ½Σr² (about √N·ε for N residuals, with margin): below an
+#: optimum's cost by less than this (plus GN_DECREMENT·s²) a point is not a lower minimum.
+COST_ROUNDING = 1e-13
 
 
 
@@ -158,6 +166,7 @@ class _Fit:
     status: int
     message: str
     joined: int | None = None       # the earlier start whose optimum this one reached (status -2)
+    parked: bool = False            # it finished while an earlier start still ran
     _gram: np.ndarray | None = None
 
     def gram(self) -> np.ndarray:
@@ -319,6 +328,35 @@ def _landing(z, r, J, step, z_opt, lo, hi) -> np.ndarray:
     return z + step
 
 
+def _basin(z, r, J, step, c: float, s2: float, optima: Sequence[_Fit], lo, hi) -> _Fit | None:
+    """The first of ``optima`` (converged earlier starts) in whose basin the point ``z`` (residuals
+    ``r``, Jacobian ``J``, Gauss–Newton ``step``, cost ``c``) lies, else None: its cost within
+    :data:`JOIN_COST`·s² above the optimum's, or below it by no more than two converged points of
+    one minimum can differ (GN_DECREMENT·s² and the cost's rounding), and its Gauss–Newton step
+    landing within :data:`JOIN_DISTANCE` standard errors of the optimum."""
+    for opt in optima:
+        below = GN_DECREMENT * s2 + COST_ROUNDING * opt.cost
+        if opt.status > 0 and opt.cost - below <= c <= opt.cost + JOIN_COST * s2:
+            d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
+            if float(d @ opt.gram() @ d) <= JOIN_DISTANCE**2 * s2:
+                return opt
+    return None
+
+
+def _lands(opt: _Fit) -> str:
+    """Why a start is in ``opt``'s basin, for its message."""
+    return (f"its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
+            f"error{'' if JOIN_DISTANCE == 1 else 's'} of start {opt.index}'s optimum")
+
+
+def _gn_step(r, J) -> np.ndarray:
+    """The Gauss–Newton step of residuals ``r`` with Jacobian ``J`` (minimum-norm if JᵀJ is singular)."""
+    try:
+        return np.linalg.solve(J.T @ J, -(J.T @ r))
+    except np.linalg.LinAlgError:       # e.g. a zero column: the minimum-norm step
+        return np.linalg.lstsq(J, -r, rcond=None)[0]
+
+
 class _Stop(Exception):
     """Ends scipy's search from inside the residual function."""
 
@@ -382,13 +420,9 @@ def _search(free, active: Sequence[int], z0, batch: ModelBatch, res, max_nfev, f
         decrement = -0.5 * float(g @ step)
         if 0 <= decrement < GN_DECREMENT * s2:
             return 1, f"Gauss-Newton decrement {decrement:.2g} below {GN_DECREMENT:g}·s² (s² = {s2:.3g})", step, c, None
-        for opt in optima:
-            if opt.status > 0 and opt.cost - 0.5 * JOIN_DISTANCE**2 * s2 <= c <= opt.cost + JOIN_COST * s2:
-                d = _landing(z, r, J, step, opt.z, lo, hi) - opt.z
-                if float(d @ opt.gram() @ d) <= JOIN_DISTANCE**2 * s2:
-                    return -2, (f"stopped early: its Gauss-Newton step lands within {JOIN_DISTANCE:g} standard "
-                                f"error{'' if JOIN_DISTANCE == 1 else 's'} of start {opt.index}'s optimum"), step, c, \
-                        opt.index
+        opt = _basin(z, r, J, step, c, s2, optima, lo, hi)
+        if opt is not None:
+            return -2, "stopped early: " + _lands(opt), step, c, opt.index
         return None, "", step, c, None
 
     def store(z, r, J):
@@ -608,18 +642,36 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
     fits: list = [None] * len(z_starts)
     optima: list = []         # the finished starts, in the order they finished (a later one may join them)
     rows0 = ScaledRows(free, x_full, active)
-    hi_a = _z_box([free[k] for k in active])[1]
 
     def search(i, first=None):
         return _search(free, active, z_starts[i][active], batch, res, max_nfev, ftol, fd_step, rows0,
                        optima if i else (), first, damped, later=i > 0)
 
+    lo_a, hi_a = _z_box([free[k] for k in active])
+    dof = res.size - len(active)
+    admitted = [0]      # starts 0 .. admitted[0] − 1 finished, and their optima offered to the later ones
+
     def finish(i, fit):
+        """Start i's fit; the optima are offered in start order, so a later start joins only an
+        earlier one's, as when they run one after another: a start that converged while an earlier
+        one still ran is tested against those earlier optima first (it joins one whose basin its
+        optimum lies in)."""
         fit.index = i
         fits[i] = fit
-        optima.append(fit)
+        fit.parked = admitted[0] < i
         if progress:
             progress(1)
+        while admitted[0] < len(fits) and fits[admitted[0]] is not None:
+            f = fits[admitted[0]]
+            if f.status > 0 and f.parked:
+                opt = _basin(f.z, f.r, f.J, _gn_step(f.r, f.J), f.cost, 2.0 * f.cost / dof if dof > 0 else 1.0,
+                             optima, lo_a, hi_a)
+                if opt is not None:
+                    f.status, f.joined = -2, opt.index
+                    f.message = f"converged before start {opt.index} had, in its basin: " + _lands(opt)
+            if f.status > 0:
+                optima.append(f)
+            admitted[0] += 1
 
     if len(z_starts) > 1 and _regroups(batch, len(_layout(batch, rows0, res)[0])):
         # with rows independent of their call (_regroups) the starts advance together, a round at
@@ -641,7 +693,6 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         firsts: dict = {}
         for i in range(len(z_starts)):
             if i == 1 and len(z_starts) > 2:    # the later starts' first points in one model call
-                lo_a = _z_box([free[k] for k in active])[0]
                 pts = [np.clip(z[active], lo_a, hi_a) for z in z_starts[1:]]
                 firsts = dict(enumerate(_residuals_and_jacobians(batch, rows0, pts, hi_a, fd_step, res), start=1))
             finish(i, _run(search(i, firsts.get(i)), lambda z: _residuals_and_jacobian(batch, rows0, z, hi_a, fd_step,

@@ -91,7 +91,7 @@ start that reaches an earlier optimum stops there.  After both, that pair takes 
 
 Left, and why: (1) in a pair refit the later starts take as many points as the first (over the
 88 pair refits of the 24 strips below: 10842 points, 2415 of them in start 0), because they join an earlier
-optimum only when their Gauss–Newton step lands within 0.1 standard errors of it, which in the
+optimum only when their Gauss–Newton step lands within 0.1 standard errors of it (1 since 2026-11-27), which in the
 curved valley is at the very end; they do matter (45104: start 1 found a cost 2.07 lower than start
 0).  A join test along the valley belongs in the engine (lsq.py, h-cal's).  (2) Later starts that
 never come near the best (44102: 238 points in 3 starts ending > 100 above the best, one from the
@@ -160,8 +160,8 @@ difference at a bound.  The trust region crawled: on the data's viscous_fluid re
 the optimum was 0.06 away) — at a noise-size cost (s² ≈ 0.9) JᵀJ underrates the curvature along
 the direction the data barely determine (the neglected Σ rᵢ∇²rᵢ) — and the valley is curved, so
 even 1 % of that step raised the cost by 0.02: scipy's trust region rejected step after step.
-The later starts, which the engine stops when their Gauss–Newton step lands within 0.1 standard
-errors of an earlier optimum, crawled the same valley, where that step is wrong until the very
+The later starts, which the engine stopped when their Gauss–Newton step landed within 0.1 standard
+errors of an earlier optimum (1 since 2026-11-27), crawled the same valley, where that step is wrong until the very
 end (they joined after 54-132 points, or ran into the 200-point budget: 705 of the refit's 830
 points).  Tried and dropped: a line search along the Gauss–Newton step (straight or bent by its
 geodesic acceleration: the valley leaves a straight line at once), Newton steps on a
