@@ -59,8 +59,8 @@
    its probe and the result ~5 ms.  Session 13 (2026-11-27, the starts advancing together: each
    round's points of every running start share model calls, lsq's module doc; a later start
    joins at 1 standard error instead of 0.1; main = e83b7c5 exported; 2 shared cores, load 1.5-3
-   with other jobs): ``--ratio 30 --cpu`` alternating, five runs each: this 1.098 / 1.098 / 1.050
-   / 1.079 / 1.036 (20.4-21.2 ms, 20 model calls, vs 18.7-20.0 ms), main 1.280 / 1.225 / 1.247 /
+   with other jobs): ``--ratio 30 --cpu`` alternating, five runs each (the first three before the
+   review's fix, which changes no point or call here): this 1.098 / 1.098 / 1.050 / 1.079 / 1.036 (20.4-21.2 ms, 20 model calls, vs 18.7-20.0 ms), main 1.280 / 1.225 / 1.247 /
    1.228 / 1.224 (23.6-25.1 ms, 35 calls, vs 18.5-20.3 ms) — **the goal is met** on this case.
    Not tuned on (``--ratio 12 --cpu --noise-seed S --start-seed S``, S = 7..17, once each):
    this 1.102 0.877 1.346 0.988 1.142 1.247 0.924 1.024 0.962 1.361 1.058 (median 1.058; <= 1.14 in
