@@ -11,13 +11,19 @@ realises and simulates, so both records
 are time-domain experiments measured like a DAQ (:mod:`scenarios.virtual_lab`): the first with the
 table's design (``temperatures_c``, ``fmin_hz`` … ``rms``, ``output_noise_rms``, ``noise_seed``),
 the second with the same design moved to the recommended band, temperatures and drive level, and
-a new noise seed.  The virtual lab records the model's main quantity only (actuator M, sensor S), so the
+its own noise stream (:func:`record_noise_seed`).  The virtual lab records the model's main quantity only (actuator M, sensor S), so the
 search is restricted to it; the two records are then of the same quantity and are merged
 (:func:`physmodel.estimation.next_measurement.merge_records`, lines the first record already holds
 left out of the second) and diagnosed jointly.  When no single record is expected to separate
-every competing pair and two are (``NextMeasurement.also``), the virtual lab takes both (the
-second with the next noise seed, none of the lines already held) and the three are diagnosed
-together.
+every competing pair and two are (``NextMeasurement.also``), the virtual lab takes both (each
+with its own noise stream, none of the lines already held) and the three are diagnosed together.
+
+Noise streams (since 2026-11-27): the first record's is ``noise_seed``'s; the recommended record ``k``
+(1, and 2 for a second one) draws from the ``SeedSequence`` entropy ``[next_noise_seed, k]``
+(``next_noise_seed`` defaults to ``noise_seed``), which no other record, and no integer seed a user
+may give anywhere, produces.  Before, the recommended records used the integers ``next_noise_seed``
+(default ``noise_seed + 1``) and ``next_noise_seed + 1`` — another run's ``noise_seed``, or this
+run's own first record's when ``next_noise_seed = noise_seed - 1``.
 """
 
 from __future__ import annotations
@@ -126,6 +132,28 @@ def _design(sweep_cfg: dict, r) -> dict:
     return sw2
 
 
+#: Seeds are one 32-bit word each: a ``SeedSequence`` pads its entropy with zeros to four words, so
+#: with a wider (two-word) seed ``[seed, k]`` could repeat another seed's stream.
+SEED_LIMIT = 2**32
+
+
+def record_noise_seed(cfg: dict, k: int, where: str = "") -> int | list[int]:
+    """The noise seed of record ``k`` of the step (0 the first record, 1 the recommended record, 2 a
+    second one): ``noise_seed`` for the first, the ``SeedSequence`` entropy ``[next_noise_seed, k]``
+    for the others (``next_noise_seed`` defaults to ``noise_seed``).  ``[root, 0]`` and the integer
+    ``root`` give one stream (zero-padding), so the first record's stream is ``noise_seed``'s as a
+    plain integer seed and ``k ≥ 1`` makes every recommended record's its own: distinct from each
+    other's, from the first's and from any integer seed's.  A seed outside ``[0, 2**32)`` raises
+    :class:`ScenarioError` naming the key."""
+    for key in ("noise_seed", "next_noise_seed"):
+        v = cfg.get(key)
+        if v is not None and not (isinstance(v, int) and not isinstance(v, bool) and 0 <= v < SEED_LIMIT):
+            raise ScenarioError(f"{where}[next_measurement] {key} = {v!r}: expected an integer in [0, 2**32)")
+    if k == 0:
+        return int(cfg["noise_seed"])
+    return [int(cfg.get("next_noise_seed", cfg["noise_seed"])), int(k)]
+
+
 def step_next_measurement(ctx: RunContext):
     """Ambiguous on one virtual-lab record → the recommended measurement → named on both."""
     from physmodel.estimation.next_measurement import merge_records
@@ -145,7 +173,7 @@ def step_next_measurement(ctx: RunContext):
     truth = InstrumentModel(ctx.model, effects)
     sweep_cfg = {"source": "virtual_lab", "excitation": "multisine",
                  **{k: cfg[k] for k in DESIGN if k in cfg}}
-    noise_cfg = {"kind": "time", "output_noise_rms": cfg["output_noise_rms"], "seed": int(cfg["noise_seed"])}
+    noise_cfg = {"kind": "time", "output_noise_rms": cfg["output_noise_rms"], "seed": record_noise_seed(cfg, 0, where)}
     lab1 = from_config(truth, sweep_cfg, noise_cfg, where=where)
     rec1 = lab1.sweep
     ctx.file(rec1.to_csv(ctx.out / "next_measurement" / "record1.csv"))
@@ -172,13 +200,13 @@ def step_next_measurement(ctx: RunContext):
         ctx.metric("next_measurement.target", nm.target)
         ctx.metric("next_measurement.expected_to_separate", nm.separates)
         fs = float(sweep_cfg["fs_hz"])
-        both, seed2 = rec1, int(cfg.get("next_noise_seed", int(cfg["noise_seed"]) + 1))
+        both = rec1
         for rj in [r] + list(nm.also):      # every record checked before any is written (no half-written folder)
             if rj.band_hz[1] >= 0.4 * fs:
                 raise ScenarioError(f"{where}the recommended band reaches {rj.band_hz[1]:g} Hz, beyond the virtual "
                                     f"lab's fs_hz = {fs:g} (set [next_measurement] band_limits_hz below 0.4·fs_hz)")
         for j, rj in enumerate([r] + list(nm.also)):    # a second record when no single one separates every pair
-            nz2 = dict(noise_cfg, seed=seed2 + j)
+            nz2 = dict(noise_cfg, seed=record_noise_seed(cfg, j + 1, where))
             rec2 = _new_lines(both, from_config(truth, _design(sweep_cfg, rj), nz2, where=where).sweep)
             ctx.file(rec2.to_csv(ctx.out / "next_measurement" / f"record{j + 2}.csv"))
             both = merge_records(both, rec2)
@@ -210,4 +238,4 @@ SCHEMA_KEYS = ("effects", *DESIGN, "output_noise_rms", "noise_seed", "next_noise
                "null_draws", "null_refits", "alpha", "seed", "laws", "baseline_starts", "band_limits_hz",
                "temperature_limits_c", "levels", "power")
 
-__all__ = ["DESIGN", "InstrumentModel", "SCHEMA_KEYS", "step_next_measurement"]
+__all__ = ["DESIGN", "InstrumentModel", "SCHEMA_KEYS", "record_noise_seed", "step_next_measurement"]
