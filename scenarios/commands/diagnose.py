@@ -578,6 +578,8 @@ def run(args) -> int:
         print(f"model: {out}/model.json — {mf.describe()}; use it downstream with --model {out}/model.json")
     if d.next_measurement is not None:               # said whether or not --quiet: it is the verdict's advice
         print(f"ipmc diagnose: {d.verdict}; {d.next_measurement.message}", file=sys.stderr)
+    if d.null.get("thin_tail"):                      # said whether or not --quiet: a level the draws leave uncertain
+        print(f"ipmc diagnose: {d.null['thin_tail']}", file=sys.stderr)
     if not mf.adequate:
         print(f"ipmc diagnose: the diagnosed model does not fit the data ({mf.verdict.reason}); model.json says so "
               "and every command that reads it will too"
