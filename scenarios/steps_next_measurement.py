@@ -19,9 +19,10 @@ every competing pair and two are (``NextMeasurement.also``), the virtual lab tak
 with its own noise stream, none of the lines already held) and the three are diagnosed together.
 
 Noise streams (since 2026-11-27): the first record's is ``noise_seed``'s; the recommended record ``k``
-(1, and 2 for a second one) draws from the ``SeedSequence`` entropy ``[next_noise_seed, k]``
+(1, and 2 for a second one) draws from the ``SeedSequence`` entropy ``[next_noise_seed, k, 0, 0, 0]``
 (``next_noise_seed`` defaults to ``noise_seed``), which no other record, and no integer seed a user
-may give anywhere, produces.  Before, the recommended records used the integers ``next_noise_seed``
+may give anywhere (``ipmc simulate --seed``, a spec's ``[noise] seed``), produces — see
+:func:`record_noise_seed` for why.  Before, the recommended records used the integers ``next_noise_seed``
 (default ``noise_seed + 1``) and ``next_noise_seed + 1`` — another run's ``noise_seed``, or this
 run's own first record's when ``next_noise_seed = noise_seed - 1``.
 """
@@ -132,26 +133,40 @@ def _design(sweep_cfg: dict, r) -> dict:
     return sw2
 
 
-#: Seeds are one 32-bit word each: a ``SeedSequence`` pads its entropy with zeros to four words, so
-#: with a wider (two-word) seed ``[seed, k]`` could repeat another seed's stream.
+#: Seeds are one 32-bit word each, so the words of a recommended record's key are always
+#: ``[next_noise_seed, k, 0, 0, 0]`` (one layout, one ``(next_noise_seed, k)`` per key).
 SEED_LIMIT = 2**32
+
+#: Zero words after ``[next_noise_seed, k]`` in a recommended record's key: five words in all.
+KEY_PADDING = 3
 
 
 def record_noise_seed(cfg: dict, k: int, where: str = "") -> int | list[int]:
     """The noise seed of record ``k`` of the step (0 the first record, 1 the recommended record, 2 a
-    second one): ``noise_seed`` for the first, the ``SeedSequence`` entropy ``[next_noise_seed, k]``
-    for the others (``next_noise_seed`` defaults to ``noise_seed``).  ``[root, 0]`` and the integer
-    ``root`` give one stream (zero-padding), so the first record's stream is ``noise_seed``'s as a
-    plain integer seed and ``k ≥ 1`` makes every recommended record's its own: distinct from each
-    other's, from the first's and from any integer seed's.  A seed outside ``[0, 2**32)`` raises
-    :class:`ScenarioError` naming the key."""
+    second one): ``noise_seed`` for the first (a plain integer, its stream unchanged), the
+    ``SeedSequence`` entropy ``[next_noise_seed, k, 0, 0, 0]`` for the others (``next_noise_seed``
+    defaults to ``noise_seed``).
+
+    Why five words ending in zeros: numpy turns an integer seed into its little-endian 32-bit words
+    with no trailing zero word (0 → ``[0]``, 2**32 → ``[0, 1]``) and pads an entropy of fewer than
+    four words with zeros, so the integer ``2**32·k + s`` *is* ``[s, k]`` (and ``[s, k, 0]``,
+    ``[s, k, 0, 0]``); a spawn key is appended after the padding, so ``spawn_key=(k,)`` of ``s`` is the
+    integer ``s + 2**128·k``.  Past four words every word is mixed in, a trailing zero too, and
+    an integer of five or more words has a non-zero top word: no integer gives a list of five or more
+    words ending in 0.  Checked by experiment (numpy 2.4.6, PCG64 states from ``default_rng``): the
+    integers ``2**32·k + s``, ``2**64·k + s``, ``2**128 + 2**32·k + s``, 200 random ones in
+    ``[2**128, 2**160)`` and 0-19999 against ``[s, k, 0, 0, 0]`` for s = 0, 4, 5, 6, 2**32 − 1 and
+    k = 1, 2: none gives the same state, while ``2**32·k + s`` gives ``[s, k]``'s
+    (tests/scenarios/test_next_measurement_noise_streams.py).  The keys of two records differ in ``k``, and
+    of two runs in ``next_noise_seed``.  A seed outside ``[0, 2**32)`` raises :class:`ScenarioError`
+    naming the key."""
     for key in ("noise_seed", "next_noise_seed"):
         v = cfg.get(key)
         if v is not None and not (isinstance(v, int) and not isinstance(v, bool) and 0 <= v < SEED_LIMIT):
             raise ScenarioError(f"{where}[next_measurement] {key} = {v!r}: expected an integer in [0, 2**32)")
     if k == 0:
         return int(cfg["noise_seed"])
-    return [int(cfg.get("next_noise_seed", cfg["noise_seed"])), int(k)]
+    return [int(cfg.get("next_noise_seed", cfg["noise_seed"])), int(k), *[0] * KEY_PADDING]
 
 
 def step_next_measurement(ctx: RunContext):
@@ -238,4 +253,4 @@ SCHEMA_KEYS = ("effects", *DESIGN, "output_noise_rms", "noise_seed", "next_noise
                "null_draws", "null_refits", "alpha", "seed", "laws", "baseline_starts", "band_limits_hz",
                "temperature_limits_c", "levels", "power")
 
-__all__ = ["DESIGN", "InstrumentModel", "SCHEMA_KEYS", "record_noise_seed", "step_next_measurement"]
+__all__ = ["DESIGN", "InstrumentModel", "KEY_PADDING", "SCHEMA_KEYS", "record_noise_seed", "step_next_measurement"]

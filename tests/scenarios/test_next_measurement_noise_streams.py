@@ -1,7 +1,8 @@
 """The [next_measurement] step gives every record its own noise stream (issue 27 review): the
-recommended records' streams come from the SeedSequence entropy ``[next_noise_seed, k]``, so no
-two records of a run share one, and none is the stream of an integer seed a user may give to
-another run (before: ``next_noise_seed`` and ``next_noise_seed + 1``, integers)."""
+recommended records' streams come from the SeedSequence entropy ``[next_noise_seed, k, 0, 0, 0]``,
+so no two records of a run share one, and none is the stream of an integer seed a user may give to
+another run (before: ``next_noise_seed`` and ``next_noise_seed + 1``, integers; then ``[next_noise_seed,
+k]``, which numpy gives for the integer ``2**32·k + next_noise_seed`` too)."""
 
 from __future__ import annotations
 
@@ -19,8 +20,10 @@ def test_no_two_records_share_a_noise_stream(tmp_path, monkeypatch):
     """The bundled demo with ``next_noise_seed = noise_seed - 1`` (a value a user may well give) and a
     second recommended record (as in test_next_measurement_two_records): the noise seeds the virtual
     lab receives for records 1-3 give three different streams, and records 2 and 3 none of the
-    integer seeds 0-999 gives (any of which a user may give as another run's ``noise_seed``).  Before
-    the fix record 3 drew from ``next_noise_seed + 1 = noise_seed``: record 1's noise again."""
+    integer seeds 0-999 or ``2**32·k + next_noise_seed`` (k = 1, 2) gives (any of which a user may give
+    as another run's ``noise_seed`` or ``ipmc simulate --seed``).  Before the fix record 3 drew from
+    ``next_noise_seed + 1 = noise_seed``: record 1's noise again; with the key ``[next_noise_seed, k]``
+    record 2 drew the integer 2**32 + 4's."""
     from dataclasses import replace
 
     import scenarios.virtual_lab as vl
@@ -56,8 +59,27 @@ def test_no_two_records_share_a_noise_stream(tmp_path, monkeypatch):
     states = [_state(s) for s in seeds]
     assert states[0] == _state(5)                                   # the first record: noise_seed's stream
     assert len(set(states)) == 3, seeds
-    plain = {_state(s) for s in range(1000)}
+    plain = {_state(s) for s in [*range(1000), *(2**32 * k + 4 for k in (1, 2))]}
     assert not set(states[1:]) & plain, seeds
+
+
+@pytest.mark.parametrize("root", [0, 5, 2**32 - 1])
+def test_no_integer_gives_a_recommended_records_stream(root):
+    """The keys of :func:`record_noise_seed` against integers numpy splits into the same leading
+    words: ``2**32·k + root`` (two words ``[root, k]``), ``2**64·k + root``, and integers of five words
+    (``≥ 2**128``) with the same low words or random high ones — numpy's SeedSequence states, none equal.
+    The integer ``2**32·k + root`` does give ``[root, k]``'s state (why the key is five words)."""
+    from scenarios.steps_next_measurement import record_noise_seed
+
+    cfg = {"noise_seed": 7, "next_noise_seed": root}
+    keys = {k: _state(record_noise_seed(cfg, k)) for k in (1, 2)}
+    assert record_noise_seed(cfg, 0) == 7 and len(set(keys.values())) == 2
+    rng = np.random.default_rng(root)
+    for k, key in keys.items():
+        assert _state(2**32 * k + root) == _state([root, k])          # the reachable two-word key
+        ints = [root, 2**32 * k + root, 2**64 * k + root, 2**128 + 2**32 * k + root, 2**128 * k + root,
+                2**160 + 2**32 * k + root, *(root + 2**32 * k + 2**128 * int(h) for h in rng.integers(1, 2**62, 50))]
+        assert key not in {_state(i) for i in ints}, (root, k)
 
 
 @pytest.mark.parametrize("bad", ["-1", "4294967296", "2.5"])
