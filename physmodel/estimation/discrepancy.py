@@ -230,7 +230,9 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
     if not (0 < alpha < 0.5):
         raise IPMCError(f"alpha={alpha!r} must lie in (0, 0.5)")
-    if int(null_draws) < 200:   # 200-999 run; a quantile with < 10 draws beyond it is said (nullstats.MIN_TAIL_DRAWS)
+    # >= 200 runs; any quantile used with < 10 draws beyond it is said (nullstats.thin_tail_note): 1000 draws
+    # can be too few (K = 2: 5 beyond the 0.995 per-quantity quantile), so can 4000 (α = 0.01, K = 2: 4)
+    if int(null_draws) < 200:
         raise IPMCError(f"null_draws={null_draws!r} is too small for a {1 - alpha:g} quantile; use >= 200")
     if int(null_refits) < 0:
         raise IPMCError(f"null_refits={null_refits!r} must be >= 0")
