@@ -1,7 +1,8 @@
 """A quantile of the null draws with few draws beyond it is said (issue 27 review): 200-999 draws
 still run, but the per-quantity gap test's quantile at α_gap/K rests on about null_draws·α_gap/K
 draws (exactly ceil((null_draws − 1)·α_gap/K), ``np.quantile``'s linear interpolation), and with fewer than ``nullstats.MIN_TAIL_DRAWS`` the diagnosis says so — in its message (and so
-summary.md), in ``to_dict()['null']`` and, from ``ipmc diagnose``, on stderr."""
+summary.md), in ``to_dict()['null']``, in model.json's verdict reason (which every later command
+reads) and, from ``ipmc diagnose``, on stderr."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import numpy as np
 import pytest
 from joint_cases import make_joint_case
 
-from physmodel import IPMCParameters
+from physmodel import IPMCParameters, load_model
 from physmodel.estimation.discrepancy import diagnose
 from physmodel.estimation.nullstats import MIN_TAIL_DRAWS, draws_for_tail, null_tails, thin_tail_note
 
@@ -32,7 +33,7 @@ def _diag(case, draws):
                     candidates=PAIR, null_draws=draws, null_refits=0, seed=SEED)
 
 
-def test_a_joint_diagnosis_on_200_draws_says_its_gap_quantile_is_thin(case):
+def test_a_joint_diagnosis_on_200_draws_says_its_gap_quantile_is_thin(case, tmp_path):
     """K = 2, α = 0.05, α_gap = α/5 = 0.01: the per-quantity gap quantile (0.995) has ceil(199 × 0.005)
     = 1 draw beyond it, the pooled one (0.99) ceil(1.99) = 2, the LR threshold (0.96) ceil(7.96) = 8 — all
     under 10; 1802 draws put ceil(1801 × 0.005) = 10 beyond the 0.995 quantile (1801: 9)."""
@@ -47,6 +48,8 @@ def test_a_joint_diagnosis_on_200_draws_says_its_gap_quantile_is_thin(case):
     assert note in d.message and note in d.summary()
     rep = json.loads(json.dumps(d.to_dict(), allow_nan=False))
     assert rep["null"]["thin_tail"] == note and note in rep["message"]
+    path = d.to_model_file().save(tmp_path / "model.json")    # what later commands read: its verdict's reason
+    assert note in load_model(path).verdict.reason
 
 
 def test_a_joint_diagnosis_on_4000_draws_does_not(case):
@@ -55,6 +58,7 @@ def test_a_joint_diagnosis_on_4000_draws_does_not(case):
     d = _diag(case, 4000)
     assert min(t["draws"] for t in d.null["tails"].values()) == pytest.approx(20.0)
     assert d.null["thin_tail"] == "" and "Thin null tail" not in d.message
+    assert "Thin null tail" not in d.to_model_file().verdict.reason
 
 
 def test_the_threshold_is_a_relative_standard_error_of_about_a_third():
@@ -122,6 +126,7 @@ def test_cli_says_a_thin_tail_on_stderr(case, tmp_path, capsys):
     rc = main([*common, "--null-draws", "200", "--out", str(tmp_path / "thin")])
     err = capsys.readouterr().err
     assert rc in (0, 3) and "ipmc diagnose: Thin null tail" in err and "null_draws ≥ 1802" in err, err
+    assert "Thin null tail" in json.loads((tmp_path / "thin" / "model.json").read_text())["verdict"]["reason"]
     rc = main([*common, "--null-draws", "4000", "--out", str(tmp_path / "full")])
     err = capsys.readouterr().err
     assert rc in (0, 3) and "Thin null tail" not in err, err
