@@ -17,6 +17,10 @@ search is restricted to it; the two records are then of the same quantity and ar
 left out of the second) and diagnosed jointly.  When no single record is expected to separate
 every competing pair and two are (``NextMeasurement.also``), the virtual lab takes both (each
 with its own noise stream, none of the lines already held) and the three are diagnosed together.
+A diagnosis whose null draws leave fewer than 10 beyond a quantile its tests threshold at (the
+400 draws of the demo's ``--quick``) says so (the "Thin null tail" note of
+:func:`physmodel.estimation.nullstats.thin_tail_note`): under the report's table, in metrics.json
+(``next_measurement.thin_null_tail``, ``next_measurement.null_tail_draws``) and on stderr.
 
 Noise streams (since 2026-11-27): the first record's is ``noise_seed``'s; the recommended record ``k``
 (1, and 2 for a second one) draws from the ``SeedSequence`` entropy ``[next_noise_seed, k, 0, 0, 0]``
@@ -169,6 +173,26 @@ def record_noise_seed(cfg: dict, k: int, where: str = "") -> int | list[int]:
     return [int(cfg.get("next_noise_seed", cfg["noise_seed"])), int(k), *[0] * KEY_PADDING]
 
 
+def _thin_tails(ctx: RunContext, diagnoses: list) -> str:
+    """The diagnoses' thin-null-tail notes (a quantile of the null draws with fewer than
+    ``nullstats.MIN_TAIL_DRAWS`` draws beyond it, e.g. the 400 draws of ``--quick``): said on stderr
+    (whether or not quiet, as ``ipmc diagnose`` does), as metrics ``next_measurement.thin_null_tail``
+    (1 when any diagnosis has one) and ``next_measurement.null_tail_draws`` (the fewest draws beyond
+    any quantile of any diagnosis) in metrics.json, and returned for report.md ("" when none)."""
+    import sys
+
+    ctx.metric("next_measurement.null_tail_draws", min(t["draws"] for d in diagnoses for t in d.null["tails"].values()))
+    notes: dict = {}
+    for i, d in enumerate(diagnoses, 1):
+        if d.null.get("thin_tail"):
+            notes.setdefault(d.null["thin_tail"], []).append(str(i))
+    ctx.metric("next_measurement.thin_null_tail", bool(notes))
+    text = " ".join(f"Diagnosis {' and '.join(ds)}: {note}" for note, ds in notes.items())
+    if text:
+        print(f"{ctx.spec.name}: {text}", file=sys.stderr)
+    return text
+
+
 def step_next_measurement(ctx: RunContext):
     """Ambiguous on one virtual-lab record → the recommended measurement → named on both."""
     from physmodel.estimation.next_measurement import merge_records
@@ -238,12 +262,13 @@ def step_next_measurement(ctx: RunContext):
     ctx.metric("next_measurement.second_named_truth", d2 is not None and d2.verdict == "named" and sorted(d2.named)
                == hidden)
     ctx.metric("next_measurement.second_n_named", len(d2.named) if d2 is not None else 0)
+    thin = _thin_tails(ctx, [d for d in (d1, d2) if d is not None])
     ctx.section("The next measurement",
                 f"Hidden in the virtual lab's physics: {effects}. The first record (the table's design) is "
                 f"diagnosed: **{d1.verdict}** ({', '.join(d1.named) or 'nothing named'}).", "",
                 (nm.message if nm is not None else "No recommendation: the first verdict leaves no competing models."),
                 "", md_table(["records diagnosed", "verdict", "named", "expected λ of the added record"], rows), "",
-                "Diagnoses: `next_measurement/diagnosis1/summary.md` (with the recommendation) and "
+                *([thin, ""] if thin else []), "Diagnoses: `next_measurement/diagnosis1/summary.md` (with the recommendation) and "
                 "`next_measurement/diagnosis2/summary.md` (both records).")
 
 
