@@ -34,6 +34,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import IPMCError
 from .next_measurement_design import log_ratio, stack_real, t_solve
 from .next_measurement_results import CandidateMeasurement
 
@@ -128,9 +129,15 @@ def bath_premise(records: list, record_temperatures_c, base) -> str:
     their separation is predicted through the diagnosed model's temperature laws (those of
     ``base``, named), so a misfit at a new temperature may mean the laws, not the effect, are
     wrong.  With two records each that steps the bath is named in its role with its temperatures
-    (before, only the first's was said when both did).  Empty when none steps it."""
+    (before, only the first's was said when both did).  Empty when none steps it.  A ``None`` entry
+    (no record in that role) is left out, so ``[r, None]`` says what ``[r]`` does; more than two
+    records raise :class:`~physmodel.errors.IPMCError` (the roles are first and second)."""
+    if len(records) > 2:
+        raise IPMCError(f"bath_premise: {len(records)} records given; expected the recommended one and at most a "
+                        "second (second_record)")
+    records = [r for r in records if r is not None]
     T0 = np.asarray(record_temperatures_c, float)
-    new = [[t for t in r.temperatures_c if not np.any(np.isclose(t, T0))] if r is not None else [] for r in records]
+    new = [[t for t in r.temperatures_c if not np.any(np.isclose(t, T0))] for r in records]
     if not any(new):
         return ""
     laws = getattr(base, "laws", None)

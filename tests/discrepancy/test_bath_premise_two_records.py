@@ -7,8 +7,10 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import independent_generator as ig
+import pytest
 
 from physmodel import IPMCParameters, get_parameter_set
+from physmodel.errors import IPMCError
 from physmodel.estimation.next_measurement import next_measurement, temperature_premise
 from physmodel.estimation.next_measurement_plan import bath_premise
 
@@ -50,7 +52,7 @@ def _rec(q, *temps):
 
 def test_the_premise_of_each_case_of_two_records():
     """One of two records stepping the bath is named in its role, the other said to stay; none
-    stepping: no premise; one record: the single-record sentence (unchanged)."""
+    stepping: no premise; one record (or a second of None): main's single-record sentence, literally."""
     base = get_parameter_set("seed000_sensor_dev")
     laws = base.laws.describe()
     second = bath_premise([_rec("S", 35.0), _rec("S", 5.0, 35.0)], [35.0], base)
@@ -59,6 +61,26 @@ def test_the_premise_of_each_case_of_two_records():
     first = bath_premise([_rec("Z", 65.0), _rec("S", 35.0)], [35.0], base)
     assert first.startswith("Premise: the first experiment (Z) steps the bath to 65 °C") and "the second stays" in first
     assert bath_premise([_rec("S", 35.0), _rec("Z", 35.0)], [35.0], base) == ""
-    one = temperature_premise(_rec("S", 5.0, 35.0), [35.0], base)
-    assert one == bath_premise([_rec("S", 5.0, 35.0)], [35.0], base)
-    assert one.startswith("Premise: this experiment steps the bath to 5 °C (the record: 35 °C), so its separation")
+    for one, at, said in ((_rec("S", 5.0, 35.0), [35.0], MAIN_ONE_RECORD[0]),
+                          (_rec("Z", 5.0, 65.0), [19.0, 35.0, 55.0], MAIN_ONE_RECORD[1])):
+        assert temperature_premise(one, at, base) == said
+        assert bath_premise([one], at, base) == said and bath_premise([one, None], at, base) == said
+    assert temperature_premise(None, [35.0], base) == ""
+
+
+#: The one-record premise as main printed it (e83b7c5's ``temperature_premise``, run once on
+#: seed000_sensor_dev with the records of the test above) — the text the two-record change must keep.
+_LAWS = ("d Arrhenius(activation_energy=15000); E LogLinear(slope=-0.0075); kappa_e WaterPermittivity(); "
+         "Rp_specific IonicResistance()")
+_REST = ("so its separation relies on the diagnosed model's temperature laws (" + _LAWS + "); a misfit at the new "
+         "temperature (an 'unexplained' verdict on both records) means the laws, not the effect, may be wrong — "
+         "check them (e.g. a record of the plain strip at that temperature) before reading it as an effect.")
+MAIN_ONE_RECORD = ("Premise: this experiment steps the bath to 5 °C (the record: 35 °C), " + _REST,
+                   "Premise: this experiment steps the bath to 5, 65 °C (the record: 19, 35, 55 °C), " + _REST)
+
+
+def test_more_than_two_records_are_refused():
+    """The roles are first and second: a third record is an error, not a sentence naming two."""
+    base = get_parameter_set("seed000_sensor_dev")
+    with pytest.raises(IPMCError, match="3 records given"):
+        bath_premise([_rec("S", 5.0), _rec("S", 65.0), _rec("Z", 80.0)], [35.0], base)
