@@ -178,7 +178,9 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         Family-wise false-positive rate of the verdict [-]: the candidates' LR test runs at
         α − α/5 and the gap test at α/5 (:data:`~physmodel.estimation.diagnosis.GAP_ALPHA_DIVISOR`).
     null_draws, null_refits : int
-        Linearised null Monte-Carlo draws, and full bootstrap refits that correct its threshold.
+        Linearised null Monte-Carlo draws, and full bootstrap refits that correct its threshold.  A quantile
+        the tests use with < 10 draws beyond it is said in the message and ``null["thin_tail"]`` (each
+        quantile's draws beyond it: ``null["tails"]``; :func:`~physmodel.estimation.nullstats.thin_tail_note`).
     seed : int
         Seed of the null draws and multi-starts.
     kernel : str
