@@ -84,8 +84,8 @@ def test_no_integer_gives_a_recommended_records_stream(root):
 
 @pytest.mark.parametrize("bad", ["-1", "4294967296", "2.5"])
 def test_a_seed_outside_one_word_is_refused_naming_the_key(tmp_path, capsys, bad):
-    """``next_noise_seed`` outside [0, 2**32) (the streams are distinct for one-word seeds only) or not
-    an integer: the CLI exits 2 naming the key and the value, no traceback."""
+    """``next_noise_seed`` outside [0, 2**32) (one word, so a record's key is always ``[next_noise_seed, k,
+    0, 0, 0]``) or not an integer: the CLI exits 2 naming the key and the value, no traceback."""
     from scenarios.cli import main
     from scenarios.spec import bundled_scenarios
 
