@@ -11,13 +11,24 @@ realises and simulates, so both records
 are time-domain experiments measured like a DAQ (:mod:`scenarios.virtual_lab`): the first with the
 table's design (``temperatures_c``, ``fmin_hz`` … ``rms``, ``output_noise_rms``, ``noise_seed``),
 the second with the same design moved to the recommended band, temperatures and drive level, and
-a new noise seed.  The virtual lab records the model's main quantity only (actuator M, sensor S), so the
+its own noise stream (:func:`record_noise_seed`).  The virtual lab records the model's main quantity only (actuator M, sensor S), so the
 search is restricted to it; the two records are then of the same quantity and are merged
 (:func:`physmodel.estimation.next_measurement.merge_records`, lines the first record already holds
 left out of the second) and diagnosed jointly.  When no single record is expected to separate
-every competing pair and two are (``NextMeasurement.also``), the virtual lab takes both (the
-second with the next noise seed, none of the lines already held) and the three are diagnosed
-together.
+every competing pair and two are (``NextMeasurement.also``), the virtual lab takes both (each
+with its own noise stream, none of the lines already held) and the three are diagnosed together.
+A diagnosis whose null draws leave fewer than 10 beyond a quantile its tests threshold at (the
+400 draws of the demo's ``--quick``) says so (the "Thin null tail" note of
+:func:`physmodel.estimation.nullstats.thin_tail_note`): under the report's table, in metrics.json
+(``next_measurement.thin_null_tail``, ``next_measurement.null_tail_draws``) and on stderr.
+
+Noise streams (since 2026-11-27): the first record's is ``noise_seed``'s; the recommended record ``k``
+(1, and 2 for a second one) draws from the ``SeedSequence`` entropy ``[next_noise_seed, k, 0, 0, 0]``
+(``next_noise_seed`` defaults to ``noise_seed``), which no other record, and no integer seed a user
+may give anywhere (``ipmc simulate --seed``, a spec's ``[noise] seed``), produces — see
+:func:`record_noise_seed` for why.  Before, the recommended records used the integers ``next_noise_seed``
+(default ``noise_seed + 1``) and ``next_noise_seed + 1`` — another run's ``noise_seed``, or this
+run's own first record's when ``next_noise_seed = noise_seed - 1``.
 """
 
 from __future__ import annotations
@@ -126,6 +137,62 @@ def _design(sweep_cfg: dict, r) -> dict:
     return sw2
 
 
+#: Seeds are one 32-bit word each, so the words of a recommended record's key are always
+#: ``[next_noise_seed, k, 0, 0, 0]`` (one layout, one ``(next_noise_seed, k)`` per key).
+SEED_LIMIT = 2**32
+
+#: Zero words after ``[next_noise_seed, k]`` in a recommended record's key: five words in all.
+KEY_PADDING = 3
+
+
+def record_noise_seed(cfg: dict, k: int, where: str = "") -> int | list[int]:
+    """The noise seed of record ``k`` of the step (0 the first record, 1 the recommended record, 2 a
+    second one): ``noise_seed`` for the first (a plain integer, its stream unchanged), the
+    ``SeedSequence`` entropy ``[next_noise_seed, k, 0, 0, 0]`` for the others (``next_noise_seed``
+    defaults to ``noise_seed``).
+
+    Why five words ending in zeros: numpy turns an integer seed into its little-endian 32-bit words
+    with no trailing zero word (0 → ``[0]``, 2**32 → ``[0, 1]``) and pads an entropy of fewer than
+    four words with zeros, so the integer ``2**32·k + s`` *is* ``[s, k]`` (and ``[s, k, 0]``,
+    ``[s, k, 0, 0]``); a spawn key is appended after the padding, so ``spawn_key=(k,)`` of ``s`` is the
+    integer ``s + 2**128·k``.  Past four words every word is mixed in, a trailing zero too, and
+    an integer of five or more words has a non-zero top word: no integer gives a list of five or more
+    words ending in 0.  Checked by experiment (numpy 2.4.6, PCG64 states from ``default_rng``): the
+    integers ``2**32·k + s``, ``2**64·k + s``, ``2**128 + 2**32·k + s``, 200 random ones in
+    ``[2**128, 2**160)`` and 0-19999 against ``[s, k, 0, 0, 0]`` for s = 0, 4, 5, 6, 2**32 − 1 and
+    k = 1, 2: none gives the same state, while ``2**32·k + s`` gives ``[s, k]``'s
+    (tests/scenarios/test_next_measurement_noise_streams.py).  The keys of two records differ in ``k``, and
+    of two runs in ``next_noise_seed``.  A seed outside ``[0, 2**32)`` raises :class:`ScenarioError`
+    naming the key."""
+    for key in ("noise_seed", "next_noise_seed"):
+        v = cfg.get(key)
+        if v is not None and not (isinstance(v, int) and not isinstance(v, bool) and 0 <= v < SEED_LIMIT):
+            raise ScenarioError(f"{where}[next_measurement] {key} = {v!r}: expected an integer in [0, 2**32)")
+    if k == 0:
+        return int(cfg["noise_seed"])
+    return [int(cfg.get("next_noise_seed", cfg["noise_seed"])), int(k), *[0] * KEY_PADDING]
+
+
+def _thin_tails(ctx: RunContext, diagnoses: list) -> str:
+    """The diagnoses' thin-null-tail notes (a quantile of the null draws with fewer than
+    ``nullstats.MIN_TAIL_DRAWS`` draws beyond it, e.g. the 400 draws of ``--quick``): said on stderr
+    (whether or not quiet, as ``ipmc diagnose`` does), as metrics ``next_measurement.thin_null_tail``
+    (1 when any diagnosis has one) and ``next_measurement.null_tail_draws`` (the fewest draws beyond
+    any quantile of any diagnosis) in metrics.json, and returned for report.md ("" when none)."""
+    import sys
+
+    ctx.metric("next_measurement.null_tail_draws", min(t["draws"] for d in diagnoses for t in d.null["tails"].values()))
+    notes: dict = {}
+    for i, d in enumerate(diagnoses, 1):
+        if d.null.get("thin_tail"):
+            notes.setdefault(d.null["thin_tail"], []).append(str(i))
+    ctx.metric("next_measurement.thin_null_tail", bool(notes))
+    text = " ".join(f"Diagnosis {' and '.join(ds)}: {note}" for note, ds in notes.items())
+    if text:
+        print(f"{ctx.spec.name}: {text}", file=sys.stderr)
+    return text
+
+
 def step_next_measurement(ctx: RunContext):
     """Ambiguous on one virtual-lab record → the recommended measurement → named on both."""
     from physmodel.estimation.next_measurement import merge_records
@@ -145,7 +212,7 @@ def step_next_measurement(ctx: RunContext):
     truth = InstrumentModel(ctx.model, effects)
     sweep_cfg = {"source": "virtual_lab", "excitation": "multisine",
                  **{k: cfg[k] for k in DESIGN if k in cfg}}
-    noise_cfg = {"kind": "time", "output_noise_rms": cfg["output_noise_rms"], "seed": int(cfg["noise_seed"])}
+    noise_cfg = {"kind": "time", "output_noise_rms": cfg["output_noise_rms"], "seed": record_noise_seed(cfg, 0, where)}
     lab1 = from_config(truth, sweep_cfg, noise_cfg, where=where)
     rec1 = lab1.sweep
     ctx.file(rec1.to_csv(ctx.out / "next_measurement" / "record1.csv"))
@@ -172,13 +239,13 @@ def step_next_measurement(ctx: RunContext):
         ctx.metric("next_measurement.target", nm.target)
         ctx.metric("next_measurement.expected_to_separate", nm.separates)
         fs = float(sweep_cfg["fs_hz"])
-        both, seed2 = rec1, int(cfg.get("next_noise_seed", int(cfg["noise_seed"]) + 1))
+        both = rec1
         for rj in [r] + list(nm.also):      # every record checked before any is written (no half-written folder)
             if rj.band_hz[1] >= 0.4 * fs:
                 raise ScenarioError(f"{where}the recommended band reaches {rj.band_hz[1]:g} Hz, beyond the virtual "
                                     f"lab's fs_hz = {fs:g} (set [next_measurement] band_limits_hz below 0.4·fs_hz)")
         for j, rj in enumerate([r] + list(nm.also)):    # a second record when no single one separates every pair
-            nz2 = dict(noise_cfg, seed=seed2 + j)
+            nz2 = dict(noise_cfg, seed=record_noise_seed(cfg, j + 1, where))
             rec2 = _new_lines(both, from_config(truth, _design(sweep_cfg, rj), nz2, where=where).sweep)
             ctx.file(rec2.to_csv(ctx.out / "next_measurement" / f"record{j + 2}.csv"))
             both = merge_records(both, rec2)
@@ -195,12 +262,13 @@ def step_next_measurement(ctx: RunContext):
     ctx.metric("next_measurement.second_named_truth", d2 is not None and d2.verdict == "named" and sorted(d2.named)
                == hidden)
     ctx.metric("next_measurement.second_n_named", len(d2.named) if d2 is not None else 0)
+    thin = _thin_tails(ctx, [d for d in (d1, d2) if d is not None])
     ctx.section("The next measurement",
                 f"Hidden in the virtual lab's physics: {effects}. The first record (the table's design) is "
                 f"diagnosed: **{d1.verdict}** ({', '.join(d1.named) or 'nothing named'}).", "",
                 (nm.message if nm is not None else "No recommendation: the first verdict leaves no competing models."),
                 "", md_table(["records diagnosed", "verdict", "named", "expected λ of the added record"], rows), "",
-                "Diagnoses: `next_measurement/diagnosis1/summary.md` (with the recommendation) and "
+                *([thin, ""] if thin else []), "Diagnoses: `next_measurement/diagnosis1/summary.md` (with the recommendation) and "
                 "`next_measurement/diagnosis2/summary.md` (both records).")
 
 
@@ -210,4 +278,4 @@ SCHEMA_KEYS = ("effects", *DESIGN, "output_noise_rms", "noise_seed", "next_noise
                "null_draws", "null_refits", "alpha", "seed", "laws", "baseline_starts", "band_limits_hz",
                "temperature_limits_c", "levels", "power")
 
-__all__ = ["DESIGN", "InstrumentModel", "SCHEMA_KEYS", "step_next_measurement"]
+__all__ = ["DESIGN", "InstrumentModel", "KEY_PADDING", "SCHEMA_KEYS", "record_noise_seed", "step_next_measurement"]

@@ -76,7 +76,9 @@ class Measurement:
         recorded signal (e.g. 20 V / 2¹⁶ = 3.05e-4 V for a 16-bit ±10 V input); 0 = no quantisation.
     chain : TransimpedanceChain or None   sensors only: the seed 000 amplifier between the
         short-circuit current and the recorded voltage (its response is divided out of the estimate).
-    seed : int or None          noise seed; required when there is noise.
+    seed : int, sequence of int or None   noise seed (``np.random.default_rng``'s: an integer ≥ 0, or
+        a list of them, numpy ``SeedSequence`` entropy — the [next_measurement] step gives its
+        recommended records ``[next_noise_seed, k, 0, 0, 0]``); required when there is noise.
     """
 
     output_noise_rms: float = 0.0
@@ -84,7 +86,7 @@ class Measurement:
     output_adc_step: float = 0.0
     input_adc_step: float = 0.0
     chain: TransimpedanceChain | None = None
-    seed: int | None = None
+    seed: int | Sequence[int] | None = None
 
     def __post_init__(self):
         for k in ("output_noise_rms", "input_noise_rms", "output_adc_step", "input_adc_step"):
@@ -92,7 +94,13 @@ class Measurement:
             if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v >= 0):
                 raise IPMCError(f"Measurement.{k}={v!r} must be a finite number >= 0 (SI units)")
         if (self.output_noise_rms or self.input_noise_rms) and self.seed is None:
-            raise IPMCError("Measurement.seed: a noisy measurement needs an explicit integer seed (reproducibility)")
+            raise IPMCError("Measurement.seed: a noisy measurement needs an explicit seed, an integer >= 0 or a list "
+                            "of them (reproducibility)")
+        words = [self.seed] if isinstance(self.seed, (int, np.integer)) else self.seed
+        if self.seed is not None and not (isinstance(words, Sequence) and len(words) > 0 and all(
+                isinstance(w, (int, np.integer)) and not isinstance(w, bool) and w >= 0 for w in words)):
+            raise IPMCError(f"Measurement.seed={self.seed!r}: expected an integer >= 0 or a non-empty list of them "
+                            "(numpy SeedSequence entropy)")
         if self.chain is not None and not hasattr(self.chain, "response"):
             raise IPMCError(f"Measurement.chain={self.chain!r} must be a physmodel.TransimpedanceChain or None")
 

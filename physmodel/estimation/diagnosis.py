@@ -323,6 +323,8 @@ class Diagnosis:
             verdict = _replace(verdict, reason="; ".join([": ".join(lead + [verdict.reason.rstrip(".")])] + notes))
         if self.next_measurement is not None:         # the later commands that read the file say it too
             verdict = _replace(verdict, reason=f"{verdict.reason.rstrip('.')}. {self.next_measurement.message}")
+        if self.null.get("thin_tail"):               # a test level its null draws leave uncertain, said too
+            verdict = _replace(verdict, reason=f"{verdict.reason.rstrip('.')}. {self.null['thin_tail']}")
         if provenance is None:
             provenance = Provenance("physmodel.diagnose", data_fingerprint=self.metadata.get("data_fingerprint"),
                                     temperatures_c=tuple(self.data.temperatures().tolist()),

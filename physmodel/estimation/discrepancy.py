@@ -99,7 +99,7 @@ from .diagnosis import (
 )
 from .gap import GapTest, block_rows
 from .joint import check_acts_on, joint_data, per_quantity_sentence
-from .nullstats import bootstrap_ratio, constrained_lr, scan_lr, signature_stage
+from .nullstats import bootstrap_ratio, constrained_lr, null_tails, scan_lr, signature_stage, thin_tail_note
 from .priors import (
     WALL_DECADES,
     PenalisedProblem,
@@ -178,7 +178,9 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         Family-wise false-positive rate of the verdict [-]: the candidates' LR test runs at
         α − α/5 and the gap test at α/5 (:data:`~physmodel.estimation.diagnosis.GAP_ALPHA_DIVISOR`).
     null_draws, null_refits : int
-        Linearised null Monte-Carlo draws, and full bootstrap refits that correct its threshold.
+        Linearised null Monte-Carlo draws, and full bootstrap refits that correct its threshold.  A quantile
+        the tests use with < 10 draws beyond it is said in the message and ``null["thin_tail"]`` (each
+        quantile's draws beyond it: ``null["tails"]``; :func:`~physmodel.estimation.nullstats.thin_tail_note`).
     seed : int
         Seed of the null draws and multi-starts.
     kernel : str
@@ -230,6 +232,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         raise ParameterError(f"base must be IPMCParameters, got {type(base).__name__}")
     if not (0 < alpha < 0.5):
         raise IPMCError(f"alpha={alpha!r} must lie in (0, 0.5)")
+    # >= 200 runs; any quantile used with < 10 draws beyond it is said (nullstats.thin_tail_note): 1000 draws
+    # can be too few (K = 2: 5 beyond the 0.995 per-quantity quantile), so can 4000 (α = 0.01, K = 2: 4)
     if int(null_draws) < 200:
         raise IPMCError(f"null_draws={null_draws!r} is too small for a {1 - alpha:g} quantile; use >= 200")
     if int(null_refits) < 0:
@@ -321,6 +325,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
         [r0[i] @ r0[i] for i in block_rows(jd.sizes)]), sigs, qs, None if jd is None else jd.sizes)
     bc = partial(gap.fit_costs, residuals=lambda v, p=pm: standardised_residuals(p([v])[0], data, s_ln, s_ph))
     say("signatures", f"linearised null: LR threshold {T_lin:.3g} from {E.shape[1]} draws")
+    tails = null_tails(int(null_draws), alpha, alpha_gap, gap.K)
 
     # ---- 4. candidate refits
     counter.enter("singles")
@@ -712,7 +717,7 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
     # quantities (the pooled verdict's test, residuals.GOF_ALPHA), not at the detection α
     per_q = gap.annotate(jd.per_quantity(G0, Gf, k0, n_free_after, GOF_ALPHA), final_effects) if jd is not None else []
     pooled = gap.pooled_row(per_q, final_effects)      # the pooled gap test (gap.py), None for one quantity
-    message += per_quantity_sentence(per_q, pooled)
+    message += per_quantity_sentence(per_q, pooled) + (thin := thin_tail_note(tails, int(null_draws)))
     declare_confusable(confusable, separation, confusability, sigs, raw_sigs, data)
     say("audit", f"verdict {verdict}" + (f": {', '.join(named)}" if named else ""))
     fe = {c: {k.split(".", 1)[1]: final_fit.values[k] for k in final_fit.names if k.startswith(c + ".")}
@@ -728,7 +733,8 @@ def diagnose(data: FrequencySweep | Sequence[FrequencySweep], base: IPMCParamete
                         "max over candidates) scaled by full-refit parametric bootstrap",
               "draws": int(null_draws), "refits": int(null_refits), "lr_threshold_linearised": T_lin,
               "nonlinearity_ratio": ratio, "bootstrap_full_max_lr": full_max, "bootstrap_lin_max_lr": lin_used,
-              "alpha_gap": alpha_gap, "gap_test": gap.describe(pooled), "seed": seed},
+              "alpha_gap": alpha_gap, "gap_test": gap.describe(pooled), "seed": seed, "tails": tails,
+              "thin_tail": thin.strip()},
         noise_estimated=estimated, elapsed_s=time.perf_counter() - t0, data=data,
         predicted_before=G0, predicted_after=Gf,
         metadata={"base": base.name, "kernel": kernel, "free": names0, "baseline_effects": beff, "candidates": cand,

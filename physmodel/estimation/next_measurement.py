@@ -130,7 +130,7 @@ from .next_measurement_design import (
     t_solve,
     t_sums,
 )
-from .next_measurement_plan import record_base, second_record
+from .next_measurement_plan import bath_premise, record_base, second_record
 from .next_measurement_results import CandidateMeasurement, NextMeasurement, json_ready, merge_records
 from .residuals import noise_std
 
@@ -579,8 +579,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
         forms = {"found": forms_said, "contests": {k: c.describe(
             lambda f: {k2: v for k2, v in f.values.items() if "." in k2}) for k, c in contests.items()},
             "note": _forms_note(forms_said, contests, d.alpha).strip()}
-    premise = temperature_premise(chosen, T_data, d.base_parameters) \
-        or (temperature_premise(plan.second, T_data, d.base_parameters) if plan is not None else "")
+    premise = bath_premise([chosen] + ([plan.second] if plan is not None else []), T_data, d.base_parameters)
     msg += t_note + (" " + premise if premise else "")
     return NextMeasurement([tuple(m) for m in mods], chosen, bool(sep_ok), target, float(current), len(rows),
                            ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form + same_refit,
@@ -703,20 +702,9 @@ def temperature_premise(r, record_temperatures_c, base) -> str:
     """The premise of a recommended experiment ``r`` that steps the bath away from the record's
     temperatures: its separation is predicted through the diagnosed model's temperature laws (those
     of ``base``, named), so a misfit at the new temperature may mean the laws, not the effect, are
-    wrong.  Empty when ``r`` (or its temperatures) stays at the record's."""
-    if r is None:
-        return ""
-    new = [t for t in r.temperatures_c if not np.any(np.isclose(t, np.asarray(record_temperatures_c, float)))]
-    if not new:
-        return ""
-    laws = getattr(base, "laws", None)
-    said = laws.describe() if laws is not None else "the parameter set's"
-    at = ", ".join(f"{t:g}" for t in np.unique(np.asarray(record_temperatures_c, float)))
-    return (f"Premise: this experiment steps the bath to {', '.join(f'{t:g}' for t in new)} °C (the record: {at} "
-            f"°C), so its separation relies on the diagnosed model's temperature laws ({said}); a misfit at the "
-            "new temperature (an 'unexplained' verdict on both records) means the laws, not the effect, may be "
-            "wrong — check them (e.g. a record of the plain strip at that temperature) before reading it as an "
-            "effect.")
+    wrong.  Empty when ``r`` (or its temperatures) stays at the record's.  Two records:
+    :func:`~physmodel.estimation.next_measurement_plan.bath_premise`."""
+    return bath_premise([r], record_temperatures_c, base)
 
 
 

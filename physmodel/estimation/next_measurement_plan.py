@@ -34,6 +34,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import IPMCError
 from .next_measurement_design import log_ratio, stack_real, t_solve
 from .next_measurement_results import CandidateMeasurement
 
@@ -122,4 +123,46 @@ def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: di
                       {k: {name: float(v[j]) for name, v in d.items()} for k, d in by.items()})
 
 
-__all__ = ["RecordPair", "overlaps", "record_base", "second_record"]
+def bath_premise(records: list, record_temperatures_c, base) -> str:
+    """The premise of the recommended experiments (``records``: the recommended one, then a second
+    of :func:`second_record`) that step the bath away from the diagnosed record's temperatures:
+    their separation is predicted through the diagnosed model's temperature laws (those of
+    ``base``, named), so a misfit at a new temperature may mean the laws, not the effect, are
+    wrong.  With two records each that steps the bath is named in its role with its temperatures
+    (before, only the first's was said when both did).  Empty when none steps it.  A ``None`` entry
+    (no record in that role) is left out, so ``[r, None]`` says what ``[r]`` does; more than two
+    records raise :class:`~physmodel.errors.IPMCError` (the roles are first and second)."""
+    if len(records) > 2:
+        raise IPMCError(f"bath_premise: {len(records)} records given; expected the recommended one and at most a "
+                        "second (second_record)")
+    records = [r for r in records if r is not None]
+    T0 = np.asarray(record_temperatures_c, float)
+    new = [[t for t in r.temperatures_c if not np.any(np.isclose(t, T0))] for r in records]
+    if not any(new):
+        return ""
+    laws = getattr(base, "laws", None)
+    said = laws.describe() if laws is not None else "the parameter set's"
+    at = ", ".join(f"{t:g}" for t in np.unique(T0))
+    check = ("means the laws, not the effect, may be wrong — check them (e.g. a record of the plain strip at that "
+             "temperature) before reading it as an effect.")
+    temps = [", ".join(f"{t:g}" for t in n) for n in new]
+    if len(records) == 1:
+        return (f"Premise: this experiment steps the bath to {temps[0]} °C (the record: {at} °C), so its separation "
+                f"relies on the diagnosed model's temperature laws ({said}); a misfit at the new temperature (an "
+                f"'unexplained' verdict on both records) {check}")
+    role = ("first", "second")
+    stepping = [i for i in range(len(records)) if new[i]]
+    if len(stepping) == len(records):
+        which = ("both experiments step the bath: " + "; ".join(
+            f"the {role[i]} ({records[i].quantity}) to {temps[i]} °C" for i in stepping)
+            + f" (the record: {at} °C), so the separation of each, and of the records together,")
+    else:
+        i = stepping[0]
+        which = (f"the {role[i]} experiment ({records[i].quantity}) steps the bath to {temps[i]} °C (the record: "
+                 f"{at} °C; the {role[1 - i]} stays at the record's temperatures), so its separation, and that of "
+                 "the records together,")
+    return (f"Premise: {which} relies on the diagnosed model's temperature laws ({said}); a misfit at a new "
+            f"temperature (an 'unexplained' verdict on the records together) {check}")
+
+
+__all__ = ["RecordPair", "bath_premise", "overlaps", "record_base", "second_record"]

@@ -223,3 +223,63 @@ def bootstrap_ratio(E, lin_max, G0, data, s_ln, s_ph, n_refits: int, fit_null, r
     if full_max and sum(lin_used) > 0:
         ratio = float(np.clip(sum(full_max) / sum(lin_used), 1.0, 3.0))
     return ratio, full_max, lin_used
+
+
+#: The fewest null draws beyond a quantile the diagnosis thresholds at before its result says the
+#: quantile is thin (:func:`draws_beyond`: the draws actually beyond ``np.quantile``'s linear
+#: interpolation, not the expected n·p).  The tail probability beyond the empirical (1 − p) quantile
+#: of n draws (the test's realised level) is Beta-distributed (order statistics of uniforms), with
+#: relative standard deviation ≈ sqrt((1 − p)/(n·p)) ≈ 1/sqrt(n_tail), n_tail ≈ n·p: at 10 draws ≈ 32 %,
+#: so a nominal 0.5 % test realises about 0.34-0.66 % (± 1 SD); with 1-2 draws (200 draws at α_gap/2 =
+#: 0.005) it is uncertain by 70-100 %, a level not known within a factor of two.  10 is also the tail
+#: the former floor of 200 draws gave the α = 0.05 quantile it was written for (200 × 0.05), now
+#: asked of every quantile used: the LR test's at α − α_gap, the gap test's at α_gap/K per quantity
+#: (Bonferroni, :mod:`~physmodel.estimation.gap`) and the pooled one at α_gap.
+MIN_TAIL_DRAWS = 10
+
+
+def draws_beyond(null_draws: int, p: float) -> int:
+    """How many of ``null_draws`` (distinct) draws lie above their ``np.quantile`` at ``1 − p`` (linear
+    interpolation, numpy's default, as every threshold of the diagnosis uses): the quantile sits at
+    sorted position (n − 1)(1 − p), so the draws beyond it are ceil((n − 1)·p) — e.g. 10 of 950 at
+    p = 0.01, where n·p says 9.5.  Rounded to 9 digits first, so an integer (n − 1)·p is not pushed
+    up by floating point."""
+    return math.ceil(round((null_draws - 1) * p, 9))
+
+
+def null_tails(null_draws: int, alpha: float, alpha_gap: float, K: int) -> dict:
+    """``{quantile: {"tail_probability": p, "draws": draws beyond it}}`` (:func:`draws_beyond`) for
+    every quantile of the null draws a diagnosis with ``K`` quantities thresholds at (the LR test at
+    α − α_gap; the gap test at α_gap for one quantity, else at α_gap/K per quantity and α_gap pooled)."""
+    tails = {"LR threshold": alpha - alpha_gap}
+    if K == 1:
+        tails["gap threshold"] = alpha_gap
+    else:
+        tails["per-quantity gap threshold"] = alpha_gap / K
+        tails["pooled gap threshold"] = alpha_gap
+    return {k: {"tail_probability": p, "draws": draws_beyond(null_draws, p)} for k, p in tails.items()}
+
+
+def draws_for_tail(p: float, tail: int = MIN_TAIL_DRAWS) -> int:
+    """The fewest null draws that put ``tail`` draws beyond the (1 − p) quantile (:func:`draws_beyond`)."""
+    n = math.floor((tail - 1) / p) + 2                  # (n − 1)·p > tail − 1, then exact on the integers
+    while draws_beyond(n - 1, p) >= tail:
+        n -= 1
+    while draws_beyond(n, p) < tail:
+        n += 1
+    return n
+
+
+def thin_tail_note(tails: dict, null_draws: int) -> str:
+    """A sentence for the diagnosis's message when any quantile of ``tails`` (:func:`null_tails`)
+    has fewer than :data:`MIN_TAIL_DRAWS` draws beyond it, else ``""``."""
+    thin = {k: t for k, t in tails.items() if t["draws"] < MIN_TAIL_DRAWS}
+    if not thin:
+        return ""
+    need = draws_for_tail(min(t["tail_probability"] for t in tails.values()))
+    which = ", ".join(f"{t['draws']} beyond the {k} (its {1 - t['tail_probability']:.4g} quantile)"
+                      for k, t in thin.items())
+    return (f" Thin null tail: of the {null_draws} null draws, {which} — fewer than {MIN_TAIL_DRAWS}, so the "
+            f"actual level of each test named is uncertain by more than 1/sqrt({MIN_TAIL_DRAWS}) ≈ "
+            f"{100 / math.sqrt(MIN_TAIL_DRAWS):.0f} % (relative, ≈ 1/sqrt(draws beyond)); null_draws ≥ {need} puts "
+            f"{MIN_TAIL_DRAWS} beyond every quantile.")

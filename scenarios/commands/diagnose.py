@@ -57,6 +57,13 @@ clipped to the temperature laws' valid range. When no recommendation can be made
 experiment within the limits) the diagnosis is still written, with "no recommendation: <reason>" in
 the same places.
 
+A quantile of the null draws the tests threshold at with fewer than 10 draws beyond it (the LR test's
+at α − α_gap, the gap test's at α_gap/K per quantity and α_gap pooled; e.g. two quantities on fewer
+than 1802 --null-draws at α = 0.05) leaves that test's level uncertain: the "Thin null tail" note
+says which and how many draws would do, on stderr (whether or not --quiet), in summary.md, report.json
+(null.tails: each quantile's tail probability and draws beyond it; null.thin_tail: the note) and
+model.json's verdict reason.
+
 Several measured quantities of the same strip (actuator M and Z, sensor S and Z; one file per
 quantity, ``--data`` repeated or a list): the baseline, the candidates and the null are fitted to
 all their lines together, each quantity with its own noise (its per-line σ, or estimated per
@@ -578,6 +585,8 @@ def run(args) -> int:
         print(f"model: {out}/model.json — {mf.describe()}; use it downstream with --model {out}/model.json")
     if d.next_measurement is not None:               # said whether or not --quiet: it is the verdict's advice
         print(f"ipmc diagnose: {d.verdict}; {d.next_measurement.message}", file=sys.stderr)
+    if d.null.get("thin_tail"):                      # said whether or not --quiet: a level the draws leave uncertain
+        print(f"ipmc diagnose: {d.null['thin_tail']}", file=sys.stderr)
     if not mf.adequate:
         print(f"ipmc diagnose: the diagnosed model does not fit the data ({mf.verdict.reason}); model.json says so "
               "and every command that reads it will too"

@@ -358,6 +358,28 @@ were named exactly [0.65, 1.00]; the goal (≥ 80 %) is still not met on the eva
 After the review fix (ce4fe6e: a pair's combined λ takes off the first record's refit shortfall;
 the records described in their role), the same command: the same 4/7 [0.25, 0.84], two records
 recommended 2/7 and both named, the same three misses.
+
+Noise streams (2026-11-27, issue 27 review).  Every figure above used the streams of before this
+date, where a second recommended record's noise was not its own: in the sensor mode it came from
+``seed + 1000`` — the first record's stream of case ``seed + 1000`` (two cases could share noise) —
+and in the actuator mode from round ``round + 1000``.  Since then each record of each case has its
+own stream (:func:`noise_key`: ``[NEW_NOISE, seed, round, record]``; ``--check-streams`` checks over
+seeds 0-5000 × rounds 0-9 × records 0-3 that no two share one, comparing the PCG64 states, not the
+lists).  Each round's first record keeps its stream (the same entropy less trailing zeros), so only
+cases with two records recommended (``NextMeasurement.also``) can change.  Re-run once on fresh
+seeds (pairs 50472-50491; e245eb0 against an archive of main e83b7c5, one process each, 2 shared
+cores)::
+
+    python tests/benchmarks/bench_next_measurement.py --check-streams
+    python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 50400 --seeds 4
+
+every printed line the same less the wall times: 11 detectable of 20, 3 named exactly by the first
+record, 6 ambiguous, 4/6 [0.30, 0.90] named exactly after the recommended measurement(s), 7/11
+[0.35, 0.85] after at most one round; two records recommended 2/6 (50472: Z and M, both at 5, 35,
+65 °C, together λ 65.3; 50483: M 51.8-200 Hz and Z 0.0246-1.77 Hz, λ 564), both named exactly with
+their second records' new noise as with the old; misses 50477 (CR + TD, λ 1.55) and 50481 (CR + SM,
+λ 0.49), both forecast not to separate.  ``--check-streams``: 200 040 keys, none sharing a stream,
+no first record's stream moved; the streams before: 12 003 pairs shared in the sensor mode.
 """
 
 from __future__ import annotations
@@ -391,6 +413,68 @@ from scenarios.steps_chain import CANDIDATES, physics_free  # noqa: E402
 T_C = isn.TEMPERATURE_C
 #: Seed root of the new records' noise (not the generator's: a fresh measurement).
 NEW_NOISE = 0x27_0003
+
+
+def noise_key(seed: int, record: int = 0, round_: int = 0) -> list[int]:
+    """The ``SeedSequence`` entropy of one recommended record's noise: ``[NEW_NOISE, seed, round_,
+    record]`` — the case's seed, the round (``--rounds``; 0 the first) and the record's index within
+    its round (0 the recommended record, 1… ``NextMeasurement.also``), so no other (case, round,
+    record) has its stream (``--check-streams`` enumerates them).  Each entry one 32-bit word: a wider
+    integer is two words, and a SeedSequence pads its entropy with zeros to four words (``[a, b]``
+    and ``[a, b, 0, 0]`` give the same stream), so a five-word key could repeat a four-word one.
+    The order keeps the first record's stream of every round what it was before 2026-11-27
+    (``[NEW_NOISE, seed]`` then ``[NEW_NOISE, seed, round_]``: the same entropy less trailing
+    zeros); a second record's changed (see the module doc)."""
+    key = [NEW_NOISE, int(seed), int(round_), int(record)]
+    if not all(0 <= k < 2**32 for k in key):
+        raise ValueError(f"noise_key: seed {seed}, round {round_}, record {record}: each must be in [0, 2**32)")
+    return key
+
+
+def stream_state(key) -> tuple:
+    """The state ``default_rng(key)`` seeds its PCG64 with (``SeedSequence.generate_state(4, uint64)``):
+    two keys give one stream exactly when these agree (``[a, b]`` and ``[a, b, 0]`` differ as lists
+    and give one stream)."""
+    return tuple(np.random.SeedSequence(list(key)).generate_state(4, np.uint64).tolist())
+
+
+def stream_collisions(labelled) -> list[tuple]:
+    """The pairs of labels among ``(label, key)`` whose keys give the same stream."""
+    first: dict[tuple, object] = {}
+    clashes = []
+    for label, key in labelled:
+        st = stream_state(key)
+        if st in first:
+            clashes.append((first[st], label))
+        else:
+            first[st] = label
+    return clashes
+
+
+def check_streams(seeds: range, records: int, rounds: int) -> int:
+    """``--check-streams``: every (case seed, round, record) key of :func:`noise_key` over ``seeds`` ×
+    ``rounds`` × ``records``, checked that no two share a stream, and that each round's first record
+    keeps the stream it had before 2026-11-27.  The streams used before (sensor: a second record at
+    ``seed + 1000``, the first record's stream of case ``seed + 1000``; actuator: ``[seed, round +
+    1000·record]``) are enumerated alongside, to show the check can fail.  Returns the number of
+    clashes of the current keys plus the first records whose stream changed."""
+    grid = [(s, k, j) for s in seeds for k in range(rounds) for j in range(records)]
+    new = stream_collisions(((s, k, j), noise_key(s, j, k)) for s, k, j in grid)
+    old_sensor = stream_collisions(((s, 0, j), [NEW_NOISE, s + 1000 * j]) for s in seeds for j in range(records))
+    old_act = stream_collisions(((s, k, j), [NEW_NOISE, s] + ([k + 1000 * j] if k + 1000 * j else []))
+                                for s, k, j in grid)
+    moved = [(s, k) for s in seeds for k in range(rounds)
+             if stream_state(noise_key(s, 0, k)) != stream_state([NEW_NOISE, s] + ([k] if k else []))]
+    print(f"noise streams, (seed, round, record) over seeds {seeds.start}-{seeds.stop - 1} x rounds 0-{rounds - 1} "
+          f"x records 0-{records - 1}: {len(grid)} keys, {len(new)} pairs sharing a stream"
+          + (f" (e.g. {new[:3]})" if new else "")
+          + f"; first records of a round whose stream changed: {len(moved)}"
+          + (f" (e.g. {moved[:3]})" if moved else "")
+          + f".  Before 2026-11-27: sensor {len(old_sensor)} pairs sharing a stream (e.g. {old_sensor[:2]}), "
+          f"actuator {len(old_act)}")
+    return len(new) + len(moved)
+
+
 LABELS = ("amplifier", "delay")
 
 
@@ -412,15 +496,15 @@ def run_diagnosis(sweep, args):
 LAW_ERROR = {"ea_d": 20e3, "e_logslope": -0.005}
 
 
-def measure(truth, rec, seed: int, laws: dict | None = None) -> FrequencySweep:
+def measure(truth, rec, seed: int, laws: dict | None = None, record: int = 0) -> FrequencySweep:
     """The independent sensor at the recommended lines (bath temperatures included), with its own
-    (relative) noise, a fresh seed; ``laws`` its strip's temperature-law constants (default the
-    generator's, the library's defaults)."""
+    (relative) noise, a fresh stream (:func:`noise_key`: the case's ``seed``, the ``record``'s index);
+    ``laws`` its strip's temperature-law constants (default the generator's, the library's defaults)."""
     f = np.asarray(rec.line_frequencies_hz, float)
     T = np.asarray(rec.line_temperatures_c, float)
     H1 = isn.response(truth["base"], truth["effects"], f, temperature_c=T, laws=laws) * 1e3     # A/m -> uA/mm
     sig = truth["sigma_rel"] / math.sqrt(2.0)
-    rng = np.random.default_rng([NEW_NOISE, seed])
+    rng = np.random.default_rng(noise_key(seed, record))
     noisy = H1 * (1 + sig * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)))
     return FrequencySweep(T, f, noisy, np.full(f.size, 20 / math.log(10) * sig),
                           np.full(f.size, math.degrees(sig)), "tip_displacement", "mm", "current", "uA",
@@ -433,15 +517,15 @@ ACTUATOR_FREE = ("alpha0", "d", "kappa_e", "xi", "omega_n")
 ACTUATOR_LABELS = ("contact_resistance", "diffusivity_temperature")
 
 
-def measure_actuator(truth, r, seed: int, round_: int = 0) -> tuple[str, FrequencySweep]:
+def measure_actuator(truth, r, seed: int, round_: int = 0, record: int = 0) -> tuple[str, FrequencySweep]:
     """The independent actuator at the recommended lines (its own physics, at each bath temperature),
-    with the generator's relative noise and a fresh seed (another for each later ``round_``):
-    ``(quantity, sweep)``."""
+    with the generator's relative noise and a fresh stream (:func:`noise_key`: the case's ``seed``,
+    the ``round_``, the ``record``'s index within it): ``(quantity, sweep)``."""
     T, f = r.line_temperatures_c, r.line_frequencies_hz
     H = np.concatenate([ip.actuator_response(truth["base"], f[T == t], [t], truth["effects"])[r.quantity][0]
                         for t in np.unique(T)])
     sig = truth["noise"]["sigma_rel"] / math.sqrt(2.0)      # the generator's relative noise, a fresh seed
-    rng = np.random.default_rng([NEW_NOISE, seed] + ([round_] if round_ else []))
+    rng = np.random.default_rng(noise_key(seed, record, round_))
     noisy = H * (1 + sig * (rng.standard_normal(H.size) + 1j * rng.standard_normal(H.size)))
     std = (np.full(f.size, 20 / math.log(10) * sig), np.full(f.size, math.degrees(sig)))
     if r.quantity == "M":
@@ -494,7 +578,7 @@ def run_actuator_case(seed: int, label: str, args) -> dict:
         if r is not None and nm.also:         # two records recommended: both measured, diagnosed together
             records = {"M": sweep}
             for j, x in enumerate([r] + nm.also):
-                data, q = records_add(records, *measure_actuator(truth, x, seed, ALSO_ROUND * j))
+                data, q = records_add(records, *measure_actuator(truth, x, seed, 0, j))
             row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
             d2 = diag(data, q)
             row.update(second=d2.verdict, second_named=sorted(d2.named))
@@ -560,7 +644,7 @@ def run_pair_case(seed: int, label: str, args) -> dict:
         if r is not None:
             records = {"M": sweep}
             for j, x in enumerate([r] + nm.also):      # every recommended record (a second one: nm.also)
-                data, q = records_add(records, *measure_actuator(truth, x, seed, ALSO_ROUND * j))
+                data, q = records_add(records, *measure_actuator(truth, x, seed, 0, j))
             if nm.also:
                 row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
             d2 = diag(data, q, **on_chain(records, chain))
@@ -577,7 +661,7 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                 if rk is None:
                     break
                 for j, x in enumerate([rk] + nm.also):
-                    data, q = records_add(records, *measure_actuator(truth, x, seed, k + ALSO_ROUND * j))
+                    data, q = records_add(records, *measure_actuator(truth, x, seed, k, j))
                 d = diag(data, q, **on_chain(records, chain))
                 later.append({"recommended": rk.describe() + "".join(f" and {x.describe()}" for x in nm.also),
                               "lam_linear": nm.together["separation"] if nm.also else rk.separation, "lam_expected":
@@ -588,10 +672,6 @@ def run_pair_case(seed: int, label: str, args) -> dict:
     row["success"] = row["second"] == "named" and row["second_named"] == expected
     row["success_final"] = row.get("final") == "named" and row.get("final_named") == expected
     return row
-
-
-#: Noise-seed offset of a second recommended record (``NextMeasurement.also``) from its round's first.
-ALSO_ROUND = 1000
 
 
 def records_add(records: dict, q: str, new: FrequencySweep) -> tuple:
@@ -697,8 +777,7 @@ def run_case(seed: int, label: str, args) -> dict:
             new = measure(truth, nm.recommended, seed, LAW_ERROR if args.law_error else None)
             both = merge_records(sweep, new)
             for j, x in enumerate(nm.also):         # a second recommended record (S too): merged as well
-                both = merge_records(both, measure(truth, x, seed + ALSO_ROUND * (j + 1),
-                                                   LAW_ERROR if args.law_error else None))
+                both = merge_records(both, measure(truth, x, seed, LAW_ERROR if args.law_error else None, j + 1))
             if nm.also:
                 row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
             d2 = run_diagnosis(both, args)
@@ -775,7 +854,12 @@ def main(argv=None):
                          "and amplifier on M only (CHAIN_ON_M)")
     ap.add_argument("--min-ambiguous", type=int, default=0,
                     help="stop once this many ambiguous cases are scored (0: run every seed)")
+    ap.add_argument("--check-streams", action="store_true",
+                    help="no cases: check that no two (seed, round, record) of seeds 0-5000, rounds 0-9, records "
+                         "0-3 share a noise stream (exit 1 if any do)")
     args = ap.parse_args(argv)
+    if args.check_streams:
+        sys.exit(1 if check_streams(range(5001), 4, 10) else 0)
     act = args.kind == "actuator"
     if act and args.law_error:
         ap.error("--law-error: the sensor's laws only (--kind sensor)")

@@ -231,6 +231,11 @@ def test_measurement_validation():
         Measurement(output_noise_rms=1e-6)
     with pytest.raises(IPMCError, match="output_adc_step"):
         Measurement(output_adc_step=-1.0)
+    for bad in (-1, [5, -1], [], 2.5, True, "5"):         # numpy would refuse them deeper down, or take "5"
+        with pytest.raises(IPMCError, match=r"Measurement\.seed=.*expected an integer >= 0 or a non-empty list"):
+            Measurement(output_noise_rms=1e-6, seed=bad)
+    for good in (0, 2**40, [5, 1, 0, 0, 0], (7,)):         # an integer, or SeedSequence entropy
+        assert Measurement(output_noise_rms=1e-6, seed=good).seed == good
     with pytest.raises(IPMCError, match="model"):
         virtual_lab(object(), multisine([1.0], 100.0, 1.0), [25.0], periods=2)
 
