@@ -222,6 +222,58 @@ figures say:
   ``unexplained``: each quantity within its own threshold, M 369.5 ≤ 371.8, Z 362.9 ≤ 375.3, pooled
   732.5 > 696 — the message says "The gap test leaves the gap open pooled over M and Z"); gain
   ripple 48200-48207 and M alone: identical.
+* Out of library, how detectable are the misses (2026-11-27, issue 27; ``--detectability``, the
+  rule above).  Run once per set on the branch (library code = main at e83b7c5: the verdicts of the
+  fresh set are those of main's own run, case for case), the last two commands above: 48900-48907
+  (development: the set whose misses the previous paragraph describes) and 50000-50007 (fresh);
+  [Wilson 95 %]:
+
+  ==============================================  =========================  =========================
+  ``unexplained``, jointly with Z (M alone)        48900-48907                50000-50007 (fresh)
+  ==============================================  =========================  =========================
+  all cases                                       14/24 (12/24)              14/24 (13/24)
+  detectable, generator's λ ≥ 25 (the rule)       14/18 (12/18)              14/17 (13/17)
+  gap test's noise-free power ≥ ½                 **14/15** (12/14)          **14/15** (13/14)
+  Σ gap power (an ideal gap test's count)         15.4 (14.7)                15.4 (14.4)
+  ==============================================  =========================  =========================
+
+  Pooled, jointly: all 28/48 [0.44, 0.71]; λ_gen ≥ 25 28/35 [0.64, 0.90]; gap power ≥ ½ **28/30**
+  [0.79, 0.98] (M alone 25/48, 25/35, 25/28 [0.73, 0.96]).  The misses by kind, jointly (20):
+  undetectable (gap power < ½) → ``none`` 15 — every gain ripple missed (noise-free λ 6-60, power
+  ≤ 0.39: a magnitude ripple the baseline cannot absorb, but too small for a test over 310 lines)
+  and the creeps of noise-free λ ≤ 39 (power ≤ 0.12); undetectable → named/ambiguous distributed_cpe (/ series_cpe) 3
+  (48900 LR 12.9 and 48902 LR 18.4 with no gap; 50004 with a marginal gap, M 384/373, the CPE closing
+  it); detectable → ambiguous distributed_cpe / series_cpe 2 (48901, gap power 0.51, no gap in the
+  record; 50000, power 0.68, a marginal gap M 384/378 the CPE closes); a wrong pair name 0.  M alone
+  (23): undetectable → ``none`` 18, undetectable → named distributed_cpe 2 (no gap), detectable →
+  named distributed_cpe + permittivity_temperature with a gap 2 (48903, 50001: the pair closes M's
+  gap; jointly both are ``unexplained`` — Z pins κe and d) and ambiguous with a gap 1 (48904).
+  What the oracle says of the five creeps named or ambiguous jointly: the library's noise-free
+  baseline keeps λ 18-99 jointly (its M-alone fit absorbs most of a weak creep: λ 3-18), the CPE
+  takes a noise-free LR of 6-34 of it (the LR test's non-centrality; its threshold is ~10-12) and
+  leaves λ 12-65, a remainder the pooled gap test after the CPE sees with power 0.02-0.30.  So
+  the name is what the data say at this noise: a weak CPE is as likely as what is left, and no test
+  of the library's residual can tell them apart more often than that.  The fitted CPEs are not
+  implausible either (48900-48902, development: S_area 0.0009-0.0019 at the bottom of its range
+  [0, 2.5], its off value, n 0.89-0.96 inside [0.5, 1]: what a weak in-library CPE gives too).
+  Not corrected — no principled rule is visible: a named effect with a significant LR and no gap
+  is the normal signature of a *weak in-library* effect (the LR test has 1-2 dof, the gap test
+  ~300: at λ 25 the LR test's power is high and the gap test's 6-10 %), so "no gap → unexplained"
+  would turn weak correct names into ``unexplained``; a looser closing test (the pooled one at
+  α = 5 % rather than α_gap = 1 %) would see a remainder of λ 53-65 with power 0.43-0.56 instead of
+  0.20-0.30 (ncx2, 613 dof) but fail correct in-library names at up to ~α + α_gap instead of
+  ~2·α_gap (union bound) — a trade against the named-exactly row, not a fix, left to the issue, not
+  tuned here.  The out-of-library row's 90 % is met where the gap
+  test can see the effect (28/30); the rest are effects the data cannot show at their noise, for
+  which ``none`` (15 of 18) is the honest verdict.  Timing with the oracle: ~45 s per case
+  (two more diagnoses on noise-free data, every candidate, null_draws 200).
+  Fresh seeds of the other sets, run once on main at e83b7c5 (``/tmp`` archive; no rule, so no
+  "after"): ``--set contact --first-seed 50100 --seeds 5`` jointly 10/10 [0.72, 1.00] (M alone
+  5/10: every contact resistance ambiguous with the diffusivity law but 50101, λ 3.3, ``none``);
+  ``--set thermal --first-seed 50200 --seeds 4`` jointly 11/12 [0.65, 0.99] (50201 water uptake,
+  λ 8.3, ambiguous; M alone the same); ``--set null --first-seed 50300 --seeds 24`` no false
+  positive jointly 23/24 [0.80, 0.99] (50308 viscous_fluid named), M alone 22/24 (50305 ambiguous,
+  50308 water_uptake named).
 * Sensor: Z does not separate a lag from an amplifier pole — neither acts on the strip's own
   impedance, and with the library's default (chain effects on every quantity, i.e. Z measured
   through S's amplifier) they act identically on both.  Without ``acts_on`` every sensor S+Z case
