@@ -21,6 +21,26 @@ diagnosis is told so (``acts_on = {amplifier_bandwidth: [S], time_delay: [S]}``)
 verdict ``named`` with exactly the library name(s) of the hidden effect; a false positive: anything
 but ``none`` on a null strip.
 
+``--detectability`` (actuator sets) adds an oracle the diagnosis does not produce, per case: the
+generator's noise-free M and Z (the hidden effect on; the records' own per-line σ), the library's
+baseline calibrated to them (the diagnosis's own baseline fit, the five free parameters, no noise),
+and the non-centrality each quantity keeps, λ = 2·cost of that noise-free fit in units of the
+per-line σ — M alone, and M and Z jointly (per quantity and pooled).  From λ, the power of the gap
+test at the library's α_gap = α/5 (``scipy.stats.ncx2``: χ² with 2N − p dof for M alone at α_gap;
+per quantity 2N_k − p·N_k/N dof at α_gap/2, the gap significant if either is, 1 − Π(1 − power);
+pooled at α_gap; these quantiles reproduce the library's Monte-Carlo thresholds, 365-377 and ~700)
+— the only test whose rejection can make a verdict ``unexplained``; and the best library
+candidate's noise-free LR with what it leaves, λ − LR, and that remainder's pooled gap power.
+The summary gives the set's success rate on all cases, on the *detectable* ones by the rule of
+``bench_discrepancy.py`` reused (``DETECTABLE``: the generator's ``lam_baseline`` ≥ 25, λ after
+refitting its own perturbed base), and on those whose gap test has power ≥ ½ (an out-of-library
+effect the gap test misses more often than not cannot be called ``unexplained`` by it; ``none`` is
+then the expected answer); with the threshold-free comparison Σ power (the expected number of
+cases an ideal gap test fires on, with its binomial sd), and the misses by kind (undetectable:
+gap power < ½; detectable → ``none``; detectable → named/ambiguous by the LR test with no
+significant gap, or with one — a library effect or pair closed it).  λ ≥ 25 is an LR-test rule
+(few dof): at 2·155 lines it gives the gap test a power of only 6-10 %, which is why both are shown.
+
     python tests/benchmarks/bench_joint_diagnosis.py --set contact --first-seed 8100 --seeds 10
     python tests/benchmarks/bench_joint_diagnosis.py --set contact --candidates all --first-seed 8200 --seeds 5
     python tests/benchmarks/bench_joint_diagnosis.py --set thermal --first-seed 8300 --seeds 6
@@ -39,6 +59,8 @@ but ``none`` on a null strip.
     python tests/benchmarks/bench_joint_diagnosis.py --set oo --first-seed 48900 --seeds 8
     python tests/benchmarks/bench_joint_diagnosis.py --set contact --first-seed 49100 --seeds 5
     python tests/benchmarks/bench_joint_diagnosis.py --set thermal --first-seed 49200 --seeds 4
+    python tests/benchmarks/bench_joint_diagnosis.py --set oo --first-seed 48900 --seeds 8 --detectability
+    python tests/benchmarks/bench_joint_diagnosis.py --set oo --first-seed 50000 --seeds 8 --detectability
 
 Measured 2026-11-26 with the commands above (fresh seeds; development used 900-905), library
 defaults null_draws 4000, null_refits 4, 2 cores shared with other jobs; [Wilson 95 %]:
@@ -200,6 +222,58 @@ figures say:
   ``unexplained``: each quantity within its own threshold, M 369.5 ≤ 371.8, Z 362.9 ≤ 375.3, pooled
   732.5 > 696 — the message says "The gap test leaves the gap open pooled over M and Z"); gain
   ripple 48200-48207 and M alone: identical.
+* Out of library, how detectable are the misses (2026-11-27, issue 27; ``--detectability``, the
+  rule above).  Run once per set on the branch (library code = main at e83b7c5: the verdicts of the
+  fresh set are those of main's own run, case for case), the last two commands above: 48900-48907
+  (development: the set whose misses the previous paragraph describes) and 50000-50007 (fresh);
+  [Wilson 95 %]:
+
+  ==============================================  =========================  =========================
+  ``unexplained``, jointly with Z (M alone)        48900-48907                50000-50007 (fresh)
+  ==============================================  =========================  =========================
+  all cases                                       14/24 (12/24)              14/24 (13/24)
+  detectable, generator's λ ≥ 25 (the rule)       14/18 (12/18)              14/17 (13/17)
+  gap test's noise-free power ≥ ½                 **14/15** (12/14)          **14/15** (13/14)
+  Σ gap power (an ideal gap test's count)         15.4 (14.7)                15.4 (14.4)
+  ==============================================  =========================  =========================
+
+  Pooled, jointly: all 28/48 [0.44, 0.71]; λ_gen ≥ 25 28/35 [0.64, 0.90]; gap power ≥ ½ **28/30**
+  [0.79, 0.98] (M alone 25/48, 25/35, 25/28 [0.73, 0.96]).  The misses by kind, jointly (20):
+  undetectable (gap power < ½) → ``none`` 15 — every gain ripple missed (noise-free λ 6-60, power
+  ≤ 0.39: a magnitude ripple the baseline cannot absorb, but too small for a test over 310 lines)
+  and the creeps of noise-free λ ≤ 39 (power ≤ 0.12); undetectable → named/ambiguous distributed_cpe (/ series_cpe) 3
+  (48900 LR 12.9 and 48902 LR 18.4 with no gap; 50004 with a marginal gap, M 384/373, the CPE closing
+  it); detectable → ambiguous distributed_cpe / series_cpe 2 (48901, gap power 0.51, no gap in the
+  record; 50000, power 0.68, a marginal gap M 384/378 the CPE closes); a wrong pair name 0.  M alone
+  (23): undetectable → ``none`` 18, undetectable → named distributed_cpe 2 (no gap), detectable →
+  named distributed_cpe + permittivity_temperature with a gap 2 (48903, 50001: the pair closes M's
+  gap; jointly both are ``unexplained`` — Z pins κe and d) and ambiguous with a gap 1 (48904).
+  What the oracle says of the five creeps named or ambiguous jointly: the library's noise-free
+  baseline keeps λ 18-99 jointly (its M-alone fit absorbs most of a weak creep: λ 3-18), the CPE
+  takes a noise-free LR of 6-34 of it (the LR test's non-centrality; its threshold is ~10-12) and
+  leaves λ 12-65, a remainder the pooled gap test after the CPE sees with power 0.02-0.30.  So
+  the name is what the data say at this noise: a weak CPE is as likely as what is left, and no test
+  of the library's residual can tell them apart more often than that.  The fitted CPEs are not
+  implausible either (48900-48902, development: S_area 0.0009-0.0019 at the bottom of its range
+  [0, 2.5], its off value, n 0.89-0.96 inside [0.5, 1]: what a weak in-library CPE gives too).
+  Not corrected — no principled rule is visible: a named effect with a significant LR and no gap
+  is the normal signature of a *weak in-library* effect (the LR test has 1-2 dof, the gap test
+  ~300: at λ 25 the LR test's power is high and the gap test's 6-10 %), so "no gap → unexplained"
+  would turn weak correct names into ``unexplained``; a looser closing test (the pooled one at
+  α = 5 % rather than α_gap = 1 %) would see a remainder of λ 53-65 with power 0.43-0.56 instead of
+  0.20-0.30 (ncx2, 613 dof) but fail correct in-library names at up to ~α + α_gap instead of
+  ~2·α_gap (union bound) — a trade against the named-exactly row, not a fix, left to the issue, not
+  tuned here.  The out-of-library row's 90 % is met where the gap
+  test can see the effect (28/30); the rest are effects the data cannot show at their noise, for
+  which ``none`` (15 of 18) is the honest verdict.  Timing with the oracle: ~45 s per case
+  (two more diagnoses on noise-free data, every candidate, null_draws 200).
+  Fresh seeds of the other sets, run once on main at e83b7c5 (``/tmp`` archive; no rule, so no
+  "after"): ``--set contact --first-seed 50100 --seeds 5`` jointly 10/10 [0.72, 1.00] (M alone
+  5/10: every contact resistance ambiguous with the diffusivity law but 50101, λ 3.3, ``none``);
+  ``--set thermal --first-seed 50200 --seeds 4`` jointly 11/12 [0.65, 0.99] (50201 water uptake,
+  λ 8.3, ambiguous; M alone the same); ``--set null --first-seed 50300 --seeds 24`` no false
+  positive jointly 23/24 [0.80, 0.99] (50308 viscous_fluid named), M alone 22/24 (50305 ambiguous,
+  50308 water_uptake named).
 * Sensor: Z does not separate a lag from an amplifier pole — neither acts on the strip's own
   impedance, and with the library's default (chain effects on every quantity, i.e. Z measured
   through S's amplifier) they act identically on both.  Without ``acts_on`` every sensor S+Z case
@@ -231,11 +305,18 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 ROOT = Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests" / "discrepancy")]
 
+import independent_generator as ig  # noqa: E402
+import independent_physics as ip  # noqa: E402
 import independent_sensor as isn  # noqa: E402
 import joint_cases as jc  # noqa: E402
+import numpy as np  # noqa: E402
 from _stats import wilson  # noqa: E402
+from bench_discrepancy import DETECTABLE  # noqa: E402  (the detectability rule, reused: λ ≥ 25)
+from scipy.stats import chi2, ncx2  # noqa: E402
 
 from physmodel import IPMCParameters, get_parameter_set  # noqa: E402
+from physmodel.data.sweep import FrequencySweep  # noqa: E402
+from physmodel.estimation.diagnosis import GAP_ALPHA_DIVISOR  # noqa: E402
 from physmodel.estimation.discrepancy import diagnose  # noqa: E402
 
 ACTUATOR_FREE = ("alpha0", "d", "kappa_e", "xi", "omega_n")
@@ -246,8 +327,74 @@ SETS = {
     "oo": ("actuator", ("viscoelastic_creep", "fixture_resonance", "gain_ripple")),
     "sensor": ("sensor", ("amplifier", "delay")),
 }
+#: The diagnosis's default α and its gap test's share (the library's level, not chosen here).
+ALPHA = 0.05
+ALPHA_GAP = ALPHA / GAP_ALPHA_DIVISOR
 #: The sensor chain's element acts on S, not on the analyser's Z.
 SENSOR_ACTS_ON = {"amplifier_bandwidth": ["S"], "time_delay": ["S"]}
+
+
+def exact_sweep(sweep: FrequencySweep, response) -> FrequencySweep:
+    """``sweep`` with its response replaced by the noise-free ``response`` (the same lines and σ)."""
+    return FrequencySweep(sweep.temperature_c, sweep.frequency_hz, np.asarray(response, dtype=complex),
+                          sweep.magnitude_std_db, sweep.phase_std_deg, sweep.input_name, sweep.input_unit,
+                          sweep.output_name, sweep.output_unit, {"source": "noise-free (detectability oracle)"})
+
+
+def gap_power(lam: float, dof: float, level: float) -> float:
+    """Power of a χ² test of ``dof`` degrees of freedom at ``level`` (1 − its size) against the
+    non-centrality ``lam``: P(χ'²(dof, λ) > χ²_dof quantile at ``level``) (scipy.stats.ncx2)."""
+    thr = chi2.ppf(level, dof)
+    return float(chi2.sf(thr, dof)) if lam <= 0 else float(ncx2.sf(thr, dof, lam))
+
+
+def detectability(first: FrequencySweep, Z: FrequencySweep, truth: dict, base: IPMCParameters, seed: int) -> dict:
+    """The oracle of ``--detectability`` (module docstring): the generator's noise-free M and Z (the
+    hidden effect on, the records' own σ), the library's baseline calibrated to them (the workflow's
+    five free parameters; the diagnosis's own baseline fit, no candidate), and the non-centrality
+    each quantity keeps, λ = 2·cost of that noise-free fit, with the power it gives the gap test at
+    the library's α_gap: per quantity at α_gap/K against χ² with its lines' share of the dof, the
+    gap significant if any quantity's is (1 − Π(1 − power)); pooled at α_gap; M alone at α_gap."""
+    f, T = np.asarray(ig.FREQUENCIES_HZ, float), np.asarray(ig.TEMPERATURES_C, float)
+    resp = ip.actuator_response(truth["base"], f, T, truth["effects"])
+    Mx = exact_sweep(first, 1e3 * resp["M"].reshape(-1))          # mm/V, as make_case writes it
+    Zx = exact_sweep(Z, resp["Z"].reshape(-1))
+    kw = dict(kind="actuator", free=ACTUATOR_FREE, null_draws=200, null_refits=0, seed=seed)
+    d1 = diagnose(Mx, base, **kw)
+    d2 = diagnose([Mx, Zx], base, **kw)
+
+    def best(d, lam, dof):
+        # the library candidate that absorbs most of the noise-free gap: its LR (the LR test's
+        # non-centrality) and what it leaves, λ − LR, with the pooled gap test's power on that
+        c = max(d.candidates.values(), key=lambda x: x.lr, default=None)
+        if c is None:
+            return ("", 0.0, lam, gap_power(lam, dof, 1 - ALPHA_GAP))
+        left = max(lam - c.lr, 0.0)
+        return (c.name, float(c.lr), left, gap_power(left, dof - c.n_parameters, 1 - ALPHA_GAP))
+    p = len(d1.baseline.names)
+    n = first.frequency_hz.size
+    lam1 = 2 * float(d1.baseline.metadata["data_cost"])
+    lam_q = {r["quantity"]: 2 * float(r["cost_before"]) for r in d2.per_quantity}
+    lines = {r["quantity"]: int(r["lines"]) for r in d2.per_quantity}
+    n_all, K = sum(lines.values()), len(lines)
+    pow_q = {q: gap_power(lam_q[q], 2 * lines[q] - p * lines[q] / n_all, 1 - ALPHA_GAP / K) for q in lam_q}
+    return {"lam_alone": lam1, "power_alone": gap_power(lam1, 2 * n - p, 1 - ALPHA_GAP),
+            "lam_q": lam_q, "power_q": pow_q, "power_any": 1 - float(np.prod([1 - x for x in pow_q.values()])),
+            "lam_pooled": sum(lam_q.values()),
+            "power_pooled": gap_power(sum(lam_q.values()), 2 * n_all - p, 1 - ALPHA_GAP),
+            "best_alone": best(d1, lam1, 2 * n - p), "best_joint": best(d2, sum(lam_q.values()), 2 * n_all - p)}
+
+
+def gap_record(d) -> dict:
+    """What the noisy diagnosis ``d`` saw: the baseline's gap (significant anywhere), each quantity's
+    2·cost and threshold, the pooled one, the LR threshold and the best candidate's LR."""
+    gt = d.null.get("gap_test", {})
+    pooled = gt.get("pooled") or {}
+    best = max(d.candidates.values(), key=lambda c: c.lr, default=None)
+    return {"gap": any(gt["baseline_2cost"][q] > gt["thresholds_2cost"][q] for q in gt["thresholds_2cost"]),
+            "two_cost": dict(gt["baseline_2cost"]), "thr": dict(gt["thresholds_2cost"]),
+            "pooled": (pooled.get("two_cost_before"), pooled.get("threshold_before_2cost")),
+            "T": d.threshold, "best": (best.name, best.lr) if best else ("", 0.0)}
 
 
 def run_case(seed: int, label: str, kind: str, args) -> dict:
@@ -278,12 +425,14 @@ def run_case(seed: int, label: str, kind: str, args) -> dict:
     d2 = diagnose([first, Z], base, acts_on=acts_on, **kw)
     t2 = time.perf_counter()
     oo = kind == "actuator" and truth.get("out_of_library", False)
+    det = detectability(first, Z, truth, base, seed) if (args.detectability and kind == "actuator") else None
     ok = lambda d: ((d.verdict == "unexplained") if oo else (d.verdict == "none") if not expected  # noqa: E731
                     else (d.verdict == "named" and sorted(d.named) == expected))
     return {"seed": seed, "label": label, "expected": expected, "lam": lam,
             "single": (d1.verdict, sorted(d1.named)), "joint": (d2.verdict, sorted(d2.named)),
             "single_ok": ok(d1), "joint_ok": ok(d2), "t_single": t1 - t0, "t_joint": t2 - t1,
-            "misfit": [r["quantity"] for r in d2.per_quantity if r["misfit"]]}
+            "misfit": [r["quantity"] for r in d2.per_quantity if r["misfit"]], "det": det,
+            "gap_single": gap_record(d1), "gap_joint": gap_record(d2)}
 
 
 def main(argv=None):
@@ -295,6 +444,9 @@ def main(argv=None):
     ap.add_argument("--candidates", choices=("set", "all"), default="set",
                     help="set: contact -> the confusable pair, sensor -> lag and amplifier pole, thermal/null -> "
                          "every candidate; all: every candidate that applies")
+    ap.add_argument("--detectability", action="store_true",
+                    help="actuator sets: each case's noise-free non-centrality and gap-test power (module docstring), "
+                         "and the rates on the detectable cases")
     ap.add_argument("--null-draws", type=int, default=4000)
     ap.add_argument("--null-refits", type=int, default=4)
     args = ap.parse_args(argv)
@@ -310,6 +462,8 @@ def main(argv=None):
                   f"{'OK' if r['single_ok'] else '--'} | joint {r['joint'][0]} {r['joint'][1]} "
                   f"{'OK' if r['joint_ok'] else '--'}" + (f" (misfit left in {r['misfit']})" if r["misfit"] else "")
                   + f" ({r['t_single']:.0f} s, {r['t_joint']:.0f} s)", flush=True)
+            if r["det"] is not None:
+                print("      " + _det_line(r), flush=True)
     n = len(rows)
     for key, what in (("single_ok", "one quantity"), ("joint_ok", "joint")):
         k = sum(r[key] for r in rows)
@@ -323,9 +477,63 @@ def main(argv=None):
         print(f"  {lab}: one quantity {sum(r['single_ok'] for r in sub)}/{len(sub)}, joint "
               f"{sum(r['joint_ok'] for r in sub)}/{len(sub)}")
     print(f"  verdicts, one quantity: {_count(r['single'][0] for r in rows)}; joint: {_count(r['joint'][0] for r in rows)}")
+    if any(r["det"] is not None for r in rows):
+        _det_summary(rows, args.set == "oo")
     print(f"  mean time per diagnosis: one quantity {sum(r['t_single'] for r in rows) / n:.1f} s, joint "
           f"{sum(r['t_joint'] for r in rows) / n:.1f} s; elapsed {time.perf_counter() - t0:.0f} s")
     return rows
+
+
+def _det_line(r: dict) -> str:
+    """One case's detectability: the generator's λ (the rule), the noise-free library fit's λ and
+    the gap test's power, M alone and jointly, and what each noisy diagnosis's gap test saw."""
+    d, gs, gj = r["det"], r["gap_single"], r["gap_joint"]
+    q = " ".join(f"{k} λ {d['lam_q'][k]:.0f} P {d['power_q'][k]:.2f}" for k in d["lam_q"])
+    two = lambda g: ", ".join(f"{k} {g['two_cost'][k]:.0f}/{g['thr'][k]:.0f}" for k in g["thr"])  # noqa: E731
+    pj = gj["pooled"]
+    b1, b2 = d["best_alone"], d["best_joint"]
+    return (f"detectable {'yes' if r['lam'] >= DETECTABLE else 'no'} (λ_gen {r['lam']:.0f}); noise-free library fit: "
+            f"M alone λ {d['lam_alone']:.0f} P {d['power_alone']:.2f} | joint {q}, any P {d['power_any']:.2f}, pooled "
+            f"λ {d['lam_pooled']:.0f} P {d['power_pooled']:.2f}; noise-free best candidate alone {b1[0]} LR {b1[1]:.0f} "
+            f"leaves λ {b1[2]:.0f} P {b1[3]:.2f}, joint {b2[0]} LR {b2[1]:.0f} leaves λ {b2[2]:.0f} P {b2[3]:.2f}"
+            f" || noisy: alone gap {'yes' if gs['gap'] else 'no'} "
+            f"({two(gs)}), best {gs['best'][0]} LR {gs['best'][1]:.1f}/{gs['T']:.1f} | joint gap "
+            f"{'yes' if gj['gap'] else 'no'} ({two(gj)}, pooled {pj[0]:.0f}/{pj[1]:.0f}), best {gj['best'][0]} "
+            f"LR {gj['best'][1]:.1f}/{gj['T']:.1f}")
+
+
+def _miss_class(r: dict, key: str, oo: bool) -> str:
+    """An out-of-library miss by kind: undetectable (the gap test's power below ½: ``none`` is then
+    the expected answer) or detectable, and its verdict: ``none``, or named/ambiguous by the LR test
+    with no significant gap in the noisy record, or with one (a library effect or pair closed it)."""
+    v = r[key][0]
+    ok = r[key + "_ok"]
+    if ok or not oo:
+        return "ok" if ok else "miss"
+    d = r["det"]
+    powr = d["power_alone"] if key == "single" else d["power_any"]
+    gap = r["gap_single" if key == "single" else "gap_joint"]["gap"]
+    kind = "undetectable (gap power < 0.5)" if powr < 0.5 else "detectable"
+    if v == "none":
+        return f"{kind} → none"
+    return f"{kind} → {v} " + ("with a gap (closed by a library effect)" if gap else "by the LR test, no gap")
+
+
+def _det_summary(rows: list, oo: bool) -> None:
+    """``unexplained`` (or the set's success) on all cases, on the detectable ones (the generator's
+    λ ≥ DETECTABLE) and on those whose gap test has power ≥ ½; the expected count of an ideal gap
+    test (Σ power); the misses by kind."""
+    for key, what, pw in (("single", "one quantity", "power_alone"), ("joint", "joint", "power_any")):
+        rr = [r for r in rows if r["det"] is not None]
+        parts = []
+        for name, sub in (("all", rr), (f"λ_gen ≥ {DETECTABLE:g}", [r for r in rr if r["lam"] >= DETECTABLE]),
+                          ("gap power ≥ 0.5", [r for r in rr if r["det"][pw] >= 0.5])):
+            k, n = sum(r[key + "_ok"] for r in sub), len(sub)
+            lo, hi = wilson(k, n) if n else (math.nan, math.nan)
+            parts.append(f"{name} {k}/{n} [{lo:.2f}, {hi:.2f}]")
+        ps = [r["det"][pw] for r in rr]
+        print(f"{what:13s}: " + "; ".join(parts) + f"; Σ gap power {sum(ps):.1f} (sd {math.sqrt(sum(x * (1 - x) for x in ps)):.1f})")
+        print("  misses: " + str(_count(_miss_class(r, key, oo) for r in rr if not r[key + "_ok"])))
 
 
 def _count(vs) -> dict:
