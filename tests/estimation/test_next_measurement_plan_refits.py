@@ -19,6 +19,7 @@ from next_measurement_cases import virtual_lab_record
 
 from physmodel.data.sweep import FrequencySweep
 from physmodel.data.units import QUANTITY_UNITS
+from physmodel.errors import IPMCError
 from physmodel.estimation.next_measurement_design import (
     REFIT_STARTS,
     CompetingModel,
@@ -35,7 +36,7 @@ from physmodel.estimation.next_measurement_design import (
 )
 from physmodel.estimation.next_measurement_plan import RecordPair, record_base, refit_plan
 from physmodel.estimation.next_measurement_results import CandidateMeasurement, merge_records
-from physmodel.estimation.residuals import noise_std
+from physmodel.estimation.residuals import noise_std, standardised_residuals
 
 
 @pytest.fixture(scope="module")
@@ -167,3 +168,27 @@ def test_a_rival_that_holds_the_truth_is_not_separated_by_two_records(ambiguous)
     assert tg["separation"] == lam and tg["separation_linearised"] == lin and not tg["linearised_only"]
     assert tg["refits"]["fits"] == 4 and tg["refits"]["starts"] == 2 * REFIT_STARTS
     assert tg["refits"]["evaluations"] > 0
+
+
+def test_two_records_of_two_quantities_stack_with_the_record(ambiguous):
+    """An S record merged with the (S) record and a Z record diagnosed jointly with it (the one-quantity
+    record's view does not stack two quantities itself: joint_data): every line is there once (the
+    record's, then each new one), the truth's χ² on its own predictions is nothing (the data and the
+    model's stacking agree line by line), and the rival refitted to both together leaves no
+    less than to either alone (min_θ [Q₁ + Q₂] ≥ max(min Q₁, min Q₂): invariant of least squares)."""
+    from physmodel.estimation.next_measurement_design import refit_data
+
+    a = ambiguous
+    r1 = _exp("S", 35.0, np.geomspace(150.0, 400.0, 6), True)
+    z = _exp("Z", 35.0, np.geomspace(1.0, 100.0, 7), True)
+    sw, factory = refit_data(a.d, [r1, z], a.nm, a.ab, a.view)
+    assert sw.frequency_hz.size == a.d.data.frequency_hz.size + r1.n_lines + z.n_lines
+    G = np.asarray(factory(a.ab.model)([a.ab.values])[0])
+    s_ln, s_ph, _ = noise_std(sw)
+    res = standardised_residuals(G, sw, s_ln, s_ph)
+    assert float(res @ res) < 1e-20          # the truth's χ² on its own predictions: rounding only
+    both = refit_lambda(a.d, [r1, z], a.nm, a.ab, a.td, 100, view=a.view)
+    each = [refit_lambda(a.d, r, a.nm, a.ab, a.td, 100, view=a.view) for r in (r1, z)]
+    assert both >= max(each) * (1 - 1e-3)
+    with pytest.raises(IPMCError, match="no experiment"):
+        refit_lambda(a.d, [], a.nm, a.ab, a.td, 10, view=a.view)
