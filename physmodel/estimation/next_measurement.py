@@ -268,7 +268,8 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         The competing models (effect names each, the best first; default :func:`competing_models`).
     check_refit : int
         How many of the preferred experiments to check by nonlinear refits of the rivals, in order,
-        until one reaches the target (0: none).
+        until one reaches the target; two records are checked together as well (0: none, and two
+        records are then recommended on their linearised λ, ``together["linearised_only"]``).
     max_nfev : int
         Function evaluations of each refit.
     acts_on : mapping or None
