@@ -380,6 +380,36 @@ record, 6 ambiguous, 4/6 [0.30, 0.90] named exactly after the recommended measur
 their second records' new noise as with the old; misses 50477 (CR + TD, λ 1.55) and 50481 (CR + SM,
 λ 0.49), both forecast not to separate.  ``--check-streams``: 200 040 keys, none sharing a stream,
 no first record's stream moved; the streams before: 12 003 pairs shared in the sensor mode.
+
+Two records checked by refits (2026-11-27, issue 27 item 3).  A recommended pair of records is now
+checked as a single record is: for each competing pair the rival is refitted to the truth's
+noiseless predictions on BOTH records together (with the diagnosed record's lines when either is
+evaluated with it), from the single-record check's starts, the least over the two directions
+(``next_measurement_plan.refit_plan``); the two are recommended only when the refits reach the
+target too, else the pair that falls short is said with its shortfall and no second record is
+recommended.  ``NextMeasurement.together["separation"]`` is now the refits' λ (the linearised one
+is ``separation_linearised``): this file still prints it as "together λ ... linearised" (its
+label, not changed here).  Run once on fresh seeds, the branch (h-tworefit 8a34544) and an
+archive of main (83bbb29), one process each, 2 shared cores::
+
+    python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 50600 --seeds 4
+
+every printed line the same less the wall times: 12 detectable of 20, 3 named exactly by the first
+record, 9 ambiguous; named exactly after the recommended measurement(s) 4/9 [0.19, 0.73] on main
+and on the branch, 7/12 [0.32, 0.81] after at most one round on both; two records recommended 1/9
+on both (50674: M 5, 35, 65 °C, 0.06-41 Hz ×2 and Z 5, 35, 65 °C, 0.01-0.9 Hz; λ 121.8
+linearised, 122.2 after the refits), named exactly.  The development blocks (``--first-seed 47000``
+and ``48000 --seeds 4``, the same two trees) likewise: 3/9 [0.12, 0.65] and 6/9 [0.35, 0.88] on
+both, every line the same but the two-record cases' λ, each confirmed by the refits — 47079 52.64
+→ 52.64, 47082 4510 → 4493, 48081 1380 → 1370, 48084 1530 → 1500, 48085 216.4 → 216.2 (linearised
+→ after the refits).  So no measured case had its pair of records overturned; the refusal is
+checked by the unit tests (tests/estimation/test_next_measurement_plan_refits.py: a rival whose
+family holds the truth, λ 1.7e6 linearised and 1e-23 after the refits; test_next_measurement_plan:
+seed 47079 with a second M record claimed at λ 1e6 linearised, 1.74 after the refits for the
+contact resistance against the diffusivity law, which only Z tells apart).  Cost: the check refits
+each rival twice per direction (24 fits for 6 pairs); ``next_measurement`` CPU per call on the
+two-record cases 1.5 → 2.3 s (50674, 40 fits), 2.1 → 3.1 s (47079), 3.7 → 5.3 s (47082), 1.9 →
+2.8 s (48085), main → branch; the medians printed above stay 1-2 s.
 """
 
 from __future__ import annotations
