@@ -192,3 +192,40 @@ def test_two_records_of_two_quantities_stack_with_the_record(ambiguous):
     assert both >= max(each) * (1 - 1e-3)
     with pytest.raises(IPMCError, match="no experiment"):
         refit_lambda(a.d, [], a.nm, a.ab, a.td, 10, view=a.view)
+
+
+def test_a_joint_diagnosis_stacks_two_records_into_its_quantities():
+    """A joint diagnosis (S and Z of the independent sensor, seed 950, as test_next_measurement_joint):
+    two S records merged into its S record and the Z record kept — every line once; the truth's χ²
+    on its own predictions nil; the rival refitted to both no closer than to either alone; and the
+    one-experiment call main's bit for bit on the joint view too."""
+    from next_measurement_cases import independent
+
+    from physmodel import get_parameter_set
+    from physmodel.estimation.discrepancy import diagnose
+    from physmodel.estimation.next_measurement_design import refit_data
+    from scenarios.steps_chain import physics_free
+
+    isn, jc = independent("independent_sensor"), independent("joint_cases")
+    S, Z, _ = jc.make_joint_sensor_case(950, "amplifier")
+    p0 = get_parameter_set("seed000_sensor_dev", T_ref=isn.TEMPERATURE_C + 273.15)
+    cands = ["amplifier_bandwidth", "time_delay"]
+    d = diagnose([S, Z], p0, kind="sensor", quantity=("S", "Z"), candidates=cands,
+                 free=physics_free(p0, ["a0", "d", "kappa_e"], math.copysign(1, p0.a0)), null_draws=400,
+                 null_refits=0, seed=1, acts_on={c: ["S"] for c in cands})
+    assert d.joint is not None and d.verdict == "ambiguous"
+    ab, td = fit_competing_models(d, [("amplifier_bandwidth",), ("time_delay",)], 100)
+    nm, view = noise_model(d), RecordView(d)
+    T = float(S.temperature_c[0])
+    r1 = _exp("S", T, np.geomspace(150.0, 400.0, 6), True)
+    r2 = _exp("S", T, np.geomspace(450.0, 1000.0, 6), True)
+    sw, factory = refit_data(d, [r1, r2], nm, ab, view)
+    assert sw.frequency_hz.size == S.frequency_hz.size + Z.frequency_hz.size + r1.n_lines + r2.n_lines
+    G = np.asarray(factory(ab.model)([ab.values])[0])
+    s_ln, s_ph, _ = noise_std(sw)
+    res = standardised_residuals(G, sw, s_ln, s_ph)
+    assert float(res @ res) < 1e-20
+    both = refit_lambda(d, [r1, r2], nm, ab, td, 100, view=view)
+    each = [refit_lambda(d, r, nm, ab, td, 100, view=view) for r in (r1, r2)]
+    assert both >= max(each) * (1 - 1e-3)
+    assert each[0] == _refit_lambda_main(d, r1, nm, ab, td, 100, view=view)
