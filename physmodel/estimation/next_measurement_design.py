@@ -377,11 +377,14 @@ def refit_lambda(d, r, nm: dict, truth: CompetingModel, rival: CompetingModel, m
         free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in rival.free]
         res = fit_parameters(sw, None, free, predict_many=pm, starts=n, seed=0, max_nfev=max_nfev, identify=False,
                              hold_undetermined=False)
-        best = min(best, 2.0 * float(res.cost))
+        lam = 2.0 * float(res.cost)
+        best = min(best, lam) if lam == lam else float("nan")   # NaN stays NaN: not separated (review)
         if count is not None:
             count["fits"] = count.get("fits", 0) + 1
             count["starts"] = count.get("starts", 0) + len(res.starts)
             count["evaluations"] = count.get("evaluations", 0) + int(sum(s.nfev for s in res.starts))
+        if best != best:
+            break
     return best
 
 

@@ -85,12 +85,13 @@ class RecordPair:
         """:attr:`~physmodel.estimation.next_measurement_results.NextMeasurement.together` of the
         plan: ``separation`` the refits' λ when checked (else the linearised one),
         ``separation_linearised``, ``separation_by_pair`` (linearised, per direction),
-        ``refit_by_pair``, ``linearised_only`` and ``refits``."""
+        ``refit_by_pair``, ``linearised_only``, ``refits`` and ``recommended`` (True here; the search
+        sets it False for a plan the refits refuse)."""
         checked = bool(self.refit_by_pair)
         return {"separation": self.separation_refit if checked else self.separation,
-                "separation_linearised": self.separation, "separation_by_pair": self.separation_by_pair,
+                "separation_linearised": self.separation, "separation_by_pair": dict(self.separation_by_pair),
                 "refit_by_pair": dict(self.refit_by_pair), "linearised_only": not checked,
-                "refits": dict(self.refits)}
+                "refits": dict(self.refits), "recommended": True}
 
 
 def record_base(rec_a: tuple, rec_b: tuple, w0: np.ndarray) -> tuple:
@@ -165,8 +166,9 @@ def refit_plan(d, plan: RecordPair, first: CandidateMeasurement, pairs: list, nm
 
     count: dict = {"fits": 0, "starts": 0, "evaluations": 0}
     by = refit_check(d, pairs, [first, plan.second], nm, max_nfev, label, view, count=count)
-    return replace(plan, separation_refit=float(min(by.values())) if by else float("nan"), refit_by_pair=by,
-                   refits=count)
+    # a pair whose refits gave no finite λ is not separated: NaN, whatever the order of the pairs
+    least = float("nan") if not by or any(v != v for v in by.values()) else float(min(by.values()))
+    return replace(plan, separation_refit=least, refit_by_pair=by, refits=count)
 
 
 def bath_premise(records: list, record_temperatures_c, base) -> str:

@@ -388,8 +388,10 @@ evaluated with it), from the single-record check's starts, the least over the tw
 (``next_measurement_plan.refit_plan``); the two are recommended only when the refits reach the
 target too, else the pair that falls short is said with its shortfall and no second record is
 recommended.  ``NextMeasurement.together["separation"]`` is now the refits' λ (the linearised one
-is ``separation_linearised``): this file still prints it as "together λ ... linearised" (its
-label, not changed here).  Run once on fresh seeds, the branch (h-tworefit 8a34544) and an
+is ``separation_linearised``): the runs below printed it as "together λ ... linearised"; since
+the review this file prints both ("together λ L linearised, R refit"), and a later round's
+"λ expected" of two records is theirs (before, the first record's own refit λ beside the two
+records' λ).  Run once on fresh seeds, the branch (h-tworefit 8a34544) and an
 archive of main (83bbb29), one process each, 2 shared cores::
 
     python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 50600 --seeds 4
@@ -609,7 +611,8 @@ def run_actuator_case(seed: int, label: str, args) -> dict:
             records = {"M": sweep}
             for j, x in enumerate([r] + nm.also):
                 data, q = records_add(records, *measure_actuator(truth, x, seed, 0, j))
-            row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+            row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"],
+                       lam_together_linear=nm.together.get("separation_linearised", float("nan")))
             d2 = diag(data, q)
             row.update(second=d2.verdict, second_named=sorted(d2.named))
         elif r is not None:
@@ -676,7 +679,8 @@ def run_pair_case(seed: int, label: str, args) -> dict:
             for j, x in enumerate([r] + nm.also):      # every recommended record (a second one: nm.also)
                 data, q = records_add(records, *measure_actuator(truth, x, seed, 0, j))
             if nm.also:
-                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"],
+                       lam_together_linear=nm.together.get("separation_linearised", float("nan")))
             d2 = diag(data, q, **on_chain(records, chain))
             row.update(second=d2.verdict, second_named=sorted(d2.named),
                        second_final=sorted(d2.final_effects or ()), second_message=d2.message)
@@ -694,8 +698,9 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                     data, q = records_add(records, *measure_actuator(truth, x, seed, k, j))
                 d = diag(data, q, **on_chain(records, chain))
                 later.append({"recommended": rk.describe() + "".join(f" and {x.describe()}" for x in nm.also),
-                              "lam_linear": nm.together["separation"] if nm.also else rk.separation, "lam_expected":
-                              rk.separation_refit, "separates": nm.separates, "verdict": d.verdict,
+                              "lam_linear": nm.together["separation_linearised"] if nm.also else rk.separation,
+                              "lam_expected": nm.together["separation"] if nm.also else rk.separation_refit,
+                              "separates": nm.separates, "verdict": d.verdict,
                               "named": sorted(d.named)})
             row.update(later=later, final=d.verdict, final_named=sorted(d.named))
     row["dt"] = time.perf_counter() - t0
@@ -730,7 +735,7 @@ def pair_report(rows: list) -> None:
             continue
         rec = (f"{r['recommended']}; λ {r['lam_linear']:.3g} / {r['lam_expected']:.3g}"
                + "".join(f"; and, with it, {a}" for a in r.get("also", []))
-               + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+               + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
                + f"; {'yes' if r['separates'] else 'no'}" if r["recommended"] else "-")
         print(f"| {r['seed']} | {lam} | {r['first']} {r['first_named']} | {rec} | "
               + (f"{r['second']} {r['second_named']} {'OK' if r['success'] else 'MISS'}" if r["second"] else "-")
@@ -809,7 +814,8 @@ def run_case(seed: int, label: str, args) -> dict:
             for j, x in enumerate(nm.also):         # a second recommended record (S too): merged as well
                 both = merge_records(both, measure(truth, x, seed, LAW_ERROR if args.law_error else None, j + 1))
             if nm.also:
-                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"],
+                       lam_together_linear=nm.together.get("separation_linearised", float("nan")))
             d2 = run_diagnosis(both, args)
             row.update(second=d2.verdict, second_named=sorted(d2.named), residual=residual_ratio(d2))
     row["dt"] = time.perf_counter() - t0
@@ -909,7 +915,7 @@ def main(argv=None):
                   f"{r['first']} {r['first_named']}"
                   + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} refit"
                      + "".join(f" and, with it, {a}" for a in r.get("also", []))
-                     + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+                     + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
                      + f"; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
                      f"inseparable {r['inseparable'] or '-'}] -> {r['second']} {r['second_named']} "
                      f"{'OK' if r['success'] else 'MISS'}" if r["recommended"] else "")
@@ -934,7 +940,7 @@ def main(argv=None):
             print(f"  seed {r['seed']} {lab:10s} λ {r['lam']:8.1f}: {r['first']} {r['first_named']}"
                   + (f" -> [{r['recommended']}"
                      + "".join(f" and, with it, {a}" for a in r.get("also", []))
-                     + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+                     + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
                      + f"; λ expected {r['lam_expected']:.3g}] -> {r['second']} {r['second_named']}"
                      f" {'OK' if r['success'] else 'MISS'}" if r['recommended'] else "")
                   + (f" cost/expected {r['residual']:.3g}" if r.get("residual") is not None else "")

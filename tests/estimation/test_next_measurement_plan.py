@@ -145,6 +145,7 @@ def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(seed47079, monke
     assert nm.together["separation"] == min(nm.together["refit_by_pair"].values()) >= nm.target
     assert nm.together["refits"]["fits"] == 2 * 2 * len(r.separation_by_pair)     # 2 calls × 2 directions a pair
     assert 0.5 < nm.together["separation"] / lin < 2.0
+    assert nm.together["recommended"] is True and nm.to_dict()["together"]["recommended"] is True   # review
     assert "and, with it," in nm.message and "together expected λ" in nm.message
     assert "checked by refits of the rivals to both records together" in nm.message
     assert nm.to_dict()["also"][0]["quantity"] == also[0].quantity

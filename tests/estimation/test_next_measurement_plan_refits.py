@@ -229,3 +229,18 @@ def test_a_joint_diagnosis_stacks_two_records_into_its_quantities():
     each = [refit_lambda(d, r, nm, ab, td, 100, view=view) for r in (r1, r2)]
     assert both >= max(each) * (1 - 1e-3)
     assert each[0] == _refit_lambda_main(d, r1, nm, ab, td, 100, view=view)
+
+
+
+def test_a_pair_without_a_finite_refit_is_not_separated(monkeypatch):
+    # review: min(inf, nan) is inf, so a NaN refit λ could read as "infinitely separated"; refit_plan's
+    # least λ must be NaN (short of any target) whatever the order of the pairs
+    from physmodel.estimation import next_measurement_design as design
+    from physmodel.estimation import next_measurement_plan as plan_mod
+
+    for by in ({"A vs B": float("nan"), "C vs D": 50.0}, {"C vs D": 50.0, "A vs B": float("nan")}):
+        monkeypatch.setattr(design, "refit_check", lambda *a, by=by, **k: dict(by))
+        rp = plan_mod.RecordPair(second=None, separation=100.0)          # type: ignore[arg-type]
+        checked = plan_mod.refit_plan(None, rp, None, [], {}, 10, str, None)
+        assert "A vs B" in checked.short(42.0)
+        assert not checked.together()["separation"] >= 42.0
