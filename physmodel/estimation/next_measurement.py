@@ -66,9 +66,10 @@ the resonance), a second experiment is searched to add to the recommended one (g
 maximising the least over the pairs of the two records' λ, computed by stacking their
 normal-equation sums (λ is not additive: the rival refits one set of parameters to both), none of
 its lines the first's (:mod:`~physmodel.estimation.next_measurement_plan`).  When the two reach λ*
-they are recommended together (``NextMeasurement.also``; ``separates`` then refers to both; their λ
-is linearised only, the refits check the first alone); otherwise the single recommendation stands,
-unchanged.
+they are checked by full refits of the rivals to both records together, and recommended together
+when the refits reach λ* too (``NextMeasurement.also``; ``separates`` then refers to both; the pair
+the refits leave short is said with its shortfall, and not recommended); otherwise the single
+recommendation stands, unchanged.
 
 Temperatures: the search offers bath steps (a 5-point grid of the allowed range and its ends with
 the middle) for every quantity the models predict at other temperatures through the parameter set's
@@ -130,7 +131,7 @@ from .next_measurement_design import (
     t_solve,
     t_sums,
 )
-from .next_measurement_plan import bath_premise, record_base, second_record
+from .next_measurement_plan import bath_premise, record_base, refit_plan, second_record
 from .next_measurement_results import CandidateMeasurement, NextMeasurement, json_ready, merge_records
 from .residuals import noise_std
 
@@ -267,7 +268,8 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
         The competing models (effect names each, the best first; default :func:`competing_models`).
     check_refit : int
         How many of the preferred experiments to check by nonlinear refits of the rivals, in order,
-        until one reaches the target (0: none).
+        until one reaches the target; two records are checked together as well (0: none, and two
+        records are then recommended on their linearised λ, ``together["linearised_only"]``).
     max_nfev : int
         Function evaluations of each refit.
     acts_on : mapping or None
@@ -536,7 +538,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     chosen = good[0] if good else (max(checked, key=lambda r: r.separation_refit) if checked else order[0])
     sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
-    plan = None          # no single experiment reaches the target: a second one with it (next_measurement_plan)
+    plan = plan_short = None     # no single experiment reaches the target: a second one with it (next_measurement_plan)
     # one pair: more data of one kind, said as 'lower the noise' (as before); a first record whose linearised λ
     # reaches the target but whose refits do not: the linearisation is not to be built on (no second record)
     if len(live) > 1 and not sep_ok and chosen.separation < target:
@@ -546,6 +548,9 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                  for k, v in chosen.refit_by_pair.items() if math.isfinite(v) and k in chosen.separation_by_pair}
         plan = second_record(chosen, rows, sums, bases, [key(a, b) for a, b in live], short)
         plan = plan if plan is not None and plan.separation >= target else None
+        if plan is not None and check_refit > 0:     # the pair checked by refits on both records together
+            plan = refit_plan(d, plan, chosen, live, nm, max_nfev, label, view)
+            plan, plan_short = (None, plan) if plan.short(target) else (plan, None)
     who = " vs ".join(" + ".join(m) for m in mods)
     alike = _inseparable_note(same_form, same_refit, bool(contests))
     if not live:
@@ -562,9 +567,11 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
             chosen = replace(chosen, joint=True, added_quantity=True)
         msg = (f"Next measurements to separate {who} (no single experiment within the limits is expected to): "
                f"{chosen.describe()} and, with it, {plan.second.describe()}: together expected λ = "
-               f"{plan.separation:.3g}, linearised, the records diagnosed together (≥ {target:.3g} needed for "
-               f"{power:.0%} power at α = {d.alpha:g}; the first alone gives {shortfall(chosen)[1]}, the record "
-               f"alone {current:.3g}; the refits checked the first alone, not the pair).{alike}")
+               + (f"{plan.separation_refit:.3g}, checked by refits of the rivals to both records together "
+                  f"({plan.separation:.3g} linearised)" if plan.refit_by_pair else f"{plan.separation:.3g}, "
+                  "linearised only (no refit check asked)")
+               + f", the records diagnosed together (≥ {target:.3g} needed for {power:.0%} power at α = "
+               f"{d.alpha:g}; the first alone gives {shortfall(chosen)[1]}, the record alone {current:.3g}).{alike}")
     else:
         lam_low, lam_words = shortfall(chosen)
         msg = (f"No experiment within the limits is expected to separate {who} at the noise of this record: the "
@@ -573,6 +580,12 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam_low)}× "
                   "as many" if 0 < lam_low < target else "")
                + f"), widen the limits, or accept the ambiguity.{alike}")
+        if plan_short is not None:       # two records reached the target linearised, not after the refits
+            msg += (f" Two records were checked too: with it, {plan_short.second.describe()} gives λ = "
+                    f"{plan_short.separation:.3g} linearised, but after refits of the rivals to both records together "
+                    + "; ".join(f"{k} reaches only {v:.3g} (short of {target:.3g} by {target - v:.3g})"
+                                for k, v in plan_short.short(target).items())
+                    + ": not expected to separate, so not recommended.")
     forms: dict = {}
     if contests:
         msg += _forms_note(forms_said, contests, d.alpha)
@@ -586,8 +599,8 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                            {q: max(r.separation for r in rows if r.quantity == q) for q in qs
                             if any(r.quantity == q for r in rows)}, list(same_refit), premise, forms,
                            also=[plan.second] if plan is not None else [],
-                           together={"separation": plan.separation, "separation_by_pair": plan.separation_by_pair,
-                                     "linearised_only": True} if plan is not None else {})
+                           together=plan.together() if plan is not None else
+                           {**plan_short.together(), "recommended": False} if plan_short is not None else {})
 
 
 def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, first_inseparable=()) -> tuple:

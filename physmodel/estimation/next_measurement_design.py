@@ -288,39 +288,45 @@ def log_unit_factor(record: FrequencySweep, sk: FrequencySweep) -> float:
 
 
 
-def refit_check(d, pairs: list, r: CandidateMeasurement, nm: dict, max_nfev: int, label,
-                view: RecordView | None = None) -> dict:
-    """λ of experiment ``r`` by full refits: each rival refitted to the other's noiseless predictions
-    on the new lines (with the record's lines when joint) from its own fit, from its effect at its
-    typical size and from :data:`REFIT_STARTS` − 2 more Latin-hypercube starts; ``{"A vs B": the
-    least over the two directions}`` for each of ``pairs``."""
+def refit_check(d, pairs: list, r, nm: dict, max_nfev: int, label, view: RecordView | None = None,
+                count: dict | None = None) -> dict:
+    """λ of experiment ``r`` (or of the experiments of a sequence ``r`` together: a two-record plan,
+    :mod:`~physmodel.estimation.next_measurement_plan`) by full refits: each rival refitted to the
+    other's noiseless predictions on the new lines (with the record's lines when joint) from its own
+    fit, from its effect at its typical size and from :data:`REFIT_STARTS` − 2 more Latin-hypercube
+    starts; ``{"A vs B": the least over the two directions}`` for each of ``pairs``.  ``count``
+    (:func:`refit_lambda`) tallies the refits."""
     out = {}
     for a, b in pairs:
-        out[f"{label(a)} vs {label(b)}"] = min(refit_lambda(d, r, nm, truth, rival, max_nfev, view=view)
+        out[f"{label(a)} vs {label(b)}"] = min(refit_lambda(d, r, nm, truth, rival, max_nfev, view=view, count=count)
                                                for truth, rival in ((a, b), (b, a)))
     return out
 
 
-def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, rival: CompetingModel,
-                 max_nfev: int, rival_starts: Sequence[dict] = (), view: RecordView | None = None) -> float:
-    """λ of experiment ``r`` when ``truth`` is true: ``rival`` refitted to its noiseless predictions
-    (:func:`refit_check`), from its own fit, its effect at its typical size (and Latin-hypercube
-    starts) and each of ``rival_starts`` (values of every free parameter: the rival's other forms)."""
-    from .lsq import fit_parameters
-
-    view = view or RecordView(d)
-    in_name, unit_in, out_name, unit_out = QUANTITY_UNITS[(d.kind, r.quantity)]
-    sk = FrequencySweep(r.line_temperatures_c, r.line_frequencies_hz, np.ones(r.n_lines, complex), None, None,
-                        in_name, unit_in, out_name, unit_out)
-    cb = d.metadata.get("candidate_bounds", {})
-    same = r.quantity in view.sweeps
-    nm_q = nm["by_quantity"][r.quantity] if view.joint and same else nm
-    best = math.inf
-    G = np.asarray(view.many(truth.model, sk, r.quantity)([truth.values])[0])
-    if r.joint:
-        rs = view.sweeps.get(r.quantity)
+def refit_data(d, records: Sequence[CandidateMeasurement], nm: dict, truth: CompetingModel,
+               view: RecordView) -> tuple:
+    """(sweep, predictor factory ``model -> many``) of the new ``records`` as ``truth`` predicts them,
+    noiseless, each line with the σ it is expected to carry (:func:`line_sigma`): when any record is
+    evaluated with the diagnosed record (``joint``) the record's lines too (as ``truth`` predicts
+    them, with their σ), a record of a quantity the record holds merged into it and another quantity
+    diagnosed jointly; otherwise the records alone (two of one quantity merged, of two quantities
+    diagnosed jointly).  One record: the sweep :func:`refit_lambda` always refitted to."""
+    joint = any(r.joint for r in records)
+    new: dict = {}
+    for r in records:
+        in_name, unit_in, out_name, unit_out = QUANTITY_UNITS[(d.kind, r.quantity)]
+        sk = FrequencySweep(r.line_temperatures_c, r.line_frequencies_hz, np.ones(r.n_lines, complex), None, None,
+                            in_name, unit_in, out_name, unit_out)
+        G = np.asarray(view.many(truth.model, sk, r.quantity)([truth.values])[0])
+        same = joint and r.quantity in view.sweeps       # σ regressed on |G| of the record's quantity
+        rs = view.sweeps.get(r.quantity) if same else None
         logabs = np.log(np.abs(G)) + (log_unit_factor(rs, sk) if rs is not None else 0.0)
-        s_ln, s_ph = line_sigma(nm_q, logabs, np.array([r.level]), same)
+        s_ln, s_ph = line_sigma(nm["by_quantity"][r.quantity] if view.joint and same else nm, logabs,
+                                np.array([r.level]), same)
+        sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
+                            sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
+        new[r.quantity] = merge_records(new[r.quantity], sw) if r.quantity in new else sw
+    if joint:
         sweeps = {}
         for q0, s0 in view.sweeps.items():      # the record, as the truth predicts it, with its σ
             G0 = np.asarray(view.many(truth.model, s0, q0)([truth.values])[0])
@@ -331,26 +337,57 @@ def refit_lambda(d, r: CandidateMeasurement, nm: dict, truth: CompetingModel, ri
                 std0 = (s0.magnitude_std_db, s0.phase_std_deg)
             sweeps[q0] = FrequencySweep(s0.temperature_c, s0.frequency_hz, G0, *std0, s0.input_name,
                                         s0.input_unit, s0.output_name, s0.output_unit)
-        new = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
-                             sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-        sweeps[r.quantity] = merge_records(sweeps[r.quantity], new) if same else new
-        sw, factory = view.restacked(sweeps)
+        for q, sw in new.items():
+            sweeps[q] = merge_records(sweeps[q], sw) if q in sweeps else sw
+        if view.joint or len(sweeps) == 1:
+            return view.restacked(sweeps)
+    elif len(new) == 1:
+        (q, sw), = new.items()
+        return sw, lambda model: view.many(model, sw, q)
     else:
-        s_ln, s_ph = line_sigma(nm, np.log(np.abs(G)), np.array([r.level]), False)
-        sw = FrequencySweep(sk.temperature_c, sk.frequency_hz, G, s_ln[0] * 20 / math.log(10), np.degrees(s_ph[0]),
-                            sk.input_name, sk.input_unit, sk.output_name, sk.output_unit)
-        factory = lambda model, sw=sw: view.many(model, sw, r.quantity)  # noqa: E731
+        sweeps = new
+    from .joint import joint_data  # several quantities the one-quantity view does not stack itself
+
+    jd = joint_data(list(sweeps.values()), d.kind, tuple(sweeps))
+    acts = {**view.acts_on, **view.new_acts_on}
+    return jd.stacked, lambda model: jd.predictor(model, acts)
+
+
+def refit_lambda(d, r, nm: dict, truth: CompetingModel, rival: CompetingModel, max_nfev: int,
+                 rival_starts: Sequence[dict] = (), view: RecordView | None = None, count: dict | None = None) -> float:
+    """λ of experiment ``r`` (a :class:`CandidateMeasurement`, or a sequence of them measured
+    together, :func:`refit_data`) when ``truth`` is true: ``rival`` refitted to its noiseless
+    predictions (:func:`refit_check`), from its own fit, its effect at its typical size (and
+    Latin-hypercube starts) and each of ``rival_starts`` (values of every free parameter: the
+    rival's other forms).  ``count``, when given, is added to: ``fits`` (least-squares calls),
+    ``starts`` and ``evaluations`` (their function evaluations)."""
+    from .lsq import fit_parameters
+
+    view = view or RecordView(d)
+    records = [r] if isinstance(r, CandidateMeasurement) else list(r)
+    if not records:
+        raise IPMCError("refit_lambda: no experiment given")
+    sw, factory = refit_data(d, records, nm, truth, view)
     pm = factory(rival.model)
+    cb = d.metadata.get("candidate_bounds", {})
+    best = math.inf
     typical = {f"{c}.{p}": v[2] for c in rival.effects for p, v in cb.get(c, {}).items()}
     starts = [(rival.values, 1), ({**rival.values, **typical}, REFIT_STARTS - 1)] + [(s, 1) for s in rival_starts]
     for start, n in starts:
         free = [fp.with_initial(min(max(start[fp.name], fp.lower), fp.upper)) for fp in rival.free]
         res = fit_parameters(sw, None, free, predict_many=pm, starts=n, seed=0, max_nfev=max_nfev, identify=False,
                              hold_undetermined=False)
-        best = min(best, 2.0 * float(res.cost))
+        lam = 2.0 * float(res.cost)
+        best = min(best, lam) if lam == lam else float("nan")   # NaN stays NaN: not separated (review)
+        if count is not None:
+            count["fits"] = count.get("fits", 0) + 1
+            count["starts"] = count.get("starts", 0) + len(res.starts)
+            count["evaluations"] = count.get("evaluations", 0) + int(sum(s.nfev for s in res.starts))
+        if best != best:
+            break
     return best
 
 
 __all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
-           "log_ratio", "log_unit_factor", "check_new_acts_on", "new_quantity_acts_on", "noise_model", "refit_check", "refit_lambda", "refit_model", "stack_real",
+           "log_ratio", "log_unit_factor", "check_new_acts_on", "new_quantity_acts_on", "noise_model", "refit_check", "refit_data", "refit_lambda", "refit_model", "stack_real",
            "sweep_noise_model", "t_criterion", "t_solve", "t_sums"]

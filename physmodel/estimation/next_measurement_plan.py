@@ -21,8 +21,15 @@ same quantity merged, another quantity jointly), and solved
 
 Not overlapping: a second record of the first's quantity holds none of its lines (temperature and
 frequency, whatever the drive level).  The pair is recommended only when it reaches the target
-where the best single experiment does not; its λ is linearised only (the nonlinear refits check the
-single experiments, not the pair — said in the message).  Pairs searched with their models' other
+where the best single experiment does not, linearised and then after full nonlinear refits
+(:func:`refit_plan`, 2026-11-27): for each competing pair each model in turn is the truth and the
+rival is refitted to its noiseless predictions on BOTH records together (with the diagnosed
+record's lines when they are evaluated with it), from the starts the single-record check uses (the
+rival's own fit, its effect at its typical size, :data:`~physmodel.estimation.next_measurement_design.REFIT_STARTS`),
+the least over the two directions (:func:`~physmodel.estimation.next_measurement_design.refit_lambda`
+of the two records).  The linearisation overstates what a rival reaches after a refit (a rival in
+another form may match both records), so a pair the refits leave below the target is said, with
+its shortfall, and the two records are not recommended.  Pairs searched with their models' other
 forms (:mod:`~physmodel.estimation.next_measurement_forms`) are not combined: when one is still
 competing no second record is searched.  Nor is one for a single pair: there a second record only
 adds lines of the same kind, which the shortfall message already covers (more periods).
@@ -53,12 +60,38 @@ class RecordPair:
         Linearised λ of both records (with the diagnosed record where either is evaluated with it),
         the least over the live pairs and the two directions. [-]
     separation_by_pair : dict
-        ``"A vs B"`` → {"A true": λ_A, "B true": λ_B} of both records. [-]
+        ``"A vs B"`` → {"A true": λ_A, "B true": λ_B} of both records (linearised). [-]
+    separation_refit : float
+        λ of both records after the refits (:func:`refit_plan`), the least over the live pairs; NaN
+        unless checked. [-]
+    refit_by_pair : dict
+        ``"A vs B"`` → λ of both records after the refits, the least over the two directions. [-]
+    refits : dict
+        What the check cost: ``fits`` (least-squares calls), ``starts``, ``evaluations``.
     """
 
     second: CandidateMeasurement
     separation: float
     separation_by_pair: dict = field(default_factory=dict)
+    separation_refit: float = float("nan")
+    refit_by_pair: dict = field(default_factory=dict)
+    refits: dict = field(default_factory=dict)
+
+    def short(self, target: float) -> dict:
+        """``{"A vs B": λ after the refits}`` of the pairs the refits leave below ``target``."""
+        return {k: v for k, v in self.refit_by_pair.items() if not v >= target}
+
+    def together(self) -> dict:
+        """:attr:`~physmodel.estimation.next_measurement_results.NextMeasurement.together` of the
+        plan: ``separation`` the refits' λ when checked (else the linearised one),
+        ``separation_linearised``, ``separation_by_pair`` (linearised, per direction),
+        ``refit_by_pair``, ``linearised_only``, ``refits`` and ``recommended`` (True here; the search
+        sets it False for a plan the refits refuse)."""
+        checked = bool(self.refit_by_pair)
+        return {"separation": self.separation_refit if checked else self.separation,
+                "separation_linearised": self.separation, "separation_by_pair": dict(self.separation_by_pair),
+                "refit_by_pair": dict(self.refit_by_pair), "linearised_only": not checked,
+                "refits": dict(self.refits), "recommended": True}
 
 
 def record_base(rec_a: tuple, rec_b: tuple, w0: np.ndarray) -> tuple:
@@ -123,6 +156,21 @@ def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: di
                       {k: {name: float(v[j]) for name, v in d.items()} for k, d in by.items()})
 
 
+def refit_plan(d, plan: RecordPair, first: CandidateMeasurement, pairs: list, nm: dict, max_nfev: int, label,
+               view) -> RecordPair:
+    """``plan`` checked by full nonlinear refits (module doc): for each of ``pairs`` (model pairs)
+    the least over the two directions of the rival refitted to the truth's noiseless predictions on
+    ``first`` and ``plan.second`` together
+    (:func:`~physmodel.estimation.next_measurement_design.refit_check`), and what the refits cost."""
+    from .next_measurement_design import refit_check
+
+    count: dict = {"fits": 0, "starts": 0, "evaluations": 0}
+    by = refit_check(d, pairs, [first, plan.second], nm, max_nfev, label, view, count=count)
+    # a pair whose refits gave no finite λ is not separated: NaN, whatever the order of the pairs
+    least = float("nan") if not by or any(v != v for v in by.values()) else float(min(by.values()))
+    return replace(plan, separation_refit=least, refit_by_pair=by, refits=count)
+
+
 def bath_premise(records: list, record_temperatures_c, base) -> str:
     """The premise of the recommended experiments (``records``: the recommended one, then a second
     of :func:`second_record`) that step the bath away from the diagnosed record's temperatures:
@@ -165,4 +213,4 @@ def bath_premise(records: list, record_temperatures_c, base) -> str:
             f"temperature (an 'unexplained' verdict on the records together) {check}")
 
 
-__all__ = ["RecordPair", "bath_premise", "overlaps", "record_base", "second_record"]
+__all__ = ["RecordPair", "bath_premise", "overlaps", "record_base", "refit_plan", "second_record"]

@@ -164,12 +164,19 @@ class NextMeasurement:
         when every effect acts on every quantity it applies to.  ``message`` ends by saying it.
     also : list of CandidateMeasurement
         A second experiment to run with ``recommended`` when no single one is expected to separate
-        every pair and the two together are (:mod:`~physmodel.estimation.next_measurement_plan`);
-        empty otherwise.  ``separates`` then refers to the two records together.
+        every pair and the two together are, linearised and after refits of the rivals to both
+        records together (:mod:`~physmodel.estimation.next_measurement_plan`); empty otherwise.
+        ``separates`` then refers to the two records together.
     together : dict
-        With ``also``: ``separation`` (linearised λ of the records together, the least over the
-        pairs), ``separation_by_pair`` and ``linearised_only`` (True: the refits checked
-        ``recommended`` alone); empty otherwise.
+        With ``also``: ``separation`` (λ of the records together after the refits, the least over the
+        pairs; the linearised one when ``check_refit`` is 0), ``separation_linearised``,
+        ``separation_by_pair`` (linearised, per direction), ``refit_by_pair`` (after the refits, the
+        least over the directions), ``linearised_only`` (True: not checked by refits) and ``refits``
+        (their ``fits``, ``starts`` and ``evaluations``), ``recommended`` True.  The linearised values
+        have the first record's refit shortfall taken off each pair.  When two records reached the target
+        linearised but a pair falls short after the refits: the same keys with ``recommended``
+        False, ``also`` empty and the message saying which pair falls short and by how much.  Empty
+        otherwise.
     """
 
     models: list

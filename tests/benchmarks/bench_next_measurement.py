@@ -380,6 +380,38 @@ record, 6 ambiguous, 4/6 [0.30, 0.90] named exactly after the recommended measur
 their second records' new noise as with the old; misses 50477 (CR + TD, λ 1.55) and 50481 (CR + SM,
 λ 0.49), both forecast not to separate.  ``--check-streams``: 200 040 keys, none sharing a stream,
 no first record's stream moved; the streams before: 12 003 pairs shared in the sensor mode.
+
+Two records checked by refits (2026-11-27, issue 27 item 3).  A recommended pair of records is now
+checked as a single record is: for each competing pair the rival is refitted to the truth's
+noiseless predictions on BOTH records together (with the diagnosed record's lines when either is
+evaluated with it), from the single-record check's starts, the least over the two directions
+(``next_measurement_plan.refit_plan``); the two are recommended only when the refits reach the
+target too, else the pair that falls short is said with its shortfall and no second record is
+recommended.  ``NextMeasurement.together["separation"]`` is now the refits' λ (the linearised one
+is ``separation_linearised``): the runs below printed it as "together λ ... linearised"; since
+the review this file prints both ("together λ L linearised, R refit"), and a later round's
+"λ expected" of two records is theirs (before, the first record's own refit λ beside the two
+records' λ).  Run once on fresh seeds, the branch (h-tworefit 8a34544) and an
+archive of main (83bbb29), one process each, 2 shared cores::
+
+    python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 50600 --seeds 4
+
+every printed line the same less the wall times: 12 detectable of 20, 3 named exactly by the first
+record, 9 ambiguous; named exactly after the recommended measurement(s) 4/9 [0.19, 0.73] on main
+and on the branch, 7/12 [0.32, 0.81] after at most one round on both; two records recommended 1/9
+on both (50674: M 5, 35, 65 °C, 0.06-41 Hz ×2 and Z 5, 35, 65 °C, 0.01-0.9 Hz; λ 121.8
+linearised, 122.2 after the refits), named exactly.  The development blocks (``--first-seed 47000``
+and ``48000 --seeds 4``, the same two trees) likewise: 3/9 [0.12, 0.65] and 6/9 [0.35, 0.88] on
+both, every line the same but the two-record cases' λ, each confirmed by the refits — 47079 52.64
+→ 52.64, 47082 4510 → 4493, 48081 1380 → 1370, 48084 1530 → 1500, 48085 216.4 → 216.2 (linearised
+→ after the refits).  So no measured case had its pair of records overturned; the refusal is
+checked by the unit tests (tests/estimation/test_next_measurement_plan_refits.py: a rival whose
+family holds the truth, λ 1.7e6 linearised and 1e-23 after the refits; test_next_measurement_plan:
+seed 47079 with a second M record claimed at λ 1e6 linearised, 1.74 after the refits for the
+contact resistance against the diffusivity law, which only Z tells apart).  Cost: the check refits
+each rival twice per direction (24 fits for 6 pairs); ``next_measurement`` CPU per call on the
+two-record cases 1.5 → 2.3 s (50674, 40 fits), 2.1 → 3.1 s (47079), 3.7 → 5.3 s (47082), 1.9 →
+2.8 s (48085), main → branch; the medians printed above stay 1-2 s.
 """
 
 from __future__ import annotations
@@ -579,7 +611,8 @@ def run_actuator_case(seed: int, label: str, args) -> dict:
             records = {"M": sweep}
             for j, x in enumerate([r] + nm.also):
                 data, q = records_add(records, *measure_actuator(truth, x, seed, 0, j))
-            row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+            row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"],
+                       lam_together_linear=nm.together.get("separation_linearised", float("nan")))
             d2 = diag(data, q)
             row.update(second=d2.verdict, second_named=sorted(d2.named))
         elif r is not None:
@@ -646,7 +679,8 @@ def run_pair_case(seed: int, label: str, args) -> dict:
             for j, x in enumerate([r] + nm.also):      # every recommended record (a second one: nm.also)
                 data, q = records_add(records, *measure_actuator(truth, x, seed, 0, j))
             if nm.also:
-                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"],
+                       lam_together_linear=nm.together.get("separation_linearised", float("nan")))
             d2 = diag(data, q, **on_chain(records, chain))
             row.update(second=d2.verdict, second_named=sorted(d2.named),
                        second_final=sorted(d2.final_effects or ()), second_message=d2.message)
@@ -664,8 +698,9 @@ def run_pair_case(seed: int, label: str, args) -> dict:
                     data, q = records_add(records, *measure_actuator(truth, x, seed, k, j))
                 d = diag(data, q, **on_chain(records, chain))
                 later.append({"recommended": rk.describe() + "".join(f" and {x.describe()}" for x in nm.also),
-                              "lam_linear": nm.together["separation"] if nm.also else rk.separation, "lam_expected":
-                              rk.separation_refit, "separates": nm.separates, "verdict": d.verdict,
+                              "lam_linear": nm.together["separation_linearised"] if nm.also else rk.separation,
+                              "lam_expected": nm.together["separation"] if nm.also else rk.separation_refit,
+                              "separates": nm.separates, "verdict": d.verdict,
                               "named": sorted(d.named)})
             row.update(later=later, final=d.verdict, final_named=sorted(d.named))
     row["dt"] = time.perf_counter() - t0
@@ -700,7 +735,7 @@ def pair_report(rows: list) -> None:
             continue
         rec = (f"{r['recommended']}; λ {r['lam_linear']:.3g} / {r['lam_expected']:.3g}"
                + "".join(f"; and, with it, {a}" for a in r.get("also", []))
-               + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+               + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
                + f"; {'yes' if r['separates'] else 'no'}" if r["recommended"] else "-")
         print(f"| {r['seed']} | {lam} | {r['first']} {r['first_named']} | {rec} | "
               + (f"{r['second']} {r['second_named']} {'OK' if r['success'] else 'MISS'}" if r["second"] else "-")
@@ -779,7 +814,8 @@ def run_case(seed: int, label: str, args) -> dict:
             for j, x in enumerate(nm.also):         # a second recommended record (S too): merged as well
                 both = merge_records(both, measure(truth, x, seed, LAW_ERROR if args.law_error else None, j + 1))
             if nm.also:
-                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"])
+                row.update(also=[x.describe() for x in nm.also], lam_together=nm.together["separation"],
+                       lam_together_linear=nm.together.get("separation_linearised", float("nan")))
             d2 = run_diagnosis(both, args)
             row.update(second=d2.verdict, second_named=sorted(d2.named), residual=residual_ratio(d2))
     row["dt"] = time.perf_counter() - t0
@@ -879,7 +915,7 @@ def main(argv=None):
                   f"{r['first']} {r['first_named']}"
                   + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} refit"
                      + "".join(f" and, with it, {a}" for a in r.get("also", []))
-                     + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+                     + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
                      + f"; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
                      f"inseparable {r['inseparable'] or '-'}] -> {r['second']} {r['second_named']} "
                      f"{'OK' if r['success'] else 'MISS'}" if r["recommended"] else "")
@@ -904,7 +940,7 @@ def main(argv=None):
             print(f"  seed {r['seed']} {lab:10s} λ {r['lam']:8.1f}: {r['first']} {r['first_named']}"
                   + (f" -> [{r['recommended']}"
                      + "".join(f" and, with it, {a}" for a in r.get("also", []))
-                     + (f"; together λ {r['lam_together']:.3g} linearised" if "lam_together" in r else "")
+                     + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
                      + f"; λ expected {r['lam_expected']:.3g}] -> {r['second']} {r['second_named']}"
                      f" {'OK' if r['success'] else 'MISS'}" if r['recommended'] else "")
                   + (f" cost/expected {r['residual']:.3g}" if r.get("residual") is not None else "")

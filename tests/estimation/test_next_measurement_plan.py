@@ -100,17 +100,14 @@ def sums_subset(sums: dict, n: int) -> dict:
     return {p: {d: tuple(a[:n] for a in v) for d, v in dd.items()} for p, dd in sums.items()}
 
 
-def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(monkeypatch):
+@pytest.fixture(scope="module")
+def seed47079():
     """Development seed 47079 of bench_next_measurement ``--pairs`` (the independent generator's own
-    physics: contact resistance + delay): the first record leaves the pair and its twins (diffusivity
-    law, amplifier pole) ambiguous; the delay against the pole parts only in M (the chain is on M,
-    declared), the contact resistance against the diffusivity law best in Z, so no single record
-    reaches the target and two are recommended, one M and one Z, with the message saying both."""
+    physics: contact resistance + delay) diagnosed on M as the bench does."""
     from next_measurement_cases import independent
 
     from physmodel import IPMCParameters
     from physmodel.estimation.discrepancy import diagnose
-    from physmodel.estimation.next_measurement import next_measurement
 
     ig = independent("independent_generator")
     sweep, truth = ig.make_case(47079, "contact_resistance+time_delay",
@@ -119,14 +116,38 @@ def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(monkeypatch):
     d = diagnose(sweep, base, kind="actuator", quantity="M", free=("alpha0", "d", "kappa_e", "xi", "omega_n"),
                  seed=47079)
     assert d.verdict == "ambiguous"
-    nm = next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, 200.0),
-                          acts_on={"time_delay": ("M",), "amplifier_bandwidth": ("M",)})
+    return d
+
+
+def _search_47079(d):
+    from physmodel.estimation.next_measurement import next_measurement
+
+    return next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, 200.0),
+                            acts_on={"time_delay": ("M",), "amplifier_bandwidth": ("M",)})
+
+
+def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(seed47079, monkeypatch):
+    """Seed 47079: the first record leaves the pair and its twins (diffusivity law, amplifier pole)
+    ambiguous; the delay against the pole parts only in M (the chain is on M, declared), the
+    contact resistance against the diffusivity law best in Z, so no single record reaches the
+    target and two are recommended, one M and one Z, with the message saying both; the refits of
+    the rivals to both records together confirm it, within the linearised value's order."""
+    d = seed47079
+    nm = _search_47079(d)
     r, also = nm.recommended, nm.also
     assert len(also) == 1 and {r.quantity, also[0].quantity} == {"M", "Z"}
     assert r.separation < nm.target <= nm.together["separation"] and nm.separates
     assert set(nm.together["separation_by_pair"]) == set(r.separation_by_pair)
-    assert min(min(v.values()) for v in nm.together["separation_by_pair"].values()) == nm.together["separation"]
-    assert "and, with it," in nm.message and "together expected λ" in nm.message and "linearised" in nm.message
+    lin = nm.together["separation_linearised"]
+    assert min(min(v.values()) for v in nm.together["separation_by_pair"].values()) == lin
+    # checked by refits of the rivals to both records together (the least over the pairs and directions)
+    assert not nm.together["linearised_only"] and set(nm.together["refit_by_pair"]) == set(r.separation_by_pair)
+    assert nm.together["separation"] == min(nm.together["refit_by_pair"].values()) >= nm.target
+    assert nm.together["refits"]["fits"] == 2 * 2 * len(r.separation_by_pair)     # 2 calls × 2 directions a pair
+    assert 0.5 < nm.together["separation"] / lin < 2.0
+    assert nm.together["recommended"] is True and nm.to_dict()["together"]["recommended"] is True   # review
+    assert "and, with it," in nm.message and "together expected λ" in nm.message
+    assert "checked by refits of the rivals to both records together" in nm.message
     assert nm.to_dict()["also"][0]["quantity"] == also[0].quantity
     # the pair's λ counts the first record's linearised sums: where its refits fall short of them for a
     # pair the first record carries alone, the shortfall is taken off, so a second record that sees
@@ -145,6 +166,36 @@ def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(monkeypatch):
         return out
 
     monkeypatch.setattr(nmod, "refit_check", capped)
-    nm2 = next_measurement(d, quantities=["M", "Z"], band_limits_hz=(0.01, 200.0),
-                           acts_on={"time_delay": ("M",), "amplifier_bandwidth": ("M",)})
+    nm2 = _search_47079(d)
     assert not nm2.separates and nm2.also == [] and "and, with it," not in nm2.message
+
+
+def test_two_records_the_refits_do_not_confirm_are_not_recommended(seed47079, monkeypatch):
+    """Seed 47079 with the second record swapped for a second M record (the best M one that does not
+    overlap the first) and its linearised λ claimed at 1e6: M cannot tell the contact resistance
+    from the diffusivity law (they part in Z), so the refits of the rivals to both records together
+    leave those pairs short of the target; the search must not claim separation, nor recommend the
+    pair, and must say which pair falls short and by how much."""
+    import physmodel.estimation.next_measurement as nmod
+    from physmodel.estimation.next_measurement_plan import RecordPair
+
+    real = nmod.second_record
+
+    def claimed(first, rows, *a, **k):
+        real(first, rows, *a, **k)
+        m = max((r for r in rows if r.quantity == first.quantity and not overlaps(first, r)),
+                key=lambda r: r.separation)
+        return RecordPair(m, 1e6, {})
+
+    monkeypatch.setattr(nmod, "second_record", claimed)
+    nm = _search_47079(seed47079)
+    tg = nm.together
+    assert not nm.separates and nm.also == [] and "and, with it," not in nm.message
+    assert tg["recommended"] is False and tg["separation_linearised"] == 1e6 and not tg["linearised_only"]
+    short = {k: v for k, v in tg["refit_by_pair"].items() if v < nm.target}
+    assert short and tg["separation"] == min(tg["refit_by_pair"].values()) < nm.target
+    assert all(k.count(" vs ") == 1 and "contact_resistance" in k and "diffusivity_temperature" in k for k in short)
+    assert "Two records were checked too" in nm.message and "not recommended" in nm.message
+    for k, v in short.items():
+        assert f"{k} reaches only {v:.3g} (short of {nm.target:.3g} by {nm.target - v:.3g})" in nm.message
+    assert nm.to_dict()["together"]["recommended"] is False
