@@ -549,7 +549,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
         plan = second_record(chosen, rows, sums, bases, [key(a, b) for a, b in live], short)
         plan = plan if plan is not None and plan.separation >= target else None
         if plan is not None and check_refit > 0:     # the pair checked by refits on both records together
-            plan = refit_plan(d, plan, chosen, live, nm, max_nfev, label, view)
+            plan = refit_plan(d, plan, chosen, live, nm, max_nfev, label, view, target)
             plan, plan_short = (None, plan) if plan.short(target) else (plan, None)
     who = " vs ".join(" + ".join(m) for m in mods)
     alike = _inseparable_note(same_form, same_refit, bool(contests))

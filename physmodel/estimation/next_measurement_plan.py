@@ -37,6 +37,7 @@ adds lines of the same kind, which the shortfall message already covers (more pe
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -157,15 +158,24 @@ def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: di
 
 
 def refit_plan(d, plan: RecordPair, first: CandidateMeasurement, pairs: list, nm: dict, max_nfev: int, label,
-               view) -> RecordPair:
+               view, target: float = math.inf) -> RecordPair:
     """``plan`` checked by full nonlinear refits (module doc): for each of ``pairs`` (model pairs)
     the least over the two directions of the rival refitted to the truth's noiseless predictions on
     ``first`` and ``plan.second`` together
-    (:func:`~physmodel.estimation.next_measurement_design.refit_check`), and what the refits cost."""
+    (:func:`~physmodel.estimation.next_measurement_design.refit_check`), and what the refits cost.
+    A pair whose refits on ``first`` alone already reach ``target`` (``first.refit_by_pair``) is not
+    refitted again: a rival fitted to more lines cannot fit them better, so its λ on both records is
+    at least that one, which it keeps (a lower bound)."""
     from .next_measurement_design import refit_check
 
     count: dict = {"fits": 0, "starts": 0, "evaluations": 0}
-    by = refit_check(d, pairs, [first, plan.second], nm, max_nfev, label, view, count=count)
+    done = {f"{label(a)} vs {label(b)}": first.refit_by_pair.get(f"{label(a)} vs {label(b)}", math.nan)
+            for a, b in pairs}
+    done = {k: v for k, v in done.items() if v >= target}
+    rest = [(a, b) for a, b in pairs if f"{label(a)} vs {label(b)}" not in done]
+    by = {**done, **(refit_check(d, rest, [first, plan.second], nm, max_nfev, label, view, count=count)
+                     if rest else {})}
+    by = {f"{label(a)} vs {label(b)}": by[f"{label(a)} vs {label(b)}"] for a, b in pairs}     # the pairs' order
     # a pair whose refits gave no finite λ is not separated: NaN, whatever the order of the pairs
     least = float("nan") if not by or any(v != v for v in by.values()) else float(min(by.values()))
     return replace(plan, separation_refit=least, refit_by_pair=by, refits=count)

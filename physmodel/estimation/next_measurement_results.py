@@ -171,7 +171,8 @@ class NextMeasurement:
         With ``also``: ``separation`` (λ of the records together after the refits, the least over the
         pairs; the linearised one when ``check_refit`` is 0), ``separation_linearised``,
         ``separation_by_pair`` (linearised, per direction), ``refit_by_pair`` (after the refits, the
-        least over the directions), ``linearised_only`` (True: not checked by refits) and ``refits``
+        least over the directions; a pair the first record's refits already separate keeps that
+        value, a lower bound, and is not refitted again), ``linearised_only`` (True: not checked by refits) and ``refits``
         (their ``fits``, ``starts`` and ``evaluations``), ``recommended`` True.  The linearised values
         have the first record's refit shortfall taken off each pair.  When two records reached the target
         linearised but a pair falls short after the refits: the same keys with ``recommended``
