@@ -16,7 +16,7 @@ def _state(seed) -> tuple:
     return tuple(np.random.SeedSequence(seed).generate_state(4, np.uint64).tolist())
 
 
-def test_no_two_records_share_a_noise_stream(tmp_path, monkeypatch):
+def test_no_two_records_share_a_noise_stream(tmp_path, monkeypatch, second_recommended_record):
     """The bundled demo with ``next_noise_seed = noise_seed - 1`` (a value a user may well give) and a
     second recommended record (as in test_next_measurement_two_records): the noise seeds the virtual
     lab receives for records 1-3 give three different streams, and records 2 and 3 none of the
@@ -24,31 +24,17 @@ def test_no_two_records_share_a_noise_stream(tmp_path, monkeypatch):
     as another run's ``noise_seed`` or ``ipmc simulate --seed``).  Before the fix record 3 drew from
     ``next_noise_seed + 1 = noise_seed``: record 1's noise again; with the key ``[next_noise_seed, k]``
     record 2 drew the integer 2**32 + 4's."""
-    from dataclasses import replace
-
     import scenarios.virtual_lab as vl
-    from physmodel.estimation.diagnosis import Diagnosis
     from scenarios.runner import run_scenario
     from scenarios.spec import bundled_scenarios, load_scenario
 
-    real_nm, real_lab = Diagnosis.recommend_next_measurement, vl.from_config
+    real_lab = vl.from_config
     seeds = []
-
-    def with_second(self, **kw):
-        nm = real_nm(self, **kw)
-        r = nm.recommended
-        f = np.arange(1.0, 10.0)
-        nm.also = [replace(r, band_hz=(1.0, 9.0), temperatures_c=(35.0,), level=1.0, n_lines=f.size, frequencies_hz=f,
-                           line_temperatures_c=np.full(f.size, 35.0), line_frequencies_hz=f)]
-        nm.together = {"separation": r.separation, "separation_by_pair": dict(r.separation_by_pair),
-                       "linearised_only": True}
-        return nm
 
     def lab(model, sweep, noise=None, where=""):
         seeds.append(noise["seed"])
         return real_lab(model, sweep, noise, where)
 
-    monkeypatch.setattr(Diagnosis, "recommend_next_measurement", with_second)
     monkeypatch.setattr(vl, "from_config", lab)
     demo = [p for p in bundled_scenarios() if p.stem == "next_measurement_demo"][0].read_text(encoding="utf-8")
     assert "noise_seed = 5\n" in demo

@@ -7,31 +7,15 @@ from __future__ import annotations
 import numpy as np
 
 
-def test_the_virtual_lab_takes_the_second_recommended_record(tmp_path, monkeypatch):
+def test_the_virtual_lab_takes_the_second_recommended_record(tmp_path, second_recommended_record):
     """The bundled demo with the recommendation given a second record (1-9 Hz at the record's 35 °C,
     below the first record's band — a record no search chose here, added by the test so that the
     step's handling is checked on a fast bundled case): record3.csv holds it, in its band and
     sharing no line with records 1 and 2, and the summary's table counts three records."""
-    from dataclasses import replace
-
     from physmodel.data.files import read_csv
-    from physmodel.estimation.diagnosis import Diagnosis
     from scenarios.runner import run_scenario
     from scenarios.spec import bundled_scenarios, load_scenario
 
-    real = Diagnosis.recommend_next_measurement
-
-    def with_second(self, **kw):
-        nm = real(self, **kw)
-        r = nm.recommended
-        f = np.arange(1.0, 10.0)
-        nm.also = [replace(r, band_hz=(1.0, 9.0), temperatures_c=(35.0,), level=1.0, n_lines=f.size, frequencies_hz=f,
-                           line_temperatures_c=np.full(f.size, 35.0), line_frequencies_hz=f)]
-        nm.together = {"separation": r.separation, "separation_by_pair": dict(r.separation_by_pair),
-                       "linearised_only": True}
-        return nm
-
-    monkeypatch.setattr(Diagnosis, "recommend_next_measurement", with_second)
     path = [p for p in bundled_scenarios() if p.stem == "next_measurement_demo"][0]
     run_scenario(load_scenario(path, quick=True), tmp_path / "run", quiet=True)
     out = tmp_path / "run" / "next_measurement"
