@@ -74,8 +74,8 @@ class RecordView:
         #: declaration, :func:`~physmodel.estimation.next_measurement.next_measurement`'s ``acts_on``)
         self.new_acts_on = new_quantity_acts_on(d, acts_on) if acts_on else {}
         #: λ of the refits made in this search (:func:`refit_lambda`), by what determines them: the
-        #: truth and the rival (the objects), the refitted lines (their data and σ, quantities and
-        #: stacking) and the starts.  Two experiments that differ only where a refit cannot see it
+        #: rival (its effects, values and free parameters), the refitted lines (the truth's
+        #: predictions and their σ, quantities and stacking) and the starts.  Two experiments that differ only where a refit cannot see it
         #: (e.g. drive ×1 and ×2 of a linear model under relative noise: the same lines, the same σ)
         #: are refitted once.
         self.refits: dict = {}
@@ -376,8 +376,10 @@ def refit_lambda(d, r, nm: dict, truth: CompetingModel, rival: CompetingModel, m
     if not records:
         raise IPMCError("refit_lambda: no experiment given")
     sw, factory = refit_data(d, records, nm, truth, view)
-    key = (id(truth), id(rival), max_nfev, repr(list(rival_starts)), tuple((r.quantity, r.joint) for r in records),
-           refit_fingerprint(sw))
+    # by content, not identity (a model made for one check and freed may share a later one's id): the
+    # truth is in the refitted lines (its predictions), the rival in its effects, values and free box
+    key = (rival.effects, repr(sorted(rival.values.items())), repr(rival.free), max_nfev, repr(list(rival_starts)),
+           tuple((r.quantity, r.joint) for r in records), refit_fingerprint(sw))
     if key in view.refits:          # the same refit made before in this search: its λ, no new fit
         return view.refits[key]
     pm = factory(rival.model)

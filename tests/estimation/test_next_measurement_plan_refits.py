@@ -141,6 +141,9 @@ def test_a_refit_made_before_in_the_search_is_not_made_again(ambiguous):
     assert fits == 1
     assert refit_lambda(a.d, _exp("S", 35.0, np.geomspace(150.0, 1000.0, 8), True), a.nm, a.ab, a.td, 60, view=view,
                         count=count) == first and count["fits"] == fits
+    # by content: another CompetingModel with the same effects, values and free parameters is the same rival
+    twin = CompetingModel(a.d, a.td.effects, dict(a.td.values), list(a.td.free))
+    assert refit_lambda(a.d, r, a.nm, a.ab, twin, 60, view=view, count=count) == first and count["fits"] == fits
     other = refit_lambda(a.d, _exp("S", 35.0, np.geomspace(200.0, 1000.0, 8), True), a.nm, a.ab, a.td, 60, view=view,
                          count=count)
     assert count["fits"] == fits + 1 and other != first
