@@ -94,3 +94,15 @@ def test_identical_fits_cannot_be_told_apart():
     assert vuong_z(r, r, 0.5 * r @ r, 0.5 * r @ r) == 0.0
     assert vuong_z(r, r, 10.0, 11.0) == 0.0          # same residuals, a penalty apart: still equivalent
     assert vuong_critical(0.05) == pytest.approx(1.959963984540054, rel=1e-12)
+
+
+def test_vuong_power_is_the_normal_cdf_of_its_shift():
+    """P(z > z_crit) for z ~ N(√λ/2, 1): against mpmath's normal CDF at 30 digits (an oracle outside
+    scipy), over λ from 0 to far beyond the target, and negative λ read as 0."""
+    import mpmath
+
+    mpmath.mp.dps = 30
+    zc = vuong_critical(0.05)
+    for lam in (-1.0, 0.0, 1e-6, 0.5, 4.0, 42.0, 100.0, 1e4):
+        want = float(mpmath.ncdf(mpmath.sqrt(max(lam, 0.0)) / 2 - mpmath.mpf(zc)))
+        assert vuong_power(lam, zc) == pytest.approx(want, rel=1e-13, abs=1e-300)
