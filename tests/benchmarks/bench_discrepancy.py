@@ -133,6 +133,25 @@ workflow's free set; not examined further, the seed is held out); time_delay + l
 (λ 17445) -> before 'at bound' leakage, after ambiguous [leakage, water_uptake] (leakage's bound no
 longer matters, so the same miss now shows as a wrong ambiguous list); viscoelastic creep (out of
 library, λ 54) -> series_cpe in both.
+
+Two effects on fresh seeds (2026-11-27, main 428e24f: pairs searched, joint gap rule, refit-checked
+next measurements; seeds 51500-51519 never run before, once, one process, 2 shared cores)::
+
+    python3 tests/benchmarks/bench_discrepancy.py --generator independent --labels pairs --n-per-label 4 \
+        --first-seed 51500 --null 0 --workers 1 --no-real
+
+    both named, each detectable on top of the other          13/15 = 0.87 [0.62, 0.96]
+      the same, detectable after the workflow's free set      13/13 [0.77, 1.00]
+      of those, verdict 'named' exactly                        7/13 = 0.54 [0.29, 0.77]
+    both named, all cases                                     13/20 = 0.65 [0.43, 0.82]
+    correct names downgraded to 'at bound'; at a bound unsaid  0; 0
+    time per diagnosis                                        mean 6.6 s, median 6.1 s, max 13.6 s (wall)
+
+The two detectable misses both lose the leakage: contact_resistance + leakage -> ambiguous
+[contact_resistance, diffusivity_temperature], time_delay + leakage -> ambiguous [amplifier_bandwidth,
+time_delay] (each names the other member with its declared twin); the five others are not detectable
+(λ of one member below 25 on top of the other).  The six 'ambiguous' among the 13 are the declared
+twins the band cannot separate: the next measurement's row (bench_next_measurement.py --pairs).
 """
 
 from __future__ import annotations
