@@ -525,6 +525,8 @@ def _loc_lines(rows) -> list:
         return ["- no cell exceeds its band"]
     out = ["| band [Hz] | T [°C] | part | lines | RMS std. residual | RMS dB or deg | mean |", "|---|---|---|---|---|---|---|"]
     for r in flagged:
+        if "quantity" in r:          # a joint record: the quantity with the part
+            r = {**r, "part": f"{r['quantity']} {r['part']}"}
         if r["temperature_c"] is None:
             out.append(f"| {r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} | all | {r['part']} | {r['n']} | – | – | "
                        f"slope {r['slope_per_K']:.3g}/K (z = {r['z']:.3g}) |")
@@ -597,7 +599,8 @@ def worst_cells(rows) -> str:
     flagged = sorted((r for r in rows if r["flagged"] and r["temperature_c"] is not None), key=lambda r: r["p_value"])
     if not flagged:
         return "no single cell (a diffuse misfit)"
-    parts = [f"{r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} Hz at {r['temperature_c']:g} °C ({r['part']})"
+    parts = [(f"{r['quantity']} " if "quantity" in r else "")        # a joint record's rows name their quantity
+             + f"{r['band_hz'][0]:.3g}–{r['band_hz'][1]:.3g} Hz at {r['temperature_c']:g} °C ({r['part']})"
              for r in flagged[:3]]
     return ", ".join(parts)
 

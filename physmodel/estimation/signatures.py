@@ -68,23 +68,47 @@ def project_out(Q, A):
 
 
 def localise(data: FrequencySweep, r: np.ndarray, alpha: float, n_bands: int = 4) -> list:
-    """Standardised residuals by band × temperature × part, flagged at Bonferroni level α."""
+    """Standardised residuals by band × temperature × part, flagged at Bonferroni level α.
+
+    A joint record (:class:`~physmodel.estimation.joint.StackedSweep`: ``metadata["quantities"]``
+    and ``["block_sizes"]``) is localised per quantity — each block's own bands, every row naming
+    its ``"quantity"`` — with the Bonferroni count over all blocks' cells: a gap in Z's lines is
+    said as Z's, not pooled into bands shared with M's lines."""
+    N = data.frequency_hz.size
+    s_ln, s_ph, _ = noise_std(data)
+    meta = data.metadata or {}
+    qs, sizes = meta.get("quantities"), meta.get("block_sizes")
+    if not qs or not sizes or len(qs) != len(sizes) or len(qs) < 2 or sum(int(n) for n in sizes) != N:
+        return _localise_lines(data.frequency_hz, data.temperature_c, data.temperatures(), r[:N], r[N:], s_ln, s_ph,
+                               alpha, n_bands, None, n_bands * data.temperatures().size * 2)
+    ends = np.cumsum([0] + [int(n) for n in sizes])
+    blocks = [slice(int(a), int(b)) for a, b in zip(ends[:-1], ends[1:])]
+    temps = [np.unique(data.temperature_c[b]) for b in blocks]
+    cells = sum(n_bands * t.size * 2 for t in temps)
+    rows: list = []
+    for q, b, t in zip(qs, blocks, temps):
+        rows += _localise_lines(data.frequency_hz[b], data.temperature_c[b], t, r[:N][b], r[N:][b], s_ln[b], s_ph[b],
+                                alpha, n_bands, str(q), cells)
+    return rows
+
+
+def _localise_lines(freq, temp_c, temps, r_mag, r_ph, s_ln, s_ph, alpha: float, n_bands: int, quantity, cells: int) -> list:
+    """:func:`localise`'s table of one block of lines (frequencies [Hz], temperatures [°C], their
+    sorted unique temperatures, the magnitude and phase residuals and σ), ``cells`` the Bonferroni
+    count; rows carry ``"quantity"`` when it is not None."""
     from scipy.stats import chi2
 
-    N = data.frequency_hz.size
-    lf = np.log10(data.frequency_hz)
+    lf = np.log10(freq)
     edges = np.linspace(lf.min(), lf.max() + 1e-12, n_bands + 1)
     band = np.clip(np.searchsorted(edges, lf, side="right") - 1, 0, n_bands - 1)
-    temps = data.temperatures()
-    s_ln, s_ph, _ = noise_std(data)
-    parts = (("magnitude", r[:N], s_ln * 20 / math.log(10)), ("phase", r[N:], np.degrees(s_ph)))
+    parts = (("magnitude", r_mag, s_ln * 20 / math.log(10)), ("phase", r_ph, np.degrees(s_ph)))
     rows = []
-    cells = n_bands * temps.size * 2
+    tag = {} if quantity is None else {"quantity": quantity}
     for bi in range(n_bands):
         for pname, rr, scale in parts:
             means = []
             for t in temps:
-                m = (band == bi) & (data.temperature_c == t)
+                m = (band == bi) & (temp_c == t)
                 n = int(m.sum())
                 if n == 0:
                     continue
@@ -95,7 +119,7 @@ def localise(data: FrequencySweep, r: np.ndarray, alpha: float, n_bands: int = 4
                              "temperature_c": float(t), "part": pname, "n": n,
                              "rms_std": float(math.sqrt(ss / n)), "mean_std": float(x.mean()),
                              "rms_physical": float(np.sqrt(np.mean((x * scale[m]) ** 2))),
-                             "p_value": p, "flagged": bool(p < alpha / cells)})
+                             "p_value": p, "flagged": bool(p < alpha / cells), **tag})
                 means.append((float(t), float(x.mean()), n))
             if len(means) >= 3:
                 T = np.array([m[0] for m in means])
@@ -109,7 +133,7 @@ def localise(data: FrequencySweep, r: np.ndarray, alpha: float, n_bands: int = 4
                              "part": pname + " trend with T", "n": int(w.sum()), "rms_std": float("nan"),
                              "mean_std": slope, "rms_physical": float("nan"),
                              "p_value": float(2 * _norm_sf(abs(z))), "flagged": bool(2 * _norm_sf(abs(z)) < alpha / cells),
-                             "slope_per_K": slope, "z": float(z)})
+                             "slope_per_K": slope, "z": float(z), **tag})
     return rows
 
 
