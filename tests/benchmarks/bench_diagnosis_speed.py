@@ -20,6 +20,52 @@ parameter sets predicted, batched model calls, least-squares fits, fit points (e
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 
+Measured 2026-11-27, sixth round (the next measurement's refits; "before" = 0e3466e, "after" = 428e24f,
+each exported to a plain folder, interleaved; 2 cores shared with two other sessions, load 2-3)::
+
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2 --roots BEFORE,AFTER \
+        --cases 41038:contact_resistance+time_delay,44102:added_fluid_mass,51600:contact_resistance+time_delay,\
+51601:contact_resistance+leakage,51602:time_delay+leakage,51603:modulus_temperature+diffusivity_temperature,\
+51604:contact_resistance+time_delay
+
+    case                                          ipmc calibrate   ipmc diagnose CPU s   diagnose / calibrate
+                                                  CPU s b / a      before    after        before   after
+    41038 contact_resistance+time_delay           1.55 / 1.59      10.38     7.48         6.7x     4.7x
+    44102 added_fluid_mass                        1.53 / 1.51       6.85     6.78         4.5x     4.5x
+    fresh two-effect strips (never timed before):
+    51600 contact_resistance+time_delay           1.47 / 1.44       7.76     7.03         5.3x     4.9x
+    51601 contact_resistance+leakage              1.43 / 1.46       4.02     4.00         2.8x     2.7x
+    51602 time_delay+leakage                      1.43 / 1.51       5.32     5.57         3.7x     3.7x
+    51603 modulus_temperature+diffusivity_temp.   1.43 / 1.49       4.12     3.93         2.9x     2.6x
+    51604 contact_resistance+time_delay           1.43 / 1.43       6.58     6.36         4.6x     4.4x
+
+and the five default cases (``--commands --rounds 2 --roots BEFORE,dba8448``, the first two changes
+below): 41000 2.8x / 2.8x, 41009 3.0x / 3.0x, 41003 2.5x / 2.5x, 41005 3.9x / 4.2x, 41038 6.9x /
+5.2x.  Median 4.5x -> 4.4x, max 6.7x -> 4.9x: every case within 5x again (41038 had gone to 6.7-6.9x
+with the two-record refit check of 2026-11-27 morning).  What changed, all in the next-measurement
+search that ``ipmc diagnose`` runs on an ambiguous verdict (the diagnosis itself is untouched:
+``diagnose()`` gives the same numbers):
+
+* a refit made before in the same search is not made again (``RecordView.refits``, keyed by the
+  refitted lines' data and σ, the rival and the starts): on 41038, 12 of the 36 refits were drive
+  ×1 and ×2 of one band, the same least-squares problem for a linear model under relative noise;
+* each rival refit is one multi-start (its own fit, its effect at typical size and its other forms
+  as ``initials``, one Latin-hypercube start) with damped steps from every start
+  (``fit_parameters(damped="all")``), where it was two fits whose start 0 went straight to scipy's
+  trust region and crawled to ``max_nfev`` in 11 of 24 fits: refit CPU 3.97 -> 2.43 s on 41038;
+* ``vuong_power`` evaluates the normal CDF with ``scipy.special.ndtr`` (3314 calls, ~75 µs each
+  through ``scipy.stats.norm``).
+
+The reports (report.json, model.json) are the same number by number on the cases without a
+next measurement; with one, the refit λ agree to 5e-12 relative (the largest difference printed)
+and every verdict, recommendation and message is the same.  The next-measurement benchmark gives
+the same per-case verdicts before and after (``bench_next_measurement.py --kind actuator --pairs
+--first-seed 50600 --seeds 4``, ``--kind actuator --first-seed 7300 --seeds 10``, ``--first-seed
+7400 --seeds 4``), its slowest pair case 18 -> 11 s wall.  What remains costly: in these refits
+three starts often end at one cost after ~55 evaluations each without joining — two mirror optima
+of a two-pole amplifier (the poles swapped) are the same cost at points 6 standard errors apart, so
+the basin test rightly does not join them.
+
 Measured 2026-11-26, fifth round (h-d44: why strip 44102's pair refits with viscous_fluid take so
 many points; 2 cores shared by ~6 sessions, load 3-5): "before" = 133819a (main, exported to a
 plain folder), "after" = this branch, interleaved as in the third round::
