@@ -62,9 +62,14 @@ and every verdict, recommendation and message is the same.  The next-measurement
 the same per-case verdicts before and after (``bench_next_measurement.py --kind actuator --pairs
 --first-seed 50600 --seeds 4``, ``--kind actuator --first-seed 7300 --seeds 10``, ``--first-seed
 7400 --seeds 4``), its slowest pair case 18 -> 11 s wall.  What remains costly: in these refits
-three starts often end at one cost after ~55 evaluations each without joining — two mirror optima
-of a two-pole amplifier (the poles swapped) are the same cost at points 6 standard errors apart, so
-the basin test rightly does not join them.
+three starts often end at one optimum after ~55 evaluations each without joining.  Traced on 41038
+(truth contact resistance + delay, rival contact resistance + amplifier, an I record): starts 0 and
+1 end at the same values to 5 digits, the amplifier's two time constants collapsed onto one (τ₁ =
+τ₂, where their Jacobian columns coincide), start 2 at the same cost with other mechanical values
+(an I record does not see them).  JᵀJ is near-singular there, so the Gauss–Newton landing the
+basin test uses falls far off (34 s² in the optimum's metric at equal cost) and no start joins.  A
+minimum-norm landing would join them; it is the engine's rule for every fit (calibration and
+diagnosis too), not changed here.
 
 Measured 2026-11-26, fifth round (h-d44: why strip 44102's pair refits with viscous_fluid take so
 many points; 2 cores shared by ~6 sessions, load 3-5): "before" = 133819a (main, exported to a
