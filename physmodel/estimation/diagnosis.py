@@ -443,7 +443,7 @@ class Diagnosis:
         for lab, g in (("before", gb), ("after", ga)):
             L.append(f"| {lab} | {g['cost']:.4g} | {g['expected_cost']:.4g} ± {g['cost_std']:.3g} | {g['z']:.3g} | "
                      + " | ".join(f"{a:.3g} / {b:.3g}" for a, b in zip(g["rms_db"], g["rms_deg"])) + " |")
-        L += ["", f"Gap shrink (cost − expected, before / after): {gap_shrink(self):.3g}×", "",
+        L += ["", f"Gap shrink (cost − expected, before / after): {gap_shrink_words(self)}", "",
               f"LR threshold (at {self.alpha * (1 - 1 / GAP_ALPHA_DIVISOR):g} of the verdict's family-wise "
               f"α = {self.alpha:g}, Monte Carlo under the null): {self.threshold:.3g}; "
               f"gap threshold on 2·cost (at α/{GAP_ALPHA_DIVISOR:g}): " + (f"{self.gap_threshold:.4g}" if not self.per_quantity
@@ -513,10 +513,21 @@ class Diagnosis:
 
 
 def gap_shrink(d: Diagnosis) -> float:
-    """(cost − expected) before / after, the excess cost removed by the named effect(s)."""
+    """(cost − expected) before / after, the excess cost removed by the named effect(s); the after
+    excess floored at the cost's spread.  NaN when there was no gap to shrink: the cost before
+    within one spread of its expectation (e.g. a verdict ``none`` on a record the baseline fits;
+    the ratio of two noise-size numbers, negative below the expectation, meant nothing)."""
     before = d.gap_before["cost"] - d.gap_before["expected_cost"]
+    if not before > d.gap_before["cost_std"]:
+        return float("nan")
     after = max(d.gap_after["cost"] - d.gap_after["expected_cost"], d.gap_after["cost_std"])
     return float(before / after) if after > 0 else float("inf")
+
+
+def gap_shrink_words(d: Diagnosis) -> str:
+    """:func:`gap_shrink` as said in a message or report: ``"12.3×"``, or that there was no gap."""
+    g = gap_shrink(d)
+    return f"{g:.3g}×" if g == g else "none to shrink (the cost before was within its spread of the expectation)"
 
 
 def _loc_lines(rows) -> list:

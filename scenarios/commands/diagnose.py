@@ -527,7 +527,8 @@ def run(args) -> int:
     """Execute ``ipmc diagnose``: 0 when the final model fits the data, 3 when not (unless
     ``--accept-misfit``); bad input raises IPMCError (exit 2)."""
     from physmodel.data.files import check_output_folder, output_folder
-    from physmodel.estimation.discrepancy import diagnose, gap_shrink
+    from physmodel.estimation.diagnosis import gap_shrink_words
+    from physmodel.estimation.discrepancy import diagnose
 
     data, base, kw, out = build(args)
     next_kw = _next_kw(args, args.next_table, kw["kind"])      # before the diagnosis, whatever its verdict
@@ -577,7 +578,7 @@ def run(args) -> int:
         print(f"verdict: {d.verdict}" + (f" ({', '.join(d.named)})" if d.named else ""))
         print(d.message)
         print(f"weighted cost {d.gap_before['cost']:.4g} -> {d.gap_after['cost']:.4g} "
-              f"(expected {d.gap_after['expected_cost']:.4g}); gap shrink {gap_shrink(d):.3g}x; "
+              f"(expected {d.gap_after['expected_cost']:.4g}); gap shrink {gap_shrink_words(d)}; "
               f"{d.elapsed_s:.1f} s")
         figs = ("bode_before.png, bode_after.png" if d.joint is None else
                 ", ".join(f"bode_before_{q}.png, bode_after_{q}.png" for q in d.joint.quantities))
