@@ -548,7 +548,7 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
                    probe: SensitivityProbe | None = None, fd_step: float = FD_STEP,
                    progress: Callable[[int], None] | None = None,
                    predict_array: Callable[[np.ndarray], np.ndarray] | None = None,
-                   initials: Sequence[Values] = (), damped: bool | str = True) -> CalibrationResult:
+                   initials: Sequence[Values] = (), damped: bool = True) -> CalibrationResult:
     """Fit ``free`` parameters of a generic predictor to ``data`` by weighted least squares.
 
     Parameters
@@ -591,12 +591,10 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         taken after start 0 and before the Latin-hypercube ones: several warm starts searched
         as one multi-start, so a later one that reaches an earlier optimum stops there (status
         −2, :func:`joined_start`).
-    damped : bool or "all"
+    damped : bool
         The later starts take Levenberg–Marquardt steps before scipy's trust region (module doc);
         False: they go to the trust region at once, as start 0 does (for starts whose optimum
-        lies at a bound, where the damped steps crawl along it); ``"all"``: start 0 takes them too
-        (a start far from the optimum in a flat valley, e.g. a rival model refitted to another's
-        predictions, where the trust region crawls: :func:`~physmodel.estimation.next_measurement_design.refit_lambda`).
+        lies at a bound, where the damped steps crawl along it).
 
     Returns
     -------
@@ -620,8 +618,6 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
         raise IPMCError(f"hold_undetermined must be True, False, 'insensitive' or 'always', got {hold_undetermined!r}")
     if max_nfev is not None and int(max_nfev) < 1:
         raise IPMCError(f"max_nfev must be >= 1, got {max_nfev}")
-    if damped not in (True, False, "all"):
-        raise IPMCError(f"damped must be True, False or 'all', got {damped!r}")
     fixed = dict(fixed or {})
     estimated, n_lines = res.estimated, res.n_values
     if res.size <= len(free):
@@ -649,7 +645,7 @@ def fit_parameters(data: FrequencySweep | ScalarObservations, predict: Callable[
 
     def search(i, first=None):
         return _search(free, active, z_starts[i][active], batch, res, max_nfev, ftol, fd_step, rows0,
-                       optima if i else (), first, bool(damped), later=i > 0 or damped == "all")
+                       optima if i else (), first, damped, later=i > 0)
 
     lo_a, hi_a = _z_box([free[k] for k in active])
     dof = res.size - len(active)

@@ -129,27 +129,3 @@ def test_a_point_on_the_valleys_wall_is_not_a_bracket_end():
                          np.array([0.1, 0.0]), 2.0 * start[6] / 19)
     assert out[6] == min(seen) and out[6] < start[6]
     assert count[0] <= 15, count      # 28 when the wall point bracketed the search
-
-
-@pytest.mark.parametrize("seed", range(6))
-def test_damped_steps_from_every_start_reach_the_valleys_optimum(seed):
-    """``damped="all"``: start 0 takes the Levenberg–Marquardt steps the later starts take before
-    the trust region (next_measurement_design.refit_lambda's refits); it must reach the same
-    closed-form optimum, with a warm start given as ``initials`` searched in the same multi-start."""
-    residuals, a_opt, cost_opt, profile = _problem(seed)
-    obs = ScalarObservations(values=np.ones(M + 1), sigma_ln=np.ones(M + 1))
-    free = [FreeParameter("a", 0.0, 1.0, "linear", 0.1), FreeParameter("b", -2.0, 2.0, "linear", 0.0)]
-    res = fit_parameters(obs, None, free, predict_array=lambda X: np.exp(residuals(X)), identify=False,
-                         hold_undetermined=False, max_nfev=60, damped="all", initials=[{"a": 0.9, "b": 0.0}], starts=2)
-    assert res.converged, res.message
-    assert res.cost == pytest.approx(cost_opt, abs=1e-8)
-    assert profile(res.values["a"]) <= cost_opt + 1e-8
-
-
-def test_damped_takes_true_false_or_all():
-    from physmodel.errors import IPMCError
-
-    obs = ScalarObservations(values=np.ones(3), sigma_ln=np.ones(3))
-    with pytest.raises(IPMCError, match="damped must be True, False or 'all'"):
-        fit_parameters(obs, None, [FreeParameter("a", 0.0, 1.0, "linear", 0.1)],
-                       predict_array=lambda X: np.exp(np.repeat(X, 3, axis=1)), damped="yes")
