@@ -20,7 +20,7 @@ parameter sets predicted, batched model calls, least-squares fits, fit points (e
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 
-Measured 2026-11-27, sixth round (the next measurement's refits; "before" = 0e3466e, "after" = 428e24f,
+Measured 2026-11-27, sixth round (the next measurement's refits; "before" = 0e3466e, "after" = 9cd2bce,
 each exported to a plain folder, interleaved; 2 cores shared with two other sessions, load 2-3)::
 
     python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2 --roots BEFORE,AFTER \
@@ -30,46 +30,40 @@ each exported to a plain folder, interleaved; 2 cores shared with two other sess
 
     case                                          ipmc calibrate   ipmc diagnose CPU s   diagnose / calibrate
                                                   CPU s b / a      before    after        before   after
-    41038 contact_resistance+time_delay           1.55 / 1.59      10.38     7.48         6.7x     4.7x
-    44102 added_fluid_mass                        1.53 / 1.51       6.85     6.78         4.5x     4.5x
+    41038 contact_resistance+time_delay           1.41 / 1.46       9.78     8.46         6.9x     5.8x
+    44102 added_fluid_mass                        1.43 / 1.41       6.60     6.44         4.6x     4.6x
     fresh two-effect strips (never timed before):
-    51600 contact_resistance+time_delay           1.47 / 1.44       7.76     7.03         5.3x     4.9x
-    51601 contact_resistance+leakage              1.43 / 1.46       4.02     4.00         2.8x     2.7x
-    51602 time_delay+leakage                      1.43 / 1.51       5.32     5.57         3.7x     3.7x
-    51603 modulus_temperature+diffusivity_temp.   1.43 / 1.49       4.12     3.93         2.9x     2.6x
-    51604 contact_resistance+time_delay           1.43 / 1.43       6.58     6.36         4.6x     4.4x
+    51600 contact_resistance+time_delay           1.41 / 1.51       7.56     7.85         5.3x     5.2x
+    51601 contact_resistance+leakage              1.40 / 1.49       3.98     3.98         2.9x     2.7x
+    51602 time_delay+leakage                      1.45 / 1.52       5.41     5.23         3.7x     3.4x
+    51603 modulus_temperature+diffusivity_temp.   1.50 / 1.44       4.06     4.02         2.7x     2.8x
+    51604 contact_resistance+time_delay           1.45 / 1.53       6.98     6.82         4.8x     4.5x
 
-and the five default cases (``--commands --rounds 2 --roots BEFORE,dba8448``, the first two changes
-below): 41000 2.8x / 2.8x, 41009 3.0x / 3.0x, 41003 2.5x / 2.5x, 41005 3.9x / 4.2x, 41038 6.9x /
-5.2x.  Median 4.5x -> 4.4x, max 6.7x -> 4.9x: every case within 5x again (41038 had gone to 6.7-6.9x
-with the two-record refit check of 2026-11-27 morning).  What changed, all in the next-measurement
-search that ``ipmc diagnose`` runs on an ambiguous verdict (the diagnosis itself is untouched:
-``diagnose()`` gives the same numbers):
+Every report.json and model.json the same number by number.  Median 4.6x -> 4.5x, max 6.9x ->
+5.8x: two strips stay above 5x, both contact resistance + delay left ambiguous among four pairs,
+where ``ipmc diagnose`` runs the next-measurement search and its refit checks (41038 had gone to
+6.7-6.9x with the two-record refit check of 2026-11-27 morning).  What changed: a refit made
+before in the same search is not made again (``RecordView.refits``, keyed by the refitted lines'
+data and σ, the rival and the starts; on 41038 12 of 36 refits were drive ×1 and ×2 of one band,
+the same problem for a linear model under relative noise), and ``vuong_power`` evaluates the
+normal CDF with ``scipy.special.ndtr`` (3314 calls, ~75 µs each through ``scipy.stats.norm``).
 
-* a refit made before in the same search is not made again (``RecordView.refits``, keyed by the
-  refitted lines' data and σ, the rival and the starts): on 41038, 12 of the 36 refits were drive
-  ×1 and ×2 of one band, the same least-squares problem for a linear model under relative noise;
-* each rival refit is one multi-start (its own fit, its effect at typical size and its other forms
-  as ``initials``, one Latin-hypercube start) with damped steps from every start
-  (``fit_parameters(damped="all")``), where it was two fits whose start 0 went straight to scipy's
-  trust region and crawled to ``max_nfev`` in 11 of 24 fits: refit CPU 3.97 -> 2.43 s on 41038;
-* ``vuong_power`` evaluates the normal CDF with ``scipy.special.ndtr`` (3314 calls, ~75 µs each
-  through ``scipy.stats.norm``).
-
-The reports (report.json, model.json) are the same number by number on the cases without a
-next measurement; with one, the refit λ agree to 5e-12 relative (the largest difference printed)
-and every verdict, recommendation and message is the same.  The next-measurement benchmark gives
-the same per-case verdicts before and after (``bench_next_measurement.py --kind actuator --pairs
---first-seed 50600 --seeds 4``, ``--kind actuator --first-seed 7300 --seeds 10``, ``--first-seed
-7400 --seeds 4``), its slowest pair case 18 -> 11 s wall.  What remains costly: in these refits
-three starts often end at one optimum after ~55 evaluations each without joining.  Traced on 41038
-(truth contact resistance + delay, rival contact resistance + amplifier, an I record): starts 0 and
-1 end at the same values to 5 digits, the amplifier's two time constants collapsed onto one (τ₁ =
-τ₂, where their Jacobian columns coincide), start 2 at the same cost with other mechanical values
-(an I record does not see them).  JᵀJ is near-singular there, so the Gauss–Newton landing the
-basin test uses falls far off (34 s² in the optimum's metric at equal cost) and no start joins.  A
-minimum-norm landing would join them; it is the engine's rule for every fit (calibration and
-diagnosis too), not changed here.
+Tried and withdrawn (review): each rival's starts searched as one multi-start with damped steps
+from every start took 41038 to 4.7x and the maximum over these strips to 4.9x, with the same λ on
+41038 — but on the refit tests' fixture (576 refits of S and Z records) 33 λ moved, some by two
+orders of magnitude both ways, and 2 pairs went from below the target to "separated": another
+path ends in another basin, and a start joined a far lower optimum because a refit's cost is
+misfit, not noise, and the join test scales with it.  A refit λ is what a separation claim rests
+on, so the refits keep their paths.  What the remaining time is: in these refits three starts
+often end at one optimum after ~55 evaluations each without joining.  Traced on 41038 (truth
+contact resistance + delay, rival contact resistance + amplifier, an I record): starts 0 and 1 end
+at the same values to 5 digits, the amplifier's two time constants collapsed onto one (τ₁ = τ₂,
+where their Jacobian columns coincide), start 2 at the same cost with other mechanical values (an I
+record does not see them).  JᵀJ is near-singular there, so the Gauss–Newton landing the basin test
+uses falls far off.  Grouping several starts' points in one model call (the effect predictor's
+rows are independent of their call: bitwise on 126 effect combinations) was measured too and is
+slower: started together, a later start cannot join an earlier optimum before it exists, and the
+diagnosis's singles took 1683 points instead of 1040.
 
 Measured 2026-11-26, fifth round (h-d44: why strip 44102's pair refits with viscous_fluid take so
 many points; 2 cores shared by ~6 sessions, load 3-5): "before" = 133819a (main, exported to a
