@@ -369,7 +369,7 @@ def refit_lambda(d, r, nm: dict, truth: CompetingModel, rival: CompetingModel, m
     fit: in a refit the cost is misfit, not noise, and a start must not join another's optimum by a
     test scaled with it).  A refit made before in the same search
     (``view.refits``, :func:`refit_fingerprint`) is not made again.  ``count``, when given, is added to: ``fits`` (least-squares calls),
-    ``starts`` and ``evaluations`` (their function evaluations)."""
+    ``starts`` and ``evaluations`` (their function evaluations), and ``cached`` (refits answered from ``view.refits``)."""
     from .lsq import fit_parameters
 
     view = view or RecordView(d)
@@ -382,6 +382,8 @@ def refit_lambda(d, r, nm: dict, truth: CompetingModel, rival: CompetingModel, m
     key = (tuple(rival.effects), repr(sorted(rival.values.items())), repr(rival.free), max_nfev, repr(list(rival_starts)),
            tuple((r.quantity, r.joint) for r in records), refit_fingerprint(sw))
     if key in view.refits:          # the same refit made before in this search: its λ, no new fit
+        if count is not None:
+            count["cached"] = count.get("cached", 0) + 1
         return view.refits[key]
     pm = factory(rival.model)
     cb = d.metadata.get("candidate_bounds", {})

@@ -138,7 +138,7 @@ def test_a_refit_made_before_in_the_search_is_not_made_again(ambiguous):
     fits = count["fits"]
     assert fits == 2                    # the rival's own fit, then its typical-size start with one LHS start
     assert refit_lambda(a.d, _exp("S", 35.0, np.geomspace(150.0, 1000.0, 8), True), a.nm, a.ab, a.td, 60, view=view,
-                        count=count) == first and count["fits"] == fits
+                        count=count) == first and count["fits"] == fits and count["cached"] == 1
     twin = CompetingModel(a.d, list(a.td.effects), dict(a.td.values), list(a.td.free))    # effects as a list too
     assert refit_lambda(a.d, r, a.nm, a.ab, twin, 60, view=view, count=count) == first and count["fits"] == fits
     other = refit_lambda(a.d, _exp("S", 35.0, np.geomspace(200.0, 1000.0, 8), True), a.nm, a.ab, a.td, 60, view=view,
