@@ -408,13 +408,13 @@ def refit_lambda(d, r, nm: dict, truth: CompetingModel, rival: CompetingModel, m
 
 def refit_fingerprint(sw: FrequencySweep) -> tuple:
     """What of the refitted lines ``sw`` a refit depends on: their temperatures, frequencies,
-    responses and σ (the bytes), units and, stacked, the blocks (``metadata``'s quantities and
-    sizes) — two equal fingerprints are the same least-squares problem (:func:`refit_lambda`)."""
+    responses and σ (the bytes), units and, stacked, the blocks (``metadata``'s quantities, sizes
+    and units) — two equal fingerprints are the same least-squares problem (:func:`refit_lambda`)."""
     arrays = tuple(None if a is None else np.asarray(a).tobytes()
                    for a in (sw.temperature_c, sw.frequency_hz, sw.response, sw.magnitude_std_db, sw.phase_std_deg))
     meta = sw.metadata or {}
     return (type(sw).__name__, sw.input_unit, sw.output_unit, arrays, repr(meta.get("quantities")),
-            repr(meta.get("block_sizes")))
+            repr(meta.get("block_sizes")), repr(meta.get("units")))
 
 
 __all__ = ["CompetingModel", "FD_RELATIVE_STEP", "REFIT_STARTS", "RecordView", "fit_competing_models", "line_sigma",
