@@ -67,9 +67,14 @@ maximising the least over the pairs of the two records' λ, computed by stacking
 normal-equation sums (λ is not additive: the rival refits one set of parameters to both), none of
 its lines the first's (:mod:`~physmodel.estimation.next_measurement_plan`).  When the two reach λ*
 they are checked by full refits of the rivals to both records together, and recommended together
-when the refits reach λ* too (``NextMeasurement.also``; ``separates`` then refers to both; the pair
-the refits leave short is said with its shortfall, and not recommended); otherwise the single
-recommendation stands, unchanged.
+when the refits reach λ* too (``NextMeasurement.also``; ``separates`` then refers to both).  A
+second record the refits refuse gives way to the next-best by linearised λ (at most
+:data:`~physmodel.estimation.next_measurement_plan.MORE_SECOND_RECORDS` more, each checked, the
+first confirmed taken); when none is confirmed, the checked pair of largest λ after the refits is
+still recommended when it is above the first record's own — ``separates`` False, the message and
+``together["short"]`` saying what it reaches, the pairs short and by how much, and the remedies —
+and otherwise not (said); when the two do not reach λ* linearised the single recommendation
+stands, unchanged.
 
 Temperatures: the search offers bath steps (a 5-point grid of the allowed range and its ends with
 the middle) for every quantity the models predict at other temperatures through the parameter set's

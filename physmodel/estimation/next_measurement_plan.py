@@ -29,7 +29,15 @@ rival's own fit, its effect at its typical size, :data:`~physmodel.estimation.ne
 the least over the two directions (:func:`~physmodel.estimation.next_measurement_design.refit_lambda`
 of the two records).  The linearisation overstates what a rival reaches after a refit (a rival in
 another form may match both records), so a pair the refits leave below the target is said, with
-its shortfall, and the two records are not recommended.  Pairs searched with their models' other
+its shortfall.  Then (:func:`choose_plan`, the project lead's decisions of issue 27 item 3) the
+next-best second records by linearised λ that reach the target linearised are checked in turn, at
+most :data:`MORE_SECOND_RECORDS` more, and the first the refits confirm is recommended; when none
+is, the checked plan of largest λ after the refits is still recommended, SHORT (``separates``
+False; its shortfall, the pairs short and the remedies said, and ``together["short"]``), when that
+λ is above the first record's own after the refits — the best single record — and otherwise the
+two records are not recommended (said).  Note that a rival refitted to more lines cannot fit them
+better, so a plan's λ per pair is at least the first record's (up to the optimiser): "above" is
+met unless the second record adds nothing to the least pair.  Pairs searched with their models' other
 forms (:mod:`~physmodel.estimation.next_measurement_forms`) are not combined: when one is still
 competing no second record is searched.  Nor is one for a single pair: there a second record only
 adds lines of the same kind, which the shortfall message already covers (more periods).

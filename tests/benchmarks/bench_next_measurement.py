@@ -661,11 +661,16 @@ def run_pair_case(seed: int, label: str, args) -> dict:
     row.update(first=d1.verdict, first_named=sorted(d1.named), first_final=sorted(d1.final_effects or ()),
                first_declared=sorted(" ~ ".join(sorted((a, b))) for a, b, _ in d1.confusable))
     if d1.verdict in ("ambiguous", "at_bound"):
-        t1 = time.perf_counter()
+        t1, c1 = time.perf_counter(), time.process_time()
         chain = None if args.no_acts_on else CHAIN_ON_M
         nm = next_measurement(d1, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz),
                               **({"acts_on": chain} if chain else {}))
         r = nm.recommended
+        tg = nm.together
+        row.update(nm_cpu=time.process_time() - c1, plan=(
+            "" if not tg else "refused" if not tg.get("recommended") else "short, offered" if not nm.separates
+            else "confirmed") + (f", {len(tg['checked'])} checked, {tg['refits_total'].get('fits', 0)} refit fits"
+                                 if tg.get("checked") else ""))
         row.update(nm_s=time.perf_counter() - t1, models=[" + ".join(m) for m in nm.models],
                    truth_competing=any(sorted(m) == expected for m in nm.models), inseparable=list(nm.inseparable),
                    as_fitted=list(nm.inseparable_as_fitted), separates=nm.separates,
@@ -916,13 +921,15 @@ def main(argv=None):
                   + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} refit"
                      + "".join(f" and, with it, {a}" for a in r.get("also", []))
                      + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
+                     + (f"; two-record plan {r['plan']}" if r.get("plan") else "")
                      + f"; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
                      f"inseparable {r['inseparable'] or '-'}] -> {r['second']} {r['second_named']} "
                      f"{'OK' if r['success'] else 'MISS'}" if r["recommended"] else "")
                   + "".join(f" -> [{x['recommended']}; λ expected {x['lam_linear']:.3g} linearised, "
                             f"{x['lam_expected']:.3g} refit; {'separates' if x['separates'] else 'not expected to separate'}]"
                             f" -> {x['verdict']} {x['named']}" for x in r.get("later", []))
-                  + f" ({r['dt']:.0f} s)"), flush=True)
+                  + f" ({r['dt']:.0f} s" + (f"; next_measurement CPU {r['nm_cpu']:.1f} s" if "nm_cpu" in r else "")
+                  + ")"), flush=True)
         pair_report(rows)
         print(f"elapsed {time.perf_counter() - t0:.0f} s")
         return rows
