@@ -231,7 +231,7 @@ def test_a_refused_second_record_gives_way_to_the_next_best(seed47079, monkeypat
     assert nm.to_dict()["together"]["checked"][0]["quantity"] == "M"
 
 
-def test_a_short_pair_of_records_better_than_the_first_alone_is_offered(seed47079, monkeypatch):
+def test_a_short_pair_of_records_better_than_the_first_alone_is_offered(seed47079, monkeypatch, tmp_path):
     """Seed 47079 with every second record tried an M record claimed at λ 1e6: the refits leave the
     contact resistance against the diffusivity law short in each (three tried: the linearised best
     and two more), so none reaches the target; the one of largest λ after the refits is still above
@@ -260,6 +260,19 @@ def test_a_short_pair_of_records_better_than_the_first_alone_is_offered(seed4707
     assert nm.to_dict()["together"]["short"] == tg["short"] and nm.to_dict()["separates"] is False
     assert "alone or with a second, is expected to separate" in nm.message and "and, with it," in nm.message
     assert f"about {math.ceil(nm.target / lam)}× as many" in nm.message and "accept the ambiguity" in nm.message
+    # what `ipmc diagnose` writes carries it: report.json, summary.md and model.json's verdict reason
+    # (its stderr line is the message, as test_next_measurement's CLI test checks)
+    import json
+    from dataclasses import replace
+
+    d = replace(seed47079)
+    d.next_measurement = nm
+    d.write_report(tmp_path)
+    rep = json.loads((tmp_path / "report.json").read_text())["next_measurement"]
+    assert rep["separates"] is False and rep["also"] and rep["together"]["short"] == json.loads(json.dumps(tg["short"]))
+    k = next(iter(tg["short"]))
+    assert f"{k} reaches only" in (tmp_path / "summary.md").read_text()
+    assert f"{k} reaches only" in d.to_model_file().verdict.reason
 
 
 def test_a_short_pair_of_records_not_better_than_the_first_alone_is_not_recommended(seed47079, monkeypatch):
