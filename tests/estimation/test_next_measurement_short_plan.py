@@ -40,6 +40,8 @@ def _setup(monkeypatch, linearised: dict, refit: dict, first_refit: float = 10.0
     rows = [first] + [_row("Z", [float(i), float(i) + 0.5]) for i in range(10, 10 + len(linearised))]
     name = {id(r): n for r, n in zip(rows[1:], linearised)}
     tried: list = []
+    asked: list = []
+    _setup.asked = asked            # type: ignore[attr-defined]
 
     def fake_second(first_, rows_, sums, bases, live, deficit=None, exclude=()):
         cand = [r for r in rows_[1:] if not any(covered(r, x) for x in exclude)]
@@ -48,9 +50,10 @@ def _setup(monkeypatch, linearised: dict, refit: dict, first_refit: float = 10.0
         r = max(cand, key=lambda r: linearised[name[id(r)]])
         return RecordPair(r, linearised[name[id(r)]], {})
 
-    def fake_refit(d, plan, first_, pairs, nm, max_nfev, label, view, target=math.inf):
+    def fake_refit(d, plan, first_, pairs, nm, max_nfev, label, view, target=math.inf, suspects=(), floor=math.nan):
         n = name[id(plan.second)]
         tried.append(n)
+        asked.append((set(suspects), floor))
         return RecordPair(plan.second, plan.separation, {}, refit[n], {"A vs B": refit[n]}, {"fits": 4})
 
     monkeypatch.setattr(plan_mod, "second_record", fake_second)
@@ -84,6 +87,8 @@ def test_at_most_two_more_are_tried_and_the_best_short_one_above_the_first_is_of
     first, rows, tried = _setup(monkeypatch, lin, {"a": 20.0, "b": 35.0, "c": 25.0, "d": 99.0}, first_refit=10.0)
     pick = _choose(first, rows)
     assert tried == ["a", "b", "c"] and len(tried) == 1 + MORE_SECOND_RECORDS     # d (it would reach) is not tried
+    # each later plan is told the pairs short before and the best λ had (the first record's, then a plan's)
+    assert _setup.asked == [(set(), 10.0), ({"A vs B"}, 20.0), ({"A vs B"}, 35.0)]
     assert pick.short and pick.plan is not None and pick.plan.separation_refit == 35.0 and pick.refused is None
     tg = pick.together()
     assert tg["recommended"] is True and tg["separation"] == 35.0
@@ -116,13 +121,29 @@ def test_without_the_refit_check_the_linearised_plan_stands(monkeypatch):
     assert pick.together()["linearised_only"] is True and pick.together()["recommended"] is True
 
 
-def test_a_record_of_the_same_lines_at_no_higher_drive_is_not_tried_again():
-    """covered: the same lines at a lower (or the same) drive cannot do better after the refits (σ
-    does not fall with the drive); a higher drive, other lines or another quantity may."""
-    a = _row("Z", [10.0, 20.0], level=2.0)
-    assert covered(_row("Z", [10.0, 20.0], level=1.0), a) and covered(_row("Z", [10.0, 20.0], level=2.0), a)
-    assert not covered(_row("Z", [10.0, 20.0], level=3.0), a)
-    assert not covered(_row("Z", [10.0, 30.0], level=1.0), a) and not covered(_row("M", [10.0, 20.0], level=1.0), a)
+def test_a_record_of_the_same_lines_and_no_larger_weights_is_not_tried_again():
+    """covered: merged into the record's quantity, the same lines at a lower (or the same) drive
+    cannot do better after the refits (σ does not fall with a lower drive) and a higher drive may;
+    in a quantity the record does not hold σ does not depend on the drive (line_sigma: the
+    record's median), so any drive gives the same weights; other lines or another quantity may."""
+    from dataclasses import replace
+
+    from physmodel.estimation.next_measurement_design import line_sigma
+
+    nm = {"slope": -0.5, "ref_ln": 0.01, "ref_ph": 0.01, "median_ln": 0.02, "median_ph": 0.02}
+    lv = np.array([1.0, 3.0])
+    other = line_sigma(nm, np.zeros(3), lv, False)
+    assert np.array_equal(other[0][0], other[0][1])          # another quantity: σ the same at every drive
+    merged = line_sigma(nm, np.zeros(3), lv, True)
+    assert np.all(merged[0][1] < merged[0][0])               # the record's quantity: σ falls with the drive
+    a = replace(_row("M", [10.0, 20.0], level=2.0), joint=True)
+    assert covered(replace(a, level=1.0), a) and covered(replace(a, level=2.0), a)
+    assert not covered(replace(a, level=3.0), a)
+    z = _row("Z", [10.0, 20.0], level=1.0)                    # a record of its own
+    zj = replace(z, joint=True, added_quantity=True)          # diagnosed jointly as one more quantity
+    for x in (z, zj):
+        assert covered(replace(x, level=2.0), x) and covered(replace(x, level=0.5), x)
+    assert not covered(_row("Z", [10.0, 30.0]), z) and not covered(_row("M", [10.0, 20.0]), z)
 
 
 def test_second_record_skips_the_records_already_refused():
@@ -144,3 +165,35 @@ def test_second_record_skips_the_records_already_refused():
     p2 = second_record(first, rows, sums, bases, ["A"], exclude=[p1.second])
     assert p2 is not None and p2.second is rows[3] and p2.separation == pytest.approx(n * 4.0)
     assert second_record(first, rows, sums, bases, ["A"], exclude=[rows[1], rows[3]]) is None
+
+
+def test_a_plan_whose_suspect_pairs_stay_below_the_best_had_is_not_refitted_further(monkeypatch):
+    """refit_plan with ``suspects``: those pairs are refitted first; below the target and not above
+    ``floor``, the plan's least over every pair can be no larger (a least over more pairs), so it can
+    neither separate nor beat the best had — the other pairs are left (complete False).  Above the
+    floor, or reaching the target, every pair is refitted as before."""
+    from physmodel.estimation import next_measurement_design as design
+
+    asked: list = []
+    values = {"A vs B": 20.0, "C vs D": 60.0, "E vs F": 70.0}
+
+    def fake_check(d, pairs, records, *a, **k):
+        asked.append([f"{p[0]} vs {p[1]}" for p in pairs])
+        return {f"{p[0]} vs {p[1]}": values[f"{p[0]} vs {p[1]}"] for p in pairs}
+
+    monkeypatch.setattr(design, "refit_check", fake_check)
+    first = _row("M", [1.0, 2.0])
+    pairs = [("A", "B"), ("C", "D"), ("E", "F")]
+    rp = RecordPair(_row("Z", [5.0, 6.0]), 100.0)
+    out = plan_mod.refit_plan(None, rp, first, pairs, {}, 10, str, None, TARGET, suspects={"A vs B"}, floor=30.0)
+    assert asked == [["A vs B"]] and not out.complete and out.refit_by_pair == {"A vs B": 20.0}
+    assert out.separation_refit == 20.0 and out.summary()["complete"] is False
+    for floor, a_b in ((15.0, 20.0), (30.0, 50.0)):       # above the floor, or reaching the target
+        values["A vs B"] = a_b
+        asked.clear()
+        out = plan_mod.refit_plan(None, rp, first, pairs, {}, 10, str, None, TARGET, suspects={"A vs B"}, floor=floor)
+        assert asked == [["A vs B"], ["C vs D", "E vs F"]] and out.complete
+        assert out.refit_by_pair == {"A vs B": a_b, "C vs D": 60.0, "E vs F": 70.0} and out.separation_refit == min(a_b, 60.0)
+    asked.clear()
+    out = plan_mod.refit_plan(None, rp, first, pairs, {}, 10, str, None, TARGET)       # no suspects: as before
+    assert asked == [["A vs B", "C vs D", "E vs F"]] and out.complete
