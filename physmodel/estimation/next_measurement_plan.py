@@ -46,7 +46,7 @@ adds lines of the same kind, which the shortfall message already covers (more pe
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -188,8 +188,10 @@ def choose_plan(d, first: CandidateMeasurement, rows: list, sums: dict, bases: d
             out.plan = plan
             return out
         had = [v for v in [first.separation_refit] + [p.separation_refit for p in out.checked] if v == v]
+        short = [(k, v) for p in out.checked for k, v in p.short(target).items()]
         plan = refit_plan(d, plan, first, pairs, nm, max_nfev, label, view, target,
-                          suspects={k for p in out.checked for k in p.short(target)}, floor=max(had, default=math.nan))
+                          suspects={k: min((v for x, v in short if x == k), default=math.nan) for k, _ in short},
+                          floor=max(had, default=math.nan))
         out.checked.append(plan)
         if not plan.short(target):
             out.plan = plan
@@ -287,7 +289,8 @@ def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: di
 
 
 def refit_plan(d, plan: RecordPair, first: CandidateMeasurement, pairs: list, nm: dict, max_nfev: int, label,
-               view, target: float = math.inf, suspects: Collection[str] = (), floor: float = math.nan) -> RecordPair:
+               view, target: float = math.inf, suspects: Mapping[str, float] | None = None,
+               floor: float = math.nan) -> RecordPair:
     """``plan`` checked by full nonlinear refits (module doc): for each of ``pairs`` (model pairs)
     the least over the two directions of the rival refitted to the truth's noiseless predictions on
     ``first`` and ``plan.second`` together
@@ -296,26 +299,36 @@ def refit_plan(d, plan: RecordPair, first: CandidateMeasurement, pairs: list, nm
     refitted again: a rival fitted to more lines cannot fit them better, so its λ on both records is
     at least that one, which it keeps (a lower bound).
 
-    ``suspects`` (pairs ``"A vs B"`` a plan checked before fell short in) are refitted first; when
-    their least λ is below ``target`` and not above ``floor`` (the best λ already had: the first
-    record's or a checked plan's), the plan can neither separate nor beat it — its least over every
-    pair is no larger — so the other pairs are not refitted: the plan is returned ``complete`` False
-    with those pairs only (:func:`choose_plan`'s bound on the cost; 41038: 24 fits a plan → 8)."""
-    from .next_measurement_design import refit_check
+    ``suspects`` (``{"A vs B": λ}``: the pairs a plan checked before fell short in, with the least λ
+    they had) are refitted first, the lowest first, one direction at a time; as soon as one
+    direction's λ is below ``target`` and not above ``floor`` (the best λ already had: the first
+    record's or a checked plan's), the plan can neither separate nor beat it — a pair's λ is the
+    least over its directions and the plan's the least over the pairs, so no larger — and nothing
+    more is refitted: the plan is returned ``complete`` False with the pairs refitted so far (the
+    last one's λ that direction's, an upper bound) (:func:`choose_plan`'s bound on the cost;
+    41038: 24 fits a plan → 2).  Otherwise every pair's λ is the one :func:`refit_check` gives."""
+    from .next_measurement_design import refit_check, refit_lambda
 
     count: dict = {"fits": 0, "starts": 0, "evaluations": 0}
     done = {f"{label(a)} vs {label(b)}": first.refit_by_pair.get(f"{label(a)} vs {label(b)}", math.nan)
             for a, b in pairs}
     done = {k: v for k, v in done.items() if v >= target}
     rest = [(a, b) for a, b in pairs if f"{label(a)} vs {label(b)}" not in done]
-    early = [p for p in rest if f"{label(p[0])} vs {label(p[1])}" in suspects]
-    if early and len(early) < len(rest):
-        part = refit_check(d, early, [first, plan.second], nm, max_nfev, label, view, count=count)
-        low = float("nan") if any(v != v for v in part.values()) else float(min(part.values()))
-        if not low >= target and not low > floor:
-            return replace(plan, separation_refit=low, refit_by_pair=part, refits=count, complete=False)
-        done.update(part)
-        rest = [p for p in rest if p not in early]
+    sus = suspects or {}
+    early = sorted((p for p in rest if f"{label(p[0])} vs {label(p[1])}" in sus),
+                   key=lambda p: sus[f"{label(p[0])} vs {label(p[1])}"])
+    part: dict = {}
+    for a, b in early:
+        k, vals = f"{label(a)} vs {label(b)}", []
+        for truth, rival in ((a, b), (b, a)):
+            vals.append(refit_lambda(d, [first, plan.second], nm, truth, rival, max_nfev, view=view, count=count))
+            if not vals[-1] >= target and not vals[-1] > floor:       # NaN too: not separated
+                part[k] = min(vals)
+                low = float("nan") if any(v != v for v in part.values()) else float(min(part.values()))
+                return replace(plan, separation_refit=low, refit_by_pair=part, refits=count, complete=False)
+        part[k] = min(vals)
+    done.update(part)
+    rest = [p for p in rest if p not in early]
     by = {**done, **(refit_check(d, rest, [first, plan.second], nm, max_nfev, label, view, count=count)
                      if rest else {})}
     by = {f"{label(a)} vs {label(b)}": by[f"{label(a)} vs {label(b)}"] for a, b in pairs}     # the pairs' order

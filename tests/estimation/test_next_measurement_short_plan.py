@@ -50,10 +50,10 @@ def _setup(monkeypatch, linearised: dict, refit: dict, first_refit: float = 10.0
         r = max(cand, key=lambda r: linearised[name[id(r)]])
         return RecordPair(r, linearised[name[id(r)]], {})
 
-    def fake_refit(d, plan, first_, pairs, nm, max_nfev, label, view, target=math.inf, suspects=(), floor=math.nan):
+    def fake_refit(d, plan, first_, pairs, nm, max_nfev, label, view, target=math.inf, suspects=None, floor=math.nan):
         n = name[id(plan.second)]
         tried.append(n)
-        asked.append((set(suspects), floor))
+        asked.append((dict(suspects or {}), floor))
         return RecordPair(plan.second, plan.separation, {}, refit[n], {"A vs B": refit[n]}, {"fits": 4})
 
     monkeypatch.setattr(plan_mod, "second_record", fake_second)
@@ -87,8 +87,9 @@ def test_at_most_two_more_are_tried_and_the_best_short_one_above_the_first_is_of
     first, rows, tried = _setup(monkeypatch, lin, {"a": 20.0, "b": 35.0, "c": 25.0, "d": 99.0}, first_refit=10.0)
     pick = _choose(first, rows)
     assert tried == ["a", "b", "c"] and len(tried) == 1 + MORE_SECOND_RECORDS     # d (it would reach) is not tried
-    # each later plan is told the pairs short before and the best λ had (the first record's, then a plan's)
-    assert _setup.asked == [(set(), 10.0), ({"A vs B"}, 20.0), ({"A vs B"}, 35.0)]
+    # each later plan is told the pairs short before (their least λ) and the best λ had (the first
+    # record's, then a plan's)
+    assert _setup.asked == [({}, 10.0), ({"A vs B": 20.0}, 20.0), ({"A vs B": 20.0}, 35.0)]
     assert pick.short and pick.plan is not None and pick.plan.separation_refit == 35.0 and pick.refused is None
     tg = pick.together()
     assert tg["recommended"] is True and tg["separation"] == 35.0
@@ -168,32 +169,42 @@ def test_second_record_skips_the_records_already_refused():
 
 
 def test_a_plan_whose_suspect_pairs_stay_below_the_best_had_is_not_refitted_further(monkeypatch):
-    """refit_plan with ``suspects``: those pairs are refitted first; below the target and not above
-    ``floor``, the plan's least over every pair can be no larger (a least over more pairs), so it can
-    neither separate nor beat the best had — the other pairs are left (complete False).  Above the
-    floor, or reaching the target, every pair is refitted as before."""
+    """refit_plan with ``suspects``: those pairs are refitted first (the lowest first), one direction at
+    a time; a direction below the target and not above ``floor`` bounds the pair's λ (the least over
+    its directions) and so the plan's (the least over the pairs): it can neither separate nor beat the
+    best had, and nothing more is refitted (complete False).  Otherwise every pair gets what
+    refit_check gives (both directions, their least), as without suspects."""
     from physmodel.estimation import next_measurement_design as design
 
     asked: list = []
-    values = {"A vs B": 20.0, "C vs D": 60.0, "E vs F": 70.0}
+    lam = {("A", "B"): 20.0, ("B", "A"): 25.0, ("C", "D"): 60.0, ("D", "C"): 65.0, ("E", "F"): 70.0, ("F", "E"): 75.0}
+
+    def fake_lambda(d, records, nm, truth, rival, *a, **k):
+        asked.append((truth, rival))
+        return lam[(truth, rival)]
 
     def fake_check(d, pairs, records, *a, **k):
-        asked.append([f"{p[0]} vs {p[1]}" for p in pairs])
-        return {f"{p[0]} vs {p[1]}": values[f"{p[0]} vs {p[1]}"] for p in pairs}
+        return {f"{x} vs {y}": min(fake_lambda(d, records, None, x, y), fake_lambda(d, records, None, y, x))
+                for x, y in pairs}
 
+    monkeypatch.setattr(design, "refit_lambda", fake_lambda)
     monkeypatch.setattr(design, "refit_check", fake_check)
     first = _row("M", [1.0, 2.0])
     pairs = [("A", "B"), ("C", "D"), ("E", "F")]
     rp = RecordPair(_row("Z", [5.0, 6.0]), 100.0)
-    out = plan_mod.refit_plan(None, rp, first, pairs, {}, 10, str, None, TARGET, suspects={"A vs B"}, floor=30.0)
-    assert asked == [["A vs B"]] and not out.complete and out.refit_by_pair == {"A vs B": 20.0}
+    run = lambda sus, floor: plan_mod.refit_plan(None, rp, first, pairs, {}, 10, str, None, TARGET,  # noqa: E731
+                                                 suspects=sus, floor=floor)
+    out = run({"C vs D": 50.0, "A vs B": 30.0}, 30.0)
+    assert asked == [("A", "B")] and not out.complete and out.refit_by_pair == {"A vs B": 20.0}
     assert out.separation_refit == 20.0 and out.summary()["complete"] is False
-    for floor, a_b in ((15.0, 20.0), (30.0, 50.0)):       # above the floor, or reaching the target
-        values["A vs B"] = a_b
-        asked.clear()
-        out = plan_mod.refit_plan(None, rp, first, pairs, {}, 10, str, None, TARGET, suspects={"A vs B"}, floor=floor)
-        assert asked == [["A vs B"], ["C vs D", "E vs F"]] and out.complete
-        assert out.refit_by_pair == {"A vs B": a_b, "C vs D": 60.0, "E vs F": 70.0} and out.separation_refit == min(a_b, 60.0)
     asked.clear()
-    out = plan_mod.refit_plan(None, rp, first, pairs, {}, 10, str, None, TARGET)       # no suspects: as before
-    assert asked == [["A vs B", "C vs D", "E vs F"]] and out.complete
+    out = run({"A vs B": 30.0}, 15.0)                  # above the floor: every pair, as refit_check gives
+    assert asked == [("A", "B"), ("B", "A"), ("C", "D"), ("D", "C"), ("E", "F"), ("F", "E")] and out.complete
+    assert out.refit_by_pair == {"A vs B": 20.0, "C vs D": 60.0, "E vs F": 70.0} and out.separation_refit == 20.0
+    lam[("A", "B")] = 50.0                              # the first direction reaches the target, the second not
+    asked.clear()
+    out = run({"A vs B": 30.0}, 30.0)
+    assert asked == [("A", "B"), ("B", "A")] and not out.complete and out.refit_by_pair == {"A vs B": 25.0}
+    asked.clear()
+    out = run(None, 30.0)                               # no suspects: as before
+    assert len(asked) == 6 and out.complete and out.refit_by_pair == {"A vs B": 25.0, "C vs D": 60.0, "E vs F": 70.0}
