@@ -194,7 +194,12 @@ def _thin_tails(ctx: RunContext, diagnoses: list) -> str:
 
 
 def step_next_measurement(ctx: RunContext):
-    """Ambiguous on one virtual-lab record → the recommended measurement → named on both."""
+    """Ambiguous on one virtual-lab record → the recommended measurement → named on both.  A
+    recommendation not expected to separate (one record, or two short of the target after the
+    refits — ``also`` with ``separates`` False) is measured all the same, the best there is, and
+    its shortfall said: in the table, on stderr and as the metric ``next_measurement.short_by``."""
+    import sys
+
     from physmodel.estimation.next_measurement import merge_records
 
     from . import plots
@@ -254,8 +259,13 @@ def step_next_measurement(ctx: RunContext):
         plots.diagnosis_figures(d2, folder2)
         what = f"adds {r.describe()}" + "".join(f" and {x.describe()}" for x in nm.also)
         lam = ctx.metrics["next_measurement.expected_separation"]
+        ctx.metric("next_measurement.short_by", 0.0 if nm.separates else max(float(nm.target - lam), 0.0))
+        short = "" if nm.separates else f" (short of {nm.target:.3g} needed: not expected to separate)"
+        if short:        # the records were taken all the same (the best there is): said, not only in the report
+            print(f"{ctx.spec.name}: the recommended record{'s' if nm.also else ''}, expected λ {lam:.3g}{short}",
+                  file=sys.stderr)
         rows.append((f"1 + {' + '.join(str(j + 2) for j in range(1 + len(nm.also)))}: {what}", d2.verdict,
-                     ", ".join(d2.named) or "–", f"{lam:.3g}"))
+                     ", ".join(d2.named) or "–", f"{lam:.3g}{short}"))
     for p in sorted((ctx.out / "next_measurement").rglob("*")):
         if p.is_file() and not p.name.startswith(".") and p.suffix != ".csv":
             ctx.file(Path(p))

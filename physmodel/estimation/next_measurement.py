@@ -67,9 +67,14 @@ maximising the least over the pairs of the two records' λ, computed by stacking
 normal-equation sums (λ is not additive: the rival refits one set of parameters to both), none of
 its lines the first's (:mod:`~physmodel.estimation.next_measurement_plan`).  When the two reach λ*
 they are checked by full refits of the rivals to both records together, and recommended together
-when the refits reach λ* too (``NextMeasurement.also``; ``separates`` then refers to both; the pair
-the refits leave short is said with its shortfall, and not recommended); otherwise the single
-recommendation stands, unchanged.
+when the refits reach λ* too (``NextMeasurement.also``; ``separates`` then refers to both).  A
+second record the refits refuse gives way to the next-best by linearised λ (at most
+:data:`~physmodel.estimation.next_measurement_plan.MORE_SECOND_RECORDS` more, each checked, the
+first confirmed taken); when none is confirmed, the checked pair of largest λ after the refits is
+still recommended when it is above the first record's own — ``separates`` False, the message and
+``together["short"]`` saying what it reaches, the pairs short and by how much, and the remedies —
+and otherwise not (said); when the two do not reach λ* linearised the single recommendation
+stands, unchanged.
 
 Temperatures: the search offers bath steps (a 5-point grid of the allowed range and its ends with
 the middle) for every quantity the models predict at other temperatures through the parameter set's
@@ -131,7 +136,7 @@ from .next_measurement_design import (
     t_solve,
     t_sums,
 )
-from .next_measurement_plan import bath_premise, record_base, refit_plan, second_record
+from .next_measurement_plan import PlanChoice, bath_premise, choose_plan, plan_message, record_base, refused_message
 from .next_measurement_results import CandidateMeasurement, NextMeasurement, json_ready, merge_records
 from .residuals import noise_std
 
@@ -538,7 +543,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     chosen = good[0] if good else (max(checked, key=lambda r: r.separation_refit) if checked else order[0])
     sep_ok = bool(live) and chosen.separation >= target and (not checked or chosen.separation_refit >= target)
     lam_said = chosen.separation_refit if math.isfinite(chosen.separation_refit) else chosen.separation
-    plan = plan_short = None     # no single experiment reaches the target: a second one with it (next_measurement_plan)
+    pick = PlanChoice(target=target)     # no single experiment reaches the target: a second one with it (next_measurement_plan)
     # one pair: more data of one kind, said as 'lower the noise' (as before); a first record whose linearised λ
     # reaches the target but whose refits do not: the linearisation is not to be built on (no second record)
     if len(live) > 1 and not sep_ok and chosen.separation < target:
@@ -546,11 +551,8 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                  for a, b in live}
         short = {k: max(0.0, min(chosen.separation_by_pair[k].values()) - v)
                  for k, v in chosen.refit_by_pair.items() if math.isfinite(v) and k in chosen.separation_by_pair}
-        plan = second_record(chosen, rows, sums, bases, [key(a, b) for a, b in live], short)
-        plan = plan if plan is not None and plan.separation >= target else None
-        if plan is not None and check_refit > 0:     # the pair checked by refits on both records together
-            plan = refit_plan(d, plan, chosen, live, nm, max_nfev, label, view, target)
-            plan, plan_short = (None, plan) if plan.short(target) else (plan, None)
+        pick = choose_plan(d, chosen, rows, sums, bases, live, short, target, check_refit, nm, max_nfev, label, view)
+    plan, plan_short = pick.plan, pick.refused
     who = " vs ".join(" + ".join(m) for m in mods)
     alike = _inseparable_note(same_form, same_refit, bool(contests))
     if not live:
@@ -562,16 +564,10 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                f"(≥ {target:.3g} needed for {power:.0%} power at α = {d.alpha:g}; the record alone gives "
                f"{current:.3g}).{alike}")
     elif plan is not None:
-        sep_ok = True
+        sep_ok = not pick.short
         if plan.second.joint and not chosen.joint:    # the pair's λ counts the record: the first joins it too
             chosen = replace(chosen, joint=True, added_quantity=True)
-        msg = (f"Next measurements to separate {who} (no single experiment within the limits is expected to): "
-               f"{chosen.describe()} and, with it, {plan.second.describe()}: together expected λ = "
-               + (f"{plan.separation_refit:.3g}, checked by refits of the rivals to both records together "
-                  f"({plan.separation:.3g} linearised)" if plan.refit_by_pair else f"{plan.separation:.3g}, "
-                  "linearised only (no refit check asked)")
-               + f", the records diagnosed together (≥ {target:.3g} needed for {power:.0%} power at α = "
-               f"{d.alpha:g}; the first alone gives {shortfall(chosen)[1]}, the record alone {current:.3g}).{alike}")
+        msg = plan_message(pick, chosen, who, power, d.alpha, shortfall(chosen)[1], current) + alike
     else:
         lam_low, lam_words = shortfall(chosen)
         msg = (f"No experiment within the limits is expected to separate {who} at the noise of this record: the "
@@ -581,11 +577,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                   "as many" if 0 < lam_low < target else "")
                + f"), widen the limits, or accept the ambiguity.{alike}")
         if plan_short is not None:       # two records reached the target linearised, not after the refits
-            msg += (f" Two records were checked too: with it, {plan_short.second.describe()} gives λ = "
-                    f"{plan_short.separation:.3g} linearised, but after refits of the rivals to both records together "
-                    + "; ".join(f"{k} reaches only {v:.3g} (short of {target:.3g} by {target - v:.3g})"
-                                for k, v in plan_short.short(target).items())
-                    + ": not expected to separate, so not recommended.")
+            msg += refused_message(pick, shortfall(chosen)[1])
     forms: dict = {}
     if contests:
         msg += _forms_note(forms_said, contests, d.alpha)
@@ -598,9 +590,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                            ranking[:10], nm, {label(m): m.values for m in fitted}, msg, same_form + same_refit,
                            {q: max(r.separation for r in rows if r.quantity == q) for q in qs
                             if any(r.quantity == q for r in rows)}, list(same_refit), premise, forms,
-                           also=[plan.second] if plan is not None else [],
-                           together=plan.together() if plan is not None else
-                           {**plan_short.together(), "recommended": False} if plan_short is not None else {})
+                           also=[plan.second] if plan is not None else [], together=pick.together())
 
 
 def _contests(d, fitted, alts, pairs, key, label, qs, f_grid, T_grid, nm, view, first_inseparable=()) -> tuple:

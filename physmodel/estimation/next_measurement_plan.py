@@ -29,7 +29,15 @@ rival's own fit, its effect at its typical size, :data:`~physmodel.estimation.ne
 the least over the two directions (:func:`~physmodel.estimation.next_measurement_design.refit_lambda`
 of the two records).  The linearisation overstates what a rival reaches after a refit (a rival in
 another form may match both records), so a pair the refits leave below the target is said, with
-its shortfall, and the two records are not recommended.  Pairs searched with their models' other
+its shortfall.  Then (:func:`choose_plan`, the project lead's decisions of issue 27 item 3) the
+next-best second records by linearised λ that reach the target linearised are checked in turn, at
+most :data:`MORE_SECOND_RECORDS` more, and the first the refits confirm is recommended; when none
+is, the checked plan of largest λ after the refits is still recommended, SHORT (``separates``
+False; its shortfall, the pairs short and the remedies said, and ``together["short"]``), when that
+λ is above the first record's own after the refits — the best single record — and otherwise the
+two records are not recommended (said).  Note that a rival refitted to more lines cannot fit them
+better, so a plan's λ per pair is at least the first record's (up to the optimiser): "above" is
+met unless the second record adds nothing to the least pair.  Pairs searched with their models' other
 forms (:mod:`~physmodel.estimation.next_measurement_forms`) are not combined: when one is still
 competing no second record is searched.  Nor is one for a single pair: there a second record only
 adds lines of the same kind, which the shortfall message already covers (more periods).
@@ -38,6 +46,7 @@ adds lines of the same kind, which the shortfall message already covers (more pe
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -69,6 +78,10 @@ class RecordPair:
         ``"A vs B"`` → λ of both records after the refits, the least over the two directions. [-]
     refits : dict
         What the check cost: ``fits`` (least-squares calls), ``starts``, ``evaluations``.
+    complete : bool
+        False when the refits stopped early (:func:`refit_plan`'s ``suspects``): ``refit_by_pair``
+        holds only the pairs refitted, and ``separation_refit`` is their least, an upper bound of
+        the plan's.
     """
 
     second: CandidateMeasurement
@@ -77,22 +90,124 @@ class RecordPair:
     separation_refit: float = float("nan")
     refit_by_pair: dict = field(default_factory=dict)
     refits: dict = field(default_factory=dict)
+    complete: bool = True
 
     def short(self, target: float) -> dict:
         """``{"A vs B": λ after the refits}`` of the pairs the refits leave below ``target``."""
         return {k: v for k, v in self.refit_by_pair.items() if not v >= target}
 
-    def together(self) -> dict:
+    def together(self, target: float | None = None) -> dict:
         """:attr:`~physmodel.estimation.next_measurement_results.NextMeasurement.together` of the
         plan: ``separation`` the refits' λ when checked (else the linearised one),
         ``separation_linearised``, ``separation_by_pair`` (linearised, per direction),
         ``refit_by_pair``, ``linearised_only``, ``refits`` and ``recommended`` (True here; the search
-        sets it False for a plan the refits refuse)."""
+        sets it False for a plan it does not recommend); with ``target``, ``short``: ``{"A vs B":
+        {"separation": λ after the refits, "short_by": target − λ}}`` of the pairs the refits leave
+        below it (empty when none)."""
         checked = bool(self.refit_by_pair)
-        return {"separation": self.separation_refit if checked else self.separation,
-                "separation_linearised": self.separation, "separation_by_pair": dict(self.separation_by_pair),
-                "refit_by_pair": dict(self.refit_by_pair), "linearised_only": not checked,
-                "refits": dict(self.refits), "recommended": True}
+        out = {"separation": self.separation_refit if checked else self.separation,
+               "separation_linearised": self.separation, "separation_by_pair": dict(self.separation_by_pair),
+               "refit_by_pair": dict(self.refit_by_pair), "linearised_only": not checked,
+               "refits": dict(self.refits), "recommended": True}
+        if target is not None:
+            out["short"] = {k: {"separation": v, "short_by": target - v} for k, v in self.short(target).items()}
+        return out
+
+    def summary(self) -> dict:
+        """The checked plan in brief (``NextMeasurement.together["checked"]``): the second record
+        (``second``, its ``quantity``), ``separation_linearised``, ``separation`` (after the refits)
+        and ``refit_by_pair``."""
+        return {"second": self.second.describe(), "quantity": self.second.quantity,
+                "separation_linearised": self.separation, "separation": self.separation_refit,
+                "refit_by_pair": dict(self.refit_by_pair), "complete": self.complete, "fits": self.refits.get("fits", 0)}
+
+
+#: Second records tried after the linearised best is refused by the refits, the next-best by
+#: linearised λ (each refit-checked; the search stops at the first reaching the target): a bound on
+#: the check's cost, which ``ipmc diagnose`` pays (the project lead's decision, issue 27 item 3).
+MORE_SECOND_RECORDS = 2
+
+
+@dataclass
+class PlanChoice:
+    """What :func:`choose_plan` decided.
+
+    Attributes
+    ----------
+    plan : RecordPair or None
+        The two records recommended: reaching the target (after the refits when checked), or — when
+        ``short`` — short of it but better than the first record alone.
+    short : bool
+        ``plan`` is short of the target after the refits (offered as the best there is).
+    refused : RecordPair or None
+        Without ``plan``: the best checked plan, short of the target and not better than the first
+        record alone (not recommended; said).
+    checked : list of RecordPair
+        Every plan checked by refits, in the order tried (by linearised λ).
+    target : float
+        The separation needed. [-]
+    """
+
+    plan: RecordPair | None = None
+    short: bool = False
+    refused: RecordPair | None = None
+    checked: list = field(default_factory=list)
+    target: float = math.inf
+
+    def together(self) -> dict:
+        """:attr:`~physmodel.estimation.next_measurement_results.NextMeasurement.together`: the
+        recommended plan's (or the refused one's, ``recommended`` False) with ``short``,
+        ``checked`` (each plan checked, :meth:`RecordPair.summary`) and ``refits_total`` (the
+        refits' cost over them); empty when no plan was searched to the target."""
+        shown = self.plan or self.refused
+        if shown is None:
+            return {}
+        total: dict = {}
+        for p in self.checked:
+            for k, v in p.refits.items():
+                total[k] = total.get(k, 0) + v
+        return {**shown.together(self.target), "recommended": self.plan is not None,
+                "checked": [p.summary() for p in self.checked], "refits_total": total}
+
+
+def choose_plan(d, first: CandidateMeasurement, rows: list, sums: dict, bases: dict, pairs: list, deficit: dict,
+                target: float, check_refit: int, nm: dict, max_nfev: int, label, view) -> PlanChoice:
+    """The second record to run with ``first`` (module doc): the linearised best
+    (:func:`second_record`, over ``pairs``' keys ``"A vs B"``) when it reaches ``target``, checked by
+    the refits (:func:`refit_plan`, when ``check_refit`` > 0); when the refits refuse it, the
+    next-best by linearised λ that also reach the target linearised, up to
+    :data:`MORE_SECOND_RECORDS` more, each checked, stopping at the first the refits confirm.  When
+    none is confirmed, the checked plan of largest λ after the refits is still recommended, short,
+    when that λ is above ``first``'s own after the refits (its ``separation_refit``: the best single
+    record); else none is (``refused``)."""
+    keys = [f"{label(a)} vs {label(b)}" for a, b in pairs]
+    out = PlanChoice(target=target)
+    plan = second_record(first, rows, sums, bases, keys, deficit)
+    while plan is not None and plan.separation >= target:
+        if check_refit <= 0:          # linearised only (said so)
+            out.plan = plan
+            return out
+        had = [v for v in [first.separation_refit] + [p.separation_refit for p in out.checked] if v == v]
+        short = [(k, v) for p in out.checked for k, v in p.short(target).items()]
+        plan = refit_plan(d, plan, first, pairs, nm, max_nfev, label, view, target,
+                          suspects={k: min((v for x, v in short if x == k), default=math.nan) for k, _ in short},
+                          floor=max(had, default=math.nan))
+        out.checked.append(plan)
+        if not plan.short(target):
+            out.plan = plan
+            return out
+        if len(out.checked) > MORE_SECOND_RECORDS:
+            break
+        plan = second_record(first, rows, sums, bases, keys, deficit, exclude=[p.second for p in out.checked])
+    if not out.checked:
+        return out
+    best = max((p for p in out.checked if p.complete),       # a plan stopped early is below one checked before
+               key=lambda p: p.separation_refit if p.separation_refit == p.separation_refit else -math.inf)
+    if best.separation_refit > first.separation_refit:      # NaN on either side: not better
+        out.plan, out.short = best, True
+    else:
+        out.refused = best
+    return out
 
 
 def record_base(rec_a: tuple, rec_b: tuple, w0: np.ndarray) -> tuple:
@@ -116,10 +231,25 @@ def overlaps(r1: CandidateMeasurement, r2: CandidateMeasurement) -> bool:
     return any(x in have for x in zip(r2.line_temperatures_c.tolist(), r2.line_frequencies_hz.tolist()))
 
 
+def covered(r: CandidateMeasurement, tried: CandidateMeasurement) -> bool:
+    """Whether experiment ``r`` holds exactly the lines of ``tried`` (quantity, temperature and
+    frequency) with no larger weights: at no higher a drive, or at any drive for a quantity the
+    diagnosed record does not hold (its σ is the record's median, whatever the drive:
+    :func:`~physmodel.estimation.next_measurement_design.line_sigma`).  Its refits cannot reach more
+    than ``tried``'s (in the record's quantity σ does not fall with a lower drive, the noise model's
+    slope b ≤ 0, and λ = min_δ Σ w r² does not grow when no weight does), so after ``tried`` was
+    refused it is not worth a refit (41038: the Z record at drive ×2 after ×1, the same λ, 24 fits)."""
+    level_sets_sigma = r.joint and not r.added_quantity          # merged into a quantity the record holds
+    return (r.quantity == tried.quantity and (r.level <= tried.level or not level_sets_sigma)
+            and np.array_equal(r.line_temperatures_c, tried.line_temperatures_c)
+            and np.array_equal(r.line_frequencies_hz, tried.line_frequencies_hz))
+
+
 def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: dict, live: list,
-                  deficit: dict | None = None) -> RecordPair | None:
+                  deficit: dict | None = None, exclude: Sequence[CandidateMeasurement] = ()) -> RecordPair | None:
     """The experiment of ``rows`` that, added to ``first``, maximises the least over the ``live``
-    pairs (``"A vs B"``) of the combined linearised λ (module doc).
+    pairs (``"A vs B"``) of the combined linearised λ (module doc); none :func:`covered` by one of
+    ``exclude`` (second records already refused by the refits: the next-best by linearised λ).
 
     ``deficit[pair]``: how far the refits of ``first`` fell below its linearised λ of that pair
     (≥ 0; 0 where not checked).  It is taken off the pair's combined λ: the combination adds only
@@ -133,7 +263,8 @@ def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: di
     if not live or any(k not in sums for k in live):
         return None
     i1 = next(i for i, r in enumerate(rows) if r is first)
-    cand = np.array([j for j, r in enumerate(rows) if not overlaps(first, r)], int)
+    cand = np.array([j for j, r in enumerate(rows) if not overlaps(first, r)
+                     and not any(covered(r, x) for x in exclude)], int)
     if cand.size == 0:
         return None
     with_rec = np.array([first.joint or rows[j].joint for j in cand], float)
@@ -158,27 +289,107 @@ def second_record(first: CandidateMeasurement, rows: list, sums: dict, bases: di
 
 
 def refit_plan(d, plan: RecordPair, first: CandidateMeasurement, pairs: list, nm: dict, max_nfev: int, label,
-               view, target: float = math.inf) -> RecordPair:
+               view, target: float = math.inf, suspects: Mapping[str, float] | None = None,
+               floor: float = math.nan) -> RecordPair:
     """``plan`` checked by full nonlinear refits (module doc): for each of ``pairs`` (model pairs)
     the least over the two directions of the rival refitted to the truth's noiseless predictions on
     ``first`` and ``plan.second`` together
     (:func:`~physmodel.estimation.next_measurement_design.refit_check`), and what the refits cost.
     A pair whose refits on ``first`` alone already reach ``target`` (``first.refit_by_pair``) is not
     refitted again: a rival fitted to more lines cannot fit them better, so its λ on both records is
-    at least that one, which it keeps (a lower bound)."""
-    from .next_measurement_design import refit_check
+    at least that one, which it keeps (a lower bound).
+
+    ``suspects`` (``{"A vs B": λ}``: the pairs a plan checked before fell short in, with the least λ
+    they had) are refitted first, the lowest first, one direction at a time; as soon as one
+    direction's λ is below ``target`` and not above ``floor`` (the best λ already had: the first
+    record's or a checked plan's), the plan can neither separate nor beat it — a pair's λ is the
+    least over its directions and the plan's the least over the pairs, so no larger — and nothing
+    more is refitted: the plan is returned ``complete`` False with the pairs refitted so far (the
+    last one's λ that direction's, an upper bound) (:func:`choose_plan`'s bound on the cost;
+    41038: 24 fits a plan → 2).  Otherwise every pair's λ is the one :func:`refit_check` gives."""
+    from .next_measurement_design import refit_check, refit_lambda
 
     count: dict = {"fits": 0, "starts": 0, "evaluations": 0}
     done = {f"{label(a)} vs {label(b)}": first.refit_by_pair.get(f"{label(a)} vs {label(b)}", math.nan)
             for a, b in pairs}
     done = {k: v for k, v in done.items() if v >= target}
     rest = [(a, b) for a, b in pairs if f"{label(a)} vs {label(b)}" not in done]
+    sus = suspects or {}
+    early = sorted((p for p in rest if f"{label(p[0])} vs {label(p[1])}" in sus),
+                   key=lambda p: sus[f"{label(p[0])} vs {label(p[1])}"])
+    part: dict = {}
+    for a, b in early:
+        k, vals = f"{label(a)} vs {label(b)}", []
+        for truth, rival in ((a, b), (b, a)):
+            vals.append(refit_lambda(d, [first, plan.second], nm, truth, rival, max_nfev, view=view, count=count))
+            if not vals[-1] >= target and not vals[-1] > floor:       # NaN too: not separated
+                part[k] = min(vals)
+                low = float("nan") if any(v != v for v in part.values()) else float(min(part.values()))
+                return replace(plan, separation_refit=low, refit_by_pair=part, refits=count, complete=False)
+        part[k] = min(vals)
+    done.update(part)
+    rest = [p for p in rest if p not in early]
     by = {**done, **(refit_check(d, rest, [first, plan.second], nm, max_nfev, label, view, count=count)
                      if rest else {})}
     by = {f"{label(a)} vs {label(b)}": by[f"{label(a)} vs {label(b)}"] for a, b in pairs}     # the pairs' order
     # a pair whose refits gave no finite λ is not separated: NaN, whatever the order of the pairs
     least = float("nan") if not by or any(v != v for v in by.values()) else float(min(by.values()))
     return replace(plan, separation_refit=least, refit_by_pair=by, refits=count)
+
+
+def _short_words(plan: RecordPair, target: float) -> str:
+    """The pairs ``plan``'s refits leave below ``target``, each with its λ and shortfall."""
+    return "; ".join(f"{k} reaches only {v:.3g} (short of {target:.3g} by {target - v:.3g})"
+                     for k, v in plan.short(target).items())
+
+
+def plan_message(pick: PlanChoice, first: CandidateMeasurement, who: str, power: float, alpha: float,
+                 first_words: str, current: float) -> str:
+    """The message of a recommended plan (``pick.plan``): the two records and their λ together;
+    when short (``pick.short``), that no experiment, alone or with a second, is expected to separate,
+    the pairs that fall short and by how much, and the remedies (more periods — λ grows in proportion
+    to the periods averaged, so about ⌈target/λ⌉× as many —, wider limits, or the ambiguity
+    accepted).  ``first_words``: the first record's own λ in words; ``current``: the record's."""
+    plan, target = pick.plan, pick.target
+    assert plan is not None
+    both = f"{first.describe()} and, with it, {plan.second.describe()}"
+    need = f"{target:.3g} needed for {power:.0%} power at α = {alpha:g}"
+    alone = f"the first alone gives {first_words}, the record alone {current:.3g}"
+    tried = len(pick.checked)
+    if not pick.short:
+        refused = pick.checked[:-1]
+        return (f"Next measurements to separate {who} (no single experiment within the limits is expected to): "
+                f"{both}: together expected λ = "
+                + (f"{plan.separation_refit:.3g}, checked by refits of the rivals to both records together "
+                   f"({plan.separation:.3g} linearised)" if plan.refit_by_pair else f"{plan.separation:.3g}, "
+                   "linearised only (no refit check asked)")
+                + f", the records diagnosed together (≥ {need}; {alone})."
+                + (f" {len(refused)} second record(s) of larger linearised λ fell short after the refits ("
+                   + "; ".join(f"{p.second.describe()}: λ {p.separation_refit:.3g}" for p in refused) + ")."
+                   if refused else ""))
+    lam = plan.separation_refit
+    return (f"No experiment within the limits, alone or with a second, is expected to separate {who} at the noise "
+            f"of this record; the best is two records, {both}: together expected λ = {lam:.3g} after refits of the "
+            f"rivals to both records together ({plan.separation:.3g} linearised) < {need}, the records diagnosed "
+            f"together ({alone}); short after the refits: {_short_words(plan, target)}"
+            + (f" (the most of the {tried} pairs of records checked, by linearised λ)" if tried > 1 else "")
+            + ". Lower the noise (more periods in both records"
+            + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam)}× as many"
+               if 0 < lam < target else "")
+            + "), widen the limits, or accept the ambiguity.")
+
+
+def refused_message(pick: PlanChoice, first_words: str) -> str:
+    """The sentence added to a short single record's message when two records reached the target
+    linearised but every checked pair falls short after the refits and none is better than the
+    first record alone (``first_words``: its λ in words): not recommended."""
+    best, target, n = pick.refused, pick.target, len(pick.checked)
+    assert best is not None
+    return (" Two records were checked too" + (f" ({n} second records, by linearised λ; the best after the refits "
+                                                "said)" if n > 1 else "")
+            + f": with it, {best.second.describe()} gives λ = {best.separation:.3g} linearised, but after refits of "
+            f"the rivals to both records together {_short_words(best, target)}: not expected to separate, nor better "
+            f"than the first alone ({first_words}), so not recommended.")
 
 
 def bath_premise(records: list, record_temperatures_c, base) -> str:
@@ -223,4 +434,5 @@ def bath_premise(records: list, record_temperatures_c, base) -> str:
             f"temperature (an 'unexplained' verdict on the records together) {check}")
 
 
-__all__ = ["RecordPair", "bath_premise", "overlaps", "record_base", "refit_plan", "second_record"]
+__all__ = ["MORE_SECOND_RECORDS", "PlanChoice", "RecordPair", "bath_premise", "choose_plan", "covered", "overlaps",
+           "plan_message", "record_base", "refit_plan", "refused_message", "second_record"]

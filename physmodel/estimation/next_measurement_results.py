@@ -119,7 +119,8 @@ class NextMeasurement:
     recommended : CandidateMeasurement or None
         The experiment to run (None when there is nothing to separate).
     separates : bool
-        The recommendation is expected to reach ``target`` (and its refit check agrees).
+        The recommendation (with ``also``, both records) is expected to reach ``target`` (and its
+        refit check agrees).
     target : float
         The separation needed, 4 (z_crit + Φ⁻¹(power))². [-]
     current : float
@@ -165,7 +166,9 @@ class NextMeasurement:
     also : list of CandidateMeasurement
         A second experiment to run with ``recommended`` when no single one is expected to separate
         every pair and the two together are, linearised and after refits of the rivals to both
-        records together (:mod:`~physmodel.estimation.next_measurement_plan`); empty otherwise.
+        records together (:mod:`~physmodel.estimation.next_measurement_plan`) — or, short of the
+        target after the refits, when the two reach more than the first alone (``separates``
+        False; ``together["short"]`` and the message say the shortfall); empty otherwise.
         ``separates`` then refers to the two records together.
     together : dict
         With ``also``: ``separation`` (λ of the records together after the refits, the least over the
@@ -173,9 +176,15 @@ class NextMeasurement:
         ``separation_by_pair`` (linearised, per direction), ``refit_by_pair`` (after the refits, the
         least over the directions; a pair the first record's refits already separate keeps that
         value, a lower bound, and is not refitted again), ``linearised_only`` (True: not checked by refits) and ``refits``
-        (their ``fits``, ``starts`` and ``evaluations``), ``recommended`` True.  The linearised values
-        have the first record's refit shortfall taken off each pair.  When two records reached the target
-        linearised but a pair falls short after the refits: the same keys with ``recommended``
+        (their ``fits``, ``starts`` and ``evaluations``), ``recommended`` True, ``short`` (``"A vs
+        B"`` → ``{"separation": λ after the refits, "short_by": target − λ}`` of the pairs below the
+        target; empty when none), ``checked`` (each pair of records checked by refits, in the order
+        tried: ``second``, ``quantity``, ``separation_linearised``, ``separation``,
+        ``refit_by_pair``) and ``refits_total`` (the refits' cost over them).  The linearised values
+        have the first record's refit shortfall taken off each pair.  A plan short after the refits
+        but above the first record's own λ: these keys, ``recommended`` True, ``separates`` False.
+        When two records reached the target linearised but every one checked falls short after the
+        refits and none is above the first alone: the best checked's keys with ``recommended``
         False, ``also`` empty and the message saying which pair falls short and by how much.  Empty
         otherwise.
     """

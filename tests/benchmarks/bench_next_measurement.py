@@ -412,6 +412,83 @@ contact resistance against the diffusivity law, which only Z tells apart).  Cost
 each rival twice per direction (24 fits for 6 pairs); ``next_measurement`` CPU per call on the
 two-record cases 1.5 → 2.3 s (50674, 40 fits), 2.1 → 3.1 s (47079), 3.7 → 5.3 s (47082), 1.9 →
 2.8 s (48085), main → branch; the medians printed above stay 1-2 s.
+
+Short and next-best two-record plans (2026-11-27, issue 27 item 3, the project lead's decisions;
+``next_measurement_plan.choose_plan``).  A second record the refits refuse now gives way to the
+next-best by linearised λ (those still reaching the target linearised; at most two more, each
+refit-checked, the first confirmed taken); when none is confirmed, the checked pair of records of
+largest λ after the refits is still recommended when it is above the first record's own refit λ —
+``separates`` False, the message and ``together["short"]`` saying what it reaches, the pairs short
+and by how much and the remedies (periods ×⌈target/λ⌉, wider limits, or the ambiguity accepted) —
+and otherwise not, as before.  The cost is bounded: a record of the same lines whose weights cannot
+be larger is not tried again (another quantity's σ does not depend on the drive), and a later plan
+refits first, one direction at a time, the pairs an earlier one fell short in, and stops as soon as
+one is below the target and the best λ had.  This file now prints, per case, the plan's status
+("confirmed", "short, offered", "refused"), the plans checked, their refit fits and the
+``next_measurement`` CPU (process time).  The refusal case, the independent-generator strip 41038 of
+bench_diagnosis_speed (contact resistance + delay; the CLI's defaults): main refused I 5, 35, 65 °C
+4.84-500 Hz + Z 19-55 °C 4.84-500 Hz (λ 101.9 linearised, 34.1 after the refits, target 42) and
+recommended the I record alone (λ 11); now the Z plan is refused, then H 4.84-500 Hz (λ 85.1
+linearised, ≤ 29.4 after the refits) and M 55-500 Hz ×2 (82.7, ≤ 29.1) are tried and stopped after
+4 fits each, and I + Z is offered short (λ 34.1 > 11; ``separates`` False; the two short pairs, 38.5
+and 34.1, said; about 2× the periods).  Cost there: refit fits 24 → 32, ``next_measurement`` CPU
+5.3 → 6.0 s (without the two bounds: 72 fits, 9.6 s); ``ipmc diagnose`` against ``ipmc calibrate``
+on the main of this date (6bde386) with this branch applied: 7.25 → 7.67 s CPU, 5.0× → 5.4×
+(``bench_diagnosis_speed.py --commands --rounds 3 --roots <main>,<main + branch> --cases
+41038:contact_resistance+time_delay``; an earlier round 4.8× → 5.8× before the direction-at-a-time
+bound).  The bench, run once on fresh seeds on the branch (fc83ca7; later commits change only a
+plan checked after a refusal, which none of these cases has) and on an archive of main (0e3466e),
+one process each, 2 shared cores::
+
+    python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 51000 --seeds 4
+    python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 51200 --seeds 4
+
+==============================================  =====================  =====================
+named exactly after the recommended              main (0e3466e)         branch (fc83ca7)
+measurement(s), Wilson 95 %
+==============================================  =====================  =====================
+block 51000 (51072-51091): 15 detectable,       9/11 [0.52, 0.95]      9/11 [0.52, 0.95]
+3 named by the first record, 11 ambiguous
+block 51200 (51272-51291): 12 detectable,       6/9 [0.35, 0.88]       6/9 [0.35, 0.88]
+2 named by the first record, 9 ambiguous
+together (fresh)                                15/20 [0.53, 0.89]     15/20 [0.53, 0.89]
+50600 (development, 50672-50691)                4/9 [0.19, 0.73]       4/9 [0.19, 0.73]
+two records recommended | named exactly         3 | 3 (both trees: 50674, 51084, 51280)
+==============================================  =====================  =====================
+
+Every printed line the same on both trees but the new printing and the wall times: no case of the
+three blocks had a plan refused — each two-record plan (50674: M + Z, 20 refit fits; 51084: Z + M, 8;
+51280: M + Z, 4) was confirmed at the first try — so neither change fires on them, and their
+``next_measurement`` CPU is main's (median of three calls, main | branch: 1.95 | 2.06, 4.82 | 4.83,
+4.72 | 4.71 s).  The misses, per case (both trees):
+
+* Greedy first record (four of the ten misses): 50676, 50679 (CR + TD, development) and, probed
+  after the evaluation run, 51277 (CR + TD) and 51282 (CR + SM): the first record
+  is the best SINGLE one, a compromise (M 5, 35, 65 °C, 0.01-0.9 Hz ×2, least λ 5.8, 9.7, 1.2, 0.33)
+  that separates no pair; the best second record with it (Z; for 51282 M 2.2-200 Hz) lifts the contact resistance against
+  the diffusivity law to hundreds but leaves the delay against the pole near the first's (13.7, 13.5,
+  1.9; 51282: 0.38), short linearised, so no plan is refit-checked and neither change applies.  Started
+  from each pair's own best record instead (analysis only, not in the code), the greedy second gives
+  together 1420 (50676: M 19-55 °C 51.8-200 Hz ×2 + Z 5, 35, 65 °C 0.01-0.9 Hz), 3120 (50679, the
+  same), 198 (51277, the same) and 114 (51282: M 2.2-200 Hz ×2 + Z) linearised, all above 42: the
+  plan search should start from more than one first record (the next step; not built here, and the
+  last two cases are evaluation seeds, so a change built on them needs fresh ones).
+* Pairs the data cannot separate (forecast λ ≤ 5 for every record and pair of records found):
+  50678 (CR + TD 252: single 3.3, greedy plan 6.5, from each pair's best first at most 27 linearised),
+  50687 (CR 39 + LK: the pair below λ 1, said inseparable), 51088 (TD 63 + LK: 2.05), 51279 (CR 40,
+  TD 52: 4.9; pairs searched with other forms, which are not combined into two records).
+* Other forms: 50688 (TD + LK, one pair, no second record for one pair): linearised λ 8.8 but 264
+  after the refits (so "not expected to separate" — both must reach the target); the second
+  diagnosis named distributed_cpe + time_delay (leakage swapped for a candidate not among the
+  competing models: misnamed).  51077 (CR + TD): the Z record (λ 368) separated the contact
+  resistance from the diffusivity law, and AB ~ TD, called inseparable as fitted, stayed ambiguous.
+* First diagnoses that missed the second effect: none among the misses (the truth among the
+  competing models 9/9, 10/11, 9/9; the one case without it, 51084, CR + LK, competing as water
+  uptake and the permittivity law, got two records, Z + M, and was named exactly).
+* Short plans (1) and refused plans (2): none among the bench's cases; 41038 above is the one real
+  case measured, and the unit tests (tests/estimation/test_next_measurement_short_plan.py,
+  test_next_measurement_plan.py on seed 47079 with the second records swapped for M records that
+  cannot tell the contact resistance from the diffusivity law) check both.
 """
 
 from __future__ import annotations
@@ -661,11 +738,16 @@ def run_pair_case(seed: int, label: str, args) -> dict:
     row.update(first=d1.verdict, first_named=sorted(d1.named), first_final=sorted(d1.final_effects or ()),
                first_declared=sorted(" ~ ".join(sorted((a, b))) for a, b, _ in d1.confusable))
     if d1.verdict in ("ambiguous", "at_bound"):
-        t1 = time.perf_counter()
+        t1, c1 = time.perf_counter(), time.process_time()
         chain = None if args.no_acts_on else CHAIN_ON_M
         nm = next_measurement(d1, quantities=["M", "Z"], band_limits_hz=(0.01, args.fmax_hz),
                               **({"acts_on": chain} if chain else {}))
         r = nm.recommended
+        tg = nm.together
+        row.update(nm_cpu=time.process_time() - c1, plan=(
+            "" if not tg else "refused" if not tg.get("recommended") else "short, offered" if not nm.separates
+            else "confirmed") + (f", {len(tg['checked'])} checked, {tg['refits_total'].get('fits', 0)} refit fits"
+                                 if tg.get("checked") else ""))
         row.update(nm_s=time.perf_counter() - t1, models=[" + ".join(m) for m in nm.models],
                    truth_competing=any(sorted(m) == expected for m in nm.models), inseparable=list(nm.inseparable),
                    as_fitted=list(nm.inseparable_as_fitted), separates=nm.separates,
@@ -916,13 +998,15 @@ def main(argv=None):
                   + (f" -> [{r['recommended']}; λ expected {r['lam_linear']:.3g} linearised, {r['lam_expected']:.3g} refit"
                      + "".join(f" and, with it, {a}" for a in r.get("also", []))
                      + (f"; together λ {r.get('lam_together_linear', float('nan')):.3g} linearised, {r['lam_together']:.3g} refit" if "lam_together" in r else "")
+                     + (f"; two-record plan {r['plan']}" if r.get("plan") else "")
                      + f"; {'separates' if r['separates'] else 'not expected to separate'}; models {r['models']}; "
                      f"inseparable {r['inseparable'] or '-'}] -> {r['second']} {r['second_named']} "
                      f"{'OK' if r['success'] else 'MISS'}" if r["recommended"] else "")
                   + "".join(f" -> [{x['recommended']}; λ expected {x['lam_linear']:.3g} linearised, "
                             f"{x['lam_expected']:.3g} refit; {'separates' if x['separates'] else 'not expected to separate'}]"
                             f" -> {x['verdict']} {x['named']}" for x in r.get("later", []))
-                  + f" ({r['dt']:.0f} s)"), flush=True)
+                  + f" ({r['dt']:.0f} s" + (f"; next_measurement CPU {r['nm_cpu']:.1f} s" if "nm_cpu" in r else "")
+                  + ")"), flush=True)
         pair_report(rows)
         print(f"elapsed {time.perf_counter() - t0:.0f} s")
         return rows

@@ -420,11 +420,13 @@ def test_one_pair_short_of_the_target_gets_no_second_record(ambiguous, monkeypat
     asks for a second record (that is for pairs that need different experiments), and the
     recommendation is the single one with its shortfall, as before."""
     import physmodel.estimation.next_measurement as search
+    import physmodel.estimation.next_measurement_plan as plan_mod
 
     def refuse(*a, **k):
         raise AssertionError("a second record was searched for one pair")
 
-    monkeypatch.setattr(search, "second_record", refuse)      # the name the search calls
+    monkeypatch.setattr(search, "choose_plan", refuse)      # the names the search calls
+    monkeypatch.setattr(plan_mod, "second_record", refuse)
     nm = next_measurement(ambiguous.d, quantities=["S"], temperature_limits_c=(35.0, 35.0), band_limits_hz=(0.1, 100.0))
     assert len(nm.models) == 2 and not nm.separates and nm.also == [] and nm.together == {}
     assert nm.message.startswith("No experiment within the limits is expected to separate")

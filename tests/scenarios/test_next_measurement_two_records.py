@@ -27,3 +27,37 @@ def test_the_virtual_lab_takes_the_second_recommended_record(tmp_path, second_re
     assert not held & {(float(t), float(f)) for t, f in zip(r3.temperature_c, r3.frequency_hz)}
     text = " ".join(p.read_text(encoding="utf-8") for p in (tmp_path / "run").glob("*.md"))
     assert "1 + 2 + 3: adds" in text
+
+
+def test_two_records_short_of_the_target_are_taken_and_the_shortfall_said(tmp_path, capsys, monkeypatch,
+                                                                          second_recommended_record):
+    """The same, with the two records offered short (``also`` set, ``separates`` False — the best
+    plan when no pair of records reaches the target after the refits): the virtual lab takes both
+    all the same, and the table, stderr and metrics.json say the shortfall against the target."""
+    import json
+
+    from physmodel.estimation.diagnosis import Diagnosis
+    from scenarios.runner import run_scenario
+    from scenarios.spec import bundled_scenarios, load_scenario
+
+    with_second = Diagnosis.recommend_next_measurement
+
+    def short(self, **kw):
+        nm = with_second(self, **kw)
+        nm.separates = False
+        nm.together["separation"] = 0.5 * nm.target        # a stated λ: half the target
+        return nm
+
+    monkeypatch.setattr(Diagnosis, "recommend_next_measurement", short)
+    path = [p for p in bundled_scenarios() if p.stem == "next_measurement_demo"][0]
+    run_scenario(load_scenario(path, quick=True), tmp_path / "run", quiet=True)
+    out = tmp_path / "run" / "next_measurement"
+    assert (out / "record3.csv").exists()
+    metrics = json.loads((tmp_path / "run" / "metrics.json").read_text(encoding="utf-8"))["metrics"]
+    target = metrics["next_measurement.target"]
+    assert metrics["next_measurement.expected_to_separate"] in (0, False)
+    assert metrics["next_measurement.short_by"] == 0.5 * target
+    said = f"expected λ {0.5 * target:.3g} (short of {target:.3g} needed: not expected to separate)"
+    assert said in capsys.readouterr().err
+    text = " ".join(p.read_text(encoding="utf-8") for p in (tmp_path / "run").glob("*.md"))
+    assert "1 + 2 + 3: adds" in text and f"{0.5 * target:.3g} (short of {target:.3g} needed" in text
