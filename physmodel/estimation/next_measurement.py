@@ -761,6 +761,6 @@ def _temperature_limits(limits, base) -> tuple[float, float, str]:
 
 
 __all__ = ["CandidateMeasurement", "NextMeasurement", "competing_models", "json_ready", "merge_records",
-           "next_measurement", "temperature_premise", "MAX_BATH_C",
+           "next_measurement", "shortfall", "temperature_premise", "MAX_BATH_C",
            "PERIODS", "BATH_SETTLE_S", "SAME_FORM_LAMBDA", "REFIT_STARTS", "FD_RELATIVE_STEP",
            "DEFAULT_BAND_LIMITS_HZ", "DEFAULT_LEVELS", "DEFAULT_TEMPERATURE_LIMITS_C"]

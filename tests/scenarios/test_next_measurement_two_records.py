@@ -61,3 +61,33 @@ def test_two_records_short_of_the_target_are_taken_and_the_shortfall_said(tmp_pa
     assert said in capsys.readouterr().err
     text = " ".join(p.read_text(encoding="utf-8") for p in (tmp_path / "run").glob("*.md"))
     assert "1 + 2 + 3: adds" in text and f"{0.5 * target:.3g} (short of {target:.3g} needed" in text
+
+
+def test_one_record_short_is_said_at_the_lesser_of_its_linearised_and_refit_lambda(tmp_path, capsys, monkeypatch):
+    """A single recommended record not expected to separate whose refits give MORE than its
+    linearisation (bench_next_measurement's 50688: 8.8 linearised, 264 after the refits): the step
+    says it at the lesser, as the library's message does (review: it printed "expected λ 264 (short
+    of 42 needed)" with short_by 0)."""
+    import json
+    from dataclasses import replace
+
+    from physmodel.estimation.diagnosis import Diagnosis
+    from scenarios.runner import run_scenario
+    from scenarios.spec import bundled_scenarios, load_scenario
+
+    real = Diagnosis.recommend_next_measurement
+
+    def stated(self, **kw):
+        nm = real(self, **kw)
+        nm.recommended = replace(nm.recommended, separation=8.8, separation_refit=264.0)
+        nm.separates, nm.also, nm.together = False, [], {}
+        return nm
+
+    monkeypatch.setattr(Diagnosis, "recommend_next_measurement", stated)
+    path = [p for p in bundled_scenarios() if p.stem == "next_measurement_demo"][0]
+    run_scenario(load_scenario(path, quick=True), tmp_path / "run", quiet=True)
+    metrics = json.loads((tmp_path / "run" / "metrics.json").read_text(encoding="utf-8"))["metrics"]
+    target = metrics["next_measurement.target"]
+    assert metrics["next_measurement.expected_separation"] == 8.8
+    assert metrics["next_measurement.short_by"] == target - 8.8
+    assert f"expected λ 8.8 (short of {target:.3g} needed" in capsys.readouterr().err
