@@ -747,7 +747,9 @@ def run_pair_case(seed: int, label: str, args) -> dict:
         row.update(nm_cpu=time.process_time() - c1, plan=(
             "" if not tg else "refused" if not tg.get("recommended") else "short, offered" if not nm.separates
             else "confirmed") + (f", {len(tg['checked'])} checked, {tg['refits_total'].get('fits', 0)} refit fits"
-                                 if tg.get("checked") else ""))
+                                 if tg.get("checked") else "")
+            + (f", first record pair {tg['first_for']}'s best (greedy {tg['greedy_linearised']:.3g} linearised)"
+               if tg.get("first_for") else ""))
         row.update(nm_s=time.perf_counter() - t1, models=[" + ".join(m) for m in nm.models],
                    truth_competing=any(sorted(m) == expected for m in nm.models), inseparable=list(nm.inseparable),
                    as_fitted=list(nm.inseparable_as_fitted), separates=nm.separates,
