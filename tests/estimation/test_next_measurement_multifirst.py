@@ -174,3 +174,20 @@ def test_a_greedy_plan_reaching_the_target_is_kept():
     first, pick = _choose(rows, sums, bases, target=6.0)
     assert pick.first is None and pick.plan is not None and name[id(first)] == "comp"
     assert pick.plan.separation == pytest.approx(6.76) and pick.together()["first_for"] is None
+
+
+def test_the_messages_name_the_other_first_record(monkeypatch):
+    """A plan from a pair's own best record says so (the pair, and the greedy plan's λ it beat);
+    a refused one names the record it started from and compares with the best single record."""
+    rows, sums, bases, _, name = _case()
+    _fake_refit(monkeypatch, 30.0)
+    _, pick = _choose(rows, sums, bases, check_refit=1, first_refit=5.0)
+    msg = plan_mod.plan_message(pick, pick.first, "the models", 0.9, 0.05, "25 linearised", 0.5)
+    assert f"the first is the best experiment for {KA}, not the best single one" in msg
+    assert f"gives only λ = {pick.greedy:.3g} linearised" in msg and pick.first.describe() in msg
+    _fake_refit(monkeypatch, 10.0)
+    _, pick = _choose(rows, sums, bases, check_refit=1, first_refit=12.0)
+    assert pick.refused is not None
+    said = plan_mod.refused_message(pick, "12 after the refits")
+    assert f"started instead from {pick.first.describe()} (the best experiment for {KA})" in said
+    assert "nor better than the best single record alone (12 after the refits)" in said
