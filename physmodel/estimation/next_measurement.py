@@ -65,7 +65,9 @@ quantities — contact resistance vs the diffusivity law in Z, a delay vs an amp
 the resonance), a second experiment is searched to add to the recommended one (greedy): the one
 maximising the least over the pairs of the two records' λ, computed by stacking their
 normal-equation sums (λ is not additive: the rival refits one set of parameters to both), none of
-its lines the first's (:mod:`~physmodel.estimation.next_measurement_plan`).  When the two reach λ*
+its lines the first's (:mod:`~physmodel.estimation.next_measurement_plan`); when that pair falls short
+of λ* linearised, the plans started from each competing pair's own best record are searched too and
+the one of largest λ taken (the first record then that pair's best, said).  When the two reach λ*
 they are checked by full refits of the rivals to both records together, and recommended together
 when the refits reach λ* too (``NextMeasurement.also``; ``separates`` then refers to both).  A
 second record the refits refuse gives way to the next-best by linearised λ (at most
@@ -565,6 +567,7 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
                f"{current:.3g}).{alike}")
     elif plan is not None:
         sep_ok = not pick.short
+        chosen = pick.first or chosen       # the plan may start from a pair's own best record (issue 27)
         if plan.second.joint and not chosen.joint:    # the pair's λ counts the record: the first joins it too
             chosen = replace(chosen, joint=True, added_quantity=True)
         msg = plan_message(pick, chosen, who, power, d.alpha, shortfall(chosen)[1], current) + alike

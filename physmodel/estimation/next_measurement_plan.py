@@ -6,6 +6,12 @@ resistance vs the diffusivity law separate in Z; a time delay vs an amplifier po
 resonance) no single experiment reaches the target for every pair, and the least over the pairs
 picks a record that separates none.  Then a SECOND experiment is searched to add to the best single
 one (greedy): the one maximising the least over the pairs of the two records' combined λ.
+The best single record may be a compromise that separates no pair, and then no second record lifts
+every pair with it; so when the greedy plan falls short of the target linearised, the plans whose
+first record is each pair's own best (:func:`first_records`) are searched too, each with its best
+second record, and the one of largest λ is taken (:func:`choose_plan`; issue 27 item 3: seeds 50676,
+50679, 51277, 51282 of bench_next_measurement, a greedy λ of 13.7, 13.5, 1.9, 0.38, from a pair's
+best record 1420, 3120, 198, 114, the target 42).
 
 Combined λ.  The linearised T-criterion of an experiment is λ = min_δ Σ w |Δ − Jδ|² over the rival's
 parameters δ (:func:`~physmodel.estimation.next_measurement_design.t_criterion`).  For independent
@@ -146,6 +152,16 @@ class PlanChoice:
         Every plan checked by refits, in the order tried (by linearised λ).
     target : float
         The separation needed. [-]
+    first : CandidateMeasurement or None
+        The plans' first record when it is not the best single record (the one given to
+        :func:`choose_plan`) but a pair's own best (:func:`first_records`): the greedy plan from the
+        best single record falls short of ``target`` linearised and this one's plan is larger.
+        None when the plans start from the best single record.
+    first_for : str
+        The pair (``"A vs B"``) ``first`` is the best record of; empty when ``first`` is None.
+    greedy : float
+        The linearised λ of the greedy plan from the best single record (NaN when none was found);
+        set when ``first`` is. [-]
     """
 
     plan: RecordPair | None = None
@@ -153,12 +169,18 @@ class PlanChoice:
     refused: RecordPair | None = None
     checked: list = field(default_factory=list)
     target: float = math.inf
+    first: CandidateMeasurement | None = None
+    first_for: str = ""
+    greedy: float = float("nan")
 
     def together(self) -> dict:
         """:attr:`~physmodel.estimation.next_measurement_results.NextMeasurement.together`: the
         recommended plan's (or the refused one's, ``recommended`` False) with ``short``,
-        ``checked`` (each plan checked, :meth:`RecordPair.summary`) and ``refits_total`` (the
-        refits' cost over them); empty when no plan was searched to the target."""
+        ``checked`` (each plan checked, :meth:`RecordPair.summary`), ``refits_total`` (the
+        refits' cost over them) and ``first_for`` (the pair whose own best record is the plans'
+        first, :attr:`first_for`, with ``first`` its description and ``greedy_linearised`` the
+        greedy plan's λ; None when the plans start from the best single record); empty when no plan
+        was searched to the target."""
         shown = self.plan or self.refused
         if shown is None:
             return {}
@@ -166,8 +188,26 @@ class PlanChoice:
         for p in self.checked:
             for k, v in p.refits.items():
                 total[k] = total.get(k, 0) + v
-        return {**shown.together(self.target), "recommended": self.plan is not None,
-                "checked": [p.summary() for p in self.checked], "refits_total": total}
+        out = {**shown.together(self.target), "recommended": self.plan is not None,
+               "checked": [p.summary() for p in self.checked], "refits_total": total,
+               "first_for": self.first_for or None}
+        if self.first is not None:
+            out.update(first=self.first.describe(), greedy_linearised=self.greedy)
+        return out
+
+
+def first_records(first: CandidateMeasurement, rows: list, live: list) -> list:
+    """The other first records a plan may start from: for each ``live`` pair (``"A vs B"``) the
+    experiment of ``rows`` maximising that pair's λ (the least over its two directions, linearised),
+    ``[(pair, record)]``, each record once (the first pair it is best for) and ``first`` — the best
+    single record, the greedy start — left out.  At most one per pair: a handful."""
+    out: list = []
+    for k in live:
+        best = max(rows, key=lambda r: min(r.separation_by_pair[k].values()) if k in r.separation_by_pair
+                   else -math.inf)
+        if best is not first and all(best is not r for _, r in out):
+            out.append((k, best))
+    return out
 
 
 def choose_plan(d, first: CandidateMeasurement, rows: list, sums: dict, bases: dict, pairs: list, deficit: dict,
@@ -179,15 +219,31 @@ def choose_plan(d, first: CandidateMeasurement, rows: list, sums: dict, bases: d
     :data:`MORE_SECOND_RECORDS` more, each checked, stopping at the first the refits confirm.  When
     none is confirmed, the checked plan of largest λ after the refits is still recommended, short,
     when that λ is above ``first``'s own after the refits (its ``separation_refit``: the best single
-    record); else none is (``refused``)."""
+    record); else none is (``refused``).
+
+    When the greedy plan from ``first`` (the best single record) falls short of ``target``
+    linearised, the plans started from each pair's own best record (:func:`first_records`) are
+    searched too, each with its best second record (:func:`second_record`, linearised: cheap), and
+    the one of largest λ is taken when it is larger than the greedy one (``PlanChoice.first``); it,
+    and its next-best second records, go through the same check, and "better than the first
+    record" stays the best single record's refit λ (the recommendation without a second record).
+    The other first record's refits are not known, so no ``deficit`` is taken off its plans."""
     keys = [f"{label(a)} vs {label(b)}" for a, b in pairs]
     out = PlanChoice(target=target)
+    single = first
     plan = second_record(first, rows, sums, bases, keys, deficit)
+    if plan is None or plan.separation < target:      # the greedy first record may be a compromise (issue 27)
+        greedy = plan.separation if plan is not None else math.nan
+        for k, f in first_records(first, rows, keys):
+            p = second_record(f, rows, sums, bases, keys)
+            if p is not None and (plan is None or p.separation > plan.separation):
+                plan, first, deficit = p, f, {}
+                out.first, out.first_for, out.greedy = f, k, greedy
     while plan is not None and plan.separation >= target:
         if check_refit <= 0:          # linearised only (said so)
             out.plan = plan
             return out
-        had = [v for v in [first.separation_refit] + [p.separation_refit for p in out.checked] if v == v]
+        had = [v for v in [single.separation_refit] + [p.separation_refit for p in out.checked] if v == v]
         short = [(k, v) for p in out.checked for k, v in p.short(target).items()]
         plan = refit_plan(d, plan, first, pairs, nm, max_nfev, label, view, target,
                           suspects={k: min((v for x, v in short if x == k), default=math.nan) for k, _ in short},
@@ -203,7 +259,7 @@ def choose_plan(d, first: CandidateMeasurement, rows: list, sums: dict, bases: d
         return out
     best = max((p for p in out.checked if p.complete),       # a plan stopped early is below one checked before
                key=lambda p: p.separation_refit if p.separation_refit == p.separation_refit else -math.inf)
-    if best.separation_refit > first.separation_refit:      # NaN on either side: not better
+    if best.separation_refit > single.separation_refit:      # NaN on either side: not better
         out.plan, out.short = best, True
     else:
         out.refused = best
@@ -356,6 +412,9 @@ def plan_message(pick: PlanChoice, first: CandidateMeasurement, who: str, power:
     need = f"{target:.3g} needed for {power:.0%} power at α = {alpha:g}"
     alone = f"the first alone gives {first_words}, the record alone {current:.3g}"
     tried = len(pick.checked)
+    if pick.first is not None:       # a pair's own best record, not the best single one (issue 27)
+        alone += (f"; the first is the best experiment for {pick.first_for}, not the best single one, with which "
+                  f"the best second record gives only λ = {pick.greedy:.3g} linearised")
     if not pick.short:
         refused = pick.checked[:-1]
         return (f"Next measurements to separate {who} (no single experiment within the limits is expected to): "
@@ -385,11 +444,14 @@ def refused_message(pick: PlanChoice, first_words: str) -> str:
     first record alone (``first_words``: its λ in words): not recommended."""
     best, target, n = pick.refused, pick.target, len(pick.checked)
     assert best is not None
+    start = ("with it" if pick.first is None else
+             f"started instead from {pick.first.describe()} (the best experiment for {pick.first_for})")
     return (" Two records were checked too" + (f" ({n} second records, by linearised λ; the best after the refits "
                                                 "said)" if n > 1 else "")
-            + f": with it, {best.second.describe()} gives λ = {best.separation:.3g} linearised, but after refits of "
+            + f": {start}, {best.second.describe()} gives λ = {best.separation:.3g} linearised, but after refits of "
             f"the rivals to both records together {_short_words(best, target)}: not expected to separate, nor better "
-            f"than the first alone ({first_words}), so not recommended.")
+            f"than the {'first' if pick.first is None else 'best single record'} alone ({first_words}), so not "
+            "recommended.")
 
 
 def bath_premise(records: list, record_temperatures_c, base) -> str:
@@ -434,5 +496,6 @@ def bath_premise(records: list, record_temperatures_c, base) -> str:
             f"temperature (an 'unexplained' verdict on the records together) {check}")
 
 
-__all__ = ["MORE_SECOND_RECORDS", "PlanChoice", "RecordPair", "bath_premise", "choose_plan", "covered", "overlaps",
+__all__ = ["MORE_SECOND_RECORDS", "PlanChoice", "RecordPair", "bath_premise", "choose_plan", "covered", "first_records",
+           "overlaps",
            "plan_message", "record_base", "refit_plan", "refused_message", "second_record"]

@@ -180,8 +180,12 @@ class NextMeasurement:
         B"`` → ``{"separation": λ after the refits, "short_by": target − λ}`` of the pairs below the
         target; empty when none), ``checked`` (each pair of records checked by refits, in the order
         tried: ``second``, ``quantity``, ``separation_linearised``, ``separation``,
-        ``refit_by_pair``) and ``refits_total`` (the refits' cost over them).  The linearised values
-        have the first record's refit shortfall taken off each pair.  A plan short after the refits
+        ``refit_by_pair``), ``refits_total`` (the refits' cost over them) and ``first_for`` (None
+        when the plans start from the best single record; else the pair whose own best record is
+        ``recommended``, searched because the greedy plan from the best single record fell short of
+        the target linearised — ``greedy_linearised`` its λ, ``first`` the record's description).
+        The linearised values have the first record's refit shortfall taken off each pair (none for
+        a pair's own best first record, which is not refitted alone).  A plan short after the refits
         but above the first record's own λ: these keys, ``recommended`` True, ``separates`` False.
         When two records reached the target linearised but every one checked falls short after the
         refits and none is above the first alone: the best checked's keys with ``recommended``

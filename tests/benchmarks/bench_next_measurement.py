@@ -489,6 +489,61 @@ three blocks had a plan refused — each two-record plan (50674: M + Z, 20 refit
   case measured, and the unit tests (tests/estimation/test_next_measurement_short_plan.py,
   test_next_measurement_plan.py on seed 47079 with the second records swapped for M records that
   cannot tell the contact resistance from the diffusivity law) check both.
+
+Two-record plans from more than one first record (2026-11-27, issue 27 item 3; branch h-multifirst,
+``next_measurement_plan.first_records``).  When the greedy plan from the best single record falls
+short of the target linearised, the plans whose first record is each competing pair's own best are
+searched too (each with its best second record, linearised) and the one of largest λ is taken, then
+refit-checked as any plan (confirmed, next-best, short or refused; "better than the first record"
+is still the best single record's refit λ).  Oracle: tests/estimation/test_next_measurement_multifirst.py
+(a compromise first record, λ stated by hand and checked by brute-force lstsq over every pair of
+records; it fails on h-shortplan, which finds no plan).  Run once on fresh seeds, the branch
+(a0921bf) and an archive of h-shortplan (9edd530), one process at a time, 2 shared cores::
+
+    python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 51400 --seeds 4
+    python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed 51800 --seeds 4
+
+==============================================  =====================  =====================
+named exactly after the recommended              h-shortplan (9edd530)  branch (a0921bf)
+measurement(s), Wilson 95 %
+==============================================  =====================  =====================
+block 51400 (51472-51491): 14 detectable,       6/10 [0.31, 0.83]      7/10 [0.40, 0.89]
+3 named by the first record, 10 ambiguous
+block 51800 (51872-51891): 8 detectable,        1/3 [0.06, 0.79]       2/3 [0.21, 0.94]
+5 named by the first record, 3 ambiguous
+together (fresh)                                7/13 [0.29, 0.77]      9/13 [0.42, 0.87]
+after at most one round (fresh)                 15/22 [0.47, 0.84]     17/22 [0.57, 0.90]
+50600 (development, 50672-50691)                4/9 [0.19, 0.73]       6/9 [0.35, 0.88]
+51200 (development, 51272-51291)                6/9 [0.35, 0.88]       7/9 [0.45, 0.94]
+==============================================  =====================  =====================
+
+Every other line the same.  The cases the change fired in (the greedy plan short, a pair's own best
+first record's plan taken; every one confirmed by its refits at the first try):
+
+* Fresh: 51480 (CR + SM; greedy 21.7 linearised; M 5, 35, 65 °C 2.2-200 Hz ×2 + Z 5, 35, 65 °C
+  0.01-0.9 Hz, 3610 linearised, 3590 after the refits), named exactly (was ambiguous); 51883 (CR +
+  SM, six competing models; greedy 27.1; M 19-55 °C 51.8-200 Hz ×2 + Z 5, 35, 65 °C 0.01-0.9 Hz,
+  127 linearised, 44.6 refit), named exactly (was ambiguous); 51877 (CR 94 + TD; greedy 3.95; the
+  same M + Z, 104 / 103), still a MISS, now misnamed instead of ambiguous: the records together
+  named time_delay alone (the weak contact resistance not named).
+* Development: 50676 and 50679 (CR + TD; greedy 13.7, 13.5; M 19-55 °C 51.8-200 Hz ×2 + Z 5, 35,
+  65 °C 0.01-0.9 Hz, 1420 / 1370 and 3120 / 3090) and 51277 (CR + TD; greedy 1.85; the same, 198 /
+  194), all named exactly (were ambiguous); 51282 (CR 77 + SM; greedy 0.38; M 5, 35, 65 °C 2.2-200
+  Hz ×2 + Z, 114 / 114), still a MISS, now 'unexplained' instead of ambiguous (second_mode alone
+  left).  The two new misses are the two weakest contact resistances (first-record λ 77, 94) and
+  are not investigated here (the diagnosis of the three records, not the plan).
+
+Cost (``next_measurement`` process CPU, median of three calls, h-shortplan → branch, as the bench
+calls it): where the change fires, the linearised search adds two ``second_record`` calls (40-90 ms)
+but the plan it finds is refit-checked in full — the other first record has no refits of its own,
+so no pair is carried and every pair is refitted, 4 fits a pair — 50676 2.00 → 3.35 s (24 fits),
+50679 2.42 → 3.55, 51277 1.78 → 2.92, 51282 2.55 → 4.26, 51480 2.21 → 4.57, 51877 2.86 → 4.38,
+51883 10.97 → 15.91 s (60 fits, 15 pairs).  Elsewhere unchanged within the noise (the two-record
+cases already confirmed: 50674 2.21 | 2.13, 51280 5.31 | 4.72, 51476 2.57 | 2.38, 51478 2.35 |
+2.16, 51483 5.28 | 5.13, 51488 1.02 | 1.03, 51874 1.65 | 1.75 s).  41038 of bench_diagnosis_speed
+(the CLI's defaults; its greedy plan reaches the target linearised, so the change does not fire):
+the same plan and message, ``next_measurement`` CPU 6.60, 7.01 s (h-shortplan) against 6.48, 6.45
+s (branch), two calls each on a loaded machine.
 """
 
 from __future__ import annotations
@@ -747,7 +802,9 @@ def run_pair_case(seed: int, label: str, args) -> dict:
         row.update(nm_cpu=time.process_time() - c1, plan=(
             "" if not tg else "refused" if not tg.get("recommended") else "short, offered" if not nm.separates
             else "confirmed") + (f", {len(tg['checked'])} checked, {tg['refits_total'].get('fits', 0)} refit fits"
-                                 if tg.get("checked") else ""))
+                                 if tg.get("checked") else "")
+            + (f", first record pair {tg['first_for']}'s best (greedy {tg['greedy_linearised']:.3g} linearised)"
+               if tg.get("first_for") else ""))
         row.update(nm_s=time.perf_counter() - t1, models=[" + ".join(m) for m in nm.models],
                    truth_competing=any(sorted(m) == expected for m in nm.models), inseparable=list(nm.inseparable),
                    as_fitted=list(nm.inseparable_as_fitted), separates=nm.separates,

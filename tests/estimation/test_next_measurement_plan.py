@@ -172,7 +172,16 @@ def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(seed47079, monke
 
     monkeypatch.setattr(nmod, "refit_check", capped)
     nm2 = _search_47079(d)
-    assert not nm2.separates and nm2.also == [] and "and, with it," not in nm2.message
+    # the greedy plan from the first record is short once the shortfall is taken off (it was recommended
+    # before the review); a plan started from another pair's own best record (issue 27, first_records)
+    # is not built on the capped refits: it is recommended only when its own refits of every pair, on
+    # both records together, reach the target (here they do: the cap is on the single-record check only)
+    tg2 = nm2.together
+    assert tg2["greedy_linearised"] < nm2.target and tg2["first_for"] is not None
+    assert nm2.recommended.describe() != r.describe() and "and, with it," in nm2.message
+    assert "not the best single one" in nm2.message
+    assert tg2["refits"]["fits"] == 2 * 2 * len(r.separation_by_pair)      # every pair refitted, none carried
+    assert nm2.separates == (tg2["refit_by_pair"][carried] >= nm2.target and tg2["separation"] >= nm2.target)
 
 
 def _claimed_m(real, every: bool):
