@@ -538,7 +538,8 @@ def _search(d, fitted: list, alts: dict | None, *, mods, qs, lv, band_limits_hz,
     live = [(a, b) for a, b in pairs if key(a, b) not in same_form + same_refit]
     for r in checked:
         vals = [v for k, v in r.refit_by_pair.items() if k not in same_refit]
-        r.separation_refit = float(min(vals)) if vals else 0.0
+        # NaN (a refit that gave no λ: not separated) whatever the pairs' order — min() kept it only first
+        r.separation_refit = float("nan") if any(v != v for v in vals) else float(min(vals)) if vals else 0.0
     done = {id(r) for r in checked}
     good = [r for r in order if id(r) in done and r.separation_refit >= target] \
         or [r for r in checked if r.separation_refit >= target]

@@ -40,10 +40,11 @@ next-best second records by linearised λ that reach the target linearised are c
 most :data:`MORE_SECOND_RECORDS` more, and the first the refits confirm is recommended; when none
 is, the checked plan of largest λ after the refits is still recommended, SHORT (``separates``
 False; its shortfall, the pairs short and the remedies said, and ``together["short"]``), when that
-λ is above the first record's own after the refits — the best single record — and otherwise the
-two records are not recommended (said).  Note that a rival refitted to more lines cannot fit them
-better, so a plan's λ per pair is at least the first record's (up to the optimiser): "above" is
-met unless the second record adds nothing to the least pair.  Pairs searched with their models' other
+λ is above the first record's own after the refits — the best single record — by more than
+:data:`SHORT_PLAN_GAIN` (a material gain, not an optimiser's: the second experiment costs the user
+a measurement), and otherwise the two records are not recommended (said).  Note that a rival
+refitted to more lines cannot fit them better, so a plan from the best single record has, per
+pair, at least that record's λ (up to the optimiser); a plan from another first record need not.  Pairs searched with their models' other
 forms (:mod:`~physmodel.estimation.next_measurement_forms`) are not combined: when one is still
 competing no second record is searched.  Nor is one for a single pair: there a second record only
 adds lines of the same kind, which the shortfall message already covers (more periods).
@@ -132,6 +133,10 @@ class RecordPair:
 #: linearised λ (each refit-checked; the search stops at the first reaching the target): a bound on
 #: the check's cost, which ``ipmc diagnose`` pays (the project lead's decision, issue 27 item 3).
 MORE_SECOND_RECORDS = 2
+#: A short two-record plan is offered only when its least λ after the refits is above the best
+#: single record's by more than this fraction: a material gain (the 10 % at which a message also
+#: states the other of two λ, ``next_measurement.shortfall``), not an optimiser's.
+SHORT_PLAN_GAIN = 0.1
 
 
 @dataclass
@@ -160,8 +165,11 @@ class PlanChoice:
     first_for : str
         The pair (``"A vs B"``) ``first`` is the best record of; empty when ``first`` is None.
     greedy : float
-        The linearised λ of the greedy plan from the best single record (NaN when none was found);
-        set when ``first`` is. [-]
+        The linearised λ of the greedy plan from the best single record, no refit shortfall taken
+        off (NaN when no second record can be added to it); set when ``first`` is. [-]
+    single : CandidateMeasurement or None
+        The best single record (the one given to :func:`choose_plan`): its refit λ is the bar a
+        short plan must clear.
     """
 
     plan: RecordPair | None = None
@@ -172,6 +180,7 @@ class PlanChoice:
     first: CandidateMeasurement | None = None
     first_for: str = ""
     greedy: float = float("nan")
+    single: CandidateMeasurement | None = None
 
     def together(self) -> dict:
         """:attr:`~physmodel.estimation.next_measurement_results.NextMeasurement.together`: the
@@ -227,17 +236,21 @@ def choose_plan(d, first: CandidateMeasurement, rows: list, sums: dict, bases: d
     the one of largest λ is taken when it is larger than the greedy one (``PlanChoice.first``); it,
     and its next-best second records, go through the same check, and "better than the first
     record" stays the best single record's refit λ (the recommendation without a second record).
-    The other first record's refits are not known, so no ``deficit`` is taken off its plans."""
+    The other first record is compared on one footing — linearised, no refit shortfall taken off
+    either (review: the greedy plan's deficit had been compared with the other's none) — and no
+    ``deficit`` is taken off its plans."""
     keys = [f"{label(a)} vs {label(b)}" for a, b in pairs]
-    out = PlanChoice(target=target)
+    out = PlanChoice(target=target, single=first)
     single = first
     plan = second_record(first, rows, sums, bases, keys, deficit)
     if plan is None or plan.separation < target:      # the greedy first record may be a compromise (issue 27)
-        greedy = plan.separation if plan is not None else math.nan
+        raw = second_record(first, rows, sums, bases, keys) if deficit else plan    # linearised, as the others
+        greedy = raw.separation if raw is not None else math.nan
+        bar = greedy
         for k, f in first_records(first, rows, keys):
             p = second_record(f, rows, sums, bases, keys)
-            if p is not None and (plan is None or p.separation > plan.separation):
-                plan, first, deficit = p, f, {}
+            if p is not None and not p.separation <= bar:     # NaN bar (no greedy plan): any plan
+                plan, first, deficit, bar = p, f, {}, p.separation
                 out.first, out.first_for, out.greedy = f, k, greedy
     while plan is not None and plan.separation >= target:
         if check_refit <= 0:          # linearised only (said so)
@@ -259,7 +272,7 @@ def choose_plan(d, first: CandidateMeasurement, rows: list, sums: dict, bases: d
         return out
     best = max((p for p in out.checked if p.complete),       # a plan stopped early is below one checked before
                key=lambda p: p.separation_refit if p.separation_refit == p.separation_refit else -math.inf)
-    if best.separation_refit > single.separation_refit:      # NaN on either side: not better
+    if best.separation_refit > (1.0 + SHORT_PLAN_GAIN) * single.separation_refit:      # NaN either side: not better
         out.plan, out.short = best, True
     else:
         out.refused = best
@@ -362,7 +375,7 @@ def refit_plan(d, plan: RecordPair, first: CandidateMeasurement, pairs: list, nm
     least over its directions and the plan's the least over the pairs, so no larger — and nothing
     more is refitted: the plan is returned ``complete`` False with the pairs refitted so far (the
     last one's λ that direction's, an upper bound) (:func:`choose_plan`'s bound on the cost;
-    41038: 24 fits a plan → 2).  Otherwise every pair's λ is the one :func:`refit_check` gives."""
+    41038: 24 fits a plan → 4).  Otherwise every pair's λ is the one :func:`refit_check` gives."""
     from .next_measurement_design import refit_check, refit_lambda
 
     count: dict = {"fits": 0, "starts": 0, "evaluations": 0}
@@ -413,8 +426,14 @@ def plan_message(pick: PlanChoice, first: CandidateMeasurement, who: str, power:
     alone = f"the first alone gives {first_words}, the record alone {current:.3g}"
     tried = len(pick.checked)
     if pick.first is not None:       # a pair's own best record, not the best single one (issue 27)
-        alone += (f"; the first is the best experiment for {pick.first_for}, not the best single one, with which "
-                  f"the best second record gives only λ = {pick.greedy:.3g} linearised")
+        if first.separation_refit != first.separation_refit and not first_words.endswith("linearised"):
+            alone = alone.replace(f"gives {first_words},", f"gives {first_words} linearised (not refitted alone),", 1)
+        single = pick.single
+        with_single = ("to which no second record can be added" if pick.greedy != pick.greedy else
+                       f"with which the best second record gives only λ = {pick.greedy:.3g} linearised")
+        alone += (f"; the first is the best experiment for {pick.first_for}, not the best single one"
+                  + (f" ({single.describe()}: {_refit_words(single)})" if single is not None else "")
+                  + f", {with_single}")
     if not pick.short:
         refused = pick.checked[:-1]
         return (f"Next measurements to separate {who} (no single experiment within the limits is expected to): "
@@ -424,18 +443,31 @@ def plan_message(pick: PlanChoice, first: CandidateMeasurement, who: str, power:
                    "linearised only (no refit check asked)")
                 + f", the records diagnosed together (≥ {need}; {alone})."
                 + (f" {len(refused)} second record(s) of larger linearised λ fell short after the refits ("
-                   + "; ".join(f"{p.second.describe()}: λ {p.separation_refit:.3g}" for p in refused) + ")."
+                   + "; ".join(f"{p.second.describe()}: {_plan_refit_words(p)}" for p in refused) + ")."
                    if refused else ""))
     lam = plan.separation_refit
-    return (f"No experiment within the limits, alone or with a second, is expected to separate {who} at the noise "
-            f"of this record; the best is two records, {both}: together expected λ = {lam:.3g} after refits of the "
+    return (f"No single experiment within the limits is expected to separate {who} at the noise of this record, nor "
+            + ("the pair of records checked by refits" if tried == 1 else
+               f"any of the {tried} pairs of records checked by refits (chosen by linearised λ)")
+            + f"; the best checked is two records, {both}: together expected λ = {lam:.3g} after refits of the "
             f"rivals to both records together ({plan.separation:.3g} linearised) < {need}, the records diagnosed "
             f"together ({alone}); short after the refits: {_short_words(plan, target)}"
-            + (f" (the most of the {tried} pairs of records checked, by linearised λ)" if tried > 1 else "")
             + ". Lower the noise (more periods in both records"
             + (f": λ grows in proportion to the periods averaged, so about {math.ceil(target / lam)}× as many"
                if 0 < lam < target else "")
             + "), widen the limits, or accept the ambiguity.")
+
+
+def _refit_words(r: CandidateMeasurement) -> str:
+    """A single record's λ as said beside a plan: after its refits, else linearised."""
+    return (f"λ {r.separation_refit:.3g} after the refits" if r.separation_refit == r.separation_refit else
+            f"λ {r.separation:.3g} linearised")
+
+
+def _plan_refit_words(p: RecordPair) -> str:
+    """A checked plan's λ after the refits; an upper bound when they stopped early (``complete``
+    False: a pair fell below what an earlier plan reached, so its least is no larger)."""
+    return f"λ {p.separation_refit:.3g}" if p.complete else f"λ ≤ {p.separation_refit:.3g} (refits stopped early)"
 
 
 def refused_message(pick: PlanChoice, first_words: str) -> str:
@@ -449,9 +481,12 @@ def refused_message(pick: PlanChoice, first_words: str) -> str:
     return (" Two records were checked too" + (f" ({n} second records, by linearised λ; the best after the refits "
                                                 "said)" if n > 1 else "")
             + f": {start}, {best.second.describe()} gives λ = {best.separation:.3g} linearised, but after refits of "
-            f"the rivals to both records together {_short_words(best, target)}: not expected to separate, nor better "
-            f"than the {'first' if pick.first is None else 'best single record'} alone ({first_words}), so not "
-            "recommended.")
+            f"the rivals to both records together {_short_words(best, target)}: not expected to separate, "
+            + (f"nor better than the {'first' if pick.first is None else 'best single record'} alone "
+               f"({first_words}) by more than {SHORT_PLAN_GAIN:.0%}"
+               if pick.single is None or pick.single.separation_refit == pick.single.separation_refit else
+               "and the best single record's refits gave no λ to compare it with")
+            + ", so not recommended.")
 
 
 def bath_premise(records: list, record_temperatures_c, base) -> str:
@@ -496,6 +531,6 @@ def bath_premise(records: list, record_temperatures_c, base) -> str:
             f"temperature (an 'unexplained' verdict on the records together) {check}")
 
 
-__all__ = ["MORE_SECOND_RECORDS", "PlanChoice", "RecordPair", "bath_premise", "choose_plan", "covered", "first_records",
+__all__ = ["MORE_SECOND_RECORDS", "SHORT_PLAN_GAIN", "PlanChoice", "RecordPair", "bath_premise", "choose_plan", "covered", "first_records",
            "overlaps",
            "plan_message", "record_base", "refit_plan", "refused_message", "second_record"]

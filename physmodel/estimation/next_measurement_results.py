@@ -181,12 +181,15 @@ class NextMeasurement:
         target; empty when none), ``checked`` (each pair of records checked by refits, in the order
         tried: ``second``, ``quantity``, ``separation_linearised``, ``separation``,
         ``refit_by_pair``), ``refits_total`` (the refits' cost over them) and ``first_for`` (None
-        when the plans start from the best single record; else the pair whose own best record is
-        ``recommended``, searched because the greedy plan from the best single record fell short of
-        the target linearised — ``greedy_linearised`` its λ, ``first`` the record's description).
-        The linearised values have the first record's refit shortfall taken off each pair (none for
-        a pair's own best first record, which is not refitted alone).  A plan short after the refits
-        but above the first record's own λ: these keys, ``recommended`` True, ``separates`` False.
+        when the plans start from the best single record; else the pair whose own best record the
+        plans start from — ``recommended`` when a plan is, the best single record stays so when
+        none is — searched because the greedy plan from the best single record fell short of the
+        target linearised: ``greedy_linearised`` its λ with no refit shortfall taken off, ``first``
+        the record's description).  The plans' linearised values have the first record's refit
+        shortfall taken off each pair (none for a pair's own best first record: its refits, if it was
+        among the records checked alone, are not used).  A plan short after the refits but above the
+        best single record's own λ by more than ``SHORT_PLAN_GAIN``: these keys, ``recommended``
+        True, ``separates`` False.
         When two records reached the target linearised but every one checked falls short after the
         refits and none is above the first alone: the best checked's keys with ``recommended``
         False, ``also`` empty and the message saying which pair falls short and by how much.  Empty

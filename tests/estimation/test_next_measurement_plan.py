@@ -177,7 +177,8 @@ def test_the_independent_actuator_pair_gets_an_m_and_a_z_record(seed47079, monke
     # is not built on the capped refits: it is recommended only when its own refits of every pair, on
     # both records together, reach the target (here they do: the cap is on the single-record check only)
     tg2 = nm2.together
-    assert tg2["greedy_linearised"] < nm2.target and tg2["first_for"] is not None
+    assert tg2["first_for"] is not None, tg2     # a plan from another pair's best record, larger than the greedy one (both raw)
+    assert tg2["greedy_linearised"] >= nm2.target     # raw (review: compared with no shortfall taken off either)
     assert nm2.recommended.describe() != r.describe() and "and, with it," in nm2.message
     assert "not the best single one" in nm2.message
     assert tg2["refits"]["fits"] == 2 * 2 * len(r.separation_by_pair)      # every pair refitted, none carried
@@ -246,11 +247,14 @@ def test_a_short_pair_of_records_better_than_the_first_alone_is_offered(seed4707
     and two more), so none reaches the target; the one of largest λ after the refits is still above
     the first record's own (a rival refitted to more lines cannot fit them better: per pair at least
     the first record's refit λ, the invariant checked here), so it is recommended with
-    ``separates`` False and its shortfall in the message and in to_dict."""
+    ``separates`` False and its shortfall in the message and in to_dict.  Its gain here is small
+    (1.74 against 1.63 after the refits): below the default margin ``SHORT_PLAN_GAIN`` (10 %), which
+    this test sets to 0 to check how an offered plan travels; the next test checks the default."""
     import math
 
     from physmodel.estimation import next_measurement_plan as plan_mod
 
+    monkeypatch.setattr(plan_mod, "SHORT_PLAN_GAIN", 0.0)
     _patch_second_record(monkeypatch, _claimed_m(plan_mod.second_record, every=True))
     nm = _search_47079(seed47079)
     r, tg = nm.recommended, nm.together
@@ -267,7 +271,9 @@ def test_a_short_pair_of_records_better_than_the_first_alone_is_offered(seed4707
         assert v == {"separation": tg["refit_by_pair"][k], "short_by": nm.target - tg["refit_by_pair"][k]}
         assert f"{k} reaches only {v['separation']:.3g} (short of {nm.target:.3g} by {v['short_by']:.3g})" in nm.message
     assert nm.to_dict()["together"]["short"] == tg["short"] and nm.to_dict()["separates"] is False
-    assert "alone or with a second, is expected to separate" in nm.message and "and, with it," in nm.message
+    assert "No single experiment within the limits is expected to separate" in nm.message
+    assert f"nor any of the {len(tg['checked'])} pairs of records checked by refits" in nm.message   # review: not all pairs
+    assert "and, with it," in nm.message
     assert f"about {math.ceil(nm.target / lam)}× as many" in nm.message and "accept the ambiguity" in nm.message
     # what `ipmc diagnose` writes carries it: report.json, summary.md and model.json's verdict reason
     # (its stderr line is the message, as test_next_measurement's CLI test checks)
@@ -282,6 +288,21 @@ def test_a_short_pair_of_records_better_than_the_first_alone_is_offered(seed4707
     k = next(iter(tg["short"]))
     assert f"{k} reaches only" in (tmp_path / "summary.md").read_text()
     assert f"{k} reaches only" in d.to_model_file().verdict.reason
+
+
+def test_a_short_pair_of_records_with_an_optimiser_size_gain_is_not_recommended(seed47079, monkeypatch):
+    """The same records with the default margin: the best plan's 1.74 after the refits is above the
+    first record's 1.63 by 7 %, under ``SHORT_PLAN_GAIN`` — not a gain worth a second experiment
+    (review of the short plans: a strict ">" sent the user to measure for an optimiser's
+    difference); not recommended, and the message says by what margin it would have had to win."""
+    from physmodel.estimation import next_measurement_plan as plan_mod
+
+    _patch_second_record(monkeypatch, _claimed_m(plan_mod.second_record, every=True))
+    nm = _search_47079(seed47079)
+    best = max(c["separation"] for c in nm.together["checked"])
+    assert nm.recommended.separation_refit < best <= (1 + plan_mod.SHORT_PLAN_GAIN) * nm.recommended.separation_refit
+    assert not nm.also and not nm.separates and nm.together["recommended"] is False
+    assert f"by more than {plan_mod.SHORT_PLAN_GAIN:.0%}, so not recommended" in nm.message
 
 
 def test_a_short_pair_of_records_not_better_than_the_first_alone_is_not_recommended(seed47079, monkeypatch):
