@@ -184,8 +184,8 @@ class NextMeasurement:
         when the plans start from the best single record; else the pair whose own best record the
         plans start from — ``recommended`` when a plan is, the best single record stays so when
         none is — searched because the greedy plan from the best single record fell short of the
-        target linearised: ``greedy_linearised`` its λ with no refit shortfall taken off, ``first``
-        the record's description).  The plans' linearised values have the first record's refit
+        target: ``greedy`` its λ with the best single record's refit shortfall taken off,
+        ``greedy_linearised`` without, ``first`` the record's description).  The plans' linearised values have the first record's refit
         shortfall taken off each pair (none for a pair's own best first record: its refits, if it was
         among the records checked alone, are not used).  A plan short after the refits but above the
         best single record's own λ by more than ``SHORT_PLAN_GAIN``: these keys, ``recommended``
