@@ -48,6 +48,15 @@ data and σ, the rival and the starts; on 41038 12 of 36 refits were drive ×1 a
 the same problem for a linear model under relative noise), and ``vuong_power`` evaluates the
 normal CDF with ``scipy.special.ndtr`` (3314 calls, ~75 µs each through ``scipy.stats.norm``).
 
+Then with the two-record plans of the same day merged (short plans offered, next-best second
+records, plans from each pair's own best record; main 02e0ef8 against 0e3466e, the
+same command, load 3-4 while two benchmarks ran): 41038 7.0x -> 6.8x (it now offers I + Z short at
+λ 34.1, whose refits cost what the cache saved), 51600 5.5x / 5.5x, 51604 4.7x / 5.0x, 44102 4.7x,
+51601-51603 2.7-3.9x; median 4.7x.  So the diagnosis-time row is not met on the two-effect strips
+whose verdict leaves four pairs ambiguous: there ``ipmc diagnose`` spends more on the next
+measurement's refit checks than on the diagnosis (41038, in process: diagnose() 3.2 s, the search
+~4-5 s).
+
 Tried and withdrawn (review): each rival's starts searched as one multi-start with damped steps
 from every start took 41038 to 4.7x and the maximum over these strips to 4.9x, with the same λ on
 41038 — but on the refit tests' fixture (576 refits of S and Z records) 33 λ moved, some by two
