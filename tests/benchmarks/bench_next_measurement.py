@@ -563,6 +563,17 @@ fresh together 9/13 [0.42, 0.87] named exactly after the recommended measurement
 change of today was tuned on, 18/24 = 0.75 [0.55, 0.88] (goal 80 %).  One fresh case is
 misnamed after its records (51877, time_delay alone for contact resistance 94 + delay), where it
 was ambiguous before: the table's "named exactly" counts a wrong name as it counts an ambiguous one.
+
+Why 51877 ends misnamed (traced 2026-11-27, not fixed): in the three records' joint diagnosis the
+pair contact_resistance + time_delay gains 185 over time_delay alone (T = 17.2), but a second
+effect must also beat max(T, CLOSE_FRACTION × the baseline's excess) or close the gap strictly; the
+recommended high-band M record (chosen to separate the delay from the amplifier pole) multiplied
+the delay's signal ~18×, the excess 9 750 -> 179 500, that bar 48.8 -> 898.  The contact
+resistance is detectable there (λ 153 on top of the delay in the generator's noise-free truth; the
+noise-free records give the same verdict, and with the share floor off it is named exactly); the
+generator's delay (skew + hold) keeps M at 1.2× its expectation, so the strict closing fails too.
+Leads: test a second effect against the first effect's other forms instead of a share of its size;
+have the plan search predict whether the weaker member stays nameable under the diagnosis's rule.
 """
 
 from __future__ import annotations
