@@ -73,7 +73,8 @@ when the refits reach λ* too (``NextMeasurement.also``; ``separates`` then refe
 second record the refits refuse gives way to the next-best by linearised λ (at most
 :data:`~physmodel.estimation.next_measurement_plan.MORE_SECOND_RECORDS` more, each checked, the
 first confirmed taken); when none is confirmed, the checked pair of largest λ after the refits is
-still recommended when it is above the first record's own — ``separates`` False, the message and
+still recommended when it is above the best single record's own by more than
+:data:`~physmodel.estimation.next_measurement_plan.SHORT_PLAN_GAIN` — ``separates`` False, the message and
 ``together["short"]`` saying what it reaches, the pairs short and by how much, and the remedies —
 and otherwise not (said); when the two do not reach λ* linearised the single recommendation
 stands, unchanged.

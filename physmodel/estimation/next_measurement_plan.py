@@ -421,19 +421,20 @@ def _short_words(plan: RecordPair, target: float) -> str:
 def plan_message(pick: PlanChoice, first: CandidateMeasurement, who: str, power: float, alpha: float,
                  first_words: str, current: float) -> str:
     """The message of a recommended plan (``pick.plan``): the two records and their λ together;
-    when short (``pick.short``), that no experiment, alone or with a second, is expected to separate,
-    the pairs that fall short and by how much, and the remedies (more periods — λ grows in proportion
+    when short (``pick.short``), that no single experiment nor any pair of records checked by refits
+    is expected to separate, the pairs that fall short and by how much, and the remedies (more periods — λ grows in proportion
     to the periods averaged, so about ⌈target/λ⌉× as many —, wider limits, or the ambiguity
     accepted).  ``first_words``: the first record's own λ in words; ``current``: the record's."""
     plan, target = pick.plan, pick.target
     assert plan is not None
     both = f"{first.describe()} and, with it, {plan.second.describe()}"
     need = f"{target:.3g} needed for {power:.0%} power at α = {alpha:g}"
+    if (pick.first is not None and first.separation_refit != first.separation_refit
+            and not first_words.endswith("linearised")):
+        first_words += " linearised (not refitted alone)"
     alone = f"the first alone gives {first_words}, the record alone {current:.3g}"
     tried = len(pick.checked)
     if pick.first is not None:       # a pair's own best record, not the best single one (issue 27)
-        if first.separation_refit != first.separation_refit and not first_words.endswith("linearised"):
-            alone = alone.replace(f"gives {first_words},", f"gives {first_words} linearised (not refitted alone),", 1)
         single = pick.single
         with_single = ("to which no second record can be added" if pick.greedy != pick.greedy else
                        f"with which the best second record gives only λ = {pick.greedy:.3g} with that record's "
