@@ -574,6 +574,19 @@ noise-free records give the same verdict, and with the share floor off it is nam
 generator's delay (skew + hold) keeps M at 1.2× its expectation, so the strict closing fails too.
 Leads: test a second effect against the first effect's other forms instead of a share of its size;
 have the plan search predict whether the weaker member stays nameable under the diagnosis's rule.
+
+Tried 2026-11-27 (session 15) and withdrawn before any benchmark: the share taken per quantity (a
+second effect accepted when, in some quantity, its gain over the best single passes T and that
+quantity's own CLOSE_FRACTION share — the slack ``GapTest.closes_blocks`` already applies per
+quantity; one quantity: today's rule bit for bit).  On 51877's three records the contact
+resistance's 185 splits M 177.6, Z 7.8 (baseline 2·cost M 179 988, Z 199; thresholds 446, 168): its
+signal is in M, beside the delay's, so a per-quantity share does not free it.  The same records say
+how the share rule errs here: the delay alone leaves M 181 above its threshold (its allowed slack is
+898), the pair takes 177.6 of it and leaves M at 449.5 against 446 — the generator's delay (skew +
+hold) keeps M ~75 above its χ² expectation (375), so the strict closing that rescues a pair fails by
+3.5.  A rule that compares the second effect with what the first actually leaves (not with what it
+is allowed to leave) would free it, and is the one to measure next against bench_discrepancy's
+single-effect and wrong-form cases (its false second names).
 """
 
 from __future__ import annotations
