@@ -588,6 +588,18 @@ hold) keeps M ~75 above its χ² expectation (375), so the strict closing that r
 is allowed to leave) would free it, and is the one to measure next against bench_discrepancy's
 single-effect and wrong-form cases (its false second names).
 
+Also tried in session 15 and withdrawn: the share as a bound local to where the second effect acts.
+If the first effect's form mismatch is at most √CLOSE_FRACTION of the baseline's excess on every
+residual row (e_i), a second effect whose projected signature spans U can take at most
+CLOSE_FRACTION·√eᵀ|UUᵀ|√e of it (Cauchy-Schwarz; never more than today's global share).  On 51877
+that bound is 6.7 (the contact resistance gains 185, so it is named); on the singles
+(``bench_discrepancy.py --labels singles --first-seed 52600 --n-per-label 2``) it accepted no
+extra pair; but on the pair block 52000 it accepted 14 pairs the global share refused — most with
+a wrong second member (modulus_temperature + series_cpe, water_uptake + electrode_resistance,
+time_delay + higher_modes) — and turned one misnamed and one ambiguous case into longer ambiguous
+lists, 4/9 either way.  The per-row premise is too weak a guard: a form mismatch is not bounded row
+by row by the effect's own excess.
+
 Fresh blocks, session 15 (2026-11-27, main 71afd4f = 9d85573's code, each block run once, one process,
 2 cores shared with other benchmarks)::
 
