@@ -287,6 +287,9 @@ class ParameterTable:
     columns: dict
     groups: list
     n: int
+    #: The temperatures this table's groups were evaluated at: ``{(shape, bytes of °C): (T [K], the
+    #: groups' law factors)}``, shared by the tables :meth:`with_columns` makes (the same groups).
+    seen: dict = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def of(cls, params: IPMCParameters | Sequence[IPMCParameters]) -> ParameterTable:
@@ -317,27 +320,46 @@ class ParameterTable:
             members.setdefault(key, []).append(i)
         return cls(columns, [(plist[idx[0]], np.asarray(idx)) for idx in members.values()], n)
 
-    def state(self, temperature_c) -> State:
-        """The :class:`State` of the batch at ``temperature_c`` [°C]."""
+    def with_columns(self, columns: dict, n: int) -> ParameterTable:
+        """A table of ``n`` sets with these ``columns`` (each (n, 1) [SI]) and this table's groups
+        (their laws and ``T_ref``), sharing what the groups' laws gave at each temperature."""
+        return ParameterTable(columns, self.groups, n, self.seen)
+
+    def _laws_at(self, temperature_c) -> tuple:
+        """``(T [K], [the law factors of each group], those of a single group as rows (1, n_T) or
+        None)`` at ``temperature_c`` [°C], kept per temperature array (a fit evaluates one table's
+        groups at one grid many times; the arrays are read-only)."""
+        t = np.asarray(temperature_c, dtype=float)
+        key = (t.shape, t.tobytes())
+        hit = self.seen.get(key)
+        if hit is not None:
+            return hit
         T = np.atleast_1d(celsius_to_kelvin(temperature_c)).astype(float)
         if T.ndim != 1:
             raise ParameterError(f"temperature_c must be a scalar or 1-D array, got shape {T.shape}")
+        T.flags.writeable = False
+        factors = [p.laws.factors(T, p.T_ref) for p, _ in self.groups]
+        out = (T, factors, {k: v[None, :] for k, v in factors[0].items()} if len(factors) == 1 else None)
+        if len(self.seen) >= 16:
+            self.seen.pop(next(iter(self.seen)))
+        self.seen[key] = out
+        return out
+
+    def state(self, temperature_c) -> State:
+        """The :class:`State` of the batch at ``temperature_c`` [°C]."""
+        T, factors, fac = self._laws_at(temperature_c)
         n, col = self.n, self.columns
-        if len(self.groups) == 1:
-            p = self.groups[0][0]
-            fac = {k: v[None, :] for k, v in p.laws.factors(T, p.T_ref).items()}
-        else:
+        if fac is None:
             fac = {name: np.empty((n, T.size)) for name in LAW_PARAMETERS}
-            for p, idx in self.groups:
-                f = p.laws.factors(T, p.T_ref)
+            for (_, idx), f in zip(self.groups, factors, strict=True):
                 for name in LAW_PARAMETERS:
                     fac[name][idx] = f[name]
         # the fields constant along T repeated over it (fresh arrays, as the products below are)
-        vals = {name: np.repeat(col[name][:, :, None], T.size, axis=1) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
+        vals = {name: col[name][:, :, None].repeat(T.size, axis=1) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
         for name in LAW_PARAMETERS:
             vals[name] = (col[name] * fac[name])[:, :, None]
         W = vals["W"]
-        vals["T"] = np.repeat(T[None, :, None], n, axis=0)
+        vals["T"] = T[None, :, None].repeat(n, axis=0)
         vals["r1"] = vals.pop("r1_sheet") / W
         vals["r2"] = vals.pop("r2_specific") / W
         vals["Rp"] = vals.pop("Rp_specific") / W

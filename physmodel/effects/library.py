@@ -205,7 +205,7 @@ def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], pa
             g = np.array(given)
             cols[name] = np.where(g, check_field_values(name, np.where(g, a, 1.0)), cols[name][:, 0])[:, None]
     cols = {k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()}
-    return ParameterTable(cols, table.groups, n)
+    return table.with_columns(cols, n)
 
 
 def _group_value(e: Effect, given: Mapping[str, float], own_effects: Mapping) -> tuple:
@@ -256,6 +256,8 @@ class _EffectMixin:
         self._active: list = [(get_effect(n), v, None) for n, v in self.effects.items()
                               if not get_effect(n).is_off(v)]
         self._batch_table: ParameterTable | None = None
+        self._split: tuple | None = None            # _active by level (_levels)
+        self._t_ref_of: tuple | None = None         # (params, T_ref) (_t_ref)
 
     def _use_table(self, table: ParameterTable) -> None:
         """Evaluate the parameter sets of ``table`` (built as arrays by :func:`_table_of`, one row
@@ -362,12 +364,13 @@ class _EffectMixin:
 
     def state(self, temperature_c) -> State:
         st = super().state(temperature_c) if self._batch_table is None else self._batch_table.state(temperature_c)
-        acts = [(e, v, m) for e, v, m in self._active if e.level == "parameter"]
+        acts = self._levels()["parameter"]
         if not acts:
             return st
-        d0 = {k: np.array(getattr(st, k), dtype=float) for k in STATE_FIELDS}
+        # the state's own arrays (fresh ones each call; the effects replace entries, never write into them)
+        d0 = {k: getattr(st, k) for k in STATE_FIELDS}
         d = dict(d0)
-        T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
+        T_ref = self._t_ref()
         for e, v, m in acts:
             new = e.apply(dict(d), T_ref, v)
             d = new if m is None else {k: np.where(m, new[k], d[k]) for k in d}
@@ -385,15 +388,41 @@ class _EffectMixin:
         qs = self._check_quantities(quantities or self.quantities)
         f = check_frequencies(frequency_hz)
         T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
-        s = 2j * np.pi * f
+        res = self._respond(f, T, 2j * np.pi * f, qs, out, progress)
+        return FrequencyResponse(
+            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
+            values=res, units={q: self.units[q] for q in qs},
+            descriptions={q: self.descriptions[q] for q in qs},
+        )
+
+    def _levels(self) -> dict:
+        """The entries of ``_active`` by level, split once per ``_active`` list."""
+        split = self._split
+        if split is None or split[0] is not self._active:
+            by = {lv: [x for x in self._active if x[0].level == lv] for lv in ("parameter", "strip", "response", "series")}
+            by["kernel"] = next(((e, v) for e, v, _ in self._active if e.level == "kernel"), None)
+            split = self._split = (self._active, by)
+        return split[1]
+
+    def _t_ref(self) -> np.ndarray:
+        """The sets' reference temperatures (n_sets, 1, 1) [K], read-only, once per ``params`` list."""
+        hit, params = self._t_ref_of, self.params
+        if hit is None or hit[0] is not params or len(hit[1]) != len(params):
+            t = np.array([p.T_ref for p in params], dtype=float)[:, None, None]
+            t.flags.writeable = False
+            hit = self._t_ref_of = (params, t)
+        return hit[1]
+
+    def _respond(self, f, T, s, qs, out=None, progress=None) -> dict:
+        """:meth:`frequency_response`'s values ``{q: (n_sets, n_T, n_f)}`` at checked frequencies
+        ``f`` [Hz] (1-D), temperatures ``T`` [°C] (1-D float) and ``s = 2j·π·f`` [1/s]."""
         st = self.state(T)
-        resp = [(e, v, m) for e, v, m in self._active if e.level == "response"]
-        series = [(e, v, m) for e, v, m in self._active if e.level == "series"]
+        levels = self._levels()
+        resp, series, kern = levels["response"], levels["series"], levels["kernel"]
         need = set(qs)
         if series:
             need.add("Z")
         need = tuple(q for q in self.quantities if q in need)
-        kern = next(((e, v) for e, v, _ in self._active if e.level == "kernel"), None)
         s_kernel = s if kern is None else kern[0].apply(s, kern[1])
         if kern is None and progress is None:
             # the model's own evaluation of a state: an actuator batch whose sets repeat an
@@ -414,10 +443,10 @@ class _EffectMixin:
                     vals["G"] = G
                 if "M" in need:
                     vals["M"] = vals["H"] * G
-        T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
+        T_ref = self._t_ref()
         ctx = _Context(s[None, None, :], s_kernel if s_kernel.ndim == 3 else s_kernel[None, None, :], st, dict(vals),
                        T_ref)
-        strip = [(e, v, m) for e, v, m in self._active if e.level == "strip"]
+        strip = levels["strip"]
         if strip:                           # the strip itself: every quantity computed, Z included
             partly = [m for _, _, m in strip if m is not None]
             x0 = ctx.x if partly else None  # the line without them, for the sets where they are off
@@ -452,11 +481,7 @@ class _EffectMixin:
                 res[q] = out[q]
             else:
                 res[q] = np.asarray(vals[q], dtype=complex)
-        return FrequencyResponse(
-            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
-            values=res, units={q: self.units[q] for q in qs},
-            descriptions={q: self.descriptions[q] for q in qs},
-        )
+        return res
 
     def evaluate(self, *a, **k):  # pragma: no cover - guard
         raise IPMCError("EffectModel evaluates on the imaginary axis only; use frequency_response()")
@@ -502,6 +527,8 @@ class _EffectMixin:
         models: dict = {}
 
         plans: dict = {}        # the fast path's plan of each tuple of names (None: the general path)
+        repeated: dict = {}     # the fast path's base columns over n sets, by n
+        grid: list = []         # the fast path's (frequencies [Hz], temperatures [°C], s), checked once
 
         def plan_of(keys: tuple):
             """Where the names ``keys`` go when every set gives exactly these: ``(base, omega,
@@ -548,8 +575,12 @@ class _EffectMixin:
             if omega is not None:
                 rho = density_for_mode(X[:, omega], cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
                 cols["rho"] = check_field_values("rho", rho)[:, None]
-            table = ParameterTable({k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()},
-                                   table0.groups, n)
+            rep = repeated.get(n)
+            if rep is None:         # the base's columns over n sets, once per n (read-only, only read)
+                rep = repeated[n] = {k: np.repeat(v, n, axis=0) for k, v in table0.columns.items()}
+                for v in rep.values():
+                    v.flags.writeable = False
+            table = table0.with_columns({k: v if len(v) == n else rep[k] for k, v in cols.items()}, n)
             m = models.get(((), n))
             if m is None:
                 if len(models) >= 64:
@@ -558,7 +589,13 @@ class _EffectMixin:
             m._use_table(table)
             if not m._batch_effect_arrays({e: {p: X[:, j] for p, j in pj.items()} for e, pj in effects.items()}):
                 return None                 # a kernel effect on in some sets only: the general path
-            r = m.frequency_response(freqs, temps, quantities=(q,))[q]
+            if not grid:            # the frequencies and temperatures, checked once (as frequency_response does)
+                f = check_frequencies(freqs)
+                T = np.array(np.atleast_1d(np.asarray(temps, dtype=float)))
+                s = 2j * np.pi * f
+                f.flags.writeable = T.flags.writeable = s.flags.writeable = False
+                grid.append((f, T, s))
+            r = m._respond(*grid[0], (q,))[q]
             # C order, as the general path's: r[:, ti, fi] alone comes out in Fortran order, and the
             # estimation layer's reductions and products over it then round differently
             out = np.empty((n, data.response.size), dtype=complex)
