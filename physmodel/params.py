@@ -166,17 +166,22 @@ def first_mode_omega(E, rho, L, h):
     return BETA1L_SQ / L**2 * np.sqrt(E * h**2 / (3.0 * rho))
 
 
+def field_range_ok(name: str, lo: float, hi: float) -> bool:
+    """Whether values of numeric field ``name`` whose minimum is ``lo`` and maximum ``hi`` (NaN if
+    any is NaN) all pass the checks :class:`IPMCParameters` makes (see :func:`check_field_values`)."""
+    m = _FIELD_META[name]
+    return (lo == lo and hi == hi and (m["allow_inf"] or (hi < math.inf and lo > -math.inf))
+            and (not m["positive"] or lo > 0 or (lo == 0 and m["allow_zero"])))
+
+
 def check_field_values(name: str, values) -> np.ndarray:
     """The checks :class:`IPMCParameters` makes of numeric field ``name``, over an array of values
     (one per parameter set, e.g. a batch built without a record per set); returns them as floats.
     A bad value is a :class:`ParameterError` worded as the record's own."""
     m = _FIELD_META[name]
     v = np.asarray(values, dtype=float)
-    if v.size:                  # the usual case, all good, from two reductions (NaN propagates into both)
-        lo, hi = float(v.min()), float(v.max())
-        if (lo == lo and hi == hi and (m["allow_inf"] or (hi < math.inf and lo > -math.inf))
-                and (not m["positive"] or lo > 0 or (lo == 0 and m["allow_zero"]))):
-            return v
+    if v.size and field_range_ok(name, float(v.min()), float(v.max())):
+        return v                # the usual case, all good, from two reductions (NaN propagates into both)
     bad = np.isnan(v)
     if not m["allow_inf"]:
         bad |= np.isinf(v)
@@ -196,10 +201,11 @@ def check_field_values(name: str, values) -> np.ndarray:
 def density_for_mode(omega_n, E, L, h):
     """Effective density [kg/m³] that puts the first mode at ``omega_n`` [rad/s] (arrays broadcast)."""
     w = np.asarray(omega_n, dtype=float)
-    bad = ~(np.isfinite(w) & (w > 0))
-    if np.any(bad):
-        raise ParameterError(f"omega_n={float(w[bad].ravel()[0]) if w.ndim else omega_n!r} rad/s must be a positive "
-                             "finite number")
+    if not (w.size and w.min() > 0 and w.max() < math.inf):  # the usual case in two reductions (NaN fails it)
+        bad = ~(np.isfinite(w) & (w > 0))
+        if np.any(bad):
+            raise ParameterError(f"omega_n={float(w[bad].ravel()[0]) if w.ndim else omega_n!r} rad/s must be a "
+                                 "positive finite number")
     return E * h**2 / 3.0 * (BETA1L_SQ / (L**2 * omega_n)) ** 2
 
 
@@ -390,5 +396,5 @@ def describe(p: IPMCParameters) -> str:
 
 
 __all__ = ["IPMCParameters", "State", "ParameterTable", "state_at", "first_mode_omega", "density_for_mode", "describe",
-           "check_field_values",
+           "check_field_values", "field_range_ok",
            "as_parameter_list"]

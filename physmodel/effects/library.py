@@ -46,6 +46,7 @@ from ..params import (
     State,
     check_field_values,
     density_for_mode,
+    field_range_ok,
     first_mode_omega,
 )
 from ..sensor import SensorModel
@@ -224,14 +225,16 @@ def _batched_entry(e: Effect, vals: dict):
     is off in every set; sets where it is off take its off values."""
     for p in e.parameters:
         a = vals[p.name]
-        ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
-        if not np.all(ok):
+        lo, hi = float(a.min()), float(a.max())     # NaN propagates into both: the usual case in two reductions
+        if not (p.lower <= lo and hi <= p.upper and math.isfinite(lo) and math.isfinite(hi)):
+            ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
             v = float(a[~ok][0])
             raise ParameterError(f"{e.name}.{p.name}={v!r} [{p.unit}] must lie in [{p.lower:g}, {p.upper:g}]")
     on = e.on_mask(vals)
-    if not np.any(on):
+    n_on = np.count_nonzero(on)
+    if not n_on:
         return None
-    if np.all(on):
+    if n_on == on.size:
         mask = None
     else:            # off sets take the off values: the effect sees no switched-off mixture
         mask = on[:, None, None]
@@ -570,8 +573,10 @@ class _EffectMixin:
                 return None
             base, omega, effects = plan
             cols = dict(table0.columns)
+            lo, hi = X.min(axis=0).tolist(), X.max(axis=0).tolist()     # each column's (NaN propagates)
             for name, j in base:
-                cols[name] = check_field_values(name, X[:, j])[:, None]
+                # check_field_values's test from the column's extremes; it words a bad value
+                cols[name] = (X[:, j] if field_range_ok(name, lo[j], hi[j]) else check_field_values(name, X[:, j]))[:, None]
             if omega is not None:
                 rho = density_for_mode(X[:, omega], cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
                 cols["rho"] = check_field_values("rho", rho)[:, None]
