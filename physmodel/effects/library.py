@@ -386,12 +386,17 @@ class _EffectMixin:
         return State(**d)
 
     def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
-                           progress=None) -> FrequencyResponse:
-        """Like the base model's, with every effect applied.  ``out`` is filled if given."""
+                           progress=None, *, checked: tuple | None = None) -> FrequencyResponse:
+        """Like the base model's, with every effect applied.  ``out`` is filled if given.
+        ``checked``: ``(f, T, s)``, these ``frequency_hz`` checked, ``temperature_c`` as a 1-D float
+        array and s = 2j·π·f, made once by a caller that evaluates them many times (a predictor)."""
         qs = self._check_quantities(quantities or self.quantities)
-        f = check_frequencies(frequency_hz)
-        T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
-        res = self._respond(f, T, 2j * np.pi * f, qs, out, progress)
+        if checked is None:
+            f = check_frequencies(frequency_hz)
+            T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
+            checked = (f, T, 2j * np.pi * f)
+        f, T, _ = checked
+        res = self._respond(*checked, qs, out, progress)
         return FrequencyResponse(
             frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
             values=res, units={q: self.units[q] for q in qs},
@@ -600,7 +605,7 @@ class _EffectMixin:
                 s = 2j * np.pi * f
                 f.flags.writeable = T.flags.writeable = s.flags.writeable = False
                 grid.append((f, T, s))
-            r = m._respond(*grid[0], (q,))[q]
+            r = m.frequency_response(freqs, temps, quantities=(q,), checked=grid[0])[q]
             # C order, as the general path's: r[:, ti, fi] alone comes out in Fortran order, and the
             # estimation layer's reductions and products over it then round differently
             out = np.empty((n, data.response.size), dtype=complex)
