@@ -248,6 +248,14 @@ class State:
     def second_moment(self):
         return 2.0 / 3.0 * self.W * self.h**3
 
+    @classmethod
+    def of(cls, values) -> State:
+        """The state whose arrays are ``values[field]`` for every field of :data:`STATE_FIELDS`
+        (the arrays themselves, as ``State(**values)`` keeps them; without its per-field setup)."""
+        st = object.__new__(cls)
+        st.__dict__.update({k: values[k] for k in STATE_FIELDS})
+        return st
+
     def take(self, i_set: int, i_T: int) -> State:
         """The state of one parameter set at one temperature (arrays of shape (1, 1, 1))."""
         return State(**{k: getattr(self, k)[i_set:i_set + 1, i_T:i_T + 1] for k in STATE_FIELDS})
@@ -371,7 +379,7 @@ class ParameterTable:
         vals["Rp"] = vals.pop("Rp_specific") / W
         vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * vals["T"])
         vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
-        return State(**{k: vals[k] for k in STATE_FIELDS})
+        return State.of(vals)
 
 
 def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -> State:

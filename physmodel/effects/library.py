@@ -377,13 +377,17 @@ class _EffectMixin:
         for e, v, m in acts:
             new = e.apply(dict(d), T_ref, v)
             d = new if m is None else {k: np.where(m, new[k], d[k]) for k in d}
-        d["K"] = debye_rate(d["d"], d["C_minus"], d["kappa_e"], d["T"])
-        d["omega_n"] = first_mode_omega(d["E"], d["rho"], d["L"], d["h"])
+        # recomputed from what the effects replaced (inputs they left are the same arrays, and the
+        # state's K and ωn are these expressions of them: the same numbers)
+        if any(d[k] is not d0[k] for k in ("d", "C_minus", "kappa_e", "T")):
+            d["K"] = debye_rate(d["d"], d["C_minus"], d["kappa_e"], d["T"])
+        if any(d[k] is not d0[k] for k in ("E", "rho", "L", "h")):
+            d["omega_n"] = first_mode_omega(d["E"], d["rho"], d["L"], d["h"])
         if all(m is not None for _, _, m in acts):      # sets with every parameter effect off: the base state
             changed = np.logical_or.reduce([m for _, _, m in acts])
             for k in ("K", "omega_n"):
                 d[k] = np.where(changed, d[k], d0[k])
-        return State(**d)
+        return State.of(d)
 
     def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
                            progress=None, *, checked: tuple | None = None) -> FrequencyResponse:
