@@ -128,7 +128,11 @@ class Effect:
         """:meth:`is_off` negated, elementwise over arrays of values (one entry per parameter set)."""
         if self.switch is not None:
             return np.asarray(values[self.switch]) != self.parameter(self.switch).off
-        return np.logical_or.reduce([np.asarray(values[p.name]) != p.off for p in self.parameters])
+        on = None               # the parameters' tests or-ed in turn (no stacked array)
+        for p in self.parameters:
+            x = np.asarray(values[p.name]) != p.off
+            on = x if on is None else on | x
+        return on
 
     def applies_to(self, kind: str, quantity: str) -> bool:
         return kind in self.kinds and quantity in self.quantities

@@ -87,6 +87,14 @@ class _Context:
         return self._x
 
 
+@functools.lru_cache(maxsize=256)
+def _needed(quantities: tuple, qs: tuple, series: bool) -> tuple:
+    """The quantities of ``quantities`` (a model's, in its order) to evaluate for ``qs``: Z too
+    when a series effect is on."""
+    need = set(qs) | ({"Z"} if series else set())
+    return tuple(q for q in quantities if q in need)
+
+
 def _where_on(on, value, off_value):
     """``value`` in the parameter sets where an effect is on, ``off_value`` elsewhere (``on`` None: all)."""
     return value if on is None else np.where(on, value, off_value)
@@ -261,6 +269,7 @@ class _EffectMixin:
         self._batch_table: ParameterTable | None = None
         self._split: tuple | None = None            # _active by level (_levels)
         self._t_ref_of: tuple | None = None         # (params, T_ref) (_t_ref)
+        self._names_of: tuple | None = None         # (params, names) (_set_names)
 
     def _use_table(self, table: ParameterTable) -> None:
         """Evaluate the parameter sets of ``table`` (built as arrays by :func:`_table_of`, one row
@@ -335,7 +344,7 @@ class _EffectMixin:
             e = get_effect(name)
             if self.kind not in e.kinds:
                 raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model (it applies to {e.kinds})")
-            own = self.effects.get(name, e.off)
+            own = self.effects[name] if name in self.effects else e.off
             if not e.batchable and name in given and e.level == "kernel":
                 g = given[name]
                 vals = {p.name: np.asarray(g[p.name], dtype=float) if p.name in g else np.full(n, float(own[p.name]))
@@ -402,19 +411,32 @@ class _EffectMixin:
         f, T, _ = checked
         res = self._respond(*checked, qs, out, progress)
         return FrequencyResponse(
-            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
+            frequency_hz=f, temperature_c=T, parameter_sets=self._set_names(),
             values=res, units={q: self.units[q] for q in qs},
             descriptions={q: self.descriptions[q] for q in qs},
         )
 
     def _levels(self) -> dict:
-        """The entries of ``_active`` by level, split once per ``_active`` list."""
+        """The entries of ``_active`` by level (in their order; "kernel": the first kernel effect's
+        ``(effect, values)`` or None), split once per ``_active`` list."""
         split = self._split
         if split is None or split[0] is not self._active:
-            by = {lv: [x for x in self._active if x[0].level == lv] for lv in ("parameter", "strip", "response", "series")}
-            by["kernel"] = next(((e, v) for e, v, _ in self._active if e.level == "kernel"), None)
+            by: dict = {"parameter": [], "strip": [], "response": [], "series": [], "kernel": None}
+            for x in self._active:
+                level = x[0].level
+                if level != "kernel":
+                    by[level].append(x)
+                elif by["kernel"] is None:
+                    by["kernel"] = x[:2]
             split = self._split = (self._active, by)
         return split[1]
+
+    def _set_names(self) -> tuple:
+        """The sets' names, once per ``params`` list."""
+        hit, params = self._names_of, self.params
+        if hit is None or hit[0] is not params or len(hit[1]) != len(params):
+            hit = self._names_of = (params, tuple(p.name for p in params))
+        return hit[1]
 
     def _t_ref(self) -> np.ndarray:
         """The sets' reference temperatures (n_sets, 1, 1) [K], read-only, once per ``params`` list."""
@@ -431,10 +453,7 @@ class _EffectMixin:
         st = self.state(T)
         levels = self._levels()
         resp, series, kern = levels["response"], levels["series"], levels["kernel"]
-        need = set(qs)
-        if series:
-            need.add("Z")
-        need = tuple(q for q in self.quantities if q in need)
+        need = _needed(self.quantities, qs, bool(series))
         s_kernel = s if kern is None else kern[0].apply(s, kern[1])
         if kern is None and progress is None:
             # the model's own evaluation of a state: an actuator batch whose sets repeat an
