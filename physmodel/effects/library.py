@@ -388,9 +388,9 @@ class _EffectMixin:
             d = new if m is None else {k: np.where(m, new[k], d[k]) for k in d}
         # recomputed from what the effects replaced (inputs they left are the same arrays, and the
         # state's K and ωn are these expressions of them: the same numbers)
-        if any(d[k] is not d0[k] for k in ("d", "C_minus", "kappa_e", "T")):
+        if any(d[k] is not d0[k] for k in ("K", "d", "C_minus", "kappa_e", "T")):
             d["K"] = debye_rate(d["d"], d["C_minus"], d["kappa_e"], d["T"])
-        if any(d[k] is not d0[k] for k in ("E", "rho", "L", "h")):
+        if any(d[k] is not d0[k] for k in ("omega_n", "E", "rho", "L", "h")):
             d["omega_n"] = first_mode_omega(d["E"], d["rho"], d["L"], d["h"])
         if all(m is not None for _, _, m in acts):      # sets with every parameter effect off: the base state
             changed = np.logical_or.reduce([m for _, _, m in acts])
