@@ -250,7 +250,7 @@ class State:
 
     @classmethod
     def of(cls, values) -> State:
-        """The state whose arrays are ``values[field]`` for every field of :data:`STATE_FIELDS`
+        """The state whose arrays are ``values[field]`` for every field of the state (``STATE_FIELDS``)
         (the arrays themselves, as ``State(**values)`` keeps them; without its per-field setup)."""
         st = object.__new__(cls)
         st.__dict__.update({k: values[k] for k in STATE_FIELDS})
