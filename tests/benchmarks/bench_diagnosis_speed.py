@@ -39,7 +39,9 @@ every CPU figure here is ~1.5x the sixth round's)::
     41009 water_uptake                            2.04 / 2.03       6.20      5.80        3.0x     2.9x
 
 Every report.json and model.json the same number by number; median 4.7x -> 4.1x, max 6.4x ->
-5.9x: 41038 stays above 5x.  Stronger than the reports: every batched model output, every
+5.9x: 41038 stays above 5x.  Again with three rounds (``--rounds 3 --cases 41038:...,51600:...``,
+load 2-3): 41038 calibrate 2.19 / 2.14 s, diagnose 14.85 -> 12.72 s CPU, 6.8x -> 6.0x; 51600
+2.31 / 2.19, 11.53 -> 10.54, 5.0x -> 4.8x; the reports the same.  Stronger than the reports: every batched model output, every
 ``ModelBatch`` output and every standardised residual vector of an in-process ``ipmc diagnose``
 (41038: 24765 arrays; 41009: 7665; 51603: 6888; 44102: 12790) hashed in call order, the same
 from both checkouts (PYTHONHASHSEED=0: set iteration orders some calls).  The model calls
