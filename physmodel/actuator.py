@@ -145,7 +145,7 @@ def shared_sets(values, n_sets: int, n_T: int, differ=LINE_FIELDS):
     # a set's line is the same as another's when its slice's bytes and those of the line's own
     # fields (r1, L) are: the slice's read once
     sl = rows(SLICE_FIELDS)
-    own = rows(LINE_FIELDS[len(SLICE_FIELDS):])
+    own = rows(tuple(f for f in LINE_FIELDS if f not in SLICE_FIELDS))
     line_keys = sl if own is None else own if sl is None else list(zip(sl, own, strict=True))
     line = firsts(line_keys, range(n_sets))
     return _shared_index(line, firsts(sl, sorted(set(line))), n_T)

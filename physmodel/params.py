@@ -302,8 +302,9 @@ class ParameterTable:
     groups: list
     n: int
     #: The temperatures this table's groups were evaluated at: ``{(shape, bytes of °C): (T [K], the
-    #: groups' law factors)}``, shared by the tables :meth:`with_columns` makes (the same groups).
-    seen: dict = field(default_factory=dict, compare=False, repr=False)
+    #: groups' law factors)}``, shared by the tables :meth:`with_columns` makes (the same groups);
+    #: not an init field, so ``dataclasses.replace`` (other groups, perhaps) starts with none.
+    seen: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     @classmethod
     def of(cls, params: IPMCParameters | Sequence[IPMCParameters]) -> ParameterTable:
@@ -337,7 +338,9 @@ class ParameterTable:
     def with_columns(self, columns: dict, n: int) -> ParameterTable:
         """A table of ``n`` sets with these ``columns`` (each (n, 1) [SI]) and this table's groups
         (their laws and ``T_ref``), sharing what the groups' laws gave at each temperature."""
-        return ParameterTable(columns, self.groups, n, self.seen)
+        out = ParameterTable(columns, self.groups, n)
+        object.__setattr__(out, "seen", self.seen)      # not an init field: replace() starts afresh
+        return out
 
     def _laws_at(self, temperature_c) -> tuple:
         """``(T [K], [the law factors of each group], those of a single group as rows (1, n_T) or

@@ -402,7 +402,8 @@ class _EffectMixin:
                            progress=None, *, checked: tuple | None = None) -> FrequencyResponse:
         """Like the base model's, with every effect applied.  ``out`` is filled if given.
         ``checked``: ``(f, T, s)``, these ``frequency_hz`` checked, ``temperature_c`` as a 1-D float
-        array and s = 2j·π·f, made once by a caller that evaluates them many times (a predictor)."""
+        array and s = 2j·π·f, made once by a caller that evaluates them many times (a predictor);
+        when given, ``frequency_hz`` and ``temperature_c`` are not read (the caller vouches for it)."""
         qs = self._check_quantities(quantities or self.quantities)
         if checked is None:
             f = check_frequencies(frequency_hz)
@@ -610,6 +611,8 @@ class _EffectMixin:
                 cols["rho"] = check_field_values("rho", rho)[:, None]
             rep = repeated.get(n)
             if rep is None:         # the base's columns over n sets, once per n (read-only, only read)
+                if len(repeated) >= 16:
+                    repeated.pop(next(iter(repeated)))
                 rep = repeated[n] = {k: np.repeat(v, n, axis=0) for k, v in table0.columns.items()}
                 for v in rep.values():
                     v.flags.writeable = False

@@ -117,3 +117,40 @@ def test_bad_values_are_refused_in_a_batch_as_alone(change, words):
         batch[k].update(change)
         with pytest.raises(ParameterError, match=words.replace("+", r"\+").replace(".", r"\.")):
             many(batch)
+
+
+@pytest.mark.parametrize("name, first, second, words", [
+    ("contact_resistance.r2_specific", -1e-6, -5.0, "contact_resistance.r2_specific=-1e-06"),
+    ("d", -1e-10, -3e-9, "d=-1e-10"),
+    ("omega_n", -3.0, -700.0, "omega_n=-3.0"),
+])
+def test_of_two_bad_values_the_first_is_named_not_the_extreme(name, first, second, words):
+    sweep = synthesize_sweep(EffectModel(P, "actuator", {}), "M", FREQS, TEMPS)
+    many = EffectModel(P, "actuator", {}).predictor(sweep, "M").many
+    good = {"d": P.d, "omega_n": P.omega_n, "contact_resistance.r2_specific": 1e-5}
+    batch = [dict(good), dict(good, **{name: first}), dict(good, **{name: second})]
+    with pytest.raises(ParameterError, match=words.replace(".", r"\.")):
+        many(batch)
+
+
+def test_a_new_params_list_is_seen_by_the_kept_names_and_reference_temperatures():
+    """Assigning another list (the documented way) changes the names and T_ref the model keeps."""
+    m = EffectModel([P, P], "actuator", {"electrode_resistance": {"r1_sheet": 50.0}})
+    m.frequency_response(FREQS, TEMPS, quantities=("M",))
+    other = P.replace(name="other", T_ref=P.T_ref + 10.0)
+    m.params = [other, P]
+    got = m.frequency_response(FREQS, TEMPS, quantities=("M",))
+    fresh = EffectModel([other, P], "actuator", {"electrode_resistance": {"r1_sheet": 50.0}}).frequency_response(
+        FREQS, TEMPS, quantities=("M",))
+    assert got.parameter_sets == fresh.parameter_sets == ("other", P.name)
+    assert _same(got["M"], fresh["M"])
+
+
+def test_replace_of_a_table_does_not_carry_its_kept_law_factors():
+    from dataclasses import replace
+
+    a = ParameterTable.of(P)
+    a.state(TEMPS)                                  # keeps P's law factors at TEMPS
+    q = P.replace(laws=P.laws.with_(E=LogLinear(slope=-0.02)))
+    b = replace(a, groups=ParameterTable.of(q).groups)
+    assert _same_state(b.state(TEMPS), ParameterTable(a.columns, ParameterTable.of(q).groups, a.n).state(TEMPS))
