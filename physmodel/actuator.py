@@ -126,18 +126,29 @@ def shared_sets(values, n_sets: int, n_T: int, differ=LINE_FIELDS):
     of which only the fields ``differ`` may differ between sets (the others must be the same in
     every set: they are not compared).  Sets are compared bit for bit (their bytes)."""
 
-    def firsts(fields, sets):
-        """For each of ``sets`` the position in ``sets`` of the first one with the same bytes of ``fields``."""
+    def rows(fields):
+        """Each set's bytes of ``fields`` (those in ``differ``), or None when none is."""
         fs = [f for f in fields if f in differ]
         if not fs:
-            return (0,) * len(sets)
+            return None
         b = np.concatenate([np.asarray(values[f]).reshape(n_sets, n_T, 1) for f in fs], axis=2).tobytes()
         w = len(b) // n_sets
-        seen: dict = {}
-        return tuple(seen.setdefault(b[i * w:(i + 1) * w], j) for j, i in enumerate(sets))
+        return [b[i * w:(i + 1) * w] for i in range(n_sets)]
 
-    line = firsts(LINE_FIELDS, range(n_sets))
-    return _shared_index(line, firsts(SLICE_FIELDS, sorted(set(line))), n_T)
+    def firsts(keys, sets):
+        """For each of ``sets`` the position in ``sets`` of the first one with the same key."""
+        if keys is None:
+            return (0,) * len(sets)
+        seen: dict = {}
+        return tuple(seen.setdefault(keys[i], j) for j, i in enumerate(sets))
+
+    # a set's line is the same as another's when its slice's bytes and those of the line's own
+    # fields (r1, L) are: the slice's read once
+    sl = rows(SLICE_FIELDS)
+    own = rows(tuple(f for f in LINE_FIELDS if f not in SLICE_FIELDS))
+    line_keys = sl if own is None else own if sl is None else list(zip(sl, own, strict=True))
+    line = firsts(line_keys, range(n_sets))
+    return _shared_index(line, firsts(sl, sorted(set(line))), n_T)
 
 
 @lru_cache(maxsize=64)
@@ -208,7 +219,7 @@ class ActuatorModel(PhysicsModel):
         if shared is None:
             return super().evaluate_state(state, s, qs)
         n = n_sets * n_T
-        p = {k: np.ascontiguousarray(getattr(state, k).reshape(n))[:, None] for k in STATE_FIELDS}
+        p = {k: getattr(state, k).reshape(n, 1) for k in STATE_FIELDS}
         vals = actuator_kernel(p, s[None, :], qs, shared)
         return {q: vals[q].reshape(n_sets, n_T, s.size) for q in qs}
 

@@ -183,7 +183,8 @@ class PhysicsModel:
 
     @property
     def params(self) -> list[IPMCParameters]:
-        """The parameter sets (first axis of every result)."""
+        """The parameter sets (first axis of every result).  Assign a new list to change them: the
+        sets' arrays and names are built on assignment, so editing the list in place is not seen."""
         return self._params
 
     @params.setter

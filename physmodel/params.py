@@ -166,17 +166,22 @@ def first_mode_omega(E, rho, L, h):
     return BETA1L_SQ / L**2 * np.sqrt(E * h**2 / (3.0 * rho))
 
 
+def field_range_ok(name: str, lo: float, hi: float) -> bool:
+    """Whether values of numeric field ``name`` whose minimum is ``lo`` and maximum ``hi`` (NaN if
+    any is NaN) all pass the checks :class:`IPMCParameters` makes (see :func:`check_field_values`)."""
+    m = _FIELD_META[name]
+    return (lo == lo and hi == hi and (m["allow_inf"] or (hi < math.inf and lo > -math.inf))
+            and (not m["positive"] or lo > 0 or (lo == 0 and m["allow_zero"])))
+
+
 def check_field_values(name: str, values) -> np.ndarray:
     """The checks :class:`IPMCParameters` makes of numeric field ``name``, over an array of values
     (one per parameter set, e.g. a batch built without a record per set); returns them as floats.
     A bad value is a :class:`ParameterError` worded as the record's own."""
     m = _FIELD_META[name]
     v = np.asarray(values, dtype=float)
-    if v.size:                  # the usual case, all good, from two reductions (NaN propagates into both)
-        lo, hi = float(v.min()), float(v.max())
-        if (lo == lo and hi == hi and (m["allow_inf"] or (hi < math.inf and lo > -math.inf))
-                and (not m["positive"] or lo > 0 or (lo == 0 and m["allow_zero"]))):
-            return v
+    if v.size and field_range_ok(name, float(v.min()), float(v.max())):
+        return v                # the usual case, all good, from two reductions (NaN propagates into both)
     bad = np.isnan(v)
     if not m["allow_inf"]:
         bad |= np.isinf(v)
@@ -196,10 +201,11 @@ def check_field_values(name: str, values) -> np.ndarray:
 def density_for_mode(omega_n, E, L, h):
     """Effective density [kg/m³] that puts the first mode at ``omega_n`` [rad/s] (arrays broadcast)."""
     w = np.asarray(omega_n, dtype=float)
-    bad = ~(np.isfinite(w) & (w > 0))
-    if np.any(bad):
-        raise ParameterError(f"omega_n={float(w[bad].ravel()[0]) if w.ndim else omega_n!r} rad/s must be a positive "
-                             "finite number")
+    if not (w.size and w.min() > 0 and w.max() < math.inf):  # the usual case in two reductions (NaN fails it)
+        bad = ~(np.isfinite(w) & (w > 0))
+        if np.any(bad):
+            raise ParameterError(f"omega_n={float(w[bad].ravel()[0]) if w.ndim else omega_n!r} rad/s must be a "
+                                 "positive finite number")
     return E * h**2 / 3.0 * (BETA1L_SQ / (L**2 * omega_n)) ** 2
 
 
@@ -241,6 +247,14 @@ class State:
     @property
     def second_moment(self):
         return 2.0 / 3.0 * self.W * self.h**3
+
+    @classmethod
+    def of(cls, values) -> State:
+        """The state whose arrays are ``values[field]`` for every field of the state (``STATE_FIELDS``)
+        (the arrays themselves, as ``State(**values)`` keeps them; without its per-field setup)."""
+        st = object.__new__(cls)
+        st.__dict__.update({k: values[k] for k in STATE_FIELDS})
+        return st
 
     def take(self, i_set: int, i_T: int) -> State:
         """The state of one parameter set at one temperature (arrays of shape (1, 1, 1))."""
@@ -287,6 +301,10 @@ class ParameterTable:
     columns: dict
     groups: list
     n: int
+    #: The temperatures this table's groups were evaluated at: ``{(shape, bytes of °C): (T [K], the
+    #: groups' law factors)}``, shared by the tables :meth:`with_columns` makes (the same groups);
+    #: not an init field, so ``dataclasses.replace`` (other groups, perhaps) starts with none.
+    seen: dict = field(default_factory=dict, init=False, compare=False, repr=False)
 
     @classmethod
     def of(cls, params: IPMCParameters | Sequence[IPMCParameters]) -> ParameterTable:
@@ -317,33 +335,54 @@ class ParameterTable:
             members.setdefault(key, []).append(i)
         return cls(columns, [(plist[idx[0]], np.asarray(idx)) for idx in members.values()], n)
 
-    def state(self, temperature_c) -> State:
-        """The :class:`State` of the batch at ``temperature_c`` [°C]."""
+    def with_columns(self, columns: dict, n: int) -> ParameterTable:
+        """A table of ``n`` sets with these ``columns`` (each (n, 1) [SI]) and this table's groups
+        (their laws and ``T_ref``), sharing what the groups' laws gave at each temperature."""
+        out = ParameterTable(columns, self.groups, n)
+        object.__setattr__(out, "seen", self.seen)      # not an init field: replace() starts afresh
+        return out
+
+    def _laws_at(self, temperature_c) -> tuple:
+        """``(T [K], [the law factors of each group], those of a single group as rows (1, n_T) or
+        None)`` at ``temperature_c`` [°C], kept per temperature array (a fit evaluates one table's
+        groups at one grid many times; the arrays are read-only)."""
+        t = np.asarray(temperature_c, dtype=float)
+        key = (t.shape, t.tobytes())
+        hit = self.seen.get(key)
+        if hit is not None:
+            return hit
         T = np.atleast_1d(celsius_to_kelvin(temperature_c)).astype(float)
         if T.ndim != 1:
             raise ParameterError(f"temperature_c must be a scalar or 1-D array, got shape {T.shape}")
+        T.flags.writeable = False
+        factors = [p.laws.factors(T, p.T_ref) for p, _ in self.groups]
+        out = (T, factors, {k: v[None, :] for k, v in factors[0].items()} if len(factors) == 1 else None)
+        if len(self.seen) >= 16:
+            self.seen.pop(next(iter(self.seen)))
+        self.seen[key] = out
+        return out
+
+    def state(self, temperature_c) -> State:
+        """The :class:`State` of the batch at ``temperature_c`` [°C]."""
+        T, factors, fac = self._laws_at(temperature_c)
         n, col = self.n, self.columns
-        if len(self.groups) == 1:
-            p = self.groups[0][0]
-            fac = {k: v[None, :] for k, v in p.laws.factors(T, p.T_ref).items()}
-        else:
+        if fac is None:
             fac = {name: np.empty((n, T.size)) for name in LAW_PARAMETERS}
-            for p, idx in self.groups:
-                f = p.laws.factors(T, p.T_ref)
+            for (_, idx), f in zip(self.groups, factors, strict=True):
                 for name in LAW_PARAMETERS:
                     fac[name][idx] = f[name]
         # the fields constant along T repeated over it (fresh arrays, as the products below are)
-        vals = {name: np.repeat(col[name][:, :, None], T.size, axis=1) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
+        vals = {name: col[name][:, :, None].repeat(T.size, axis=1) for name in ("L", "W", "alpha0", "a0", "rho", "xi")}
         for name in LAW_PARAMETERS:
             vals[name] = (col[name] * fac[name])[:, :, None]
         W = vals["W"]
-        vals["T"] = np.repeat(T[None, :, None], n, axis=0)
+        vals["T"] = T[None, :, None].repeat(n, axis=0)
         vals["r1"] = vals.pop("r1_sheet") / W
         vals["r2"] = vals.pop("r2_specific") / W
         vals["Rp"] = vals.pop("Rp_specific") / W
         vals["K"] = FARADAY**2 * vals["d"] * vals["C_minus"] / (vals["kappa_e"] * R_GAS * vals["T"])
         vals["omega_n"] = first_mode_omega(vals["E"], vals["rho"], vals["L"], vals["h"])
-        return State(**{k: vals[k] for k in STATE_FIELDS})
+        return State.of(vals)
 
 
 def state_at(params: IPMCParameters | Sequence[IPMCParameters], temperature_c) -> State:
@@ -368,5 +407,5 @@ def describe(p: IPMCParameters) -> str:
 
 
 __all__ = ["IPMCParameters", "State", "ParameterTable", "state_at", "first_mode_omega", "density_for_mode", "describe",
-           "check_field_values",
+           "check_field_values", "field_range_ok",
            "as_parameter_list"]

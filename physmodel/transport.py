@@ -58,9 +58,9 @@ def charge_terms(s, h, d, K) -> ChargeTerms:
     s = np.asarray(s)
     u = s + K
     c = h * h / d
-    if np.iscomplexobj(s) and not np.any(s.real):
+    if np.iscomplexobj(s) and not s.real.any():
         g = _gamma_on_axis(s.imag, K, c)        # frequency responses: s = jω
-        t, gmt = tanh_and_gmt(g, min_real=np.min(np.sqrt(c * K)))   # Re γ ≥ γ0 on the axis
+        t, gmt = tanh_and_gmt(g, min_real=np.sqrt(c * K).min())   # Re γ ≥ γ0 on the axis
     else:
         g = principal_sqrt(u * c)
         t, gmt = tanh_and_gmt(g)

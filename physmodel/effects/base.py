@@ -67,7 +67,8 @@ class Effect:
     ``level``: ``parameter`` (changes the State), ``strip`` (a factor on every quantity of the strip
     itself, its impedance included, applied before the chain), ``response`` (a factor on a response),
     ``series`` (an impedance in series with the strip), ``kernel`` (changes the charge dynamics).
-    ``apply`` is private machinery of the declaring module.  ``switch``: the parameter whose off
+    ``apply`` is private machinery of the declaring module (a parameter-level ``apply`` returns the
+    state's dict with the arrays it changes replaced, never written into in place).  ``switch``: the parameter whose off
     value switches the effect off whatever the others are (None: all parameters at off).
     ``fit_bounds(params) -> {param: (lower, upper, typical)}``: candidate bounds scaled to the
     strip ``params`` (:class:`~physmodel.params.IPMCParameters`), with their rationale in
@@ -128,7 +129,11 @@ class Effect:
         """:meth:`is_off` negated, elementwise over arrays of values (one entry per parameter set)."""
         if self.switch is not None:
             return np.asarray(values[self.switch]) != self.parameter(self.switch).off
-        return np.logical_or.reduce([np.asarray(values[p.name]) != p.off for p in self.parameters])
+        on = None               # the parameters' tests or-ed in turn (no stacked array)
+        for p in self.parameters:
+            x = np.asarray(values[p.name]) != p.off
+            on = x if on is None else on | x
+        return np.asarray(False) if on is None else on
 
     def applies_to(self, kind: str, quantity: str) -> bool:
         return kind in self.kinds and quantity in self.quantities

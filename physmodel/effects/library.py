@@ -46,6 +46,7 @@ from ..params import (
     State,
     check_field_values,
     density_for_mode,
+    field_range_ok,
     first_mode_omega,
 )
 from ..sensor import SensorModel
@@ -84,6 +85,14 @@ class _Context:
             A = electrode.strip_terms(p, self.s_kernel, want_xcoth=False).A
             self._x = electrode.line_argument(A, p["r1"], p["L"])
         return self._x
+
+
+@functools.lru_cache(maxsize=256)
+def _needed(quantities: tuple, qs: tuple, series: bool) -> tuple:
+    """The quantities of ``quantities`` (a model's, in its order) to evaluate for ``qs``: Z too
+    when a series effect is on."""
+    need = set(qs) | ({"Z"} if series else set())
+    return tuple(q for q in quantities if q in need)
 
 
 def _where_on(on, value, off_value):
@@ -205,7 +214,7 @@ def _table_of(base: IPMCParameters, base_vals: Sequence[Mapping[str, float]], pa
             g = np.array(given)
             cols[name] = np.where(g, check_field_values(name, np.where(g, a, 1.0)), cols[name][:, 0])[:, None]
     cols = {k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()}
-    return ParameterTable(cols, table.groups, n)
+    return table.with_columns(cols, n)
 
 
 def _group_value(e: Effect, given: Mapping[str, float], own_effects: Mapping) -> tuple:
@@ -224,14 +233,16 @@ def _batched_entry(e: Effect, vals: dict):
     is off in every set; sets where it is off take its off values."""
     for p in e.parameters:
         a = vals[p.name]
-        ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
-        if not np.all(ok):
+        lo, hi = float(a.min()), float(a.max())     # NaN propagates into both: the usual case in two reductions
+        if not (p.lower <= lo and hi <= p.upper and math.isfinite(lo) and math.isfinite(hi)):
+            ok = np.isfinite(a) & (a >= p.lower) & (a <= p.upper)
             v = float(a[~ok][0])
             raise ParameterError(f"{e.name}.{p.name}={v!r} [{p.unit}] must lie in [{p.lower:g}, {p.upper:g}]")
     on = e.on_mask(vals)
-    if not np.any(on):
+    n_on = np.count_nonzero(on)
+    if not n_on:
         return None
-    if np.all(on):
+    if n_on == on.size:
         mask = None
     else:            # off sets take the off values: the effect sees no switched-off mixture
         mask = on[:, None, None]
@@ -256,6 +267,9 @@ class _EffectMixin:
         self._active: list = [(get_effect(n), v, None) for n, v in self.effects.items()
                               if not get_effect(n).is_off(v)]
         self._batch_table: ParameterTable | None = None
+        self._split: tuple | None = None            # _active by level (_levels)
+        self._t_ref_of: tuple | None = None         # (params, T_ref) (_t_ref)
+        self._names_of: tuple | None = None         # (params, names) (_set_names)
 
     def _use_table(self, table: ParameterTable) -> None:
         """Evaluate the parameter sets of ``table`` (built as arrays by :func:`_table_of`, one row
@@ -330,7 +344,7 @@ class _EffectMixin:
             e = get_effect(name)
             if self.kind not in e.kinds:
                 raise IPMCError(f"effect {name!r} does not apply to a {self.kind} model (it applies to {e.kinds})")
-            own = self.effects.get(name, e.off)
+            own = self.effects[name] if name in self.effects else e.off
             if not e.batchable and name in given and e.level == "kernel":
                 g = given[name]
                 vals = {p.name: np.asarray(g[p.name], dtype=float) if p.name in g else np.full(n, float(own[p.name]))
@@ -362,38 +376,85 @@ class _EffectMixin:
 
     def state(self, temperature_c) -> State:
         st = super().state(temperature_c) if self._batch_table is None else self._batch_table.state(temperature_c)
-        acts = [(e, v, m) for e, v, m in self._active if e.level == "parameter"]
+        acts = self._levels()["parameter"]
         if not acts:
             return st
-        d0 = {k: np.array(getattr(st, k), dtype=float) for k in STATE_FIELDS}
+        # the state's own arrays (fresh ones each call; the effects replace entries, never write into them)
+        d0 = {k: getattr(st, k) for k in STATE_FIELDS}
         d = dict(d0)
-        T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
+        T_ref = self._t_ref()
         for e, v, m in acts:
             new = e.apply(dict(d), T_ref, v)
             d = new if m is None else {k: np.where(m, new[k], d[k]) for k in d}
-        d["K"] = debye_rate(d["d"], d["C_minus"], d["kappa_e"], d["T"])
-        d["omega_n"] = first_mode_omega(d["E"], d["rho"], d["L"], d["h"])
+        # recomputed from what the effects replaced (inputs they left are the same arrays, and the
+        # state's K and ωn are these expressions of them: the same numbers)
+        if any(d[k] is not d0[k] for k in ("K", "d", "C_minus", "kappa_e", "T")):
+            d["K"] = debye_rate(d["d"], d["C_minus"], d["kappa_e"], d["T"])
+        if any(d[k] is not d0[k] for k in ("omega_n", "E", "rho", "L", "h")):
+            d["omega_n"] = first_mode_omega(d["E"], d["rho"], d["L"], d["h"])
         if all(m is not None for _, _, m in acts):      # sets with every parameter effect off: the base state
             changed = np.logical_or.reduce([m for _, _, m in acts])
             for k in ("K", "omega_n"):
                 d[k] = np.where(changed, d[k], d0[k])
-        return State(**d)
+        return State.of(d)
 
     def frequency_response(self, frequency_hz, temperature_c, quantities=None, out=None,
-                           progress=None) -> FrequencyResponse:
-        """Like the base model's, with every effect applied.  ``out`` is filled if given."""
+                           progress=None, *, checked: tuple | None = None) -> FrequencyResponse:
+        """Like the base model's, with every effect applied.  ``out`` is filled if given.
+        ``checked``: ``(f, T, s)``, these ``frequency_hz`` checked, ``temperature_c`` as a 1-D float
+        array and s = 2j·π·f, made once by a caller that evaluates them many times (a predictor);
+        when given, ``frequency_hz`` and ``temperature_c`` are not read (the caller vouches for it)."""
         qs = self._check_quantities(quantities or self.quantities)
-        f = check_frequencies(frequency_hz)
-        T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
-        s = 2j * np.pi * f
+        if checked is None:
+            f = check_frequencies(frequency_hz)
+            T = np.atleast_1d(np.asarray(temperature_c, dtype=float))
+            checked = (f, T, 2j * np.pi * f)
+        f, T, _ = checked
+        res = self._respond(*checked, qs, out, progress)
+        return FrequencyResponse(
+            frequency_hz=f, temperature_c=T, parameter_sets=self._set_names(),
+            values=res, units={q: self.units[q] for q in qs},
+            descriptions={q: self.descriptions[q] for q in qs},
+        )
+
+    def _levels(self) -> dict:
+        """The entries of ``_active`` by level (in their order; "kernel": the first kernel effect's
+        ``(effect, values)`` or None), split once per ``_active`` list."""
+        split = self._split
+        if split is None or split[0] is not self._active:
+            by: dict = {"parameter": [], "strip": [], "response": [], "series": [], "kernel": None}
+            for x in self._active:
+                level = x[0].level
+                if level != "kernel":
+                    by[level].append(x)
+                elif by["kernel"] is None:
+                    by["kernel"] = x[:2]
+            split = self._split = (self._active, by)
+        return split[1]
+
+    def _set_names(self) -> tuple:
+        """The sets' names, once per ``params`` list."""
+        hit, params = self._names_of, self.params
+        if hit is None or hit[0] is not params or len(hit[1]) != len(params):
+            hit = self._names_of = (params, tuple(p.name for p in params))
+        return hit[1]
+
+    def _t_ref(self) -> np.ndarray:
+        """The sets' reference temperatures (n_sets, 1, 1) [K], read-only, once per ``params`` list."""
+        hit, params = self._t_ref_of, self.params
+        if hit is None or hit[0] is not params or len(hit[1]) != len(params):
+            t = np.array([p.T_ref for p in params], dtype=float)[:, None, None]
+            t.flags.writeable = False
+            hit = self._t_ref_of = (params, t)
+        return hit[1]
+
+    def _respond(self, f, T, s, qs, out=None, progress=None) -> dict:
+        """:meth:`frequency_response`'s values ``{q: (n_sets, n_T, n_f)}`` at checked frequencies
+        ``f`` [Hz] (1-D), temperatures ``T`` [°C] (1-D float) and ``s = 2j·π·f`` [1/s]."""
         st = self.state(T)
-        resp = [(e, v, m) for e, v, m in self._active if e.level == "response"]
-        series = [(e, v, m) for e, v, m in self._active if e.level == "series"]
-        need = set(qs)
-        if series:
-            need.add("Z")
-        need = tuple(q for q in self.quantities if q in need)
-        kern = next(((e, v) for e, v, _ in self._active if e.level == "kernel"), None)
+        levels = self._levels()
+        resp, series, kern = levels["response"], levels["series"], levels["kernel"]
+        need = _needed(self.quantities, qs, bool(series))
         s_kernel = s if kern is None else kern[0].apply(s, kern[1])
         if kern is None and progress is None:
             # the model's own evaluation of a state: an actuator batch whose sets repeat an
@@ -414,10 +475,10 @@ class _EffectMixin:
                     vals["G"] = G
                 if "M" in need:
                     vals["M"] = vals["H"] * G
-        T_ref = np.array([p.T_ref for p in self.params], dtype=float)[:, None, None]
+        T_ref = self._t_ref()
         ctx = _Context(s[None, None, :], s_kernel if s_kernel.ndim == 3 else s_kernel[None, None, :], st, dict(vals),
                        T_ref)
-        strip = [(e, v, m) for e, v, m in self._active if e.level == "strip"]
+        strip = levels["strip"]
         if strip:                           # the strip itself: every quantity computed, Z included
             partly = [m for _, _, m in strip if m is not None]
             x0 = ctx.x if partly else None  # the line without them, for the sets where they are off
@@ -452,11 +513,7 @@ class _EffectMixin:
                 res[q] = out[q]
             else:
                 res[q] = np.asarray(vals[q], dtype=complex)
-        return FrequencyResponse(
-            frequency_hz=f, temperature_c=T, parameter_sets=tuple(p.name for p in self.params),
-            values=res, units={q: self.units[q] for q in qs},
-            descriptions={q: self.descriptions[q] for q in qs},
-        )
+        return res
 
     def evaluate(self, *a, **k):  # pragma: no cover - guard
         raise IPMCError("EffectModel evaluates on the imaginary axis only; use frequency_response()")
@@ -502,6 +559,8 @@ class _EffectMixin:
         models: dict = {}
 
         plans: dict = {}        # the fast path's plan of each tuple of names (None: the general path)
+        repeated: dict = {}     # the fast path's base columns over n sets, by n
+        grid: list = []         # the fast path's (frequencies [Hz], temperatures [°C], s), checked once
 
         def plan_of(keys: tuple):
             """Where the names ``keys`` go when every set gives exactly these: ``(base, omega,
@@ -543,13 +602,21 @@ class _EffectMixin:
                 return None
             base, omega, effects = plan
             cols = dict(table0.columns)
+            lo, hi = X.min(axis=0).tolist(), X.max(axis=0).tolist()     # each column's (NaN propagates)
             for name, j in base:
-                cols[name] = check_field_values(name, X[:, j])[:, None]
+                # check_field_values's test from the column's extremes; it words a bad value
+                cols[name] = (X[:, j] if field_range_ok(name, lo[j], hi[j]) else check_field_values(name, X[:, j]))[:, None]
             if omega is not None:
                 rho = density_for_mode(X[:, omega], cols["E"][:, 0], cols["L"][:, 0], cols["h"][:, 0])
                 cols["rho"] = check_field_values("rho", rho)[:, None]
-            table = ParameterTable({k: v if len(v) == n else np.repeat(v, n, axis=0) for k, v in cols.items()},
-                                   table0.groups, n)
+            rep = repeated.get(n)
+            if rep is None:         # the base's columns over n sets, once per n (read-only, only read)
+                if len(repeated) >= 16:
+                    repeated.pop(next(iter(repeated)))
+                rep = repeated[n] = {k: np.repeat(v, n, axis=0) for k, v in table0.columns.items()}
+                for v in rep.values():
+                    v.flags.writeable = False
+            table = table0.with_columns({k: v if len(v) == n else rep[k] for k, v in cols.items()}, n)
             m = models.get(((), n))
             if m is None:
                 if len(models) >= 64:
@@ -558,7 +625,13 @@ class _EffectMixin:
             m._use_table(table)
             if not m._batch_effect_arrays({e: {p: X[:, j] for p, j in pj.items()} for e, pj in effects.items()}):
                 return None                 # a kernel effect on in some sets only: the general path
-            r = m.frequency_response(freqs, temps, quantities=(q,))[q]
+            if not grid:            # the frequencies and temperatures, checked once (as frequency_response does)
+                f = check_frequencies(freqs)
+                T = np.array(np.atleast_1d(np.asarray(temps, dtype=float)))
+                s = 2j * np.pi * f
+                f.flags.writeable = T.flags.writeable = s.flags.writeable = False
+                grid.append((f, T, s))
+            r = m.frequency_response(freqs, temps, quantities=(q,), checked=grid[0])[q]
             # C order, as the general path's: r[:, ti, fi] alone comes out in Fortran order, and the
             # estimation layer's reductions and products over it then round differently
             out = np.empty((n, data.response.size), dtype=complex)

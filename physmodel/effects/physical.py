@@ -49,7 +49,9 @@ def polymer_area_resistance(p) -> float:
 
 # --------------------------------------------------------------------------- parameter level
 # Each _p_* receives a dict of State arrays (n_sets, n_T, 1), the reference temperature array
-# and the effect's values, and returns the updated dict (K and omega_n are recomputed after).
+# and the effect's values, and returns the updated dict with the arrays it changes REPLACED, never
+# written into (the model recomputes K and omega_n after only when an input of theirs was replaced,
+# and keeps the base state's arrays between calls).
 def _p_electrode(st, T_ref, v):
     st["r1"] = st["r1"] + v["r1_sheet"] / st["W"]
     return st

@@ -20,6 +20,62 @@ parameter sets predicted, batched model calls, least-squares fits, fit points (e
 vector and Jacobian in one batched model call), wall and CPU seconds.  Each process is single-threaded
 (OMP/BLAS pinned to 1); CPU time is the steadier figure on a shared machine.
 
+Measured 2026-11-27, seventh round (h-speed: the per-call overhead of the model path, the same
+numbers bit for bit; "before" = main 9d85573, "after" = h-speed a114d03 (its successors change docstrings only), each exported to a plain
+folder, interleaved; 2 cores shared with two other benchmarks and a test suite, load 2-4, so
+every CPU figure here is ~1.5x the sixth round's)::
+
+    python3 tests/benchmarks/bench_diagnosis_speed.py --commands --rounds 2 --roots BEFORE,AFTER \
+        --cases 41038:contact_resistance+time_delay,51600:contact_resistance+time_delay,44102:added_fluid_mass,\
+51603:modulus_temperature+diffusivity_temperature,41009:water_uptake
+
+    case                                          ipmc calibrate   ipmc diagnose CPU s   diagnose / calibrate
+                                                  CPU s b / a      before    after        before   after
+    41038 contact_resistance+time_delay           2.43 / 2.34      15.49     13.88        6.4x     5.9x
+    51600 contact_resistance+time_delay           2.28 / 2.41      12.54     11.84        5.5x     4.9x
+    44102 added_fluid_mass                        2.31 / 2.45      10.80     10.02        4.7x     4.1x
+    not profiled on:
+    51603 modulus_temperature+diffusivity_temp.   2.23 / 2.23       6.06      5.84        2.7x     2.6x
+    41009 water_uptake                            2.04 / 2.03       6.20      5.80        3.0x     2.9x
+
+Every report.json and model.json the same number by number; median 4.7x -> 4.1x, max 6.4x ->
+5.9x: 41038 stays above 5x.  Again with three rounds (``--rounds 3 --cases 41038:...,51600:...``,
+load 2-3): 41038 calibrate 2.19 / 2.14 s, diagnose 14.85 -> 12.72 s CPU, 6.8x -> 6.0x; 51600
+2.31 / 2.19, 11.53 -> 10.54, 5.0x -> 4.8x; the reports the same.  Stronger than the reports: every batched model output, every
+``ModelBatch`` output and every standardised residual vector of an in-process ``ipmc diagnose``
+(41038: 24765 arrays; 41009: 7665; 51603: 6888; 44102: 12790) hashed in call order, the same
+from both checkouts (PYTHONHASHSEED=0: set iteration orders some calls).  The model calls
+alone: the 9963 ``predict.many`` calls of 41038 recorded and replayed in one process (fresh
+predictors, 3 rounds, alternating checkouts): 6.8-7.4 s CPU before, 5.1-5.4 after (-24 %), the
+outputs' digest the same; valgrind's instruction count of the first 3000 calls 12.17e9 ->
+10.38e9 (-15 %; Python's own work, which the change removes, costs more time per instruction
+than the numerics that stay).  Each step, on that replay: (1) what does not change between
+calls kept — a parameter table's law factors and kelvin temperatures per temperature array
+(``ParameterTable.with_columns`` shares them; ``TemperatureLaws.factors``' own cache hashed the
+laws record per call), the predictor's frequencies, temperatures and s checked once
+(``frequency_response(checked=...)``), the base columns over n sets once per n, T_ref, the
+state's fields not copied: 6.67 -> 5.47 s; (2) the values' checks from two reductions each
+(extremes) instead of elementwise tests and ``np.all`` (the same outcomes and messages): 5.47 ->
+4.87 s (on a loaded machine; ~0.3 s is noise); (3) ``shared_sets`` reading the slice fields'
+bytes once, ``State.of``, K and ωn recomputed after parameter effects only when an effect
+replaced one of their inputs: ~5.40 -> 5.12 s; (4) small ones (``on_mask`` without a stacked
+array, ``_active`` split in one pass): -0.9 % instructions.  tests/physmodel/test_model_path_reuse.py
+checks what is kept against fresh evaluations, bit for bit (each test fails on a mutation of
+what it guards).
+
+Where 41038's CPU is now (in process, with the hooks): ~14.5 s, the model calls ~5.5 of it; the
+rest is the least-squares engine and scipy's trust region around them (lsq.py), the search's
+refit bookkeeping, the null scan, start-up and figures.  Not done, and why: a real operand cast
+to complex once before a mixed product (numpy has no mixed loops: the cast runs through the
+iterator's buffer on every element, ~2.5 % of a call's instructions), because the complex
+loops it would then take (broadcast instead of buffered) are other SIMD variants and might
+round otherwise; a memo of repeated batches (242 of the 9963 calls repeat one within a
+predictor, 334 across predictors of the same model and data: ~3 %); which sets share an
+electrode line decided from the table's columns instead of the state's bytes (cheaper, but it
+can decide otherwise where two columns round to one state); an array path for the diagnosis's
+predictors (the ``ModelBatch`` rows go to dicts and back to an array in ``predict_fast``, ~15 µs
+a call, but the wrappers between them are in priors.py and refits.py).
+
 Measured 2026-11-27, sixth round (the next measurement's refits; "before" = 0e3466e, "after" = 9cd2bce,
 each exported to a plain folder, interleaved; 2 cores shared with two other sessions, load 2-3)::
 
