@@ -1004,6 +1004,12 @@ def pair_report(rows: list) -> None:
               f"{okf}/{len(amb)} (Wilson 95 % [{lo3:.2f}, {hi3:.2f}])")
     print(f"  the truth among the competing models: {sum(bool(r.get('truth_competing')) for r in amb)}/{len(amb)}; "
           f"expected to separate: {sum(bool(r['separates']) for r in amb)}/{len(amb)}")
+    sep = [r for r in amb if r["separates"]]
+    if sep:                 # the forecast's calibration: it targets 90 % power
+        ok_s = sum(r["success"] for r in sep)
+        lo_s, hi_s = wilson(ok_s, len(sep))
+        print(f"  where expected to separate, named exactly: {ok_s}/{len(sep)} (Wilson 95 % [{lo_s:.2f}, {hi_s:.2f}]; "
+              "the forecast's target power 90 %)")
     two = [r for r in amb if r.get("also")]
     print(f"  two records recommended (no single one expected to separate every pair): {len(two)}/{len(amb)}, "
           f"named exactly {sum(r['success'] for r in two)}/{len(two)}")
