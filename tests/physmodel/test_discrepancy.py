@@ -162,9 +162,13 @@ def test_sensor_amplifier_pole_is_named():
                             np.logspace(1, 2, 20), [25, 45, 65], MagnitudePhaseNoise(0.2, 1.0), seed=int(rng.integers(2**31)))
     d = diagnose(data, ps, kind="sensor", free=("a0", "d"), seed=1, null_refits=2)
     assert _named_ok(d, "amplifier_bandwidth"), d.message
-    fitted = d.final.values["amplifier_bandwidth.time_constant"]
-    assert d.final.ci_lower["amplifier_bandwidth.time_constant"] <= tau <= d.final.ci_upper["amplifier_bandwidth.time_constant"] \
-        or abs(fitted / tau - 1) < 0.05
+    # the two poles are symmetric (1/((1 + sτa)(1 + sτb))): which one ends as the dominant one's name
+    # depends on the optimiser's path, which differs with the numpy/scipy build (lowest versions: the
+    # dominant pole came out as second_time_constant), so the pole near the truth is the one checked
+    names = ("amplifier_bandwidth.time_constant", "amplifier_bandwidth.second_time_constant")
+    dom = max(names, key=lambda n: d.final.values[n])
+    fitted = d.final.values[dom]
+    assert d.final.ci_lower[dom] <= tau <= d.final.ci_upper[dom] or abs(fitted / tau - 1) < 0.05
 
 
 def test_linearised_null_gives_the_chi_bar_squared_boundary_mixture():
