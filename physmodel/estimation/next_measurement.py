@@ -351,11 +351,11 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
 
 
 #: Said with every forecast separation: its premise, and how often it held where the truth's form was
-#: not the library's (``tests/benchmarks/bench_next_measurement.py``, fresh blocks 52000-53400).
+#: not the library's (``tests/benchmarks/bench_next_measurement.py``, fresh blocks 52000-53800).
 FORMS_PREMISE = ("The forecast takes one of the competing models as the strip's exact form; a form the library "
                  "does not have (a DAC's zero-order hold beside a delay, say) can leave the new records ambiguous "
                  "or misnamed, so read the verdict of the records diagnosed together, not this forecast (on an "
-                 "independently written generator's two-effect strips, 18 of 29 forecast separations ended "
+                 "independently written generator's two-effect strips, 23 of 34 forecast separations ended "
                  "named exactly).")
 
 #: Said when a pair is inseparable as fitted and its models fit the record in no other form.

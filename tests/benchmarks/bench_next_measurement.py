@@ -604,7 +604,7 @@ Fresh blocks, session 15 (2026-11-27, main 71afd4f = 9d85573's code, each block 
 2 cores shared with other benchmarks)::
 
     python tests/benchmarks/bench_next_measurement.py --kind actuator --pairs --first-seed N --seeds 4
-    # N = 52000, 52400, 52800, 53000, 53400
+    # N = 52000, 52400, 52800, 53000, 53400; 53800 on main e30ac71 (after h-speed, bit for bit)
 
 ===========  ==========  ==============================  ===============================
 block        named       of those forecast to separate   of those forecast not to
@@ -615,18 +615,19 @@ block        named       of those forecast to separate   of those forecast not t
 52800        5/9         5/6                             0/3
 53000        5/11        4/7                             1/4
 53400        3/7         2/4                             1/3
-together     20/45       18/29                           2/16
+53800        5/7         5/5                             0/2
+together     25/52       23/34                           2/18
 ===========  ==========  ==============================  ===============================
 
-Together **20/45 = 0.44 [0.31, 0.59]** named exactly; 18/29 = 0.62 [0.44, 0.77] where the search
-forecast separation.  So the 18/24 of the three earlier blocks (51000, 51400, 51800) was a favourable draw: over all eight
-blocks 38/69 = 0.55 [0.43, 0.66] against the goal of 80 %.  Two findings for the next person:
+Together **25/52 = 0.48 [0.35, 0.61]** named exactly; 23/34 = 0.68 [0.51, 0.81] where the search
+forecast separation.  So the 18/24 of the three earlier blocks (51000, 51400, 51800) was a favourable draw: over all nine
+blocks 43/76 = 0.57 [0.45, 0.67] against the goal of 80 %.  Two findings for the next person:
 
-* 16 of the 45 ambiguous cases are forecast NOT to separate by any record (or pair of records)
+* 18 of the 52 ambiguous cases are forecast NOT to separate by any record (or pair of records)
   within the lab's limits (0.01-200 Hz, 5-65 °C, drive ×1, ×2) — the search says so, and the second
   verdict is then 'ambiguous' (13) or misnamed (1): the limit of the lab, not of the search.
-* The forecast is over-confident where it says "separates": 18/29 named exactly where the design
-  target is 90 % power.  Of the 11 such misses, 8 end 'ambiguous' and 3 misnamed (52079: the
+* The forecast is over-confident where it says "separates": 23/34 named exactly where the design
+  target is 90 % power.  Of the 11 such misses (the first five blocks), 8 end 'ambiguous' and 3 misnamed (52079: the
   amplifier pole named for the delay; 52091, 53089: the leakage lost beside the delay); 6 of the
   11 carry a time_delay.  The forecast assumes one of the competing models is exactly true; the
   independent generator's delay is a channel skew times a DAC zero-order hold
