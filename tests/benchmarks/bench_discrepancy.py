@@ -152,6 +152,23 @@ The two detectable misses both lose the leakage: contact_resistance + leakage ->
 time_delay] (each names the other member with its declared twin); the five others are not detectable
 (λ of one member below 25 on top of the other).  The six 'ambiguous' among the 13 are the declared
 twins the band cannot separate: the next measurement's row (bench_next_measurement.py --pairs).
+
+Again on fresh seeds (2026-11-27, session 15, main 54a23ee; 54000-54019 never run before, once)::
+
+    python3 tests/benchmarks/bench_discrepancy.py --generator independent --labels pairs --n-per-label 4 \
+        --first-seed 54000 --null 0 --workers 1 --no-real
+
+    both named, each detectable on top of the other          11/18 = 0.61 [0.39, 0.80]
+      the same, detectable after the workflow's free set      11/15 = 0.73 [0.48, 0.89]
+      of those, verdict 'named' exactly                        3/15 = 0.20 [0.07, 0.45]
+    both named, all cases                                     11/20 = 0.55 [0.34, 0.74]
+    correct names downgraded to 'at bound'                    0
+
+With 51500's, 24/33 = 0.73 [0.56, 0.85] both named where each is detectable on top of the other:
+below the 80 % goal once more cases are in.  The detectable misses lose the weaker member beside
+its own declared twins (contact resistance beside higher_modes / second_mode; leakage beside the
+delay and the pole), or, once, name another pair at a bound (contact_resistance + leakage ->
+permittivity_temperature + water_uptake, 'at bound', not a confident name).
 """
 
 from __future__ import annotations
