@@ -635,6 +635,10 @@ blocks 43/76 = 0.57 [0.45, 0.67] against the goal of 80 %.  Two findings for the
   magnitude (−0.6 dB at 200 Hz for T = 1 ms) exactly in the high band recommended to part the delay
   from the pole.
 
+The contrast on the sensor, where the independent sensor's delay and amplifier are the library's
+forms (a pure delay, two poles): fresh seeds 7460-7463 (``--first-seed 7460 --seeds 4``, main 54a23ee)
+7/7 named exactly after the recommended record, 7/7 forecast to separate.
+
 Tried and NOT kept (session 15): the library's time_delay with a zero-order hold T_h (Franklin,
 Powell & Workman §4.3.1).  (a) Physical form, e^{−s(τ + T_h/2)}·sinc(ωT_h/2) with the skew τ ≥ 0:
 development blocks 52000 6/9 (main 4/9), 52400 4/9 (3/9), 52800 5/9 (5/9); on a fresh block 53000
