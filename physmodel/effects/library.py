@@ -269,7 +269,6 @@ class _EffectMixin:
         self._batch_table: ParameterTable | None = None
         self._split: tuple | None = None            # _active by level (_levels)
         self._t_ref_of: tuple | None = None         # (params, T_ref) (_t_ref)
-        self._names_of: tuple | None = None         # (params, names) (_set_names)
 
     def _use_table(self, table: ParameterTable) -> None:
         """Evaluate the parameter sets of ``table`` (built as arrays by :func:`_table_of`, one row
@@ -412,7 +411,7 @@ class _EffectMixin:
         f, T, _ = checked
         res = self._respond(*checked, qs, out, progress)
         return FrequencyResponse(
-            frequency_hz=f, temperature_c=T, parameter_sets=self._set_names(),
+            frequency_hz=f, temperature_c=T, parameter_sets=self._names,
             values=res, units={q: self.units[q] for q in qs},
             descriptions={q: self.descriptions[q] for q in qs},
         )
@@ -431,13 +430,6 @@ class _EffectMixin:
                     by["kernel"] = x[:2]
             split = self._split = (self._active, by)
         return split[1]
-
-    def _set_names(self) -> tuple:
-        """The sets' names, once per ``params`` list."""
-        hit, params = self._names_of, self.params
-        if hit is None or hit[0] is not params or len(hit[1]) != len(params):
-            hit = self._names_of = (params, tuple(p.name for p in params))
-        return hit[1]
 
     def _t_ref(self) -> np.ndarray:
         """The sets' reference temperatures (n_sets, 1, 1) [K], read-only, once per ``params`` list."""

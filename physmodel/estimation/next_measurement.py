@@ -327,7 +327,11 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                 z_crit=z_crit, target=target, nm=nm, view=view)
     out = _search(d, fitted, None, **opts)
     assert out is not None          # None only when other forms are given
-    out.acts_on, out.message = assumed, out.message + acts_note + (" " + FORMS_PREMISE if out.separates else "")
+    def said(r: NextMeasurement) -> str:
+        """``r``'s message with the acts_on premise and, for a forecast separation, its form premise."""
+        return r.message + acts_note + (" " + FORMS_PREMISE if r.separates else "")
+
+    out.acts_on, out.message = assumed, said(out)
     if not out.inseparable:
         return out
     # a pair inseparable as fitted: the search again, with the other forms its models' fits may take
@@ -346,7 +350,7 @@ def next_measurement(d, *, quantities: Sequence[str] | None = None,
                      "found": {}, "note": FORMS_NONE}
         out.message += " " + FORMS_NONE
         return out
-    again.acts_on, again.message = assumed, again.message + acts_note + (" " + FORMS_PREMISE if again.separates else "")
+    again.acts_on, again.message = assumed, said(again)
     return again
 
 
